@@ -1,0 +1,218 @@
+//! The compile step: [`ModelSpec`] → [`Model`]. Checks physical validity, normalizes axes, fuses
+//! fixed joints into their parent body (inertia composed, every link kept as a [`Frame`]), and lays
+//! out q and v in depth-first file order (DESIGN.md, layer 3).
+
+use crate::io::LoadError;
+use crate::model::spec::{InertialSpec, JointSpec, JointType, ModelSpec};
+use crate::model::{Body, Frame, Geom, Joint, JointKind, Model, NO_DOF};
+use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
+use std::collections::HashMap;
+
+/// Relative tolerance for the symmetry, sign and triangle-inequality checks of inertia tensors.
+const INERTIA_TOL: f64 = 1e-9;
+
+/// Compiles a spec into a model.
+pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
+    let file = spec.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+    if spec.links.is_empty() {
+        return Err(LoadError::Empty { file });
+    }
+    check_unique_names(spec)?;
+
+    let mut bodies = vec![Body {
+        name: "world".to_string(),
+        parent: 0,
+        x_parent_joint: Transform::identity(),
+        inertia: RigidInertia::zero(),
+    }];
+    let mut joints: Vec<Joint> = Vec::new();
+    let mut frames: Vec<Frame> = Vec::new();
+    let mut geoms: Vec<Geom> = Vec::new();
+    // For each link: the body it belongs to and its pose in that body's frame.
+    let mut link_body: Vec<(usize, Transform)> = Vec::with_capacity(spec.links.len());
+    let (mut nq, mut nv) = (0, 0);
+
+    // Pass 1, links in depth-first order: create a body per movable joint, fuse fixed ones.
+    for (li, link) in spec.links.iter().enumerate() {
+        let (parent_body, x_pbody_plink) = match link.parent {
+            Some(p) if p >= li => {
+                return Err(LoadError::Invalid {
+                    loc: link.loc.clone(),
+                    element: "link".into(),
+                    detail: format!("link '{}' comes before its parent in the spec (loader bug)", link.name),
+                });
+            }
+            Some(p) => link_body[p],
+            None => (0, Transform::identity()),
+        };
+        let x_pbody_joint = x_pbody_plink * link.joint.x_parent_joint;
+        match joint_kind(&link.joint)? {
+            None => link_body.push((parent_body, x_pbody_joint)),
+            Some(kind) => {
+                let b = bodies.len();
+                bodies.push(Body {
+                    name: link.name.clone(),
+                    parent: parent_body,
+                    x_parent_joint: x_pbody_joint,
+                    inertia: RigidInertia::zero(),
+                });
+                let j = &link.joint;
+                let (jnq, jnv) = (kind.nq(), kind.nv());
+                joints.push(Joint {
+                    name: j.name.clone(),
+                    kind,
+                    body: b,
+                    parent: parent_body,
+                    qpos_adr: nq,
+                    dof_adr: nv,
+                    limits: j.limits,
+                    damping: j.damping,
+                    friction: j.friction,
+                    armature: j.armature,
+                    mimic: j.mimic.clone(),
+                });
+                nq += jnq;
+                nv += jnv;
+                link_body.push((b, Transform::identity()));
+            }
+        }
+        let (body, x_body_link) = link_body[li];
+        // Mass properties of the link, moved into its body's frame.
+        if let Some(inertial) = &link.inertial {
+            let i_link = link_inertia(&link.name, inertial)?;
+            bodies[body].inertia += &i_link.transformed(&x_body_link);
+        }
+        frames.push(Frame { name: link.name.clone(), body, x_body_frame: x_body_link });
+        for g in &link.geoms {
+            geoms.push(Geom {
+                link: link.name.clone(),
+                body,
+                x_body_geom: x_body_link * g.x_link_geom,
+                shape: g.shape.clone(),
+                collision: g.collision,
+            });
+        }
+    }
+
+    // Pass 2: per-dof tables (λ for the sparse factorization, armature, damping).
+    let mut dof_parent = vec![NO_DOF; nv];
+    let mut dof_body = vec![0; nv];
+    let mut dof_armature = vec![0.0; nv];
+    let mut dof_damping = vec![0.0; nv];
+    for j in &joints {
+        let parent_last = if j.parent == 0 {
+            NO_DOF
+        } else {
+            let pj = &joints[j.parent - 1];
+            pj.dof_adr + pj.kind.nv() - 1
+        };
+        for k in 0..j.kind.nv() {
+            let d = j.dof_adr + k;
+            dof_parent[d] = if k == 0 { parent_last } else { d - 1 };
+            dof_body[d] = j.body;
+            dof_armature[d] = j.armature;
+            dof_damping[d] = j.damping;
+        }
+    }
+
+    Ok(Model {
+        name: spec.name.clone(),
+        source: spec.source.clone(),
+        gravity: spec.gravity,
+        bodies,
+        joints,
+        frames,
+        geoms,
+        nq,
+        nv,
+        dof_parent,
+        dof_body,
+        dof_armature,
+        dof_damping,
+    })
+}
+
+fn check_unique_names(spec: &ModelSpec) -> Result<(), LoadError> {
+    let mut links = HashMap::new();
+    let mut joints = HashMap::new();
+    for l in &spec.links {
+        if links.insert(l.name.as_str(), ()).is_some() {
+            return Err(LoadError::DuplicateName {
+                loc: l.loc.clone(),
+                element: "link",
+                name: l.name.clone(),
+            });
+        }
+        if !l.joint.name.is_empty() && joints.insert(l.joint.name.as_str(), ()).is_some() {
+            return Err(LoadError::DuplicateName {
+                loc: l.joint.loc.clone(),
+                element: "joint",
+                name: l.joint.name.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The movable joint kind of a spec joint (`None` for fixed), with its axis normalized.
+fn joint_kind(j: &JointSpec) -> Result<Option<JointKind>, LoadError> {
+    let axis = || {
+        let n = j.axis.norm();
+        if !(n > 1e-12) || !n.is_finite() {
+            Err(LoadError::ZeroAxis { loc: j.loc.clone(), joint: j.name.clone() })
+        } else {
+            Ok(j.axis / n)
+        }
+    };
+    Ok(match j.jtype {
+        JointType::Fixed => None,
+        JointType::Revolute => Some(JointKind::Revolute { axis: axis()?, continuous: false }),
+        JointType::Continuous => Some(JointKind::Revolute { axis: axis()?, continuous: true }),
+        JointType::Prismatic => Some(JointKind::Prismatic { axis: axis()? }),
+        JointType::Floating => Some(JointKind::Free),
+        JointType::Ball => Some(JointKind::Ball),
+        JointType::Planar => {
+            let normal = axis()?;
+            // In-plane axes: a right-handed orthonormal pair (axis1, axis2, normal); for the
+            // usual normal z they are x and y.
+            let seed = if normal.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+            let axis1 = (seed - normal * normal.dot(&seed)).normalize();
+            let axis2 = normal.cross(&axis1);
+            Some(JointKind::Planar { axis1, axis2, normal })
+        }
+    })
+}
+
+/// Checks an `<inertial>` and returns it as a spatial inertia in link coordinates.
+fn link_inertia(link: &str, i: &InertialSpec) -> Result<RigidInertia, LoadError> {
+    let err =
+        |detail: String| LoadError::NonPhysicalInertia { loc: i.loc.clone(), link: link.to_string(), detail };
+    if !i.mass.is_finite() || i.mass < 0.0 {
+        if i.mass.is_finite() {
+            return Err(LoadError::NegativeMass { loc: i.loc.clone(), link: link.to_string(), mass: i.mass });
+        }
+        return Err(err(format!("mass is {}", i.mass)));
+    }
+    let m = &i.inertia;
+    if m.iter().any(|x| !x.is_finite()) {
+        return Err(err("an inertia entry is not a finite number".into()));
+    }
+    let scale = m.abs().max().max(f64::MIN_POSITIVE);
+    if (m - m.transpose()).abs().max() > INERTIA_TOL * scale {
+        return Err(err("the tensor is not symmetric".into()));
+    }
+    let mut eig: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
+    eig.sort_by(f64::total_cmp);
+    if eig[0] < -INERTIA_TOL * scale {
+        return Err(err(format!("principal moments {eig:?} include a negative one")));
+    }
+    if eig[0] + eig[1] < eig[2] - INERTIA_TOL * scale {
+        return Err(err(format!(
+            "principal moments {eig:?} violate the triangle inequality ({} + {} < {})",
+            eig[0], eig[1], eig[2]
+        )));
+    }
+    let r = i.x_link_inertial.rot;
+    let i_com: Mat3 = r * m * r.transpose();
+    Ok(RigidInertia::from_com(i.mass, i.x_link_inertial.pos, i_com))
+}

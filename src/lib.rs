@@ -1,0 +1,18 @@
+//! # lagrange
+//!
+//! A multibody dynamics engine: URDF (and soon MJCF) models become kinematic trees in generalized
+//! coordinates; the recursive algorithms of Featherstone's *Rigid Body Dynamics Algorithms* (RBDA)
+//! give forward kinematics, Jacobians, inverse dynamics (RNEA), the mass matrix (CRBA) with its
+//! tree-sparse factorization, and forward dynamics (ABA); time steppers integrate them.
+//!
+//! State vectors use MuJoCo's qpos/qvel layout; see `DESIGN.md` and the README.
+
+pub mod compile;
+pub mod dynamics;
+pub mod integrate;
+pub mod io;
+pub mod kinematics;
+pub mod model;
+pub mod spatial;
+
+pub use model::{Data, Model};

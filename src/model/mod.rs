@@ -1,0 +1,196 @@
+//! The immutable [`Model`] and the mutable [`Data`] workspace (DESIGN.md, layer 2).
+//!
+//! A model is a kinematic tree of *bodies* in parent-before-child order; body 0 is the world and
+//! every other body `b` hangs from its parent through exactly one movable joint (`joints[b - 1]`).
+//! Fixed joints were fused by the compile step; every original link survives as a [`Frame`].
+
+mod data;
+mod joint;
+pub mod spec;
+
+pub use data::Data;
+pub use joint::{axis_angle, JointKind};
+
+use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
+use std::path::PathBuf;
+
+/// Where an element came from, for error messages: file and 1-based line.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SourceLoc {
+    pub file: String,
+    pub line: u32,
+}
+
+impl std::fmt::Display for SourceLoc {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.line > 0 {
+            write!(f, "{}:{}", self.file, self.line)
+        } else {
+            write!(f, "{}", self.file)
+        }
+    }
+}
+
+/// A movable joint of the compiled tree.
+#[derive(Clone, Debug)]
+pub struct Joint {
+    pub name: String,
+    pub kind: JointKind,
+    /// Index of the body this joint moves (its child).
+    pub body: usize,
+    /// Index of the parent body.
+    pub parent: usize,
+    /// First index of this joint's coordinates in q.
+    pub qpos_adr: usize,
+    /// First index of this joint's degrees of freedom in v.
+    pub dof_adr: usize,
+    /// Position limits `[lower, upper]` of a one-dof joint, if limited. Not enforced yet.
+    pub limits: Option<[f64; 2]>,
+    /// Viscous damping coefficient (N·m·s/rad or N·s/m) applied by `simulate` as `−damping·v`.
+    pub damping: f64,
+    /// Coulomb friction (stored; enforced by the constraints work, not yet).
+    pub friction: f64,
+    /// Rotor armature added to the diagonal of M (MuJoCo's `dof_armature`).
+    pub armature: f64,
+    /// URDF `<mimic>`: stored, enforced by the constraints work (not yet).
+    pub mimic: Option<Mimic>,
+}
+
+/// URDF `<mimic joint multiplier offset>`: q = multiplier · q_joint + offset.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mimic {
+    pub joint: String,
+    pub multiplier: f64,
+    pub offset: f64,
+}
+
+/// A rigid body of the compiled tree (the fused links included).
+#[derive(Clone, Debug)]
+pub struct Body {
+    pub name: String,
+    /// Parent body (0 = world; the world's own parent is 0).
+    pub parent: usize,
+    /// Pose of this body's joint frame in the parent body frame (`x_parent_joint`).
+    pub x_parent_joint: Transform,
+    /// Spatial inertia in body coordinates, fused links included.
+    pub inertia: RigidInertia,
+}
+
+impl Body {
+    /// Mass of the body (fused links included).
+    pub fn mass(&self) -> f64 {
+        self.inertia.mass
+    }
+    /// Centre of mass in the body frame.
+    pub fn com(&self) -> Vec3 {
+        self.inertia.com()
+    }
+    /// Inertia tensor about the centre of mass, in body-frame axes.
+    pub fn inertia_com(&self) -> Mat3 {
+        self.inertia.i_com()
+    }
+}
+
+/// A named frame rigidly attached to a body: every URDF link is one (fused or not).
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub name: String,
+    pub body: usize,
+    /// Pose of the frame in its body's frame.
+    pub x_body_frame: Transform,
+}
+
+/// A geometry kept from the model file (not yet used by dynamics).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Geom {
+    /// Name of the link or body it belongs to.
+    pub link: String,
+    pub body: usize,
+    pub x_body_geom: Transform,
+    pub shape: spec::Shape,
+    /// Whether it came from a collision (true) or visual (false) element.
+    pub collision: bool,
+}
+
+/// The compiled, immutable model. Build it with a loader (e.g. [`crate::io::load`]) or by
+/// compiling a [`spec::ModelSpec`].
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub name: String,
+    pub source: Option<PathBuf>,
+    /// Gravity acceleration in the world frame (m/s²).
+    pub gravity: Vec3,
+    /// Bodies, world first, parents before children.
+    pub bodies: Vec<Body>,
+    /// Movable joints: `joints[b - 1]` moves body `b`.
+    pub joints: Vec<Joint>,
+    pub frames: Vec<Frame>,
+    pub geoms: Vec<Geom>,
+    pub nq: usize,
+    pub nv: usize,
+    /// For each degree of freedom, the previous degree of freedom on the path to the root
+    /// (Featherstone's λ for the tree-sparse factorization, RBDA §6.3), or `usize::MAX`.
+    pub dof_parent: Vec<usize>,
+    /// For each degree of freedom, the body it moves.
+    pub dof_body: Vec<usize>,
+    /// Armature per degree of freedom.
+    pub dof_armature: Vec<f64>,
+    /// Damping per degree of freedom.
+    pub dof_damping: Vec<f64>,
+}
+
+/// Marker for "no parent degree of freedom".
+pub const NO_DOF: usize = usize::MAX;
+
+impl Model {
+    /// Number of bodies including the world.
+    pub fn nbody(&self) -> usize {
+        self.bodies.len()
+    }
+    /// The joint moving body `b` (b ≥ 1).
+    #[inline]
+    pub fn joint_of(&self, b: usize) -> &Joint {
+        &self.joints[b - 1]
+    }
+    /// Total mass of all bodies.
+    pub fn total_mass(&self) -> f64 {
+        self.bodies.iter().map(|b| b.inertia.mass).sum()
+    }
+    /// Index of a frame by name.
+    pub fn frame_id(&self, name: &str) -> Option<usize> {
+        self.frames.iter().position(|f| f.name == name)
+    }
+    /// Index of a joint by name.
+    pub fn joint_id(&self, name: &str) -> Option<usize> {
+        self.joints.iter().position(|j| j.name == name)
+    }
+    /// Neutral configuration (zeros, identity quaternions).
+    pub fn neutral(&self) -> Vec<f64> {
+        let mut q = vec![0.0; self.nq];
+        for j in &self.joints {
+            j.kind.neutral(&mut q[j.qpos_adr..j.qpos_adr + j.kind.nq()]);
+        }
+        q
+    }
+    /// Whether any joint has viscous damping (the passive pass of `simulate`).
+    pub fn has_damping(&self) -> bool {
+        self.dof_damping.iter().any(|&d| d != 0.0)
+    }
+}
+
+/// `q ← q ⊕ v·dt` for the whole configuration (MuJoCo's `mj_integratePos`).
+pub fn integrate_configuration(model: &Model, q: &mut [f64], v: &[f64], dt: f64) {
+    for j in &model.joints {
+        let (qa, va) = (j.qpos_adr, j.dof_adr);
+        j.kind.integrate(&mut q[qa..qa + j.kind.nq()], &v[va..va + j.kind.nv()], dt);
+    }
+}
+
+/// The tangent `v` (length nv) with `q0 ⊕ v = q1`.
+pub fn difference_configuration(model: &Model, q0: &[f64], q1: &[f64], v: &mut [f64]) {
+    for j in &model.joints {
+        let (qa, va) = (j.qpos_adr, j.dof_adr);
+        let (nq, nv) = (j.kind.nq(), j.kind.nv());
+        j.kind.difference(&q0[qa..qa + nq], &q1[qa..qa + nq], &mut v[va..va + nv]);
+    }
+}

@@ -1,0 +1,136 @@
+//! Spatial inertia of a rigid body (RBDA §2.13, eq. 2.62–2.63) and articulated-body inertia
+//! (RBDA §7.2), with their change of coordinates (RBDA eq. 2.66).
+
+use super::{skew, Force, Mat3, Motion, Transform, Vec3};
+use std::ops::AddAssign;
+
+/// Spatial inertia of a rigid body about the origin of the frame it is expressed in, stored
+/// compactly as mass `m`, first moment `h = m c` (c the centre of mass) and the rotational inertia
+/// about the origin `i_origin = I_c − m [c]×²` (parallel-axis theorem, notes eq. 56).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RigidInertia {
+    pub mass: f64,
+    pub h: Vec3,
+    pub i_origin: Mat3,
+}
+
+impl Default for RigidInertia {
+    fn default() -> Self {
+        Self::zero()
+    }
+}
+
+impl RigidInertia {
+    pub fn zero() -> Self {
+        Self { mass: 0.0, h: Vec3::zeros(), i_origin: Mat3::zeros() }
+    }
+    /// From mass, centre of mass `com` and inertia `i_com` about the centre of mass (same axes).
+    pub fn from_com(mass: f64, com: Vec3, i_com: Mat3) -> Self {
+        let cx = skew(&com);
+        Self { mass, h: com * mass, i_origin: i_com - cx * cx * mass }
+    }
+    /// Centre of mass (origin if massless).
+    pub fn com(&self) -> Vec3 {
+        if self.mass > 0.0 {
+            self.h / self.mass
+        } else {
+            Vec3::zeros()
+        }
+    }
+    /// Rotational inertia about the centre of mass, in this frame's axes.
+    pub fn i_com(&self) -> Mat3 {
+        let c = self.com();
+        let cx = skew(&c);
+        self.i_origin + cx * cx * self.mass
+    }
+    /// Momentum `I v` (RBDA eq. 2.63): n = I_o ω + h × v, f = m v − h × ω.
+    #[inline]
+    pub fn mul_motion(&self, v: &Motion) -> Force {
+        Force {
+            ang: self.i_origin * v.ang + self.h.cross(&v.lin),
+            lin: v.lin * self.mass - self.h.cross(&v.ang),
+        }
+    }
+    /// The same inertia expressed in frame a, given the pose `x_a_b` of its current frame b.
+    #[inline]
+    pub fn transformed(&self, x_a_b: &Transform) -> RigidInertia {
+        let r = &x_a_b.rot;
+        let p = &x_a_b.pos;
+        let h_rot = r * self.h;
+        let px = skew(p);
+        let hx = skew(&h_rot);
+        // I_a = R I_b Rᵀ − ([h']×[p]× + [p]×[h']×) − m [p]×², with h' = R h.
+        let i_origin = r * self.i_origin * r.transpose() - (hx * px + px * hx) - px * px * self.mass;
+        RigidInertia { mass: self.mass, h: h_rot + p * self.mass, i_origin }
+    }
+    /// Kinetic energy ½ vᵀ I v.
+    #[inline]
+    pub fn kinetic_energy(&self, v: &Motion) -> f64 {
+        0.5 * v.dot(&self.mul_motion(v))
+    }
+}
+
+impl AddAssign<&RigidInertia> for RigidInertia {
+    fn add_assign(&mut self, o: &RigidInertia) {
+        self.mass += o.mass;
+        self.h += o.h;
+        self.i_origin += o.i_origin;
+    }
+}
+
+/// A general symmetric 6×6 spatial inertia `[[a, b], [bᵀ, c]]` (angular-first), as articulated
+/// bodies have (RBDA §7.2): `a` angular–angular, `b` angular–linear, `c` linear–linear.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ArticulatedInertia {
+    pub a: Mat3,
+    pub b: Mat3,
+    pub c: Mat3,
+}
+
+impl Default for ArticulatedInertia {
+    fn default() -> Self {
+        Self { a: Mat3::zeros(), b: Mat3::zeros(), c: Mat3::zeros() }
+    }
+}
+
+impl From<&RigidInertia> for ArticulatedInertia {
+    fn from(i: &RigidInertia) -> Self {
+        let hx = skew(&i.h);
+        Self { a: i.i_origin, b: hx, c: Mat3::identity() * i.mass }
+    }
+}
+
+impl ArticulatedInertia {
+    /// `I v`.
+    #[inline]
+    pub fn mul_motion(&self, v: &Motion) -> Force {
+        Force { ang: self.a * v.ang + self.b * v.lin, lin: self.b.tr_mul(&v.ang) + self.c * v.lin }
+    }
+    /// Subtracts the rank-one update `u uᵀ / d` where `u` is a spatial force (RBDA eq. 7.42 for a
+    /// single degree of freedom).
+    #[inline]
+    pub fn sub_rank_one(&mut self, u: &Force, d_inv: f64) {
+        let un = u.ang * d_inv;
+        let uf = u.lin * d_inv;
+        self.a -= un * u.ang.transpose();
+        self.b -= un * u.lin.transpose();
+        self.c -= uf * u.lin.transpose();
+    }
+    /// Adds this inertia, currently in frame b, to `target` expressed in frame a, given `x_a_b`
+    /// (the congruence ᵃX*_b I ᵇXₐ, RBDA eq. 2.66): first rotate, then shift the origin by `pos`.
+    #[inline]
+    pub fn add_transformed_to(&self, x_a_b: &Transform, target: &mut ArticulatedInertia) {
+        let r = &x_a_b.rot;
+        let rt = r.transpose();
+        let a = r * self.a * rt;
+        let b = r * self.b * rt;
+        let c = r * self.c * rt;
+        let px = skew(&x_a_b.pos);
+        // Shift: A'' = A + [p]× Bᵀ + ([p]× Bᵀ)ᵀ + [p]× C [p]×ᵀ,  B'' = B + [p]× C,  C'' = C.
+        let pxc = px * c;
+        let pxbt = px * b.transpose();
+        target.a += a + pxbt + pxbt.transpose() - pxc * px;
+        target.b += b + pxc;
+        target.c += c;
+    }
+}

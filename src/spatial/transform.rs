@@ -1,0 +1,107 @@
+//! Rigid transforms and the Plücker transforms they induce on spatial vectors (RBDA §2.8).
+
+use super::{Force, Mat3, Motion, Vec3};
+use nalgebra::{Quaternion, UnitQuaternion};
+use std::ops::Mul;
+
+/// Pose `x_a_b` of frame b in frame a: a point with coordinates `p_b` in b has coordinates
+/// `p_a = rot * p_b + pos` in a. `rot` is the orientation of b's axes in a, `pos` the position of
+/// b's origin in a.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transform {
+    pub rot: Mat3,
+    pub pos: Vec3,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Self::identity()
+    }
+}
+
+/// The skew-symmetric matrix `[v]×` with `[v]× w = v × w`.
+#[inline]
+pub fn skew(v: &Vec3) -> Mat3 {
+    Mat3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// Rotation matrix of a quaternion given as `[w, x, y, z]` (normalized first).
+pub fn quat_to_matrix(w: f64, x: f64, y: f64, z: f64) -> Mat3 {
+    UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)).to_rotation_matrix().into_inner()
+}
+
+impl Transform {
+    pub fn identity() -> Self {
+        Self { rot: Mat3::identity(), pos: Vec3::zeros() }
+    }
+    pub fn new(rot: Mat3, pos: Vec3) -> Self {
+        Self { rot, pos }
+    }
+    pub fn from_translation(pos: Vec3) -> Self {
+        Self { rot: Mat3::identity(), pos }
+    }
+    /// Pose from URDF `xyz` and `rpy`: R = Rz(yaw) · Ry(pitch) · Rx(roll) (fixed-axis roll, pitch,
+    /// yaw), as the URDF specification defines it.
+    pub fn from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Self {
+        let rot = nalgebra::Rotation3::from_euler_angles(rpy[0], rpy[1], rpy[2]).into_inner();
+        Self { rot, pos: Vec3::new(xyz[0], xyz[1], xyz[2]) }
+    }
+    /// Orientation as a unit quaternion `[w, x, y, z]` with `w ≥ 0`.
+    pub fn quat_wxyz(&self) -> [f64; 4] {
+        let q = UnitQuaternion::from_matrix(&self.rot);
+        let s = if q.w < 0.0 { -1.0 } else { 1.0 };
+        [s * q.w, s * q.i, s * q.j, s * q.k]
+    }
+    /// The inverse pose `x_b_a`.
+    #[inline]
+    pub fn inverse(&self) -> Self {
+        let rt = self.rot.transpose();
+        Self { rot: rt, pos: -(rt * self.pos) }
+    }
+    /// Coordinates in a of a point given in b.
+    #[inline]
+    pub fn act_point(&self, p_b: &Vec3) -> Vec3 {
+        self.rot * p_b + self.pos
+    }
+    /// Motion vector from b coordinates to a coordinates (RBDA eq. 2.24, the inverse of `ᵇXₐ`).
+    #[inline]
+    pub fn act_motion(&self, m_b: &Motion) -> Motion {
+        let ang = self.rot * m_b.ang;
+        Motion { ang, lin: self.rot * m_b.lin + self.pos.cross(&ang) }
+    }
+    /// Motion vector from a coordinates to b coordinates (`ᵇXₐ m`).
+    #[inline]
+    pub fn inv_act_motion(&self, m_a: &Motion) -> Motion {
+        let rt = self.rot.transpose();
+        Motion { ang: rt * m_a.ang, lin: rt * (m_a.lin - self.pos.cross(&m_a.ang)) }
+    }
+    /// Force vector from b coordinates to a coordinates (`ᵃX*_b f`, RBDA eq. 2.25).
+    #[inline]
+    pub fn act_force(&self, f_b: &Force) -> Force {
+        let lin = self.rot * f_b.lin;
+        Force { ang: self.rot * f_b.ang + self.pos.cross(&lin), lin }
+    }
+    /// Force vector from a coordinates to b coordinates.
+    #[inline]
+    pub fn inv_act_force(&self, f_a: &Force) -> Force {
+        let rt = self.rot.transpose();
+        Force { ang: rt * (f_a.ang - self.pos.cross(&f_a.lin)), lin: rt * f_a.lin }
+    }
+}
+
+impl Mul for Transform {
+    type Output = Transform;
+    /// Composition `x_a_b * x_b_c = x_a_c`.
+    #[inline]
+    fn mul(self, o: Transform) -> Transform {
+        Transform { rot: self.rot * o.rot, pos: self.rot * o.pos + self.pos }
+    }
+}
+
+impl Mul<&Transform> for &Transform {
+    type Output = Transform;
+    #[inline]
+    fn mul(self, o: &Transform) -> Transform {
+        Transform { rot: self.rot * o.rot, pos: self.rot * o.pos + self.pos }
+    }
+}
