@@ -1,1 +1,114 @@
-//! Kinematics
+//! Forward kinematics, body velocities and frame Jacobians (RBDA §4.1, §8.1).
+
+use crate::model::{Data, Model};
+use crate::spatial::{Motion, Transform, Vec3};
+use nalgebra::DMatrix;
+
+/// Updates one body's joint: `x_parent_body[b]` = placement · X_J(q) and its motion-subspace
+/// columns `s_body` (body coordinates). Shared first step of every recursive algorithm.
+#[inline]
+pub(crate) fn update_joint(model: &Model, data: &mut Data, b: usize, q: &[f64]) {
+    let body = &model.bodies[b];
+    let j = model.joint_of(b);
+    let (qa, da) = (j.qpos_adr, j.dof_adr);
+    let x_joint = j.kind.transform(&q[qa..qa + j.kind.nq()]);
+    data.x_parent_body[b] = body.x_parent_joint * x_joint;
+    j.kind.motion_subspace(&x_joint, &mut data.s_body[da..da + j.kind.nv()]);
+}
+
+/// Joint velocity `v_J = S q̇` of body `b`, body coordinates (needs `update_joint` first).
+#[inline]
+pub(crate) fn joint_velocity(model: &Model, data: &Data, b: usize, v: &[f64]) -> Motion {
+    let j = model.joint_of(b);
+    let mut v_joint = Motion::zero();
+    for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+        v_joint += data.s_body[k] * v[k];
+    }
+    v_joint
+}
+
+/// Forward kinematics: pose of every body (`x_parent_body`, `x_world_body`) and of every named
+/// frame (`x_world_frame`) at configuration `q`, and the motion subspaces (`s_body`).
+pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
+    // Pass 1, root to leaves: x_world_body = x_world_parent · x_parent_body.
+    for b in 1..model.nbody() {
+        update_joint(model, data, b, q);
+        let p = model.bodies[b].parent;
+        data.x_world_body[b] = data.x_world_body[p] * data.x_parent_body[b];
+    }
+    // Pass 2: frames rigidly attached to bodies.
+    for (f, frame) in model.frames.iter().enumerate() {
+        data.x_world_frame[f] = data.x_world_body[frame.body] * frame.x_body_frame;
+    }
+}
+
+/// Spatial velocity of every body in body coordinates, `v_body` (RBDA eq. 5.7, first line), for
+/// velocity `v`. Needs [`forward_kinematics`] (or any algorithm's first pass) at the same q.
+pub fn forward_velocities(model: &Model, data: &mut Data, v: &[f64]) {
+    for b in 1..model.nbody() {
+        let p = model.bodies[b].parent;
+        let v_joint = joint_velocity(model, data, b, v);
+        data.v_body[b] = data.x_parent_body[b].inv_act_motion(&data.v_body[p]) + v_joint;
+    }
+}
+
+/// In which coordinates a frame velocity or Jacobian is expressed (Pinocchio's reference frames).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReferenceFrame {
+    /// Frame axes, velocity of the frame origin.
+    Local,
+    /// World axes, velocity of the frame origin (MuJoCo's `mj_jac` and Pinocchio's
+    /// LOCAL_WORLD_ALIGNED).
+    LocalWorldAligned,
+    /// World axes, velocity of the body point passing through the world origin.
+    World,
+}
+
+/// Expresses a spatial velocity given in world coordinates (about the world origin) in `reference`
+/// for a frame at pose `x_world_frame`; returns (linear, angular).
+#[inline]
+fn express(m_world: &Motion, x_world_frame: &Transform, reference: ReferenceFrame) -> (Vec3, Vec3) {
+    let p = &x_world_frame.pos;
+    match reference {
+        ReferenceFrame::World => (m_world.lin, m_world.ang),
+        ReferenceFrame::LocalWorldAligned => (m_world.lin + m_world.ang.cross(p), m_world.ang),
+        ReferenceFrame::Local => {
+            let lin = m_world.lin + m_world.ang.cross(p);
+            (x_world_frame.rot.tr_mul(&lin), x_world_frame.rot.tr_mul(&m_world.ang))
+        }
+    }
+}
+
+/// Jacobian of frame `frame` into `jac` (6 × nv): rows 0–2 linear, rows 3–5 angular velocity, in
+/// `reference` coordinates (the row order of Pinocchio). Columns of degrees of freedom that do not
+/// move the frame are zero. Needs [`forward_kinematics`] at the same q.
+pub fn frame_jacobian(
+    model: &Model,
+    data: &Data,
+    frame: usize,
+    reference: ReferenceFrame,
+    jac: &mut DMatrix<f64>,
+) {
+    jac.fill(0.0);
+    let x_world_frame = &data.x_world_frame[frame];
+    let mut b = model.frames[frame].body;
+    // Walk from the frame's body to the root: each joint's columns S, moved to world coordinates.
+    while b != 0 {
+        let j = model.joint_of(b);
+        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+            let s_world = data.x_world_body[b].act_motion(&data.s_body[k]);
+            let (lin, ang) = express(&s_world, x_world_frame, reference);
+            jac.fixed_view_mut::<3, 1>(0, k).copy_from(&lin);
+            jac.fixed_view_mut::<3, 1>(3, k).copy_from(&ang);
+        }
+        b = model.bodies[b].parent;
+    }
+}
+
+/// Velocity (linear, angular) of frame `frame` in `reference` coordinates, from the body
+/// velocities of [`forward_velocities`].
+pub fn frame_velocity(model: &Model, data: &Data, frame: usize, reference: ReferenceFrame) -> (Vec3, Vec3) {
+    let b = model.frames[frame].body;
+    let v_world = data.x_world_body[b].act_motion(&data.v_body[b]);
+    express(&v_world, &data.x_world_frame[frame], reference)
+}

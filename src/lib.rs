@@ -7,12 +7,14 @@
 //!
 //! State vectors use MuJoCo's qpos/qvel layout; see `DESIGN.md` and the README.
 
+pub mod cli;
 pub mod compile;
 pub mod dynamics;
 pub mod integrate;
 pub mod io;
 pub mod kinematics;
 pub mod model;
+pub mod sim;
 pub mod spatial;
 
 pub use model::{Data, Model};

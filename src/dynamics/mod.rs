@@ -1,1 +1,13 @@
-//! Dynamics
+//! Rigid-body dynamics (DESIGN.md, layer 5): inverse dynamics (RNEA), the joint-space inertia
+//! matrix (CRBA) and its tree-sparse factorization, forward dynamics (ABA), energy, centre of mass
+//! and momentum. Every function writes into [`Data`](crate::Data) and allocates nothing.
+
+mod aba;
+mod crba;
+mod energy;
+mod rnea;
+
+pub use aba::aba;
+pub use crba::{crba, factorize_mass_matrix, solve_mass_matrix};
+pub use energy::{center_of_mass, kinetic_energy, potential_energy, spatial_momentum};
+pub use rnea::{bias_forces, gravity_forces, rnea};

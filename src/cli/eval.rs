@@ -1,0 +1,110 @@
+//! `lagrange eval MODEL --states FILE`: one process evaluates a batch of states (the interface the
+//! validation scripts use; schema in the README).
+
+use super::CliError;
+use crate::dynamics::{aba, bias_forces, center_of_mass, crba, kinetic_energy, potential_energy};
+use crate::io::{load, LoadOptions};
+use crate::kinematics::{forward_kinematics, frame_jacobian, ReferenceFrame};
+use crate::{Data, Model};
+use nalgebra::DMatrix;
+use serde::Deserialize;
+use serde_json::{json, Map, Value};
+use std::path::Path;
+
+/// One input state: q (nq), v (nv, default zero), tau (nv, default zero).
+#[derive(Deserialize)]
+pub struct StateIn {
+    pub q: Vec<f64>,
+    #[serde(default)]
+    pub v: Option<Vec<f64>>,
+    #[serde(default)]
+    pub tau: Option<Vec<f64>>,
+}
+
+#[derive(Deserialize)]
+struct StatesFile {
+    states: Vec<StateIn>,
+}
+
+fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
+    (0..m.nrows()).map(|r| m.row(r).iter().copied().collect()).collect()
+}
+
+/// Evaluates one state: M, bias, qacc, poses of every frame, energies, com, and the requested
+/// frame Jacobians (world-aligned).
+pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]) -> Value {
+    let zeros = vec![0.0; model.nv];
+    let v = s.v.as_deref().unwrap_or(&zeros);
+    let tau = s.tau.as_deref().unwrap_or(&zeros);
+    let m = rows(crba(model, data, &s.q));
+    let bias: Vec<f64> = bias_forces(model, data, &s.q, v).iter().copied().collect();
+    let qacc: Vec<f64> = aba(model, data, &s.q, v, tau).iter().copied().collect();
+    let kinetic = kinetic_energy(model, data, &s.q, v);
+    forward_kinematics(model, data, &s.q);
+    let potential = potential_energy(model, data);
+    let com = center_of_mass(model, data);
+    let mut poses = Map::new();
+    for (f, frame) in model.frames.iter().enumerate() {
+        let x = &data.x_world_frame[f];
+        poses.insert(frame.name.clone(), json!({"pos": x.pos.as_slice(), "quat": x.quat_wxyz()}));
+    }
+    let mut out = json!({
+        "M": m, "bias": bias, "qacc": qacc, "poses": poses,
+        "kinetic": kinetic, "potential": potential, "com": com.as_slice(),
+    });
+    if !jacobians.is_empty() {
+        let mut jac = DMatrix::zeros(6, model.nv);
+        let mut jmap = Map::new();
+        for &f in jacobians {
+            frame_jacobian(model, data, f, ReferenceFrame::LocalWorldAligned, &mut jac);
+            jmap.insert(model.frames[f].name.clone(), json!(rows(&jac)));
+        }
+        out["jacobians"] = Value::Object(jmap);
+    }
+    out
+}
+
+/// Checks one input state's sizes and values.
+fn check_state(model: &Model, file: &str, i: usize, s: &StateIn) -> Result<(), CliError> {
+    let err =
+        |detail: String| CliError::Input { file: file.to_string(), detail: format!("states[{i}]: {detail}") };
+    let check = |name: &str, x: &Option<Vec<f64>>, n: usize| match x {
+        Some(x) if x.len() != n => Err(err(format!("'{name}' has {} values, the model needs {n}", x.len()))),
+        Some(x) if x.iter().any(|e| !e.is_finite()) => Err(err(format!("'{name}' has a non-finite value"))),
+        _ => Ok(()),
+    };
+    check("q", &Some(s.q.clone()), model.nq)?;
+    check("v", &s.v, model.nv)?;
+    check("tau", &s.tau, model.nv)
+}
+
+/// Runs `eval`, printing `{"results": [...]}`.
+pub fn run(path: &Path, options: &LoadOptions, states: &Path, jacobians: &[String]) -> Result<(), CliError> {
+    let model = load(path, options)?;
+    let file = states.display().to_string();
+    let text =
+        std::fs::read_to_string(states).map_err(|source| CliError::Io { file: file.clone(), source })?;
+    let input: StatesFile = serde_json::from_str(&text).map_err(|e| CliError::Input {
+        file: file.clone(),
+        detail: format!(
+            "line {}: {e}; expected {{\"states\": [{{\"q\": [...], \"v\": [...], \"tau\": [...]}}]}}",
+            e.line()
+        ),
+    })?;
+    let frame_ids = jacobians
+        .iter()
+        .map(|name| {
+            model
+                .frame_id(name)
+                .ok_or_else(|| CliError::Usage(format!("--jacobian {name}: the model has no frame '{name}'")))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut data = Data::new(&model);
+    let mut results = Vec::with_capacity(input.states.len());
+    for (i, s) in input.states.iter().enumerate() {
+        check_state(&model, &file, i, s)?;
+        results.push(evaluate(&model, &mut data, s, &frame_ids));
+    }
+    println!("{}", serde_json::to_string(&json!({ "results": results })).expect("JSON values serialize"));
+    Ok(())
+}

@@ -1,0 +1,136 @@
+//! `lagrange info MODEL [--json]`: the compiled tree, sizes and the simulation plan.
+
+use super::CliError;
+use crate::io::{load, LoadOptions};
+use crate::sim::plan;
+use crate::Model;
+use serde_json::{json, Map, Value};
+use std::path::Path;
+
+/// The `info` JSON document: keys `nq`, `nv`, `total_mass`, `bodies`, `joints`, `stages`.
+/// `com` is in the body frame, `inertia` is the 3×3 tensor about the centre of mass in body axes.
+/// Body 0 is `world` (with any links welded to it); `total_mass` counts the moving bodies only.
+pub fn to_json(model: &Model) -> Value {
+    let bodies: Vec<Value> = model
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(b, body)| {
+            let i = body.inertia_com();
+            json!({
+                "name": body.name,
+                "parent": if b == 0 { Value::Null } else { Value::from(model.bodies[body.parent].name.clone()) },
+                "mass": body.mass(),
+                "com": body.com().as_slice(),
+                "inertia": [[i[(0, 0)], i[(0, 1)], i[(0, 2)]], [i[(1, 0)], i[(1, 1)], i[(1, 2)]], [i[(2, 0)], i[(2, 1)], i[(2, 2)]]],
+            })
+        })
+        .collect();
+    let joints: Vec<Value> = model
+        .joints
+        .iter()
+        .map(|j| {
+            json!({
+                "name": j.name,
+                "type": j.kind.type_name(),
+                "parent": model.bodies[j.parent].name,
+                "child": model.bodies[j.body].name,
+                "qposadr": j.qpos_adr,
+                "dofadr": j.dof_adr,
+                "nq": j.kind.nq(),
+                "nv": j.kind.nv(),
+            })
+        })
+        .collect();
+    let mut stages = Map::new();
+    for s in plan(model) {
+        stages.insert(s.name.to_string(), json!({"status": s.status, "reason": s.reason}));
+    }
+    json!({
+        "nq": model.nq,
+        "nv": model.nv,
+        "total_mass": model.total_mass(),
+        "bodies": bodies,
+        "joints": joints,
+        "stages": stages,
+    })
+}
+
+/// Human-readable summary of a model.
+pub fn to_text(model: &Model) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let src = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "(embedded)".into());
+    let _ = writeln!(s, "model '{}' from {src}", model.name);
+    let _ = writeln!(
+        s,
+        "nq = {}, nv = {}, {} moving bodies, {} frames, total mass {:.6} kg",
+        model.nq,
+        model.nv,
+        model.nbody() - 1,
+        model.frames.len(),
+        model.total_mass()
+    );
+    let _ = writeln!(s, "\nbodies (com in body frame; inertia about com, body axes):");
+    let _ = writeln!(s, "  {:<28} {:<24} {:>10}  {:<30} diag(I)", "name", "parent", "mass", "com");
+    for (b, body) in model.bodies.iter().enumerate() {
+        let parent = if b == 0 { "-" } else { model.bodies[body.parent].name.as_str() };
+        let c = body.com();
+        let i = body.inertia_com();
+        let _ = writeln!(
+            s,
+            "  {:<28} {:<24} {:>10.5}  [{:>8.4} {:>8.4} {:>8.4}]  [{:.4e} {:.4e} {:.4e}]",
+            body.name,
+            parent,
+            body.mass(),
+            c.x,
+            c.y,
+            c.z,
+            i[(0, 0)],
+            i[(1, 1)],
+            i[(2, 2)]
+        );
+    }
+    let _ = writeln!(s, "\njoints (depth-first file order):");
+    let _ = writeln!(
+        s,
+        "  {:<26} {:<10} {:<22} {:<22} {:>7} {:>6} {:>3} {:>3}  limits",
+        "name", "type", "parent", "child", "qposadr", "dofadr", "nq", "nv"
+    );
+    for j in &model.joints {
+        let limits = match j.limits {
+            Some([lo, hi]) => format!("[{lo:.4}, {hi:.4}]"),
+            None => "-".into(),
+        };
+        let mimic =
+            j.mimic.as_ref().map(|m| format!("  mimic {} (not enforced yet)", m.joint)).unwrap_or_default();
+        let _ = writeln!(
+            s,
+            "  {:<26} {:<10} {:<22} {:<22} {:>7} {:>6} {:>3} {:>3}  {limits}{mimic}",
+            j.name,
+            j.kind.type_name(),
+            model.bodies[j.parent].name,
+            model.bodies[j.body].name,
+            j.qpos_adr,
+            j.dof_adr,
+            j.kind.nq(),
+            j.kind.nv()
+        );
+    }
+    let _ = writeln!(s, "\nsimulation plan:");
+    for st in plan(model) {
+        let _ = writeln!(s, "  {:<22} {:<22} {}", st.name, st.status, st.reason);
+    }
+    s
+}
+
+/// Runs `info`.
+pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliError> {
+    let model = load(path, options)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&to_json(&model)).expect("JSON values serialize"));
+    } else {
+        print!("{}", to_text(&model));
+    }
+    Ok(())
+}

@@ -1,0 +1,117 @@
+//! Articulated-body algorithm for forward dynamics (RBDA §7.3, Table 7.1).
+
+use crate::kinematics::{joint_velocity, update_joint};
+use crate::model::{Data, Model};
+use crate::spatial::{ArticulatedInertia, Force, Motion, Vec3};
+use nalgebra::{DVector, Matrix6};
+
+/// Forward dynamics q̈ = M(q)⁻¹ (τ − c(q, v)) into `data.qacc` (and returned), in O(n), armature
+/// included. A joint whose articulated inertia is singular (a massless subtree) yields non-finite
+/// accelerations, which the simulator reports as an error.
+pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d DVector<f64> {
+    let nb = model.nbody();
+    data.v_body[0] = Motion::zero();
+    // Pass 1, root to leaves: velocities, velocity-product accelerations c, and the rigid-body
+    // inertias and bias forces pᴬ = v ×* I v that start the articulated quantities.
+    for b in 1..nb {
+        update_joint(model, data, b, q);
+        let p = model.bodies[b].parent;
+        let v_joint = joint_velocity(model, data, b, v);
+        let v_body = data.x_parent_body[b].inv_act_motion(&data.v_body[p]) + v_joint;
+        let j = model.joint_of(b);
+        data.c_body[b] = j.kind.bias_motion(&v_joint) + v_body.cross_motion(&v_joint);
+        let inertia = &model.bodies[b].inertia;
+        data.i_articulated[b] = ArticulatedInertia::from(inertia);
+        data.f_body[b] = v_body.cross_force(&inertia.mul_motion(&v_body));
+        data.v_body[b] = v_body;
+    }
+    // Pass 2, leaves to root: U = Iᴬ S, D = Sᵀ U, u = τ − Sᵀ pᴬ; hand the articulated inertia
+    // Iᵃ = Iᴬ − U D⁻¹ Uᵀ and bias pᵃ = pᴬ + Iᵃ c + U D⁻¹ u to the parent (RBDA eq. 7.42–7.43).
+    for b in (1..nb).rev() {
+        let j = model.joint_of(b);
+        let (da, nv_j) = (j.dof_adr, j.kind.nv());
+        let i_a = data.i_articulated[b];
+        let p_a = data.f_body[b];
+        let mut i_handed = i_a;
+        let mut p_handed = p_a;
+        if nv_j == 1 {
+            let u_col = i_a.mul_motion(&data.s_body[da]);
+            let d = data.s_body[da].dot(&u_col) + model.dof_armature[da];
+            let d_inv = 1.0 / d;
+            let u = tau[da] - data.s_body[da].dot(&p_a);
+            data.u_dof[da] = u_col;
+            data.u_tau[da] = u;
+            data.d_inv[b][(0, 0)] = d_inv;
+            i_handed.sub_rank_one(&u_col, d_inv);
+            p_handed += u_col * (d_inv * u);
+        } else {
+            let mut d = Matrix6::<f64>::identity();
+            for k in 0..nv_j {
+                data.u_dof[da + k] = i_a.mul_motion(&data.s_body[da + k]);
+                data.u_tau[da + k] = tau[da + k] - data.s_body[da + k].dot(&p_a);
+            }
+            for k in 0..nv_j {
+                for l in 0..nv_j {
+                    d[(k, l)] = data.s_body[da + k].dot(&data.u_dof[da + l]);
+                }
+                d[(k, k)] += model.dof_armature[da + k];
+            }
+            // D is embedded in an identity so that the fixed-size inverse holds D⁻¹ top-left.
+            let d_inv = d.try_inverse().unwrap_or_else(|| Matrix6::from_element(f64::NAN));
+            data.d_inv[b] = d_inv;
+            for k in 0..nv_j {
+                let mut coeff_u = 0.0;
+                for l in 0..nv_j {
+                    i_handed.sub_outer(&data.u_dof[da + k], &data.u_dof[da + l], d_inv[(k, l)]);
+                    coeff_u += d_inv[(k, l)] * data.u_tau[da + l];
+                }
+                p_handed += data.u_dof[da + k] * coeff_u;
+            }
+        }
+        let p = model.bodies[b].parent;
+        if p != 0 {
+            p_handed += i_handed.mul_motion(&data.c_body[b]);
+            let x = data.x_parent_body[b];
+            let mut target = data.i_articulated[p];
+            i_handed.add_transformed_to(&x, &mut target);
+            data.i_articulated[p] = target;
+            data.f_body[p] += x.act_force(&p_handed);
+        }
+    }
+    // Pass 3, root to leaves: accelerations q̈ = D⁻¹(u − Uᵀ a′), a = a′ + S q̈ with
+    // a′ = X a_parent + c; gravity enters as the world's upward acceleration.
+    data.a_body[0] = Motion::new(Vec3::zeros(), -model.gravity);
+    for b in 1..nb {
+        let j = model.joint_of(b);
+        let (da, nv_j) = (j.dof_adr, j.kind.nv());
+        let p = model.bodies[b].parent;
+        let a_prime = data.x_parent_body[b].inv_act_motion(&data.a_body[p]) + data.c_body[b];
+        let mut a_body = a_prime;
+        let mut rhs = [0.0; 6];
+        for k in 0..nv_j {
+            rhs[k] = data.u_tau[da + k] - a_prime.dot(&data.u_dof[da + k]);
+        }
+        for k in 0..nv_j {
+            let mut acc = 0.0;
+            for (l, r) in rhs.iter().enumerate().take(nv_j) {
+                acc += data.d_inv[b][(k, l)] * r;
+            }
+            data.qacc[da + k] = acc;
+            a_body += data.s_body[da + k] * acc;
+        }
+        data.a_body[b] = a_body;
+    }
+    &data.qacc
+}
+
+impl ArticulatedInertia {
+    /// Subtracts `coeff · u₁ u₂ᵀ` (one term of U D⁻¹ Uᵀ for multi-dof joints).
+    #[inline]
+    pub(crate) fn sub_outer(&mut self, u1: &Force, u2: &Force, coeff: f64) {
+        let n1 = u1.ang * coeff;
+        let f1 = u1.lin * coeff;
+        self.a -= n1 * u2.ang.transpose();
+        self.b -= n1 * u2.lin.transpose();
+        self.c -= f1 * u2.lin.transpose();
+    }
+}

@@ -1,0 +1,55 @@
+//! Energy, centre of mass and momentum of the moving bodies (notes §2.1–2.2, §1.5). Bodies welded
+//! to the world (body 0) are excluded, as in MuJoCo and Pinocchio.
+
+use crate::kinematics::{forward_kinematics, forward_velocities};
+use crate::model::{Data, Model};
+use crate::spatial::{Force, Vec3};
+
+/// Kinetic energy T = Σ ½ vᵢ·Iᵢvᵢ + ½ Σ armature·v² (= ½ vᵀ M v, MuJoCo's definition). Runs forward
+/// kinematics and velocities at (q, v).
+pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> f64 {
+    forward_kinematics(model, data, q);
+    forward_velocities(model, data, v);
+    let bodies: f64 =
+        (1..model.nbody()).map(|b| model.bodies[b].inertia.kinetic_energy(&data.v_body[b])).sum();
+    let armature: f64 = model.dof_armature.iter().zip(v).map(|(a, vi)| 0.5 * a * vi * vi).sum();
+    bodies + armature
+}
+
+/// Potential energy V = −Σ mᵢ g·cᵢ (zero at the world origin). Needs [`forward_kinematics`].
+pub fn potential_energy(model: &Model, data: &Data) -> f64 {
+    (1..model.nbody())
+        .map(|b| {
+            let inertia = &model.bodies[b].inertia;
+            -inertia.mass * model.gravity.dot(&data.x_world_body[b].act_point(&inertia.com()))
+        })
+        .sum()
+}
+
+/// Centre of mass of the moving bodies in the world frame (notes eq. 31). Needs
+/// [`forward_kinematics`]. The origin if they are massless.
+pub fn center_of_mass(model: &Model, data: &Data) -> Vec3 {
+    let mut first_moment = Vec3::zeros();
+    let mut mass = 0.0;
+    for b in 1..model.nbody() {
+        let inertia = &model.bodies[b].inertia;
+        first_moment += data.x_world_body[b].act_point(&inertia.com()) * inertia.mass;
+        mass += inertia.mass;
+    }
+    if mass > 0.0 {
+        first_moment / mass
+    } else {
+        Vec3::zeros()
+    }
+}
+
+/// Spatial momentum in world coordinates: `lin` = linear momentum, `ang` = angular momentum about
+/// the world origin. Needs [`forward_kinematics`] and [`forward_velocities`].
+pub fn spatial_momentum(model: &Model, data: &Data) -> Force {
+    let mut h = Force::zero();
+    for b in 1..model.nbody() {
+        let h_body = model.bodies[b].inertia.mul_motion(&data.v_body[b]);
+        h += data.x_world_body[b].act_force(&h_body);
+    }
+    h
+}

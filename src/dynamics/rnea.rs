@@ -1,0 +1,64 @@
+//! Recursive Newton–Euler inverse dynamics (RBDA §5.3, Table 5.1).
+
+use crate::kinematics::{joint_velocity, update_joint};
+use crate::model::{Data, Model};
+use crate::spatial::{Motion, Vec3};
+use nalgebra::DVector;
+
+/// Inverse dynamics τ = M(q) q̈ + c(q, v) into `data.tau` (and returned). Gravity enters as a
+/// fictitious upward acceleration of the world (RBDA §5.3); armature adds `armature · q̈`.
+pub fn rnea<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], qacc: &[f64]) -> &'d DVector<f64> {
+    data.v_body[0] = Motion::zero();
+    data.a_body[0] = Motion::new(Vec3::zeros(), -model.gravity);
+    // Pass 1, root to leaves: body velocities, accelerations and the net force each needs.
+    for b in 1..model.nbody() {
+        update_joint(model, data, b, q);
+        let p = model.bodies[b].parent;
+        let x = data.x_parent_body[b];
+        let v_joint = joint_velocity(model, data, b, v);
+        let j = model.joint_of(b);
+        let mut a_joint = j.kind.bias_motion(&v_joint);
+        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+            a_joint += data.s_body[k] * qacc[k];
+        }
+        let v_body = x.inv_act_motion(&data.v_body[p]) + v_joint;
+        let a_body = x.inv_act_motion(&data.a_body[p]) + a_joint + v_body.cross_motion(&v_joint);
+        let inertia = &model.bodies[b].inertia;
+        // f = I a + v ×* I v (RBDA eq. 5.9).
+        data.f_body[b] = inertia.mul_motion(&a_body) + v_body.cross_force(&inertia.mul_motion(&v_body));
+        data.v_body[b] = v_body;
+        data.a_body[b] = a_body;
+    }
+    // Pass 2, leaves to root: project forces on the joint axes, pass the rest to the parent.
+    for b in (1..model.nbody()).rev() {
+        let j = model.joint_of(b);
+        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+            data.tau[k] = data.s_body[k].dot(&data.f_body[b]) + model.dof_armature[k] * qacc[k];
+        }
+        let p = model.bodies[b].parent;
+        if p != 0 {
+            let f_parent = data.x_parent_body[b].act_force(&data.f_body[b]);
+            data.f_body[p] += f_parent;
+        }
+    }
+    &data.tau
+}
+
+/// Bias forces c(q, v) = RNEA(q, v, 0): Coriolis, centrifugal and gravity (MuJoCo's
+/// `qfrc_bias`), into `data.tau`.
+pub fn bias_forces<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64]) -> &'d DVector<f64> {
+    data.scratch_v.fill(0.0);
+    let zeros = std::mem::take(&mut data.scratch_v);
+    rnea(model, data, q, v, zeros.as_slice());
+    data.scratch_v = zeros;
+    &data.tau
+}
+
+/// Generalized gravity g(q) = RNEA(q, 0, 0), into `data.tau`.
+pub fn gravity_forces<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DVector<f64> {
+    data.scratch_v.fill(0.0);
+    let zeros = std::mem::take(&mut data.scratch_v);
+    rnea(model, data, q, zeros.as_slice(), zeros.as_slice());
+    data.scratch_v = zeros;
+    &data.tau
+}
