@@ -158,7 +158,7 @@ fn check_unique_names(spec: &ModelSpec) -> Result<(), LoadError> {
 fn joint_kind(j: &JointSpec) -> Result<Option<JointKind>, LoadError> {
     let axis = || {
         let n = j.axis.norm();
-        if !(n > 1e-12) || !n.is_finite() {
+        if n.is_nan() || n <= 1e-12 || !n.is_finite() {
             Err(LoadError::ZeroAxis { loc: j.loc.clone(), joint: j.name.clone() })
         } else {
             Ok(j.axis / n)

@@ -8,7 +8,7 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum LoadError {
-    #[error("{file}: cannot read the file: {source}")]
+    #[error("{file}: cannot read the file: {source}; check the path and that the file is readable")]
     Io {
         file: String,
         #[source]
@@ -18,30 +18,51 @@ pub enum LoadError {
     Xml { file: String, line: u32, col: u32, detail: String },
     #[error("{loc}: <{element}>: {detail}")]
     Invalid { loc: SourceLoc, element: String, detail: String },
-    #[error("{loc}: joint '{joint}': unknown joint type '{found}'; use one of revolute, continuous, prismatic, fixed, floating, planar")]
+    #[error("{loc}: joint '{joint}': unknown joint type '{found}'; use one of revolute, continuous, prismatic, fixed, floating, planar (or spherical)")]
     UnknownJointType { loc: SourceLoc, joint: String, found: String },
     #[error("{loc}: joint '{joint}': {role} link '{link}' is not defined; add <link name=\"{link}\"> or fix the name")]
     MissingLink { loc: SourceLoc, joint: String, role: &'static str, link: String },
     #[error("{loc}: joint '{joint}': link '{link}' already has parent joint '{other}'; a link can have only one parent joint (loops need an equality constraint, not a second joint)")]
     TwoParents { loc: SourceLoc, joint: String, link: String, other: String },
-    #[error("{file}: the links {links:?} form a cycle (through joint '{joint}'); a URDF must be a tree")]
-    Cycle { file: String, joint: String, links: Vec<String> },
-    #[error("{file}: the model has {} root links ({roots:?}); it must have exactly one link that is no joint's child: connect the others with joints", roots.len())]
+    #[error("{loc}: joint '{joint}': the links {} form a cycle; a URDF must be a tree: remove or re-parent one joint of the loop (loops need an equality constraint, not a joint)", list(.links))]
+    Cycle { loc: SourceLoc, joint: String, links: Vec<String> },
+    #[error("{file}: the model has {} root links ({}); it must have exactly one link that is no joint's child: connect the others with joints or delete them", roots.len(), list(.roots))]
     MultipleRoots { file: String, roots: Vec<String> },
-    #[error("{file}: the model has no links")]
+    #[error("{file}: the model has no links; add at least one <link name=\"...\">")]
     Empty { file: String },
-    #[error("{loc}: {element} '{name}' is defined twice; names must be unique")]
+    #[error("{loc}: {element} '{name}' is defined twice; names must be unique: rename one of them")]
     DuplicateName { loc: SourceLoc, element: &'static str, name: String },
     #[error("{loc}: joint '{joint}': axis is zero; give a nonzero <axis xyz=\"...\">")]
     ZeroAxis { loc: SourceLoc, joint: String },
-    #[error("{loc}: link '{link}': negative mass {mass}; mass must be ≥ 0 kg")]
+    #[error("{loc}: link '{link}': negative mass {mass}; mass must be ≥ 0 kg: fix <mass value=\"...\">")]
     NegativeMass { loc: SourceLoc, link: String, mass: f64 },
-    #[error("{loc}: link '{link}': non-physical inertia: {detail}; an inertia tensor must be symmetric positive semi-definite with principal moments satisfying the triangle inequality (I1 + I2 ≥ I3)")]
+    #[error("{loc}: link '{link}': non-physical inertia: {detail}; an inertia tensor must be symmetric positive semi-definite with principal moments satisfying the triangle inequality (I1 + I2 ≥ I3): fix the <inertia> values")]
     NonPhysicalInertia { loc: SourceLoc, link: String, detail: String },
-    #[error("{loc}: link '{link}': cannot resolve '{uri}': package '{package}' not found in {searched:?}; pass --package-dir DIR (the folder holding '{package}/') or set ROS_PACKAGE_PATH")]
-    PackageNotFound { loc: SourceLoc, link: String, uri: String, package: String, searched: Vec<String> },
-    #[error("{loc}: link '{link}': mesh file '{path}' does not exist")]
+    #[error("{loc}: link '{link}': cannot resolve '{uri}': package '{package}' not found (searched: {}); pass --package-dir DIR (the folder holding '{package}/') or add it to ROS_PACKAGE_PATH", searched_list(.searched))]
+    PackageNotFound {
+        loc: SourceLoc,
+        link: String,
+        uri: String,
+        package: String,
+        /// The folders searched, in order (boxed to keep `LoadError` small).
+        searched: Box<[String]>,
+    },
+    #[error("{loc}: link '{link}': mesh file '{path}' does not exist; fix the filename, or point --package-dir / ROS_PACKAGE_PATH at the right package for a package:// path")]
     MeshNotFound { loc: SourceLoc, link: String, path: String },
     #[error("{file}: unsupported model format (expected .urdf or .xml)")]
     UnsupportedFormat { file: String },
+}
+
+/// `["a", "b"]` → `'a', 'b'`.
+fn list(names: &[String]) -> String {
+    names.iter().map(|n| format!("'{n}'")).collect::<Vec<_>>().join(", ")
+}
+
+/// The searched folders of a `package://` lookup, or a note that there were none.
+fn searched_list(dirs: &[String]) -> String {
+    if dirs.is_empty() {
+        "no folders: no --package-dir given and ROS_PACKAGE_PATH is unset".to_string()
+    } else {
+        list(dirs)
+    }
 }
