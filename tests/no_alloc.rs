@@ -1,0 +1,104 @@
+//! Memory discipline (DESIGN.md, "Style"): once `Data` exists, the kinematics and dynamics
+//! kernels and the integrators perform zero heap allocations. A counting global allocator counts
+//! the allocations this thread makes while the kernels run.
+
+use lagrange::dynamics::{aba, bias_forces, crba, factorize_mass_matrix, rnea, solve_mass_matrix};
+use lagrange::integrate::{IntegratorKind, State};
+use lagrange::io::{load, LoadOptions};
+use lagrange::kinematics::{forward_kinematics, forward_velocities, frame_jacobian, ReferenceFrame};
+use lagrange::Data;
+use nalgebra::{DMatrix, DVector};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::path::Path;
+
+struct Counting;
+
+thread_local! {
+    static ACTIVE: Cell<bool> = const { Cell::new(false) };
+    static COUNT: Cell<u64> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if ACTIVE.with(|a| a.get()) {
+            COUNT.with(|c| c.set(c.get() + 1));
+        }
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if ACTIVE.with(|a| a.get()) {
+            COUNT.with(|c| c.set(c.get() + 1));
+        }
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Counts the heap allocations `f` makes on this thread.
+fn allocations(f: impl FnOnce()) -> u64 {
+    COUNT.with(|c| c.set(0));
+    ACTIVE.with(|a| a.set(true));
+    f();
+    ACTIVE.with(|a| a.set(false));
+    COUNT.with(|c| c.get())
+}
+
+#[test]
+fn kernels_and_integrators_do_not_allocate() {
+    // The counter must see allocations at all, or a zero below would prove nothing.
+    assert!(allocations(|| drop(std::hint::black_box(vec![1u8; 16]))) >= 1);
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (file, floating) in [
+        ("models/ur5/ur5.urdf", false),
+        ("models/solo12/solo12.urdf", true),
+        ("models/talos_reduced/talos_reduced.urdf", true),
+    ] {
+        let model = load(&root.join(file), &LoadOptions { floating, ..Default::default() }).unwrap();
+        let mut data = Data::new(&model);
+        let mut q = model.neutral();
+        for (k, x) in q.iter_mut().enumerate() {
+            if model
+                .joints
+                .iter()
+                .all(|j| !(j.qpos_adr..j.qpos_adr + j.kind.nq()).contains(&k) || j.kind.nq() == 1)
+            {
+                *x += 0.1 * k as f64;
+            }
+        }
+        let v: Vec<f64> = (0..model.nv).map(|k| 0.3 - 0.05 * k as f64).collect();
+        let tau: Vec<f64> = (0..model.nv).map(|k| 0.2 * k as f64).collect();
+        let mut jac = DMatrix::zeros(6, model.nv);
+        let mut x = DVector::from_vec(tau.clone());
+        let frame = model.frames.len() - 1;
+        let kernels = allocations(|| {
+            forward_kinematics(&model, &mut data, &q);
+            forward_velocities(&model, &mut data, &v);
+            frame_jacobian(&model, &data, frame, ReferenceFrame::LocalWorldAligned, &mut jac);
+            rnea(&model, &mut data, &q, &v, &tau);
+            bias_forces(&model, &mut data, &q, &v);
+            crba(&model, &mut data, &q);
+            factorize_mass_matrix(&model, &mut data);
+            solve_mass_matrix(&model, &data, &mut x);
+            aba(&model, &mut data, &q, &v, &tau);
+        });
+        assert_eq!(kernels, 0, "{file}: kernels allocated {kernels} times");
+        for kind in [IntegratorKind::Euler, IntegratorKind::Rk4] {
+            let mut integrator = kind.build(&model);
+            let mut state =
+                State { time: 0.0, q: DVector::from_vec(q.clone()), v: DVector::from_vec(v.clone()) };
+            let steps = allocations(|| {
+                for _ in 0..10 {
+                    integrator.step(&model, &mut data, &mut state, &tau, 1e-3);
+                }
+            });
+            assert_eq!(steps, 0, "{file}: {kind:?} steps allocated {steps} times");
+        }
+        println!("{file}: 0 allocations in FK, velocities, Jacobian, RNEA, bias, CRBA, LTDL, solve, ABA, Euler, RK4");
+    }
+}
