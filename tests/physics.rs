@@ -3,11 +3,7 @@
 
 mod common;
 
-use common::ALGO_REL;
-// TEMP: moved into tests/common/mod.rs once it is free.
-const INTEGRATOR_ORDER_BAND: f64 = 1.25;
-const PERIOD_SMALL_AMPLITUDE_REL: f64 = 1e-9;
-const RK4_CONSERVATION_REL: f64 = 1e-9;
+use common::{ALGO_REL, INTEGRATOR_ORDER_BAND, PERIOD_SMALL_AMPLITUDE_REL, RK4_CONSERVATION_REL};
 use lagrange::dynamics::{aba, crba, gravity_forces};
 use lagrange::integrate::{IntegratorKind, State};
 use lagrange::io::{load, LoadOptions};

@@ -37,6 +37,8 @@ pub struct Summary {
     pub energy_scale: f64,
     /// The state at the end of the run.
     pub final_state: State,
+    /// Joints that went outside their (not yet enforced) limits, with the farthest excursion.
+    pub limit_excursions: Vec<(String, f64)>,
 }
 
 fn parse_list(name: &str, s: &str, n: usize) -> Result<Vec<f64>, CliError> {
@@ -97,6 +99,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     let mut energy = energy_start;
     let (mut max_dev, mut max_kinetic) = (0.0f64, 0.0f64);
     let mut wall = Duration::ZERO;
+    let mut excursions = vec![0.0; model.joints.len()];
     for k in 0..=steps {
         if let Some((w, file)) = csv.as_mut() {
             write_row(w, &sim, energy).map_err(|source| CliError::Io { file: file.clone(), source })?;
@@ -112,6 +115,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         let kinetic = energy - crate::dynamics::potential_energy(model, &sim.data);
         max_kinetic = max_kinetic.max(kinetic);
         max_dev = max_dev.max((energy - energy_start).abs());
+        track_limit_excursions(model, &sim.state, &mut excursions);
         if k % 4096 == 0 {
             progress.set_position(k);
         }
@@ -128,7 +132,24 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         energy_max_dev: max_dev,
         energy_scale: energy_start.abs().max(max_kinetic).max(f64::MIN_POSITIVE),
         final_state: sim.state.clone(),
+        limit_excursions: model
+            .joints
+            .iter()
+            .zip(&excursions)
+            .filter(|(_, &e)| e > 0.0)
+            .map(|(j, &e)| (j.name.clone(), e))
+            .collect(),
     })
+}
+
+/// Records, per joint, how far beyond its limits the state has gone (0 if never).
+fn track_limit_excursions(model: &Model, state: &State, excursions: &mut [f64]) {
+    for (j, e) in model.joints.iter().zip(excursions.iter_mut()) {
+        if let Some([lo, hi]) = j.limits {
+            let q = state.q[j.qpos_adr];
+            *e = e.max(lo - q).max(q - hi);
+        }
+    }
 }
 
 fn write_header(w: &mut impl Write, model: &Model) -> std::io::Result<()> {
@@ -183,6 +204,12 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
         s.energy_max_dev,
         s.energy_max_dev / s.energy_scale
     );
+    for (joint, by) in &s.limit_excursions {
+        let _ = writeln!(
+            out,
+            "note: joint '{joint}' went {by:.4} beyond its limits (limits are not enforced yet)"
+        );
+    }
     let _ = writeln!(out, "final state at t = {:.6} s:", state.time);
     for j in &model.joints {
         let q: Vec<String> = state.q.as_slice()[j.qpos_adr..j.qpos_adr + j.kind.nq()]

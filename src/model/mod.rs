@@ -152,9 +152,10 @@ impl Model {
     pub fn joint_of(&self, b: usize) -> &Joint {
         &self.joints[b - 1]
     }
-    /// Total mass of all bodies.
+    /// Total mass of the moving bodies (body 0, the world with the links welded to it, excluded,
+    /// as in MuJoCo and Pinocchio).
     pub fn total_mass(&self) -> f64 {
-        self.bodies.iter().map(|b| b.inertia.mass).sum()
+        self.bodies.iter().skip(1).map(|b| b.inertia.mass).sum()
     }
     /// Index of a frame by name.
     pub fn frame_id(&self, name: &str) -> Option<usize> {

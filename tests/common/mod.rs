@@ -1,0 +1,446 @@
+//! Shared by the integration tests: the tolerances (the ONLY place they live), the relative-error
+//! definition, a random kinematic-tree generator covering every joint type, random states, and
+//! loading the shipped robots.
+//!
+//! Each test binary uses a different subset of these helpers, hence the `dead_code` allowance.
+#![allow(dead_code)]
+
+use lagrange::compile::compile;
+use lagrange::io::{load, LoadOptions};
+use lagrange::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, ModelSpec};
+use lagrange::model::{JointKind, SourceLoc};
+use lagrange::spatial::{quat_to_matrix, Mat3, Transform, Vec3};
+use lagrange::Model;
+use nalgebra::DMatrix;
+use rand::rngs::SmallRng;
+use rand::{Rng, SeedableRng};
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+// ------------------------------------------------------------------------------------------------
+// Tolerances
+// ------------------------------------------------------------------------------------------------
+
+/// Relative tolerance of algorithm-against-algorithm checks (ABA vs. M⁻¹(τ − c), RNEA∘ABA = id,
+/// Jacobian·v vs. propagated velocities, energy and momentum balances). Every quantity is computed
+/// in f64 by two routes that differ only by the order of round-off, so the norm-wise relative
+/// difference is a small multiple of ε = 2.2e-16 times the condition of the problem. 1e-12 leaves
+/// ~4500 ε for the accumulation over trees of up to ~30 bodies and for cond(M) of the random
+/// trees and robots (the ABA/solve comparison is the most sensitive one; see the printout).
+pub const ALGO_REL: f64 = 1e-12;
+
+/// Relative tolerance against reference data (Pinocchio golden files). The references are
+/// themselves f64 round-off accurate; the DESIGN target is 1e-9 relative on M, bias, ABA, poses.
+pub const REF_REL: f64 = 1e-9;
+
+/// Base step of the finite differences on the configuration manifold (see [`FD_REL`]).
+pub const FD_STEP: f64 = 1e-3;
+
+/// Relative tolerance of Jacobians against finite differences of forward kinematics.
+///
+/// The derivative is the Richardson extrapolation `(4 D(h/2) − D(h)) / 3` of central differences
+/// `D(h) = (f(q ⊕ h eₖ) − f(q ⊕ −h eₖ)) / 2h`, with `h` = [`FD_STEP`] = 1e-3. `D` is even in `h`
+/// (true also for the rotation part, `log(R₊R₋ᵀ)/2h`), so the extrapolation cancels the h² term:
+/// - truncation: `h⁴/480 · |f⁽⁵⁾|` ≈ 2e-15 for the O(1)–O(10) derivatives of rotations about unit
+///   axes at lever arms of at most a few metres;
+/// - round-off: each forward-kinematics evaluation carries ≈ κ ε |f| with κ ≲ 30 (the depth of the
+///   chain), and the extrapolation weights sum to 3/h, giving ≈ 3 κ ε |f| / h ≈ 2e-11 · |f| with
+///   |f| ≲ 5 m.
+///
+/// The two add up to ≲ 1e-10 of the Jacobian's scale; the tolerance keeps a factor 10 above that.
+pub const FD_REL: f64 = 1e-9;
+
+/// Band for measured convergence orders of time integrators (used by `tests/physics.rs`): when dt
+/// halves, an order-p method's error must shrink by a ratio within `[2ᵖ / BAND, 2ᵖ · BAND]`. The
+/// asymptotic ratio is exactly 2ᵖ; at the step sizes used the next term of the error expansion is
+/// a few per cent of the leading one (measured RK4 ratios 14.4–15.7 for 16, Euler 2.00 and 4.00), and
+/// 1.25 keeps neighbouring orders well apart (2ᵖ·1.25 < 2ᵖ⁺¹/1.25).
+pub const INTEGRATOR_ORDER_BAND: f64 = 1.25;
+
+/// Relative error of the small-amplitude period of the physical pendulum (notes eq. 59) measured
+/// from an RK4 run of 4000 steps per period (`tests/physics.rs`). Model errors: the amplitude
+/// correction θ₀²/16 = 6.25e-12 at θ₀ = 1e-5 (eq. 59 is its limit θ₀ → 0); RK4's phase error
+/// ≈ (ω dt)⁴/120 ≈ 5e-14 for ω dt = 2π/4000. Measured 6.3e-12 (the amplitude term); 1e-10 leaves a
+/// factor ~15 over the sum.
+pub const PERIOD_SMALL_AMPLITUDE_REL: f64 = 1e-10;
+
+/// Drift of a conserved quantity along an RK4 trajectory (`tests/physics.rs`: the cyclic momentum
+/// of the pendulum on a movable support over 5 s at dt = 1e-3), relative to its scale. RK4's
+/// global error is ≈ T·ω⁵dt⁴/120 ≈ 4e-11 for ω ≈ 4 rad/s (measured 2.6e-12); 1e-9 bounds it with a
+/// margin of 25 over the estimate, while a first-order error (≈ ω² dt ≈ 1e-2) would fail by far.
+pub const RK4_CONSERVATION_REL: f64 = 1e-9;
+
+/// Floor of the denominator of the relative error: only there to turn 0/0 (two exactly-zero
+/// quantities, e.g. the Jacobian of a frame welded to the world) into 0. It is far below any
+/// physical magnitude, so it never hides a real discrepancy.
+pub const REL_FLOOR: f64 = 1e-300;
+
+// ------------------------------------------------------------------------------------------------
+// Relative errors
+// ------------------------------------------------------------------------------------------------
+
+/// Norm-wise relative error `‖a − b‖_∞ / max(‖a‖_∞, ‖b‖_∞, REL_FLOOR)` and the index where
+/// `|a − b|` is largest.
+pub fn rel_err_vec_at(a: &[f64], b: &[f64]) -> (f64, usize) {
+    assert_eq!(a.len(), b.len(), "rel_err_vec: lengths differ");
+    let mut diff = 0.0;
+    let mut at = 0;
+    let mut scale = REL_FLOOR;
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        let d = (x - y).abs();
+        // NaN compares false: make it win so that it is reported.
+        if d > diff || (d.is_nan() && !diff.is_nan()) {
+            diff = d;
+            at = i;
+        }
+        scale = scale.max(x.abs()).max(y.abs());
+    }
+    (diff / scale, at)
+}
+
+/// Norm-wise relative error of two vectors (see [`rel_err_vec_at`]).
+pub fn rel_err_vec(a: &[f64], b: &[f64]) -> f64 {
+    rel_err_vec_at(a, b).0
+}
+
+/// Norm-wise relative error of two scalars: `|a − b| / max(|a|, |b|, REL_FLOOR)`.
+pub fn rel_err(a: f64, b: f64) -> f64 {
+    rel_err_vec(&[a], &[b])
+}
+
+/// Norm-wise relative error of two matrices with the max-abs-entry norm, and the (row, column) of
+/// the largest entry difference.
+pub fn rel_err_mat_at(a: &DMatrix<f64>, b: &DMatrix<f64>) -> (f64, (usize, usize)) {
+    assert_eq!(a.shape(), b.shape(), "rel_err_mat: shapes differ");
+    // Column-major storage: index i ↔ (i % nrows, i / nrows).
+    let (e, i) = rel_err_vec_at(a.as_slice(), b.as_slice());
+    (e, (i % a.nrows().max(1), i / a.nrows().max(1)))
+}
+
+/// Norm-wise relative error of two matrices (see [`rel_err_mat_at`]).
+pub fn rel_err_mat(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    rel_err_mat_at(a, b).0
+}
+
+/// Asserts `rel_err_vec(a, b) ≤ tol`, printing the error and where it is largest; returns it.
+pub fn assert_close_vec(name: &str, a: &[f64], b: &[f64], tol: f64) -> f64 {
+    let (e, i) = rel_err_vec_at(a, b);
+    let (ai, bi) = (a.get(i).copied().unwrap_or(f64::NAN), b.get(i).copied().unwrap_or(f64::NAN));
+    println!("{name}: rel err {e:.3e} (largest at [{i}]: {ai:.17e} vs {bi:.17e}), tol {tol:.0e}");
+    assert!(e <= tol, "{name}: rel err {e:.3e} > {tol:.0e} at [{i}]: {ai:.17e} vs {bi:.17e}");
+    e
+}
+
+/// Asserts `rel_err_mat(a, b) ≤ tol`, printing the error and where it is largest; returns it.
+pub fn assert_close_mat(name: &str, a: &DMatrix<f64>, b: &DMatrix<f64>, tol: f64) -> f64 {
+    let (e, (r, c)) = rel_err_mat_at(a, b);
+    println!("{name}: rel err {e:.3e} (largest at ({r}, {c})), tol {tol:.0e}");
+    assert!(e <= tol, "{name}: rel err {e:.3e} > {tol:.0e} at ({r}, {c}): {} vs {}", a[(r, c)], b[(r, c)]);
+    e
+}
+
+/// The largest error of one check over many comparisons, with where it happened; prints a one-line
+/// summary and asserts at the end, so that the numbers are printed even when the check fails.
+#[derive(Debug)]
+pub struct MaxErr {
+    pub label: String,
+    pub tol: f64,
+    pub max: f64,
+    pub at: String,
+    pub count: usize,
+    pub failures: Vec<String>,
+}
+
+impl MaxErr {
+    pub fn new(label: &str, tol: f64) -> Self {
+        Self { label: label.to_string(), tol, max: 0.0, at: String::new(), count: 0, failures: Vec::new() }
+    }
+    /// Records one error; `at` describes where (model, state, item) and is evaluated lazily.
+    pub fn add(&mut self, err: f64, at: impl FnOnce() -> String) {
+        self.count += 1;
+        let bad = err > self.tol || err.is_nan();
+        if err > self.max || (err.is_nan() && !self.max.is_nan()) || self.count == 1 {
+            self.max = err;
+            let s = at();
+            if bad && self.failures.len() < 10 {
+                self.failures.push(format!("{err:.3e} at {s}"));
+            }
+            self.at = s;
+        } else if bad && self.failures.len() < 10 {
+            self.failures.push(format!("{err:.3e} at {}", at()));
+        }
+    }
+    /// Prints the one-line summary.
+    pub fn report(&self) {
+        println!(
+            "{:<58} max rel err {:>10.3e}  (tol {:.0e}, {} comparisons; worst: {})",
+            self.label, self.max, self.tol, self.count, self.at
+        );
+    }
+    /// Whether every recorded error was within tolerance (a NaN never is).
+    pub fn ok(&self) -> bool {
+        self.max <= self.tol && !self.max.is_nan()
+    }
+}
+
+/// Prints every summary, then fails if any check exceeded its tolerance.
+pub fn report_and_assert(checks: &[&MaxErr]) {
+    for c in checks {
+        c.report();
+    }
+    let bad: Vec<String> = checks
+        .iter()
+        .filter(|c| !c.ok() || c.count == 0)
+        .map(|c| {
+            if c.count == 0 {
+                format!("{}: nothing was compared", c.label)
+            } else {
+                format!("{}: {:.3e} > {:.0e}; first failures: {:?}", c.label, c.max, c.tol, c.failures)
+            }
+        })
+        .collect();
+    assert!(bad.is_empty(), "failed checks:\n{}", bad.join("\n"));
+}
+
+// ------------------------------------------------------------------------------------------------
+// Random models
+// ------------------------------------------------------------------------------------------------
+
+/// Every joint type a spec can hold (the coverage test checks that each appears).
+pub const ALL_JOINT_TYPES: [JointType; 7] = [
+    JointType::Fixed,
+    JointType::Revolute,
+    JointType::Continuous,
+    JointType::Prismatic,
+    JointType::Floating,
+    JointType::Planar,
+    JointType::Ball,
+];
+
+/// A uniformly random rotation (Shoemake's subgroup algorithm) as a unit quaternion [w, x, y, z].
+pub fn random_quat(rng: &mut impl Rng) -> [f64; 4] {
+    let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    let (t2, t3) = (2.0 * PI * u2, 2.0 * PI * u3);
+    [b * t3.cos(), a * t2.sin(), a * t2.cos(), b * t3.sin()]
+}
+
+/// A uniformly random rotation matrix.
+pub fn random_rotation(rng: &mut impl Rng) -> Mat3 {
+    let q = random_quat(rng);
+    quat_to_matrix(q[0], q[1], q[2], q[3])
+}
+
+/// A vector with components uniform in [−r, r].
+pub fn random_vec3(rng: &mut impl Rng, r: f64) -> Vec3 {
+    Vec3::new(rng.random_range(-r..=r), rng.random_range(-r..=r), rng.random_range(-r..=r))
+}
+
+/// A random unit vector (uniform on the sphere).
+pub fn random_unit(rng: &mut impl Rng) -> Vec3 {
+    loop {
+        let v = random_vec3(rng, 1.0);
+        let n = v.norm();
+        if n > 0.1 && n <= 1.0 {
+            return v / n;
+        }
+    }
+}
+
+/// A random physical inertial: mass in [0.5, 3] kg; principal moments `m (s₂ + s₃)`,
+/// `m (s₁ + s₃)`, `m (s₁ + s₂)` with sᵢ = ∫xᵢ² dm / m ∈ [0.002, 0.05] m² (which is exactly the set of
+/// moments satisfying the triangle inequality); random principal axes; centre of mass within
+/// 0.2 m of the link origin.
+pub fn random_inertial(rng: &mut impl Rng) -> InertialSpec {
+    let mass = rng.random_range(0.5..=3.0);
+    let s: [f64; 3] = std::array::from_fn(|_| rng.random_range(0.002..=0.05));
+    let principal = Mat3::from_diagonal(&Vec3::new(s[1] + s[2], s[0] + s[2], s[0] + s[1])) * mass;
+    let rot = random_rotation(rng);
+    let com = random_vec3(rng, 0.2);
+    // Half the time give the tensor in rotated axes with an unrotated inertial frame: the compile
+    // step must treat both the same way.
+    let (x_link_inertial, inertia) = if rng.random_bool(0.5) {
+        (Transform::new(rot, com), principal)
+    } else {
+        (Transform::from_translation(com), rot * principal * rot.transpose())
+    };
+    InertialSpec { mass, x_link_inertial, inertia, loc: SourceLoc::default() }
+}
+
+/// Random joint type. The root may be any type (a fixed root welds its subtree to the world);
+/// below it free joints are rarer (a free joint anywhere in the tree is legal, just unusual).
+fn random_joint_type(rng: &mut impl Rng, root: bool) -> JointType {
+    // (type, weight)
+    let table: &[(JointType, u32)] = if root {
+        &[
+            (JointType::Floating, 30),
+            (JointType::Fixed, 14),
+            (JointType::Revolute, 14),
+            (JointType::Continuous, 8),
+            (JointType::Prismatic, 10),
+            (JointType::Planar, 10),
+            (JointType::Ball, 14),
+        ]
+    } else {
+        &[
+            (JointType::Revolute, 26),
+            (JointType::Continuous, 12),
+            (JointType::Prismatic, 14),
+            (JointType::Ball, 14),
+            (JointType::Planar, 8),
+            (JointType::Fixed, 18),
+            (JointType::Floating, 8),
+        ]
+    };
+    let total: u32 = table.iter().map(|t| t.1).sum();
+    let mut pick = rng.random_range(0..total);
+    for &(t, w) in table {
+        if pick < w {
+            return t;
+        }
+        pick -= w;
+    }
+    unreachable!()
+}
+
+/// A random tree of `n_links` links (so at most `n_links` bodies; fixed joints get fused) as a
+/// spec: each link's parent is a uniformly random earlier link; joint placements are a random
+/// rotation and a translation in [−0.5, 0.5]³ m; axes are random (and deliberately not unit: the
+/// compile step normalizes them); every joint type appears with fixed probabilities; a third of
+/// the movable joints get an armature in [0.01, 0.2]; movable links always carry a random physical
+/// inertial, fixed ones most of the time (a massless fixed link is fused into its parent body
+/// without changing it). Gravity has magnitude 9.81 in a random direction. Deterministic in
+/// `seed`; at least one degree of freedom.
+pub fn random_tree_spec(seed: u64, n_links: usize) -> ModelSpec {
+    assert!(n_links >= 1);
+    let mut rng = SmallRng::seed_from_u64(seed);
+    let mut links: Vec<LinkSpec> = Vec::with_capacity(n_links);
+    for i in 0..n_links {
+        let parent = if i == 0 { None } else { Some(rng.random_range(0..i)) };
+        let mut jtype = random_joint_type(&mut rng, i == 0);
+        if i + 1 == n_links && links.iter().all(|l| l.joint.jtype == JointType::Fixed) {
+            jtype = JointType::Revolute; // at least one degree of freedom
+        }
+        let mut joint = JointSpec::new(&format!("joint{i}"), jtype, SourceLoc::default());
+        joint.x_parent_joint = Transform::new(random_rotation(&mut rng), random_vec3(&mut rng, 0.5));
+        joint.axis = random_unit(&mut rng) * rng.random_range(0.5..=2.0);
+        if jtype != JointType::Fixed && rng.random_bool(1.0 / 3.0) {
+            joint.armature = rng.random_range(0.01..=0.2);
+        }
+        if jtype == JointType::Revolute || jtype == JointType::Prismatic {
+            joint.limits = Some([-PI, PI]);
+        }
+        let inertial = if jtype != JointType::Fixed || rng.random_bool(0.7) {
+            Some(random_inertial(&mut rng))
+        } else {
+            None
+        };
+        links.push(LinkSpec {
+            name: format!("link{i}"),
+            loc: SourceLoc::default(),
+            parent,
+            joint,
+            inertial,
+            geoms: Vec::new(),
+        });
+    }
+    let gravity = random_unit(&mut rng) * 9.81;
+    ModelSpec { name: format!("random_tree_{seed}_{n_links}"), source: None, gravity, links }
+}
+
+/// [`random_tree_spec`] compiled into a model.
+pub fn random_tree(seed: u64, n_links: usize) -> Model {
+    compile(&random_tree_spec(seed, n_links)).expect("random tree must compile")
+}
+
+/// Sizes (in links) of the random trees of the cross-checks: 26 trees from 1 to 40 links (fixed
+/// links are fused, so the largest have about 30 bodies).
+pub const TREE_SIZES: [usize; 26] =
+    [1, 1, 2, 2, 3, 3, 4, 5, 6, 7, 8, 9, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30, 30, 36, 40];
+
+/// The random trees of the cross-checks, with their specs: tree k has `TREE_SIZES[k]` links and
+/// seed `1000 + k`.
+pub fn random_trees() -> Vec<(String, ModelSpec, Model)> {
+    TREE_SIZES
+        .iter()
+        .enumerate()
+        .map(|(k, &n)| {
+            let seed = 1000 + k as u64;
+            let spec = random_tree_spec(seed, n);
+            let model = compile(&spec).expect("random tree must compile");
+            (format!("tree(seed {seed}, {n} links, nv {})", model.nv), spec, model)
+        })
+        .collect()
+}
+
+// ------------------------------------------------------------------------------------------------
+// Random states
+// ------------------------------------------------------------------------------------------------
+
+/// A random configuration: one-dof joints uniform in [−π, π]; free-joint positions and planar
+/// translations uniform in [−1, 1]; quaternions uniformly random unit quaternions (either sign).
+pub fn random_q(model: &Model, rng: &mut impl Rng) -> Vec<f64> {
+    let mut q = vec![0.0; model.nq];
+    for j in &model.joints {
+        let qj = &mut q[j.qpos_adr..j.qpos_adr + j.kind.nq()];
+        match &j.kind {
+            JointKind::Revolute { .. } | JointKind::Prismatic { .. } => qj[0] = rng.random_range(-PI..=PI),
+            JointKind::Free => {
+                for x in &mut qj[0..3] {
+                    *x = rng.random_range(-1.0..=1.0);
+                }
+                qj[3..7].copy_from_slice(&random_quat(rng));
+            }
+            JointKind::Ball => qj.copy_from_slice(&random_quat(rng)),
+            JointKind::Planar { .. } => {
+                qj[0] = rng.random_range(-1.0..=1.0);
+                qj[1] = rng.random_range(-1.0..=1.0);
+                qj[2] = rng.random_range(-PI..=PI);
+            }
+        }
+    }
+    q
+}
+
+/// A random velocity, uniform in [−2, 2] per coordinate.
+pub fn random_v(model: &Model, rng: &mut impl Rng) -> Vec<f64> {
+    (0..model.nv).map(|_| rng.random_range(-2.0..=2.0)).collect()
+}
+
+/// A random generalized force, uniform in [−5, 5] per coordinate.
+pub fn random_tau(model: &Model, rng: &mut impl Rng) -> Vec<f64> {
+    (0..model.nv).map(|_| rng.random_range(-5.0..=5.0)).collect()
+}
+
+/// A seeded small RNG.
+pub fn rng(seed: u64) -> SmallRng {
+    SmallRng::seed_from_u64(seed)
+}
+
+// ------------------------------------------------------------------------------------------------
+// Shipped robots
+// ------------------------------------------------------------------------------------------------
+
+/// The shipped robots: (name, floating base).
+pub const ROBOTS: [(&str, bool); 4] =
+    [("ur5", false), ("panda", false), ("solo12", true), ("talos_reduced", true)];
+
+/// Absolute path of a file given relative to the repository root.
+pub fn repo_path(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+/// Loads `models/<name>/<name>.urdf`, with a free root joint if `floating`.
+pub fn load_robot(name: &str, floating: bool) -> Model {
+    let path = repo_path(&format!("models/{name}/{name}.urdf"));
+    let options = LoadOptions { floating, ..Default::default() };
+    match load(&path, &options) {
+        Ok(m) => m,
+        Err(e) => panic!("loading {}: {e}", path.display()),
+    }
+}
+
+/// All four robots, loaded.
+pub fn robots() -> Vec<(String, Model)> {
+    ROBOTS.iter().map(|&(name, floating)| (name.to_string(), load_robot(name, floating))).collect()
+}
