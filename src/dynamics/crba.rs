@@ -3,52 +3,53 @@
 
 use crate::kinematics::update_joint;
 use crate::model::{Data, Model, NO_DOF};
-use crate::spatial::Force;
 use nalgebra::{DMatrix, DVector};
 
 /// Joint-space inertia matrix M(q), armature included, into `data.mass_matrix` (and returned).
+///
+/// The composite-rigid-body algorithm (RBDA Table 6.2) evaluated in world coordinates: composite
+/// inertias then add without change of frame, and the entry M[i][j] for j an ancestor degree of
+/// freedom is the plain product S_jᵀ (Iᶜ_i S_i) of world-frame vectors, so the walk up the tree
+/// transforms nothing.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64> {
-    // Pass 1: joint transforms and motion subspaces; composite inertias start as body inertias.
+    // Pass 1, root to leaves: poses, world-frame motion subspaces and body inertias.
     for b in 1..model.nbody() {
         update_joint(model, data, b, q);
-        data.i_composite[b] = model.bodies[b].inertia;
+        let p = model.bodies[b].parent;
+        let x_world_body = data.x_world_body[p] * data.x_parent_body[b];
+        data.x_world_body[b] = x_world_body;
+        let j = model.joint_of(b);
+        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+            data.s_world[k] = x_world_body.act_motion(&data.s_body[k]);
+        }
+        data.i_composite[b] = model.bodies[b].inertia.transformed(&x_world_body);
     }
     data.mass_matrix.fill(0.0);
-    // Pass 2, leaves to root: F = Iᶜ S, then walk F up the ancestors, filling M's row block.
-    let mut f_cols = [Force::zero(); 6];
+    let nv = model.nv;
+    let m = data.mass_matrix.as_mut_slice();
+    // Pass 2, leaves to root: F = Iᶜ S for each dof of b, dotted with the S of b and its ancestors;
+    // then the finished composite inertia of b joins its parent's.
     for b in (1..model.nbody()).rev() {
         let j = model.joint_of(b);
-        let (da, nv_j) = (j.dof_adr, j.kind.nv());
-        for k in 0..nv_j {
-            f_cols[k] = data.i_composite[b].mul_motion(&data.s_body[da + k]);
-            for l in 0..=k {
-                let m_kl = data.s_body[da + l].dot(&f_cols[k]);
-                data.mass_matrix[(da + k, da + l)] = m_kl;
-                data.mass_matrix[(da + l, da + k)] = m_kl;
-            }
-            data.mass_matrix[(da + k, da + k)] += model.dof_armature[da + k];
-        }
-        let mut cur = b;
-        while model.bodies[cur].parent != 0 {
-            let x = data.x_parent_body[cur];
-            for f in f_cols.iter_mut().take(nv_j) {
-                *f = x.act_force(f);
-            }
-            cur = model.bodies[cur].parent;
-            let jc = model.joint_of(cur);
-            for k in 0..nv_j {
-                for l in jc.dof_adr..jc.dof_adr + jc.kind.nv() {
-                    let m_kl = data.s_body[l].dot(&f_cols[k]);
-                    data.mass_matrix[(da + k, l)] = m_kl;
-                    data.mass_matrix[(l, da + k)] = m_kl;
+        let i_c = data.i_composite[b];
+        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+            let f_world = i_c.mul_motion(&data.s_world[k]);
+            let mut l = k;
+            loop {
+                // Column-major storage: (row k, col l) at k + l·nv; M is symmetric.
+                let m_kl = data.s_world[l].dot(&f_world);
+                m[k + l * nv] = m_kl;
+                m[l + k * nv] = m_kl;
+                l = model.dof_parent[l];
+                if l == NO_DOF {
+                    break;
                 }
             }
+            m[k + k * nv] += model.dof_armature[k];
         }
-        // The subtree of b is complete: add it to its parent's composite inertia.
         let p = model.bodies[b].parent;
         if p != 0 {
-            let i_in_parent = data.i_composite[b].transformed(&data.x_parent_body[b]);
-            data.i_composite[p] += &i_in_parent;
+            data.i_composite[p] += &i_c;
         }
     }
     &data.mass_matrix
@@ -58,18 +59,21 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64
 /// sparsity: fill-in stays on the ancestor paths λ (RBDA Table 6.3). Run [`crba`] first.
 pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
     let lambda = &model.dof_parent;
-    let h = &mut data.mass_factor;
-    h.copy_from(&data.mass_matrix);
-    for k in (0..model.nv).rev() {
+    let nv = model.nv;
+    data.mass_factor.copy_from(&data.mass_matrix);
+    // Column-major storage: entry (r, c) at r + c·nv.
+    let h = data.mass_factor.as_mut_slice();
+    for k in (0..nv).rev() {
+        let h_kk = h[k + k * nv];
         let mut i = lambda[k];
         while i != NO_DOF {
-            let a = h[(k, i)] / h[(k, k)];
+            let a = h[k + i * nv] / h_kk;
             let mut j = i;
             while j != NO_DOF {
-                h[(i, j)] -= a * h[(k, j)];
+                h[i + j * nv] -= a * h[k + j * nv];
                 j = lambda[j];
             }
-            h[(k, i)] = a;
+            h[k + i * nv] = a;
             i = lambda[i];
         }
     }
@@ -79,24 +83,25 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
 /// (RBDA Table 6.4): x ← L⁻¹ D⁻¹ L⁻ᵀ b.
 pub fn solve_mass_matrix(model: &Model, data: &Data, x: &mut DVector<f64>) {
     let lambda = &model.dof_parent;
-    let h = &data.mass_factor;
+    let nv = model.nv;
+    let h = data.mass_factor.as_slice();
     // Lᵀ z = b, from the leaves up.
-    for i in (0..model.nv).rev() {
+    for i in (0..nv).rev() {
         let mut j = lambda[i];
         while j != NO_DOF {
-            x[j] -= h[(i, j)] * x[i];
+            x[j] -= h[i + j * nv] * x[i];
             j = lambda[j];
         }
     }
     // D w = z.
-    for i in 0..model.nv {
-        x[i] /= h[(i, i)];
+    for i in 0..nv {
+        x[i] /= h[i + i * nv];
     }
     // L x = w, from the root down.
-    for i in 0..model.nv {
+    for i in 0..nv {
         let mut j = lambda[i];
         while j != NO_DOF {
-            x[i] -= h[(i, j)] * x[j];
+            x[i] -= h[i + j * nv] * x[j];
             j = lambda[j];
         }
     }

@@ -17,6 +17,8 @@ pub struct Data {
     pub x_world_frame: Vec<Transform>,
     /// Motion subspace column of each degree of freedom, in its body's coordinates.
     pub s_body: Vec<Motion>,
+    /// Motion subspace column of each degree of freedom in world coordinates (CRBA).
+    pub s_world: Vec<Motion>,
     /// Spatial velocity of each body, body coordinates.
     pub v_body: Vec<Motion>,
     /// Spatial acceleration of each body (including the gravity offset in RNEA/ABA), body coords.
@@ -25,7 +27,7 @@ pub struct Data {
     pub c_body: Vec<Motion>,
     /// Net spatial force on each body (RNEA) or articulated bias force (ABA), body coordinates.
     pub f_body: Vec<Force>,
-    /// Composite rigid-body inertia of each subtree (CRBA), body coordinates.
+    /// Composite rigid-body inertia of each subtree (CRBA), world coordinates.
     pub i_composite: Vec<RigidInertia>,
     /// Articulated-body inertia of each body (ABA), body coordinates.
     pub i_articulated: Vec<ArticulatedInertia>,
@@ -57,6 +59,7 @@ impl Data {
             x_world_body: vec![Transform::identity(); nb],
             x_world_frame: vec![Transform::identity(); model.frames.len()],
             s_body: vec![Motion::zero(); nv],
+            s_world: vec![Motion::zero(); nv],
             v_body: vec![Motion::zero(); nb],
             a_body: vec![Motion::zero(); nb],
             c_body: vec![Motion::zero(); nb],
