@@ -124,6 +124,25 @@ impl<'m> Simulation<'m> {
     }
 
     fn check_finite(&self) -> Result<(), SimError> {
+        if self.state.q.iter().chain(self.state.v.iter()).all(|x| x.is_finite()) {
+            return Ok(());
+        }
+        // Non-finite values spread through ABA to every joint; the origin is a joint whose
+        // articulated inertia D = Sᵀ Iᴬ S was singular. Leaves first, the first such joint has
+        // only finite descendants.
+        for b in (1..self.model.nbody()).rev() {
+            let j = self.model.joint_of(b);
+            let d_inv = self.data.d_inv[b][(0, 0)];
+            if !d_inv.is_finite() {
+                return Err(SimError::Diverged {
+                    time: self.state.time,
+                    step: self.steps,
+                    quantity: "articulated inertia about the axis (D⁻¹)",
+                    joint: j.name.clone(),
+                    value: d_inv,
+                });
+            }
+        }
         for (quantity, values, by_dof) in
             [("position", self.state.q.as_slice(), false), ("velocity", self.state.v.as_slice(), true)]
         {

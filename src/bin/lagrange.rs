@@ -42,7 +42,7 @@ enum Command {
         /// JSON file `{"states": [{"q": [...], "v": [...], "tau": [...]}]}`.
         #[arg(long)]
         states: PathBuf,
-        /// JSON output (the default; text output is a short summary).
+        /// Accepted for symmetry with `info`: the output is always JSON.
         #[arg(long)]
         json: bool,
         /// Also output the Jacobian of this frame (world-aligned, rows: linear then angular);

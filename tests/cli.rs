@@ -1,0 +1,181 @@
+//! End-to-end tests of the `lagrange` binary: `info --json` keys, `eval` against the Pinocchio
+//! reference data, `simulate` output and CSV, the default run, and input errors.
+
+mod common;
+
+use common::{rel_err_mat, rel_err_vec, REF_REL};
+use nalgebra::DMatrix;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn lagrange(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_lagrange"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the binary runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+fn temp_file(name: &str, text: &str) -> PathBuf {
+    let path = std::env::temp_dir().join(format!("lagrange-cli-{}-{name}", std::process::id()));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn keys(v: &Value) -> Vec<String> {
+    let mut k: Vec<String> = v.as_object().expect("an object").keys().cloned().collect();
+    k.sort();
+    k
+}
+
+#[test]
+fn info_json_has_exactly_the_documented_keys() {
+    let (ok, out, err) = lagrange(&["info", "models/solo12/solo12.urdf", "--floating", "--json"]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(keys(&v), ["bodies", "joints", "nq", "nv", "stages", "total_mass"]);
+    assert_eq!((v["nq"].as_u64(), v["nv"].as_u64()), (Some(19), Some(18)));
+    assert_eq!(keys(&v["bodies"][1]), ["com", "inertia", "mass", "name", "parent"]);
+    assert_eq!(keys(&v["joints"][0]), ["child", "dofadr", "name", "nq", "nv", "parent", "qposadr", "type"]);
+    assert_eq!(v["joints"][0]["name"], "root_joint");
+    assert_eq!(v["joints"][0]["type"], "free");
+    assert_eq!(v["stages"]["collision"]["status"], "skipped");
+    assert_eq!(v["stages"]["joint limits"]["status"], "parsed, not simulated");
+    let total: f64 = v["total_mass"].as_f64().unwrap();
+    assert!((total - 2.50000279).abs() < 1e-6, "{total}");
+}
+
+#[test]
+fn info_text_lists_the_plan_and_mimic() {
+    let (ok, out, err) = lagrange(&["info", "models/panda/panda.urdf"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("simulation plan:"), "{out}");
+    assert!(out.contains("mimic panda_finger_joint1 (not enforced yet)"), "{out}");
+    assert!(out.contains("equality constraints") && out.contains("1 mimic joints"), "{out}");
+}
+
+/// `eval` on the Pinocchio reference states reproduces M, bias, qacc and poses at REF_REL.
+#[test]
+fn eval_matches_pinocchio_reference_data() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let golden: Value = serde_json::from_str(
+        &std::fs::read_to_string(root.join("tests/data/pinocchio/talos_reduced.json")).unwrap(),
+    )
+    .unwrap();
+    let states: Vec<Value> = golden["states"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| serde_json::json!({"q": s["q"], "v": s["v"], "tau": s["tau"]}))
+        .collect();
+    let input = temp_file("states.json", &serde_json::json!({ "states": states }).to_string());
+    let (ok, out, err) = lagrange(&[
+        "eval",
+        "models/talos_reduced/talos_reduced.urdf",
+        "--floating",
+        "--states",
+        input.to_str().unwrap(),
+        "--jacobian",
+        "left_sole_link",
+    ]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let results = v["results"].as_array().unwrap();
+    assert_eq!(results.len(), states.len());
+    let vec = |x: &Value| x.as_array().unwrap().iter().map(|e| e.as_f64().unwrap()).collect::<Vec<f64>>();
+    let mat = |x: &Value| {
+        let rows: Vec<Vec<f64>> = x.as_array().unwrap().iter().map(vec).collect();
+        DMatrix::from_fn(rows.len(), rows[0].len(), |r, c| rows[r][c])
+    };
+    let mut worst = 0.0f64;
+    for (r, s) in results.iter().zip(golden["states"].as_array().unwrap()) {
+        worst = worst.max(rel_err_mat(&mat(&r["M"]), &mat(&s["M"])));
+        worst = worst.max(rel_err_vec(&vec(&r["bias"]), &vec(&s["bias"])));
+        worst = worst.max(rel_err_vec(&vec(&r["qacc"]), &vec(&s["qacc"])));
+        worst = worst.max(rel_err_vec(&vec(&r["com"]), &vec(&s["com"])));
+        let pos = |x: &Value, l: &str| vec(&x["poses"][l]["pos"]);
+        worst = worst.max(rel_err_vec(&pos(r, "left_sole_link"), &pos(s, "left_sole_link")));
+        let jac = mat(&r["jacobians"]["left_sole_link"]);
+        assert_eq!((jac.nrows(), jac.ncols()), (6, 38));
+    }
+    println!("eval vs Pinocchio (talos_reduced): worst relative error {worst:.2e}");
+    assert!(worst <= REF_REL, "{worst}");
+}
+
+#[test]
+fn eval_rejects_a_state_of_the_wrong_size() {
+    let input = temp_file("bad_states.json", r#"{"states": [{"q": [0.0, 1.0], "v": [0, 0, 0, 0, 0, 0]}]}"#);
+    let (ok, _, err) = lagrange(&["eval", "models/ur5/ur5.urdf", "--states", input.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("states[0]: 'q' has 2 values, the model needs 6"), "{err}");
+    let input = temp_file("malformed_states.json", "{\"states\": [\n{\"q\": [0.0,]}]}");
+    let (ok, _, err) = lagrange(&["eval", "models/ur5/ur5.urdf", "--states", input.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("line 2") && err.contains("expected {\"states\""), "{err}");
+}
+
+#[test]
+fn simulate_prints_a_summary_and_writes_the_csv() {
+    let csv = std::env::temp_dir().join(format!("lagrange-cli-{}-traj.csv", std::process::id()));
+    let (ok, out, err) = lagrange(&[
+        "simulate",
+        "models/textbook/double_pendulum.urdf",
+        "--duration",
+        "0.5",
+        "--dt",
+        "0.001",
+        "--integrator",
+        "euler",
+        "--q0",
+        "2.0,0.5",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    for needle in ["500 steps", "real-time factor", "energy: start", "final state", "shoulder", "elbow"] {
+        assert!(out.contains(needle), "missing '{needle}' in {out}");
+    }
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next().unwrap(), "time,q:shoulder[0],q:elbow[0],v:shoulder[0],v:elbow[0],energy");
+    assert_eq!(lines.count(), 501);
+}
+
+#[test]
+fn simulate_rejects_bad_arguments_with_a_fix() {
+    let (ok, _, err) = lagrange(&["simulate", "models/ur5/ur5.urdf", "--q0", "1,2"]);
+    assert!(!ok);
+    assert!(err.contains("--q0: 2 values given, the model needs 6"), "{err}");
+    let (ok, _, err) = lagrange(&["simulate", "models/ur5/ur5.urdf", "--dt", "0"]);
+    assert!(!ok);
+    assert!(err.contains("dt > 0"), "{err}");
+}
+
+#[test]
+fn default_run_simulates_the_embedded_model() {
+    let (ok, out, err) = lagrange(&[]);
+    assert!(ok, "{err}");
+    for needle in ["embedded default model", "model 'ur5'", "simulation plan:", "5000 steps", "energy: start"]
+    {
+        assert!(out.contains(needle), "missing '{needle}' in {out}");
+    }
+}
+
+#[test]
+fn load_errors_reach_the_user_with_file_and_line() {
+    let urdf = temp_file("zero_axis.urdf", "<robot name=\"r\">\n<link name=\"a\"/>\n<link name=\"b\"/>\n<joint name=\"j\" type=\"revolute\">\n<parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 0\"/>\n</joint>\n</robot>\n");
+    let (ok, _, err) = lagrange(&["info", urdf.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(
+        err.contains(&format!("{}:4", urdf.display()))
+            && err.contains("joint 'j'")
+            && err.contains("axis is zero"),
+        "{err}"
+    );
+}
