@@ -27,16 +27,22 @@ pub(crate) fn joint_velocity(model: &Model, data: &Data, b: usize, v: &[f64]) ->
     v_joint
 }
 
-/// Forward kinematics: pose of every body (`x_parent_body`, `x_world_body`) and of every named
-/// frame (`x_world_frame`) at configuration `q`, and the motion subspaces (`s_body`).
-pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
-    // Pass 1, root to leaves: x_world_body = x_world_parent · x_parent_body.
+/// Root to leaves: joint transforms and subspaces (`update_joint`), then
+/// `x_world_body = x_world_parent · x_parent_body`. The first pass of FK and of CRBA.
+#[inline]
+pub(crate) fn body_poses(model: &Model, data: &mut Data, q: &[f64]) {
     for b in 1..model.nbody() {
         update_joint(model, data, b, q);
         let p = model.bodies[b].parent;
         data.x_world_body[b] = data.x_world_body[p] * data.x_parent_body[b];
     }
-    // Pass 2: frames rigidly attached to bodies.
+}
+
+/// Forward kinematics: pose of every body (`x_parent_body`, `x_world_body`) and of every named
+/// frame (`x_world_frame`) at configuration `q`, and the motion subspaces (`s_body`).
+pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
+    body_poses(model, data, q);
+    // Frames rigidly attached to bodies.
     for (f, frame) in model.frames.iter().enumerate() {
         data.x_world_frame[f] = data.x_world_body[frame.body] * frame.x_body_frame;
     }

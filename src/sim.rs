@@ -170,11 +170,11 @@ impl<'m> Simulation<'m> {
         Ok(())
     }
 
-    /// Total mechanical energy T + V at the current state.
-    pub fn energy(&mut self) -> f64 {
+    /// Kinetic and potential energy (T, V) at the current state (forward kinematics included).
+    pub fn energies(&mut self) -> (f64, f64) {
         let (q, v) = (self.state.q.as_slice(), self.state.v.as_slice());
         let kinetic = dynamics::kinetic_energy(self.model, &mut self.data, q, v);
-        kinetic + dynamics::potential_energy(self.model, &self.data)
+        (kinetic, dynamics::potential_energy(self.model, &self.data))
     }
 
     /// Forward kinematics at the current state (poses in `data`).

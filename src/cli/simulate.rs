@@ -95,7 +95,10 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     } else {
         ProgressBar::hidden()
     };
-    let energy_start = sim.energy();
+    let energy_start = {
+        let (kinetic, potential) = sim.energies();
+        kinetic + potential
+    };
     let mut energy = energy_start;
     let (mut max_dev, mut max_kinetic) = (0.0f64, 0.0f64);
     let mut wall = Duration::ZERO;
@@ -111,8 +114,8 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         sim.step(request.dt)?;
         wall += t0.elapsed();
         // Energy monitoring is outside the timed step.
-        energy = sim.energy();
-        let kinetic = energy - crate::dynamics::potential_energy(model, &sim.data);
+        let (kinetic, potential) = sim.energies();
+        energy = kinetic + potential;
         max_kinetic = max_kinetic.max(kinetic);
         max_dev = max_dev.max((energy - energy_start).abs());
         track_limit_excursions(model, &sim.state, &mut excursions);

@@ -1,7 +1,7 @@
 //! Composite-rigid-body algorithm for M(q) (RBDA §6.2, Table 6.2) and the tree-sparse LᵀDL
 //! factorization and solve (RBDA §6.3, Tables 6.3–6.4).
 
-use crate::kinematics::update_joint;
+use crate::kinematics::body_poses;
 use crate::model::{Data, Model, NO_DOF};
 use nalgebra::{DMatrix, DVector};
 
@@ -12,12 +12,10 @@ use nalgebra::{DMatrix, DVector};
 /// freedom is the plain product S_jᵀ (Iᶜ_i S_i) of world-frame vectors, so the walk up the tree
 /// transforms nothing.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64> {
-    // Pass 1, root to leaves: poses, world-frame motion subspaces and body inertias.
+    // Pass 1: body poses; then world-frame motion subspaces and body inertias.
+    body_poses(model, data, q);
     for b in 1..model.nbody() {
-        update_joint(model, data, b, q);
-        let p = model.bodies[b].parent;
-        let x_world_body = data.x_world_body[p] * data.x_parent_body[b];
-        data.x_world_body[b] = x_world_body;
+        let x_world_body = data.x_world_body[b];
         let j = model.joint_of(b);
         for k in j.dof_adr..j.dof_adr + j.kind.nv() {
             data.s_world[k] = x_world_body.act_motion(&data.s_body[k]);
