@@ -3,8 +3,8 @@
 //! out q and v in depth-first file order (DESIGN.md, layer 3).
 
 use crate::io::LoadError;
-use crate::model::spec::{InertialSpec, JointSpec, JointType, ModelSpec};
-use crate::model::{Body, Frame, Geom, Joint, JointKind, Model, NO_DOF};
+use crate::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec};
+use crate::model::{Body, Frame, FrameKind, Geom, Joint, JointKind, Model, NO_DOF};
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
 use std::collections::HashMap;
 
@@ -18,6 +18,19 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         return Err(LoadError::Empty { file });
     }
     check_unique_names(spec)?;
+    let mut meshes = crate::io::geom_mass::MeshCache::default();
+    // Pass 0: every link's own mass properties (explicit or from its geoms), with the compiler's
+    // bounds; then `settotalmass` scales the moving links.
+    let mut link_inertias = Vec::with_capacity(spec.links.len());
+    let mut geom_masses = Vec::with_capacity(spec.links.len());
+    for link in &spec.links {
+        let (inertia, masses) = link_mass(link, &spec.mass_rules, &mut meshes)?;
+        link_inertias.push(inertia);
+        geom_masses.push(masses);
+    }
+    if let Some(total) = spec.mass_rules.total_mass {
+        scale_total_mass(spec, &mut link_inertias, &mut geom_masses, total);
+    }
 
     let mut bodies = vec![Body {
         name: "world".to_string(),
@@ -69,6 +82,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                     damping: j.damping,
                     friction: j.friction,
                     armature: j.armature,
+                    stiffness: j.stiffness,
+                    spring_ref: j.spring_ref,
                     mimic: j.mimic.clone(),
                 });
                 nq += jnq;
@@ -78,18 +93,33 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         }
         let (body, x_body_link) = link_body[li];
         // Mass properties of the link, moved into its body's frame.
-        if let Some(inertial) = &link.inertial {
-            let i_link = link_inertia(&link.name, inertial)?;
-            bodies[body].inertia += &i_link.transformed(&x_body_link);
+        let i_link = link_inertias[li];
+        bodies[body].inertia += &i_link.transformed(&x_body_link);
+        frames.push(Frame {
+            name: link.name.clone(),
+            kind: FrameKind::Link,
+            body,
+            x_body_frame: x_body_link,
+            inertia: i_link,
+        });
+        for f in &link.frames {
+            frames.push(Frame {
+                name: f.name.clone(),
+                kind: f.kind,
+                body,
+                x_body_frame: x_body_link * f.x_link_frame,
+                inertia: RigidInertia::zero(),
+            });
         }
-        frames.push(Frame { name: link.name.clone(), body, x_body_frame: x_body_link });
-        for g in &link.geoms {
+        for (g, &mass) in link.geoms.iter().zip(&geom_masses[li]) {
             geoms.push(Geom {
+                name: g.name.clone(),
                 link: link.name.clone(),
                 body,
                 x_body_geom: x_body_link * g.x_link_geom,
                 shape: g.shape.clone(),
                 collision: g.collision,
+                mass,
             });
         }
     }
@@ -115,6 +145,28 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         }
     }
 
+    // Pass 3: the reference configuration, joint by joint.
+    let mut qpos0 = vec![0.0; nq];
+    for (j, link) in joints.iter().zip(spec.links.iter().filter(|l| l.joint.jtype != JointType::Fixed)) {
+        let q = &mut qpos0[j.qpos_adr..j.qpos_adr + j.kind.nq()];
+        if link.joint.qpos0.is_empty() {
+            j.kind.neutral(q);
+        } else if link.joint.qpos0.len() == q.len() {
+            q.copy_from_slice(&link.joint.qpos0);
+        } else {
+            return Err(LoadError::Invalid {
+                loc: link.joint.loc.clone(),
+                element: "joint".into(),
+                detail: format!(
+                    "joint '{}' has a reference configuration of {} values, its type needs {} (loader bug)",
+                    j.name,
+                    link.joint.qpos0.len(),
+                    q.len()
+                ),
+            });
+        }
+    }
+
     Ok(Model {
         name: spec.name.clone(),
         source: spec.source.clone(),
@@ -129,7 +181,82 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         dof_body,
         dof_armature,
         dof_damping,
+        qpos0,
+        options: spec.options.clone(),
+        keyframes: spec.keyframes.clone(),
+        elements: spec.elements.clone(),
     })
+}
+
+/// A link's own mass properties in link coordinates and the mass each of its geoms contributed:
+/// from its geoms when the loader asks (MuJoCo `inertiafromgeom`), else its checked `<inertial>`;
+/// then the compiler's lower bounds and inertia balancing ([`MassRules`]).
+fn link_mass(
+    link: &LinkSpec,
+    rules: &MassRules,
+    meshes: &mut crate::io::geom_mass::MeshCache,
+) -> Result<(RigidInertia, Vec<f64>), LoadError> {
+    let mut geom_masses = vec![0.0; link.geoms.len()];
+    let inertia = if link.inertia_from_geoms {
+        let mut sum = RigidInertia::zero();
+        for (g, m) in link.geoms.iter().zip(geom_masses.iter_mut()) {
+            let i_geom = crate::io::geom_mass::geom_inertia(g, &link.name, meshes)?;
+            *m = i_geom.mass;
+            sum += &i_geom.transformed(&g.x_link_geom);
+        }
+        sum
+    } else if let Some(inertial) = &link.inertial {
+        link_inertia(&link.name, inertial)?
+    } else {
+        RigidInertia::zero()
+    };
+    // The world body keeps no mass; every other link obeys the bounds.
+    if link.parent.is_none() && link.joint.jtype == JointType::Fixed {
+        return Ok((inertia, geom_masses));
+    }
+    Ok((apply_bounds(inertia, rules), geom_masses))
+}
+
+/// MuJoCo's `boundmass`, `boundinertia` and `balanceinertia` on a link's principal moments
+/// (`mjCBody::Compile`); the tensor is untouched when no rule fires.
+fn apply_bounds(inertia: RigidInertia, rules: &MassRules) -> RigidInertia {
+    let mass = inertia.mass.max(rules.bound_mass);
+    let com = inertia.com();
+    let i_com = inertia.i_com();
+    let eig = i_com.symmetric_eigen();
+    let mut moments = eig.eigenvalues.map(|l| l.max(rules.bound_inertia));
+    let violated = (0..3).any(|k| moments[k] > moments[(k + 1) % 3] + moments[(k + 2) % 3]);
+    if violated && rules.balance_inertia {
+        moments = Vec3::repeat(moments.sum() / 3.0);
+    }
+    if mass == inertia.mass && moments == eig.eigenvalues {
+        return inertia;
+    }
+    let i_new = eig.eigenvectors * Mat3::from_diagonal(&moments) * eig.eigenvectors.transpose();
+    RigidInertia::from_com(mass, com, i_new)
+}
+
+/// MuJoCo's `settotalmass`: scale the masses and inertias of all links but the world so that they
+/// total `total` (`mj_setTotalmass`).
+fn scale_total_mass(
+    spec: &ModelSpec,
+    inertias: &mut [RigidInertia],
+    geom_masses: &mut [Vec<f64>],
+    total: f64,
+) {
+    let is_world = |l: &LinkSpec| l.parent.is_none() && l.joint.jtype == JointType::Fixed;
+    let sum: f64 =
+        spec.links.iter().zip(inertias.iter()).filter(|(l, _)| !is_world(l)).map(|(_, i)| i.mass).sum();
+    if sum <= 0.0 {
+        return;
+    }
+    let s = total / sum;
+    for ((l, i), gm) in spec.links.iter().zip(inertias.iter_mut()).zip(geom_masses.iter_mut()) {
+        if !is_world(l) {
+            *i = RigidInertia { mass: i.mass * s, h: i.h * s, i_origin: i.i_origin * s };
+            gm.iter_mut().for_each(|m| *m *= s);
+        }
+    }
 }
 
 fn check_unique_names(spec: &ModelSpec) -> Result<(), LoadError> {

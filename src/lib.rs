@@ -17,6 +17,7 @@ pub mod dynamics;
 pub mod integrate;
 pub mod io;
 pub mod kinematics;
+pub mod mass;
 pub mod model;
 pub mod sim;
 pub mod spatial;

@@ -562,9 +562,18 @@ fn free_body(com: Vec3, i_com_principal: Vec3, r_principal: Mat3, gravity: Vec3)
         parent: None,
         joint,
         inertial: Some(inertial),
+        inertia_from_geoms: false,
         geoms: Vec::new(),
+        frames: Vec::new(),
     };
-    compile(&ModelSpec { name: "free_body".into(), source: None, gravity, links: vec![link] }).unwrap()
+    compile(&ModelSpec {
+        name: "free_body".into(),
+        source: None,
+        gravity,
+        links: vec![link],
+        ..Default::default()
+    })
+    .unwrap()
 }
 
 #[test]

@@ -49,6 +49,8 @@ pub enum LoadError {
     },
     #[error("{loc}: link '{link}': mesh file '{path}' does not exist; fix the filename, or point --package-dir / ROS_PACKAGE_PATH at the right package for a package:// path")]
     MeshNotFound { loc: SourceLoc, link: String, path: String },
+    #[error("{loc}: body '{link}': the mass properties of mesh '{path}' are needed (the body's inertia comes from its geoms) but {reason}")]
+    MeshMass { loc: SourceLoc, link: String, path: String, reason: String },
     #[error("{file}: unsupported model format (expected .urdf or .xml)")]
     UnsupportedFormat { file: String },
 }

@@ -2,6 +2,7 @@
 //! Loaders never touch dynamics code.
 
 mod error;
+pub mod geom_mass;
 pub mod package;
 pub mod urdf;
 

@@ -423,7 +423,9 @@ fn build_spec(
             parent,
             joint,
             inertial,
+            inertia_from_geoms: false,
             geoms,
+            frames: Vec::new(),
         });
     }
     Ok(ModelSpec {
@@ -431,6 +433,7 @@ fn build_spec(
         source: Some(path.to_path_buf()),
         gravity: Vec3::new(0.0, 0.0, -9.81),
         links,
+        ..Default::default()
     })
 }
 
@@ -630,14 +633,17 @@ fn geom_specs(
             Shape::Box { size } => size.iter().copied().collect(),
             Shape::Cylinder { radius, length } | Shape::Capsule { radius, length } => vec![*radius, *length],
             Shape::Sphere { radius } => vec![*radius],
-            Shape::Mesh { .. } => Vec::new(),
+            // URDF has no ellipsoids, planes or height fields.
+            Shape::Mesh { .. } | Shape::Ellipsoid { .. } | Shape::Plane { .. } | Shape::Hfield { .. } => {
+                Vec::new()
+            }
         };
         if !size_ok(&dims) {
             return Err(bad(format!(
                 "the geometry has a negative or non-finite size {dims:?}; sizes must be ≥ 0"
             )));
         }
-        geoms.push(GeomSpec { x_link_geom: pose(origin), shape, collision: g.collision });
+        geoms.push(GeomSpec { collision: g.collision, ..GeomSpec::new(shape, pose(origin), g.loc.clone()) });
     }
     Ok(geoms)
 }

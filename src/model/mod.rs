@@ -5,10 +5,12 @@
 //! Fixed joints were fused by the compile step; every original link survives as a [`Frame`].
 
 mod data;
+mod elements;
 mod joint;
 pub mod spec;
 
 pub use data::Data;
+pub use elements::{Element, Keyframe, Options};
 pub use joint::{axis_angle, JointKind};
 
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
@@ -52,6 +54,10 @@ pub struct Joint {
     pub friction: f64,
     /// Rotor armature added to the diagonal of M (MuJoCo's `dof_armature`).
     pub armature: f64,
+    /// Spring stiffness and rest position (MuJoCo `stiffness`, `springref`), applied by
+    /// `simulate` as `−stiffness·(q − spring_ref)` for hinge and slide joints.
+    pub stiffness: f64,
+    pub spring_ref: f64,
     /// URDF `<mimic>`: stored, enforced by the constraints work (not yet).
     pub mimic: Option<Mimic>,
 }
@@ -91,25 +97,45 @@ impl Body {
     }
 }
 
-/// A named frame rigidly attached to a body: every URDF link is one (fused or not).
+/// What a named frame stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameKind {
+    /// A URDF link or MJCF body (fused into its parent body or not).
+    Link,
+    /// An MJCF site.
+    Site,
+    /// An intermediate frame the MJCF loader makes for a joint anchor or the joints of a
+    /// multi-joint body.
+    Joint,
+}
+
+/// A named frame rigidly attached to a body: every URDF link and MJCF body is one (fused or not).
 #[derive(Clone, Debug)]
 pub struct Frame {
     pub name: String,
+    pub kind: FrameKind,
     pub body: usize,
     /// Pose of the frame in its body's frame.
     pub x_body_frame: Transform,
+    /// The link's own mass properties in this frame's coordinates (before fusion; zero for
+    /// sites and massless links).
+    pub inertia: RigidInertia,
 }
 
 /// A geometry kept from the model file (not yet used by dynamics).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Geom {
+    /// The geom's own name (MJCF), empty if unnamed.
+    pub name: String,
     /// Name of the link or body it belongs to.
     pub link: String,
     pub body: usize,
     pub x_body_geom: Transform,
     pub shape: spec::Shape,
-    /// Whether it came from a collision (true) or visual (false) element.
+    /// Whether it takes part in collisions (URDF `<collision>`; MJCF contype/conaffinity ≠ 0).
     pub collision: bool,
+    /// The mass it contributed to its body (0 if the body's inertia was given explicitly).
+    pub mass: f64,
 }
 
 /// The compiled, immutable model. Build it with a loader (e.g. [`crate::io::load`]) or by
@@ -137,6 +163,15 @@ pub struct Model {
     pub dof_armature: Vec<f64>,
     /// Damping per degree of freedom.
     pub dof_damping: Vec<f64>,
+    /// Reference configuration (MuJoCo's `qpos0`: hinge/slide `ref`, a free body's pose in the
+    /// file, identity quaternions): the default initial state.
+    pub qpos0: Vec<f64>,
+    /// Simulation options from the file.
+    pub options: Options,
+    /// Named initial states (MJCF `<keyframe>`).
+    pub keyframes: Vec<Keyframe>,
+    /// Elements parsed and kept but not simulated yet (listed by `lagrange info`).
+    pub elements: Vec<Element>,
 }
 
 /// Marker for "no parent degree of freedom".
@@ -164,6 +199,14 @@ impl Model {
     /// Index of a joint by name.
     pub fn joint_id(&self, name: &str) -> Option<usize> {
         self.joints.iter().position(|j| j.name == name)
+    }
+    /// Index of a keyframe by name.
+    pub fn keyframe_id(&self, name: &str) -> Option<usize> {
+        self.keyframes.iter().position(|k| k.name == name)
+    }
+    /// Whether any hinge or slide joint has a spring.
+    pub fn has_springs(&self) -> bool {
+        self.joints.iter().any(|j| j.stiffness != 0.0)
     }
     /// Neutral configuration (zeros, identity quaternions).
     pub fn neutral(&self) -> Vec<f64> {

@@ -2,7 +2,8 @@
 //! it into a [`Model`](super::Model). Links are a tree in depth-first file order; fixed joints are
 //! still present here.
 
-use super::{Mimic, SourceLoc};
+use super::{Element, Keyframe, Mimic, Options, SourceLoc};
+use crate::mass::{Distribution, GeomMass};
 use crate::spatial::{Mat3, Transform, Vec3};
 use std::path::PathBuf;
 
@@ -17,6 +18,28 @@ pub struct ModelSpec {
     /// Links in depth-first file order: every link's parent comes before it; `links[0]` is the
     /// root, attached to the world by its `joint` (fixed, or free when floating).
     pub links: Vec<LinkSpec>,
+    /// Rules the compile step applies to every link's mass properties (MJCF `<compiler>`).
+    pub mass_rules: MassRules,
+    /// Simulation options (MJCF `<option>`; defaults for URDF).
+    pub options: Options,
+    /// Named initial states (MJCF `<keyframe>`), in qpos/qvel layout.
+    pub keyframes: Vec<Keyframe>,
+    /// Elements kept but not (yet) simulated: actuators, sensors, equality constraints, tendons,
+    /// contact pairs and exclusions.
+    pub elements: Vec<Element>,
+}
+
+/// MuJoCo's `<compiler>` rules for mass properties, applied per link in this order: inertia from
+/// geoms (decided per link, [`LinkSpec::inertia_from_geoms`]), `boundmass` and `boundinertia` (lower
+/// bounds on the mass and the principal moments), `balanceinertia` (replace moments that violate
+/// the triangle inequality by their mean), then `settotalmass` (scale all moving masses).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MassRules {
+    pub bound_mass: f64,
+    pub bound_inertia: f64,
+    pub balance_inertia: bool,
+    /// Scale the masses and inertias of the moving links so that they total this (kg).
+    pub total_mass: Option<f64>,
 }
 
 /// One link (URDF) or body (MJCF) with the joint that attaches it to its parent.
@@ -28,7 +51,22 @@ pub struct LinkSpec {
     pub parent: Option<usize>,
     pub joint: JointSpec,
     pub inertial: Option<InertialSpec>,
+    /// Compute the mass properties from the geoms' (replacing `inertial`): MJCF
+    /// `inertiafromgeom`, decided by the loader.
+    pub inertia_from_geoms: bool,
     pub geoms: Vec<GeomSpec>,
+    /// Further named frames rigidly attached to the link (MJCF sites; the MJCF body frame when a
+    /// joint anchor or several joints put the link frame elsewhere).
+    pub frames: Vec<FrameSpec>,
+}
+
+/// A named frame attached to a link.
+#[derive(Clone, Debug)]
+pub struct FrameSpec {
+    pub name: String,
+    pub loc: SourceLoc,
+    pub kind: super::FrameKind,
+    pub x_link_frame: Transform,
 }
 
 /// Joint types as model files name them.
@@ -57,6 +95,11 @@ pub struct JointSpec {
     pub damping: f64,
     pub friction: f64,
     pub armature: f64,
+    /// Joint spring: stiffness and its rest position (in q), MuJoCo `stiffness` / `springref`.
+    pub stiffness: f64,
+    pub spring_ref: f64,
+    /// The joint's reference configuration (MuJoCo `qpos0`); empty means neutral.
+    pub qpos0: Vec<f64>,
     pub mimic: Option<Mimic>,
 }
 
@@ -73,6 +116,9 @@ impl JointSpec {
             damping: 0.0,
             friction: 0.0,
             armature: 0.0,
+            stiffness: 0.0,
+            spring_ref: 0.0,
+            qpos0: Vec::new(),
             mimic: None,
         }
     }
@@ -105,6 +151,18 @@ pub enum Shape {
     Sphere {
         radius: f64,
     },
+    /// An ellipsoid with the given semi-axes (MJCF).
+    Ellipsoid {
+        radii: Vec3,
+    },
+    /// An infinite plane z = 0 of the geom frame (MJCF; `size` is for drawing only).
+    Plane {
+        size: Vec3,
+    },
+    /// A height field asset (MJCF), by name.
+    Hfield {
+        name: String,
+    },
     /// A mesh file, resolved to a path on disk, with its scale.
     Mesh {
         path: PathBuf,
@@ -115,7 +173,40 @@ pub enum Shape {
 /// A visual or collision geometry of a link.
 #[derive(Clone, Debug)]
 pub struct GeomSpec {
+    pub name: String,
+    pub loc: SourceLoc,
     pub x_link_geom: Transform,
     pub shape: Shape,
+    /// Whether it takes part in collisions (URDF `<collision>`; MJCF contype or conaffinity ≠ 0).
     pub collision: bool,
+    /// The mass it contributes when the link's inertia comes from its geoms.
+    pub mass: GeomMass,
+    pub distribution: Distribution,
+    /// For meshes: how MuJoCo computes its inertia (`<mesh inertia>`).
+    pub mesh_inertia: crate::mass::MeshInertia,
+    /// MJCF `group`, `contype`, `conaffinity`, `friction`.
+    pub group: i32,
+    pub contype: u32,
+    pub conaffinity: u32,
+    pub friction: [f64; 3],
+}
+
+impl GeomSpec {
+    /// A massless geom of `shape` at `x_link_geom` with MuJoCo's default contact parameters.
+    pub fn new(shape: Shape, x_link_geom: Transform, loc: SourceLoc) -> Self {
+        Self {
+            name: String::new(),
+            loc,
+            x_link_geom,
+            shape,
+            collision: true,
+            mass: GeomMass::None,
+            distribution: Distribution::Volume,
+            mesh_inertia: Default::default(),
+            group: 0,
+            contype: 1,
+            conaffinity: 1,
+            friction: [1.0, 0.005, 0.0001],
+        }
+    }
 }

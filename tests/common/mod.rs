@@ -341,11 +341,19 @@ pub fn random_tree_spec(seed: u64, n_links: usize) -> ModelSpec {
             parent,
             joint,
             inertial,
+            inertia_from_geoms: false,
             geoms: Vec::new(),
+            frames: Vec::new(),
         });
     }
     let gravity = random_unit(&mut rng) * 9.81;
-    ModelSpec { name: format!("random_tree_{seed}_{n_links}"), source: None, gravity, links }
+    ModelSpec {
+        name: format!("random_tree_{seed}_{n_links}"),
+        source: None,
+        gravity,
+        links,
+        ..Default::default()
+    }
 }
 
 /// [`random_tree_spec`] compiled into a model.

@@ -1,0 +1,67 @@
+//! Mass properties of a spec geom (MuJoCo `inertiafromgeom`): primitives in closed form, meshes
+//! through [`crate::mass`], each mesh file read once per compile.
+
+use super::LoadError;
+use crate::mass::{self, GeomMass, MeshInertia, Primitive};
+use crate::model::spec::{GeomSpec, Shape};
+use crate::spatial::{RigidInertia, Vec3};
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+/// Unit-density mesh mass properties by (file, scale, mode), so that a mesh used by several geoms
+/// is read and integrated once.
+#[derive(Default)]
+pub struct MeshCache {
+    entries: HashMap<(PathBuf, [u64; 3], MeshInertia), (f64, RigidInertia)>,
+}
+
+/// The mass properties a geom contributes to its link, in the geom's frame.
+pub fn geom_inertia(g: &GeomSpec, link: &str, meshes: &mut MeshCache) -> Result<RigidInertia, LoadError> {
+    if g.mass == GeomMass::None {
+        return Ok(RigidInertia::zero());
+    }
+    let primitive = match &g.shape {
+        Shape::Sphere { radius } => Primitive::Sphere { radius: *radius },
+        Shape::Capsule { radius, length } => {
+            Primitive::Capsule { radius: *radius, half_length: length / 2.0 }
+        }
+        Shape::Cylinder { radius, length } => {
+            Primitive::Cylinder { radius: *radius, half_length: length / 2.0 }
+        }
+        Shape::Box { size } => Primitive::Box { half_extents: size / 2.0 },
+        Shape::Ellipsoid { radii } => Primitive::Ellipsoid { radii: *radii },
+        // Planes and height fields carry no mass (MuJoCo gives them zero volume in bodies).
+        Shape::Plane { .. } | Shape::Hfield { .. } => return Ok(RigidInertia::zero()),
+        Shape::Mesh { path, scale } => return mesh_geom_inertia(g, link, path, scale, meshes),
+    };
+    let measure = mass::primitive_measure(&primitive, g.distribution);
+    let m = mass::resolve_mass(g.mass, measure);
+    Ok(mass::primitive_inertia(&primitive, g.distribution, m))
+}
+
+fn mesh_geom_inertia(
+    g: &GeomSpec,
+    link: &str,
+    path: &PathBuf,
+    scale: &Vec3,
+    meshes: &mut MeshCache,
+) -> Result<RigidInertia, LoadError> {
+    let key = (path.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()], g.mesh_inertia);
+    let (measure, unit) = match meshes.entries.get(&key) {
+        Some(e) => *e,
+        None => {
+            let err = |e: mass::MeshError| LoadError::MeshMass {
+                loc: g.loc.clone(),
+                link: link.to_string(),
+                path: path.display().to_string(),
+                reason: e.to_string(),
+            };
+            let mesh = mass::read_mesh(path, scale).map_err(err)?;
+            let e = mass::mesh_inertia(&mesh, g.mesh_inertia).map_err(err)?;
+            meshes.entries.insert(key, e);
+            e
+        }
+    };
+    let m = mass::resolve_mass(g.mass, measure);
+    Ok(mass::scaled_to_mass(&unit, m))
+}

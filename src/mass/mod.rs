@@ -1,0 +1,68 @@
+//! Mass properties of primitives and triangle meshes (DESIGN.md, layer 4).
+//!
+//! Every function returns a [`RigidInertia`] expressed in the shape's own frame (mass, first
+//! moment, rotational inertia about the frame origin), so placing a shape in a body is
+//! [`RigidInertia::transformed`] and composing shapes is `+=` (notes §3, eq. 56 and 81–83).
+
+mod mesh;
+mod primitive;
+
+pub use mesh::{mesh_inertia, read_mesh, MeshError, TriangleMesh};
+pub use primitive::{primitive_inertia, primitive_measure, Primitive};
+
+use crate::spatial::RigidInertia;
+
+/// How mass is spread over a shape: through its volume (a solid) or over its surface (a thin
+/// shell, MJCF `shellinertia="true"` / mesh `inertia="shell"`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Distribution {
+    #[default]
+    Volume,
+    Shell,
+}
+
+/// How a geometry's mass is given.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum GeomMass {
+    /// The geometry carries no mass (URDF visuals, MJCF geoms outside the inertia groups).
+    #[default]
+    None,
+    /// Mass = density × volume (kg/m³), or × area for shells (kg/m²).
+    Density(f64),
+    /// A total mass (kg); the density follows from the volume or area.
+    Mass(f64),
+}
+
+/// The mass of `measure` (a volume or an area) under `mass`, MuJoCo's rule: an explicit mass wins,
+/// else density × measure.
+pub fn resolve_mass(mass: GeomMass, measure: f64) -> f64 {
+    match mass {
+        GeomMass::None => 0.0,
+        GeomMass::Density(rho) => rho * measure,
+        GeomMass::Mass(m) => m,
+    }
+}
+
+/// Scales a unit-density inertia (as the mesh routines return) to the given total mass.
+pub fn scaled_to_mass(unit: &RigidInertia, mass: f64) -> RigidInertia {
+    if unit.mass <= 0.0 {
+        return RigidInertia::zero();
+    }
+    let s = mass / unit.mass;
+    RigidInertia { mass, h: unit.h * s, i_origin: unit.i_origin * s }
+}
+
+/// MuJoCo's mesh inertia modes (`<mesh inertia="...">`; MuJoCo's default is `legacy`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum MeshInertia {
+    /// The solid convex hull of the mesh.
+    Convex,
+    /// The solid the closed, consistently oriented mesh encloses.
+    Exact,
+    /// MuJoCo's historical rule: the mesh's tetrahedra about its centroid with their volumes
+    /// taken as absolute values (tolerates misoriented faces, overcounts non-convex meshes).
+    #[default]
+    Legacy,
+    /// A thin shell over the mesh surface.
+    Shell,
+}
