@@ -6,7 +6,7 @@ use crate::mass::{self, GeomMass, MeshInertia, Primitive};
 use crate::model::spec::{GeomSpec, Shape};
 use crate::spatial::{RigidInertia, Vec3};
 use std::collections::HashMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Unit-density mesh mass properties by (file, scale, mode), so that a mesh used by several geoms
 /// is read and integrated once.
@@ -42,11 +42,11 @@ pub fn geom_inertia(g: &GeomSpec, link: &str, meshes: &mut MeshCache) -> Result<
 fn mesh_geom_inertia(
     g: &GeomSpec,
     link: &str,
-    path: &PathBuf,
+    path: &Path,
     scale: &Vec3,
     meshes: &mut MeshCache,
 ) -> Result<RigidInertia, LoadError> {
-    let key = (path.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()], g.mesh_inertia);
+    let key = (path.to_path_buf(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()], g.mesh_inertia);
     let (measure, unit) = match meshes.entries.get(&key) {
         Some(e) => *e,
         None => {
