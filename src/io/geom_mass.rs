@@ -17,7 +17,9 @@ pub struct MeshCache {
 
 /// The mass properties a geom contributes to its link, in the geom's frame.
 pub fn geom_inertia(g: &GeomSpec, link: &str, meshes: &mut MeshCache) -> Result<RigidInertia, LoadError> {
-    if g.mass == GeomMass::None {
+    // Massless geoms (visuals, `density="0"`, `mass="0"`) are never measured: a broken mesh used
+    // only for drawing or collision is no error.
+    if matches!(g.mass, GeomMass::None | GeomMass::Density(0.0) | GeomMass::Mass(0.0)) {
         return Ok(RigidInertia::zero());
     }
     let primitive = match &g.shape {
