@@ -4,7 +4,7 @@
 
 use crate::io::LoadError;
 use crate::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec};
-use crate::model::{Body, Frame, FrameKind, Geom, Joint, JointKind, Model, NO_DOF};
+use crate::model::{Body, Frame, Geom, Joint, JointKind, Model, NO_DOF};
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
 use std::collections::HashMap;
 
@@ -97,7 +97,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         bodies[body].inertia += &i_link.transformed(&x_body_link);
         frames.push(Frame {
             name: link.name.clone(),
-            kind: FrameKind::Link,
+            kind: link.kind,
             body,
             x_body_frame: x_body_link,
             inertia: i_link,
@@ -185,6 +185,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         options: spec.options.clone(),
         keyframes: spec.keyframes.clone(),
         elements: spec.elements.clone(),
+        warnings: spec.warnings.clone(),
     })
 }
 

@@ -5,6 +5,7 @@ use super::CliError;
 use crate::dynamics::{aba, bias_forces, center_of_mass, crba, kinetic_energy, potential_energy};
 use crate::io::{load, LoadOptions};
 use crate::kinematics::{forward_kinematics, frame_jacobian, ReferenceFrame};
+use crate::model::FrameKind;
 use crate::{Data, Model};
 use nalgebra::DMatrix;
 use serde::Deserialize;
@@ -43,13 +44,16 @@ pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]
     forward_kinematics(model, data, &s.q);
     let potential = potential_energy(model, data);
     let com = center_of_mass(model, data);
-    let mut poses = Map::new();
+    // Links/bodies (and joint-anchor frames) in "poses", MJCF sites in "sites": MuJoCo keeps
+    // bodies and sites in separate namespaces, and models reuse names across them.
+    let (mut poses, mut sites) = (Map::new(), Map::new());
     for (f, frame) in model.frames.iter().enumerate() {
         let x = &data.x_world_frame[f];
-        poses.insert(frame.name.clone(), json!({"pos": x.pos.as_slice(), "quat": x.quat_wxyz()}));
+        let map = if frame.kind == FrameKind::Site { &mut sites } else { &mut poses };
+        map.insert(frame.name.clone(), json!({"pos": x.pos.as_slice(), "quat": x.quat_wxyz()}));
     }
     let mut out = json!({
-        "M": m, "bias": bias, "qacc": qacc, "poses": poses,
+        "M": m, "bias": bias, "qacc": qacc, "poses": poses, "sites": sites,
         "kinetic": kinetic, "potential": potential, "com": com.as_slice(),
     });
     if !jacobians.is_empty() {

@@ -51,6 +51,22 @@ pub enum LoadError {
     MeshNotFound { loc: SourceLoc, link: String, path: String },
     #[error("{loc}: body '{link}': the mass properties of mesh '{path}' are needed (the body's inertia comes from its geoms) but {reason}")]
     MeshMass { loc: SourceLoc, link: String, path: String, reason: String },
+    #[error("{loc}: <include>: include cycle: {}; remove one of these includes", .chain.join(" includes "))]
+    IncludeCycle { loc: SourceLoc, chain: Vec<String> },
+    #[error(
+        "{loc}: <include>: cannot read '{path}': {reason}; include paths are relative to the including file"
+    )]
+    IncludeNotFound { loc: SourceLoc, path: String, reason: String },
+    #[error("{loc}: <{element}>: unknown default class '{class}'; define <default class=\"{class}\"> or fix the name")]
+    UnknownClass { loc: SourceLoc, element: String, class: String },
+    #[error("{loc}: <{element}>: attribute '{attribute}' {detail}")]
+    BadAttribute { loc: SourceLoc, element: String, attribute: String, detail: String },
+    #[error("{loc}: <{element}>: unknown {kind} '{target}'; define it or fix the name")]
+    UnknownReference { loc: SourceLoc, element: String, kind: &'static str, target: String },
+    #[error("{loc}: <{element}>: {what} is not supported yet and would change the dynamics; {fix}")]
+    Unsupported { loc: SourceLoc, element: String, what: String, fix: String },
+    #[error("{loc}: <{element}>: file '{path}' does not exist; fix the file name or <compiler meshdir/assetdir> (relative paths start at the model file's folder)")]
+    AssetNotFound { loc: SourceLoc, element: String, path: String },
     #[error("{file}: unsupported model format (expected .urdf or .xml)")]
     UnsupportedFormat { file: String },
 }

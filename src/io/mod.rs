@@ -3,6 +3,7 @@
 
 mod error;
 pub mod geom_mass;
+pub mod mjcf;
 pub mod package;
 pub mod urdf;
 
@@ -24,7 +25,7 @@ pub struct LoadOptions {
     pub floating: bool,
 }
 
-/// Loads a model file, choosing the loader by extension (`.urdf`; `.xml` MJCF arrives later).
+/// Loads a model file, choosing the loader by extension (`.urdf`, or `.xml` for MJCF).
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Model, LoadError> {
     compile(&load_spec(path, options)?)
 }
@@ -37,6 +38,7 @@ pub fn load_spec(path: &Path, options: &LoadOptions) -> Result<ModelSpec, LoadEr
         std::fs::read_to_string(path).map_err(|source| LoadError::Io { file: file.clone(), source })?;
     match ext.as_str() {
         "urdf" => urdf::parse(&text, path, options),
+        "xml" | "mjcf" => mjcf::parse_str(&text, path, options),
         _ => Err(LoadError::UnsupportedFormat { file }),
     }
 }

@@ -16,7 +16,7 @@
 use super::package::{base_dir, package_search_dirs, resolve_uri, ResolveError};
 use super::{LoadError, LoadOptions};
 use crate::model::spec::{GeomSpec, InertialSpec, JointSpec, JointType, LinkSpec, ModelSpec, Shape};
-use crate::model::{Mimic, SourceLoc};
+use crate::model::{FrameKind, Mimic, SourceLoc};
 use crate::spatial::{Mat3, Transform, Vec3};
 use roxmltree::{Document, Node, ParsingOptions};
 use std::collections::HashMap;
@@ -425,6 +425,7 @@ fn build_spec(
             inertial,
             inertia_from_geoms: false,
             geoms,
+            kind: FrameKind::Link,
             frames: Vec::new(),
         });
     }

@@ -4,11 +4,21 @@
 //! moment, rotational inertia about the frame origin), so placing a shape in a body is
 //! [`RigidInertia::transformed`] and composing shapes is `+=` (notes §3, eq. 56 and 81–83).
 
+mod error;
 mod mesh;
+mod mesh_io;
 mod primitive;
+mod principal;
+mod topology;
 
-pub use mesh::{mesh_inertia, read_mesh, MeshError, TriangleMesh};
+pub use error::MeshError;
+pub use mesh::{convex_hull, mesh_inertia, TriangleMesh};
+pub use mesh_io::{read_mesh, read_mesh_with, ObjObjects, ReadOptions};
 pub use primitive::{primitive_inertia, primitive_measure, Primitive};
+pub use principal::{
+    compose, parallel_axis, principal, principal_angle_xy, principal_axes, rotate_tensor, Principal,
+};
+pub use topology::Topology;
 
 use crate::spatial::RigidInertia;
 

@@ -172,6 +172,8 @@ pub struct Model {
     pub keyframes: Vec<Keyframe>,
     /// Elements parsed and kept but not simulated yet (listed by `lagrange info`).
     pub elements: Vec<Element>,
+    /// What the loader ignored or could not interpret, each with file:line.
+    pub warnings: Vec<String>,
 }
 
 /// Marker for "no parent degree of freedom".
@@ -192,9 +194,17 @@ impl Model {
     pub fn total_mass(&self) -> f64 {
         self.bodies.iter().skip(1).map(|b| b.inertia.mass).sum()
     }
-    /// Index of a frame by name.
+    /// Index of a frame by name: a link or body if one has the name, else a site or joint-anchor
+    /// frame (MJCF keeps bodies and sites in separate namespaces; see [`Model::site_id`]).
     pub fn frame_id(&self, name: &str) -> Option<usize> {
-        self.frames.iter().position(|f| f.name == name)
+        self.frames
+            .iter()
+            .position(|f| f.name == name && f.kind == FrameKind::Link)
+            .or_else(|| self.frames.iter().position(|f| f.name == name))
+    }
+    /// Index of the frame of an MJCF site by name.
+    pub fn site_id(&self, name: &str) -> Option<usize> {
+        self.frames.iter().position(|f| f.name == name && f.kind == FrameKind::Site)
     }
     /// Index of a joint by name.
     pub fn joint_id(&self, name: &str) -> Option<usize> {

@@ -27,6 +27,8 @@ pub struct ModelSpec {
     /// Elements kept but not (yet) simulated: actuators, sensors, equality constraints, tendons,
     /// contact pairs and exclusions.
     pub elements: Vec<Element>,
+    /// Loader warnings (unknown attributes, ignored elements), each with file:line.
+    pub warnings: Vec<String>,
 }
 
 /// MuJoCo's `<compiler>` rules for mass properties, applied per link in this order: inertia from
@@ -55,6 +57,8 @@ pub struct LinkSpec {
     /// `inertiafromgeom`, decided by the loader.
     pub inertia_from_geoms: bool,
     pub geoms: Vec<GeomSpec>,
+    /// What the link's own frame stands for (MJCF joint anchors get [`FrameKind::Joint`]).
+    pub kind: super::FrameKind,
     /// Further named frames rigidly attached to the link (MJCF sites; the MJCF body frame when a
     /// joint anchor or several joints put the link frame elsewhere).
     pub frames: Vec<FrameSpec>,

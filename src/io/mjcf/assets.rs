@@ -1,0 +1,85 @@
+//! `<asset>`: mesh files (with their default class, scale and inertia mode) by name. Textures,
+//! materials and height fields are accepted; they do not affect the dynamics.
+
+use super::defaults::{Defaults, MAIN};
+use super::xml::Element;
+use super::Compiler;
+use crate::io::LoadError;
+use crate::mass::MeshInertia;
+use crate::spatial::Vec3;
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+/// A mesh asset: the file on disk, its scale and how MuJoCo computes its inertia.
+#[derive(Clone, Debug)]
+pub struct MeshAsset {
+    pub path: PathBuf,
+    pub scale: Vec3,
+    pub inertia: MeshInertia,
+}
+
+/// All `<mesh>` assets by name (a mesh without a name is named after its file, extension removed).
+pub(crate) fn meshes(
+    root: &Element,
+    defaults: &Defaults,
+    compiler: &Compiler,
+) -> Result<HashMap<String, MeshAsset>, LoadError> {
+    let mut out = HashMap::new();
+    for section in root.children_named("asset") {
+        for e in section.children_named("mesh") {
+            let a = defaults.resolve(e, MAIN)?;
+            let Some(file) = a.text("file") else {
+                return Err(LoadError::Unsupported {
+                    loc: e.loc.clone(),
+                    element: "mesh".into(),
+                    what: "a mesh without a file (inline vertices, builtin shapes)".into(),
+                    fix: "save the mesh to an STL or OBJ file and give its name in 'file'".into(),
+                });
+            };
+            // MuJoCo looks in the mesh folder first, then (for a file pulled in by <include>)
+            // next to the including file.
+            let mut path = compiler.meshdir.join(file);
+            if !path.is_file() {
+                if let Some(dir) = std::path::Path::new(&e.loc.file).parent() {
+                    if dir.join(file).is_file() {
+                        path = dir.join(file);
+                    }
+                }
+            }
+            if !path.is_file() {
+                return Err(LoadError::AssetNotFound {
+                    loc: e.loc.clone(),
+                    element: "mesh".into(),
+                    path: path.display().to_string(),
+                });
+            }
+            let name = match a.text("name") {
+                Some(n) => n.to_string(),
+                None => {
+                    let stem =
+                        std::path::Path::new(file).file_stem().and_then(|s| s.to_str()).unwrap_or(file);
+                    stem.to_string()
+                }
+            };
+            let inertia = match a.keyword("inertia", &["convex", "exact", "legacy", "shell"])?.as_deref() {
+                Some("convex") => MeshInertia::Convex,
+                Some("exact") => MeshInertia::Exact,
+                Some("shell") => MeshInertia::Shell,
+                _ => MeshInertia::Legacy,
+            };
+            for moved in ["refpos", "refquat"] {
+                if a.has(moved) {
+                    return Err(LoadError::Unsupported {
+                        loc: e.loc.clone(),
+                        element: "mesh".into(),
+                        what: format!("'{moved}'"),
+                        fix: "transform the mesh file instead, or place the geom with pos/quat".into(),
+                    });
+                }
+            }
+            let scale = a.vec3("scale")?.unwrap_or(Vec3::repeat(1.0));
+            out.insert(name, MeshAsset { path, scale, inertia });
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,121 @@
+//! MJCF default classes (MuJoCo semantics): the top-level `<default>` is class `main`; a nested
+//! `<default class="c">` starts as a copy of its parent and overrides per element type; an element
+//! takes the class named by its `class` attribute, else the `childclass` of the nearest enclosing
+//! `<body>`/`<frame>` that has one, else `main`. All actuator shortcuts (`motor`, `position`, ...)
+//! share one actuator default, as in MuJoCo.
+
+use super::attrs::Attrs;
+use super::xml::Element;
+use crate::io::LoadError;
+use std::collections::HashMap;
+
+/// The element types whose defaults actuators share.
+const ACTUATOR_TAGS: [&str; 12] = [
+    "general",
+    "motor",
+    "position",
+    "velocity",
+    "intvelocity",
+    "damper",
+    "cylinder",
+    "muscle",
+    "adhesion",
+    "dcmotor",
+    "pid",
+    "orientation",
+];
+
+/// The key under which an element type's defaults are stored.
+fn key(tag: &str) -> &str {
+    if ACTUATOR_TAGS.contains(&tag) {
+        "actuator"
+    } else {
+        tag
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+struct Class {
+    by_tag: HashMap<String, Vec<(String, String)>>,
+}
+
+/// All default classes of a model.
+#[derive(Debug, Default)]
+pub struct Defaults {
+    classes: HashMap<String, Class>,
+}
+
+pub const MAIN: &str = "main";
+
+impl Defaults {
+    /// Reads every `<default>` section of the root.
+    pub fn build(root: &Element) -> Result<Self, LoadError> {
+        let mut d = Defaults::default();
+        d.classes.insert(MAIN.to_string(), Class::default());
+        for section in root.children_named("default") {
+            // The top-level default is `main` whatever it is called; several sections (from
+            // includes) add up.
+            let main = d.classes[MAIN].clone();
+            d.read(section, MAIN, &main)?;
+        }
+        Ok(d)
+    }
+
+    fn read(&mut self, node: &Element, name: &str, parent: &Class) -> Result<(), LoadError> {
+        let mut class = parent.clone();
+        for child in &node.children {
+            if child.tag == "default" {
+                continue;
+            }
+            let slot = class.by_tag.entry(key(&child.tag).to_string()).or_default();
+            for (k, v) in &child.attrs {
+                match slot.iter_mut().find(|(sk, _)| sk == k) {
+                    Some(s) => s.1 = v.clone(),
+                    None => slot.push((k.clone(), v.clone())),
+                }
+            }
+        }
+        for child in node.children_named("default") {
+            let Some(child_name) = child.attr("class") else {
+                return Err(LoadError::Invalid {
+                    loc: child.loc.clone(),
+                    element: "default".into(),
+                    detail: "a nested <default> needs a 'class' attribute".into(),
+                });
+            };
+            if self.classes.contains_key(child_name) && child_name != MAIN {
+                return Err(LoadError::DuplicateName {
+                    loc: child.loc.clone(),
+                    element: "default class",
+                    name: child_name.to_string(),
+                });
+            }
+            self.read(child, child_name, &class)?;
+        }
+        self.classes.insert(name.to_string(), class);
+        Ok(())
+    }
+
+    /// Whether a class exists.
+    pub fn has(&self, class: &str) -> bool {
+        self.classes.contains_key(class)
+    }
+
+    /// The attributes of `element` over the defaults of its class: its `class` attribute, else
+    /// `childclass` (the enclosing body's or frame's), else `main`.
+    pub fn resolve(&self, element: &Element, childclass: &str) -> Result<Attrs, LoadError> {
+        let class_name = element.attr("class").unwrap_or(childclass);
+        let Some(class) = self.classes.get(class_name) else {
+            return Err(LoadError::UnknownClass {
+                loc: element.loc.clone(),
+                element: element.tag.clone(),
+                class: class_name.to_string(),
+            });
+        };
+        let empty = Vec::new();
+        let defaults = class.by_tag.get(key(&element.tag)).unwrap_or(&empty);
+        let explicit: Vec<(String, String)> =
+            element.attrs.iter().filter(|(k, _)| k != "class").cloned().collect();
+        Ok(Attrs::new(&element.tag, &element.loc, defaults, &explicit))
+    }
+}

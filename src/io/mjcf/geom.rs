@@ -1,0 +1,176 @@
+//! `<geom>` and `<site>` placement and shape (MuJoCo's `mjCGeom::Compile`): `type` (sphere by
+//! default), `size` in half-lengths, `fromto` (capsule, cylinder, box, ellipsoid: centre at the
+//! midpoint, z along the segment, half-length |to − from|/2 into size[1] — size[2] for boxes and
+//! ellipsoids, whose size[1] becomes size[0]), `mass` or `density` (1000 kg/m³ by default),
+//! `shellinertia`, and the mesh asset a mesh geom names.
+
+use super::assets::MeshAsset;
+use super::attrs::Attrs;
+use super::orientation::{rotation, z_to_matrix, AngleConvention};
+use super::Compiler;
+use crate::io::LoadError;
+use crate::mass::{Distribution, GeomMass};
+use crate::model::spec::{GeomSpec, Shape};
+use crate::spatial::{Transform, Vec3};
+use std::collections::HashMap;
+
+const GEOM_TYPES: [&str; 9] =
+    ["plane", "hfield", "sphere", "capsule", "ellipsoid", "cylinder", "box", "mesh", "sdf"];
+
+/// The placement and size of a geom or site after `fromto`: pose in its parent frame and the size
+/// vector (half-lengths).
+fn placement(a: &Attrs, gtype: &str, angles: &AngleConvention) -> Result<(Transform, [f64; 3]), LoadError> {
+    let mut size = [0.0; 3];
+    if let Some(v) = a.some_numbers("size", 1, 3)? {
+        size[..v.len()].copy_from_slice(&v);
+    }
+    if let Some(ft) = a.array::<6>("fromto")? {
+        if !matches!(gtype, "capsule" | "cylinder" | "box" | "ellipsoid") {
+            return Err(
+                a.error("fromto", format!("needs a capsule, cylinder, box or ellipsoid, not a {gtype}"))
+            );
+        }
+        let from = Vec3::new(ft[0], ft[1], ft[2]);
+        let to = Vec3::new(ft[3], ft[4], ft[5]);
+        let d = from - to;
+        let half = d.norm() / 2.0;
+        if half < 1e-14 {
+            return Err(a.error("fromto", "has coincident end points"));
+        }
+        if matches!(gtype, "box" | "ellipsoid") {
+            size[2] = half;
+            size[1] = size[0];
+        } else {
+            size[1] = half;
+        }
+        return Ok((Transform::new(z_to_matrix(&d), (from + to) / 2.0), size));
+    }
+    let pos = a.vec3("pos")?.unwrap_or_default();
+    Ok((Transform::new(rotation(a, angles)?, pos), size))
+}
+
+/// A site: its pose in the parent frame.
+pub(crate) fn site_pose(a: &Attrs, angles: &AngleConvention) -> Result<Transform, LoadError> {
+    let gtype = a.keyword("type", &GEOM_TYPES)?.unwrap_or_else(|| "sphere".into());
+    Ok(placement(a, &gtype, angles)?.0)
+}
+
+/// A geom as a spec geom placed in its link (`x_link_parent`: pose of the enclosing frame).
+pub(crate) fn geom(
+    a: &Attrs,
+    x_link_parent: &Transform,
+    compiler: &Compiler,
+    meshes: &HashMap<String, MeshAsset>,
+    infer_inertia: bool,
+) -> Result<GeomSpec, LoadError> {
+    let gtype = a.keyword("type", &GEOM_TYPES)?.unwrap_or_else(|| "sphere".into());
+    let (x_parent_geom, size) = placement(a, &gtype, &compiler.angles)?;
+    let positive = |n: usize| -> Result<(), LoadError> {
+        if size[..n].iter().any(|&s| s <= 0.0) {
+            return Err(a.error(
+                "size",
+                format!("of a {gtype} needs {n} positive value{}", if n > 1 { "s" } else { "" }),
+            ));
+        }
+        Ok(())
+    };
+    let mut mesh_inertia = Default::default();
+    let shape = match gtype.as_str() {
+        "sphere" => {
+            positive(1)?;
+            Shape::Sphere { radius: size[0] }
+        }
+        "capsule" => {
+            positive(2)?;
+            Shape::Capsule { radius: size[0], length: 2.0 * size[1] }
+        }
+        "cylinder" => {
+            positive(2)?;
+            Shape::Cylinder { radius: size[0], length: 2.0 * size[1] }
+        }
+        "box" => {
+            positive(3)?;
+            Shape::Box { size: Vec3::new(2.0 * size[0], 2.0 * size[1], 2.0 * size[2]) }
+        }
+        "ellipsoid" => {
+            positive(3)?;
+            Shape::Ellipsoid { radii: Vec3::from(size) }
+        }
+        "plane" => Shape::Plane { size: Vec3::from(size) },
+        "hfield" => Shape::Hfield { name: a.text("hfield").unwrap_or("").to_string() },
+        "mesh" => {
+            let Some(name) = a.text("mesh") else {
+                return Err(a.error("mesh", "is missing: a mesh geom must name a <mesh> asset"));
+            };
+            let Some(m) = meshes.get(name) else {
+                return Err(LoadError::UnknownReference {
+                    loc: a.loc.clone(),
+                    element: "geom".into(),
+                    kind: "mesh",
+                    target: name.to_string(),
+                });
+            };
+            mesh_inertia = m.inertia;
+            Shape::Mesh { path: m.path.clone(), scale: m.scale }
+        }
+        other => {
+            return Err(LoadError::Unsupported {
+                loc: a.loc.clone(),
+                element: "geom".into(),
+                what: format!("geom type '{other}'"),
+                fix: "use a mesh or a primitive".into(),
+            });
+        }
+    };
+    if a.has("mesh") && gtype != "mesh" {
+        return Err(LoadError::Unsupported {
+            loc: a.loc.clone(),
+            element: "geom".into(),
+            what: format!("a {gtype} fitted to a mesh (type=\"{gtype}\" with mesh=)"),
+            fix: "give the primitive's size explicitly".into(),
+        });
+    }
+    let group = a.int("group")?.unwrap_or(0);
+    let shell = a.bool("shellinertia")?.unwrap_or(false);
+    if shell && gtype == "mesh" {
+        return Err(a.error(
+            "shellinertia",
+            "cannot be used on a mesh geom; set inertia=\"shell\" on the <mesh> asset instead (as MuJoCo requires)",
+        ));
+    }
+    let in_groups = group >= compiler.inertia_groups[0] && group <= compiler.inertia_groups[1];
+    let mass = if !infer_inertia || !in_groups {
+        GeomMass::None
+    } else if let Some(m) = a.real("mass")? {
+        if m < 0.0 {
+            return Err(a.error("mass", format!("is {m}; mass must be ≥ 0")));
+        }
+        GeomMass::Mass(m)
+    } else {
+        let rho = a.real("density")?.unwrap_or(1000.0);
+        if rho < 0.0 {
+            return Err(a.error("density", format!("is {rho}; density must be ≥ 0")));
+        }
+        GeomMass::Density(rho)
+    };
+    let contype = a.int("contype")?.unwrap_or(1);
+    let conaffinity = a.int("conaffinity")?.unwrap_or(1);
+    let mut friction = [1.0, 0.005, 0.0001];
+    if let Some(f) = a.some_numbers("friction", 1, 3)? {
+        friction[..f.len()].copy_from_slice(&f);
+    }
+    Ok(GeomSpec {
+        name: a.text("name").unwrap_or("").to_string(),
+        loc: a.loc.clone(),
+        x_link_geom: *x_link_parent * x_parent_geom,
+        shape,
+        collision: contype != 0 || conaffinity != 0,
+        mass,
+        distribution: if shell { Distribution::Shell } else { Distribution::Volume },
+        mesh_inertia,
+        group: group as i32,
+        contype: contype as u32,
+        conaffinity: conaffinity as u32,
+        friction,
+    })
+}

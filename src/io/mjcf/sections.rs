@@ -1,0 +1,200 @@
+//! The MJCF sections around the tree: `<compiler>`, `<option>`, `<keyframe>`, and the elements kept
+//! but not simulated yet (`<equality>`, `<tendon>`, `<actuator>`, `<sensor>`, `<contact>`).
+
+use super::attrs::Attrs;
+use super::defaults::{Defaults, MAIN};
+use super::orientation::AngleConvention;
+use super::xml::Element;
+use super::{Compiler, InertiaFromGeom};
+use crate::io::LoadError;
+use crate::model::spec::MassRules;
+use crate::model::{Element as KeptElement, Keyframe, Options};
+use crate::spatial::Vec3;
+use std::path::Path;
+
+fn plain(e: &Element) -> Attrs {
+    Attrs::new(&e.tag, &e.loc, &[], &e.attrs)
+}
+
+/// Reads every `<compiler>` (later ones override earlier ones, as MuJoCo applies them in order).
+pub(crate) fn compiler(root: &Element, dir: &Path) -> Result<Compiler, LoadError> {
+    let mut c = Compiler {
+        angles: AngleConvention::default(),
+        meshdir: dir.to_path_buf(),
+        autolimits: true,
+        inertia_from_geom: InertiaFromGeom::Auto,
+        inertia_groups: [0, 5],
+        mass_rules: MassRules::default(),
+    };
+    for e in root.children_named("compiler") {
+        let a = plain(e);
+        if let Some(angle) = a.keyword("angle", &["radian", "degree"])? {
+            c.angles.to_radians = if angle == "radian" { 1.0 } else { std::f64::consts::PI / 180.0 };
+        }
+        if let Some(seq) = a.text("eulerseq") {
+            let bytes = seq.as_bytes();
+            if bytes.len() != 3 || !bytes.iter().all(|b| b"xyzXYZ".contains(b)) {
+                return Err(a.error("eulerseq", format!("is '{seq}'; give three of x y z X Y Z (lower case: rotating axes, upper case: fixed axes)")));
+            }
+            c.angles.eulerseq = [bytes[0], bytes[1], bytes[2]];
+        }
+        // `assetdir` sets the mesh folder unless `meshdir` is given too.
+        for attr in ["assetdir", "meshdir"] {
+            if let Some(d) = a.text(attr) {
+                c.meshdir = dir.join(d);
+            }
+        }
+        if let Some(v) = a.bool("autolimits")? {
+            c.autolimits = v;
+        }
+        if let Some(v) = a.keyword("inertiafromgeom", &["false", "true", "auto"])? {
+            c.inertia_from_geom = match v.as_str() {
+                "false" => InertiaFromGeom::False,
+                "true" => InertiaFromGeom::True,
+                _ => InertiaFromGeom::Auto,
+            };
+        }
+        if let Some(v) = a.array::<2>("inertiagrouprange")? {
+            c.inertia_groups = [v[0] as i64, v[1] as i64];
+        }
+        if let Some(v) = a.real("boundmass")? {
+            c.mass_rules.bound_mass = v;
+        }
+        if let Some(v) = a.real("boundinertia")? {
+            c.mass_rules.bound_inertia = v;
+        }
+        if let Some(v) = a.bool("balanceinertia")? {
+            c.mass_rules.balance_inertia = v;
+        }
+        if let Some(v) = a.real("settotalmass")? {
+            c.mass_rules.total_mass = (v > 0.0).then_some(v);
+        }
+        if a.text("coordinate") == Some("global") {
+            return Err(a.error(
+                "coordinate",
+                "is 'global', which MuJoCo no longer supports; convert the model to local coordinates (MuJoCo ≤ 2.3.3 can re-save it)",
+            ));
+        }
+    }
+    Ok(c)
+}
+
+/// Reads `<option>`: time step, integrator, flags, and gravity (zero when `<flag gravity="disable">`).
+pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
+    let mut o = Options::default();
+    let mut gravity = Vec3::new(0.0, 0.0, -9.81);
+    for e in root.children_named("option") {
+        let a = plain(e);
+        if let Some(v) = a.real("timestep")? {
+            if v <= 0.0 {
+                return Err(a.error("timestep", format!("is {v}; the time step must be positive")));
+            }
+            o.timestep = v;
+        }
+        if let Some(v) = a.vec3("gravity")? {
+            gravity = v;
+        }
+        if let Some(v) = a.keyword("integrator", &["Euler", "RK4", "implicit", "implicitfast"])? {
+            o.integrator = v;
+        }
+        for f in e.children_named("flag") {
+            for (name, value) in &f.attrs {
+                let on = match value.as_str() {
+                    "enable" => true,
+                    "disable" => false,
+                    other => {
+                        return Err(plain(f).error(name, format!("is '{other}'; use enable or disable")));
+                    }
+                };
+                o.flags.retain(|(n, _)| n != name);
+                o.flags.push((name.clone(), on));
+            }
+        }
+    }
+    if o.disabled("gravity") {
+        gravity = Vec3::zeros();
+    }
+    Ok((o, gravity))
+}
+
+/// Reads `<keyframe>`: each `<key>` with its name, time and state vectors (sizes are checked by
+/// the compile step against nq and nv).
+pub(crate) fn keyframes(root: &Element) -> Result<Vec<Keyframe>, LoadError> {
+    let mut keys = Vec::new();
+    for section in root.children_named("keyframe") {
+        for (i, k) in section.children_named("key").enumerate() {
+            let a = plain(k);
+            keys.push(Keyframe {
+                name: a.text("name").map_or_else(|| format!("key{i}"), str::to_string),
+                loc: k.loc.clone(),
+                time: a.real("time")?.unwrap_or(0.0),
+                qpos: a.numbers("qpos")?,
+                qvel: a.numbers("qvel")?,
+                ctrl: a.numbers("ctrl")?,
+            });
+        }
+    }
+    Ok(keys)
+}
+
+/// Attributes that name the objects an element acts on.
+const TARGET_ATTRS: [&str; 22] = [
+    "joint",
+    "joint1",
+    "joint2",
+    "body",
+    "body1",
+    "body2",
+    "site",
+    "site1",
+    "site2",
+    "tendon",
+    "tendon1",
+    "tendon2",
+    "geom",
+    "geom1",
+    "geom2",
+    "objname",
+    "refname",
+    "jointinparent",
+    "cranksite",
+    "slidersite",
+    "refsite",
+    "actuator",
+];
+
+/// Reads the sections whose elements are kept but not simulated yet.
+pub(crate) fn elements(root: &Element, defaults: &Defaults) -> Result<Vec<KeptElement>, LoadError> {
+    let mut out = Vec::new();
+    for category in ["equality", "tendon", "actuator", "sensor", "contact"] {
+        for section in root.children_named(category) {
+            for e in &section.children {
+                // Sensors and contact exclusions have no default classes.
+                let a = if matches!(category, "sensor") || e.tag == "exclude" {
+                    plain(e)
+                } else {
+                    defaults.resolve(e, MAIN)?
+                };
+                let mut targets: Vec<String> =
+                    TARGET_ATTRS.iter().filter_map(|t| a.text(t)).map(str::to_string).collect();
+                // Tendon paths list their joints, sites and geoms as children.
+                for c in &e.children {
+                    for t in ["joint", "site", "geom"] {
+                        if let Some(v) = c.attr(t) {
+                            targets.push(v.to_string());
+                        }
+                    }
+                }
+                out.push(KeptElement {
+                    category: category.to_string(),
+                    kind: e.tag.clone(),
+                    name: a.text("name").unwrap_or("").to_string(),
+                    targets,
+                    attributes: a.values.clone(),
+                    loc: e.loc.clone(),
+                });
+            }
+        }
+    }
+    Ok(out)
+}
