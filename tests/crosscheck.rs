@@ -564,6 +564,7 @@ fn free_body(com: Vec3, i_com_principal: Vec3, r_principal: Mat3, gravity: Vec3)
         inertial: Some(inertial),
         inertia_from_geoms: false,
         geoms: Vec::new(),
+        kind: lagrange::model::FrameKind::Link,
         frames: Vec::new(),
     };
     compile(&ModelSpec {

@@ -343,6 +343,7 @@ pub fn random_tree_spec(seed: u64, n_links: usize) -> ModelSpec {
             inertial,
             inertia_from_geoms: false,
             geoms: Vec::new(),
+            kind: lagrange::model::FrameKind::Link,
             frames: Vec::new(),
         });
     }
