@@ -4,7 +4,7 @@
 
 use crate::io::LoadError;
 use crate::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec};
-use crate::model::{Body, Frame, Geom, Joint, JointKind, Model, NO_DOF};
+use crate::model::{Body, Frame, Geom, Joint, JointKind, Model, Spring, NO_DOF};
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
 use std::collections::HashMap;
 
@@ -145,6 +145,26 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         }
     }
 
+    // Springs of one-dof joints; `<flag spring/damper="disable">` switches them off.
+    let springs = if spec.options.disabled("spring") {
+        Vec::new()
+    } else {
+        joints
+            .iter()
+            .filter(|j| j.stiffness != 0.0 && j.kind.nq() == 1)
+            .map(|j| Spring {
+                qpos_adr: j.qpos_adr,
+                dof_adr: j.dof_adr,
+                stiffness: j.stiffness,
+                rest: j.spring_ref,
+            })
+            .collect()
+    };
+    if spec.options.disabled("damper") {
+        dof_damping.iter_mut().for_each(|d| *d = 0.0);
+    }
+    check_keyframes(spec, nq, nv)?;
+
     // Pass 3: the reference configuration, joint by joint.
     let mut qpos0 = vec![0.0; nq];
     for (j, link) in joints.iter().zip(spec.links.iter().filter(|l| l.joint.jtype != JointType::Fixed)) {
@@ -181,12 +201,40 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         dof_body,
         dof_armature,
         dof_damping,
+        springs,
         qpos0,
         options: spec.options.clone(),
         keyframes: spec.keyframes.clone(),
         elements: spec.elements.clone(),
         warnings: spec.warnings.clone(),
     })
+}
+
+/// Every keyframe's vectors must have the model's sizes (qpos nq, qvel nv).
+fn check_keyframes(spec: &ModelSpec, nq: usize, nv: usize) -> Result<(), LoadError> {
+    for k in &spec.keyframes {
+        for (what, v, n) in [("qpos", &k.qpos, nq), ("qvel", &k.qvel, nv)] {
+            if let Some(v) = v {
+                if v.len() != n {
+                    return Err(LoadError::Invalid {
+                        loc: k.loc.clone(),
+                        element: "key".into(),
+                        detail: format!(
+                            "keyframe '{}': {what} has {} values, the model needs {n}; give one value per {}",
+                            k.name,
+                            v.len(),
+                            if what == "qpos" {
+                                "position coordinate (nq)"
+                            } else {
+                                "degree of freedom (nv)"
+                            }
+                        ),
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A link's own mass properties in link coordinates and the mass each of its geoms contributed:

@@ -25,15 +25,29 @@ pub fn plan(model: &Model) -> Vec<Stage> {
         reason: format!("articulated-body algorithm over {} bodies, nv = {}", model.nbody() - 1, model.nv),
     }];
     let damped = model.dof_damping.iter().filter(|&&d| d != 0.0).count();
-    stages.push(if damped > 0 {
+    let springs = model.springs.len();
+    stages.push(if damped + springs > 0 {
         Stage {
             name: "passive",
             status: "runs",
-            reason: format!("joint damping on {damped} degrees of freedom"),
+            reason: format!("joint damping on {damped} degrees of freedom, {springs} joint springs"),
         }
     } else {
         Stage { name: "passive", status: "skipped", reason: "no joint damping or springs".into() }
     });
+    // Passive elements kept from the file but not simulated: springs of ball and free joints,
+    // gravity compensation, spring-dampers, higher-order spring/damper coefficients.
+    let multi_dof_springs = model.joints.iter().filter(|j| j.stiffness != 0.0 && j.kind.nq() > 1).count();
+    let other_passive = count(model, &["body", "joint"]) + multi_dof_springs;
+    if other_passive > 0 {
+        stages.push(Stage {
+            name: "passive (other)",
+            status: "parsed, not simulated",
+            reason: format!(
+                "{other_passive} elements (gravity compensation, spring-dampers, polynomial or ball/free springs); see `info` elements"
+            ),
+        });
+    }
     let friction = model.joints.iter().filter(|j| j.friction != 0.0).count();
     let limited = model.joints.iter().filter(|j| j.limits.is_some()).count();
     let mimics = model.joints.iter().filter(|j| j.mimic.is_some()).count();
@@ -50,13 +64,50 @@ pub fn plan(model: &Model) -> Vec<Stage> {
     };
     stages.push(Stage { name: "joint limits", ..parsed(limited, "limited joints") });
     stages.push(Stage { name: "joint friction", ..parsed(friction, "joints with Coulomb friction") });
-    stages.push(Stage { name: "equality constraints", ..parsed(mimics, "mimic joints") });
     stages.push(Stage {
-        name: "collision",
-        status: "skipped",
-        reason: format!("no contact pairs ({} geoms kept for later collision support)", model.geoms.len()),
+        name: "equality constraints",
+        ..parsed(mimics + count(model, &["equality"]), "mimic joints and equality constraints")
+    });
+    stages.push(Stage { name: "tendons", ..parsed(count(model, &["tendon"]), "tendons") });
+    let actuators = count(model, &["actuator"]);
+    stages.push(if actuators > 0 {
+        Stage {
+            name: "actuators",
+            status: "parsed, not simulated",
+            reason: format!("{actuators} actuators: stored; simulate applies zero control"),
+        }
+    } else {
+        Stage { name: "actuators", status: "skipped", reason: "no actuators".into() }
+    });
+    let sensors = count(model, &["sensor"]);
+    stages.push(if sensors > 0 {
+        Stage {
+            name: "sensors",
+            status: "parsed, not simulated",
+            reason: format!("{sensors} sensors: stored, not evaluated"),
+        }
+    } else {
+        Stage { name: "sensors", status: "skipped", reason: "no sensors".into() }
+    });
+    let colliding = model.geoms.iter().filter(|g| g.collision).count();
+    let pairs = count(model, &["contact"]);
+    stages.push(if colliding + pairs > 0 {
+        Stage {
+            name: "collision",
+            status: "parsed, not simulated",
+            reason: format!(
+                "{colliding} collision geoms, {pairs} contact pair/exclude entries: stored; contacts arrive with the constraint solver"
+            ),
+        }
+    } else {
+        Stage { name: "collision", status: "skipped", reason: "no collision geometry".into() }
     });
     stages
+}
+
+/// Number of kept elements in the given categories.
+fn count(model: &Model, categories: &[&str]) -> usize {
+    model.elements.iter().filter(|e| categories.contains(&e.category.as_str())).count()
 }
 
 /// Why a simulation stopped.
@@ -170,11 +221,12 @@ impl<'m> Simulation<'m> {
         Ok(())
     }
 
-    /// Kinetic and potential energy (T, V) at the current state (forward kinematics included).
+    /// Kinetic and potential energy (T, V: gravity and joint springs) at the current state
+    /// (forward kinematics included).
     pub fn energies(&mut self) -> (f64, f64) {
         let (q, v) = (self.state.q.as_slice(), self.state.v.as_slice());
         let kinetic = dynamics::kinetic_energy(self.model, &mut self.data, q, v);
-        (kinetic, dynamics::potential_energy(self.model, &self.data))
+        (kinetic, dynamics::potential_energy(self.model, &self.data) + self.model.spring_energy(q))
     }
 
     /// Forward kinematics at the current state (poses in `data`).

@@ -39,12 +39,29 @@ fn info_json_has_exactly_the_documented_keys() {
     let (ok, out, err) = lagrange(&["info", "models/solo12/solo12.urdf", "--floating", "--json"]);
     assert!(ok, "{err}");
     let v: Value = serde_json::from_str(&out).unwrap();
-    assert_eq!(keys(&v), ["bodies", "joints", "nq", "nv", "stages", "total_mass"]);
+    assert_eq!(
+        keys(&v),
+        [
+            "bodies",
+            "elements",
+            "frames",
+            "joints",
+            "keyframes",
+            "nq",
+            "nv",
+            "options",
+            "qpos0",
+            "stages",
+            "total_mass",
+            "warnings"
+        ]
+    );
     assert_eq!((v["nq"].as_u64(), v["nv"].as_u64()), (Some(19), Some(18)));
     assert_eq!(keys(&v["bodies"][1]), ["com", "inertia", "mass", "name", "parent"]);
     assert_eq!(keys(&v["joints"][0]), ["child", "dofadr", "name", "nq", "nv", "parent", "qposadr", "type"]);
     assert_eq!(v["joints"][0]["name"], "root_joint");
     assert_eq!(v["joints"][0]["type"], "free");
+    // The shipped solo12 has its meshes stripped: no collision geometry, no collision stage.
     assert_eq!(v["stages"]["collision"]["status"], "skipped");
     assert_eq!(v["stages"]["joint limits"]["status"], "parsed, not simulated");
     let total: f64 = v["total_mass"].as_f64().unwrap();

@@ -50,7 +50,8 @@ enum Command {
         #[arg(long = "jacobian")]
         jacobians: Vec<String>,
     },
-    /// Simulate from a given or the neutral state at rest, under gravity, with zero torques.
+    /// Simulate from a keyframe, a given state, or the model's reference configuration at rest,
+    /// under gravity, with zero torques.
     Simulate {
         model: PathBuf,
         /// Simulated time in seconds.
@@ -61,7 +62,10 @@ enum Command {
         dt: f64,
         #[arg(long, value_enum, default_value_t = IntegratorArg::Rk4)]
         integrator: IntegratorArg,
-        /// Initial configuration, comma-separated (nq values; default: neutral).
+        /// Start from this MJCF keyframe (`<key name>`); --q0/--v0 override its parts.
+        #[arg(long)]
+        keyframe: Option<String>,
+        /// Initial configuration, comma-separated (nq values; default: the model's qpos0).
         #[arg(long, allow_hyphen_values = true)]
         q0: Option<String>,
         /// Initial velocity, comma-separated (nv values; default: zero).
@@ -99,8 +103,9 @@ fn main() -> ExitCode {
         Some(Command::Eval { model, states, json: _, jacobians }) => {
             eval::run(&model, &options, &states, &jacobians)
         }
-        Some(Command::Simulate { model, duration, dt, integrator, q0, v0, out }) => {
-            let request = simulate::Request { duration, dt, integrator: integrator.into(), q0, v0, out };
+        Some(Command::Simulate { model, duration, dt, integrator, keyframe, q0, v0, out }) => {
+            let request =
+                simulate::Request { duration, dt, integrator: integrator.into(), keyframe, q0, v0, out };
             simulate::run_file(&model, &options, &request)
         }
     };

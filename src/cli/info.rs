@@ -46,12 +46,37 @@ pub fn to_json(model: &Model) -> Value {
     for s in plan(model) {
         stages.insert(s.name.to_string(), json!({"status": s.status, "reason": s.reason}));
     }
+    let elements: Vec<Value> = model
+        .elements
+        .iter()
+        .map(|e| {
+            json!({"category": e.category, "kind": e.kind, "name": e.name, "targets": e.targets,
+                   "source": e.loc.to_string(), "status": "parsed, not simulated"})
+        })
+        .collect();
+    let keyframes: Vec<Value> =
+        model.keyframes.iter().map(|k| json!({"name": k.name, "time": k.time})).collect();
+    let frames: Vec<Value> = model
+        .frames
+        .iter()
+        .map(|f| {
+            json!({"name": f.name, "kind": format!("{:?}", f.kind).to_lowercase(), "body": model.bodies[f.body].name})
+        })
+        .collect();
     json!({
         "nq": model.nq,
         "nv": model.nv,
         "total_mass": model.total_mass(),
         "bodies": bodies,
         "joints": joints,
+        "frames": frames,
+        "qpos0": model.qpos0,
+        "options": {"timestep": model.options.timestep, "integrator": model.options.integrator,
+                    "gravity": model.gravity.as_slice(),
+                    "flags": model.options.flags.iter().map(|(n, on)| (n.clone(), json!(if *on { "enable" } else { "disable" }))).collect::<Map<String, Value>>()},
+        "keyframes": keyframes,
+        "elements": elements,
+        "warnings": model.warnings,
         "stages": stages,
     })
 }
@@ -117,9 +142,33 @@ pub fn to_text(model: &Model) -> String {
             j.kind.nv()
         );
     }
+    if !model.keyframes.is_empty() {
+        let names: Vec<&str> = model.keyframes.iter().map(|k| k.name.as_str()).collect();
+        let _ = writeln!(s, "\nkeyframes (simulate --keyframe NAME): {}", names.join(", "));
+    }
+    if !model.elements.is_empty() {
+        let _ = writeln!(s, "\nparsed, not simulated ({} elements):", model.elements.len());
+        let mut by_kind: Vec<(String, usize)> = Vec::new();
+        for e in &model.elements {
+            let key = format!("{} <{}>", e.category, e.kind);
+            match by_kind.iter_mut().find(|(k, _)| *k == key) {
+                Some(entry) => entry.1 += 1,
+                None => by_kind.push((key, 1)),
+            }
+        }
+        for (k, n) in by_kind {
+            let _ = writeln!(s, "  {n:>4} × {k}");
+        }
+    }
     let _ = writeln!(s, "\nsimulation plan:");
     for st in plan(model) {
         let _ = writeln!(s, "  {:<22} {:<22} {}", st.name, st.status, st.reason);
+    }
+    if !model.warnings.is_empty() {
+        let _ = writeln!(s, "\nwarnings ({}):", model.warnings.len());
+        for w in &model.warnings {
+            let _ = writeln!(s, "  {w}");
+        }
     }
     s
 }

@@ -20,6 +20,8 @@ pub struct Request {
     pub duration: f64,
     pub dt: f64,
     pub integrator: IntegratorKind,
+    /// A keyframe of the model to start from.
+    pub keyframe: Option<String>,
     pub q0: Option<String>,
     pub v0: Option<String>,
     pub out: Option<PathBuf>,
@@ -64,14 +66,29 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         )));
     }
     let mut sim = Simulation::new(model, request.integrator);
-    let q0 = match &request.q0 {
-        Some(s) => parse_list("q0", s, model.nq)?,
-        None => model.neutral(),
-    };
-    let v0 = match &request.v0 {
-        Some(s) => parse_list("v0", s, model.nv)?,
-        None => vec![0.0; model.nv],
-    };
+    // Initial state: --q0/--v0, else the keyframe's, else qpos0 at rest.
+    let (mut q0, mut v0) = (model.qpos0.clone(), vec![0.0; model.nv]);
+    if let Some(name) = &request.keyframe {
+        let Some(k) = model.keyframe_id(name).map(|k| &model.keyframes[k]) else {
+            let known: Vec<&str> = model.keyframes.iter().map(|k| k.name.as_str()).collect();
+            return Err(CliError::Usage(format!(
+                "--keyframe {name}: the model has no such keyframe (it has: {})",
+                if known.is_empty() { "none".to_string() } else { known.join(", ") }
+            )));
+        };
+        if let Some(q) = &k.qpos {
+            q0.clone_from(q);
+        }
+        if let Some(v) = &k.qvel {
+            v0.clone_from(v);
+        }
+    }
+    if let Some(s) = &request.q0 {
+        q0 = parse_list("q0", s, model.nq)?;
+    }
+    if let Some(s) = &request.v0 {
+        v0 = parse_list("v0", s, model.nv)?;
+    }
     sim.set_state(&q0, &v0)?;
     let steps = (request.duration / request.dt).round() as u64;
     let mut csv = match &request.out {
@@ -254,13 +271,14 @@ pub fn default_run() -> Result<(), CliError> {
         "lagrange {}: no arguments given, so simulating the embedded default model.",
         env!("CARGO_PKG_VERSION")
     );
-    println!("(Run `lagrange --help` for info/eval/simulate on your own URDF.)\n");
+    println!("(Run `lagrange --help` for info/eval/simulate on your own URDF or MJCF.)\n");
     print!("{}", crate::cli::info::to_text(&model));
     println!();
     let request = Request {
         duration: 5.0,
         dt: 1e-3,
         integrator: IntegratorKind::Rk4,
+        keyframe: None,
         q0: Some(DEFAULT_Q0.into()),
         v0: None,
         out: None,

@@ -24,9 +24,9 @@ pub struct State {
 }
 
 impl State {
-    /// The neutral configuration at rest, time 0.
+    /// The model's reference configuration (`qpos0`) at rest, time 0.
     pub fn neutral(model: &Model) -> Self {
-        Self { time: 0.0, q: DVector::from_vec(model.neutral()), v: DVector::zeros(model.nv) }
+        Self { time: 0.0, q: DVector::from_vec(model.qpos0.clone()), v: DVector::zeros(model.nv) }
     }
 }
 
@@ -40,7 +40,8 @@ pub trait Integrator {
     fn step(&mut self, model: &Model, data: &mut Data, state: &mut State, tau: &[f64], dt: f64);
 }
 
-/// Accelerations v̇ = ABA(q, v, τ − damping ⊙ v) into `qacc`; `tau_total` is scratch (length nv).
+/// Accelerations v̇ = ABA(q, v, τ − damping ⊙ v − k ⊙ (q − q_rest)) into `qacc` (joint damping and
+/// the springs of one-dof joints); `tau_total` is scratch (length nv).
 pub(crate) fn accelerations(
     model: &Model,
     data: &mut Data,
@@ -52,6 +53,9 @@ pub(crate) fn accelerations(
 ) {
     for k in 0..model.nv {
         tau_total[k] = tau[k] - model.dof_damping[k] * v[k];
+    }
+    for s in &model.springs {
+        tau_total[s.dof_adr] -= s.stiffness * (q[s.qpos_adr] - s.rest);
     }
     qacc.copy_from(aba(model, data, q, v, tau_total.as_slice()));
 }

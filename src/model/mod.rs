@@ -163,6 +163,9 @@ pub struct Model {
     pub dof_armature: Vec<f64>,
     /// Damping per degree of freedom.
     pub dof_damping: Vec<f64>,
+    /// Joint springs of hinge and slide joints (`−stiffness·(q − rest)`), empty when the file
+    /// disables springs (`<flag spring="disable">`).
+    pub springs: Vec<Spring>,
     /// Reference configuration (MuJoCo's `qpos0`: hinge/slide `ref`, a free body's pose in the
     /// file, identity quaternions): the default initial state.
     pub qpos0: Vec<f64>,
@@ -174,6 +177,16 @@ pub struct Model {
     pub elements: Vec<Element>,
     /// What the loader ignored or could not interpret, each with file:line.
     pub warnings: Vec<String>,
+}
+
+/// A linear spring on a one-dof joint: generalized force `−stiffness·(q[qpos_adr] − rest)` on
+/// degree of freedom `dof_adr`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spring {
+    pub qpos_adr: usize,
+    pub dof_adr: usize,
+    pub stiffness: f64,
+    pub rest: f64,
 }
 
 /// Marker for "no parent degree of freedom".
@@ -214,9 +227,13 @@ impl Model {
     pub fn keyframe_id(&self, name: &str) -> Option<usize> {
         self.keyframes.iter().position(|k| k.name == name)
     }
-    /// Whether any hinge or slide joint has a spring.
+    /// Whether any hinge or slide joint has a simulated spring.
     pub fn has_springs(&self) -> bool {
-        self.joints.iter().any(|j| j.stiffness != 0.0)
+        !self.springs.is_empty()
+    }
+    /// Potential energy stored in the joint springs, Σ ½ k (q − rest)².
+    pub fn spring_energy(&self, q: &[f64]) -> f64 {
+        self.springs.iter().map(|s| 0.5 * s.stiffness * (q[s.qpos_adr] - s.rest).powi(2)).sum()
     }
     /// Neutral configuration (zeros, identity quaternions).
     pub fn neutral(&self) -> Vec<f64> {
