@@ -4,7 +4,7 @@
 
 use crate::io::LoadError;
 use crate::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec};
-use crate::model::{Body, Frame, Geom, Joint, JointKind, Model, Spring, NO_DOF};
+use crate::model::{Body, Frame, Geom, Joint, JointKind, Model, SourceLoc, Spring, NO_DOF};
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
 use std::collections::HashMap;
 
@@ -163,7 +163,6 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     if spec.options.disabled("damper") {
         dof_damping.iter_mut().for_each(|d| *d = 0.0);
     }
-    check_keyframes(spec, nq, nv)?;
 
     // Pass 3: the reference configuration, joint by joint.
     let mut qpos0 = vec![0.0; nq];
@@ -187,6 +186,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         }
     }
 
+    let keyframes = complete_keyframes(spec, &joints, &qpos0, nv)?;
+
     Ok(Model {
         name: spec.name.clone(),
         source: spec.source.clone(),
@@ -204,18 +205,27 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         springs,
         qpos0,
         options: spec.options.clone(),
-        keyframes: spec.keyframes.clone(),
+        keyframes,
         elements: spec.elements.clone(),
         warnings: spec.warnings.clone(),
     })
 }
 
-/// Every keyframe's vectors must have the model's sizes (qpos nq, qvel nv).
-fn check_keyframes(spec: &ModelSpec, nq: usize, nv: usize) -> Result<(), LoadError> {
+/// Keyframes with full vectors, as MuJoCo completes them: a missing `qpos` is `qpos0` and a short
+/// one is padded from `qpos0`; a missing or short `qvel` is padded with zeros; quaternions are
+/// normalized. Longer vectors are errors.
+fn complete_keyframes(
+    spec: &ModelSpec,
+    joints: &[Joint],
+    qpos0: &[f64],
+    nv: usize,
+) -> Result<Vec<crate::model::Keyframe>, LoadError> {
+    let nq = qpos0.len();
+    let mut out = Vec::with_capacity(spec.keyframes.len());
     for k in &spec.keyframes {
         for (what, v, n) in [("qpos", &k.qpos, nq), ("qvel", &k.qvel, nv)] {
             if let Some(v) = v {
-                if v.len() != n {
+                if v.len() > n {
                     return Err(LoadError::Invalid {
                         loc: k.loc.clone(),
                         element: "key".into(),
@@ -233,56 +243,125 @@ fn check_keyframes(spec: &ModelSpec, nq: usize, nv: usize) -> Result<(), LoadErr
                 }
             }
         }
+        let mut qpos = qpos0.to_vec();
+        if let Some(q) = &k.qpos {
+            qpos[..q.len()].copy_from_slice(q);
+        }
+        for j in joints {
+            let quat = match j.kind {
+                JointKind::Free => j.qpos_adr + 3..j.qpos_adr + 7,
+                JointKind::Ball => j.qpos_adr..j.qpos_adr + 4,
+                _ => continue,
+            };
+            let n = qpos[quat.clone()].iter().map(|x| x * x).sum::<f64>().sqrt();
+            if n > 0.0 {
+                qpos[quat].iter_mut().for_each(|x| *x /= n);
+            }
+        }
+        let mut qvel = vec![0.0; nv];
+        if let Some(v) = &k.qvel {
+            qvel[..v.len()].copy_from_slice(v);
+        }
+        out.push(crate::model::Keyframe { qpos: Some(qpos), qvel: Some(qvel), ..k.clone() });
     }
-    Ok(())
+    Ok(out)
 }
 
 /// A link's own mass properties in link coordinates and the mass each of its geoms contributed:
-/// from its geoms when the loader asks (MuJoCo `inertiafromgeom`), else its checked `<inertial>`;
-/// then the compiler's lower bounds and inertia balancing ([`MassRules`]).
+/// from its geoms when the loader asks (MuJoCo `inertiafromgeom`) and some geom has mass, else its
+/// checked `<inertial>`; then the compiler's lower bounds and inertia balancing ([`MassRules`]).
 fn link_mass(
     link: &LinkSpec,
     rules: &MassRules,
     meshes: &mut crate::io::geom_mass::MeshCache,
 ) -> Result<(RigidInertia, Vec<f64>), LoadError> {
+    // The world body keeps no mass and obeys no bounds.
+    let world = link.parent.is_none() && link.joint.jtype == JointType::Fixed;
+    let rules = if world { &MassRules::default() } else { rules };
     let mut geom_masses = vec![0.0; link.geoms.len()];
-    let inertia = if link.inertia_from_geoms {
+    if link.inertia_from_geoms {
         let mut sum = RigidInertia::zero();
         for (g, m) in link.geoms.iter().zip(geom_masses.iter_mut()) {
             let i_geom = crate::io::geom_mass::geom_inertia(g, &link.name, meshes)?;
-            *m = i_geom.mass;
-            sum += &i_geom.transformed(&g.x_link_geom);
+            // MuJoCo ignores geoms of negligible mass (≤ mjEPS).
+            if i_geom.mass > 1e-14 {
+                *m = i_geom.mass;
+                sum += &i_geom.transformed(&g.x_link_geom);
+            }
         }
-        sum
-    } else if let Some(inertial) = &link.inertial {
-        link_inertia(&link.name, inertial)?
-    } else {
-        RigidInertia::zero()
-    };
-    // The world body keeps no mass; every other link obeys the bounds.
-    if link.parent.is_none() && link.joint.jtype == JointType::Fixed {
-        return Ok((inertia, geom_masses));
+        if sum.mass > 0.0 {
+            let (com, i_com) = (sum.com(), sum.i_com());
+            let eig = i_com.symmetric_eigen();
+            let bounded = bounded_moments(&link.name, &link.loc, eig.eigenvalues, rules)?;
+            return Ok((
+                inertia_with(sum, sum.mass.max(rules.bound_mass), com, &eig.eigenvectors, bounded),
+                geom_masses,
+            ));
+        }
     }
-    Ok((apply_bounds(inertia, rules), geom_masses))
+    let Some(i) = &link.inertial else {
+        // No mass anywhere: only the bounds can give the link some, at its origin.
+        let zero = RigidInertia::zero();
+        let bounded = bounded_moments(&link.name, &link.loc, Vec3::zeros(), rules)?;
+        return Ok((
+            inertia_with(zero, rules.bound_mass, Vec3::zeros(), &Mat3::identity(), bounded),
+            geom_masses,
+        ));
+    };
+    let (moments, axes) = check_inertial(&link.name, i)?;
+    let bounded = bounded_moments(&link.name, &i.loc, moments, rules)?;
+    let r = i.x_link_inertial.rot;
+    let given = RigidInertia::from_com(i.mass, i.x_link_inertial.pos, r * i.inertia * r.transpose());
+    Ok((
+        inertia_with(given, i.mass.max(rules.bound_mass), i.x_link_inertial.pos, &(r * axes), bounded),
+        geom_masses,
+    ))
 }
 
-/// MuJoCo's `boundmass`, `boundinertia` and `balanceinertia` on a link's principal moments
-/// (`mjCBody::Compile`); the tensor is untouched when no rule fires.
-fn apply_bounds(inertia: RigidInertia, rules: &MassRules) -> RigidInertia {
-    let mass = inertia.mass.max(rules.bound_mass);
-    let com = inertia.com();
-    let i_com = inertia.i_com();
-    let eig = i_com.symmetric_eigen();
-    let mut moments = eig.eigenvalues.map(|l| l.max(rules.bound_inertia));
-    let violated = (0..3).any(|k| moments[k] > moments[(k + 1) % 3] + moments[(k + 2) % 3]);
-    if violated && rules.balance_inertia {
-        moments = Vec3::repeat(moments.sum() / 3.0);
+/// `original` if neither its mass nor its principal moments changed (keeping it bit for bit),
+/// else the inertia rebuilt from `mass`, `com` and the new `moments` about `axes` (columns).
+fn inertia_with(
+    original: RigidInertia,
+    mass: f64,
+    com: Vec3,
+    axes: &Mat3,
+    moments: Option<Vec3>,
+) -> RigidInertia {
+    match moments {
+        None if mass == original.mass => original,
+        None => RigidInertia::from_com(mass, com, original.i_com()),
+        Some(m) => RigidInertia::from_com(mass, com, axes * Mat3::from_diagonal(&m) * axes.transpose()),
     }
-    if mass == inertia.mass && moments == eig.eigenvalues {
-        return inertia;
+}
+
+/// MuJoCo's `boundinertia` and `balanceinertia` on principal moments (`mjCBody::Compile`): the new
+/// moments, or `None` when no rule fires. Moments that violate the triangle inequality are an error
+/// unless `balanceinertia` replaces them by their mean.
+fn bounded_moments(
+    link: &str,
+    loc: &SourceLoc,
+    moments: Vec3,
+    rules: &MassRules,
+) -> Result<Option<Vec3>, LoadError> {
+    let mut m = moments.map(|l| l.max(rules.bound_inertia));
+    let scale = m.max().max(f64::MIN_POSITIVE);
+    let violated = (0..3).any(|k| m[k] > m[(k + 1) % 3] + m[(k + 2) % 3] + INERTIA_TOL * scale);
+    if violated {
+        if !rules.balance_inertia {
+            let mut e: Vec<f64> = m.iter().copied().collect();
+            e.sort_by(f64::total_cmp);
+            return Err(LoadError::NonPhysicalInertia {
+                loc: loc.clone(),
+                link: link.to_string(),
+                detail: format!(
+                    "principal moments {e:?} violate the triangle inequality ({} + {} < {}) (MJCF: <compiler balanceinertia=\"true\"> replaces them by their mean)",
+                    e[0], e[1], e[2]
+                ),
+            });
+        }
+        m = Vec3::repeat(m.sum() / 3.0);
     }
-    let i_new = eig.eigenvectors * Mat3::from_diagonal(&moments) * eig.eigenvectors.transpose();
-    RigidInertia::from_com(mass, com, i_new)
+    Ok((m != moments).then_some(m))
 }
 
 /// MuJoCo's `settotalmass`: scale the masses and inertias of all links but the world so that they
@@ -359,8 +438,9 @@ fn joint_kind(j: &JointSpec) -> Result<Option<JointKind>, LoadError> {
     })
 }
 
-/// Checks an `<inertial>` and returns it as a spatial inertia in link coordinates.
-fn link_inertia(link: &str, i: &InertialSpec) -> Result<RigidInertia, LoadError> {
+/// Checks an `<inertial>` (finite, non-negative mass; symmetric tensor with non-negative principal
+/// moments) and returns its principal moments and axes (columns, in inertial-frame coordinates).
+fn check_inertial(link: &str, i: &InertialSpec) -> Result<(Vec3, Mat3), LoadError> {
     let err =
         |detail: String| LoadError::NonPhysicalInertia { loc: i.loc.clone(), link: link.to_string(), detail };
     if !i.mass.is_finite() || i.mass < 0.0 {
@@ -377,18 +457,11 @@ fn link_inertia(link: &str, i: &InertialSpec) -> Result<RigidInertia, LoadError>
     if (m - m.transpose()).abs().max() > INERTIA_TOL * scale {
         return Err(err("the tensor is not symmetric".into()));
     }
-    let mut eig: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
-    eig.sort_by(f64::total_cmp);
-    if eig[0] < -INERTIA_TOL * scale {
-        return Err(err(format!("principal moments {eig:?} include a negative one")));
+    let eig = m.symmetric_eigen();
+    if eig.eigenvalues.min() < -INERTIA_TOL * scale {
+        let mut e: Vec<f64> = eig.eigenvalues.iter().copied().collect();
+        e.sort_by(f64::total_cmp);
+        return Err(err(format!("principal moments {e:?} include a negative one")));
     }
-    if eig[0] + eig[1] < eig[2] - INERTIA_TOL * scale {
-        return Err(err(format!(
-            "principal moments {eig:?} violate the triangle inequality ({} + {} < {})",
-            eig[0], eig[1], eig[2]
-        )));
-    }
-    let r = i.x_link_inertial.rot;
-    let i_com: Mat3 = r * m * r.transpose();
-    Ok(RigidInertia::from_com(i.mass, i.x_link_inertial.pos, i_com))
+    Ok((eig.eigenvalues, eig.eigenvectors))
 }

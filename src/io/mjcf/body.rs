@@ -160,8 +160,9 @@ impl<'a> TreeBuilder<'a> {
         let name = a.text("name").map_or_else(|| format!("body{id}"), str::to_string);
         let class = e.attr("childclass").unwrap_or(class).to_string();
         self.check_class(e, &class)?;
-        let x_parent_body = x_parent_frame
-            * Transform::new(rotation(&a, &self.compiler.angles)?, a.vec3("pos")?.unwrap_or_default());
+        let x_frame_body =
+            Transform::new(rotation(&a, &self.compiler.angles)?, a.vec3("pos")?.unwrap_or_default());
+        let x_parent_body = x_parent_frame * x_frame_body;
         let content = self.flatten(e, Transform::identity(), &class)?;
 
         // Joints, in order, with their anchors and axes in the body frame.
@@ -240,6 +241,17 @@ impl<'a> TreeBuilder<'a> {
             InertiaFromGeom::False => false,
             InertiaFromGeom::Auto => inertial.is_none(),
         };
+        // A body with no mass at all gets MuJoCo's default inertial frame: its own `pos` and
+        // `quat` reused as if they were body-frame coordinates (`mjCBody::Compile`, "ipos
+        // undefined"), which matters when `boundmass`/`boundinertia` give it mass.
+        let inertial = inertial.or_else(|| {
+            Some(InertialSpec {
+                mass: 0.0,
+                x_link_inertial: x_frame_body,
+                inertia: Mat3::zeros(),
+                loc: e.loc.clone(),
+            })
+        });
         self.links.push(LinkSpec {
             name,
             loc: e.loc.clone(),
