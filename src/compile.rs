@@ -124,6 +124,10 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         }
     }
 
+    if spec.mass_rules.require_moving_mass {
+        check_moving_mass(spec, &bodies, &link_body)?;
+    }
+
     // Pass 2: per-dof tables (λ for the sparse factorization, armature, damping).
     let mut dof_parent = vec![NO_DOF; nv];
     let mut dof_body = vec![0; nv];
@@ -265,6 +269,38 @@ fn complete_keyframes(
         out.push(crate::model::Keyframe { qpos: Some(qpos), qvel: Some(qvel), ..k.clone() });
     }
     Ok(out)
+}
+
+/// MuJoCo's check that every moving body has mass and inertia (`CheckBodyMassInertia`: at least
+/// `mjMINVAL` = 1e-15, its welded children counted). Bodies made for joint anchors are exempt: they
+/// stand for no MJCF body.
+fn check_moving_mass(
+    spec: &ModelSpec,
+    bodies: &[Body],
+    link_body: &[(usize, Transform)],
+) -> Result<(), LoadError> {
+    const MINVAL: f64 = 1e-15;
+    for (b, body) in bodies.iter().enumerate().skip(1) {
+        let Some(li) = (0..spec.links.len())
+            .find(|&l| link_body[l].0 == b && spec.links[l].kind == crate::model::FrameKind::Link)
+        else {
+            continue;
+        };
+        let moments = body.inertia.i_com().symmetric_eigenvalues();
+        if body.inertia.mass < MINVAL || moments.min() < MINVAL {
+            let link = &spec.links[li];
+            return Err(LoadError::NonPhysicalInertia {
+                loc: link.loc.clone(),
+                link: link.name.clone(),
+                detail: format!(
+                    "the body moves but its mass ({:e} kg) or a principal moment ({:e} kg·m²) is below 1e-15, so its acceleration is undefined (MuJoCo: \"mass and inertia of moving bodies must be larger than mjMINVAL\"); give it an <inertial> or a geom with mass",
+                    body.inertia.mass,
+                    moments.min()
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// A link's own mass properties in link coordinates and the mass each of its geoms contributed:

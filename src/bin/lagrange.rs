@@ -1,8 +1,8 @@
-//! The `lagrange` command line: `info`, `eval`, `simulate`; with no arguments it simulates the
+//! The `lagrange` command line: `info`, `eval`, `simulate`, `bench`; with no arguments it simulates the
 //! embedded default model (a UR5 arm released under gravity) and prints the summary.
 
 use clap::{Parser, Subcommand, ValueEnum};
-use lagrange::cli::{eval, info, simulate};
+use lagrange::cli::{bench, eval, info, simulate};
 use lagrange::integrate::IntegratorKind;
 use lagrange::io::LoadOptions;
 use std::path::PathBuf;
@@ -12,7 +12,7 @@ use std::process::ExitCode;
 #[command(
     name = "lagrange",
     version,
-    about = "Multibody dynamics: load URDF models, evaluate M, bias, ABA, simulate"
+    about = "Multibody dynamics: load URDF and MJCF models, evaluate M, bias, ABA, simulate"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -29,6 +29,13 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Median time to load the model (parse + compile) and of FK, RNEA, CRBA and ABA on it.
+    Bench {
+        model: PathBuf,
+        /// One JSON line instead of text.
+        #[arg(long)]
+        json: bool,
+    },
     /// Print bodies, joints, sizes and the simulation plan.
     Info {
         model: PathBuf,
@@ -100,6 +107,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         None => simulate::default_run(),
         Some(Command::Info { model, json }) => info::run(&model, &options, json),
+        Some(Command::Bench { model, json }) => bench::run(&model, &options, json),
         Some(Command::Eval { model, states, json: _, jacobians }) => {
             eval::run(&model, &options, &states, &jacobians)
         }

@@ -1,6 +1,7 @@
 //! The command implementations behind `src/bin/lagrange.rs` (DESIGN.md, layer 9), kept in the
 //! library so they are testable.
 
+pub mod bench;
 pub mod eval;
 pub mod info;
 pub mod simulate;

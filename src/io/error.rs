@@ -54,7 +54,7 @@ pub enum LoadError {
     #[error("{loc}: <include>: include cycle: {}; remove one of these includes", .chain.join(" includes "))]
     IncludeCycle { loc: SourceLoc, chain: Vec<String> },
     #[error(
-        "{loc}: <include>: cannot read '{path}': {reason}; include paths are relative to the including file"
+        "{loc}: <include>: cannot read '{path}': {reason}; MuJoCo looks for an included file in the main model's folder, then beside the including file"
     )]
     IncludeNotFound { loc: SourceLoc, path: String, reason: String },
     #[error("{loc}: <{element}>: unknown default class '{class}'; define <default class=\"{class}\"> or fix the name")]

@@ -42,6 +42,9 @@ pub struct MassRules {
     pub balance_inertia: bool,
     /// Scale the masses and inertias of the moving links so that they total this (kg).
     pub total_mass: Option<f64>,
+    /// Every moving body (its welded links included) must have mass and principal moments of at
+    /// least MuJoCo's `mjMINVAL` (MJCF; URDF allows massless moving links with massive children).
+    pub require_moving_mass: bool,
 }
 
 /// One link (URDF) or body (MJCF) with the joint that attaches it to its parent.

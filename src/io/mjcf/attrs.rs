@@ -13,6 +13,8 @@ pub struct Attrs {
     pub loc: SourceLoc,
     /// Name → value; explicit attributes replace class defaults.
     pub values: Vec<(String, String)>,
+    /// The names written on the element itself (not inherited from a class).
+    pub explicit: Vec<String>,
 }
 
 impl Attrs {
@@ -30,7 +32,8 @@ impl Attrs {
                 None => values.push((k.clone(), v.clone())),
             }
         }
-        Self { tag: tag.to_string(), loc: loc.clone(), values }
+        let explicit = explicit.iter().map(|(k, _)| k.clone()).collect();
+        Self { tag: tag.to_string(), loc: loc.clone(), values, explicit }
     }
 
     pub fn has(&self, name: &str) -> bool {

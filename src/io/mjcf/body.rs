@@ -170,6 +170,20 @@ impl<'a> TreeBuilder<'a> {
         for (je, x, jclass) in &content.joints {
             joints.push(self.joint(je, x, jclass)?);
         }
+        if let Some(ball) = joints.iter().position(|j| j.0.jtype == JointType::Ball) {
+            if let Some((later, _)) =
+                joints[ball + 1..].iter().find(|j| matches!(j.0.jtype, JointType::Ball | JointType::Revolute))
+            {
+                return Err(LoadError::Invalid {
+                    loc: later.loc.clone(),
+                    element: "joint".into(),
+                    detail: format!(
+                        "body '{name}': joint '{}' rotates after ball joint '{}' in the same body, which MuJoCo forbids; put it in a child body or before the ball joint",
+                        later.name, joints[ball].0.name
+                    ),
+                });
+            }
+        }
         let free = joints.iter().any(|j| j.0.jtype == JointType::Floating);
         if free && (joints.len() > 1 || parent != 0) {
             return Err(LoadError::Invalid {

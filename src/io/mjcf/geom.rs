@@ -25,6 +25,11 @@ fn placement(a: &Attrs, gtype: &str, angles: &AngleConvention) -> Result<(Transf
         size[..v.len()].copy_from_slice(&v);
     }
     if let Some(ft) = a.array::<6>("fromto")? {
+        if a.vec3("pos")?.is_some_and(|p| p != Vec3::zeros()) {
+            return Err(
+                a.error("fromto", "and 'pos' are both given; fromto already places the geom: remove pos")
+            );
+        }
         if !matches!(gtype, "capsule" | "cylinder" | "box" | "ellipsoid") {
             return Err(
                 a.error("fromto", format!("needs a capsule, cylinder, box or ellipsoid, not a {gtype}"))

@@ -27,14 +27,17 @@ const ORIENTATION_ATTRS: [&str; 5] = ["quat", "axisangle", "euler", "xyaxes", "z
 
 /// The rotation an element's orientation attributes give (identity if none).
 pub fn rotation(a: &Attrs, angles: &AngleConvention) -> Result<Mat3, LoadError> {
-    let given: Vec<&str> = ORIENTATION_ATTRS.iter().copied().filter(|n| a.has(n)).collect();
-    // A `quat` inherited from a default class does not conflict with an explicit alternative.
-    let given: Vec<&str> =
-        if given.len() > 1 { given.into_iter().filter(|n| *n != "quat").collect() } else { given };
-    if given.len() > 1 {
-        return Err(a.error(given[1], format!("conflicts with '{}': give only one orientation", given[0])));
+    // Two orientations written on one element are an error (as in MuJoCo); one written on the
+    // element overrides any a default class supplies.
+    let written: Vec<&str> =
+        ORIENTATION_ATTRS.iter().copied().filter(|n| a.explicit.iter().any(|e| e == n)).collect();
+    if written.len() > 1 {
+        return Err(
+            a.error(written[1], format!("conflicts with '{}': give only one orientation", written[0]))
+        );
     }
-    let Some(&which) = given.first() else { return Ok(Mat3::identity()) };
+    let inherited = ORIENTATION_ATTRS.iter().copied().find(|n| a.has(n));
+    let Some(which) = written.first().copied().or(inherited) else { return Ok(Mat3::identity()) };
     match which {
         "quat" => {
             let q = a.array::<4>("quat")?.unwrap_or([1.0, 0.0, 0.0, 0.0]);

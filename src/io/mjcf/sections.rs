@@ -24,7 +24,7 @@ pub(crate) fn compiler(root: &Element, dir: &Path) -> Result<Compiler, LoadError
         autolimits: true,
         inertia_from_geom: InertiaFromGeom::Auto,
         inertia_groups: [0, 5],
-        mass_rules: MassRules::default(),
+        mass_rules: MassRules { require_moving_mass: true, ..MassRules::default() },
     };
     for e in root.children_named("compiler") {
         let a = plain(e);

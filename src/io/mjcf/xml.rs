@@ -37,7 +37,7 @@ pub fn read_document(path: &Path) -> Result<Element, LoadError> {
 
 /// Like [`read_document`] for text already in memory (`path` names it and anchors includes).
 pub fn read_text(text: &str, path: &Path) -> Result<Element, LoadError> {
-    let mut stack = vec![canonical(path)];
+    let mut stack = Includes { open: vec![canonical(path)], seen: Vec::new() };
     let root = parse_file(text, path, &mut stack)?;
     if root.tag != "mujoco" {
         return Err(LoadError::Invalid {
@@ -49,11 +49,18 @@ pub fn read_text(text: &str, path: &Path) -> Result<Element, LoadError> {
     Ok(root)
 }
 
+/// The files being read (the include chain, for cycles) and every file included so far (MuJoCo
+/// includes a file at most once).
+struct Includes {
+    open: Vec<PathBuf>,
+    seen: Vec<PathBuf>,
+}
+
 fn canonical(path: &Path) -> PathBuf {
     path.canonicalize().unwrap_or_else(|_| path.to_path_buf())
 }
 
-fn parse_file(text: &str, path: &Path, stack: &mut Vec<PathBuf>) -> Result<Element, LoadError> {
+fn parse_file(text: &str, path: &Path, stack: &mut Includes) -> Result<Element, LoadError> {
     let file = path.display().to_string();
     let options = ParsingOptions { allow_dtd: true, ..ParsingOptions::default() };
     let doc = Document::parse_with_options(text, options).map_err(|e| LoadError::Xml {
@@ -71,7 +78,7 @@ fn convert(
     doc: &Document,
     path: &Path,
     file: &str,
-    stack: &mut Vec<PathBuf>,
+    stack: &mut Includes,
 ) -> Result<Element, LoadError> {
     let loc = SourceLoc { file: file.to_string(), line: doc.text_pos_at(node.range().start).row };
     let mut out = Element {
@@ -96,7 +103,7 @@ fn include(
     doc: &Document,
     path: &Path,
     file: &str,
-    stack: &mut Vec<PathBuf>,
+    stack: &mut Includes,
 ) -> Result<Vec<Element>, LoadError> {
     let loc = SourceLoc { file: file.to_string(), line: doc.text_pos_at(node.range().start).row };
     let Some(name) = node.attribute("file") else {
@@ -107,13 +114,13 @@ fn include(
         });
     };
     // MuJoCo tries the top-level model's folder first, then the including file's folder.
-    let top = stack.first().and_then(|p| p.parent()).map(Path::to_path_buf).unwrap_or_default();
+    let top = stack.open.first().and_then(|p| p.parent()).map(Path::to_path_buf).unwrap_or_default();
     let beside = path.parent().unwrap_or(Path::new("")).join(name);
     let target = if top.join(name).is_file() { top.join(name) } else { beside };
     let key = canonical(&target);
-    if let Some(first) = stack.iter().position(|p| *p == key) {
+    if let Some(first) = stack.open.iter().position(|p| *p == key) {
         let chain: Vec<String> =
-            stack[first..].iter().chain([&key]).map(|p| p.display().to_string()).collect();
+            stack.open[first..].iter().chain([&key]).map(|p| p.display().to_string()).collect();
         return Err(LoadError::IncludeCycle { loc, chain });
     }
     let text = std::fs::read_to_string(&target).map_err(|e| LoadError::IncludeNotFound {
@@ -121,9 +128,20 @@ fn include(
         path: target.display().to_string(),
         reason: e.to_string(),
     })?;
-    stack.push(key);
+    if stack.seen.contains(&key) {
+        return Err(LoadError::Invalid {
+            loc,
+            element: "include".into(),
+            detail: format!(
+                "'{}' is included a second time; MuJoCo includes a file at most once: remove the repeated <include>",
+                target.display()
+            ),
+        });
+    }
+    stack.seen.push(key.clone());
+    stack.open.push(key);
     let root = parse_file(&text, &target, stack)?;
-    stack.pop();
+    stack.open.pop();
     if root.tag != "mujoco" {
         return Err(LoadError::Invalid {
             loc: root.loc,

@@ -1,0 +1,74 @@
+//! `lagrange bench MODEL [--json]`: median wall time of loading the model (parse + compile) and of
+//! the dynamics kernels on it, for side-by-side comparisons with MuJoCo and Pinocchio run by
+//! `validation/bench_load.py` in the same session (DESIGN.md, "Truth": speed is quoted as ratios).
+
+use super::CliError;
+use crate::dynamics::{aba, crba, rnea};
+use crate::io::{load, LoadOptions};
+use crate::kinematics::forward_kinematics;
+use crate::model::Data;
+use crate::Model;
+use serde_json::json;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+/// Median of `f`'s run time in microseconds over batches of `inner` calls, repeated until
+/// `budget` has passed (at least 5 batches).
+fn median_us(budget: Duration, inner: u32, mut f: impl FnMut()) -> f64 {
+    let start = Instant::now();
+    let mut samples = Vec::new();
+    while samples.len() < 5 || (start.elapsed() < budget && samples.len() < 10_000) {
+        let t = Instant::now();
+        for _ in 0..inner {
+            f();
+        }
+        samples.push(t.elapsed().as_secs_f64() * 1e6 / f64::from(inner));
+    }
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
+}
+
+/// A deterministic, non-trivial state: qpos0 moved by a fixed tangent, a fixed velocity.
+fn test_state(model: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let dq: Vec<f64> = (0..model.nv).map(|i| 0.3 * ((i as f64) * 1.3).sin()).collect();
+    let mut q = model.qpos0.clone();
+    crate::model::integrate_configuration(model, &mut q, &dq, 1.0);
+    let v: Vec<f64> = (0..model.nv).map(|i| ((i as f64) * 0.7).cos()).collect();
+    let tau: Vec<f64> = (0..model.nv).map(|i| ((i as f64) * 0.4).sin()).collect();
+    (q, v, tau)
+}
+
+/// Runs `bench`: load time, then FK, RNEA, CRBA and ABA medians.
+pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliError> {
+    let model = load(path, options)?;
+    let load_us = median_us(Duration::from_secs(2), 1, || {
+        let m = load(path, options).expect("the model loaded once already");
+        std::hint::black_box(m);
+    });
+    let mut data = Data::new(&model);
+    let (q, v, tau) = test_state(&model);
+    let budget = Duration::from_millis(500);
+    let fk_us = median_us(budget, 100, || forward_kinematics(&model, &mut data, &q));
+    let rnea_us = median_us(budget, 100, || {
+        std::hint::black_box(rnea(&model, &mut data, &q, &v, &tau));
+    });
+    let crba_us = median_us(budget, 100, || {
+        std::hint::black_box(crba(&model, &mut data, &q));
+    });
+    let aba_us = median_us(budget, 100, || {
+        std::hint::black_box(aba(&model, &mut data, &q, &v, &tau));
+    });
+    if json {
+        let out = json!({"model": path.display().to_string(), "nq": model.nq, "nv": model.nv,
+            "load_us": load_us, "fk_us": fk_us, "rnea_us": rnea_us, "crba_us": crba_us, "aba_us": aba_us});
+        println!("{out}");
+    } else {
+        println!("{} (nq {}, nv {}), median µs per call:", path.display(), model.nq, model.nv);
+        println!("  load (parse + compile) {load_us:>12.1}");
+        println!("  forward kinematics     {fk_us:>12.3}");
+        println!("  RNEA                   {rnea_us:>12.3}");
+        println!("  CRBA                   {crba_us:>12.3}");
+        println!("  ABA                    {aba_us:>12.3}");
+    }
+    Ok(())
+}
