@@ -196,3 +196,35 @@ fn load_errors_reach_the_user_with_file_and_line() {
         "{err}"
     );
 }
+
+#[test]
+fn mjcf_info_lists_kept_elements_and_keyframes() {
+    let (ok, out, err) = lagrange(&["info", "models/mjcf/unitree_go1/go1.xml", "--json"]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!((v["nq"].as_u64(), v["nv"].as_u64()), (Some(19), Some(18)));
+    assert_eq!(v["keyframes"][0]["name"], "home");
+    let actuators = v["elements"].as_array().unwrap().iter().filter(|e| e["category"] == "actuator").count();
+    assert_eq!(actuators, 12);
+    assert_eq!(v["stages"]["actuators"]["status"], "parsed, not simulated");
+    assert_eq!(v["stages"]["collision"]["status"], "parsed, not simulated");
+    assert_eq!(v["options"]["timestep"], 0.002, "MuJoCo's default: go1.xml sets no <option>");
+}
+
+#[test]
+fn simulate_starts_from_a_keyframe_and_rejects_unknown_ones() {
+    let (ok, out, err) = lagrange(&[
+        "simulate",
+        "models/mjcf/unitree_go1/go1.xml",
+        "--keyframe",
+        "home",
+        "--duration",
+        "0.01",
+    ]);
+    assert!(ok, "{err}");
+    // The home pose bends the calves to −1.8 rad; 10 ms of free fall barely moves them.
+    assert!(out.contains("FR_calf_joint            q = [-1.80"), "{out}");
+    let (ok, _, err) = lagrange(&["simulate", "models/mjcf/unitree_go1/go1.xml", "--keyframe", "crouch"]);
+    assert!(!ok);
+    assert!(err.contains("--keyframe crouch: the model has no such keyframe (it has: home)"), "{err}");
+}
