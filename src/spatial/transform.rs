@@ -48,7 +48,9 @@ impl Transform {
     }
     /// Orientation as a unit quaternion `[w, x, y, z]` with `w ≥ 0`.
     pub fn quat_wxyz(&self) -> [f64; 4] {
-        let q = UnitQuaternion::from_matrix(&self.rot);
+        // `from_rotation_matrix` is closed-form (Shepperd's method) and exact for half turns,
+        // where the iterative `from_matrix` stalls at the identity.
+        let q = UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(self.rot));
         let s = if q.w < 0.0 { -1.0 } else { 1.0 };
         [s * q.w, s * q.i, s * q.j, s * q.k]
     }

@@ -23,6 +23,7 @@ pub(crate) fn meshes(
     root: &Element,
     defaults: &Defaults,
     compiler: &Compiler,
+    main_file: &str,
 ) -> Result<HashMap<String, MeshAsset>, LoadError> {
     let mut out = HashMap::new();
     for section in root.children_named("asset") {
@@ -39,7 +40,7 @@ pub(crate) fn meshes(
             // MuJoCo looks in the mesh folder first, then (for a file pulled in by <include>)
             // next to the including file.
             let mut path = compiler.meshdir.join(file);
-            if !path.is_file() {
+            if !path.is_file() && e.loc.file != main_file {
                 if let Some(dir) = std::path::Path::new(&e.loc.file).parent() {
                     if dir.join(file).is_file() {
                         path = dir.join(file);

@@ -57,18 +57,49 @@ pub fn parse_str(text: &str, path: &Path, options: &LoadOptions) -> Result<Model
     parse_root(&root, path, options)
 }
 
+/// Every actuator, equality constraint, tendon and contact pair must name objects that exist (as
+/// MuJoCo requires); names are checked against all bodies, joints, geoms, sites and tendons.
+fn check_targets(
+    elements: &[crate::model::Element],
+    links: &[crate::model::spec::LinkSpec],
+) -> Result<(), LoadError> {
+    let mut names: std::collections::HashSet<&str> = std::collections::HashSet::new();
+    for l in links {
+        names.insert(&l.name);
+        names.insert(&l.joint.name);
+        names.extend(l.geoms.iter().map(|g| g.name.as_str()));
+        names.extend(l.frames.iter().map(|f| f.name.as_str()));
+    }
+    names.extend(elements.iter().filter(|e| e.category == "tendon").map(|e| e.name.as_str()));
+    for e in elements
+        .iter()
+        .filter(|e| matches!(e.category.as_str(), "actuator" | "equality" | "tendon" | "contact"))
+    {
+        if let Some(t) = e.targets.iter().find(|t| !names.contains(t.as_str())) {
+            return Err(LoadError::UnknownReference {
+                loc: e.loc.clone(),
+                element: e.kind.clone(),
+                kind: "object (body, joint, geom, site or tendon)",
+                target: t.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
 fn parse_root(root: &xml::Element, path: &Path, _options: &LoadOptions) -> Result<ModelSpec, LoadError> {
     let mut warnings = check::check_tree(root)?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let compiler = sections::compiler(root, &dir)?;
     let (options, gravity) = sections::options(root)?;
     let defaults = defaults::Defaults::build(root)?;
-    let meshes = assets::meshes(root, &defaults, &compiler)?;
+    let meshes = assets::meshes(root, &defaults, &compiler, &root.loc.file)?;
     let mut builder = body::TreeBuilder::new(&compiler, &defaults, &meshes);
     builder.worldbody(root)?;
     warnings.append(&mut builder.warnings);
     let keyframes = sections::keyframes(root)?;
     let mut elements = sections::elements(root, &defaults)?;
+    check_targets(&elements, &builder.links)?;
     elements.append(&mut builder.kept);
     let name = root.attr("model").unwrap_or("MuJoCo Model").to_string();
     let gravity: Vec3 = gravity;
