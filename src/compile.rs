@@ -19,12 +19,27 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     }
     check_unique_names(spec)?;
     let mut meshes = crate::io::geom_mass::MeshCache::default();
+    let mut warnings = spec.warnings.clone();
     // Pass 0: every link's own mass properties (explicit or from its geoms), with the compiler's
     // bounds; then `settotalmass` scales the moving links.
     let mut link_inertias = Vec::with_capacity(spec.links.len());
     let mut geom_masses = Vec::with_capacity(spec.links.len());
     for link in &spec.links {
-        let (inertia, masses) = link_mass(link, &spec.mass_rules, &mut meshes)?;
+        let (inertia, masses) = match link_mass(link, &spec.mass_rules, &mut meshes) {
+            Err(e @ LoadError::NonPhysicalInertia { .. }) if spec.mass_rules.accept_nonphysical => {
+                // Asked to: keep the tensor exactly as written, and say so.
+                let Some(i) = link.inertial.as_ref().filter(|_| e.to_string().contains("principal moments"))
+                else {
+                    return Err(e);
+                };
+                warnings.push(format!("{e} [kept as written: --accept-nonphysical-inertia]"));
+                let r = i.x_link_inertial.rot;
+                let inertia =
+                    RigidInertia::from_com(i.mass, i.x_link_inertial.pos, r * i.inertia * r.transpose());
+                (inertia, vec![0.0; link.geoms.len()])
+            }
+            other => other?,
+        };
         link_inertias.push(inertia);
         geom_masses.push(masses);
     }
@@ -211,7 +226,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         options: spec.options.clone(),
         keyframes,
         elements: spec.elements.clone(),
-        warnings: spec.warnings.clone(),
+        warnings,
     })
 }
 

@@ -345,7 +345,7 @@ fn mesh_that_resolves_but_does_not_exist() {
 fn mesh_inside_a_found_package_that_does_not_exist() {
     let root = std::env::temp_dir().join(format!("lagrange-load-errors-{}-pkg", std::process::id()));
     std::fs::create_dir_all(root.join("lagrange_err_pkg/meshes")).unwrap();
-    let mesh = r#"    <visual><geometry><mesh filename="package://lagrange_err_pkg/meshes/nope.stl"/></geometry></visual>"#;
+    let mesh = r#"    <collision><geometry><mesh filename="package://lagrange_err_pkg/meshes/nope.stl"/></geometry></collision>"#;
     let text = two_links("fixed", "", mesh);
     let options = LoadOptions { package_dirs: vec![root.clone()], ..Default::default() };
     let (e, file) = load_err_with("pkg_mesh_missing", &text, &options);
@@ -434,18 +434,22 @@ fn unreadable_number_is_located() {
 }
 
 #[test]
-fn mimic_of_an_unknown_joint() {
+fn mimic_of_an_unknown_joint_is_ignored_with_a_warning() {
+    // urdfdom and Pinocchio ignore such a mimic; so do we, but never silently.
     let text = two_links(
         "revolute",
         r#"    <limit lower="-1" upper="1" effort="1" velocity="1"/>
     <mimic joint="nope"/>"#,
         "",
     );
-    let (e, file) = load_err("mimic", &text);
+    let path = write_urdf("mimic", &text);
+    let model = load(&path, &LoadOptions::default()).expect("loads with a warning");
+    assert!(model.joints[0].mimic.is_none());
     let line = line_of(&text, "<joint name=\"j\"");
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
     assert_mentions(
-        &e.to_string(),
-        &[&format!("{file}:{line}:"), "joint 'j'", "mimic joint=\"nope\"", "fix the name"],
+        &model.warnings[0],
+        &[&format!("{}:{line}:", path.display()), "'j'", "mimic joint=\"nope\"", "not defined", "ignored"],
     );
 }
 
@@ -498,4 +502,38 @@ fn urdf_1_2_checks_are_located() {
 fn load_error_stays_small() {
     // Clippy's `result_large_err` limit: every `Result<_, LoadError>` moves this many bytes.
     assert!(std::mem::size_of::<LoadError>() < 128, "{}", std::mem::size_of::<LoadError>());
+}
+
+#[test]
+fn a_missing_visual_mesh_is_a_warning_and_the_visual_is_dropped() {
+    let mesh = r#"    <visual><geometry><mesh filename="file:///nonexistent/lagrange/TrunkYaw.mesh"/></geometry></visual>"#;
+    let text = two_links("fixed", "", mesh);
+    let path = write_urdf("visual_mesh_missing", &text);
+    let model = load(&path, &LoadOptions::default()).expect("a visual mesh cannot stop the load");
+    assert!(model.geoms.is_empty(), "{:?}", model.geoms);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    let line = line_of(&text, "<mesh ");
+    assert_mentions(
+        &model.warnings[0],
+        &[
+            &format!("{}:{line}", path.display()),
+            "/nonexistent/lagrange/TrunkYaw.mesh",
+            "does not exist",
+            "visual dropped",
+        ],
+    );
+}
+
+#[test]
+fn nonphysical_inertia_is_refused_unless_accepted() {
+    let inertial = r#"    <inertial><mass value="1"/><inertia ixx="0.001" iyy="0.001" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>"#;
+    let text = two_links("continuous", "", inertial);
+    let (e, _) = load_err("triangle", &text);
+    assert_mentions(&e.to_string(), &["triangle inequality", "--accept-nonphysical-inertia"]);
+    let path = write_urdf("triangle_accepted", &text);
+    let options = LoadOptions { accept_nonphysical_inertia: true, ..Default::default() };
+    let model = load(&path, &options).expect("accepted as written");
+    let i = model.bodies[1].inertia_com();
+    assert_eq!((i[(0, 0)], i[(1, 1)], i[(2, 2)]), (0.001, 0.001, 0.01), "kept exactly as written");
+    assert!(model.warnings.iter().any(|w| w.contains("kept as written")), "{:?}", model.warnings);
 }

@@ -25,6 +25,10 @@ struct Cli {
     /// free-flyer) instead of welding it.
     #[arg(long, global = true)]
     floating: bool,
+    /// Use inertia tensors that violate the triangle inequality or have negative principal
+    /// moments as written (as Pinocchio does), with a warning each, instead of refusing the model.
+    #[arg(long, global = true)]
+    accept_nonphysical_inertia: bool,
 }
 
 #[derive(Subcommand)]
@@ -103,7 +107,11 @@ impl From<IntegratorArg> for IntegratorKind {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let options = LoadOptions { package_dirs: cli.package_dirs, floating: cli.floating };
+    let options = LoadOptions {
+        package_dirs: cli.package_dirs,
+        floating: cli.floating,
+        accept_nonphysical_inertia: cli.accept_nonphysical_inertia,
+    };
     let result = match cli.command {
         None => simulate::default_run(),
         Some(Command::Info { model, json }) => info::run(&model, &options, json),

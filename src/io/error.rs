@@ -36,7 +36,7 @@ pub enum LoadError {
     ZeroAxis { loc: SourceLoc, joint: String },
     #[error("{loc}: link '{link}': negative mass {mass}; mass must be ≥ 0 kg: fix <mass value=\"...\">")]
     NegativeMass { loc: SourceLoc, link: String, mass: f64 },
-    #[error("{loc}: link '{link}': non-physical inertia: {detail}; an inertia tensor must be symmetric positive semi-definite with principal moments satisfying the triangle inequality (I1 + I2 ≥ I3): fix the <inertia> values")]
+    #[error("{loc}: link '{link}': non-physical inertia: {detail}; an inertia tensor must be symmetric positive semi-definite with principal moments satisfying the triangle inequality (I1 + I2 ≥ I3): fix the <inertia> values, or pass --accept-nonphysical-inertia to use them as written (as Pinocchio does)")]
     NonPhysicalInertia { loc: SourceLoc, link: String, detail: String },
     #[error("{loc}: link '{link}': cannot resolve '{uri}': package '{package}' not found (searched: {}); pass --package-dir DIR (the folder holding '{package}/') or add it to ROS_PACKAGE_PATH", searched_list(.searched))]
     PackageNotFound {

@@ -23,6 +23,10 @@ pub struct LoadOptions {
     /// Attach the URDF root link to the world with a free joint named `root_joint` (like
     /// Pinocchio's free-flyer) instead of welding it.
     pub floating: bool,
+    /// Use inertia tensors that violate the triangle inequality or have slightly negative
+    /// principal moments as written (as Pinocchio does), with a warning each, instead of
+    /// rejecting the model (CLI `--accept-nonphysical-inertia`).
+    pub accept_nonphysical_inertia: bool,
 }
 
 /// Loads a model file, choosing the loader by extension (`.urdf`, or `.xml` for MJCF).

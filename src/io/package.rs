@@ -43,6 +43,8 @@ pub fn package_search_dirs(package_dirs: &[PathBuf]) -> Vec<PathBuf> {
 /// The returned path is not checked for existence except where the search needs it.
 pub fn resolve_uri(uri: &str, base_dir: &Path, search_dirs: &[PathBuf]) -> Result<PathBuf, ResolveError> {
     if let Some(rest) = uri.strip_prefix("package://") {
+        // `package:///NAME/path` (an empty host, as some files write) means `package://NAME/path`.
+        let rest = rest.strip_prefix('/').unwrap_or(rest);
         let (package, rel) = rest.split_once('/').unwrap_or((rest, ""));
         if package.is_empty() {
             return Err(ResolveError::BadUri(format!(
@@ -118,7 +120,12 @@ mod tests {
         assert_eq!(resolve_uri("meshes/b.stl", base, &[]), Ok(PathBuf::from("/models/robot/meshes/b.stl")));
         assert_eq!(resolve_uri("/abs/b.stl", base, &[]), Ok(PathBuf::from("/abs/b.stl")));
         assert!(matches!(resolve_uri("http://x/y.stl", base, &[]), Err(ResolveError::BadUri(_))));
-        assert!(matches!(resolve_uri("package:///y.stl", base, &[]), Err(ResolveError::BadUri(_))));
+        assert!(matches!(resolve_uri("package:///", base, &[]), Err(ResolveError::BadUri(_))));
+        // `package:///NAME/...` (empty host) reads as `package://NAME/...`.
+        assert!(matches!(
+            resolve_uri("package:///nope_pkg_xyz/y.stl", base, &[]),
+            Err(ResolveError::PackageNotFound { package, .. }) if package == "nope_pkg_xyz"
+        ));
         match resolve_uri("package://nope_pkg_xyz/y.stl", base, &[PathBuf::from("/nonexistent")]) {
             Err(ResolveError::PackageNotFound { package, searched }) => {
                 assert_eq!(package, "nope_pkg_xyz");

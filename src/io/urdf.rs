@@ -15,7 +15,9 @@
 
 use super::package::{base_dir, package_search_dirs, resolve_uri, ResolveError};
 use super::{LoadError, LoadOptions};
-use crate::model::spec::{GeomSpec, InertialSpec, JointSpec, JointType, LinkSpec, ModelSpec, Shape};
+use crate::model::spec::{
+    GeomSpec, InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec, Shape,
+};
 use crate::model::{FrameKind, Mimic, SourceLoc};
 use crate::spatial::{Mat3, Transform, Vec3};
 use roxmltree::{Document, Node, ParsingOptions};
@@ -50,10 +52,28 @@ pub fn parse(text: &str, path: &Path, options: &LoadOptions) -> Result<ModelSpec
         detail: e.to_string(),
     })?;
     let index = Index::build(&doc, &ctx)?;
-    let robot = urdf_rs::read_from_string(text).map_err(|e| diagnose(&doc, &ctx, &index, &e.to_string()))?;
+    // A material <texture> without a file name (which urdf-rs rejects) only affects drawing: it
+    // is blanked out, keeping every byte offset, with a warning.
+    let mut warnings = Vec::new();
+    let mut cleaned: Option<String> = None;
+    for node in doc.descendants().filter(|n| is(n, "texture") && n.attribute("filename").is_none()) {
+        let range = node.range();
+        let text = cleaned.get_or_insert_with(|| text.to_string());
+        text.replace_range(range.clone(), &" ".repeat(range.len()));
+        warnings.push(format!(
+            "{}: <texture> without a filename ignored (it only affects drawing)",
+            ctx.loc(node)
+        ));
+    }
+    let urdf_text = cleaned.as_deref().unwrap_or(text);
+    let robot =
+        urdf_rs::read_from_string(urdf_text).map_err(|e| diagnose(&doc, &ctx, &index, &e.to_string()))?;
     index.check_matches(&robot, &ctx, &doc)?;
     let tree = Tree::build(&index, &ctx)?;
-    build_spec(&robot, &index, &tree, path, options)
+    let mut spec = build_spec(&robot, &index, &tree, path, options)?;
+    warnings.append(&mut spec.warnings);
+    spec.warnings = warnings;
+    Ok(spec)
 }
 
 /// File name and line table for locating byte offsets.
@@ -400,6 +420,7 @@ fn build_spec(
     let search_dirs = package_search_dirs(&options.package_dirs);
     let base = base_dir(path);
     let joint_exists = |name: &str| index.joints.iter().any(|j| j.name == name);
+    let mut warnings = Vec::new();
 
     let mut links = Vec::with_capacity(tree.order.len());
     for &li in &tree.order {
@@ -407,7 +428,10 @@ fn build_spec(
         let (parent, joint) = match tree.parent_joint[li] {
             Some(ji) => {
                 let parent = spec_index[tree.joint_parent[ji]];
-                (Some(parent), joint_spec(&robot.joints[ji], &index.joints[ji], index, &joint_exists)?)
+                (
+                    Some(parent),
+                    joint_spec(&robot.joints[ji], &index.joints[ji], index, &joint_exists, &mut warnings)?,
+                )
             }
             None => (None, root_joint(link_index, index, options)?),
         };
@@ -416,7 +440,7 @@ fn build_spec(
             Some(loc) => Some(inertial_spec(&urdf_link.inertial, &link_index.name, loc)?),
             None => None,
         };
-        let geoms = geom_specs(urdf_link, link_index, &base, &search_dirs)?;
+        let geoms = geom_specs(urdf_link, link_index, &base, &search_dirs, &mut warnings)?;
         links.push(LinkSpec {
             name: link_index.name.clone(),
             loc: link_index.loc.clone(),
@@ -434,6 +458,11 @@ fn build_spec(
         source: Some(path.to_path_buf()),
         gravity: Vec3::new(0.0, 0.0, -9.81),
         links,
+        mass_rules: MassRules {
+            accept_nonphysical: options.accept_nonphysical_inertia,
+            ..MassRules::default()
+        },
+        warnings,
         ..Default::default()
     })
 }
@@ -475,6 +504,7 @@ fn joint_spec(
     ji: &JointIndex,
     index: &Index,
     joint_exists: &dyn Fn(&str) -> bool,
+    warnings: &mut Vec<String>,
 ) -> Result<JointSpec, LoadError> {
     let invalid = |loc: &SourceLoc, element: &str, detail: String| LoadError::Invalid {
         loc: loc.clone(),
@@ -524,17 +554,17 @@ fn joint_spec(
         spec.damping = d.damping;
         spec.friction = d.friction;
     }
-    if let Some(m) = &j.mimic {
-        if !joint_exists(&m.joint) {
-            return Err(invalid(
-                &ji.loc,
-                "joint",
-                format!(
-                    "joint '{name}': <mimic joint=\"{}\"> names a joint that is not defined; fix the name",
-                    m.joint
-                ),
+    if let Some(m) = j.mimic.as_ref().filter(|m| {
+        // A mimic of an undefined joint is ignored, as urdfdom and Pinocchio do, with a warning.
+        let known = joint_exists(&m.joint);
+        if !known {
+            warnings.push(format!(
+                "{}: <joint> '{name}': <mimic joint=\"{}\"> names a joint that is not defined; the mimic is ignored",
+                ji.loc, m.joint
             ));
         }
+        known
+    }) {
         let mimic = Mimic {
             joint: m.joint.clone(),
             multiplier: m.multiplier.unwrap_or(1.0),
@@ -580,6 +610,7 @@ fn geom_specs(
     li: &LinkIndex,
     base: &Path,
     search_dirs: &[PathBuf],
+    warnings: &mut Vec<String>,
 ) -> Result<Vec<GeomSpec>, LoadError> {
     let (mut visuals, mut collisions) = (link.visual.iter(), link.collision.iter());
     let mut geoms = Vec::with_capacity(li.geoms.len());
@@ -626,7 +657,15 @@ fn geom_specs(
                     )));
                 }
                 let loc = g.mesh_loc.clone().unwrap_or_else(|| g.loc.clone());
-                let path = resolve_mesh(filename, &li.name, &loc, base, search_dirs)?;
+                let path = match resolve_mesh(filename, &li.name, &loc, base, search_dirs) {
+                    // A missing file of a visual mesh cannot change the dynamics: the visual is
+                    // dropped with a warning (as Pinocchio's kinematic model ignores it).
+                    Err(e @ LoadError::MeshNotFound { .. }) if !g.collision => {
+                        warnings.push(format!("{e} [visual dropped]"));
+                        continue;
+                    }
+                    other => other?,
+                };
                 Shape::Mesh { path, scale: Vec3::new(scale[0], scale[1], scale[2]) }
             }
         };

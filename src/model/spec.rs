@@ -45,6 +45,9 @@ pub struct MassRules {
     /// Every moving body (its welded links included) must have mass and principal moments of at
     /// least MuJoCo's `mjMINVAL` (MJCF; URDF allows massless moving links with massive children).
     pub require_moving_mass: bool,
+    /// Keep non-physical inertias (triangle inequality, negative principal moments) as written,
+    /// with a warning, instead of rejecting them.
+    pub accept_nonphysical: bool,
 }
 
 /// One link (URDF) or body (MJCF) with the joint that attaches it to its parent.
