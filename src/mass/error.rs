@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use thiserror::Error;
 
 /// Advice appended to every defect that makes a mesh unusable as a solid.
-const SOLID_FIX: &str = "give the body an explicit <inertial> (URDF: an <inertial> element)";
+const SOLID_FIX: &str = "give the body (URDF: the link) an explicit <inertial>";
 
 /// Why a mesh cannot be read or cannot give mass properties.
 #[derive(Debug, Error)]
@@ -56,15 +56,16 @@ pub enum MeshError {
     /// algorithm failed).
     #[error("its convex hull cannot be computed ({detail}); use <mesh inertia=\"shell\"> or {SOLID_FIX}")]
     Hull { detail: String },
-    /// Some edges bound only one triangle: the surface has holes and encloses no volume.
+    /// The surface has holes large enough to leave its volume undetermined.
     #[error(
-        "it is not closed: {edges} boundary edge(s) (edges used by an odd number of triangles), \
-         e.g. the edge from {} to {}, so it encloses no definite volume; close the holes (e.g. \
+        "it is not closed: {edges} boundary edge(s) (edges used by an odd number of triangles) \
+         form {holes} hole(s) of total area {hole_area:.3e} m², e.g. at the edge from {} to {}, \
+         which leave its volume uncertain by up to {:.1e} of its value; close the holes (e.g. \
          MeshLab 'Close Holes'), or use <mesh inertia=\"shell\"> (mass on the surface) or \
          inertia=\"convex\" (the solid hull), or {SOLID_FIX}",
-        fmt_point(.example.0), fmt_point(.example.1)
+        fmt_point(.example.0), fmt_point(.example.1), .relative
     )]
-    Open { edges: usize, example: ([f64; 3], [f64; 3]) },
+    Open { edges: usize, holes: usize, hole_area: f64, relative: f64, example: ([f64; 3], [f64; 3]) },
     /// Neighbouring triangles are wound in opposite senses (MuJoCo: "faces of mesh have
     /// inconsistent orientation").
     #[error(

@@ -12,10 +12,10 @@
 //! The inertia tensor follows from the second moments `S` as `I = tr(S) 1 − S` (notes eq. 68–69).
 
 use super::error::MeshError;
+use super::fast_hash::{point_key, FastMap};
 use super::topology;
 use super::MeshInertia;
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
-use std::collections::HashMap;
 
 /// MuJoCo's `mjMINVAL`: the smallest area (m²) and volume (m³) it accepts, and the smallest
 /// `|(b − a) × (c − a)|` of a triangle that counts (`triangle()` in user_mesh.cc).
@@ -25,6 +25,13 @@ const MINVAL: f64 = 1e-15;
 /// size (a sphere has `V / A^{3/2} ≈ 0.094`, a plate of thickness t and width w about `0.35 t/w`,
 /// so this only rejects plates thinner than ~3e-12 of their width).
 const FLAT_REL: f64 = 1e-12;
+
+/// A surface whose holes, or (exact mode) wrongly wound triangles, could change its volume by more
+/// than this fraction does not bound a definite solid (see [`super::Topology::hole_area`] and
+/// [`super::Topology::misoriented_area`]). Pinholes and cracks of CAD exports stay below it (the
+/// MuJoCo corpus: ≤ 6.4e-7), missing faces far above (≥ 8.6e-6, most above 1e-2); flipped sliver
+/// triangles that MuJoCo's own orientation check skips (area under 3.2e-8) stay below it too.
+const DEFECT_REL: f64 = 1e-6;
 
 /// MuJoCo's tolerances on the triangle inequality of the principal moments (`mjCMesh::Process`:
 /// `A + B ≥ C (1 − rtol) − atol`).
@@ -87,6 +94,18 @@ impl TriangleMesh {
         topology::analyze(self)
     }
 
+    /// Length of the diagonal of the axis-aligned bounding box (0 for an empty mesh).
+    pub fn diameter(&self) -> f64 {
+        let Some(first) = self.vertices.first() else { return 0.0 };
+        let (lo, hi) = self.vertices.iter().fold((*first, *first), |(lo, hi), v| (lo.inf(v), hi.sup(v)));
+        (hi - lo).norm()
+    }
+
+    fn point(&self, i: u32) -> [f64; 3] {
+        let v = self.vertices[i as usize];
+        [v.x, v.y, v.z]
+    }
+
     fn corners(&self, t: &[u32; 3]) -> [Vec3; 3] {
         t.map(|i| self.vertices[i as usize])
     }
@@ -120,10 +139,12 @@ impl TriangleMesh {
 /// `measure · c` and rotational inertia about the mesh origin.
 ///
 /// The modes (MuJoCo `<mesh inertia>`, `mjtMeshInertia`; MuJoCo's default is `legacy`):
-/// - [`MeshInertia::Exact`]: the solid the surface encloses. The mesh must be closed and
-///   consistently oriented ([`MeshError::Open`], [`MeshError::Misoriented`]; MuJoCo checks only
-///   the orientation) with positive volume ([`MeshError::NegativeVolume`] — an inside-out mesh is
-///   never flipped silently).
+/// - [`MeshInertia::Exact`]: the solid the surface encloses. The surface must be closed
+///   ([`MeshError::Open`]) and consistently oriented ([`MeshError::Misoriented`]: no edge run
+///   twice in the same direction, MuJoCo's test), with positive volume
+///   ([`MeshError::NegativeVolume`] — an inside-out mesh is never flipped silently). Defects that
+///   cannot move the volume by more than 1e-6 of itself are tolerated: T-junctions, CAD pinholes,
+///   wrongly wound sliver triangles (which MuJoCo's own test skips below 3.2e-8 in file units).
 /// - [`MeshInertia::Legacy`]: MuJoCo's historical rule. The centre of mass and the volume are
 ///   sums over the tetrahedra of each triangle with the area-weighted centroid of the faces as
 ///   apex, each volume taken as `|V|`; the inertia (and the volume returned) are the same sums
@@ -131,7 +152,8 @@ impl TriangleMesh {
 ///   those points (every convex mesh); larger otherwise, and it tolerates misoriented triangles —
 ///   that is its documented purpose, not a silent fix. The mesh must still be closed
 ///   ([`MeshError::Open`]): for a surface with holes the result depends on the apex and means
-///   nothing.
+///   nothing; and it must not be inside out as a whole (negative signed volume,
+///   [`MeshError::NegativeVolume`]), which MuJoCo would silently turn positive.
 /// - [`MeshInertia::Convex`]: the solid convex hull of all vertices (parry3d's quickhull; MuJoCo
 ///   uses qhull). Any vertex cloud with volume works.
 /// - [`MeshInertia::Shell`]: mass spread uniformly over the surface area (MJCF
@@ -143,14 +165,11 @@ impl TriangleMesh {
 /// non-physical results ([`MeshError::NonPhysicalInertia`], MuJoCo's eigenvalue checks).
 pub fn mesh_inertia(mesh: &TriangleMesh, mode: MeshInertia) -> Result<(f64, RigidInertia), MeshError> {
     mesh.validate()?;
-    let mut hull: Option<TriangleMesh> = None;
-    if mesh.triangles.is_empty() {
-        hull = Some(convex_hull(&mesh.vertices)?);
-    }
+    let hull = if mesh.triangles.is_empty() { Some(convex_hull(&mesh.vertices)?) } else { None };
     // The surface: the mesh's own triangles (or the hull's when it has none).
     let surface = hull.as_ref().unwrap_or(mesh);
     let (area, face_centroid) = face_centroid(surface);
-    if !(area >= MINVAL) {
+    if area.is_nan() || area < MINVAL {
         return Err(MeshError::ZeroArea { area });
     }
     let (measure, com, second_moment) = match mode {
@@ -159,22 +178,27 @@ pub fn mesh_inertia(mesh: &TriangleMesh, mode: MeshInertia) -> Result<(f64, Rigi
             (measure, face_centroid, s)
         }
         MeshInertia::Exact | MeshInertia::Legacy | MeshInertia::Convex => {
-            if mode != MeshInertia::Convex {
-                check_closed(surface, mode)?;
-            }
-            let solid = match mode {
-                MeshInertia::Convex => match &hull {
-                    Some(h) => h,
-                    None => hull.insert(convex_hull(&mesh.vertices)?),
-                },
+            // The surface must bound a solid (the hull always does).
+            let topo = (mode != MeshInertia::Convex).then(|| surface.topology());
+            let own_hull;
+            let solid = match (mode, &hull) {
+                (MeshInertia::Convex, None) => {
+                    own_hull = convex_hull(&mesh.vertices)?;
+                    &own_hull
+                }
                 _ => surface,
             };
             let weight = if mode == MeshInertia::Legacy { Weight::AbsVolume } else { Weight::Volume };
-            let (volume, com) = volume_and_centroid(solid, &face_centroid, weight);
-            if volume < 0.0 {
-                return Err(MeshError::NegativeVolume { volume });
+            let (volume, signed, com) = volume_and_centroid(solid, &face_centroid, weight);
+            if let Some(t) = &topo {
+                check_defects(surface, t, mode, volume)?;
             }
-            if !(volume >= MINVAL) || volume <= FLAT_REL * area.powf(1.5) {
+            // An inside-out mesh is refused in every mode, legacy included: its |V| per
+            // tetrahedron tolerates some wrongly wound triangles, not a surface turned inside out.
+            if signed < 0.0 {
+                return Err(MeshError::NegativeVolume { volume: signed });
+            }
+            if volume.is_nan() || volume < MINVAL || volume <= FLAT_REL * area.powf(1.5) {
                 return Err(MeshError::VolumeTooSmall { volume });
             }
             let (measure, s) = second_moments(solid, &com, weight);
@@ -187,30 +211,45 @@ pub fn mesh_inertia(mesh: &TriangleMesh, mode: MeshInertia) -> Result<(f64, Rigi
     Ok((measure, RigidInertia::from_com(measure, com, i_com)))
 }
 
-/// Exact mode needs a closed, consistently oriented surface; legacy needs a closed one.
-fn check_closed(surface: &TriangleMesh, mode: MeshInertia) -> Result<(), MeshError> {
-    let topo = surface.topology();
-    let point = |i: u32| {
-        let v = surface.vertices[i as usize];
-        [v.x, v.y, v.z]
-    };
-    if mode == MeshInertia::Exact && topo.misoriented_edges > 0 {
-        let (a, b) = topo.misoriented_example.unwrap_or_default();
-        return Err(MeshError::Misoriented { edges: topo.misoriented_edges, example: (point(a), point(b)) });
+/// Refuses a surface whose holes (any solid mode) or wrongly wound triangles (exact mode) could
+/// change its volume by more than [`DEFECT_REL`]: holes of area `A_h` by up to `d·A_h/3`, flipped
+/// triangles of area `A_f` by up to `2·d·A_f/3` (`d` the diameter).
+fn check_defects(
+    surface: &TriangleMesh,
+    t: &topology::Topology,
+    mode: MeshInertia,
+    volume: f64,
+) -> Result<(), MeshError> {
+    let d = surface.diameter();
+    let v = volume.abs();
+    let too_large = |spread: f64| spread > 0.0 && (v.is_nan() || spread > DEFECT_REL * v);
+    let hole_spread = d * t.hole_area / 3.0;
+    if too_large(hole_spread) {
+        let (a, b) = t.boundary_example.unwrap_or_default();
+        return Err(MeshError::Open {
+            edges: t.boundary_edges,
+            holes: t.boundary_loops,
+            hole_area: t.hole_area,
+            relative: hole_spread / v,
+            example: (surface.point(a), surface.point(b)),
+        });
     }
-    if topo.boundary_edges > 0 {
-        let (a, b) = topo.boundary_example.unwrap_or_default();
-        return Err(MeshError::Open { edges: topo.boundary_edges, example: (point(a), point(b)) });
+    if mode == MeshInertia::Exact && too_large(2.0 * d * t.misoriented_area / 3.0) {
+        let (a, b) = t.misoriented_example.unwrap_or_default();
+        return Err(MeshError::Misoriented {
+            edges: t.misoriented_edges,
+            example: (surface.point(a), surface.point(b)),
+        });
     }
     Ok(())
 }
 
-/// MuJoCo's checks on the principal moments: the largest positive, and the triangle inequality
+/// MuJoCo's checks on the principal moments: the smallest positive, and the triangle inequality
 /// within its tolerances (`mjCMesh::Process`).
 fn check_physical(i_com: &Mat3) -> Result<(), MeshError> {
     let (m, _) = super::principal_axes(i_com);
     let moments = [m.x, m.y, m.z];
-    if !(m.z > 0.0) || moments.iter().any(|x| !x.is_finite()) {
+    if moments.iter().any(|x| !x.is_finite()) || m.x <= 0.0 {
         return Err(MeshError::NonPhysicalInertia { moments, why: "are not all positive" });
     }
     if m.x + m.y < m.z * (1.0 - TRIANGLE_RTOL) - TRIANGLE_ATOL {
@@ -249,10 +288,11 @@ fn face_centroid(m: &TriangleMesh) -> (f64, Vec3) {
     (area, centroid)
 }
 
-/// Volume and centroid of the solid as the sum over the tetrahedra (triangle, `apex`)
-/// (`ComputeVolume`): each tetrahedron's centroid is `¾ (triangle centroid) + ¼ apex`.
-fn volume_and_centroid(m: &TriangleMesh, apex: &Vec3, weight: Weight) -> (f64, Vec3) {
-    let mut volume = 0.0;
+/// Volume (weighted as asked), signed volume, and centroid of the solid as the sum over the
+/// tetrahedra (triangle, `apex`) (`ComputeVolume`): each tetrahedron's centroid is
+/// `¾ (triangle centroid) + ¼ apex`.
+fn volume_and_centroid(m: &TriangleMesh, apex: &Vec3, weight: Weight) -> (f64, f64, Vec3) {
+    let (mut volume, mut signed) = (0.0, 0.0);
     let mut moment = Vec3::zeros();
     for t in &m.triangles {
         let [a, b, c] = m.corners(t);
@@ -261,15 +301,14 @@ fn volume_and_centroid(m: &TriangleMesh, apex: &Vec3, weight: Weight) -> (f64, V
             continue;
         }
         let center = (a + b + c) / 3.0;
-        let mut v = (center - apex).dot(&n) / 6.0;
-        if weight == Weight::AbsVolume {
-            v = v.abs();
-        }
+        let s = (center - apex).dot(&n) / 6.0;
+        let v = if weight == Weight::AbsVolume { s.abs() } else { s };
+        signed += s;
         volume += v;
         moment += (center * 0.75 + apex * 0.25) * v;
     }
     let centroid = if volume.abs() >= MINVAL { moment / volume } else { *apex };
-    (volume, centroid)
+    (volume, signed, centroid)
 }
 
 /// Total weight (volume or area) and second moment `S = ∫ x xᵀ` about `origin`
@@ -304,16 +343,15 @@ fn second_moments(m: &TriangleMesh, origin: &Vec3, weight: Weight) -> (f64, Mat3
 pub fn convex_hull(vertices: &[Vec3]) -> Result<TriangleMesh, MeshError> {
     let err = |detail: &str| MeshError::Hull { detail: detail.to_string() };
     // Distinct points only (parry rejects duplicates).
-    let mut seen: HashMap<[u64; 3], ()> = HashMap::with_capacity(vertices.len());
-    let points: Vec<Vec3> = vertices
-        .iter()
-        .filter(|v| {
-            seen.insert([(v.x + 0.0).to_bits(), (v.y + 0.0).to_bits(), (v.z + 0.0).to_bits()], ()).is_none()
-        })
-        .copied()
-        .collect();
+    let mut seen: FastMap<[u64; 3], ()> =
+        FastMap::with_capacity_and_hasher(vertices.len(), Default::default());
+    let points: Vec<Vec3> =
+        vertices.iter().filter(|v| seen.insert(point_key(v.x, v.y, v.z), ()).is_none()).copied().collect();
     if points.iter().any(|v| !v.iter().all(|x| x.is_finite())) {
         return Err(err("a vertex is not finite"));
+    }
+    if points.len() < 4 {
+        return Err(err(&format!("it has {} distinct vertices, fewer than the 4 of a solid", points.len())));
     }
     let p0 = points[0];
     let Some(p1) = points.iter().find(|p| (*p - p0).norm() > MINVAL) else {
@@ -342,7 +380,8 @@ pub fn convex_hull(vertices: &[Vec3]) -> Result<TriangleMesh, MeshError> {
     };
     let hull =
         TriangleMesh { vertices: hv.iter().map(|p| Vec3::new(p.x, p.y, p.z)).collect(), triangles: hi };
-    if !(hull.signed_volume() > 0.0) || hull.triangles.len() < 4 {
+    let volume = hull.signed_volume();
+    if volume.is_nan() || volume <= 0.0 || hull.triangles.len() < 4 {
         return Err(err("the hull has no volume"));
     }
     Ok(hull)

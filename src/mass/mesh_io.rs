@@ -1,7 +1,10 @@
 //! Reading triangle meshes: STL (binary and ASCII), Wavefront OBJ and MuJoCo's binary MSH, with
 //! MuJoCo's conventions where they matter for mass properties:
-//! - binary STL vertices are `f32`; identical vertices are merged (as MuJoCo's STL decoder does),
-//!   so that shared edges are recognised;
+//! - coordinates are `f32` values (binary STL and MSH store them so; decimal STL and OBJ
+//!   coordinates are rounded to the nearest `f32`, as MuJoCo stores mesh vertices), so that mass
+//!   properties agree with MuJoCo to round-off;
+//! - STL vertices at identical positions are merged (as MuJoCo's STL decoder does), so that
+//!   shared edges are recognised;
 //! - OBJ faces with more than three corners are split into a fan `(v0, vk, vk+1)`, which is what
 //!   tinyobjloader's ear clipping (used by MuJoCo) gives for convex faces; by default only the
 //!   first object of the file is used — the faces before the first `o`/`g` line that follows a
@@ -13,9 +16,9 @@
 //! COLLADA (`.dae`) and other formats give [`MeshError::UnsupportedFormat`].
 
 use super::error::MeshError;
+use super::fast_hash::{point_key, FastMap};
 use super::mesh::TriangleMesh;
 use crate::spatial::Vec3;
-use std::collections::HashMap;
 use std::path::Path;
 
 /// Which objects of a multi-object OBJ file become the mesh.
@@ -63,6 +66,14 @@ pub fn read_mesh_with(path: &Path, scale: &Vec3, options: &ReadOptions) -> Resul
     Ok(mesh)
 }
 
+/// A decimal coordinate as the nearest `f32`, widened: MuJoCo stores mesh vertices as `float`
+/// (and tinyobjloader parses them so), and STL is single precision by definition. Keeping the
+/// same values makes mass properties agree with MuJoCo to round-off instead of to ~1e-7 (more
+/// for thin parts, where a volume is a small difference of large terms).
+fn parse_f32(s: &str) -> Option<f64> {
+    s.parse::<f64>().ok().map(|x| x as f32 as f64)
+}
+
 fn parse_error(
     path: &Path,
     format: &'static str,
@@ -75,13 +86,19 @@ fn parse_error(
 /// Merges bitwise-identical vertices (with −0 read as +0) while building an indexed mesh.
 #[derive(Default)]
 struct VertexMerger {
-    index: HashMap<[u64; 3], u32>,
+    index: FastMap<[u64; 3], u32>,
     vertices: Vec<Vec3>,
 }
 
 impl VertexMerger {
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            index: FastMap::with_capacity_and_hasher(n, Default::default()),
+            vertices: Vec::with_capacity(n),
+        }
+    }
     fn id(&mut self, v: Vec3) -> u32 {
-        let key = [(v.x + 0.0).to_bits(), (v.y + 0.0).to_bits(), (v.z + 0.0).to_bits()];
+        let key = point_key(v.x, v.y, v.z);
         let next = self.vertices.len() as u32;
         *self.index.entry(key).or_insert_with(|| {
             self.vertices.push(v);
@@ -125,7 +142,8 @@ fn parse_stl_binary(bytes: &[u8], n: usize, path: &Path) -> Result<TriangleMesh,
     if n == 0 {
         return Err(parse_error(path, "binary STL", None, "it holds no triangles"));
     }
-    let mut merger = VertexMerger::default();
+    // A closed mesh has about half as many vertices as triangles.
+    let mut merger = VertexMerger::with_capacity(n / 2 + 3);
     let mut triangles = Vec::with_capacity(n);
     let f32_at = |o: usize| f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]) as f64;
     for t in 0..n {
@@ -171,7 +189,7 @@ fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriangleMesh, MeshError>
                 }
                 let mut c = [0.0; 3];
                 for x in &mut c {
-                    *x = tok.next().and_then(|s| s.parse::<f64>().ok()).ok_or_else(|| {
+                    *x = tok.next().and_then(parse_f32).ok_or_else(|| {
                         parse_error(
                             path,
                             F,
@@ -232,7 +250,7 @@ pub(crate) fn parse_obj(bytes: &[u8], path: &Path, objects: ObjObjects) -> Resul
             "v" => {
                 let mut c = [0.0; 3];
                 for x in &mut c {
-                    *x = tok.next().and_then(|s| s.parse::<f64>().ok()).ok_or_else(|| {
+                    *x = tok.next().and_then(parse_f32).ok_or_else(|| {
                         parse_error(
                             path,
                             F,

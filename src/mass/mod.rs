@@ -2,9 +2,25 @@
 //!
 //! Every function returns a [`RigidInertia`] expressed in the shape's own frame (mass, first
 //! moment, rotational inertia about the frame origin), so placing a shape in a body is
-//! [`RigidInertia::transformed`] and composing shapes is `+=` (notes §3, eq. 56 and 81–83).
+//! [`RigidInertia::transformed`] and composing shapes is `+=` or [`compose`] (notes §3, eq. 56
+//! and 81–83).
+//!
+//! - `primitive`: MuJoCo's closed forms for spheres, capsules, cylinders, boxes and ellipsoids,
+//!   solid and shell (`mjCGeom::GetVolume`, `mjCGeom::SetInertia`).
+//! - `mesh_io`: [`read_mesh`] for STL (binary, ASCII), OBJ and MuJoCo MSH files, scale applied.
+//! - `mesh`: [`mesh_inertia`] in MuJoCo's four mesh modes ([`MeshInertia`]), exact polyhedral
+//!   integrals, refusing meshes that do not bound the solid the mode needs ([`MeshError`]).
+//! - `topology`: closedness and orientation of a mesh ([`Topology`]).
+//! - `principal`: principal moments and axes, parallel-axis shift, tensor rotation,
+//!   composition.
+//! - `error`: [`MeshError`], whose messages name the defect and the fix.
+//!
+//! The convex hull (convex mode) is parry3d-f64's; every other integral is computed here, in
+//! MuJoCo's order of operations (`mjCMesh::Process`), because MuJoCo's legacy mode (its default)
+//! has no counterpart in parry and the other modes must agree with MuJoCo to round-off.
 
 mod error;
+mod fast_hash;
 mod mesh;
 mod mesh_io;
 mod primitive;

@@ -30,7 +30,8 @@ pub struct Principal {
 /// When two moments are equal (a body of revolution) any orthonormal basis of their eigenspace is
 /// principal; the one returned is the eigen-solver's, made right-handed as above.
 ///
-/// Only the symmetric part of `i` is used.
+/// Only the symmetric part of `i` is used. A tensor with a non-finite entry gives NaN moments
+/// (and identity axes) rather than an endless eigen-iteration.
 pub fn principal_axes(i: &Mat3) -> (Vec3, Mat3) {
     let p = principal(i);
     (p.moments, p.axes)
@@ -38,6 +39,9 @@ pub fn principal_axes(i: &Mat3) -> (Vec3, Mat3) {
 
 /// [`principal_axes`] as a [`Principal`].
 pub fn principal(i: &Mat3) -> Principal {
+    if !i.iter().all(|x| x.is_finite()) {
+        return Principal { moments: Vec3::repeat(f64::NAN), axes: Mat3::identity() };
+    }
     let sym = (i + i.transpose()) * 0.5;
     let eig = sym.symmetric_eigen();
     let mut order = [0usize, 1, 2];

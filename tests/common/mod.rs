@@ -70,6 +70,33 @@ pub const PERIOD_SMALL_AMPLITUDE_REL: f64 = 1e-10;
 /// margin of 25 over the estimate, while a first-order error (≈ ω² dt ≈ 1e-2) would fail by far.
 pub const RK4_CONSERVATION_REL: f64 = 1e-9;
 
+/// Relative tolerance of mesh mass properties against MuJoCo (`tests/mujoco_meshes.rs`; the
+/// issue's 1e-6). Both sides integrate the same polyhedron in f64 by the same decomposition
+/// (`mjCMesh::ComputeVolume`/`ComputeInertia`), so binary STL meshes agree to the round-off of sums
+/// over up to 2e5 triangles (~1e-12); MuJoCo reads OBJ coordinates as f32 where we keep f64, a
+/// relative perturbation of ≤ 6e-8 per coordinate that moves masses and tensors by up to a few
+/// 1e-7. 1e-6 bounds that with a margin; a wrong formula or mode errs by ≥ 1e-3.
+pub const MESH_MUJOCO_REL: f64 = 1e-6;
+
+/// Relative tolerance of mass properties that are exact in f64 (`tests/mass.rs`): a polyhedron
+/// (box, L-shape, plate, T-junction box) against its closed form, a primitive formula against the
+/// notes (eq. 51–53), identities such as the perpendicular-axis theorem (eq. 54). The only error is
+/// the round-off of sums over at most a few thousand triangles, a few hundred ε.
+pub const MASS_EXACT_REL: f64 = 1e-12;
+
+/// Band for the measured convergence order of meshes inscribed in curved bodies
+/// (`tests/mass.rs`): when the resolution doubles the error of a second-order approximation must
+/// shrink by a ratio in `[4 / BAND, 4 · BAND]`. Measured ratios at n = 32 → 64 → 128 are within
+/// 1 % of 4; 1.1 keeps first (2) and third (8) order far outside.
+pub const MESH_ORDER_BAND: f64 = 1.1;
+
+/// Relative tolerance of a mesh moved by a rigid transformation against the moved mass
+/// properties (`tests/mass.rs`, translations up to 2 m of a 0.2 m part). Moving the vertices
+/// rounds each coordinate to ε·2 m, i.e. 1e-15 of 2 m but 1e-14 of the part's size; the centre of
+/// mass and the tensor about it inherit that, amplified by the cancellation in I_com = I_O − m[c]×²
+/// for offsets 10× the part. Measured ≤ 1e-12; 1e-10 leaves a factor 100.
+pub const MESH_TRANSFORM_REL: f64 = 1e-10;
+
 /// Floor of the denominator of the relative error: only there to turn 0/0 (two exactly-zero
 /// quantities, e.g. the Jacobian of a frame welded to the world) into 0. It is far below any
 /// physical magnitude, so it never hides a real discrepancy.
