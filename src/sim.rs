@@ -51,44 +51,23 @@ pub fn plan(model: &Model) -> Vec<Stage> {
     let friction = model.joints.iter().filter(|j| j.friction != 0.0).count();
     let limited = model.joints.iter().filter(|j| j.limits.is_some()).count();
     let mimics = model.joints.iter().filter(|j| j.mimic.is_some()).count();
-    let parsed = |n: usize, what: &str| {
+    // A stage for `n` kept elements: "parsed, not simulated" with `why`, or skipped if none.
+    let kept = |name: &'static str, n: usize, what: &str, why: &str| {
         if n > 0 {
-            Stage {
-                name: "",
-                status: "parsed, not simulated",
-                reason: format!("{n} {what}: stored; enforcement arrives with the constraint solver"),
-            }
+            Stage { name, status: "parsed, not simulated", reason: format!("{n} {what}: {why}") }
         } else {
-            Stage { name: "", status: "skipped", reason: format!("no {what}") }
+            Stage { name, status: "skipped", reason: format!("no {what}") }
         }
     };
-    stages.push(Stage { name: "joint limits", ..parsed(limited, "limited joints") });
-    stages.push(Stage { name: "joint friction", ..parsed(friction, "joints with Coulomb friction") });
-    stages.push(Stage {
-        name: "equality constraints",
-        ..parsed(mimics + count(model, &["equality"]), "mimic joints and equality constraints")
-    });
-    stages.push(Stage { name: "tendons", ..parsed(count(model, &["tendon"]), "tendons") });
+    const SOLVER: &str = "stored; enforcement arrives with the constraint solver";
+    stages.push(kept("joint limits", limited, "limited joints", SOLVER));
+    stages.push(kept("joint friction", friction, "joints with Coulomb friction", SOLVER));
+    let equalities = mimics + count(model, &["equality"]);
+    stages.push(kept("equality constraints", equalities, "mimic joints and equality constraints", SOLVER));
+    stages.push(kept("tendons", count(model, &["tendon"]), "tendons", SOLVER));
     let actuators = count(model, &["actuator"]);
-    stages.push(if actuators > 0 {
-        Stage {
-            name: "actuators",
-            status: "parsed, not simulated",
-            reason: format!("{actuators} actuators: stored; simulate applies zero control"),
-        }
-    } else {
-        Stage { name: "actuators", status: "skipped", reason: "no actuators".into() }
-    });
-    let sensors = count(model, &["sensor"]);
-    stages.push(if sensors > 0 {
-        Stage {
-            name: "sensors",
-            status: "parsed, not simulated",
-            reason: format!("{sensors} sensors: stored, not evaluated"),
-        }
-    } else {
-        Stage { name: "sensors", status: "skipped", reason: "no sensors".into() }
-    });
+    stages.push(kept("actuators", actuators, "actuators", "stored; simulate applies zero control"));
+    stages.push(kept("sensors", count(model, &["sensor"]), "sensors", "stored, not evaluated"));
     let colliding = model.geoms.iter().filter(|g| g.collision).count();
     let pairs = count(model, &["contact"]);
     stages.push(if colliding + pairs > 0 {
