@@ -36,6 +36,11 @@ impl Attrs {
         Self { tag: tag.to_string(), loc: loc.clone(), values, explicit }
     }
 
+    /// The attributes of an element that takes no default class (body, frame, inertial, ...).
+    pub fn plain(e: &super::xml::Element) -> Self {
+        Self::new(&e.tag, &e.loc, &[], &e.attrs)
+    }
+
     pub fn has(&self, name: &str) -> bool {
         self.values.iter().any(|(k, _)| k == name)
     }

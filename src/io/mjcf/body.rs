@@ -119,7 +119,7 @@ impl<'a> TreeBuilder<'a> {
                 "body" => c.bodies.push(entry),
                 "inertial" => c.inertial = Some((child, x)),
                 "frame" => {
-                    let a = Attrs::new("frame", &child.loc, &[], &child.attrs);
+                    let a = Attrs::plain(child);
                     let pose = Transform::new(
                         rotation(&a, &self.compiler.angles)?,
                         a.vec3("pos")?.unwrap_or_default(),
@@ -156,7 +156,7 @@ impl<'a> TreeBuilder<'a> {
     ) -> Result<(), LoadError> {
         let id = self.next_body;
         self.next_body += 1;
-        let a = Attrs::new("body", &e.loc, &[], &e.attrs);
+        let a = Attrs::plain(e);
         let name = a.text("name").map_or_else(|| format!("body{id}"), str::to_string);
         let class = e.attr("childclass").unwrap_or(class).to_string();
         self.check_class(e, &class)?;
@@ -334,11 +334,7 @@ impl<'a> TreeBuilder<'a> {
     ) -> Result<(JointSpec, Vec3), LoadError> {
         let id = self.next_joint;
         self.next_joint += 1;
-        let a = if e.tag == "freejoint" {
-            Attrs::new("freejoint", &e.loc, &[], &e.attrs)
-        } else {
-            self.defaults.resolve(e, class)?
-        };
+        let a = if e.tag == "freejoint" { Attrs::plain(e) } else { self.defaults.resolve(e, class)? };
         let name = a.text("name").map_or_else(|| format!("joint{id}"), str::to_string);
         let jtype = if e.tag == "freejoint" {
             "free".to_string()
@@ -425,7 +421,7 @@ fn inertial(
     x_frame: &Transform,
     angles: &super::orientation::AngleConvention,
 ) -> Result<InertialSpec, LoadError> {
-    let a = Attrs::new("inertial", &e.loc, &[], &e.attrs);
+    let a = Attrs::plain(e);
     let Some(mass) = a.real("mass")? else {
         return Err(a.error("mass", "is missing: <inertial> needs mass and pos"));
     };

@@ -28,7 +28,7 @@ pub(crate) fn check_tree(root: &Element) -> Result<Vec<String>, LoadError> {
 }
 
 fn check(e: &Element, decl: &ElementSchema, warnings: &mut Vec<String>) -> Result<(), LoadError> {
-    let a = Attrs::new(&e.tag, &e.loc, &[], &e.attrs);
+    let a = Attrs::plain(e);
     for name in a.check(decl)? {
         warnings.push(format!("{}: <{}>: unknown attribute '{name}' ignored", e.loc, e.tag));
     }

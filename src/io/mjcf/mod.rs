@@ -22,7 +22,6 @@ mod xml;
 
 use super::{LoadError, LoadOptions};
 use crate::model::spec::{MassRules, ModelSpec};
-use crate::spatial::Vec3;
 use orientation::AngleConvention;
 use std::path::{Path, PathBuf};
 
@@ -102,7 +101,6 @@ fn parse_root(root: &xml::Element, path: &Path, _options: &LoadOptions) -> Resul
     check_targets(&elements, &builder.links)?;
     elements.append(&mut builder.kept);
     let name = root.attr("model").unwrap_or("MuJoCo Model").to_string();
-    let gravity: Vec3 = gravity;
     Ok(ModelSpec {
         name,
         source: Some(path.to_path_buf()),

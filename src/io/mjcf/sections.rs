@@ -12,10 +12,6 @@ use crate::model::{Element as KeptElement, Keyframe, Options};
 use crate::spatial::Vec3;
 use std::path::Path;
 
-fn plain(e: &Element) -> Attrs {
-    Attrs::new(&e.tag, &e.loc, &[], &e.attrs)
-}
-
 /// Reads every `<compiler>` (later ones override earlier ones, as MuJoCo applies them in order).
 pub(crate) fn compiler(root: &Element, dir: &Path) -> Result<Compiler, LoadError> {
     let mut c = Compiler {
@@ -27,7 +23,7 @@ pub(crate) fn compiler(root: &Element, dir: &Path) -> Result<Compiler, LoadError
         mass_rules: MassRules { require_moving_mass: true, ..MassRules::default() },
     };
     for e in root.children_named("compiler") {
-        let a = plain(e);
+        let a = Attrs::plain(e);
         if let Some(angle) = a.keyword("angle", &["radian", "degree"])? {
             c.angles.to_radians = if angle == "radian" { 1.0 } else { std::f64::consts::PI / 180.0 };
         }
@@ -84,7 +80,7 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
     let mut o = Options::default();
     let mut gravity = Vec3::new(0.0, 0.0, -9.81);
     for e in root.children_named("option") {
-        let a = plain(e);
+        let a = Attrs::plain(e);
         if let Some(v) = a.real("timestep")? {
             if v <= 0.0 {
                 return Err(a.error("timestep", format!("is {v}; the time step must be positive")));
@@ -103,7 +99,9 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
                     "enable" => true,
                     "disable" => false,
                     other => {
-                        return Err(plain(f).error(name, format!("is '{other}'; use enable or disable")));
+                        return Err(
+                            Attrs::plain(f).error(name, format!("is '{other}'; use enable or disable"))
+                        );
                     }
                 };
                 o.flags.retain(|(n, _)| n != name);
@@ -123,7 +121,7 @@ pub(crate) fn keyframes(root: &Element) -> Result<Vec<Keyframe>, LoadError> {
     let mut keys = Vec::new();
     for section in root.children_named("keyframe") {
         for (i, k) in section.children_named("key").enumerate() {
-            let a = plain(k);
+            let a = Attrs::plain(k);
             keys.push(Keyframe {
                 name: a.text("name").map_or_else(|| format!("key{i}"), str::to_string),
                 loc: k.loc.clone(),
@@ -171,7 +169,7 @@ pub(crate) fn elements(root: &Element, defaults: &Defaults) -> Result<Vec<KeptEl
             for e in &section.children {
                 // Sensors and contact exclusions have no default classes.
                 let a = if matches!(category, "sensor") || e.tag == "exclude" {
-                    plain(e)
+                    Attrs::plain(e)
                 } else {
                     defaults.resolve(e, MAIN)?
                 };
