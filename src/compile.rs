@@ -25,21 +25,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let mut link_inertias = Vec::with_capacity(spec.links.len());
     let mut geom_masses = Vec::with_capacity(spec.links.len());
     for link in &spec.links {
-        let (inertia, masses) = match link_mass(link, &spec.mass_rules, &mut meshes) {
-            Err(e @ LoadError::NonPhysicalInertia { .. }) if spec.mass_rules.accept_nonphysical => {
-                // Asked to: keep the tensor exactly as written, and say so.
-                let Some(i) = link.inertial.as_ref().filter(|_| e.to_string().contains("principal moments"))
-                else {
-                    return Err(e);
-                };
-                warnings.push(format!("{e} [kept as written: --accept-nonphysical-inertia]"));
-                let r = i.x_link_inertial.rot;
-                let inertia =
-                    RigidInertia::from_com(i.mass, i.x_link_inertial.pos, r * i.inertia * r.transpose());
-                (inertia, vec![0.0; link.geoms.len()])
-            }
-            other => other?,
-        };
+        let (inertia, masses) = link_mass(link, &spec.mass_rules, &mut meshes, &mut warnings)?;
         link_inertias.push(inertia);
         geom_masses.push(masses);
     }
@@ -325,10 +311,24 @@ fn link_mass(
     link: &LinkSpec,
     rules: &MassRules,
     meshes: &mut crate::io::geom_mass::MeshCache,
+    warnings: &mut Vec<String>,
 ) -> Result<(RigidInertia, Vec<f64>), LoadError> {
-    // The world body keeps no mass and obeys no bounds.
-    let world = link.parent.is_none() && link.joint.jtype == JointType::Fixed;
-    let rules = if world { &MassRules::default() } else { rules };
+    // The world body keeps no mass and obeys no bounds (a URDF root welded to the world is one).
+    let world_rules = MassRules { accept_nonphysical: rules.accept_nonphysical, ..MassRules::default() };
+    let rules = if is_world(link) { &world_rules } else { rules };
+    // Principal moments that are not physical are an error, or, when the loader was asked to
+    // accept them, a warning with the tensor kept exactly as written (`None`: no rule fired).
+    let mut settle = |loc: &SourceLoc, moments: Result<Option<Vec3>, String>| match moments {
+        Ok(bounded) => Ok(bounded),
+        Err(detail) => {
+            let e = LoadError::NonPhysicalInertia { loc: loc.clone(), link: link.name.clone(), detail };
+            if !rules.accept_nonphysical {
+                return Err(e);
+            }
+            warnings.push(format!("{e} [kept as written: --accept-nonphysical-inertia]"));
+            Ok(None)
+        }
+    };
     let mut geom_masses = vec![0.0; link.geoms.len()];
     if link.inertia_from_geoms {
         let mut sum = RigidInertia::zero();
@@ -343,7 +343,7 @@ fn link_mass(
         if sum.mass > 0.0 {
             let (com, i_com) = (sum.com(), sum.i_com());
             let eig = i_com.symmetric_eigen();
-            let bounded = bounded_moments(&link.name, &link.loc, eig.eigenvalues, rules)?;
+            let bounded = settle(&link.loc, bounded_moments(eig.eigenvalues, rules))?;
             return Ok((
                 inertia_with(sum, sum.mass.max(rules.bound_mass), com, &eig.eigenvectors, bounded),
                 geom_masses,
@@ -353,14 +353,15 @@ fn link_mass(
     let Some(i) = &link.inertial else {
         // No mass anywhere: only the bounds can give the link some, at its origin.
         let zero = RigidInertia::zero();
-        let bounded = bounded_moments(&link.name, &link.loc, Vec3::zeros(), rules)?;
+        let bounded = settle(&link.loc, bounded_moments(Vec3::zeros(), rules))?;
         return Ok((
             inertia_with(zero, rules.bound_mass, Vec3::zeros(), &Mat3::identity(), bounded),
             geom_masses,
         ));
     };
     let (moments, axes) = check_inertial(&link.name, i)?;
-    let bounded = bounded_moments(&link.name, &i.loc, moments, rules)?;
+    let bounded =
+        settle(&i.loc, negative_moment(i, &moments).map_or_else(|| bounded_moments(moments, rules), Err))?;
     let r = i.x_link_inertial.rot;
     let given = RigidInertia::from_com(i.mass, i.x_link_inertial.pos, r * i.inertia * r.transpose());
     Ok((
@@ -386,14 +387,9 @@ fn inertia_with(
 }
 
 /// MuJoCo's `boundinertia` and `balanceinertia` on principal moments (`mjCBody::Compile`): the new
-/// moments, or `None` when no rule fires. Moments that violate the triangle inequality are an error
-/// unless `balanceinertia` replaces them by their mean.
-fn bounded_moments(
-    link: &str,
-    loc: &SourceLoc,
-    moments: Vec3,
-    rules: &MassRules,
-) -> Result<Option<Vec3>, LoadError> {
+/// moments, or `None` when no rule fires. Moments that violate the triangle inequality are a defect
+/// (its description) unless `balanceinertia` replaces them by their mean.
+fn bounded_moments(moments: Vec3, rules: &MassRules) -> Result<Option<Vec3>, String> {
     let mut m = moments.map(|l| l.max(rules.bound_inertia));
     let scale = m.max().max(f64::MIN_POSITIVE);
     let violated = (0..3).any(|k| m[k] > m[(k + 1) % 3] + m[(k + 2) % 3] + INERTIA_TOL * scale);
@@ -401,18 +397,19 @@ fn bounded_moments(
         if !rules.balance_inertia {
             let mut e: Vec<f64> = m.iter().copied().collect();
             e.sort_by(f64::total_cmp);
-            return Err(LoadError::NonPhysicalInertia {
-                loc: loc.clone(),
-                link: link.to_string(),
-                detail: format!(
-                    "principal moments {e:?} violate the triangle inequality ({} + {} < {}) (MJCF: <compiler balanceinertia=\"true\"> replaces them by their mean)",
-                    e[0], e[1], e[2]
-                ),
-            });
+            return Err(format!(
+                "principal moments {e:?} violate the triangle inequality ({} + {} < {}) (MJCF: <compiler balanceinertia=\"true\"> replaces them by their mean)",
+                e[0], e[1], e[2]
+            ));
         }
         m = Vec3::repeat(m.sum() / 3.0);
     }
     Ok((m != moments).then_some(m))
+}
+
+/// Whether the link is the world itself (no parent, welded): it keeps no mass and obeys no bounds.
+fn is_world(l: &LinkSpec) -> bool {
+    l.parent.is_none() && l.joint.jtype == JointType::Fixed
 }
 
 /// MuJoCo's `settotalmass`: scale the masses and inertias of all links but the world so that they
@@ -423,7 +420,6 @@ fn scale_total_mass(
     geom_masses: &mut [Vec<f64>],
     total: f64,
 ) {
-    let is_world = |l: &LinkSpec| l.parent.is_none() && l.joint.jtype == JointType::Fixed;
     let sum: f64 =
         spec.links.iter().zip(inertias.iter()).filter(|(l, _)| !is_world(l)).map(|(_, i)| i.mass).sum();
     if sum <= 0.0 {
@@ -489,8 +485,8 @@ fn joint_kind(j: &JointSpec) -> Result<Option<JointKind>, LoadError> {
     })
 }
 
-/// Checks an `<inertial>` (finite, non-negative mass; symmetric tensor with non-negative principal
-/// moments) and returns its principal moments and axes (columns, in inertial-frame coordinates).
+/// Checks an `<inertial>` (finite, non-negative mass; finite symmetric tensor) and returns its
+/// principal moments and axes (columns, in inertial-frame coordinates).
 fn check_inertial(link: &str, i: &InertialSpec) -> Result<(Vec3, Mat3), LoadError> {
     let err =
         |detail: String| LoadError::NonPhysicalInertia { loc: i.loc.clone(), link: link.to_string(), detail };
@@ -509,10 +505,16 @@ fn check_inertial(link: &str, i: &InertialSpec) -> Result<(Vec3, Mat3), LoadErro
         return Err(err("the tensor is not symmetric".into()));
     }
     let eig = m.symmetric_eigen();
-    if eig.eigenvalues.min() < -INERTIA_TOL * scale {
-        let mut e: Vec<f64> = eig.eigenvalues.iter().copied().collect();
-        e.sort_by(f64::total_cmp);
-        return Err(err(format!("principal moments {e:?} include a negative one")));
-    }
     Ok((eig.eigenvalues, eig.eigenvectors))
+}
+
+/// The defect of an `<inertial>` whose principal `moments` include a negative one (beyond round-off
+/// relative to its largest entry), if any.
+fn negative_moment(i: &InertialSpec, moments: &Vec3) -> Option<String> {
+    let scale = i.inertia.abs().max().max(f64::MIN_POSITIVE);
+    (moments.min() < -INERTIA_TOL * scale).then(|| {
+        let mut e: Vec<f64> = moments.iter().copied().collect();
+        e.sort_by(f64::total_cmp);
+        format!("principal moments {e:?} include a negative one")
+    })
 }
