@@ -20,7 +20,6 @@ use lagrange::kinematics::forward_kinematics;
 use lagrange::model::{FrameKind, JointKind};
 use lagrange::spatial::quat_to_matrix;
 use lagrange::{Data, Model};
-use nalgebra::DMatrix;
 use serde::Deserialize;
 
 #[derive(Deserialize)]
@@ -96,12 +95,6 @@ struct State {
     xquat: Vec<[f64; 4]>,
     site_xpos: Vec<[f64; 3]>,
     site_xquat: Vec<[f64; 4]>,
-}
-
-fn matrix(rows: &[Vec<f64>], n: usize) -> DMatrix<f64> {
-    assert_eq!(rows.len(), n, "matrix rows");
-    assert!(rows.iter().all(|r| r.len() == n), "matrix columns");
-    DMatrix::from_fn(n, n, |i, j| rows[i][j])
 }
 
 /// Whether a lagrange joint kind is the MuJoCo joint type.

@@ -13,7 +13,6 @@ use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::forward_kinematics;
 use lagrange::spatial::{quat_to_matrix, Vec3};
 use lagrange::Data;
-use nalgebra::DMatrix;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 
@@ -59,12 +58,6 @@ struct Pose {
     pos: [f64; 3],
     /// [w, x, y, z], sign canonicalized to w ≥ 0.
     quat: [f64; 4],
-}
-
-fn matrix(rows: &[Vec<f64>], n: usize) -> DMatrix<f64> {
-    assert_eq!(rows.len(), n, "matrix rows");
-    assert!(rows.iter().all(|r| r.len() == n), "matrix columns");
-    DMatrix::from_fn(n, n, |i, j| rows[i][j])
 }
 
 fn check_robot(robot: &str) {

@@ -137,6 +137,13 @@ pub fn rel_err(a: f64, b: f64) -> f64 {
 
 /// Norm-wise relative error of two matrices with the max-abs-entry norm, and the (row, column) of
 /// the largest entry difference.
+/// An n×n matrix from the rows of reference data (JSON), checking its shape.
+pub fn matrix(rows: &[Vec<f64>], n: usize) -> DMatrix<f64> {
+    assert_eq!(rows.len(), n, "matrix rows");
+    assert!(rows.iter().all(|r| r.len() == n), "matrix columns");
+    DMatrix::from_fn(n, n, |i, j| rows[i][j])
+}
+
 pub fn rel_err_mat_at(a: &DMatrix<f64>, b: &DMatrix<f64>) -> (f64, (usize, usize)) {
     assert_eq!(a.shape(), b.shape(), "rel_err_mat: shapes differ");
     // Column-major storage: index i ↔ (i % nrows, i / nrows).
