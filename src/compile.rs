@@ -428,7 +428,7 @@ fn scale_total_mass(
     let s = total / sum;
     for ((l, i), gm) in spec.links.iter().zip(inertias.iter_mut()).zip(geom_masses.iter_mut()) {
         if !is_world(l) {
-            *i = RigidInertia { mass: i.mass * s, h: i.h * s, i_origin: i.i_origin * s };
+            *i = i.scaled(s);
             gm.iter_mut().for_each(|m| *m *= s);
         }
     }

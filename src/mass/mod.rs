@@ -74,8 +74,8 @@ pub fn scaled_to_mass(unit: &RigidInertia, mass: f64) -> RigidInertia {
     if unit.mass <= 0.0 {
         return RigidInertia::zero();
     }
-    let s = mass / unit.mass;
-    RigidInertia { mass, h: unit.h * s, i_origin: unit.i_origin * s }
+    // The mass is set exactly; first moment and inertia scale with it.
+    RigidInertia { mass, ..unit.scaled(mass / unit.mass) }
 }
 
 /// MuJoCo's mesh inertia modes (`<mesh inertia="...">`; MuJoCo's default is `legacy`).

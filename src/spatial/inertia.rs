@@ -63,6 +63,11 @@ impl RigidInertia {
         let i_origin = r * self.i_origin * r.transpose() - (hx * px + px * hx) - px * px * self.mass;
         RigidInertia { mass: self.mass, h: h_rot + p * self.mass, i_origin }
     }
+    /// The same body with its density multiplied by `s` (mass, first moment and inertia scale
+    /// together; the centre of mass stays).
+    pub fn scaled(&self, s: f64) -> RigidInertia {
+        RigidInertia { mass: self.mass * s, h: self.h * s, i_origin: self.i_origin * s }
+    }
     /// Kinetic energy ½ vᵀ I v.
     #[inline]
     pub fn kinetic_energy(&self, v: &Motion) -> f64 {
