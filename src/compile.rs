@@ -281,15 +281,17 @@ fn check_moving_mass(
     link_body: &[(usize, Transform)],
 ) -> Result<(), LoadError> {
     const MINVAL: f64 = 1e-15;
-    for (b, body) in bodies.iter().enumerate().skip(1) {
-        let Some(li) = (0..spec.links.len())
-            .find(|&l| link_body[l].0 == b && spec.links[l].kind == crate::model::FrameKind::Link)
-        else {
+    let mut checked = vec![false; bodies.len()];
+    checked[0] = true;
+    // Each moving body once, named by the first MJCF body (link kind) fused into it.
+    for (link, &(b, _)) in spec.links.iter().zip(link_body) {
+        if checked[b] || link.kind != crate::model::FrameKind::Link {
             continue;
-        };
+        }
+        checked[b] = true;
+        let body = &bodies[b];
         let moments = body.inertia.i_com().symmetric_eigenvalues();
         if body.inertia.mass < MINVAL || moments.min() < MINVAL {
-            let link = &spec.links[li];
             return Err(LoadError::NonPhysicalInertia {
                 loc: link.loc.clone(),
                 link: link.name.clone(),
