@@ -11,8 +11,6 @@
 // zips over four slices would hide the RBDA table they transcribe.
 #![allow(clippy::needless_range_loop)]
 
-pub mod cli;
-pub mod compile;
 pub mod dynamics;
 pub mod integrate;
 pub mod io;

@@ -9,11 +9,11 @@
 mod common;
 
 use common::*;
-use lagrange::compile::compile;
 use lagrange::dynamics::{
     aba, bias_forces, center_of_mass, crba, factorize_mass_matrix, kinetic_energy, potential_energy, rnea,
     solve_mass_matrix, spatial_momentum,
 };
+use lagrange::io::compile;
 use lagrange::kinematics::{
     forward_kinematics, forward_velocities, frame_jacobian, frame_velocity, ReferenceFrame,
 };

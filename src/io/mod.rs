@@ -1,6 +1,7 @@
 //! Loaders: model files → [`ModelSpec`] → (compile) → [`Model`] (DESIGN.md, layer 3).
 //! Loaders never touch dynamics code.
 
+pub mod compile;
 mod error;
 pub mod geom_mass;
 pub mod mjcf;
@@ -9,9 +10,9 @@ pub mod urdf;
 
 pub use error::LoadError;
 
-use crate::compile::compile;
 use crate::model::spec::ModelSpec;
 use crate::Model;
+pub use compile::compile;
 use std::path::{Path, PathBuf};
 
 /// Options shared by all loaders (the CLI's `--package-dir` and `--floating`).

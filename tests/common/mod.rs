@@ -5,7 +5,7 @@
 //! Each test binary uses a different subset of these helpers, hence the `dead_code` allowance.
 #![allow(dead_code)]
 
-use lagrange::compile::compile;
+use lagrange::io::compile;
 use lagrange::io::{load, LoadOptions};
 use lagrange::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, ModelSpec};
 use lagrange::model::{JointKind, SourceLoc};

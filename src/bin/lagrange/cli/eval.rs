@@ -2,11 +2,11 @@
 //! validation scripts use; schema in the README).
 
 use super::CliError;
-use crate::dynamics::{aba, bias_forces, center_of_mass, crba, kinetic_energy, potential_energy};
-use crate::io::{load, LoadOptions};
-use crate::kinematics::{forward_kinematics, frame_jacobian, ReferenceFrame};
-use crate::model::FrameKind;
-use crate::{Data, Model};
+use lagrange::dynamics::{aba, bias_forces, center_of_mass, crba, kinetic_energy, potential_energy};
+use lagrange::io::{load, LoadOptions};
+use lagrange::kinematics::{forward_kinematics, frame_jacobian, ReferenceFrame};
+use lagrange::model::FrameKind;
+use lagrange::{Data, Model};
 use nalgebra::DMatrix;
 use serde::Deserialize;
 use serde_json::{json, Map, Value};

@@ -1,5 +1,5 @@
-//! The command implementations behind `src/bin/lagrange.rs` (DESIGN.md, layer 9), kept in the
-//! library so they are testable.
+//! The command implementations of the `lagrange` binary (DESIGN.md, layer 11). They live with the
+//! binary, not in the library: argument types are not part of the library API.
 
 pub mod bench;
 pub mod eval;
@@ -13,9 +13,9 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum CliError {
     #[error(transparent)]
-    Load(#[from] crate::io::LoadError),
+    Load(#[from] lagrange::io::LoadError),
     #[error(transparent)]
-    Sim(#[from] crate::sim::SimError),
+    Sim(#[from] lagrange::sim::SimError),
     #[error("{file}: {detail}")]
     Input { file: String, detail: String },
     #[error("{0}")]

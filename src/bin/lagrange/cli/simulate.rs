@@ -1,17 +1,17 @@
 //! `lagrange simulate` and the default run of `lagrange` with no arguments.
 
 use super::CliError;
-use crate::integrate::{IntegratorKind, State};
-use crate::io::{load, load_urdf_str, LoadOptions};
-use crate::sim::Simulation;
-use crate::Model;
 use indicatif::{ProgressBar, ProgressStyle};
+use lagrange::integrate::{IntegratorKind, State};
+use lagrange::io::{load, load_urdf_str, LoadOptions};
+use lagrange::sim::Simulation;
+use lagrange::Model;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// The model `lagrange` simulates when run without arguments: the UR5 arm of `models/ur5`.
-pub const DEFAULT_MODEL_URDF: &str = include_str!("../../models/ur5/ur5.urdf");
+pub const DEFAULT_MODEL_URDF: &str = include_str!("../../../../models/ur5/ur5.urdf");
 /// Initial configuration of the default run: the arm held out and released under gravity.
 pub const DEFAULT_Q0: &str = "0.0,-1.2,1.0,-0.6,1.5,0.0";
 
@@ -272,7 +272,7 @@ pub fn default_run() -> Result<(), CliError> {
         env!("CARGO_PKG_VERSION")
     );
     println!("(Run `lagrange --help` for info/eval/simulate on your own URDF or MJCF.)\n");
-    print!("{}", crate::cli::info::to_text(&model));
+    print!("{}", super::info::to_text(&model));
     println!();
     let request = Request {
         duration: 5.0,

@@ -1,9 +1,9 @@
 //! `lagrange info MODEL [--json]`: the compiled tree, sizes and the simulation plan.
 
 use super::CliError;
-use crate::io::{load, LoadOptions};
-use crate::sim::plan;
-use crate::Model;
+use lagrange::io::{load, LoadOptions};
+use lagrange::sim::plan;
+use lagrange::Model;
 use serde_json::{json, Map, Value};
 use std::path::Path;
 

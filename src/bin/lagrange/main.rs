@@ -2,7 +2,8 @@
 //! embedded default model (a UR5 arm released under gravity) and prints the summary.
 
 use clap::{Parser, Subcommand, ValueEnum};
-use lagrange::cli::{bench, eval, info, simulate};
+mod cli;
+use cli::{bench, eval, info, simulate};
 use lagrange::integrate::IntegratorKind;
 use lagrange::io::LoadOptions;
 use std::path::PathBuf;

@@ -3,11 +3,11 @@
 //! `validation/bench_load.py` in the same session (DESIGN.md, "Truth": speed is quoted as ratios).
 
 use super::CliError;
-use crate::dynamics::{aba, crba, rnea};
-use crate::io::{load, LoadOptions};
-use crate::kinematics::forward_kinematics;
-use crate::model::Data;
-use crate::Model;
+use lagrange::dynamics::{aba, crba, rnea};
+use lagrange::io::{load, LoadOptions};
+use lagrange::kinematics::forward_kinematics;
+use lagrange::model::Data;
+use lagrange::Model;
 use serde_json::json;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -32,7 +32,7 @@ fn median_us(budget: Duration, inner: u32, mut f: impl FnMut()) -> f64 {
 fn test_state(model: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let dq: Vec<f64> = (0..model.nv).map(|i| 0.3 * ((i as f64) * 1.3).sin()).collect();
     let mut q = model.qpos0.clone();
-    crate::model::integrate_configuration(model, &mut q, &dq, 1.0);
+    lagrange::model::integrate_configuration(model, &mut q, &dq, 1.0);
     let v: Vec<f64> = (0..model.nv).map(|i| ((i as f64) * 0.7).cos()).collect();
     let tau: Vec<f64> = (0..model.nv).map(|i| ((i as f64) * 0.4).sin()).collect();
     (q, v, tau)
