@@ -151,7 +151,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     }
 
     // Springs of one-dof joints; `<flag spring/damper="disable">` switches them off.
-    let springs = if spec.options.disabled("spring") {
+    let springs = if !spec.options.flags.spring {
         Vec::new()
     } else {
         joints
@@ -165,7 +165,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             })
             .collect()
     };
-    if spec.options.disabled("damper") {
+    if !spec.options.flags.damper {
         dof_damping.iter_mut().for_each(|d| *d = 0.0);
     }
 
@@ -211,6 +211,11 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         qpos0,
         options: spec.options.clone(),
         keyframes,
+        equalities: Vec::new(),
+        tendons: Vec::new(),
+        actuators: Vec::new(),
+        contact_pairs: Vec::new(),
+        contact_excludes: Vec::new(),
         elements: spec.elements.clone(),
         warnings,
     })

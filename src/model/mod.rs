@@ -4,14 +4,24 @@
 //! every other body `b` hangs from its parent through exactly one movable joint (`joints[b - 1]`).
 //! Fixed joints were fused by the compile step; every original link survives as a [`Frame`].
 
+pub mod actuator;
+pub mod contact;
 mod data;
 mod elements;
+pub mod equality;
 mod joint;
+pub mod options;
 pub mod spec;
+pub mod tendon;
 
+pub use actuator::Actuator;
+pub use contact::{ContactExclude, ContactPair};
 pub use data::Data;
-pub use elements::{Element, Keyframe, Options};
+pub use elements::{Element, Keyframe};
+pub use equality::{Equality, EqualityKind};
 pub use joint::{axis_angle, JointKind};
+pub use options::{Flags, Options};
+pub use tendon::{Tendon, TendonKind};
 
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
 use std::path::PathBuf;
@@ -173,7 +183,17 @@ pub struct Model {
     pub options: Options,
     /// Named initial states (MJCF `<keyframe>`).
     pub keyframes: Vec<Keyframe>,
-    /// Elements parsed and kept but not simulated yet (listed by `lagrange info`).
+    /// Equality constraints and URDF mimic couplings (simulated by the constraint layer).
+    pub equalities: Vec<Equality>,
+    /// Tendons in MuJoCo's order (fixed tendons are simulated, spatial ones listed).
+    pub tendons: Vec<Tendon>,
+    /// Actuators in MuJoCo's order (`ctrl` layout).
+    pub actuators: Vec<Actuator>,
+    /// Explicit contact pairs (`<contact><pair>`).
+    pub contact_pairs: Vec<ContactPair>,
+    /// Body pairs excluded from contact (`<contact><exclude>`).
+    pub contact_excludes: Vec<ContactExclude>,
+    /// Elements parsed and kept but not simulated (sensors, …; listed by `lagrange info`).
     pub elements: Vec<Element>,
     /// What the loader ignored or could not interpret, each with file:line.
     pub warnings: Vec<String>,

@@ -7,6 +7,7 @@ use super::orientation::AngleConvention;
 use super::xml::Element;
 use super::{Compiler, InertiaFromGeom};
 use crate::io::LoadError;
+use crate::model::options::{Cone, Integrator, JacobianStorage, Solver};
 use crate::model::spec::MassRules;
 use crate::model::{Element as KeptElement, Keyframe, Options};
 use crate::spatial::Vec3;
@@ -91,7 +92,53 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
             gravity = v;
         }
         if let Some(v) = a.keyword("integrator", &["Euler", "RK4", "implicit", "implicitfast"])? {
-            o.integrator = v;
+            o.integrator = match v.as_str() {
+                "Euler" => Integrator::Euler,
+                "RK4" => Integrator::Rk4,
+                "implicit" => Integrator::Implicit,
+                _ => Integrator::ImplicitFast,
+            };
+        }
+        if let Some(v) = a.keyword("cone", &["pyramidal", "elliptic"])? {
+            o.cone = if v == "pyramidal" { Cone::Pyramidal } else { Cone::Elliptic };
+        }
+        if let Some(v) = a.keyword("solver", &["PGS", "CG", "Newton"])? {
+            o.solver = match v.as_str() {
+                "PGS" => Solver::Pgs,
+                "CG" => Solver::Cg,
+                _ => Solver::Newton,
+            };
+        }
+        if let Some(v) = a.keyword("jacobian", &["dense", "sparse", "auto"])? {
+            o.jacobian = match v.as_str() {
+                "dense" => JacobianStorage::Dense,
+                "sparse" => JacobianStorage::Sparse,
+                _ => JacobianStorage::Auto,
+            };
+        }
+        for (attr, slot) in [
+            ("iterations", &mut o.iterations),
+            ("ls_iterations", &mut o.ls_iterations),
+            ("noslip_iterations", &mut o.noslip_iterations),
+        ] {
+            if let Some(v) = a.real(attr)? {
+                if v < 0.0 || v.fract() != 0.0 {
+                    return Err(a.error(attr, format!("is {v}; give a non-negative whole number")));
+                }
+                *slot = v as u32;
+            }
+        }
+        for (attr, slot) in [
+            ("tolerance", &mut o.tolerance),
+            ("ls_tolerance", &mut o.ls_tolerance),
+            ("impratio", &mut o.impratio),
+        ] {
+            if let Some(v) = a.real(attr)? {
+                if v < 0.0 {
+                    return Err(a.error(attr, format!("is {v}; it must be ≥ 0")));
+                }
+                *slot = v;
+            }
         }
         for f in e.children_named("flag") {
             for (name, value) in &f.attrs {
@@ -104,12 +151,19 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
                         );
                     }
                 };
-                o.flags.retain(|(n, _)| n != name);
-                o.flags.push((name.clone(), on));
+                match o.flags.get_mut(name) {
+                    Some(flag) => *flag = on,
+                    None => {
+                        return Err(Attrs::plain(f).error(
+                            name,
+                            "is not a MuJoCo <flag>; see the MJCF reference for the flag names".to_string(),
+                        ));
+                    }
+                }
             }
         }
     }
-    if o.disabled("gravity") {
+    if !o.flags.gravity {
         gravity = Vec3::zeros();
     }
     Ok((o, gravity))

@@ -1,0 +1,103 @@
+//! Actuators (MJCF `<actuator>`, MuJoCo's `actuator_*` arrays) in MuJoCo's general form: every
+//! shortcut (`motor`, `position`, `velocity`, …) is stored as the gain, bias and dynamics
+//! parameters MuJoCo expands it to (MuJoCo documentation, "Actuation model"). Typed here so that
+//! nothing is read back out of strings; simulated by the actuation work (until then `info` lists
+//! them as not simulated and `qfrc_actuator` stays zero).
+
+use super::SourceLoc;
+
+/// The MJCF element the actuator was written as.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ActuatorShortcut {
+    General,
+    Motor,
+    Position,
+    Velocity,
+    IntVelocity,
+    Damper,
+    Cylinder,
+    Muscle,
+    Adhesion,
+    Plugin,
+}
+
+/// What the actuator acts on (`actuator_trntype` and `actuator_trnid`), by index.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Transmission {
+    /// A joint (index in `Model::joints`).
+    Joint(usize),
+    /// A joint, with the force applied in the parent frame (ball and free joints).
+    JointInParent(usize),
+    /// A tendon (index in `Model::tendons`).
+    Tendon(usize),
+    /// A site (index in `Model::frames`), with an optional reference site.
+    Site { site: usize, refsite: Option<usize> },
+    /// A body (adhesion; index in `Model::bodies`).
+    Body(usize),
+    /// A slider-crank between two sites (frame indices).
+    SliderCrank { cranksite: usize, slidersite: usize, cranklength: f64 },
+}
+
+/// Activation dynamics (`dyntype`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DynType {
+    #[default]
+    None,
+    Integrator,
+    Filter,
+    FilterExact,
+    Muscle,
+    User,
+}
+
+/// Gain (`gaintype`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GainType {
+    #[default]
+    Fixed,
+    Affine,
+    Muscle,
+    User,
+}
+
+/// Bias (`biastype`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BiasType {
+    #[default]
+    None,
+    Affine,
+    Muscle,
+    User,
+}
+
+/// One actuator with MuJoCo's parameter vectors (lengths as `mjNDYN`, `mjNGAIN`, `mjNBIAS`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Actuator {
+    pub name: String,
+    pub shortcut: ActuatorShortcut,
+    pub transmission: Transmission,
+    /// Gear (moment arm scaling; 6 values for site and joint-in-parent transmissions).
+    pub gear: [f64; 6],
+    pub dyntype: DynType,
+    pub gaintype: GainType,
+    pub biastype: BiasType,
+    pub dynprm: [f64; 10],
+    pub gainprm: [f64; 10],
+    pub biasprm: [f64; 10],
+    /// Control range if limited (`ctrllimited`, resolved with `autolimits`).
+    pub ctrlrange: Option<[f64; 2]>,
+    /// Force range if limited.
+    pub forcerange: Option<[f64; 2]>,
+    /// Activation range if limited.
+    pub actrange: Option<[f64; 2]>,
+    /// `actearly`: use the next activation in the force (MuJoCo ≥ 3).
+    pub actearly: bool,
+    pub loc: SourceLoc,
+}
+
+impl Actuator {
+    /// Number of activation states this actuator adds (MuJoCo's `actuator_actnum`: 0 or 1 here).
+    pub fn actnum(&self) -> usize {
+        usize::from(self.dyntype != DynType::None)
+    }
+}

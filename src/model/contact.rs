@@ -1,0 +1,32 @@
+//! Explicit contact pairs and exclusions (MJCF `<contact>`), with resolved geom and body indices.
+//! Used by the collision layer when it arrives; listed by `info` until then.
+
+use super::SourceLoc;
+
+/// `<pair>`: a candidate contact between two geoms with its own parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactPair {
+    pub name: String,
+    /// Indices in [`Model::geoms`](super::Model).
+    pub geom1: usize,
+    pub geom2: usize,
+    pub condim: u32,
+    /// Sliding (2), torsional and rolling (2) friction.
+    pub friction: [f64; 5],
+    pub solref: [f64; 2],
+    pub solreffriction: [f64; 2],
+    pub solimp: [f64; 5],
+    pub margin: f64,
+    pub gap: f64,
+    pub loc: SourceLoc,
+}
+
+/// `<exclude>`: no contacts between the geoms of two bodies (indices in
+/// [`Model::bodies`](super::Model)).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactExclude {
+    pub name: String,
+    pub body1: usize,
+    pub body2: usize,
+    pub loc: SourceLoc,
+}

@@ -1,0 +1,230 @@
+//! Simulation options (MJCF `<option>`, MuJoCo's `mjOption`) as typed values with MuJoCo 4.0's
+//! defaults (MuJoCo documentation, "XML Reference → option").
+
+/// Numerical integrator (`<option integrator>`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Integrator {
+    /// Semi-implicit Euler (MuJoCo's default).
+    #[default]
+    Euler,
+    /// Classical fourth-order Runge–Kutta.
+    Rk4,
+    /// Implicit in velocity (passive and actuator derivatives); not simulated yet.
+    Implicit,
+    /// `implicit` without the Coriolis derivatives; not simulated yet.
+    ImplicitFast,
+}
+
+impl Integrator {
+    /// The name MJCF uses.
+    pub fn mjcf_name(self) -> &'static str {
+        match self {
+            Integrator::Euler => "Euler",
+            Integrator::Rk4 => "RK4",
+            Integrator::Implicit => "implicit",
+            Integrator::ImplicitFast => "implicitfast",
+        }
+    }
+}
+
+/// Friction cone of the soft contact model (`<option cone>`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Cone {
+    #[default]
+    Pyramidal,
+    Elliptic,
+}
+
+/// Constraint solver of the soft mode (`<option solver>`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Solver {
+    Pgs,
+    Cg,
+    #[default]
+    Newton,
+}
+
+/// Constraint Jacobian storage (`<option jacobian>`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum JacobianStorage {
+    Dense,
+    Sparse,
+    /// Dense up to 60 degrees of freedom, sparse above (MuJoCo's rule).
+    #[default]
+    Auto,
+}
+
+/// `<option><flag>`: each switch with MuJoCo's default. `true` means the feature is on
+/// (MuJoCo's "disable" flags default to on, its "enable" flags to off).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Flags {
+    pub constraint: bool,
+    pub equality: bool,
+    pub frictionloss: bool,
+    pub limit: bool,
+    pub contact: bool,
+    pub spring: bool,
+    pub damper: bool,
+    pub gravity: bool,
+    pub clampctrl: bool,
+    pub warmstart: bool,
+    pub filterparent: bool,
+    pub actuation: bool,
+    pub refsafe: bool,
+    pub sensor: bool,
+    pub midphase: bool,
+    pub nativeccd: bool,
+    pub eulerdamp: bool,
+    pub autoreset: bool,
+    pub override_contacts: bool,
+    pub energy: bool,
+    pub fwdinv: bool,
+    pub invdiscrete: bool,
+    pub multiccd: bool,
+    pub island: bool,
+}
+
+impl Default for Flags {
+    fn default() -> Self {
+        Self {
+            constraint: true,
+            equality: true,
+            frictionloss: true,
+            limit: true,
+            contact: true,
+            spring: true,
+            damper: true,
+            gravity: true,
+            clampctrl: true,
+            warmstart: true,
+            filterparent: true,
+            actuation: true,
+            refsafe: true,
+            sensor: true,
+            midphase: true,
+            nativeccd: true,
+            eulerdamp: true,
+            autoreset: true,
+            override_contacts: false,
+            energy: false,
+            fwdinv: false,
+            invdiscrete: false,
+            multiccd: false,
+            island: false,
+        }
+    }
+}
+
+impl Flags {
+    /// The switch named `name` as MJCF spells it (`override` for `override_contacts`).
+    pub fn get_mut(&mut self, name: &str) -> Option<&mut bool> {
+        Some(match name {
+            "constraint" => &mut self.constraint,
+            "equality" => &mut self.equality,
+            "frictionloss" => &mut self.frictionloss,
+            "limit" => &mut self.limit,
+            "contact" => &mut self.contact,
+            "spring" => &mut self.spring,
+            "damper" => &mut self.damper,
+            "gravity" => &mut self.gravity,
+            "clampctrl" => &mut self.clampctrl,
+            "warmstart" => &mut self.warmstart,
+            "filterparent" => &mut self.filterparent,
+            "actuation" => &mut self.actuation,
+            "refsafe" => &mut self.refsafe,
+            "sensor" => &mut self.sensor,
+            "midphase" => &mut self.midphase,
+            "nativeccd" => &mut self.nativeccd,
+            "eulerdamp" => &mut self.eulerdamp,
+            "autoreset" => &mut self.autoreset,
+            "override" => &mut self.override_contacts,
+            "energy" => &mut self.energy,
+            "fwdinv" => &mut self.fwdinv,
+            "invdiscrete" => &mut self.invdiscrete,
+            "multiccd" => &mut self.multiccd,
+            "island" => &mut self.island,
+            _ => return None,
+        })
+    }
+
+    /// The switches that differ from MuJoCo's defaults, as (MJCF name, on).
+    pub fn changed(&self) -> Vec<(&'static str, bool)> {
+        const NAMES: [&str; 24] = [
+            "constraint",
+            "equality",
+            "frictionloss",
+            "limit",
+            "contact",
+            "spring",
+            "damper",
+            "gravity",
+            "clampctrl",
+            "warmstart",
+            "filterparent",
+            "actuation",
+            "refsafe",
+            "sensor",
+            "midphase",
+            "nativeccd",
+            "eulerdamp",
+            "autoreset",
+            "override",
+            "energy",
+            "fwdinv",
+            "invdiscrete",
+            "multiccd",
+            "island",
+        ];
+        let (mut this, mut default) = (*self, Flags::default());
+        NAMES
+            .iter()
+            .filter_map(|&n| {
+                let on = *this.get_mut(n).expect("every listed name is a flag");
+                (on != *default.get_mut(n).expect("every listed name is a flag")).then_some((n, on))
+            })
+            .collect()
+    }
+}
+
+/// Simulation options (MJCF `<option>`; MuJoCo's defaults for URDF).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    /// Time step (s); MuJoCo's default 0.002.
+    pub timestep: f64,
+    pub integrator: Integrator,
+    pub cone: Cone,
+    pub solver: Solver,
+    pub jacobian: JacobianStorage,
+    /// Maximum iterations of the constraint solver (100).
+    pub iterations: u32,
+    /// Relative improvement below which the solver stops (1e-8).
+    pub tolerance: f64,
+    /// Maximum line-search iterations of the Newton and CG solvers (50).
+    pub ls_iterations: u32,
+    /// Line-search tolerance (0.01).
+    pub ls_tolerance: f64,
+    /// Iterations of the no-slip post-processing solver (0: off).
+    pub noslip_iterations: u32,
+    /// Ratio of frictional to normal constraint impedance (1).
+    pub impratio: f64,
+    pub flags: Flags,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            timestep: 0.002,
+            integrator: Integrator::Euler,
+            cone: Cone::Pyramidal,
+            solver: Solver::Newton,
+            jacobian: JacobianStorage::Auto,
+            iterations: 100,
+            tolerance: 1e-8,
+            ls_iterations: 50,
+            ls_tolerance: 0.01,
+            noslip_iterations: 0,
+            impratio: 1.0,
+            flags: Flags::default(),
+        }
+    }
+}

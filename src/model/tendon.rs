@@ -1,0 +1,23 @@
+//! Tendons (MJCF `<tendon>`, MuJoCo's `tendon_*`/`wrap_*` arrays). Fixed tendons — linear
+//! combinations of joint positions — are simulated; spatial tendons are listed, not simulated.
+
+use super::SourceLoc;
+
+/// One tendon, in MuJoCo's tendon order (fixed and spatial in file order).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tendon {
+    pub name: String,
+    pub kind: TendonKind,
+    /// Length limits `[lower, upper]` if limited (stored; enforced by the limits work).
+    pub range: Option<[f64; 2]>,
+    pub loc: SourceLoc,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum TendonKind {
+    /// Length `L = Σ coefᵢ · q[joint i]` over hinge and slide joints (`<fixed><joint coef>`):
+    /// (joint index, coefficient) pairs.
+    Fixed { joints: Vec<(usize, f64)> },
+    /// A spatial tendon through sites and wrapping geoms: kept, not simulated (its path's names).
+    Spatial { path: Vec<String> },
+}
