@@ -85,6 +85,29 @@ fn express(m_world: &Motion, x_world_frame: &Transform, reference: ReferenceFram
     }
 }
 
+/// Calls `column(k, s_world)` for every degree of freedom `k` on the path from body `b` to the
+/// root, with its motion-subspace column `s_world` in world coordinates (about the world origin).
+/// The columns of all other degrees of freedom of a Jacobian of body `b` are zero. Needs
+/// [`forward_kinematics`] (or any pass that fills `x_world_body` and `s_body`) at the same q.
+/// `x_world_body` and `s_body` are those buffers of [`Data`] (passed apart so that the caller may
+/// write another buffer of the same `Data`).
+#[inline]
+pub fn for_each_ancestor_dof(
+    model: &Model,
+    x_world_body: &[Transform],
+    s_body: &[Motion],
+    mut b: usize,
+    mut column: impl FnMut(usize, Motion),
+) {
+    while b != 0 {
+        let j = model.joint_of(b);
+        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+            column(k, x_world_body[b].act_motion(&s_body[k]));
+        }
+        b = model.bodies[b].parent;
+    }
+}
+
 /// Jacobian of frame `frame` into `jac` (6 × nv): rows 0–2 linear, rows 3–5 angular velocity, in
 /// `reference` coordinates (the row order of Pinocchio). Columns of degrees of freedom that do not
 /// move the frame are zero. Needs [`forward_kinematics`] at the same q.
@@ -97,18 +120,39 @@ pub fn frame_jacobian(
 ) {
     jac.fill(0.0);
     let x_world_frame = &data.x_world_frame[frame];
-    let mut b = model.frames[frame].body;
-    // Walk from the frame's body to the root: each joint's columns S, moved to world coordinates.
-    while b != 0 {
+    for_each_ancestor_dof(model, &data.x_world_body, &data.s_body, model.frames[frame].body, |k, s_world| {
+        let (lin, ang) = express(&s_world, x_world_frame, reference);
+        jac.fixed_view_mut::<3, 1>(0, k).copy_from(&lin);
+        jac.fixed_view_mut::<3, 1>(3, k).copy_from(&ang);
+    });
+}
+
+/// Spatial acceleration of every body at zero joint acceleration and without gravity, body
+/// coordinates, into `data.a_bias_body`: a = X a_parent + c_J + v × v_J (RBDA eq. 5.7 with q̈ = 0).
+/// It is what J̇v of a body-fixed point or frame is made of. Needs [`forward_velocities`] first.
+pub fn bias_accelerations(model: &Model, data: &mut Data, v: &[f64]) {
+    data.a_bias_body[0] = Motion::zero();
+    for b in 1..model.nbody() {
+        let p = model.bodies[b].parent;
+        let v_joint = joint_velocity(model, data, b, v);
         let j = model.joint_of(b);
-        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
-            let s_world = data.x_world_body[b].act_motion(&data.s_body[k]);
-            let (lin, ang) = express(&s_world, x_world_frame, reference);
-            jac.fixed_view_mut::<3, 1>(0, k).copy_from(&lin);
-            jac.fixed_view_mut::<3, 1>(3, k).copy_from(&ang);
-        }
-        b = model.bodies[b].parent;
+        data.a_bias_body[b] = data.x_parent_body[b].inv_act_motion(&data.a_bias_body[p])
+            + j.kind.bias_motion(&v_joint)
+            + data.v_body[b].cross_motion(&v_joint);
     }
+}
+
+/// Classical (not spatial) acceleration and velocity of the point `r_body` fixed in body `b` at
+/// zero joint acceleration, world coordinates: ä = R (a + α × r + ω × (v + ω × r)) with the body's
+/// spatial velocity (ω, v) and bias acceleration (α, a) in body coordinates (RBDA §2.11). Also
+/// returns the world angular bias acceleration R α. Needs [`bias_accelerations`].
+#[inline]
+pub fn point_bias_acceleration(data: &Data, b: usize, r_body: &Vec3) -> (Vec3, Vec3) {
+    let (vb, ab) = (&data.v_body[b], &data.a_bias_body[b]);
+    let v_point = vb.lin + vb.ang.cross(r_body);
+    let a_point = ab.lin + ab.ang.cross(r_body) + vb.ang.cross(&v_point);
+    let rot = &data.x_world_body[b].rot;
+    (rot * a_point, rot * ab.ang)
 }
 
 /// Velocity (linear, angular) of frame `frame` in `reference` coordinates, from the body

@@ -11,7 +11,9 @@
 // zips over four slices would hide the RBDA table they transcribe.
 #![allow(clippy::needless_range_loop)]
 
+pub mod constraint;
 pub mod dynamics;
+pub mod forward;
 pub mod integrate;
 pub mod io;
 pub mod kinematics;

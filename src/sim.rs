@@ -1,93 +1,16 @@
-//! The simulation loop and its per-step plan (DESIGN.md, layer 8): a stage runs only when the
-//! model contains what it acts on, and the plan says why each stage runs or is skipped.
+//! The simulation (DESIGN.md, layer 10): a model behind `Arc`, its [`Data`], the forward [`Plan`],
+//! a [`Stepper`], the state and the controls. The model's `<option>` timestep and integrator are
+//! honoured unless the caller overrides them ([`SimOptions`]); a non-finite state is reported with
+//! the step, time and joint, never propagated.
 
+use crate::constraint::ConstraintMode;
 use crate::dynamics;
-use crate::integrate::{Integrator, IntegratorKind, State};
+use crate::forward::{DriftCorrection, Plan};
+use crate::integrate::{IntegratorKind, State, StepReport, Stepper};
 use crate::kinematics::forward_kinematics;
 use crate::model::{Data, Model};
-use serde::Serialize;
+use std::sync::Arc;
 use thiserror::Error;
-
-/// One stage of the per-step pipeline and whether it runs.
-#[derive(Clone, Debug, Serialize, PartialEq)]
-pub struct Stage {
-    pub name: &'static str,
-    /// `"runs"`, `"skipped"` or `"parsed, not simulated"`.
-    pub status: &'static str,
-    pub reason: String,
-}
-
-/// The stages `simulate` runs for a model, in order.
-pub fn plan(model: &Model) -> Vec<Stage> {
-    let mut stages = vec![Stage {
-        name: "dynamics",
-        status: "runs",
-        reason: format!("articulated-body algorithm over {} bodies, nv = {}", model.nbody() - 1, model.nv),
-    }];
-    let damped = model.dof_damping.iter().filter(|&&d| d != 0.0).count();
-    let springs = model.springs.len();
-    stages.push(if damped + springs > 0 {
-        Stage {
-            name: "passive",
-            status: "runs",
-            reason: format!("joint damping on {damped} degrees of freedom, {springs} joint springs"),
-        }
-    } else {
-        Stage { name: "passive", status: "skipped", reason: "no joint damping or springs".into() }
-    });
-    // Passive elements kept from the file but not simulated: springs of ball and free joints,
-    // gravity compensation, spring-dampers, higher-order spring/damper coefficients.
-    let multi_dof_springs = model.joints.iter().filter(|j| j.stiffness != 0.0 && j.kind.nq() > 1).count();
-    let other_passive = count(model, &["body", "joint"]) + multi_dof_springs;
-    if other_passive > 0 {
-        stages.push(Stage {
-            name: "passive (other)",
-            status: "parsed, not simulated",
-            reason: format!(
-                "{other_passive} elements (gravity compensation, spring-dampers, polynomial or ball/free springs); see `info` elements"
-            ),
-        });
-    }
-    let friction = model.joints.iter().filter(|j| j.friction != 0.0).count();
-    let limited = model.joints.iter().filter(|j| j.limits.is_some()).count();
-    let mimics = model.joints.iter().filter(|j| j.mimic.is_some()).count();
-    // A stage for `n` kept elements: "parsed, not simulated" with `why`, or skipped if none.
-    let kept = |name: &'static str, n: usize, what: &str, why: &str| {
-        if n > 0 {
-            Stage { name, status: "parsed, not simulated", reason: format!("{n} {what}: {why}") }
-        } else {
-            Stage { name, status: "skipped", reason: format!("no {what}") }
-        }
-    };
-    const SOLVER: &str = "stored; enforcement arrives with the constraint solver";
-    stages.push(kept("joint limits", limited, "limited joints", SOLVER));
-    stages.push(kept("joint friction", friction, "joints with Coulomb friction", SOLVER));
-    let equalities = mimics + count(model, &["equality"]);
-    stages.push(kept("equality constraints", equalities, "mimic joints and equality constraints", SOLVER));
-    stages.push(kept("tendons", count(model, &["tendon"]), "tendons", SOLVER));
-    let actuators = count(model, &["actuator"]);
-    stages.push(kept("actuators", actuators, "actuators", "stored; simulate applies zero control"));
-    stages.push(kept("sensors", count(model, &["sensor"]), "sensors", "stored, not evaluated"));
-    let colliding = model.geoms.iter().filter(|g| g.collision).count();
-    let pairs = count(model, &["contact"]);
-    stages.push(if colliding + pairs > 0 {
-        Stage {
-            name: "collision",
-            status: "parsed, not simulated",
-            reason: format!(
-                "{colliding} collision geoms, {pairs} contact pair/exclude entries: stored; contacts arrive with the constraint solver"
-            ),
-        }
-    } else {
-        Stage { name: "collision", status: "skipped", reason: "no collision geometry".into() }
-    });
-    stages
-}
-
-/// Number of kept elements in the given categories.
-fn count(model: &Model, categories: &[&str]) -> usize {
-    model.elements.iter().filter(|e| categories.contains(&e.category.as_str())).count()
-}
 
 /// Why a simulation stopped.
 #[derive(Debug, Error)]
@@ -99,26 +22,55 @@ pub enum SimError {
     BadState(String),
 }
 
-/// A model, its workspace, an integrator and the current state.
-pub struct Simulation<'m> {
-    pub model: &'m Model,
-    pub data: Data,
-    pub integrator: Box<dyn Integrator + Send>,
-    pub state: State,
-    pub steps: u64,
-    tau: Vec<f64>,
+/// Choices a caller may override; `None` takes the model's own (its `<option>` and the format's
+/// constraint mode).
+#[derive(Clone, Debug, Default)]
+pub struct SimOptions {
+    pub integrator: Option<IntegratorKind>,
+    pub timestep: Option<f64>,
+    pub constraints: Option<ConstraintMode>,
+    pub drift: Option<DriftCorrection>,
 }
 
-impl<'m> Simulation<'m> {
-    /// A simulation from the neutral configuration at rest.
-    pub fn new(model: &'m Model, kind: IntegratorKind) -> Self {
+/// A model, its workspace and plan, a stepper and the current state.
+pub struct Simulation {
+    pub model: Arc<Model>,
+    pub plan: Plan,
+    pub data: Data,
+    pub stepper: Box<dyn Stepper>,
+    pub state: State,
+    /// The step size used by [`step`](Self::step).
+    pub timestep: f64,
+    pub steps: u64,
+    /// What was chosen for the caller and why (integrator fallbacks, constraint mode).
+    pub notes: Vec<String>,
+}
+
+impl Simulation {
+    /// A simulation from the model's `qpos0` at rest, with `options` over the model's own.
+    pub fn new(model: Arc<Model>, options: &SimOptions) -> Self {
+        let mut notes = Vec::new();
+        let integrator = options.integrator.unwrap_or_else(|| {
+            let (kind, note) = IntegratorKind::from_option(model.options.integrator);
+            notes.extend(note);
+            kind
+        });
+        let mut plan = Plan::new(&model, options.constraints);
+        if let Some(drift) = options.drift {
+            plan.drift = drift;
+        }
+        if plan.has_constraints() {
+            notes.push(format!("constraints: {} ({})", plan.mode.name(), plan.mode_reason));
+        }
         Self {
-            model,
-            data: Data::new(model),
-            integrator: kind.build(model),
-            state: State::neutral(model),
+            data: Data::new(&model),
+            stepper: integrator.build(&model),
+            state: State::neutral(&model),
+            timestep: options.timestep.unwrap_or(model.options.timestep),
             steps: 0,
-            tau: vec![0.0; model.nv],
+            notes,
+            plan,
+            model,
         }
     }
 
@@ -141,16 +93,23 @@ impl<'m> Simulation<'m> {
         Ok(())
     }
 
-    /// Constant applied generalized forces (zero by default).
-    pub fn tau_mut(&mut self) -> &mut [f64] {
-        &mut self.tau
+    /// Controls, one per actuator (MuJoCo's `ctrl`).
+    pub fn ctrl_mut(&mut self) -> &mut [f64] {
+        self.data.ctrl.as_mut_slice()
     }
 
-    /// Advances one step of `dt`; a non-finite result is reported, never propagated.
-    pub fn step(&mut self, dt: f64) -> Result<(), SimError> {
-        self.integrator.step(self.model, &mut self.data, &mut self.state, &self.tau, dt);
+    /// Applied generalized forces (MuJoCo's `qfrc_applied`), zero by default, held constant.
+    pub fn qfrc_applied_mut(&mut self) -> &mut [f64] {
+        self.data.qfrc_applied.as_mut_slice()
+    }
+
+    /// Advances one step of `timestep`; a non-finite result is reported, never propagated.
+    pub fn step(&mut self) -> Result<StepReport, SimError> {
+        let report =
+            self.stepper.step(&self.model, &self.plan, &mut self.data, &mut self.state, self.timestep);
         self.steps += 1;
-        self.check_finite()
+        self.check_finite()?;
+        Ok(report)
     }
 
     fn check_finite(&self) -> Result<(), SimError> {
@@ -204,12 +163,28 @@ impl<'m> Simulation<'m> {
     /// (forward kinematics included).
     pub fn energies(&mut self) -> (f64, f64) {
         let (q, v) = (self.state.q.as_slice(), self.state.v.as_slice());
-        let kinetic = dynamics::kinetic_energy(self.model, &mut self.data, q, v);
-        (kinetic, dynamics::potential_energy(self.model, &self.data) + self.model.spring_energy(q))
+        let kinetic = dynamics::kinetic_energy(&self.model, &mut self.data, q, v);
+        (kinetic, dynamics::potential_energy(&self.model, &self.data) + self.model.spring_energy(q))
     }
 
     /// Forward kinematics at the current state (poses in `data`).
     pub fn kinematics(&mut self) {
-        forward_kinematics(self.model, &mut self.data, self.state.q.as_slice());
+        forward_kinematics(&self.model, &mut self.data, self.state.q.as_slice());
+    }
+
+    /// max |φ| and max |J v| of the active constraint rows at the current state (0 without rows).
+    pub fn constraint_violation(&mut self) -> [f64; 2] {
+        if !self.plan.has_constraints() {
+            return [0.0, 0.0];
+        }
+        let (q, v) = (self.state.q.as_slice(), self.state.v.as_slice());
+        self.plan.constraints.evaluate(&self.model, &mut self.data, q, v);
+        let n = self.data.nefc;
+        [self.data.efc_pos.rows(0, n).amax(), self.data.efc_vel.rows(0, n).amax()]
+    }
+
+    /// The stepper's name.
+    pub fn integrator(&self) -> &'static str {
+        self.stepper.name()
     }
 }

@@ -43,6 +43,7 @@ fn info_json_has_exactly_the_documented_keys() {
         keys(&v),
         [
             "bodies",
+            "constraints",
             "elements",
             "frames",
             "joints",
@@ -72,9 +73,7 @@ fn info_json_has_exactly_the_documented_keys() {
 fn info_text_lists_the_plan_and_mimic() {
     let (ok, out, err) = lagrange(&["info", "models/panda/panda.urdf"]);
     assert!(ok, "{err}");
-    assert!(out.contains("simulation plan:"), "{out}");
-    assert!(out.contains("mimic panda_finger_joint1 (not enforced yet)"), "{out}");
-    assert!(out.contains("equality constraints") && out.contains("1 mimic joints"), "{out}");
+    assert!(out.contains("forward plan (constraint mode: exact; exact is the default for URDF)"), "{out}");
 }
 
 /// `eval` on the Pinocchio reference states reproduces M, bias, qacc and poses at REF_REL.
@@ -160,7 +159,10 @@ fn simulate_prints_a_summary_and_writes_the_csv() {
     }
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
-    assert_eq!(lines.next().unwrap(), "time,q:shoulder[0],q:elbow[0],v:shoulder[0],v:elbow[0],energy");
+    assert_eq!(
+        lines.next().unwrap(),
+        "time,q:shoulder[0],q:elbow[0],v:shoulder[0],v:elbow[0],energy,constraint_violation"
+    );
     assert_eq!(lines.count(), 501);
 }
 
@@ -178,8 +180,7 @@ fn simulate_rejects_bad_arguments_with_a_fix() {
 fn default_run_simulates_the_embedded_model() {
     let (ok, out, err) = lagrange(&[]);
     assert!(ok, "{err}");
-    for needle in ["embedded default model", "model 'ur5'", "simulation plan:", "5000 steps", "energy: start"]
-    {
+    for needle in ["embedded default model", "model 'ur5'", "forward plan", "5000 steps", "energy: start"] {
         assert!(out.contains(needle), "missing '{needle}' in {out}");
     }
 }
@@ -206,7 +207,7 @@ fn mjcf_info_lists_kept_elements_and_keyframes() {
     assert_eq!(v["keyframes"][0]["name"], "home");
     let actuators = v["elements"].as_array().unwrap().iter().filter(|e| e["category"] == "actuator").count();
     assert_eq!(actuators, 12);
-    assert_eq!(v["stages"]["actuators"]["status"], "parsed, not simulated");
+    assert_eq!(v["stages"]["actuation"]["status"], "parsed, not simulated");
     assert_eq!(v["stages"]["collision"]["status"], "parsed, not simulated");
     assert_eq!(v["options"]["timestep"], 0.002, "MuJoCo's default: go1.xml sets no <option>");
 }

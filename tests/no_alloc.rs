@@ -2,7 +2,9 @@
 //! kernels and the integrators perform zero heap allocations. A counting global allocator counts
 //! the allocations this thread makes while the kernels run.
 
+use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{aba, bias_forces, crba, factorize_mass_matrix, rnea, solve_mass_matrix};
+use lagrange::forward::{forward, Plan};
 use lagrange::integrate::{IntegratorKind, State};
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::{forward_kinematics, forward_velocities, frame_jacobian, ReferenceFrame};
@@ -88,13 +90,18 @@ fn kernels_and_integrators_do_not_allocate() {
             aba(&model, &mut data, &q, &v, &tau);
         });
         assert_eq!(kernels, 0, "{file}: kernels allocated {kernels} times");
+        // The staged pipeline with the model's constraint rows (projection included in the steps).
+        let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+        data.qfrc_applied.copy_from_slice(&tau);
+        let forwards = allocations(|| forward(&model, &plan, &mut data, &q, &v));
+        assert_eq!(forwards, 0, "{file}: forward allocated {forwards} times");
         for kind in [IntegratorKind::Euler, IntegratorKind::Rk4] {
             let mut integrator = kind.build(&model);
             let mut state =
                 State { time: 0.0, q: DVector::from_vec(q.clone()), v: DVector::from_vec(v.clone()) };
             let steps = allocations(|| {
                 for _ in 0..10 {
-                    integrator.step(&model, &mut data, &mut state, &tau, 1e-3);
+                    integrator.step(&model, &plan, &mut data, &mut state, 1e-3);
                 }
             });
             assert_eq!(steps, 0, "{file}: {kind:?} steps allocated {steps} times");

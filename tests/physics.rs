@@ -7,10 +7,11 @@ use common::{ALGO_REL, INTEGRATOR_ORDER_BAND, PERIOD_SMALL_AMPLITUDE_REL, RK4_CO
 use lagrange::dynamics::{aba, crba, gravity_forces};
 use lagrange::integrate::{IntegratorKind, State};
 use lagrange::io::{load, LoadOptions};
-use lagrange::sim::Simulation;
+use lagrange::sim::{SimOptions, Simulation};
 use lagrange::{Data, Model};
 use std::f64::consts::PI;
 use std::path::Path;
+use std::sync::Arc;
 
 const G: f64 = 9.81;
 
@@ -27,10 +28,13 @@ fn uniform(seed: &mut u64) -> f64 {
 
 /// Runs `n` steps of `dt` from (q0, v0) with zero torques; returns the final state.
 fn run(model: &Model, kind: IntegratorKind, q0: &[f64], v0: &[f64], dt: f64, n: usize) -> State {
-    let mut sim = Simulation::new(model, kind);
+    let mut sim = Simulation::new(
+        Arc::new(model.clone()),
+        &SimOptions { integrator: Some(kind), timestep: Some(dt), ..Default::default() },
+    );
     sim.set_state(q0, v0).unwrap();
     for _ in 0..n {
-        sim.step(dt).unwrap();
+        sim.step().unwrap();
     }
     sim.state
 }
@@ -87,12 +91,15 @@ fn pendulum_on_movable_support_conserves_x_momentum() {
     let model = textbook("pendulum_on_cart.urdf");
     let p_x = |s: &State| (m + cart) * s.v[0] + m * l * s.v[1] * s.q[1].cos();
     let drift = |dt: f64| {
-        let mut sim = Simulation::new(&model, IntegratorKind::Rk4);
+        let mut sim = Simulation::new(
+            Arc::new(model.clone()),
+            &SimOptions { integrator: Some(IntegratorKind::Rk4), timestep: Some(dt), ..Default::default() },
+        );
         sim.set_state(&[0.0, 1.2], &[0.3, -0.5]).unwrap();
         let p0 = p_x(&sim.state);
         let mut worst = 0.0f64;
         while sim.state.time < 5.0 - 1e-12 {
-            sim.step(dt).unwrap();
+            sim.step().unwrap();
             worst = worst.max((p_x(&sim.state) - p0).abs());
         }
         worst
@@ -162,11 +169,14 @@ fn elliptic_k(k: f64) -> f64 {
 /// O(dt⁴) — below the integrators' period error.
 fn simulated_period(model: &Model, kind: IntegratorKind, theta0: f64, dt: f64, t_guess: f64) -> f64 {
     let mut data = Data::new(model);
-    let mut sim = Simulation::new(model, kind);
+    let mut sim = Simulation::new(
+        Arc::new(model.clone()),
+        &SimOptions { integrator: Some(kind), timestep: Some(dt), ..Default::default() },
+    );
     sim.set_state(&[theta0], &[0.0]).unwrap();
     let mut prev = (sim.state.time, sim.state.q[0], sim.state.v[0]);
     loop {
-        sim.step(dt).unwrap();
+        sim.step().unwrap();
         let now = (sim.state.time, sim.state.q[0], sim.state.v[0]);
         if now.0 > 0.75 * t_guess && prev.2 > 0.0 && now.2 <= 0.0 {
             let mut acc = |theta: f64, omega: f64| aba(model, &mut data, &[theta], &[omega], &[0.0])[0];

@@ -3,8 +3,9 @@
 
 use lagrange::integrate::IntegratorKind;
 use lagrange::io::{load_urdf_str, LoadOptions};
-use lagrange::sim::{SimError, Simulation};
+use lagrange::sim::{SimError, SimOptions, Simulation};
 use std::path::Path;
+use std::sync::Arc;
 
 /// A pendulum whose second link is massless: its joint has no finite acceleration (D = 0).
 const MASSLESS_TIP: &str = r#"<robot name="r">
@@ -18,9 +19,11 @@ const MASSLESS_TIP: &str = r#"<robot name="r">
 #[test]
 fn diverging_simulation_names_time_joint_and_fix() {
     let model = load_urdf_str(MASSLESS_TIP, Path::new("massless_tip.urdf"), &LoadOptions::default()).unwrap();
-    let mut sim = Simulation::new(&model, IntegratorKind::Euler);
+    let options =
+        SimOptions { integrator: Some(IntegratorKind::Euler), timestep: Some(1e-3), ..Default::default() };
+    let mut sim = Simulation::new(Arc::new(model), &options);
     sim.set_state(&[0.3, 0.0], &[0.0, 0.0]).unwrap();
-    let err = sim.step(1e-3).unwrap_err();
+    let err = sim.step().unwrap_err();
     assert!(matches!(err, SimError::Diverged { .. }), "{err:?}");
     let msg = err.to_string();
     for needle in ["diverged at t = 0.001 s (step 1)", "joint 'wrist'", "reduce --dt", "massless subtree"] {
@@ -31,7 +34,8 @@ fn diverging_simulation_names_time_joint_and_fix() {
 #[test]
 fn non_finite_or_wrongly_sized_state_is_rejected() {
     let model = load_urdf_str(MASSLESS_TIP, Path::new("massless_tip.urdf"), &LoadOptions::default()).unwrap();
-    let mut sim = Simulation::new(&model, IntegratorKind::Rk4);
+    let options = SimOptions { integrator: Some(IntegratorKind::Rk4), ..Default::default() };
+    let mut sim = Simulation::new(Arc::new(model), &options);
     let msg = sim.set_state(&[f64::NAN, 0.0], &[0.0, 0.0]).unwrap_err().to_string();
     assert!(msg.contains("invalid initial state") && msg.contains("not finite"), "{msg}");
     let msg = sim.set_state(&[0.0], &[0.0, 0.0]).unwrap_err().to_string();

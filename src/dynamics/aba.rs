@@ -5,7 +5,7 @@ use crate::model::{Data, Model};
 use crate::spatial::{ArticulatedInertia, Force, Motion, Vec3};
 use nalgebra::{DVector, Matrix6};
 
-/// Forward dynamics q̈ = M(q)⁻¹ (τ − c(q, v)) into `data.qacc` (and returned), in O(n), armature
+/// Forward dynamics q̈ = M(q)⁻¹ (τ − c(q, v)) into `data.aba_qacc` (and returned), in O(n), armature
 /// included. A joint whose articulated inertia is singular (a massless subtree) yields non-finite
 /// accelerations, which the simulator reports as an error.
 pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d DVector<f64> {
@@ -96,12 +96,12 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f
             for (l, r) in rhs.iter().enumerate().take(nv_j) {
                 acc += data.d_inv[b][(k, l)] * r;
             }
-            data.qacc[da + k] = acc;
+            data.aba_qacc[da + k] = acc;
             a_body += data.s_body[da + k] * acc;
         }
         data.a_body[b] = a_body;
     }
-    &data.qacc
+    &data.aba_qacc
 }
 
 impl ArticulatedInertia {

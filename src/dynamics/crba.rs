@@ -80,9 +80,15 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
 /// Solves M x = b in place (`x` holds b on entry) with the factor of [`factorize_mass_matrix`]
 /// (RBDA Table 6.4): x ← L⁻¹ D⁻¹ L⁻ᵀ b.
 pub fn solve_mass_matrix(model: &Model, data: &Data, x: &mut DVector<f64>) {
+    solve_with_factor(model, &data.mass_factor, x.as_mut_slice());
+}
+
+/// [`solve_mass_matrix`] on a slice, with the factor passed explicitly (so that the right-hand
+/// side may be another buffer of the same `Data`).
+pub fn solve_with_factor(model: &Model, factor: &DMatrix<f64>, x: &mut [f64]) {
     let lambda = &model.dof_parent;
     let nv = model.nv;
-    let h = data.mass_factor.as_slice();
+    let h = factor.as_slice();
     // Lᵀ z = b, from the leaves up.
     for i in (0..nv).rev() {
         let mut j = lambda[i];

@@ -1,9 +1,11 @@
-//! Time steppers (DESIGN.md, layer 7). Every integrator implements [`Integrator`]; each owns the
-//! stage buffers it needs, allocated once, so a step allocates nothing.
+//! Time steppers (DESIGN.md, layer 9). Every integrator implements [`Stepper`] over the staged
+//! [`forward`](crate::forward::forward) pipeline and returns a [`StepReport`]; each owns the stage
+//! buffers it needs, allocated once, so a step allocates nothing.
 //!
 //! The continuous dynamics are q̇ = v (on the configuration manifold, see
-//! [`integrate_configuration`](crate::model::integrate_configuration)) and v̇ = ABA(q, v, τ + τ_passive),
-//! where τ_passive = −damping ⊙ v (the joint damping of the model file).
+//! [`integrate_configuration`](crate::model::integrate_configuration)) and v̇ = `qacc` of
+//! `forward`. With constraint rows, drift is corrected after each step ([`correct_drift`]): q is
+//! projected onto φ(q) = 0 and v onto J v = 0, as the plan's [`DriftCorrection`] says.
 
 mod euler;
 mod rk4;
@@ -11,11 +13,12 @@ mod rk4;
 pub use euler::SemiImplicitEuler;
 pub use rk4::RungeKutta4;
 
-use crate::dynamics::aba;
-use crate::model::{Data, Model};
+use crate::constraint::{project_positions, project_velocities};
+use crate::forward::{DriftCorrection, Plan};
+use crate::model::{options, Data, Model};
 use nalgebra::DVector;
 
-/// The state advanced by an integrator, in MuJoCo's qpos/qvel layout.
+/// The state advanced by a stepper, in MuJoCo's qpos/qvel layout.
 #[derive(Clone, Debug, PartialEq)]
 pub struct State {
     pub time: f64,
@@ -30,34 +33,51 @@ impl State {
     }
 }
 
-/// A fixed-step time stepper.
-pub trait Integrator {
+/// What one step did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepReport {
+    /// Whether the step was taken (an adaptive stepper may reject and retry).
+    pub accepted: bool,
+    /// The step size used.
+    pub h_used: f64,
+    /// The step size proposed for the next step (= `h_used` for fixed-step methods).
+    pub h_next: f64,
+    /// Local error estimate, if the method has one.
+    pub error_estimate: Option<f64>,
+    /// Iterations of constraint solvers in this step (the exact solver is direct: 0; the
+    /// Gauss–Newton iterations of the position projection are counted here).
+    pub solver_iterations: u32,
+    /// max |φ| and max |J v| after the step (0 without constraint rows).
+    pub constraint_violation: [f64; 2],
+}
+
+/// A time stepper over [`forward`](crate::forward::forward).
+pub trait Stepper: Send {
     /// Short name (`euler`, `rk4`, …).
     fn name(&self) -> &'static str;
     /// Order of the global error in the step size for smooth problems.
     fn order(&self) -> u32;
-    /// Advances `state` by `dt` under applied generalized forces `tau`.
-    fn step(&mut self, model: &Model, data: &mut Data, state: &mut State, tau: &[f64], dt: f64);
+    /// Advances `state` by `h` with the inputs in `data` (`qfrc_applied`, `ctrl`).
+    fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport;
 }
 
-/// Accelerations v̇ = ABA(q, v, τ − damping ⊙ v − k ⊙ (q − q_rest)) into `qacc` (joint damping and
-/// the springs of one-dof joints); `tau_total` is scratch (length nv).
-pub(crate) fn accelerations(
-    model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    v: &[f64],
-    tau: &[f64],
-    tau_total: &mut DVector<f64>,
-    qacc: &mut DVector<f64>,
-) {
-    for k in 0..model.nv {
-        tau_total[k] = tau[k] - model.dof_damping[k] * v[k];
+/// After a step of a constrained model: project q onto φ(q) = 0 (Gauss–Newton on the manifold)
+/// and v onto J v = 0 (M-orthogonally), if `drift.projection`. Returns (iterations, [max |φ|,
+/// max |J v|]) after the correction; no work without constraint rows.
+pub fn correct_drift(model: &Model, plan: &Plan, data: &mut Data, state: &mut State) -> (u32, [f64; 2]) {
+    if !plan.has_constraints() {
+        return (0, [0.0, 0.0]);
     }
-    for s in &model.springs {
-        tau_total[s.dof_adr] -= s.stiffness * (q[s.qpos_adr] - s.rest);
+    let DriftCorrection { projection, tolerance, .. } = plan.drift;
+    if !projection {
+        plan.constraints.evaluate(model, data, state.q.as_slice(), state.v.as_slice());
+        let n = data.nefc;
+        return (0, [data.efc_pos.rows(0, n).amax(), data.efc_vel.rows(0, n).amax()]);
     }
-    qacc.copy_from(aba(model, data, q, v, tau_total.as_slice()));
+    let (iterations, phi) =
+        project_positions(model, &plan.constraints, data, state.q.as_mut_slice(), tolerance, 50);
+    let jv = project_velocities(model, data, state.v.as_mut_slice());
+    (iterations, [phi, jv])
 }
 
 /// The integrators `simulate` offers, by name.
@@ -68,11 +88,35 @@ pub enum IntegratorKind {
 }
 
 impl IntegratorKind {
-    /// Builds the integrator with buffers sized for `model`.
-    pub fn build(self, model: &Model) -> Box<dyn Integrator + Send> {
+    /// Builds the stepper with buffers sized for `model`.
+    pub fn build(self, model: &Model) -> Box<dyn Stepper> {
         match self {
             IntegratorKind::Euler => Box::new(SemiImplicitEuler::new(model)),
             IntegratorKind::Rk4 => Box::new(RungeKutta4::new(model)),
+        }
+    }
+
+    /// The stepper for a model file's `<option integrator>`, and a note when the file asks for
+    /// one that is not available yet (implicit and implicitfast fall back to Euler, the
+    /// explicit counterpart MuJoCo would use without damping derivatives).
+    pub fn from_option(integrator: options::Integrator) -> (Self, Option<String>) {
+        match integrator {
+            options::Integrator::Euler => (IntegratorKind::Euler, None),
+            options::Integrator::Rk4 => (IntegratorKind::Rk4, None),
+            other => (
+                IntegratorKind::Euler,
+                Some(format!(
+                    "the model asks for integrator '{}', which is not implemented yet: using euler",
+                    other.mjcf_name()
+                )),
+            ),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Euler => "euler",
+            IntegratorKind::Rk4 => "rk4",
         }
     }
 }

@@ -3,7 +3,8 @@
 //! `mj_RungeKutta` does. Fourth order for joints whose configuration space is flat (hinge,
 //! slide, planar); for quaternion joints the tangent-space averaging is an approximation.
 
-use super::{accelerations, Integrator, State};
+use super::{correct_drift, State, StepReport, Stepper};
+use crate::forward::{forward, Plan};
 use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
@@ -12,7 +13,6 @@ pub struct RungeKutta4 {
     q_stage: DVector<f64>,
     v_stage: [DVector<f64>; 4],
     a_stage: [DVector<f64>; 4],
-    tau_total: DVector<f64>,
     v_mean: DVector<f64>,
 }
 
@@ -23,20 +23,19 @@ impl RungeKutta4 {
             q_stage: DVector::zeros(model.nq),
             v_stage: [z(), z(), z(), z()],
             a_stage: [z(), z(), z(), z()],
-            tau_total: z(),
             v_mean: z(),
         }
     }
 }
 
-impl Integrator for RungeKutta4 {
+impl Stepper for RungeKutta4 {
     fn name(&self) -> &'static str {
         "rk4"
     }
     fn order(&self) -> u32 {
         4
     }
-    fn step(&mut self, model: &Model, data: &mut Data, state: &mut State, tau: &[f64], dt: f64) {
+    fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         // Stage i evaluates at q ⊕ cᵢ h v_{i−1}, v + cᵢ h a_{i−1}, with c = (0, ½, ½, 1).
         const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
         for i in 0..4 {
@@ -44,25 +43,34 @@ impl Integrator for RungeKutta4 {
             self.v_stage[i].copy_from(&state.v);
             if i > 0 {
                 let (before, after) = self.v_stage.split_at_mut(i);
-                after[0].axpy(C[i] * dt, &self.a_stage[i - 1], 1.0);
+                after[0].axpy(C[i] * h, &self.a_stage[i - 1], 1.0);
                 integrate_configuration(
                     model,
                     self.q_stage.as_mut_slice(),
                     before[i - 1].as_slice(),
-                    C[i] * dt,
+                    C[i] * h,
                 );
             }
-            let (q, v) = (self.q_stage.as_slice(), self.v_stage[i].as_slice());
-            accelerations(model, data, q, v, tau, &mut self.tau_total, &mut self.a_stage[i]);
+            forward(model, plan, data, self.q_stage.as_slice(), self.v_stage[i].as_slice());
+            self.a_stage[i].copy_from(&data.qacc);
         }
         // Weighted means (1, 2, 2, 1)/6 of stage velocities and accelerations.
         let [v1, v2, v3, v4] = &self.v_stage;
         let [a1, a2, a3, a4] = &self.a_stage;
         for k in 0..model.nv {
             self.v_mean[k] = (v1[k] + 2.0 * v2[k] + 2.0 * v3[k] + v4[k]) / 6.0;
-            state.v[k] += dt * (a1[k] + 2.0 * a2[k] + 2.0 * a3[k] + a4[k]) / 6.0;
+            state.v[k] += h * (a1[k] + 2.0 * a2[k] + 2.0 * a3[k] + a4[k]) / 6.0;
         }
-        integrate_configuration(model, state.q.as_mut_slice(), self.v_mean.as_slice(), dt);
-        state.time += dt;
+        integrate_configuration(model, state.q.as_mut_slice(), self.v_mean.as_slice(), h);
+        state.time += h;
+        let (iterations, violation) = correct_drift(model, plan, data, state);
+        StepReport {
+            accepted: true,
+            h_used: h,
+            h_next: h,
+            error_estimate: None,
+            solver_iterations: iterations,
+            constraint_violation: violation,
+        }
     }
 }

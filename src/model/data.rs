@@ -1,4 +1,11 @@
 //! The mutable workspace of the algorithms, allocated once per model.
+//!
+//! Two kinds of buffers live here: the kernels' own (poses, velocities, composite and
+//! articulated inertias, `tau` of RNEA, `aba_qacc` of ABA), and the named buffers of the staged
+//! `forward` pipeline, which carry MuJoCo's names and meanings (MuJoCo documentation,
+//! "Computation → Forward dynamics"): `qfrc_bias`, `qfrc_passive`, `qfrc_actuator`,
+//! `qfrc_applied`, `qfrc_smooth`, `qacc_smooth`, `qfrc_constraint`, `qacc`, and the constraint rows
+//! `efc_*`. Each buffer keeps one meaning.
 
 use super::Model;
 use crate::spatial::{ArticulatedInertia, Force, Motion, RigidInertia, Transform};
@@ -41,12 +48,64 @@ pub struct Data {
     pub mass_matrix: DMatrix<f64>,
     /// Tree-sparse LᵀDL factor of M (RBDA §6.3): unit L strictly below the diagonal, D on it.
     pub mass_factor: DMatrix<f64>,
-    /// Generalized forces from RNEA.
+    /// Generalized forces from RNEA (the kernel's output).
     pub tau: DVector<f64>,
-    /// Generalized accelerations from ABA or a solve with M.
-    pub qacc: DVector<f64>,
+    /// Generalized accelerations from ABA (the kernel's output).
+    pub aba_qacc: DVector<f64>,
     /// Scratch vector of length nv.
     pub scratch_v: DVector<f64>,
+    /// Spatial acceleration of each body at q̈ = 0 without gravity (the velocity-product part of
+    /// the acceleration, for J̇v), body coordinates.
+    pub a_bias_body: Vec<Motion>,
+
+    // --- forward pipeline (MuJoCo's names) ---
+    /// Controls, one per actuator (MuJoCo's `ctrl`).
+    pub ctrl: DVector<f64>,
+    /// Generalized forces applied by the user (MuJoCo's `qfrc_applied`).
+    pub qfrc_applied: DVector<f64>,
+    /// Bias forces c(q, v) = RNEA(q, v, 0) (Coriolis, centrifugal, gravity). Filled by the velocity
+    /// stage when the plan solves with M (constraint rows present); the ABA path does not need it.
+    pub qfrc_bias: DVector<f64>,
+    /// Passive forces: joint damping and springs.
+    pub qfrc_passive: DVector<f64>,
+    /// Actuator forces (zero until actuators are simulated).
+    pub qfrc_actuator: DVector<f64>,
+    /// qfrc_passive + qfrc_actuator + qfrc_applied − qfrc_bias (filled on the M path).
+    pub qfrc_smooth: DVector<f64>,
+    /// Unconstrained acceleration M⁻¹(qfrc_passive + qfrc_actuator + qfrc_applied − qfrc_bias).
+    pub qacc_smooth: DVector<f64>,
+    /// Constraint forces Jᵀλ (notes §1.6, eq. 22).
+    pub qfrc_constraint: DVector<f64>,
+    /// The acceleration: qacc_smooth + M⁻¹ qfrc_constraint.
+    pub qacc: DVector<f64>,
+
+    // --- constraint rows (capacity = all equality rows of the model) ---
+    /// Whether each equality constraint is active (MuJoCo's `eq_active`, from `Equality::active`).
+    pub eq_active: Vec<bool>,
+    /// Number of active constraint rows.
+    pub nefc: usize,
+    /// Constraint Jacobian J, rows 0..nefc used (∂φ/∂q in tangent coordinates).
+    pub efc_j: DMatrix<f64>,
+    /// Position residual φ per row (MuJoCo's `efc_pos` for equality rows).
+    pub efc_pos: DVector<f64>,
+    /// J v per row (MuJoCo's `efc_vel`).
+    pub efc_vel: DVector<f64>,
+    /// J̇ v per row.
+    pub efc_jdotv: DVector<f64>,
+    /// Multiplier λ per row (MuJoCo's `efc_force`): the generalized constraint force is Jᵀλ.
+    pub efc_force: DVector<f64>,
+    /// For each row, the index of its equality constraint in `Model::equalities`.
+    pub efc_id: Vec<usize>,
+    /// M⁻¹Jᵀ, nv × nefc (columns 0..nefc used).
+    pub efc_minv_jt: DMatrix<f64>,
+    /// The Delassus matrix J M⁻¹ Jᵀ, nefc × nefc, and its factor or eigenvectors (scratch).
+    pub efc_delassus: DMatrix<f64>,
+    pub efc_factor: DMatrix<f64>,
+    /// Right-hand side and eigenvalue scratch of the dense solve, length nefc.
+    pub efc_rhs: DVector<f64>,
+    pub efc_eig: DVector<f64>,
+    /// Rank of J M⁻¹ Jᵀ at the last solve (< nefc: redundant rows, minimum-norm multipliers).
+    pub efc_rank: usize,
 }
 
 impl Data {
@@ -54,6 +113,7 @@ impl Data {
     pub fn new(model: &Model) -> Self {
         let nb = model.nbody();
         let nv = model.nv;
+        let nefc: usize = model.equalities.iter().map(|e| e.kind.nrow()).sum();
         Self {
             x_parent_body: vec![Transform::identity(); nb],
             x_world_body: vec![Transform::identity(); nb],
@@ -72,8 +132,32 @@ impl Data {
             mass_matrix: DMatrix::zeros(nv, nv),
             mass_factor: DMatrix::zeros(nv, nv),
             tau: DVector::zeros(nv),
-            qacc: DVector::zeros(nv),
+            aba_qacc: DVector::zeros(nv),
             scratch_v: DVector::zeros(nv),
+            a_bias_body: vec![Motion::zero(); nb],
+            ctrl: DVector::zeros(model.actuators.len()),
+            qfrc_applied: DVector::zeros(nv),
+            qfrc_bias: DVector::zeros(nv),
+            qfrc_passive: DVector::zeros(nv),
+            qfrc_actuator: DVector::zeros(nv),
+            qfrc_smooth: DVector::zeros(nv),
+            qacc_smooth: DVector::zeros(nv),
+            qfrc_constraint: DVector::zeros(nv),
+            qacc: DVector::zeros(nv),
+            eq_active: model.equalities.iter().map(|e| e.active).collect(),
+            nefc: 0,
+            efc_j: DMatrix::zeros(nefc, nv),
+            efc_pos: DVector::zeros(nefc),
+            efc_vel: DVector::zeros(nefc),
+            efc_jdotv: DVector::zeros(nefc),
+            efc_force: DVector::zeros(nefc),
+            efc_id: vec![0; nefc],
+            efc_minv_jt: DMatrix::zeros(nv, nefc),
+            efc_delassus: DMatrix::zeros(nefc, nefc),
+            efc_factor: DMatrix::zeros(nefc, nefc),
+            efc_rhs: DVector::zeros(nefc),
+            efc_eig: DVector::zeros(nefc),
+            efc_rank: 0,
         }
     }
 }

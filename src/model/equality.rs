@@ -57,6 +57,20 @@ pub enum EqualityKind {
 }
 
 impl EqualityKind {
+    /// Number of constraint rows it contributes when active.
+    pub fn nrow(&self) -> usize {
+        match self {
+            EqualityKind::Connect { .. } => 3,
+            EqualityKind::Weld { torquescale, .. } => {
+                if *torquescale == 0.0 {
+                    3
+                } else {
+                    6
+                }
+            }
+            EqualityKind::Joint { .. } | EqualityKind::Tendon { .. } | EqualityKind::Mimic { .. } => 1,
+        }
+    }
     /// The kind's name as the `forward` output and `info` print it.
     pub fn name(&self) -> &'static str {
         match self {

@@ -4,6 +4,8 @@
 use clap::{Parser, Subcommand, ValueEnum};
 mod cli;
 use cli::{bench, eval, info, simulate};
+use lagrange::constraint::ConstraintMode;
+use lagrange::forward::DriftCorrection;
 use lagrange::integrate::IntegratorKind;
 use lagrange::io::LoadOptions;
 use std::path::PathBuf;
@@ -30,6 +32,25 @@ struct Cli {
     /// moments as written (as Pinocchio does), with a warning each, instead of refusing the model.
     #[arg(long, global = true)]
     accept_nonphysical_inertia: bool,
+    /// Constraint model: `exact` (rigid, Lagrange multipliers) or `soft` (MuJoCo's; not
+    /// implemented yet: falls back to exact and says so). Default: soft for MJCF, exact for URDF.
+    #[arg(long, value_enum, global = true)]
+    constraints: Option<ConstraintsArg>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ConstraintsArg {
+    Exact,
+    Soft,
+}
+
+impl From<ConstraintsArg> for ConstraintMode {
+    fn from(a: ConstraintsArg) -> Self {
+        match a {
+            ConstraintsArg::Exact => ConstraintMode::Exact,
+            ConstraintsArg::Soft => ConstraintMode::Soft,
+        }
+    }
 }
 
 #[derive(Subcommand)]
@@ -69,11 +90,21 @@ enum Command {
         /// Simulated time in seconds.
         #[arg(long, default_value_t = 1.0)]
         duration: f64,
-        /// Step size in seconds.
-        #[arg(long, default_value_t = 1e-3)]
-        dt: f64,
-        #[arg(long, value_enum, default_value_t = IntegratorArg::Rk4)]
-        integrator: IntegratorArg,
+        /// Step size in seconds (default: the model's `<option timestep>`, 0.002 for URDF).
+        #[arg(long, allow_hyphen_values = true)]
+        dt: Option<f64>,
+        /// Integrator (default: the model's `<option integrator>`, Euler for URDF).
+        #[arg(long, value_enum)]
+        integrator: Option<IntegratorArg>,
+        /// Print one JSON summary object instead of text.
+        #[arg(long)]
+        json: bool,
+        /// Do not project constrained states back onto φ = 0, J v = 0 after each step.
+        #[arg(long)]
+        no_projection: bool,
+        /// Baumgarte stabilization gains α,β (J q̈ + J̇v + α J v + β φ = 0), e.g. `--baumgarte 20,100`.
+        #[arg(long)]
+        baumgarte: Option<String>,
         /// Start from this MJCF keyframe (`<key name>`); --q0/--v0 override its parts.
         #[arg(long)]
         keyframe: Option<String>,
@@ -83,7 +114,7 @@ enum Command {
         /// Initial velocity, comma-separated (nv values; default: zero).
         #[arg(long, allow_hyphen_values = true)]
         v0: Option<String>,
-        /// Write the trajectory (time, q, v, energy per step) to this CSV file.
+        /// Write the trajectory (time, q, v, energy, constraint violation per step) to this CSV file.
         #[arg(long)]
         out: Option<PathBuf>,
     },
@@ -113,18 +144,43 @@ fn main() -> ExitCode {
         floating: cli.floating,
         accept_nonphysical_inertia: cli.accept_nonphysical_inertia,
     };
+    let mode = cli.constraints.map(ConstraintMode::from);
     let result = match cli.command {
         None => simulate::default_run(),
-        Some(Command::Info { model, json }) => info::run(&model, &options, json),
+        Some(Command::Info { model, json }) => info::run(&model, &options, json, mode),
         Some(Command::Bench { model, json }) => bench::run(&model, &options, json),
         Some(Command::Eval { model, states, json: _, jacobians }) => {
-            eval::run(&model, &options, &states, &jacobians)
+            eval::run(&model, &options, &states, &jacobians, mode)
         }
-        Some(Command::Simulate { model, duration, dt, integrator, keyframe, q0, v0, out }) => {
-            let request =
-                simulate::Request { duration, dt, integrator: integrator.into(), keyframe, q0, v0, out };
+        Some(Command::Simulate {
+            model,
+            duration,
+            dt,
+            integrator,
+            json,
+            no_projection,
+            baumgarte,
+            keyframe,
+            q0,
+            v0,
+            out,
+        }) => simulate::parse_baumgarte(baumgarte.as_deref()).and_then(|baumgarte| {
+            let drift =
+                DriftCorrection { projection: !no_projection, baumgarte, ..DriftCorrection::default() };
+            let request = simulate::Request {
+                duration,
+                dt,
+                integrator: integrator.map(IntegratorKind::from),
+                constraints: mode,
+                drift,
+                json,
+                keyframe,
+                q0,
+                v0,
+                out,
+            };
             simulate::run_file(&model, &options, &request)
-        }
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

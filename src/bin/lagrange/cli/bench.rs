@@ -1,9 +1,11 @@
 //! `lagrange bench MODEL [--json]`: median wall time of loading the model (parse + compile) and of
-//! the dynamics kernels on it, for side-by-side comparisons with MuJoCo and Pinocchio run by
+//! the dynamics kernels and the staged `forward` on it, for side-by-side comparisons with MuJoCo and Pinocchio run by
 //! `validation/bench_load.py` in the same session (DESIGN.md, "Truth": speed is quoted as ratios).
 
 use super::CliError;
+use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{aba, crba, rnea};
+use lagrange::forward::{forward, Plan};
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::forward_kinematics;
 use lagrange::model::Data;
@@ -58,9 +60,17 @@ pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliErro
     let aba_us = median_us(budget, 100, || {
         std::hint::black_box(aba(&model, &mut data, &q, &v, &tau));
     });
+    // The whole staged pipeline at the same state (with the model's constraint rows, if any).
+    let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+    data.qfrc_applied.copy_from_slice(&tau);
+    let forward_us = median_us(budget, 100, || {
+        forward(&model, &plan, &mut data, &q, &v);
+        std::hint::black_box(&data.qacc);
+    });
     if json {
         let out = json!({"model": path.display().to_string(), "nq": model.nq, "nv": model.nv,
-            "load_us": load_us, "fk_us": fk_us, "rnea_us": rnea_us, "crba_us": crba_us, "aba_us": aba_us});
+            "load_us": load_us, "fk_us": fk_us, "rnea_us": rnea_us, "crba_us": crba_us, "aba_us": aba_us,
+            "forward_us": forward_us, "nefc": data.nefc});
         println!("{out}");
     } else {
         println!("{} (nq {}, nv {}), median µs per call:", path.display(), model.nq, model.nv);
@@ -69,6 +79,7 @@ pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliErro
         println!("  RNEA                   {rnea_us:>12.3}");
         println!("  CRBA                   {crba_us:>12.3}");
         println!("  ABA                    {aba_us:>12.3}");
+        println!("  forward ({:>2} rows)      {forward_us:>12.3}", data.nefc);
     }
     Ok(())
 }

@@ -2,7 +2,9 @@
 //! validation scripts use; schema in the README).
 
 use super::CliError;
+use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{aba, bias_forces, center_of_mass, crba, kinetic_energy, potential_energy};
+use lagrange::forward::{forward, Plan};
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::{forward_kinematics, frame_jacobian, ReferenceFrame};
 use lagrange::model::FrameKind;
@@ -20,6 +22,9 @@ pub struct StateIn {
     pub v: Option<Vec<f64>>,
     #[serde(default)]
     pub tau: Option<Vec<f64>>,
+    /// Controls, one per actuator (default zero).
+    #[serde(default)]
+    pub ctrl: Option<Vec<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -33,7 +38,7 @@ fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
 
 /// Evaluates one state: M, bias, qacc, poses of every frame, energies, com, and the requested
 /// frame Jacobians (world-aligned).
-pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]) -> Value {
+pub fn evaluate(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, jacobians: &[usize]) -> Value {
     let zeros = vec![0.0; model.nv];
     let v = s.v.as_deref().unwrap_or(&zeros);
     let tau = s.tau.as_deref().unwrap_or(&zeros);
@@ -65,7 +70,37 @@ pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]
         }
         out["jacobians"] = Value::Object(jmap);
     }
+    out["forward"] = forward_json(model, plan, data, s, v, tau);
     out
+}
+
+/// The staged forward pipeline at the state: `qacc` (constrained), its parts, and one entry per
+/// active constraint with its multipliers and residuals (README, "eval").
+fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f64]) -> Value {
+    data.qfrc_applied.copy_from_slice(tau);
+    data.ctrl.fill(0.0);
+    if let Some(ctrl) = &s.ctrl {
+        data.ctrl.copy_from_slice(ctrl);
+    }
+    forward(model, plan, data, &s.q, v);
+    let mut constraints = Vec::new();
+    let mut r = 0;
+    while r < data.nefc {
+        let id = data.efc_id[r];
+        let n = model.equalities[id].kind.nrow();
+        let eq = &model.equalities[id];
+        constraints.push(json!({
+            "name": eq.name, "kind": eq.kind.name(), "source": eq.loc.to_string(),
+            "force": data.efc_force.as_slice()[r..r + n], "violation": data.efc_pos.as_slice()[r..r + n],
+        }));
+        r += n;
+    }
+    let vec = |x: &nalgebra::DVector<f64>| x.as_slice().to_vec();
+    json!({
+        "qacc": vec(&data.qacc), "qacc_smooth": vec(&data.qacc_smooth), "qfrc_passive": vec(&data.qfrc_passive),
+        "qfrc_actuator": vec(&data.qfrc_actuator), "qfrc_constraint": vec(&data.qfrc_constraint),
+        "constraints": constraints,
+    })
 }
 
 /// Checks one input state's sizes and values.
@@ -79,19 +114,27 @@ fn check_state(model: &Model, file: &str, i: usize, s: &StateIn) -> Result<(), C
     };
     check("q", &Some(s.q.clone()), model.nq)?;
     check("v", &s.v, model.nv)?;
-    check("tau", &s.tau, model.nv)
+    check("tau", &s.tau, model.nv)?;
+    check("ctrl", &s.ctrl, model.actuators.len())
 }
 
 /// Runs `eval`, printing `{"results": [...]}`.
-pub fn run(path: &Path, options: &LoadOptions, states: &Path, jacobians: &[String]) -> Result<(), CliError> {
+pub fn run(
+    path: &Path,
+    options: &LoadOptions,
+    states: &Path,
+    jacobians: &[String],
+    mode: Option<ConstraintMode>,
+) -> Result<(), CliError> {
     let model = load(path, options)?;
+    let plan = Plan::new(&model, mode);
     let file = states.display().to_string();
     let text =
         std::fs::read_to_string(states).map_err(|source| CliError::Io { file: file.clone(), source })?;
     let input: StatesFile = serde_json::from_str(&text).map_err(|e| CliError::Input {
         file: file.clone(),
         detail: format!(
-            "line {}: {e}; expected {{\"states\": [{{\"q\": [...], \"v\": [...], \"tau\": [...]}}]}}",
+            "line {}: {e}; expected {{\"states\": [{{\"q\": [...], \"v\": [...], \"tau\": [...], \"ctrl\": [...]}}]}}",
             e.line()
         ),
     })?;
@@ -107,7 +150,7 @@ pub fn run(path: &Path, options: &LoadOptions, states: &Path, jacobians: &[Strin
     let mut results = Vec::with_capacity(input.states.len());
     for (i, s) in input.states.iter().enumerate() {
         check_state(&model, &file, i, s)?;
-        results.push(evaluate(&model, &mut data, s, &frame_ids));
+        results.push(evaluate(&model, &plan, &mut data, s, &frame_ids));
     }
     println!("{}", serde_json::to_string(&json!({ "results": results })).expect("JSON values serialize"));
     Ok(())

@@ -1,8 +1,9 @@
 //! `lagrange info MODEL [--json]`: the compiled tree, sizes and the simulation plan.
 
 use super::CliError;
+use lagrange::constraint::ConstraintMode;
+use lagrange::forward::Plan;
 use lagrange::io::{load, LoadOptions};
-use lagrange::sim::plan;
 use lagrange::Model;
 use serde_json::{json, Map, Value};
 use std::path::Path;
@@ -10,7 +11,8 @@ use std::path::Path;
 /// The `info` JSON document: keys `nq`, `nv`, `total_mass`, `bodies`, `joints`, `stages`.
 /// `com` is in the body frame, `inertia` is the 3×3 tensor about the centre of mass in body axes.
 /// Body 0 is `world` (with any links welded to it); `total_mass` counts the moving bodies only.
-pub fn to_json(model: &Model) -> Value {
+pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
+    let plan = Plan::new(model, mode);
     let bodies: Vec<Value> = model
         .bodies
         .iter()
@@ -43,8 +45,8 @@ pub fn to_json(model: &Model) -> Value {
         })
         .collect();
     let mut stages = Map::new();
-    for s in plan(model) {
-        stages.insert(s.name.to_string(), json!({"status": s.status, "reason": s.reason}));
+    for s in &plan.stages {
+        stages.insert(s.name.to_string(), json!({"status": s.status.as_str(), "reason": s.reason}));
     }
     let elements: Vec<Value> = model
         .elements
@@ -78,11 +80,13 @@ pub fn to_json(model: &Model) -> Value {
         "elements": elements,
         "warnings": model.warnings,
         "stages": stages,
+        "constraints": {"mode": plan.mode.name(), "reason": plan.mode_reason},
     })
 }
 
 /// Human-readable summary of a model.
-pub fn to_text(model: &Model) -> String {
+pub fn to_text(model: &Model, mode: Option<ConstraintMode>) -> String {
+    let plan = Plan::new(model, mode);
     use std::fmt::Write;
     let mut s = String::new();
     let src = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "(embedded)".into());
@@ -160,9 +164,9 @@ pub fn to_text(model: &Model) -> String {
             let _ = writeln!(s, "  {n:>4} × {k}");
         }
     }
-    let _ = writeln!(s, "\nsimulation plan:");
-    for st in plan(model) {
-        let _ = writeln!(s, "  {:<22} {:<22} {}", st.name, st.status, st.reason);
+    let _ = writeln!(s, "\nforward plan (constraint mode: {}; {}):", plan.mode.name(), plan.mode_reason);
+    for st in &plan.stages {
+        let _ = writeln!(s, "  {:<22} {:<22} {}", st.name, st.status.as_str(), st.reason);
     }
     if !model.warnings.is_empty() {
         let _ = writeln!(s, "\nwarnings ({}):", model.warnings.len());
@@ -174,12 +178,17 @@ pub fn to_text(model: &Model) -> String {
 }
 
 /// Runs `info`.
-pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliError> {
+pub fn run(
+    path: &Path,
+    options: &LoadOptions,
+    json: bool,
+    mode: Option<ConstraintMode>,
+) -> Result<(), CliError> {
     let model = load(path, options)?;
     if json {
-        println!("{}", serde_json::to_string_pretty(&to_json(&model)).expect("JSON values serialize"));
+        println!("{}", serde_json::to_string_pretty(&to_json(&model, mode)).expect("JSON values serialize"));
     } else {
-        print!("{}", to_text(&model));
+        print!("{}", to_text(&model, mode));
     }
     Ok(())
 }

@@ -2,12 +2,16 @@
 
 use super::CliError;
 use indicatif::{ProgressBar, ProgressStyle};
+use lagrange::constraint::ConstraintMode;
+use lagrange::forward::DriftCorrection;
 use lagrange::integrate::{IntegratorKind, State};
 use lagrange::io::{load, load_urdf_str, LoadOptions};
-use lagrange::sim::Simulation;
+use lagrange::sim::{SimOptions, Simulation};
 use lagrange::Model;
+use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// The model `lagrange` simulates when run without arguments: the UR5 arm of `models/ur5`.
@@ -18,8 +22,16 @@ pub const DEFAULT_Q0: &str = "0.0,-1.2,1.0,-0.6,1.5,0.0";
 /// What to simulate.
 pub struct Request {
     pub duration: f64,
-    pub dt: f64,
-    pub integrator: IntegratorKind,
+    /// Step size; None: the model's `<option timestep>`.
+    pub dt: Option<f64>,
+    /// None: the model's `<option integrator>`.
+    pub integrator: Option<IntegratorKind>,
+    /// None: the format's default mode.
+    pub constraints: Option<ConstraintMode>,
+    /// Drift correction of constrained models.
+    pub drift: DriftCorrection,
+    /// Print one JSON object instead of the text summary.
+    pub json: bool,
     /// A keyframe of the model to start from.
     pub keyframe: Option<String>,
     pub q0: Option<String>,
@@ -29,6 +41,14 @@ pub struct Request {
 
 /// What a run measured.
 pub struct Summary {
+    pub integrator: &'static str,
+    pub dt: f64,
+    /// Choices made for the user (integrator fallback, constraint mode).
+    pub notes: Vec<String>,
+    /// Largest max |φ| and max |J v| after any step.
+    pub max_violation: [f64; 2],
+    /// Smallest rank deficiency seen: (rank, rows) of J M⁻¹ Jᵀ when rows were redundant.
+    pub redundant: Option<(usize, usize)>,
     pub steps: u64,
     pub wall: Duration,
     pub energy_start: f64,
@@ -43,6 +63,16 @@ pub struct Summary {
     pub limit_excursions: Vec<(String, f64)>,
 }
 
+/// `--baumgarte α,β` → gains (both finite and ≥ 0).
+pub fn parse_baumgarte(s: Option<&str>) -> Result<Option<[f64; 2]>, CliError> {
+    let Some(s) = s else { return Ok(None) };
+    let v = parse_list("baumgarte", s, 2)?;
+    if v.iter().any(|x| !x.is_finite() || *x < 0.0) {
+        return Err(CliError::Usage(format!("--baumgarte {s}: give two finite gains α,β ≥ 0")));
+    }
+    Ok(Some([v[0], v[1]]))
+}
+
 fn parse_list(name: &str, s: &str, n: usize) -> Result<Vec<f64>, CliError> {
     let values: Result<Vec<f64>, _> = s.split(',').map(|x| x.trim().parse::<f64>()).collect();
     let values = values
@@ -55,17 +85,22 @@ fn parse_list(name: &str, s: &str, n: usize) -> Result<Vec<f64>, CliError> {
 
 /// Simulates `model` per `request`, writing the CSV if asked; returns the summary.
 pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
-    if !(request.dt > 0.0
-        && request.dt.is_finite()
-        && request.duration >= 0.0
-        && request.duration.is_finite())
-    {
+    let mut sim = Simulation::new(
+        Arc::new(model.clone()),
+        &SimOptions {
+            integrator: request.integrator,
+            timestep: request.dt,
+            constraints: request.constraints,
+            drift: Some(request.drift),
+        },
+    );
+    let dt = sim.timestep;
+    if !(dt > 0.0 && dt.is_finite() && request.duration >= 0.0 && request.duration.is_finite()) {
         return Err(CliError::Usage(format!(
-            "--dt {} and --duration {} must be finite, dt > 0, duration ≥ 0",
-            request.dt, request.duration
+            "--dt {dt} and --duration {} must be finite, dt > 0, duration ≥ 0",
+            request.duration
         )));
     }
-    let mut sim = Simulation::new(model, request.integrator);
     // Initial state: --q0/--v0, else the keyframe's, else qpos0 at rest.
     let (mut q0, mut v0) = (model.qpos0.clone(), vec![0.0; model.nv]);
     if let Some(name) = &request.keyframe {
@@ -90,7 +125,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         v0 = parse_list("v0", s, model.nv)?;
     }
     sim.set_state(&q0, &v0)?;
-    let steps = (request.duration / request.dt).round() as u64;
+    let steps = (request.duration / dt).round() as u64;
     let mut csv = match &request.out {
         Some(path) => {
             let file = std::fs::File::create(path)
@@ -120,16 +155,25 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     let (mut max_dev, mut max_kinetic) = (0.0f64, 0.0f64);
     let mut wall = Duration::ZERO;
     let mut excursions = vec![0.0; model.joints.len()];
+    let mut violation = sim.constraint_violation();
+    let mut max_violation = violation;
+    let mut redundant = None;
     for k in 0..=steps {
         if let Some((w, file)) = csv.as_mut() {
-            write_row(w, &sim, energy).map_err(|source| CliError::Io { file: file.clone(), source })?;
+            write_row(w, &sim, energy, violation[0])
+                .map_err(|source| CliError::Io { file: file.clone(), source })?;
         }
         if k == steps {
             break;
         }
         let t0 = Instant::now();
-        sim.step(request.dt)?;
+        let report = sim.step()?;
         wall += t0.elapsed();
+        violation = report.constraint_violation;
+        max_violation = [max_violation[0].max(violation[0]), max_violation[1].max(violation[1])];
+        if sim.data.nefc > 0 && sim.data.efc_rank < sim.data.nefc {
+            redundant = Some((sim.data.efc_rank, sim.data.nefc));
+        }
         // Energy monitoring is outside the timed step.
         let (kinetic, potential) = sim.energies();
         energy = kinetic + potential;
@@ -145,6 +189,11 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         w.flush().map_err(|source| CliError::Io { file, source })?;
     }
     Ok(Summary {
+        integrator: sim.integrator(),
+        dt,
+        notes: sim.notes.clone(),
+        max_violation,
+        redundant,
         steps,
         wall,
         energy_start,
@@ -184,15 +233,34 @@ fn write_header(w: &mut impl Write, model: &Model) -> std::io::Result<()> {
             write!(w, ",v:{}[{k}]", j.name)?;
         }
     }
-    writeln!(w, ",energy")
+    writeln!(w, ",energy,constraint_violation")
 }
 
-fn write_row(w: &mut impl Write, sim: &Simulation, energy: f64) -> std::io::Result<()> {
+fn write_row(w: &mut impl Write, sim: &Simulation, energy: f64, violation: f64) -> std::io::Result<()> {
     write!(w, "{}", sim.state.time)?;
     for x in sim.state.q.iter().chain(sim.state.v.iter()) {
         write!(w, ",{x}")?;
     }
-    writeln!(w, ",{energy}")
+    writeln!(w, ",{energy},{violation}")
+}
+
+/// The `simulate --json` summary: one object (README, "simulate").
+pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
+    let wall = s.wall.as_secs_f64();
+    let simulated = s.steps as f64 * s.dt;
+    json!({
+        "model": model.source.as_ref().map_or_else(|| model.name.clone(), |p| p.display().to_string()),
+        "integrator": s.integrator,
+        "dt": s.dt,
+        "steps": s.steps,
+        "time": s.final_state.time,
+        "wall_s": wall,
+        "realtime_factor": if wall > 0.0 { simulated / wall } else { f64::INFINITY },
+        "energy": {"initial": s.energy_start, "final": s.energy_end, "max_abs_drift": s.energy_max_dev},
+        "max_constraint_violation": {"position": s.max_violation[0], "velocity": s.max_violation[1]},
+        "q": s.final_state.q.as_slice(),
+        "v": s.final_state.v.as_slice(),
+    })
 }
 
 /// The text summary `simulate` prints.
@@ -200,13 +268,18 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
     let state = &s.final_state;
     use std::fmt::Write as _;
     let mut out = String::new();
-    let simulated = s.steps as f64 * request.dt;
+    let simulated = s.steps as f64 * s.dt;
     let wall = s.wall.as_secs_f64();
+    let from = if request.integrator.is_some() { "--integrator" } else { "the model's <option>" };
+    let dt_from = if request.dt.is_some() { "--dt" } else { "the model's <option>" };
     let _ = writeln!(
         out,
-        "simulated {simulated} s in {} steps of {} s ({:?})",
-        s.steps, request.dt, request.integrator
+        "simulated {simulated:.6} s in {} steps of {} s (from {dt_from}) with {} (from {from})",
+        s.steps, s.dt, s.integrator
     );
+    for note in &s.notes {
+        let _ = writeln!(out, "note: {note}");
+    }
     let _ = writeln!(
         out,
         "wall time {:.3} ms ({:.3} µs/step), real-time factor {:.0}×",
@@ -224,6 +297,25 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
         s.energy_max_dev,
         s.energy_max_dev / s.energy_scale
     );
+    if !model.equalities.is_empty() {
+        let _ = writeln!(
+            out,
+            "constraint violation: max |φ| {:.3e}, max |J v| {:.3e} after each step ({})",
+            s.max_violation[0],
+            s.max_violation[1],
+            if request.drift.projection {
+                "projected onto φ = 0, J v = 0 after each step"
+            } else {
+                "no projection"
+            }
+        );
+    }
+    if let Some((rank, rows)) = s.redundant {
+        let _ = writeln!(
+            out,
+            "warning: the constraint rows are redundant (rank {rank} of {rows} rows of J M⁻¹ Jᵀ): the multipliers are the minimum-norm ones"
+        );
+    }
     for (joint, by) in &s.limit_excursions {
         let _ = writeln!(
             out,
@@ -247,6 +339,10 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
 
 fn run_model(model: &Model, request: &Request) -> Result<(), CliError> {
     let summary = simulate(model, request)?;
+    if request.json {
+        println!("{}", summary_json(model, &summary));
+        return Ok(());
+    }
     print!("{}", summary_text(model, request, &summary));
     if let Some(out) = &request.out {
         println!("trajectory written to {}", out.display());
@@ -272,12 +368,15 @@ pub fn default_run() -> Result<(), CliError> {
         env!("CARGO_PKG_VERSION")
     );
     println!("(Run `lagrange --help` for info/eval/simulate on your own URDF or MJCF.)\n");
-    print!("{}", super::info::to_text(&model));
+    print!("{}", super::info::to_text(&model, None));
     println!();
     let request = Request {
         duration: 5.0,
-        dt: 1e-3,
-        integrator: IntegratorKind::Rk4,
+        dt: Some(1e-3),
+        integrator: Some(IntegratorKind::Rk4),
+        constraints: None,
+        drift: DriftCorrection::default(),
+        json: false,
         keyframe: None,
         q0: Some(DEFAULT_Q0.into()),
         v0: None,

@@ -1,0 +1,131 @@
+//! The exact (rigid) constraint solver: the KKT system of Lagrangian mechanics with multipliers
+//! (notes §1.6, eq. 20: M q̈ + c − τ = Jᵀλ together with the acceleration form of the constraints,
+//! J q̈ + J̇v = 0), solved by the range-space method with the tree-sparse LᵀDL factor of M
+//! (RBDA §6.3): Y = M⁻¹Jᵀ, the Delassus matrix A = J Y, then A λ = −(J q̈_smooth + J̇v) and
+//! q̈ = q̈_smooth + Y λ. Redundant rows give the minimum-norm multipliers ([`solve_psd`]).
+//!
+//! Drift correction for steppers: [`project_positions`] (Gauss–Newton onto φ(q) = 0 along
+//! M⁻¹Jᵀ, on the configuration manifold) and [`project_velocities`] (the M-orthogonal projection
+//! of v onto J v = 0).
+
+use super::{solve_psd, ConstraintModel};
+use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
+use crate::kinematics::body_poses;
+use crate::model::{integrate_configuration, Data, Model};
+
+/// Y = M⁻¹Jᵀ into `efc_minv_jt` and A = J M⁻¹ Jᵀ into `efc_delassus` for the current rows (needs
+/// the factor of M in `mass_factor`).
+fn delassus(model: &Model, data: &mut Data) {
+    let n = data.nefc;
+    let nv = model.nv;
+    let Data { efc_j, efc_minv_jt, efc_delassus, mass_factor, .. } = data;
+    for i in 0..n {
+        let mut col = efc_minv_jt.column_mut(i);
+        for k in 0..nv {
+            col[k] = efc_j[(i, k)];
+        }
+        solve_with_factor(model, mass_factor, col.as_mut_slice());
+    }
+    for i in 0..n {
+        for j in i..n {
+            let a: f64 = (0..nv).map(|k| efc_j[(i, k)] * efc_minv_jt[(k, j)]).sum();
+            efc_delassus[(i, j)] = a;
+            efc_delassus[(j, i)] = a;
+        }
+    }
+}
+
+/// Solves A μ = `efc_rhs` (first nefc entries) in place; returns the rank of A.
+fn solve_delassus(data: &mut Data) -> usize {
+    let n = data.nefc;
+    let Data { efc_delassus, efc_rhs, efc_factor, efc_eig, .. } = data;
+    solve_psd(efc_delassus, &mut efc_rhs.as_mut_slice()[..n], efc_factor, efc_eig)
+}
+
+/// The constraint stage of the exact mode. Needs, at the same state: the factor of M
+/// (`mass_factor`), the rows with `efc_pos`, `efc_vel`, `efc_jdotv`, and `qacc_smooth`. Writes
+/// `efc_force` (λ), `qfrc_constraint` (Jᵀλ), `qacc` and `efc_rank`. `baumgarte = [α, β]` adds the
+/// stabilization J q̈ + J̇v + α J v + β φ = 0 (Baumgarte 1972); `None` solves the pure KKT system.
+pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>) {
+    let n = data.nefc;
+    let nv = model.nv;
+    delassus(model, data);
+    let [alpha, beta] = baumgarte.unwrap_or([0.0, 0.0]);
+    for i in 0..n {
+        let j_qacc: f64 = (0..nv).map(|k| data.efc_j[(i, k)] * data.qacc_smooth[k]).sum();
+        data.efc_rhs[i] = -(j_qacc + data.efc_jdotv[i]) - alpha * data.efc_vel[i] - beta * data.efc_pos[i];
+    }
+    data.efc_rank = solve_delassus(data);
+    data.qacc.copy_from(&data.qacc_smooth);
+    data.qfrc_constraint.fill(0.0);
+    for i in 0..n {
+        let lambda = data.efc_rhs[i];
+        data.efc_force[i] = lambda;
+        for k in 0..nv {
+            data.qacc[k] += data.efc_minv_jt[(k, i)] * lambda;
+            data.qfrc_constraint[k] += data.efc_j[(i, k)] * lambda;
+        }
+    }
+}
+
+/// Moves `q` onto the constraint manifold φ(q) = 0 by Gauss–Newton steps Δ = −M⁻¹Jᵀ A⁺ φ applied
+/// on the configuration manifold (`q ← q ⊕ Δ`, free and ball joints included), M taken at the
+/// starting q. Stops when max |φ| ≤ `tolerance` or after `max_iterations`; returns (iterations,
+/// final max |φ|). Leaves the factor of M at the starting q in `data`.
+pub fn project_positions(
+    model: &Model,
+    constraints: &ConstraintModel,
+    data: &mut Data,
+    q: &mut [f64],
+    tolerance: f64,
+    max_iterations: u32,
+) -> (u32, f64) {
+    crba(model, data, q);
+    factorize_mass_matrix(model, data);
+    let mut iterations = 0;
+    loop {
+        if iterations > 0 {
+            body_poses(model, data, q);
+        }
+        constraints.positions(model, data, q);
+        let n = data.nefc;
+        let residual = data.efc_pos.rows(0, n).amax();
+        if residual <= tolerance || iterations >= max_iterations || !residual.is_finite() {
+            return (iterations, residual);
+        }
+        delassus(model, data);
+        for i in 0..n {
+            data.efc_rhs[i] = data.efc_pos[i];
+        }
+        solve_delassus(data);
+        data.scratch_v.fill(0.0);
+        for i in 0..n {
+            let mu = data.efc_rhs[i];
+            for k in 0..model.nv {
+                data.scratch_v[k] -= data.efc_minv_jt[(k, i)] * mu;
+            }
+        }
+        integrate_configuration(model, q, data.scratch_v.as_slice(), 1.0);
+        iterations += 1;
+    }
+}
+
+/// Replaces `v` by its M-orthogonal projection onto J v = 0 at configuration `q`:
+/// v ← v − M⁻¹Jᵀ A⁺ J v. Needs the factor of M (e.g. from [`project_positions`]) and the rows at q
+/// (`positions`); returns max |J v| after the projection.
+pub fn project_velocities(model: &Model, data: &mut Data, v: &mut [f64]) -> f64 {
+    let n = data.nefc;
+    let nv = model.nv;
+    delassus(model, data);
+    for i in 0..n {
+        data.efc_rhs[i] = (0..nv).map(|k| data.efc_j[(i, k)] * v[k]).sum();
+    }
+    solve_delassus(data);
+    for i in 0..n {
+        let mu = data.efc_rhs[i];
+        for k in 0..nv {
+            v[k] -= data.efc_minv_jt[(k, i)] * mu;
+        }
+    }
+    (0..n).map(|i| (0..nv).map(|k| data.efc_j[(i, k)] * v[k]).sum::<f64>().abs()).fold(0.0, f64::max)
+}

@@ -1,0 +1,39 @@
+//! The constraint layer (DESIGN.md, layer 7): which rows a model has ([`ConstraintModel`]), their
+//! Jacobian `J`, residual `φ`, `J v` and `J̇ v` in [`Data`](crate::Data) (`efc_*` buffers), and the
+//! exact (rigid) solver: the KKT system `M q̈ + c − τ = Jᵀλ`, `J q̈ + J̇v = 0` (notes §1.6,
+//! eq. 19–22: λ are Lagrange multipliers, `Jᵀλ` the generalized forces of constraint), plus the
+//! drift correction of the steppers (projection onto φ = 0 and J v = 0).
+//!
+//! Row kinds so far: equality constraints (connect, weld, joint coupling, fixed-tendon coupling)
+//! and URDF mimic couplings. The soft (MuJoCo-compatible) mode, limits, friction loss and
+//! contacts arrive with later issues behind the same buffers.
+
+mod dense;
+mod exact;
+mod rows;
+
+pub use dense::solve_psd;
+pub use exact::{project_positions, project_velocities, solve_exact};
+pub use rows::{ConstraintModel, RowGeometry, ScalarCoord};
+
+/// Which constraint model `forward` solves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConstraintMode {
+    /// Rigid constraints: the KKT solution (Lagrange multipliers).
+    Exact,
+    /// MuJoCo's soft convex model (solref/solimp); not implemented yet — plans built with it fall
+    /// back to `Exact` and say so.
+    Soft,
+}
+
+impl ConstraintMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            ConstraintMode::Exact => "exact",
+            ConstraintMode::Soft => "soft",
+        }
+    }
+}
+
+/// Relative size below which an eigenvalue of J M⁻¹ Jᵀ counts as zero (a redundant row).
+pub const RANK_TOLERANCE: f64 = 1e-10;

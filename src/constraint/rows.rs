@@ -1,0 +1,369 @@
+//! Constraint rows of equality constraints and mimic couplings: the [`ConstraintModel`] fixes, once
+//! per model, which rows exist and the geometry they need (MuJoCo's `mj_setConst` takes the
+//! missing anchors and relative poses at `qpos0`; MuJoCo documentation, "XML Reference →
+//! equality"); [`ConstraintModel::positions`] and [`ConstraintModel::velocities`] fill the rows
+//! `efc_j`, `efc_pos` (φ), `efc_vel` (J v) and `efc_jdotv` (J̇ v) at a state.
+//!
+//! Conventions (all vectors in world coordinates):
+//! - connect: φ = p_A − p_B, the two anchor points; J = J_A − J_B (point Jacobians).
+//! - weld: the 3 rows of connect for the frame origins, then φ_rot = s · R_B log(R_Bᵀ R_A) with
+//!   J_rot = s · (J_ω,A − J_ω,B), s = `torquescale` (no rotation rows when s = 0). MuJoCo writes
+//!   the rotation rows in quaternion form, `imag(q_B⁻¹ q_A)`; both vanish together and their
+//!   Jacobians span the same rows, so the constrained acceleration is the same.
+//! - joint / tendon / mimic: φ = x₁ − r₁ − P(x₂ − r₂), P(x) = a₀ + a₁x + … + a₄x⁴, with x the joint
+//!   value or fixed-tendon length and r its reference (qpos0 for MJCF, 0 for a URDF mimic).
+
+use crate::kinematics::{
+    bias_accelerations, for_each_ancestor_dof, forward_kinematics, forward_velocities,
+    point_bias_acceleration,
+};
+use crate::model::{Data, EqualityKind, Model, TendonKind};
+use crate::spatial::{Mat3, Transform, Vec3};
+use nalgebra::Rotation3;
+
+/// A scalar coordinate of a joint or tendon coupling: a hinge/slide joint, or a fixed tendon's
+/// length Σ coef · q.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ScalarCoord {
+    Joint {
+        qpos_adr: usize,
+        dof_adr: usize,
+    },
+    /// (qpos address, dof address, coefficient) of each joint of a fixed tendon.
+    Tendon {
+        terms: Vec<(usize, usize, f64)>,
+    },
+}
+
+impl ScalarCoord {
+    fn value(&self, q: &[f64]) -> f64 {
+        match self {
+            ScalarCoord::Joint { qpos_adr, .. } => q[*qpos_adr],
+            ScalarCoord::Tendon { terms } => terms.iter().map(|&(a, _, c)| c * q[a]).sum(),
+        }
+    }
+    fn rate(&self, v: &[f64]) -> f64 {
+        match self {
+            ScalarCoord::Joint { dof_adr, .. } => v[*dof_adr],
+            ScalarCoord::Tendon { terms } => terms.iter().map(|&(_, d, c)| c * v[d]).sum(),
+        }
+    }
+    /// Adds `scale` · ∂x/∂q to a Jacobian row.
+    fn add_jacobian(&self, scale: f64, mut row: impl FnMut(usize, f64)) {
+        match self {
+            ScalarCoord::Joint { dof_adr, .. } => row(*dof_adr, scale),
+            ScalarCoord::Tendon { terms } => terms.iter().for_each(|&(_, d, c)| row(d, scale * c)),
+        }
+    }
+}
+
+/// The geometry of one equality constraint's rows, with everything fixed at `qpos0` resolved.
+/// Bodies are compiled bodies (indices in `Model::bodies`), points and frames in their coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RowGeometry {
+    /// Point `r_a` of body `a` coincides with point `r_b` of body `b` (3 rows).
+    Points { a: usize, r_a: Vec3, b: usize, r_b: Vec3 },
+    /// Frame `x_a` of body `a` coincides with frame `x_b` of body `b` (3 + 3 rows; rotation rows
+    /// scaled by `torquescale`, absent when it is 0).
+    Frames { a: usize, x_a: Transform, b: usize, x_b: Transform, torquescale: f64 },
+    /// x₁ − ref₁ = P(x₂ − ref₂) (1 row).
+    Scalar { first: ScalarCoord, second: Option<ScalarCoord>, polycoef: [f64; 5], ref1: f64, ref2: f64 },
+}
+
+impl RowGeometry {
+    fn nrow(&self) -> usize {
+        match self {
+            RowGeometry::Points { .. } => 3,
+            RowGeometry::Frames { torquescale, .. } => {
+                if *torquescale == 0.0 {
+                    3
+                } else {
+                    6
+                }
+            }
+            RowGeometry::Scalar { .. } => 1,
+        }
+    }
+}
+
+/// One equality constraint's rows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EqualityRows {
+    /// Index in `Model::equalities`.
+    pub id: usize,
+    pub geometry: RowGeometry,
+}
+
+/// Which constraint rows a model has and their fixed geometry (built once per model).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ConstraintModel {
+    pub equalities: Vec<EqualityRows>,
+}
+
+/// P(x) and P′(x), P″(x) of MuJoCo's quartic `polycoef`.
+fn poly(c: &[f64; 5], x: f64) -> (f64, f64, f64) {
+    let p = c[0] + x * (c[1] + x * (c[2] + x * (c[3] + x * c[4])));
+    let dp = c[1] + x * (2.0 * c[2] + x * (3.0 * c[3] + x * 4.0 * c[4]));
+    let ddp = 2.0 * c[2] + x * (6.0 * c[3] + x * 12.0 * c[4]);
+    (p, dp, ddp)
+}
+
+/// log(R): the rotation vector of a rotation matrix.
+fn rotation_vector(r: &Mat3) -> Vec3 {
+    Rotation3::from_matrix_unchecked(*r).scaled_axis()
+}
+
+impl ConstraintModel {
+    /// The rows of `model`'s equality constraints (those switched off by `<flag equality>` and
+    /// all of them when `<flag constraint>` is off are left out). Anchors and relative poses that
+    /// the file leaves to `qpos0` are taken there (forward kinematics on a scratch `Data`).
+    pub fn new(model: &Model) -> Self {
+        let flags = &model.options.flags;
+        if model.equalities.is_empty() || !flags.equality || !flags.constraint {
+            return Self::default();
+        }
+        let mut data = Data::new(model);
+        forward_kinematics(model, &mut data, &model.qpos0);
+        let frame = |f: usize| {
+            let fr = &model.frames[f];
+            (fr.body, fr.x_body_frame, data.x_world_frame[f])
+        };
+        let scalar_joint = |j: usize| {
+            let jt = &model.joints[j];
+            ScalarCoord::Joint { qpos_adr: jt.qpos_adr, dof_adr: jt.dof_adr }
+        };
+        let scalar_tendon = |t: usize| match &model.tendons[t].kind {
+            TendonKind::Fixed { joints } => ScalarCoord::Tendon {
+                terms: joints
+                    .iter()
+                    .map(|&(j, c)| (model.joints[j].qpos_adr, model.joints[j].dof_adr, c))
+                    .collect(),
+            },
+            // The loader refuses equalities on spatial tendons; an empty coordinate is inert.
+            TendonKind::Spatial { .. } => ScalarCoord::Tendon { terms: Vec::new() },
+        };
+        let mut equalities = Vec::with_capacity(model.equalities.len());
+        for (id, eq) in model.equalities.iter().enumerate() {
+            let geometry = match &eq.kind {
+                EqualityKind::Connect { frame1, frame2, anchor } => {
+                    let (a, x_a1, x_w1) = frame(*frame1);
+                    let (b, x_b2, _) = frame(*frame2);
+                    match anchor {
+                        Some(p) => {
+                            let p1 = Vec3::from(*p);
+                            let p_world = x_w1.act_point(&p1);
+                            let r_b = data.x_world_body[b].inverse().act_point(&p_world);
+                            RowGeometry::Points { a, r_a: x_a1.act_point(&p1), b, r_b }
+                        }
+                        None => RowGeometry::Points { a, r_a: x_a1.pos, b, r_b: x_b2.pos },
+                    }
+                }
+                EqualityKind::Weld { frame1, frame2, anchor, relpose, torquescale, sites } => {
+                    let (a, x_a1, x_w1) = frame(*frame1);
+                    let (b, x_b2, x_w2) = frame(*frame2);
+                    let (x_a, x_b) = if *sites {
+                        (x_a1, x_b2)
+                    } else {
+                        // Frame B: body2's frame moved to the anchor; frame A: where B must be in
+                        // body1's frame (relpose, or B's pose in frame1 at qpos0).
+                        let x_2_anchor = Transform::from_translation(Vec3::from(*anchor));
+                        let x_1_target = match relpose {
+                            Some(x) => *x,
+                            None => x_w1.inverse() * (x_w2 * x_2_anchor),
+                        };
+                        (x_a1 * x_1_target, x_b2 * x_2_anchor)
+                    };
+                    RowGeometry::Frames { a, x_a, b, x_b, torquescale: *torquescale }
+                }
+                EqualityKind::Joint { joint1, joint2, polycoef } => {
+                    let q0 = |j: usize| model.qpos0[model.joints[j].qpos_adr];
+                    RowGeometry::Scalar {
+                        first: scalar_joint(*joint1),
+                        second: joint2.map(scalar_joint),
+                        polycoef: *polycoef,
+                        ref1: q0(*joint1),
+                        ref2: joint2.map_or(0.0, q0),
+                    }
+                }
+                EqualityKind::Tendon { tendon1, tendon2, polycoef } => {
+                    let first = scalar_tendon(*tendon1);
+                    let second = tendon2.map(scalar_tendon);
+                    let ref1 = first.value(&model.qpos0);
+                    let ref2 = second.as_ref().map_or(0.0, |s| s.value(&model.qpos0));
+                    RowGeometry::Scalar { first, second, polycoef: *polycoef, ref1, ref2 }
+                }
+                EqualityKind::Mimic { joint, leader, multiplier, offset } => RowGeometry::Scalar {
+                    first: scalar_joint(*joint),
+                    second: Some(scalar_joint(*leader)),
+                    polycoef: [*offset, *multiplier, 0.0, 0.0, 0.0],
+                    ref1: 0.0,
+                    ref2: 0.0,
+                },
+            };
+            equalities.push(EqualityRows { id, geometry });
+        }
+        Self { equalities }
+    }
+
+    /// Whether the model has any constraint rows at all.
+    pub fn is_empty(&self) -> bool {
+        self.equalities.is_empty()
+    }
+
+    /// Rows of the active constraints at configuration `q`: `nefc`, `efc_id`, `efc_j`, `efc_pos`.
+    /// Needs body poses and motion subspaces at q (forward kinematics, or CRBA's first pass).
+    pub fn positions(&self, model: &Model, data: &mut Data, q: &[f64]) {
+        let mut r = 0;
+        for e in &self.equalities {
+            if !data.eq_active[e.id] {
+                continue;
+            }
+            let n = e.geometry.nrow();
+            for i in r..r + n {
+                data.efc_id[i] = e.id;
+                data.efc_j.row_mut(i).fill(0.0);
+            }
+            match &e.geometry {
+                RowGeometry::Points { a, r_a, b, r_b } => {
+                    let p_a = data.x_world_body[*a].act_point(r_a);
+                    let p_b = data.x_world_body[*b].act_point(r_b);
+                    let phi = p_a - p_b;
+                    for k in 0..3 {
+                        data.efc_pos[r + k] = phi[k];
+                    }
+                    point_rows(model, data, r, *a, &p_a, 1.0, 1.0, false);
+                    point_rows(model, data, r, *b, &p_b, -1.0, 1.0, false);
+                }
+                RowGeometry::Frames { a, x_a, b, x_b, torquescale } => {
+                    let x_wa = data.x_world_body[*a] * *x_a;
+                    let x_wb = data.x_world_body[*b] * *x_b;
+                    let phi = x_wa.pos - x_wb.pos;
+                    for k in 0..3 {
+                        data.efc_pos[r + k] = phi[k];
+                    }
+                    let rotation = n == 6;
+                    if rotation {
+                        let phi_rot =
+                            x_wb.rot * rotation_vector(&(x_wb.rot.transpose() * x_wa.rot)) * *torquescale;
+                        for k in 0..3 {
+                            data.efc_pos[r + 3 + k] = phi_rot[k];
+                        }
+                    }
+                    point_rows(model, data, r, *a, &x_wa.pos, 1.0, *torquescale, rotation);
+                    point_rows(model, data, r, *b, &x_wb.pos, -1.0, *torquescale, rotation);
+                }
+                RowGeometry::Scalar { first, second, polycoef, ref1, ref2 } => {
+                    let (p, dp) = match second {
+                        Some(s) => {
+                            let (p, dp, _) = poly(polycoef, s.value(q) - ref2);
+                            (p, dp)
+                        }
+                        None => (polycoef[0], 0.0),
+                    };
+                    data.efc_pos[r] = first.value(q) - ref1 - p;
+                    let mut row = data.efc_j.row_mut(r);
+                    first.add_jacobian(1.0, |d, c| row[d] += c);
+                    if let Some(s) = second {
+                        s.add_jacobian(-dp, |d, c| row[d] += c);
+                    }
+                }
+            }
+            r += n;
+        }
+        data.nefc = r;
+    }
+
+    /// `efc_vel` = J v and `efc_jdotv` = J̇ v of the rows of [`positions`](Self::positions) at the
+    /// same q. Needs the body velocities (`v_body`, e.g. from RNEA or `forward_velocities`);
+    /// computes the bias accelerations itself.
+    pub fn velocities(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+        bias_accelerations(model, data, v);
+        let mut r = 0;
+        for e in &self.equalities {
+            if !data.eq_active[e.id] {
+                continue;
+            }
+            let n = e.geometry.nrow();
+            match &e.geometry {
+                RowGeometry::Points { a, r_a, b, r_b } => {
+                    let (va, aa, _) = point_motion(data, *a, r_a);
+                    let (vb, ab, _) = point_motion(data, *b, r_b);
+                    for k in 0..3 {
+                        data.efc_vel[r + k] = va[k] - vb[k];
+                        data.efc_jdotv[r + k] = aa[k] - ab[k];
+                    }
+                }
+                RowGeometry::Frames { a, x_a, b, x_b, torquescale } => {
+                    let (va, aa, (wa, alpha_a)) = point_motion(data, *a, &x_a.pos);
+                    let (vb, ab, (wb, alpha_b)) = point_motion(data, *b, &x_b.pos);
+                    for k in 0..3 {
+                        data.efc_vel[r + k] = va[k] - vb[k];
+                        data.efc_jdotv[r + k] = aa[k] - ab[k];
+                    }
+                    if n == 6 {
+                        for k in 0..3 {
+                            data.efc_vel[r + 3 + k] = torquescale * (wa[k] - wb[k]);
+                            data.efc_jdotv[r + 3 + k] = torquescale * (alpha_a[k] - alpha_b[k]);
+                        }
+                    }
+                }
+                RowGeometry::Scalar { first, second, polycoef, ref2, .. } => {
+                    let (dp, ddp, rate2) = match second {
+                        Some(s) => {
+                            let (_, dp, ddp) = poly(polycoef, s.value(q) - ref2);
+                            (dp, ddp, s.rate(v))
+                        }
+                        None => (0.0, 0.0, 0.0),
+                    };
+                    data.efc_vel[r] = first.rate(v) - dp * rate2;
+                    data.efc_jdotv[r] = -ddp * rate2 * rate2;
+                }
+            }
+            r += n;
+        }
+    }
+
+    /// Rows, `J v` and `J̇ v` at (q, v) from scratch: forward kinematics, body velocities, then
+    /// [`positions`](Self::positions) and [`velocities`](Self::velocities).
+    pub fn evaluate(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+        forward_kinematics(model, data, q);
+        forward_velocities(model, data, v);
+        self.positions(model, data, q);
+        self.velocities(model, data, q, v);
+    }
+}
+
+/// Velocity and bias acceleration (world) of point `r_body` of body `b`, and the body's world
+/// angular velocity and angular bias acceleration.
+fn point_motion(data: &Data, b: usize, r_body: &Vec3) -> (Vec3, Vec3, (Vec3, Vec3)) {
+    let vb = &data.v_body[b];
+    let rot = &data.x_world_body[b].rot;
+    let v_point = rot * (vb.lin + vb.ang.cross(r_body));
+    let (a_point, alpha) = point_bias_acceleration(data, b, r_body);
+    (v_point, a_point, (rot * vb.ang, alpha))
+}
+
+/// Adds `sign` × the point Jacobian of world point `p` on body `b` to rows r..r+3 of `efc_j`, and
+/// with `rotation`, `sign · scale` × the angular Jacobian to rows r+3..r+6.
+#[allow(clippy::too_many_arguments)]
+fn point_rows(
+    model: &Model,
+    data: &mut Data,
+    r: usize,
+    b: usize,
+    p: &Vec3,
+    sign: f64,
+    scale: f64,
+    rotation: bool,
+) {
+    let Data { efc_j, x_world_body, s_body, .. } = data;
+    for_each_ancestor_dof(model, x_world_body, s_body, b, |k, s_world| {
+        let lin = s_world.lin + s_world.ang.cross(p);
+        for i in 0..3 {
+            efc_j[(r + i, k)] += sign * lin[i];
+            if rotation {
+                efc_j[(r + 3 + i, k)] += sign * scale * s_world.ang[i];
+            }
+        }
+    });
+}

@@ -1,0 +1,92 @@
+//! The staged forward pipeline (DESIGN.md, layer 8), with MuJoCo's stage names (MuJoCo
+//! documentation, "Computation → Forward dynamics"): position → velocity → passive → actuation →
+//! acceleration → constraint, each writing named buffers of [`Data`]:
+//!
+//! | stage | writes |
+//! |---|---|
+//! | position | body poses, `mass_matrix` and its factor, constraint rows `efc_j`, `efc_pos` |
+//! | velocity | `qfrc_bias` = RNEA(q, v, 0), `efc_vel` = J v, `efc_jdotv` = J̇ v |
+//! | passive | `qfrc_passive` = −damping ⊙ v − k ⊙ (q − q_spring) |
+//! | actuation | `qfrc_actuator` (zero until actuators are simulated) |
+//! | acceleration | `qacc_smooth` (ABA, or M⁻¹`qfrc_smooth` on the M path), `qfrc_smooth` on the M path |
+//! | constraint | `efc_force` (λ), `qfrc_constraint` = Jᵀλ, `qacc` |
+//!
+//! Which stages run is decided once by the [`Plan`]; [`forward`] walks it. Without constraint rows
+//! the position and velocity stages are skipped and ABA gives `qacc_smooth` directly (M is never
+//! built); `qacc` = `qacc_smooth` then. `qfrc_applied` and `ctrl` are inputs set by the caller.
+
+mod plan;
+
+pub use plan::{DriftCorrection, Plan, Stage, StageKind, Status};
+
+use crate::constraint::solve_exact;
+use crate::dynamics::{aba, bias_forces, crba, factorize_mass_matrix, solve_mass_matrix};
+use crate::model::{Data, Model};
+
+/// Forward dynamics at (q, v) with the model's passive forces, `data.qfrc_applied` and
+/// `data.ctrl`: every stage of `plan` that runs, in order. The result is `data.qacc`.
+pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]) {
+    let m_path = plan.has_constraints();
+    for stage in &plan.stages {
+        if stage.status != Status::Runs {
+            continue;
+        }
+        match stage.kind {
+            StageKind::Position => {
+                crba(model, data, q);
+                factorize_mass_matrix(model, data);
+                plan.constraints.positions(model, data, q);
+            }
+            StageKind::Velocity => {
+                bias_forces(model, data, q, v);
+                data.qfrc_bias.copy_from(&data.tau);
+                // RNEA left the body velocities at v in `v_body`.
+                plan.constraints.velocities(model, data, q, v);
+            }
+            StageKind::Passive => passive(model, data, q, v),
+            StageKind::Acceleration => acceleration(model, data, q, v, m_path),
+            StageKind::Constraint => solve_exact(model, data, plan.drift.baumgarte),
+            // Row sources are built by the position stage; the rest are listings.
+            _ => {}
+        }
+    }
+    if !plan.runs(StageKind::Constraint) {
+        data.qacc.copy_from(&data.qacc_smooth);
+        data.nefc = 0;
+    }
+}
+
+/// Passive forces: joint damping −d ⊙ v and the springs of hinge and slide joints
+/// −k (q − q_spring) (MuJoCo's `mj_passive` for these elements).
+pub fn passive(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+    for k in 0..model.nv {
+        data.qfrc_passive[k] = -model.dof_damping[k] * v[k];
+    }
+    for s in &model.springs {
+        data.qfrc_passive[s.dof_adr] -= s.stiffness * (q[s.qpos_adr] - s.rest);
+    }
+}
+
+/// The unconstrained acceleration. ABA path: `qacc_smooth` = ABA(q, v, passive + actuator +
+/// applied). M path: `qfrc_smooth` = passive + actuator + applied − bias, `qacc_smooth` = M⁻¹
+/// `qfrc_smooth` with the factor of the position stage.
+fn acceleration(model: &Model, data: &mut Data, q: &[f64], v: &[f64], m_path: bool) {
+    if m_path {
+        for k in 0..model.nv {
+            data.qfrc_smooth[k] =
+                data.qfrc_passive[k] + data.qfrc_actuator[k] + data.qfrc_applied[k] - data.qfrc_bias[k];
+        }
+        data.qacc_smooth.copy_from(&data.qfrc_smooth);
+        let mut x = std::mem::take(&mut data.qacc_smooth);
+        solve_mass_matrix(model, data, &mut x);
+        data.qacc_smooth = x;
+    } else {
+        let mut tau = std::mem::take(&mut data.scratch_v);
+        for k in 0..model.nv {
+            tau[k] = data.qfrc_passive[k] + data.qfrc_actuator[k] + data.qfrc_applied[k];
+        }
+        aba(model, data, q, v, tau.as_slice());
+        data.scratch_v = tau;
+        data.qacc_smooth.copy_from(&data.aba_qacc);
+    }
+}

@@ -1,0 +1,285 @@
+//! The plan of the forward pipeline: which stages run for a model and why (DESIGN.md, layer 8).
+//! It is built once from the model; [`forward`](super::forward) walks its stages, and `lagrange
+//! info` prints the same list, so what is reported is what runs. A stage runs only when the model
+//! contains what it acts on: a scene without constraint rows never builds M (ABA path), a scene
+//! without damping or springs has no passive pass.
+
+use crate::constraint::{ConstraintMode, ConstraintModel};
+use crate::model::Model;
+use serde::Serialize;
+
+/// What a stage does (MuJoCo's stage names for the pipeline; the rest say where rows come from
+/// and what the model holds that is not simulated yet).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum StageKind {
+    Position,
+    Velocity,
+    Passive,
+    Actuation,
+    Acceleration,
+    Constraint,
+    Equality,
+    JointLimits,
+    FrictionLoss,
+    Collision,
+    Tendons,
+    Sensors,
+    PassiveOther,
+}
+
+/// Whether a stage runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Status {
+    Runs,
+    Skipped,
+    /// The model has such elements; they are kept and listed, not simulated yet.
+    NotSimulated,
+}
+
+impl Status {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Runs => "runs",
+            Status::Skipped => "skipped",
+            Status::NotSimulated => "parsed, not simulated",
+        }
+    }
+}
+
+/// One stage with its status and the reason.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Stage {
+    pub kind: StageKind,
+    pub name: &'static str,
+    pub status: Status,
+    pub reason: String,
+}
+
+/// How the steppers keep a constrained state on its manifold (DESIGN.md: drift correction belongs
+/// to the stepper, not to `forward`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DriftCorrection {
+    /// After each step, project q onto φ(q) = 0 and v onto J v = 0.
+    pub projection: bool,
+    /// Tolerance on max |φ| of the position projection.
+    pub tolerance: f64,
+    /// Baumgarte gains [α, β] of J q̈ + J̇v + α J v + β φ = 0 in the acceleration solve
+    /// (None: the pure KKT system).
+    pub baumgarte: Option<[f64; 2]>,
+}
+
+impl Default for DriftCorrection {
+    fn default() -> Self {
+        Self { projection: true, tolerance: 1e-12, baumgarte: None }
+    }
+}
+
+/// The per-model plan of [`forward`](super::forward).
+#[derive(Clone, Debug)]
+pub struct Plan {
+    pub stages: Vec<Stage>,
+    /// The constraint mode used, and why (requested, the format's default, or a fallback).
+    pub mode: ConstraintMode,
+    pub mode_reason: String,
+    /// The constraint rows of the model.
+    pub constraints: ConstraintModel,
+    pub drift: DriftCorrection,
+}
+
+impl Plan {
+    /// The plan for `model`, with the constraint mode `requested` (None: MJCF models soft, URDF
+    /// models exact, as DESIGN.md fixes).
+    pub fn new(model: &Model, requested: Option<ConstraintMode>) -> Self {
+        let (mode, mode_reason) = resolve_mode(model, requested);
+        let constraints = ConstraintModel::new(model);
+        let stages = stages(model, &constraints, mode);
+        Self { stages, mode, mode_reason, constraints, drift: DriftCorrection::default() }
+    }
+
+    /// Whether the stage of `kind` runs.
+    pub fn runs(&self, kind: StageKind) -> bool {
+        self.stages.iter().any(|s| s.kind == kind && s.status == Status::Runs)
+    }
+
+    /// Whether the model has constraint rows (and so the M path and a constraint solve).
+    pub fn has_constraints(&self) -> bool {
+        !self.constraints.is_empty()
+    }
+}
+
+fn is_mjcf(model: &Model) -> bool {
+    model.source.as_ref().and_then(|p| p.extension()).is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+}
+
+fn resolve_mode(model: &Model, requested: Option<ConstraintMode>) -> (ConstraintMode, String) {
+    let (wanted, why) = match requested {
+        Some(m) => (m, format!("{} requested", m.name())),
+        None if is_mjcf(model) => (ConstraintMode::Soft, "soft is the default for MJCF".to_string()),
+        None => (ConstraintMode::Exact, "exact is the default for URDF".to_string()),
+    };
+    match wanted {
+        ConstraintMode::Exact => (ConstraintMode::Exact, why),
+        ConstraintMode::Soft => (
+            ConstraintMode::Exact,
+            format!("{why}, but the soft (MuJoCo-compatible) mode is not implemented yet: using exact"),
+        ),
+    }
+}
+
+fn stage(kind: StageKind, name: &'static str, status: Status, reason: impl Into<String>) -> Stage {
+    Stage { kind, name, status, reason: reason.into() }
+}
+
+fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) -> Vec<Stage> {
+    use StageKind::*;
+    use Status::*;
+    let nrow: usize = constraints.equalities.iter().map(|e| model.equalities[e.id].kind.nrow()).sum();
+    let constrained = !constraints.is_empty();
+    let mut out = Vec::with_capacity(13);
+    out.push(if constrained {
+        stage(
+            Position,
+            "position",
+            Runs,
+            format!(
+                "body poses, CRBA and the tree-sparse LᵀDL factor of M (nv = {}), {nrow} constraint rows",
+                model.nv
+            ),
+        )
+    } else {
+        stage(
+            Position,
+            "position",
+            Skipped,
+            "no constraint rows: ABA computes the joint transforms in its first pass",
+        )
+    });
+    out.push(if constrained {
+        stage(Velocity, "velocity", Runs, format!("bias forces qfrc_bias (RNEA), J v and J̇ v of {nrow} rows"))
+    } else {
+        stage(
+            Velocity,
+            "velocity",
+            Skipped,
+            "no constraint rows: ABA computes velocities and bias in its passes",
+        )
+    });
+    let damped = model.dof_damping.iter().filter(|&&d| d != 0.0).count();
+    let springs = model.springs.len();
+    out.push(if damped + springs > 0 {
+        stage(
+            Passive,
+            "passive",
+            Runs,
+            format!("joint damping on {damped} degrees of freedom, {springs} joint springs"),
+        )
+    } else {
+        stage(Passive, "passive", Skipped, "no joint damping or springs")
+    });
+    // Typed actuators, and any the loader kept as a listing.
+    let actuators =
+        model.actuators.len() + model.elements.iter().filter(|e| e.category == "actuator").count();
+    out.push(if actuators == 0 {
+        stage(Actuation, "actuation", Skipped, "no actuators")
+    } else {
+        stage(
+            Actuation,
+            "actuation",
+            NotSimulated,
+            format!("{actuators} actuators: qfrc_actuator stays zero until actuation is simulated"),
+        )
+    });
+    out.push(if constrained {
+        stage(Acceleration, "acceleration", Runs, "qacc_smooth = M⁻¹ qfrc_smooth with the LᵀDL factor")
+    } else {
+        stage(
+            Acceleration,
+            "acceleration",
+            Runs,
+            format!("articulated-body algorithm over {} bodies, nv = {}", model.nbody() - 1, model.nv),
+        )
+    });
+    out.push(if constrained {
+        stage(
+            Constraint,
+            "constraint",
+            Runs,
+            format!("{} mode: KKT system with {nrow} rows, λ by the Delassus matrix J M⁻¹ Jᵀ", mode.name()),
+        )
+    } else {
+        stage(Constraint, "constraint", Skipped, "no constraint rows: qacc = qacc_smooth")
+    });
+    // Row sources and elements kept but not simulated.
+    let flags = &model.options.flags;
+    out.push(if model.equalities.is_empty() {
+        stage(Equality, "equality", Skipped, "no equality constraints or mimic joints")
+    } else if !flags.equality || !flags.constraint {
+        stage(Equality, "equality", Skipped, "switched off by <option><flag equality|constraint=\"disable\">")
+    } else {
+        let mut counts: Vec<(&str, usize)> = Vec::new();
+        for e in &model.equalities {
+            match counts.iter_mut().find(|(k, _)| *k == e.kind.name()) {
+                Some(c) => c.1 += 1,
+                None => counts.push((e.kind.name(), 1)),
+            }
+        }
+        let inactive = model.equalities.iter().filter(|e| !e.active).count();
+        let list: Vec<String> = counts.iter().map(|(k, n)| format!("{n} {k}")).collect();
+        let inactive = if inactive > 0 { format!(", {inactive} inactive at start") } else { String::new() };
+        stage(Equality, "equality", Runs, format!("{} ({nrow} rows{inactive})", list.join(", ")))
+    });
+    let limited = model.joints.iter().filter(|j| j.limits.is_some()).count();
+    out.push(kept(
+        JointLimits,
+        "joint limits",
+        limited,
+        "limited joints",
+        "stored; enforced by the limits and contact work",
+    ));
+    let friction = model.joints.iter().filter(|j| j.friction != 0.0).count();
+    out.push(kept(
+        FrictionLoss,
+        "friction loss",
+        friction,
+        "joints with friction loss",
+        "stored; enforced by the limits and contact work",
+    ));
+    let colliding = model.geoms.iter().filter(|g| g.collision).count();
+    let pairs = model.contact_pairs.len() + model.contact_excludes.len();
+    out.push(if colliding + pairs > 0 {
+        stage(
+            Collision,
+            "collision",
+            NotSimulated,
+            format!("{colliding} collision geoms, {pairs} contact pair/exclude entries: contacts arrive with the collision work"),
+        )
+    } else {
+        stage(Collision, "collision", Skipped, "no collision geometry")
+    });
+    let spatial =
+        model.tendons.iter().filter(|t| matches!(t.kind, crate::model::TendonKind::Spatial { .. })).count();
+    out.push(kept(Tendons, "spatial tendons", spatial, "spatial tendons", "kept, not simulated"));
+    let sensors = model.elements.iter().filter(|e| e.category == "sensor").count();
+    out.push(kept(Sensors, "sensors", sensors, "sensors", "kept, not evaluated"));
+    let multi_dof_springs = model.joints.iter().filter(|j| j.stiffness != 0.0 && j.kind.nq() > 1).count();
+    let other = model.elements.iter().filter(|e| matches!(e.category.as_str(), "body" | "joint")).count()
+        + multi_dof_springs;
+    if other > 0 {
+        out.push(stage(
+            PassiveOther,
+            "passive (other)",
+            NotSimulated,
+            format!("{other} elements (gravity compensation, spring-dampers, polynomial or ball/free springs); see `info` elements"),
+        ));
+    }
+    out
+}
+
+/// A stage for `n` kept elements: not simulated with `why`, or skipped if there are none.
+fn kept(kind: StageKind, name: &'static str, n: usize, what: &str, why: &str) -> Stage {
+    if n > 0 {
+        stage(kind, name, Status::NotSimulated, format!("{n} {what}: {why}"))
+    } else {
+        stage(kind, name, Status::Skipped, format!("no {what}"))
+    }
+}
