@@ -152,6 +152,8 @@ pub fn run(
         check_state(&model, &file, i, s)?;
         results.push(evaluate(&model, &plan, &mut data, s, &frame_ids));
     }
-    println!("{}", serde_json::to_string(&json!({ "results": results })).expect("JSON values serialize"));
+    let out =
+        json!({ "results": results, "constraints": {"mode": plan.mode.name(), "reason": plan.mode_reason} });
+    println!("{}", serde_json::to_string(&out).expect("JSON values serialize"));
     Ok(())
 }
