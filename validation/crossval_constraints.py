@@ -1039,7 +1039,7 @@ def render_markdown(rows: list[dict], meta: dict) -> str:
     out = [SECTION, "",
            "Exact (rigid) equality constraints, `validation/crossval_constraints` (lagrange %s, MuJoCo %s, "
            "Pinocchio %s, %d random states per model plus the same states projected onto the constraint "
-           "manifold, %.0f s). **%d of %d models pass.**" % (
+           "manifold, %.1f s). **%d of %d models pass.**" % (
                meta["commit"], meta["mujoco"], meta["pinocchio"], meta["states"], meta["seconds"], n_pass, len(rows)),
            "",
            "lagrange's `eval --constraints exact` `forward.qacc` against the rigid KKT solution built from "
@@ -1050,7 +1050,7 @@ def render_markdown(rows: list[dict], meta: dict) -> str:
            "`ref: FD, J a+J̇v` is the reference's own uncertainty: how much its qacc moves when the "
            "difference step doubles, and its KKT residual." % (FD_STEP, QACC_TOL, PASSIVE_TOL, VIOLATION_TOL),
            "",
-           "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+           "| " + " | ".join(c.replace("|", "\\|") for c in COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     for b in table_rows(rows):
         out.append("| " + " | ".join(c.replace("|", "\\|") for c in b) + " |")
     out.append("")
