@@ -73,7 +73,8 @@ fn info_text_lists_the_plan_and_mimic() {
     let (ok, out, err) = lagrange(&["info", "models/panda/panda.urdf"]);
     assert!(ok, "{err}");
     assert!(out.contains("simulation plan:"), "{out}");
-    assert!(out.contains("mimic panda_finger_joint1 (not enforced yet)"), "{out}");
+    assert!(out.contains("mimic panda_finger_joint1 (× 1 + 0)"), "{out}");
+    assert!(out.contains("1 × equality <mimic>") && out.contains("simulated (exact mode)"), "{out}");
     assert!(out.contains("equality constraints") && out.contains("1 mimic joints"), "{out}");
 }
 
@@ -256,4 +257,18 @@ fn info_lists_typed_elements_with_what_is_simulated() {
     let (ok, out, _) = lagrange(&["info", "tests/data/elements/elements.xml"]);
     assert!(ok);
     assert!(out.contains("3 × equality <weld>") && out.contains("simulated (exact mode)"), "{out}");
+}
+
+#[test]
+fn info_json_shows_urdf_mimic_on_the_joint() {
+    let (ok, out, err) = lagrange(&["info", "models/panda/panda.urdf", "--json"]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let j = v["joints"].as_array().unwrap().iter().find(|j| j["name"] == "panda_finger_joint2").unwrap();
+    assert_eq!(
+        j["mimic"],
+        serde_json::json!({"joint": "panda_finger_joint1", "multiplier": 1.0, "offset": 0.0, "equality": "mimic:panda_finger_joint2"})
+    );
+    let e = v["elements"].as_array().unwrap().iter().find(|e| e["kind"] == "mimic").unwrap();
+    assert_eq!(e["targets"], serde_json::json!(["panda_finger_joint2", "panda_finger_joint1"]));
 }

@@ -1,8 +1,9 @@
 //! Equality constraints, tendons, actuators, contact pairs and exclusions load into the model's
 //! typed sections with resolved indices and MuJoCo's values. `tests/data/elements/elements.xml`
 //! holds one of each kind; the expected numbers are MuJoCo 4.0.0's (`MjModel.eq_data`,
-//! `actuator_gainprm`, `pair_friction`, ..., printed with `mujoco.MjModel.from_xml_path`). The
-//! error cases without a file of their own in `tests/data/mjcf/errors/` are written inline here.
+//! `actuator_gainprm`, `pair_friction`, ..., printed with `mujoco.MjModel.from_xml_path`). A URDF
+//! mimic chain becomes mimic equalities. The error cases without a file of their own in
+//! `tests/data/mjcf/errors/` are written inline here.
 
 use lagrange::io::{compile, load, mjcf, LoadOptions};
 use lagrange::model::actuator::{ActuatorShortcut, BiasType, DynType, GainType, Transmission};
@@ -327,6 +328,40 @@ fn contact_pairs_and_exclusions_in_mujoco_order() {
     let body_of = |n: &str| m.frames[frame(&m, n, FrameKind::Link)].body;
     assert_eq!(m.contact_excludes.len(), 1);
     assert_eq!((m.contact_excludes[0].body1, m.contact_excludes[0].body2), (body_of("a"), body_of("c")));
+}
+
+#[test]
+fn urdf_mimic_chain_becomes_mimic_equalities() {
+    let text = r#"<robot name="chain">
+  <link name="l0"/>
+  <link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="l2"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="l3"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="a" type="revolute"><parent link="l0"/><child link="l1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="b" type="continuous"><parent link="l1"/><child link="l2"/>
+    <mimic joint="a" multiplier="2" offset="0.1"/>
+  </joint>
+  <joint name="c" type="prismatic"><parent link="l2"/><child link="l3"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
+    <mimic joint="b" multiplier="-1"/>
+  </joint>
+</robot>
+"#;
+    let m = lagrange::io::load_urdf_str(text, Path::new("chain.urdf"), &LoadOptions::default()).unwrap();
+    let (a, b, c) = (joint(&m, "a"), joint(&m, "b"), joint(&m, "c"));
+    assert_eq!(m.equalities.len(), 2);
+    assert_eq!(m.equalities[0].name, "mimic:b");
+    assert_eq!(
+        m.equalities[0].kind,
+        EqualityKind::Mimic { joint: b, leader: a, multiplier: 2.0, offset: 0.1 }
+    );
+    assert_eq!(m.equalities[0].loc.to_string(), "chain.urdf:8", "the <mimic> element");
+    assert_eq!(m.equalities[1].name, "mimic:c");
+    assert_eq!(
+        m.equalities[1].kind,
+        EqualityKind::Mimic { joint: c, leader: b, multiplier: -1.0, offset: 0.0 }
+    );
+    assert!(m.equalities.iter().all(|e| e.active && e.solref == DEFAULT_SOLREF));
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
 }
 
 /// Compiles MJCF `text` (named `inline.xml`): the model, or the error message.

@@ -1,7 +1,7 @@
 //! The compile step: [`ModelSpec`] → [`Model`]. Checks physical validity, normalizes axes, fuses
 //! fixed joints into their parent body (inertia composed, every link kept as a [`Frame`]), and lays
 //! out q and v in depth-first file order (DESIGN.md, layer 3); then resolves the equality
-//! constraints, tendons, actuators and contact pairs against the tree
+//! constraints, mimics, tendons, actuators and contact pairs against the tree
 //! ([`compile_elements`](crate::io::compile_elements)).
 
 use crate::io::LoadError;
@@ -87,7 +87,11 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                     armature: j.armature,
                     stiffness: j.stiffness,
                     spring_ref: j.spring_ref,
-                    mimic: j.mimic.clone(),
+                    mimic: j.mimic.as_ref().map(|m| crate::model::Mimic {
+                        joint: m.leader.clone(),
+                        multiplier: m.multiplier,
+                        offset: m.offset,
+                    }),
                 });
                 nq += jnq;
                 nv += jnv;

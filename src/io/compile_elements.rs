@@ -1,5 +1,5 @@
-//! The compile step for the elements around the tree: equality constraints, tendons, actuators,
-//! contact pairs and exclusions get their names resolved to indices of the compiled
+//! The compile step for the elements around the tree: equality constraints, URDF mimics, tendons,
+//! actuators, contact pairs and exclusions get their names resolved to indices of the compiled
 //! [`Model`], with MuJoCo's compile-time checks (`mjCEquality::ResolveReferences`,
 //! `mjCTendon::Compile`, `mjCActuator::Compile`, `mjCPair::Compile`).
 //!
@@ -10,9 +10,15 @@
 //! and body transmissions name the compiled body (`model.bodies`) the MJCF body belongs to.
 //! Contact pairs and exclusions come in MuJoCo's order: the lower MJCF body of each first, then
 //! stably sorted by body pair (`mjCModel::Compile`).
+//!
+//! URDF `<mimic>` becomes an [`EqualityKind::Mimic`] named `mimic:<joint>`: both joints must be
+//! revolute, continuous or prismatic; chains (a follows b, b follows c) are allowed, cycles are
+//! not. A mimic on a fixed joint is ignored with a warning (reduced models lock a mimic joint by
+//! making it fixed and keep its `<mimic>`).
 
 use crate::io::LoadError;
 use crate::model::actuator::ActuatorShortcut;
+use crate::model::equality::{DEFAULT_SOLIMP, DEFAULT_SOLREF};
 use crate::model::spec::{
     ActuatorSpec, ContactPairSpec, EqualitySpec, EqualitySpecKind, JointType, ModelSpec, TendonSpec,
     TendonSpecKind, TransmissionSpec,
@@ -74,6 +80,7 @@ pub(crate) fn compile_elements(spec: &ModelSpec, model: &Model) -> Result<Elemen
             }
         }
     }
+    mimics(spec, &names, &mut out)?;
     for a in &spec.actuators {
         out.actuators.push(actuator(a, &names, spec, &out.tendons)?);
     }
@@ -367,6 +374,125 @@ fn equality(e: &EqualitySpec, n: &Names, spec: &ModelSpec) -> Result<Option<Equa
         solimp: e.solimp,
         loc: e.loc.clone(),
     }))
+}
+
+/// The URDF mimics, in joint order, as equality constraints.
+fn mimics(spec: &ModelSpec, n: &Names, out: &mut Elements) -> Result<(), LoadError> {
+    let invalid = |loc: &SourceLoc, detail: String| LoadError::Invalid {
+        loc: loc.clone(),
+        element: "mimic".into(),
+        detail,
+    };
+    let one_dof =
+        |t: JointType| matches!(t, JointType::Revolute | JointType::Continuous | JointType::Prismatic);
+    let type_name = |t: JointType| format!("{t:?}").to_lowercase();
+    // follower joint index → (leader joint index, the mimic's location)
+    let mut leader_of: HashMap<usize, (usize, &SourceLoc)> = HashMap::new();
+    let mut order = Vec::new();
+    for link in &spec.links {
+        let j = &link.joint;
+        let Some(m) = &j.mimic else { continue };
+        if j.jtype == JointType::Fixed {
+            out.warnings.push(format!(
+                "{}: <mimic>: joint '{}' is fixed, so its <mimic joint=\"{}\"> has nothing to couple; ignored",
+                m.loc, j.name, m.leader
+            ));
+            continue;
+        }
+        if !one_dof(j.jtype) {
+            return Err(invalid(
+                &m.loc,
+                format!(
+                    "joint '{}' is {}; only revolute, continuous and prismatic joints can mimic another joint: remove the <mimic>",
+                    j.name,
+                    type_name(j.jtype)
+                ),
+            ));
+        }
+        if m.leader == j.name {
+            return Err(invalid(
+                &m.loc,
+                format!(
+                    "joint '{}' mimics itself; name the joint it follows in <mimic joint=\"...\">",
+                    j.name
+                ),
+            ));
+        }
+        let Some(&(leader_type, _)) = n.spec_joints.get(m.leader.as_str()) else {
+            return Err(invalid(
+                &m.loc,
+                format!(
+                    "joint '{}' mimics joint '{}', which is not defined; fix the name in <mimic joint=\"...\"> or remove the <mimic>",
+                    j.name, m.leader
+                ),
+            ));
+        };
+        if leader_type == JointType::Fixed {
+            return Err(invalid(
+                &m.loc,
+                format!(
+                    "joint '{}' mimics joint '{}', which is fixed (fused into its parent), so it has no coordinate to follow; make '{}' revolute or prismatic, or remove the <mimic>",
+                    j.name, m.leader, m.leader
+                ),
+            ));
+        }
+        if !one_dof(leader_type) {
+            return Err(invalid(
+                &m.loc,
+                format!(
+                    "joint '{}' mimics joint '{}', which is {}; a mimic follows a revolute, continuous or prismatic joint: remove the <mimic>",
+                    j.name,
+                    m.leader,
+                    type_name(leader_type)
+                ),
+            ));
+        }
+        let follower = n.joint(&j.name, &m.loc, "mimic")?;
+        let leader = n.joint(&m.leader, &m.loc, "mimic")?;
+        leader_of.insert(follower, (leader, &m.loc));
+        order.push((follower, leader, m));
+    }
+    // Cycles: follow each chain of leaders; coming back to a joint of the same walk closes one.
+    for &(start, _, _) in &order {
+        let mut walk = vec![start];
+        let mut cur = start;
+        while let Some(&(next, _)) = leader_of.get(&cur) {
+            if let Some(pos) = walk.iter().position(|&w| w == next) {
+                let cycle: Vec<usize> = walk[pos..].to_vec();
+                let names: Vec<String> =
+                    cycle.iter().map(|&j| format!("'{}'", n.model.joints[j].name)).collect();
+                let chain: Vec<String> = cycle
+                    .iter()
+                    .map(|&j| {
+                        let (l, _) = leader_of[&j];
+                        format!("{} mimics {}", n.model.joints[j].name, n.model.joints[l].name)
+                    })
+                    .collect();
+                let first = *cycle.iter().min().unwrap_or(&start);
+                return Err(invalid(
+                    leader_of[&first].1,
+                    format!(
+                        "the mimic joints {} form a cycle ({}); a chain of mimics must end at a joint that mimics none: remove one <mimic>",
+                        names.join(", "),
+                        chain.join(", ")
+                    ),
+                ));
+            }
+            walk.push(next);
+            cur = next;
+        }
+    }
+    for (follower, leader, m) in order {
+        out.equalities.push(Equality {
+            name: format!("mimic:{}", n.model.joints[follower].name),
+            kind: EqualityKind::Mimic { joint: follower, leader, multiplier: m.multiplier, offset: m.offset },
+            active: true,
+            solref: DEFAULT_SOLREF,
+            solimp: DEFAULT_SOLIMP,
+            loc: m.loc.clone(),
+        });
+    }
+    Ok(())
 }
 
 /// One tendon: a fixed tendon's joints must be hinge or slide joints.

@@ -5,7 +5,7 @@
 //! after it).
 
 use super::actuator::{ActuatorShortcut, BiasType, DynType, GainType};
-use super::{Element, Keyframe, Mimic, Options, SourceLoc};
+use super::{Element, Keyframe, Options, SourceLoc};
 use crate::mass::{Distribution, GeomMass};
 use crate::spatial::{Mat3, Transform, Vec3};
 use std::path::PathBuf;
@@ -27,7 +27,7 @@ pub struct ModelSpec {
     pub options: Options,
     /// Named initial states (MJCF `<keyframe>`), in qpos/qvel layout.
     pub keyframes: Vec<Keyframe>,
-    /// Equality constraints (MJCF `<equality>`), in file order.
+    /// Equality constraints (MJCF `<equality>`), in file order; URDF mimics are on their joints.
     pub equalities: Vec<EqualitySpec>,
     /// Tendons (MJCF `<tendon>`), in file order (MuJoCo's tendon order).
     pub tendons: Vec<TendonSpec>,
@@ -122,7 +122,19 @@ pub struct JointSpec {
     pub spring_ref: f64,
     /// The joint's reference configuration (MuJoCo `qpos0`); empty means neutral.
     pub qpos0: Vec<f64>,
-    pub mimic: Option<Mimic>,
+    /// URDF `<mimic>`: this joint follows another one.
+    pub mimic: Option<MimicSpec>,
+}
+
+/// URDF `<mimic joint multiplier offset>`: `q = multiplier · q[leader] + offset`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MimicSpec {
+    /// The joint followed (`joint` attribute).
+    pub leader: String,
+    pub multiplier: f64,
+    pub offset: f64,
+    /// The `<mimic>` element.
+    pub loc: SourceLoc,
 }
 
 impl JointSpec {

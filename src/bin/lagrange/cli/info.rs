@@ -127,6 +127,16 @@ fn listing(model: &Model) -> Vec<Listed> {
     out
 }
 
+/// The URDF mimic a joint follows: (leader name, multiplier, offset, equality name).
+fn mimic_of(model: &Model, j: usize) -> Option<(&str, f64, f64, &str)> {
+    model.equalities.iter().find_map(|e| match e.kind {
+        EqualityKind::Mimic { joint, leader, multiplier, offset } if joint == j => {
+            Some((model.joints[leader].name.as_str(), multiplier, offset, e.name.as_str()))
+        }
+        _ => None,
+    })
+}
+
 /// The `info` JSON document: keys `nq`, `nv`, `total_mass`, `bodies`, `joints`, `stages`.
 /// `com` is in the body frame, `inertia` is the 3×3 tensor about the centre of mass in body axes.
 /// Body 0 is `world` (with any links welded to it); `total_mass` counts the moving bodies only.
@@ -149,8 +159,9 @@ pub fn to_json(model: &Model) -> Value {
     let joints: Vec<Value> = model
         .joints
         .iter()
-        .map(|j| {
-            json!({
+        .enumerate()
+        .map(|(i, j)| {
+            let mut v = json!({
                 "name": j.name,
                 "type": j.kind.type_name(),
                 "parent": model.bodies[j.parent].name,
@@ -159,7 +170,11 @@ pub fn to_json(model: &Model) -> Value {
                 "dofadr": j.dof_adr,
                 "nq": j.kind.nq(),
                 "nv": j.kind.nv(),
-            })
+            });
+            if let Some((leader, multiplier, offset, equality)) = mimic_of(model, i) {
+                v["mimic"] = json!({"joint": leader, "multiplier": multiplier, "offset": offset, "equality": equality});
+            }
+            v
         })
         .collect();
     let mut stages = Map::new();
@@ -241,13 +256,14 @@ pub fn to_text(model: &Model) -> String {
         "  {:<26} {:<10} {:<22} {:<22} {:>7} {:>6} {:>3} {:>3}  limits",
         "name", "type", "parent", "child", "qposadr", "dofadr", "nq", "nv"
     );
-    for j in &model.joints {
+    for (i, j) in model.joints.iter().enumerate() {
         let limits = match j.limits {
             Some([lo, hi]) => format!("[{lo:.4}, {hi:.4}]"),
             None => "-".into(),
         };
-        let mimic =
-            j.mimic.as_ref().map(|m| format!("  mimic {} (not enforced yet)", m.joint)).unwrap_or_default();
+        let mimic = mimic_of(model, i)
+            .map(|(leader, multiplier, offset, _)| format!("  mimic {leader} (× {multiplier} + {offset})"))
+            .unwrap_or_default();
         let _ = writeln!(
             s,
             "  {:<26} {:<10} {:<22} {:<22} {:>7} {:>6} {:>3} {:>3}  {limits}{mimic}",
