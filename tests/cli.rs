@@ -74,6 +74,9 @@ fn info_text_lists_the_plan_and_mimic() {
     let (ok, out, err) = lagrange(&["info", "models/panda/panda.urdf"]);
     assert!(ok, "{err}");
     assert!(out.contains("forward plan (constraint mode: exact; exact is the default for URDF)"), "{out}");
+    assert!(out.contains("mimic panda_finger_joint1 (× 1 + 0)"), "{out}");
+    assert!(out.contains("1 × equality <mimic>") && out.contains("simulated (exact mode)"), "{out}");
+    assert!(out.contains("equality") && out.contains("1 mimic (1 rows)"), "{out}");
 }
 
 /// `eval` on the Pinocchio reference states reproduces M, bias, qacc and poses at REF_REL.
@@ -205,8 +208,11 @@ fn mjcf_info_lists_kept_elements_and_keyframes() {
     let v: Value = serde_json::from_str(&out).unwrap();
     assert_eq!((v["nq"].as_u64(), v["nv"].as_u64()), (Some(19), Some(18)));
     assert_eq!(v["keyframes"][0]["name"], "home");
-    let actuators = v["elements"].as_array().unwrap().iter().filter(|e| e["category"] == "actuator").count();
-    assert_eq!(actuators, 12);
+    let actuators: Vec<&Value> =
+        v["elements"].as_array().unwrap().iter().filter(|e| e["category"] == "actuator").collect();
+    assert_eq!(actuators.len(), 12);
+    assert!(actuators.iter().all(|a| a["kind"] == "position" && a["status"] == "parsed, not simulated"));
+    assert_eq!(actuators[0]["targets"][0], "FR_hip_joint");
     assert_eq!(v["stages"]["actuation"]["status"], "parsed, not simulated");
     assert_eq!(v["stages"]["collision"]["status"], "parsed, not simulated");
     assert_eq!(v["options"]["timestep"], 0.002, "MuJoCo's default: go1.xml sets no <option>");
@@ -228,4 +234,45 @@ fn simulate_starts_from_a_keyframe_and_rejects_unknown_ones() {
     let (ok, _, err) = lagrange(&["simulate", "models/mjcf/unitree_go1/go1.xml", "--keyframe", "crouch"]);
     assert!(!ok);
     assert!(err.contains("--keyframe crouch: the model has no such keyframe (it has: home)"), "{err}");
+}
+
+#[test]
+fn info_lists_typed_elements_with_what_is_simulated() {
+    let (ok, out, err) = lagrange(&["info", "tests/data/elements/elements.xml", "--json"]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let elements = v["elements"].as_array().unwrap();
+    let find =
+        |name: &str| elements.iter().find(|e| e["name"] == name).unwrap_or_else(|| panic!("no {name}"));
+    let c = find("c_body");
+    assert_eq!((c["category"].as_str(), c["kind"].as_str()), (Some("equality"), Some("connect")));
+    assert_eq!(c["targets"], serde_json::json!(["c", "world"]));
+    assert_eq!(c["status"], "simulated (exact mode)");
+    assert!(c["source"].as_str().unwrap().ends_with("elements.xml:47"), "{c}");
+    assert_eq!(find("t1")["status"], "simulated (equality rows)", "coupled by the tendon equality");
+    assert_eq!(find("rope")["status"], "parsed, not simulated");
+    assert_eq!(find("rope")["kind"], "spatial");
+    let p = find("p_class");
+    assert_eq!((p["kind"].as_str(), p["status"].as_str()), (Some("position"), Some("parsed, not simulated")));
+    assert_eq!(p["targets"], serde_json::json!(["slide"]));
+    assert_eq!(find("p0")["targets"], serde_json::json!(["floor", "gc"]));
+    assert_eq!(find("x")["kind"], "exclude");
+    // The text lists them grouped by kind and status.
+    let (ok, out, _) = lagrange(&["info", "tests/data/elements/elements.xml"]);
+    assert!(ok);
+    assert!(out.contains("3 × equality <weld>") && out.contains("simulated (exact mode)"), "{out}");
+}
+
+#[test]
+fn info_json_shows_urdf_mimic_on_the_joint() {
+    let (ok, out, err) = lagrange(&["info", "models/panda/panda.urdf", "--json"]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let j = v["joints"].as_array().unwrap().iter().find(|j| j["name"] == "panda_finger_joint2").unwrap();
+    assert_eq!(
+        j["mimic"],
+        serde_json::json!({"joint": "panda_finger_joint1", "multiplier": 1.0, "offset": 0.0, "equality": "mimic:panda_finger_joint2"})
+    );
+    let e = v["elements"].as_array().unwrap().iter().find(|e| e["kind"] == "mimic").unwrap();
+    assert_eq!(e["targets"], serde_json::json!(["panda_finger_joint2", "panda_finger_joint1"]));
 }

@@ -433,23 +433,132 @@ fn unreadable_number_is_located() {
     assert_mentions(&e.to_string(), &[&format!("{file}:{line}:"), "link 'b'", "has no <inertia>", "add one"]);
 }
 
+/// A chain of links `l0 → l1 → …` joined by `joints` (name, type, extra body), each child link
+/// with a unit inertia.
+fn chain(joints: &[(&str, &str, &str)]) -> String {
+    let mut t = String::from("<?xml version=\"1.0\"?>\n<robot name=\"r\">\n  <link name=\"l0\"/>\n");
+    for (i, (name, jtype, body)) in joints.iter().enumerate() {
+        t += &format!("  <link name=\"l{}\">\n{UNIT_INERTIAL}\n  </link>\n", i + 1);
+        t += &format!(
+            "  <joint name=\"{name}\" type=\"{jtype}\">\n    <parent link=\"l{i}\"/>\n    <child link=\"l{}\"/>\n    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/>\n{body}\n  </joint>\n",
+            i + 1
+        );
+    }
+    t + "</robot>\n"
+}
+
 #[test]
-fn mimic_of_an_unknown_joint_is_ignored_with_a_warning() {
-    // urdfdom and Pinocchio ignore such a mimic; so do we, but never silently.
-    let text = two_links(
-        "revolute",
-        r#"    <limit lower="-1" upper="1" effort="1" velocity="1"/>
-    <mimic joint="nope"/>"#,
-        "",
+fn mimic_of_an_undefined_joint_is_an_error() {
+    // urdfdom and Pinocchio ignore such a mimic; issue 10 makes it an error (an intended coupling
+    // silently lost is a different robot).
+    let text = chain(&[("a", "revolute", ""), ("j", "revolute", "    <mimic joint=\"nope\"/>")]);
+    let (e, file) = load_err("mimic_undefined", &text);
+    let line = line_of(&text, "<mimic");
+    assert_mentions(
+        &e.to_string(),
+        &[
+            &format!("{file}:{line}:"),
+            "<mimic>",
+            "joint 'j' mimics joint 'nope'",
+            "not defined",
+            "fix the name",
+        ],
     );
-    let path = write_urdf("mimic", &text);
+}
+
+#[test]
+fn mimic_of_itself_is_an_error() {
+    let text = chain(&[("j", "revolute", "    <mimic joint=\"j\" multiplier=\"2\"/>")]);
+    let (e, file) = load_err("mimic_self", &text);
+    let line = line_of(&text, "<mimic");
+    assert_mentions(
+        &e.to_string(),
+        &[&format!("{file}:{line}:"), "<mimic>", "joint 'j' mimics itself", "name the joint it follows"],
+    );
+}
+
+#[test]
+fn mimic_cycles_are_errors_naming_the_joints() {
+    let text = chain(&[
+        ("a", "revolute", "    <mimic joint=\"b\"/>"),
+        ("b", "revolute", "    <mimic joint=\"a\"/>"),
+    ]);
+    let (e, file) = load_err("mimic_cycle2", &text);
+    let line = line_of(&text, "<mimic");
+    assert_mentions(
+        &e.to_string(),
+        &[
+            &format!("{file}:{line}:"),
+            "<mimic>",
+            "'a', 'b' form a cycle",
+            "a mimics b, b mimics a",
+            "remove one <mimic>",
+        ],
+    );
+    // A longer cycle behind a joint that only follows it.
+    let text = chain(&[
+        ("x", "prismatic", "    <mimic joint=\"a\"/>"),
+        ("a", "revolute", "    <mimic joint=\"b\"/>"),
+        ("b", "continuous", "    <mimic joint=\"c\"/>"),
+        ("c", "revolute", "    <mimic joint=\"a\"/>"),
+    ]);
+    let (e, _) = load_err("mimic_cycle3", &text);
+    assert_mentions(&e.to_string(), &["'a', 'b', 'c' form a cycle", "a mimics b, b mimics c, c mimics a"]);
+    assert!(!e.to_string().contains("'x'"), "{e}");
+}
+
+#[test]
+fn mimic_of_a_fixed_joint_is_an_error() {
+    let text = chain(&[("f", "fixed", ""), ("j", "revolute", "    <mimic joint=\"f\"/>")]);
+    let (e, file) = load_err("mimic_of_fixed", &text);
+    let line = line_of(&text, "<mimic");
+    assert_mentions(
+        &e.to_string(),
+        &[
+            &format!("{file}:{line}:"),
+            "joint 'j' mimics joint 'f'",
+            "fixed (fused into its parent)",
+            "make 'f' revolute or prismatic",
+        ],
+    );
+}
+
+#[test]
+fn mimic_needs_one_dof_joints() {
+    // The follower must be revolute, continuous or prismatic ...
+    let text = chain(&[("a", "revolute", ""), ("p", "planar", "    <mimic joint=\"a\"/>")]);
+    let (e, file) = load_err("mimic_planar", &text);
+    let line = line_of(&text, "<mimic");
+    assert_mentions(
+        &e.to_string(),
+        &[
+            &format!("{file}:{line}:"),
+            "joint 'p' is planar",
+            "only revolute, continuous and prismatic joints can mimic",
+        ],
+    );
+    // ... and so must the joint it follows.
+    let text = chain(&[("fl", "floating", ""), ("j", "revolute", "    <mimic joint=\"fl\"/>")]);
+    let (e, _) = load_err("mimic_of_floating", &text);
+    assert_mentions(
+        &e.to_string(),
+        &["joint 'j' mimics joint 'fl', which is floating", "remove the <mimic>"],
+    );
+}
+
+#[test]
+fn mimic_on_a_fixed_joint_is_ignored_with_a_warning() {
+    // Reduced models (example-robot-data's talos_reduced) lock a gripper joint by making it fixed
+    // and keep its <mimic>: nothing to couple, so a warning, not an error.
+    let text = chain(&[("a", "revolute", ""), ("f", "fixed", "    <mimic joint=\"a\"/>")]);
+    let path = write_urdf("mimic_on_fixed", &text);
     let model = load(&path, &LoadOptions::default()).expect("loads with a warning");
-    assert!(model.joints[0].mimic.is_none());
-    let line = line_of(&text, "<joint name=\"j\"");
+    assert!(model.equalities.is_empty());
+    let line = line_of(&text, "<mimic");
     assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
     assert_mentions(
         &model.warnings[0],
-        &[&format!("{}:{line}:", path.display()), "'j'", "mimic joint=\"nope\"", "not defined", "ignored"],
+        &[&format!("{}:{line}:", path.display()), "joint 'f' is fixed", "mimic joint=\"a\"", "ignored"],
     );
 }
 

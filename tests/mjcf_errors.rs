@@ -133,3 +133,83 @@ fn unknown_attributes_are_warnings_with_file_and_line() {
     assert_eq!(w.len(), 1, "{:?}", model.warnings);
     assert!(w[0].contains("unknown_attribute.xml:5") && w[0].contains("<joint>"), "{}", w[0]);
 }
+
+#[test]
+fn equality_constraints_name_existing_distinct_objects() {
+    mentions(
+        "equality_unknown_body.xml",
+        &["equality_unknown_body.xml:19", "<connect>", "unknown body 'nope'", "define it or fix the name"],
+    );
+    mentions(
+        "equality_joint_not_scalar.xml",
+        &[
+            "equality_joint_not_scalar.xml:19",
+            "<joint>",
+            "joint 'ball' is a ball joint",
+            "hinge and slide joints only",
+            "connect or weld",
+        ],
+    );
+    mentions(
+        "equality_same_body.xml",
+        &[
+            "equality_same_body.xml:19",
+            "<weld>",
+            "equality 'w'",
+            "body 'b' is constrained to itself",
+            "two different",
+        ],
+    );
+    mentions(
+        "equality_sites_and_bodies.xml",
+        &[
+            "equality_sites_and_bodies.xml:19",
+            "<connect>",
+            "'body1' cannot be combined with 'site1'",
+            "site form",
+        ],
+    );
+}
+
+#[test]
+fn polycoef_takes_one_to_five_numbers() {
+    mentions(
+        "equality_polycoef_too_long.xml",
+        &["equality_polycoef_too_long.xml:19", "<joint>", "'polycoef' has 6 values, it takes 1 to 5"],
+    );
+    mentions(
+        "equality_polycoef_not_number.xml",
+        &["equality_polycoef_not_number.xml:19", "<joint>", "'polycoef'", "'x', which is not a number"],
+    );
+}
+
+#[test]
+fn tendons_actuators_and_contacts_name_what_they_act_on() {
+    mentions(
+        "tendon_ball_joint.xml",
+        &[
+            "tendon_ball_joint.xml:19",
+            "<joint>",
+            "joint 'ball' is a ball joint",
+            "fixed tendon",
+            "remove the term from tendon 't2'",
+        ],
+    );
+    mentions(
+        "actuator_unknown_joint.xml",
+        &["actuator_unknown_joint.xml:19", "<motor>", "unknown joint 'nope'", "define it or fix the name"],
+    );
+    mentions(
+        "actuator_kv_and_dampratio.xml",
+        &["actuator_kv_and_dampratio.xml:19", "<position>", "'dampratio' cannot be given together with 'kv'"],
+    );
+    mentions("pair_unknown_geom.xml", &["pair_unknown_geom.xml:19", "<pair>", "unknown geom 'nope'"]);
+    mentions(
+        "pair_bad_condim.xml",
+        &["pair_bad_condim.xml:19", "<pair>", "'condim' is 2", "1 (frictionless), 3"],
+    );
+    mentions(
+        "exclude_unknown_body.xml",
+        &["exclude_unknown_body.xml:19", "<exclude>", "unknown body 'nope'"],
+    );
+}

@@ -60,6 +60,10 @@ fn kernels_and_integrators_do_not_allocate() {
         ("models/ur5/ur5.urdf", false),
         ("models/solo12/solo12.urdf", true),
         ("models/talos_reduced/talos_reduced.urdf", true),
+        // Constrained: a mimic row, and a loop with redundant rows (the minimum-norm path).
+        ("models/panda/panda.urdf", false),
+        ("models/textbook/four_bar.xml", false),
+        ("tests/data/mjcf/constraints/connect_free_sites.xml", false),
     ] {
         let model = load(&root.join(file), &LoadOptions { floating, ..Default::default() }).unwrap();
         let mut data = Data::new(&model);

@@ -1,6 +1,8 @@
 //! The compile step: [`ModelSpec`] → [`Model`]. Checks physical validity, normalizes axes, fuses
 //! fixed joints into their parent body (inertia composed, every link kept as a [`Frame`]), and lays
-//! out q and v in depth-first file order (DESIGN.md, layer 3).
+//! out q and v in depth-first file order (DESIGN.md, layer 3); then resolves the equality
+//! constraints, mimics, tendons, actuators and contact pairs against the tree
+//! ([`compile_elements`](crate::io::compile_elements)).
 
 use crate::io::LoadError;
 use crate::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec};
@@ -85,7 +87,11 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                     armature: j.armature,
                     stiffness: j.stiffness,
                     spring_ref: j.spring_ref,
-                    mimic: j.mimic.clone(),
+                    mimic: j.mimic.as_ref().map(|m| crate::model::Mimic {
+                        joint: m.leader.clone(),
+                        multiplier: m.multiplier,
+                        offset: m.offset,
+                    }),
                 });
                 nq += jnq;
                 nv += jnv;
@@ -193,7 +199,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
 
     let keyframes = complete_keyframes(spec, &joints, &qpos0, nv)?;
 
-    Ok(Model {
+    let mut model = Model {
         name: spec.name.clone(),
         source: spec.source.clone(),
         gravity: spec.gravity,
@@ -218,7 +224,16 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         contact_excludes: Vec::new(),
         elements: spec.elements.clone(),
         warnings,
-    })
+    };
+    let mut e = crate::io::compile_elements::compile_elements(spec, &model)?;
+    model.equalities = e.equalities;
+    model.tendons = e.tendons;
+    model.actuators = e.actuators;
+    model.contact_pairs = e.contact_pairs;
+    model.contact_excludes = e.contact_excludes;
+    model.elements.append(&mut e.kept);
+    model.warnings.append(&mut e.warnings);
+    Ok(model)
 }
 
 /// Keyframes with full vectors, as MuJoCo completes them: a missing `qpos` is `qpos0` and a short

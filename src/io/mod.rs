@@ -2,6 +2,7 @@
 //! Loaders never touch dynamics code.
 
 pub mod compile;
+mod compile_elements;
 mod error;
 pub mod geom_mass;
 pub mod mjcf;

@@ -16,9 +16,9 @@
 use super::package::{base_dir, package_search_dirs, resolve_uri, ResolveError};
 use super::{LoadError, LoadOptions};
 use crate::model::spec::{
-    GeomSpec, InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec, Shape,
+    GeomSpec, InertialSpec, JointSpec, JointType, LinkSpec, MassRules, MimicSpec, ModelSpec, Shape,
 };
-use crate::model::{FrameKind, Mimic, SourceLoc};
+use crate::model::{FrameKind, SourceLoc};
 use crate::spatial::{Mat3, Transform, Vec3};
 use roxmltree::{Document, Node, ParsingOptions};
 use std::collections::HashMap;
@@ -127,6 +127,8 @@ struct JointIndex {
     parent: String,
     child: String,
     axis_loc: Option<SourceLoc>,
+    /// Location of its `<mimic>`, if any.
+    mimic_loc: Option<SourceLoc>,
     has_limit: bool,
 }
 
@@ -295,6 +297,7 @@ fn index_joint(ctx: &Ctx, node: Node, name: &str) -> Result<JointIndex, LoadErro
         parent,
         child,
         axis_loc: elements(node).find(|c| is(c, "axis")).map(|a| ctx.loc(a)),
+        mimic_loc: elements(node).find(|c| is(c, "mimic")).map(|m| ctx.loc(m)),
         has_limit: elements(node).any(|c| is(&c, "limit")),
     })
 }
@@ -419,7 +422,6 @@ fn build_spec(
     }
     let search_dirs = package_search_dirs(&options.package_dirs);
     let base = base_dir(path);
-    let joint_exists = |name: &str| index.joints.iter().any(|j| j.name == name);
     let mut warnings = Vec::new();
 
     let mut links = Vec::with_capacity(tree.order.len());
@@ -428,10 +430,7 @@ fn build_spec(
         let (parent, joint) = match tree.parent_joint[li] {
             Some(ji) => {
                 let parent = spec_index[tree.joint_parent[ji]];
-                (
-                    Some(parent),
-                    joint_spec(&robot.joints[ji], &index.joints[ji], index, &joint_exists, &mut warnings)?,
-                )
+                (Some(parent), joint_spec(&robot.joints[ji], &index.joints[ji], index)?)
             }
             None => (None, root_joint(link_index, index, options)?),
         };
@@ -499,13 +498,7 @@ fn finite_pose(p: &urdf_rs::Pose) -> bool {
     p.xyz.iter().chain(p.rpy.iter()).all(|x| x.is_finite())
 }
 
-fn joint_spec(
-    j: &urdf_rs::Joint,
-    ji: &JointIndex,
-    index: &Index,
-    joint_exists: &dyn Fn(&str) -> bool,
-    warnings: &mut Vec<String>,
-) -> Result<JointSpec, LoadError> {
+fn joint_spec(j: &urdf_rs::Joint, ji: &JointIndex, index: &Index) -> Result<JointSpec, LoadError> {
     let invalid = |loc: &SourceLoc, element: &str, detail: String| LoadError::Invalid {
         loc: loc.clone(),
         element: element.into(),
@@ -554,26 +547,18 @@ fn joint_spec(
         spec.damping = d.damping;
         spec.friction = d.friction;
     }
-    if let Some(m) = j.mimic.as_ref().filter(|m| {
-        // A mimic of an undefined joint is ignored, as urdfdom and Pinocchio do, with a warning.
-        let known = joint_exists(&m.joint);
-        if !known {
-            warnings.push(format!(
-                "{}: <joint> '{name}': <mimic joint=\"{}\"> names a joint that is not defined; the mimic is ignored",
-                ji.loc, m.joint
-            ));
-        }
-        known
-    }) {
-        let mimic = Mimic {
-            joint: m.joint.clone(),
+    // The leader is resolved, and mimic chains checked, by the compile step.
+    if let Some(m) = &j.mimic {
+        let mimic = MimicSpec {
+            leader: m.joint.clone(),
             multiplier: m.multiplier.unwrap_or(1.0),
             offset: m.offset.unwrap_or(0.0),
+            loc: ji.mimic_loc.clone().unwrap_or_else(|| ji.loc.clone()),
         };
         if !mimic.multiplier.is_finite() || !mimic.offset.is_finite() {
             return Err(invalid(
-                &ji.loc,
-                "joint",
+                &mimic.loc,
+                "mimic",
                 format!("joint '{name}': <mimic> multiplier and offset must be finite numbers; fix them"),
             ));
         }

@@ -21,6 +21,24 @@ pub enum ActuatorShortcut {
     Plugin,
 }
 
+impl ActuatorShortcut {
+    /// The MJCF element name (`motor`, `position`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            ActuatorShortcut::General => "general",
+            ActuatorShortcut::Motor => "motor",
+            ActuatorShortcut::Position => "position",
+            ActuatorShortcut::Velocity => "velocity",
+            ActuatorShortcut::IntVelocity => "intvelocity",
+            ActuatorShortcut::Damper => "damper",
+            ActuatorShortcut::Cylinder => "cylinder",
+            ActuatorShortcut::Muscle => "muscle",
+            ActuatorShortcut::Adhesion => "adhesion",
+            ActuatorShortcut::Plugin => "plugin",
+        }
+    }
+}
+
 /// What the actuator acts on (`actuator_trntype` and `actuator_trnid`), by index.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Transmission {

@@ -68,7 +68,9 @@ pub struct Joint {
     /// `simulate` as `−stiffness·(q − spring_ref)` for hinge and slide joints.
     pub stiffness: f64,
     pub spring_ref: f64,
-    /// URDF `<mimic>`: stored, enforced by the constraints work (not yet).
+    /// URDF `<mimic>`, as written. The constraint is the [`EqualityKind::Mimic`] in
+    /// [`Model::equalities`]; this copy remains only for the simulation plan (`sim::plan`) until
+    /// the plan reads the equalities.
     pub mimic: Option<Mimic>,
 }
 

@@ -1,8 +1,11 @@
 //! The model *spec*: what a loader parsed, before the compile step (DESIGN.md, layer 3) resolves
 //! it into a [`Model`](super::Model). Links are a tree in depth-first file order; fixed joints are
-//! still present here.
+//! still present here. Equality constraints, tendons, actuators and contact pairs name the objects
+//! they act on; the compile step resolves the names to indices ([`EqualitySpec`] and the types
+//! after it).
 
-use super::{Element, Keyframe, Mimic, Options, SourceLoc};
+use super::actuator::{ActuatorShortcut, BiasType, DynType, GainType};
+use super::{Element, Keyframe, Options, SourceLoc};
 use crate::mass::{Distribution, GeomMass};
 use crate::spatial::{Mat3, Transform, Vec3};
 use std::path::PathBuf;
@@ -24,8 +27,17 @@ pub struct ModelSpec {
     pub options: Options,
     /// Named initial states (MJCF `<keyframe>`), in qpos/qvel layout.
     pub keyframes: Vec<Keyframe>,
-    /// Elements kept but not (yet) simulated: actuators, sensors, equality constraints, tendons,
-    /// contact pairs and exclusions.
+    /// Equality constraints (MJCF `<equality>`), in file order; URDF mimics are on their joints.
+    pub equalities: Vec<EqualitySpec>,
+    /// Tendons (MJCF `<tendon>`), in file order (MuJoCo's tendon order).
+    pub tendons: Vec<TendonSpec>,
+    /// Actuators (MJCF `<actuator>`) in file order, shortcuts expanded.
+    pub actuators: Vec<ActuatorSpec>,
+    /// Explicit contact pairs (`<contact><pair>`).
+    pub contact_pairs: Vec<ContactPairSpec>,
+    /// Body pairs excluded from contact (`<contact><exclude>`).
+    pub contact_excludes: Vec<ContactExcludeSpec>,
+    /// Elements kept but not typed (sensors, flex equalities, …), listed by `lagrange info`.
     pub elements: Vec<Element>,
     /// Loader warnings (unknown attributes, ignored elements), each with file:line.
     pub warnings: Vec<String>,
@@ -110,7 +122,19 @@ pub struct JointSpec {
     pub spring_ref: f64,
     /// The joint's reference configuration (MuJoCo `qpos0`); empty means neutral.
     pub qpos0: Vec<f64>,
-    pub mimic: Option<Mimic>,
+    /// URDF `<mimic>`: this joint follows another one.
+    pub mimic: Option<MimicSpec>,
+}
+
+/// URDF `<mimic joint multiplier offset>`: `q = multiplier · q[leader] + offset`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MimicSpec {
+    /// The joint followed (`joint` attribute).
+    pub leader: String,
+    pub multiplier: f64,
+    pub offset: f64,
+    /// The `<mimic>` element.
+    pub loc: SourceLoc,
 }
 
 impl JointSpec {
@@ -219,4 +243,122 @@ impl GeomSpec {
             friction: [1.0, 0.005, 0.0001],
         }
     }
+}
+
+/// An equality constraint as written (MJCF `<equality>`), naming the objects it ties together;
+/// compiled into [`Equality`](super::Equality).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EqualitySpec {
+    pub name: String,
+    pub kind: EqualitySpecKind,
+    pub active: bool,
+    pub solref: [f64; 2],
+    pub solimp: [f64; 5],
+    pub loc: SourceLoc,
+}
+
+/// What an [`EqualitySpec`] ties together, by name. `body2: None` is the world.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EqualitySpecKind {
+    /// `<connect body1 body2 anchor>`: `anchor` in body1 coordinates.
+    ConnectBodies { body1: String, body2: Option<String>, anchor: [f64; 3] },
+    /// `<connect site1 site2>`.
+    ConnectSites { site1: String, site2: String },
+    /// `<weld body1 body2 anchor relpose torquescale>`: `anchor` in body2 coordinates, `relpose`
+    /// the pose of body2's anchor frame in body1 (`None`: taken at `qpos0`).
+    WeldBodies {
+        body1: String,
+        body2: Option<String>,
+        anchor: [f64; 3],
+        relpose: Option<Transform>,
+        torquescale: f64,
+    },
+    /// `<weld site1 site2 torquescale>`.
+    WeldSites { site1: String, site2: String, torquescale: f64 },
+    /// `<joint joint1 joint2 polycoef>`.
+    Joint { joint1: String, joint2: Option<String>, polycoef: [f64; 5] },
+    /// `<tendon tendon1 tendon2 polycoef>`.
+    Tendon { tendon1: String, tendon2: Option<String>, polycoef: [f64; 5] },
+}
+
+/// A tendon as written (MJCF `<fixed>` or `<spatial>`); compiled into
+/// [`Tendon`](super::Tendon).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TendonSpec {
+    pub name: String,
+    pub kind: TendonSpecKind,
+    /// Length limits if limited (`limited`/`range`, resolved with `autolimits`).
+    pub range: Option<[f64; 2]>,
+    pub loc: SourceLoc,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum TendonSpecKind {
+    /// `<fixed>`: its `<joint joint coef>` children (joint name, coefficient, element).
+    Fixed { joints: Vec<(String, f64, SourceLoc)> },
+    /// `<spatial>`: its path as (element, name): `site` and `geom` with the object's name,
+    /// `pulley` with its divisor.
+    Spatial { path: Vec<(String, String)> },
+}
+
+/// What an actuator acts on, by name (MJCF `joint`, `jointinparent`, `tendon`, `site` with
+/// `refsite`, `body`, `cranksite` with `slidersite`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum TransmissionSpec {
+    Joint(String),
+    JointInParent(String),
+    Tendon(String),
+    Site { site: String, refsite: Option<String> },
+    Body(String),
+    SliderCrank { cranksite: String, slidersite: String, cranklength: f64 },
+}
+
+/// An actuator as written, with its shortcut already expanded into MuJoCo's general form;
+/// compiled into [`Actuator`](super::Actuator).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ActuatorSpec {
+    pub name: String,
+    pub shortcut: ActuatorShortcut,
+    pub transmission: TransmissionSpec,
+    pub gear: [f64; 6],
+    pub dyntype: DynType,
+    pub gaintype: GainType,
+    pub biastype: BiasType,
+    pub dynprm: [f64; 10],
+    pub gainprm: [f64; 10],
+    pub biasprm: [f64; 10],
+    pub ctrlrange: Option<[f64; 2]>,
+    pub forcerange: Option<[f64; 2]>,
+    pub actrange: Option<[f64; 2]>,
+    pub actearly: bool,
+    /// `inheritrange` (position and intvelocity servos): the control range (activation range for
+    /// `intvelocity`) is this fraction of the target joint's or tendon's range, about its middle;
+    /// set by the compile step, which knows the target.
+    pub inheritrange: Option<f64>,
+    pub loc: SourceLoc,
+}
+
+/// `<contact><pair>` as written; compiled into [`ContactPair`](super::ContactPair).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactPairSpec {
+    pub name: String,
+    pub geom1: String,
+    pub geom2: String,
+    pub condim: u32,
+    pub friction: [f64; 5],
+    pub solref: [f64; 2],
+    pub solreffriction: [f64; 2],
+    pub solimp: [f64; 5],
+    pub margin: f64,
+    pub gap: f64,
+    pub loc: SourceLoc,
+}
+
+/// `<contact><exclude>` as written; compiled into [`ContactExclude`](super::ContactExclude).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactExcludeSpec {
+    pub name: String,
+    pub body1: String,
+    pub body2: String,
+    pub loc: SourceLoc,
 }

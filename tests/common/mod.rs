@@ -487,3 +487,11 @@ pub fn load_robot(name: &str, floating: bool) -> Model {
 pub fn robots() -> Vec<(String, Model)> {
     ROBOTS.iter().map(|&(name, floating)| (name.to_string(), load_robot(name, floating))).collect()
 }
+
+/// Exact-mode constraint checks: rod tension against notes §1.6, KKT residuals, J q̈ + J̇v = 0 and
+/// the mimic full/reduced equality are algebraic identities, checked at this relative tolerance.
+pub const CONSTRAINT_REL: f64 = 1e-10;
+/// A loop closed by projection stays closed to this (max |φ| in m over a long run).
+pub const PROJECTED_DRIFT: f64 = 1e-9;
+/// Central differences of J along v (step 1e-6) reproduce J̇v to this relative error.
+pub const JDOTV_FD_REL: f64 = 1e-6;

@@ -97,6 +97,29 @@ impl Attrs {
         Ok(Some(v))
     }
 
+    /// Overwrites the first values of `out` with the numbers of attribute `name` (at most
+    /// `out.len()` of them), as MuJoCo reads a partial array: entries not given keep their value.
+    /// Returns whether the attribute is there.
+    pub fn fill(&self, name: &str, out: &mut [f64]) -> Result<bool, LoadError> {
+        let Some(v) = self.numbers(name)? else { return Ok(false) };
+        if v.is_empty() || v.len() > out.len() {
+            return Err(self.count_error(name, v.len(), &format!("1 to {}", out.len())));
+        }
+        out[..v.len()].copy_from_slice(&v);
+        Ok(true)
+    }
+
+    /// [`Attrs::fill`] from the default class's value, then from the element's own (`self` holds
+    /// both; `class` the class's alone), so that a partial value overrides a class value entry by
+    /// entry, as in MuJoCo.
+    pub fn fill_over(&self, class: &Attrs, name: &str, out: &mut [f64]) -> Result<bool, LoadError> {
+        let from_class = class.fill(name, out)?;
+        if self.explicit.iter().any(|e| e == name) {
+            return self.fill(name, out);
+        }
+        Ok(from_class)
+    }
+
     fn count_error(&self, name: &str, got: usize, want: &str) -> LoadError {
         self.error(name, format!("has {got} value{}, it takes {want}", if got == 1 { "" } else { "s" }))
     }
@@ -133,6 +156,52 @@ impl Attrs {
             Ok(Some(text.to_string()))
         } else {
             Err(self.error(name, format!("is '{text}'; use one of {}", allowed.join(", "))))
+        }
+    }
+
+    /// A range and its `…limited` switch as MuJoCo compiles them (`checklimited`, `islimited`):
+    /// `true` needs `range` with lower < upper; `auto` (the default) is limited when
+    /// `<compiler autolimits>` is on and lower < upper, and is an error when autolimits is off and
+    /// a nonzero range is given. A reversed range left unlimited by `auto` adds a warning.
+    pub fn limited_range(
+        &self,
+        limited: &str,
+        range: &str,
+        autolimits: bool,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<[f64; 2]>, LoadError> {
+        let r = self.array::<2>(range)?;
+        match self.keyword(limited, &["false", "true", "auto"])?.as_deref() {
+            Some("false") => Ok(None),
+            Some("true") => match r {
+                Some([lo, hi]) if lo < hi => Ok(Some([lo, hi])),
+                _ => Err(self.error(
+                    range,
+                    format!(
+                        "must be given with lower < upper when {limited}=\"true\" (it is {})",
+                        r.map_or("missing".to_string(), |[lo, hi]| format!("[{lo}, {hi}]"))
+                    ),
+                )),
+            },
+            _ => match r {
+                Some(v) if v != [0.0, 0.0] && !autolimits => Err(self.error(
+                    range,
+                    format!(
+                        "is given without '{limited}' while <compiler autolimits=\"false\">; give {limited}=\"true\" or \"false\", set autolimits=\"true\", or remove the range"
+                    ),
+                )),
+                Some([lo, hi]) if lo < hi => Ok(Some([lo, hi])),
+                Some([lo, hi]) => {
+                    if [lo, hi] != [0.0, 0.0] {
+                        warnings.push(format!(
+                            "{}: <{}>: '{range}' is [{lo}, {hi}] (lower ≥ upper), so the element is not limited (MuJoCo's rule for {limited}=\"auto\")",
+                            self.loc, self.tag
+                        ));
+                    }
+                    Ok(None)
+                }
+                None => Ok(None),
+            },
         }
     }
 

@@ -38,8 +38,11 @@ fn check(e: &Element, decl: &ElementSchema, warnings: &mut Vec<String>) -> Resul
         } else {
             decl.child(&child.tag)
         };
+        // A flex equality is kept as a listed element (see `equality`); the flex it names is the
+        // error.
+        let flex_equality = e.tag == "equality" && child.tag == "flex";
         if let Some((_, fix)) = UNSUPPORTED.iter().find(|(t, _)| *t == child.tag) {
-            if child_decl.is_some() {
+            if child_decl.is_some() && !flex_equality {
                 return Err(LoadError::Unsupported {
                     loc: child.loc.clone(),
                     element: child.tag.clone(),

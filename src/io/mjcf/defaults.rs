@@ -2,7 +2,9 @@
 //! `<default class="c">` starts as a copy of its parent and overrides per element type; an element
 //! takes the class named by its `class` attribute, else the `childclass` of the nearest enclosing
 //! `<body>`/`<frame>` that has one, else `main`. All actuator shortcuts (`motor`, `position`, ...)
-//! share one actuator default, as in MuJoCo.
+//! share one actuator default, as in MuJoCo; since a shortcut written in a default expands into
+//! the shared actuator parameters, each class also keeps its actuator defaults in order
+//! ([`Defaults::actuator_defaults`]) so that the expansion can be replayed.
 
 use super::attrs::Attrs;
 use super::xml::Element;
@@ -10,7 +12,7 @@ use crate::io::LoadError;
 use std::collections::HashMap;
 
 /// The element types whose defaults actuators share.
-const ACTUATOR_TAGS: [&str; 12] = [
+pub const ACTUATOR_TAGS: [&str; 12] = [
     "general",
     "motor",
     "position",
@@ -37,6 +39,9 @@ fn key(tag: &str) -> &str {
 #[derive(Clone, Debug, Default)]
 struct Class {
     by_tag: HashMap<String, Vec<(String, String)>>,
+    /// The actuator elements of this class and its ancestors, outermost class first, each in file
+    /// order, with their own attributes.
+    actuators: Vec<Attrs>,
 }
 
 /// All default classes of a model.
@@ -66,6 +71,9 @@ impl Defaults {
         for child in &node.children {
             if child.tag == "default" {
                 continue;
+            }
+            if ACTUATOR_TAGS.contains(&child.tag.as_str()) {
+                class.actuators.push(Attrs::new(&child.tag, &child.loc, &[], &child.attrs));
             }
             let slot = class.by_tag.entry(key(&child.tag).to_string()).or_default();
             for (k, v) in &child.attrs {
@@ -104,18 +112,47 @@ impl Defaults {
     /// The attributes of `element` over the defaults of its class: its `class` attribute, else
     /// `childclass` (the enclosing body's or frame's), else `main`.
     pub fn resolve(&self, element: &Element, childclass: &str) -> Result<Attrs, LoadError> {
-        let class_name = element.attr("class").unwrap_or(childclass);
-        let Some(class) = self.classes.get(class_name) else {
-            return Err(LoadError::UnknownClass {
-                loc: element.loc.clone(),
-                element: element.tag.clone(),
-                class: class_name.to_string(),
-            });
-        };
+        self.resolve_as(element, key(&element.tag), childclass)
+    }
+
+    /// Like [`Defaults::resolve`], with the defaults written under `<default><{default_tag}>`:
+    /// the elements of `<equality>` (`connect`, `weld`, `joint`, `tendon`) take the defaults of
+    /// `<default><equality>`, those of `<tendon>` (`fixed`, `spatial`) of `<default><tendon>`.
+    pub fn resolve_as(
+        &self,
+        element: &Element,
+        default_tag: &str,
+        childclass: &str,
+    ) -> Result<Attrs, LoadError> {
+        let class = self.class_of(element, childclass)?;
         let empty = Vec::new();
-        let defaults = class.by_tag.get(key(&element.tag)).unwrap_or(&empty);
+        let defaults = class.by_tag.get(default_tag).unwrap_or(&empty);
         let explicit: Vec<(String, String)> =
             element.attrs.iter().filter(|(k, _)| k != "class").cloned().collect();
         Ok(Attrs::new(&element.tag, &element.loc, defaults, &explicit))
+    }
+
+    /// The defaults alone that [`Defaults::resolve_as`] puts under `element`'s own attributes.
+    pub fn class_defaults(&self, element: &Element, default_tag: &str) -> Result<Attrs, LoadError> {
+        let class = self.class_of(element, MAIN)?;
+        let empty = Vec::new();
+        let defaults = class.by_tag.get(default_tag).unwrap_or(&empty);
+        Ok(Attrs::new(&element.tag, &element.loc, defaults, &[]))
+    }
+
+    /// The actuator defaults of `element`'s class (outermost class first, each in file order), as
+    /// attribute sets of the tag they were written as (`motor`, `position`, ...).
+    pub fn actuator_defaults(&self, element: &Element) -> Result<&[Attrs], LoadError> {
+        let class = self.class_of(element, MAIN)?;
+        Ok(&class.actuators)
+    }
+
+    fn class_of(&self, element: &Element, childclass: &str) -> Result<&Class, LoadError> {
+        let class_name = element.attr("class").unwrap_or(childclass);
+        self.classes.get(class_name).ok_or_else(|| LoadError::UnknownClass {
+            loc: element.loc.clone(),
+            element: element.tag.clone(),
+            class: class_name.to_string(),
+        })
     }
 }

@@ -5,19 +5,25 @@
 //! element and attribute against MuJoCo's schema ([`check`]: unknown ones are warnings, elements
 //! that would change the dynamics and are not supported are errors); read `<compiler>` and
 //! `<option>`; build the default classes ([`defaults`]); read the mesh assets ([`assets`]); walk
-//! `<worldbody>` depth-first in file order into links ([`body`], [`geom`]); keep keyframes,
-//! actuators, sensors, equality constraints, tendons and contact pairs ([`sections`]).
+//! `<worldbody>` depth-first in file order into links ([`body`], [`geom`]); read keyframes and
+//! sensors ([`sections`]), equality constraints ([`equality`]), tendons ([`tendon`]), actuators
+//! ([`actuator`]) and contact pairs and exclusions ([`contact`]), whose names the compile step
+//! resolves.
 
+mod actuator;
 mod assets;
 mod attrs;
 mod body;
 mod check;
+mod contact;
 mod defaults;
+mod equality;
 mod geom;
 mod orientation;
 mod schema;
 mod schema_types;
 mod sections;
+mod tendon;
 mod xml;
 
 use super::{LoadError, LoadOptions};
@@ -56,11 +62,13 @@ pub fn parse_str(text: &str, path: &Path, options: &LoadOptions) -> Result<Model
     parse_root(&root, path, options)
 }
 
-/// Every actuator, equality constraint, tendon and contact pair must name objects that exist (as
-/// MuJoCo requires); names are checked against all bodies, joints, geoms, sites and tendons.
+/// Actuators kept untyped must still name objects that exist (as MuJoCo requires); their names
+/// are checked against all bodies, joints, geoms, sites and tendons. (Typed elements are resolved
+/// by the compile step.)
 fn check_targets(
     elements: &[crate::model::Element],
     links: &[crate::model::spec::LinkSpec],
+    tendons: &[crate::model::spec::TendonSpec],
 ) -> Result<(), LoadError> {
     let mut names: std::collections::HashSet<&str> = std::collections::HashSet::new();
     for l in links {
@@ -69,11 +77,8 @@ fn check_targets(
         names.extend(l.geoms.iter().map(|g| g.name.as_str()));
         names.extend(l.frames.iter().map(|f| f.name.as_str()));
     }
-    names.extend(elements.iter().filter(|e| e.category == "tendon").map(|e| e.name.as_str()));
-    for e in elements
-        .iter()
-        .filter(|e| matches!(e.category.as_str(), "actuator" | "equality" | "tendon" | "contact"))
-    {
+    names.extend(tendons.iter().map(|t| t.name.as_str()));
+    for e in elements.iter().filter(|e| e.category == "actuator") {
         if let Some(t) = e.targets.iter().find(|t| !names.contains(t.as_str())) {
             return Err(LoadError::UnknownReference {
                 loc: e.loc.clone(),
@@ -97,8 +102,12 @@ fn parse_root(root: &xml::Element, path: &Path, _options: &LoadOptions) -> Resul
     builder.worldbody(root)?;
     warnings.append(&mut builder.warnings);
     let keyframes = sections::keyframes(root)?;
-    let mut elements = sections::elements(root, &defaults)?;
-    check_targets(&elements, &builder.links)?;
+    let mut elements = sections::sensors(root)?;
+    let equalities = equality::equalities(root, &defaults, &mut elements, &mut warnings)?;
+    let tendons = tendon::tendons(root, &defaults, compiler.autolimits, &mut warnings)?;
+    let actuators = actuator::actuators(root, &defaults, compiler.autolimits, &mut elements, &mut warnings)?;
+    let (contact_pairs, contact_excludes) = contact::contacts(root, &defaults)?;
+    check_targets(&elements, &builder.links, &tendons)?;
     elements.append(&mut builder.kept);
     let name = root.attr("model").unwrap_or("MuJoCo Model").to_string();
     Ok(ModelSpec {
@@ -109,6 +118,11 @@ fn parse_root(root: &xml::Element, path: &Path, _options: &LoadOptions) -> Resul
         mass_rules: compiler.mass_rules.clone(),
         options,
         keyframes,
+        equalities,
+        tendons,
+        actuators,
+        contact_pairs,
+        contact_excludes,
         elements,
         warnings,
     })

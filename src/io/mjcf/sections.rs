@@ -1,8 +1,7 @@
-//! The MJCF sections around the tree: `<compiler>`, `<option>`, `<keyframe>`, and the elements kept
-//! but not simulated yet (`<equality>`, `<tendon>`, `<actuator>`, `<sensor>`, `<contact>`).
+//! The MJCF sections around the tree: `<compiler>`, `<option>`, `<keyframe>`, and `<sensor>`s,
+//! which are kept as listed elements, not evaluated.
 
 use super::attrs::Attrs;
-use super::defaults::{Defaults, MAIN};
 use super::orientation::AngleConvention;
 use super::xml::Element;
 use super::{Compiler, InertiaFromGeom};
@@ -189,63 +188,24 @@ pub(crate) fn keyframes(root: &Element) -> Result<Vec<Keyframe>, LoadError> {
     Ok(keys)
 }
 
-/// Attributes that name the objects an element acts on.
-const TARGET_ATTRS: [&str; 22] = [
-    "joint",
-    "joint1",
-    "joint2",
-    "body",
-    "body1",
-    "body2",
-    "site",
-    "site1",
-    "site2",
-    "tendon",
-    "tendon1",
-    "tendon2",
-    "geom",
-    "geom1",
-    "geom2",
-    "objname",
-    "refname",
-    "jointinparent",
-    "cranksite",
-    "slidersite",
-    "refsite",
-    "actuator",
-];
+/// Attributes of a sensor that name the objects it measures.
+const SENSOR_TARGETS: [&str; 8] =
+    ["joint", "site", "tendon", "actuator", "body", "geom", "objname", "refname"];
 
-/// Reads the sections whose elements are kept but not simulated yet.
-pub(crate) fn elements(root: &Element, defaults: &Defaults) -> Result<Vec<KeptElement>, LoadError> {
+/// Reads the `<sensor>` sections: each sensor listed with the objects it names.
+pub(crate) fn sensors(root: &Element) -> Result<Vec<KeptElement>, LoadError> {
     let mut out = Vec::new();
-    for category in ["equality", "tendon", "actuator", "sensor", "contact"] {
-        for section in root.children_named(category) {
-            for e in &section.children {
-                // Sensors and contact exclusions have no default classes.
-                let a = if matches!(category, "sensor") || e.tag == "exclude" {
-                    Attrs::plain(e)
-                } else {
-                    defaults.resolve(e, MAIN)?
-                };
-                let mut targets: Vec<String> =
-                    TARGET_ATTRS.iter().filter_map(|t| a.text(t)).map(str::to_string).collect();
-                // Tendon paths list their joints, sites and geoms as children.
-                for c in &e.children {
-                    for t in ["joint", "site", "geom"] {
-                        if let Some(v) = c.attr(t) {
-                            targets.push(v.to_string());
-                        }
-                    }
-                }
-                out.push(KeptElement {
-                    category: category.to_string(),
-                    kind: e.tag.clone(),
-                    name: a.text("name").unwrap_or("").to_string(),
-                    targets,
-                    attributes: a.values.clone(),
-                    loc: e.loc.clone(),
-                });
-            }
+    for section in root.children_named("sensor") {
+        for e in &section.children {
+            let a = Attrs::plain(e);
+            out.push(KeptElement {
+                category: "sensor".to_string(),
+                kind: e.tag.clone(),
+                name: a.text("name").unwrap_or("").to_string(),
+                targets: SENSOR_TARGETS.iter().filter_map(|t| a.text(t)).map(str::to_string).collect(),
+                attributes: a.values.clone(),
+                loc: e.loc.clone(),
+            });
         }
     }
     Ok(out)

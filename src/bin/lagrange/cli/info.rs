@@ -4,9 +4,139 @@ use super::CliError;
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::Plan;
 use lagrange::io::{load, LoadOptions};
+use lagrange::model::actuator::Transmission;
+use lagrange::model::{EqualityKind, TendonKind};
 use lagrange::Model;
 use serde_json::{json, Map, Value};
 use std::path::Path;
+
+/// One element of the model beyond the tree, as `info` lists it.
+struct Listed {
+    category: String,
+    kind: String,
+    name: String,
+    /// The names of the objects it acts on.
+    targets: Vec<String>,
+    source: String,
+    status: &'static str,
+}
+
+/// Status of elements the engine keeps without simulating them.
+const NOT_SIMULATED: &str = "parsed, not simulated";
+
+/// Every equality constraint, tendon, actuator, contact pair and exclusion, then the untyped
+/// elements (sensors, ...), with what the engine does with each.
+fn listing(model: &Model) -> Vec<Listed> {
+    let frame = |f: usize| model.frames[f].name.clone();
+    let joint = |j: usize| model.joints[j].name.clone();
+    let tendon = |t: usize| model.tendons[t].name.clone();
+    let mut out = Vec::new();
+    for e in &model.equalities {
+        let targets = match &e.kind {
+            EqualityKind::Connect { frame1, frame2, .. } | EqualityKind::Weld { frame1, frame2, .. } => {
+                vec![frame(*frame1), frame(*frame2)]
+            }
+            EqualityKind::Joint { joint1, joint2, .. } => {
+                std::iter::once(joint(*joint1)).chain(joint2.map(joint)).collect()
+            }
+            EqualityKind::Tendon { tendon1, tendon2, .. } => {
+                std::iter::once(tendon(*tendon1)).chain(tendon2.map(tendon)).collect()
+            }
+            EqualityKind::Mimic { joint: follower, leader, .. } => vec![joint(*follower), joint(*leader)],
+        };
+        out.push(Listed {
+            category: "equality".into(),
+            kind: e.kind.name().to_string(),
+            name: e.name.clone(),
+            targets,
+            source: e.loc.to_string(),
+            status: "simulated (exact mode)",
+        });
+    }
+    for (i, t) in model.tendons.iter().enumerate() {
+        let coupled = model.equalities.iter().any(|e| {
+            matches!(e.kind, EqualityKind::Tendon { tendon1, tendon2, .. } if tendon1 == i || tendon2 == Some(i))
+        });
+        let (kind, targets, status) = match &t.kind {
+            TendonKind::Fixed { joints } => (
+                "fixed",
+                joints.iter().map(|&(j, _)| joint(j)).collect(),
+                if coupled { "simulated (equality rows)" } else { "parsed" },
+            ),
+            TendonKind::Spatial { path } => ("spatial", path.clone(), NOT_SIMULATED),
+        };
+        out.push(Listed {
+            category: "tendon".into(),
+            kind: kind.to_string(),
+            name: t.name.clone(),
+            targets,
+            source: t.loc.to_string(),
+            status,
+        });
+    }
+    for a in &model.actuators {
+        let targets = match &a.transmission {
+            Transmission::Joint(j) | Transmission::JointInParent(j) => vec![joint(*j)],
+            Transmission::Tendon(t) => vec![tendon(*t)],
+            Transmission::Site { site, refsite } => {
+                std::iter::once(frame(*site)).chain(refsite.map(frame)).collect()
+            }
+            Transmission::Body(b) => vec![model.bodies[*b].name.clone()],
+            Transmission::SliderCrank { cranksite, slidersite, .. } => {
+                vec![frame(*cranksite), frame(*slidersite)]
+            }
+        };
+        out.push(Listed {
+            category: "actuator".into(),
+            kind: a.shortcut.name().to_string(),
+            name: a.name.clone(),
+            targets,
+            source: a.loc.to_string(),
+            status: NOT_SIMULATED,
+        });
+    }
+    for p in &model.contact_pairs {
+        out.push(Listed {
+            category: "contact".into(),
+            kind: "pair".into(),
+            name: p.name.clone(),
+            targets: vec![model.geoms[p.geom1].name.clone(), model.geoms[p.geom2].name.clone()],
+            source: p.loc.to_string(),
+            status: NOT_SIMULATED,
+        });
+    }
+    for x in &model.contact_excludes {
+        out.push(Listed {
+            category: "contact".into(),
+            kind: "exclude".into(),
+            name: x.name.clone(),
+            targets: vec![model.bodies[x.body1].name.clone(), model.bodies[x.body2].name.clone()],
+            source: x.loc.to_string(),
+            status: NOT_SIMULATED,
+        });
+    }
+    for e in &model.elements {
+        out.push(Listed {
+            category: e.category.clone(),
+            kind: e.kind.clone(),
+            name: e.name.clone(),
+            targets: e.targets.clone(),
+            source: e.loc.to_string(),
+            status: NOT_SIMULATED,
+        });
+    }
+    out
+}
+
+/// The URDF mimic a joint follows: (leader name, multiplier, offset, equality name).
+fn mimic_of(model: &Model, j: usize) -> Option<(&str, f64, f64, &str)> {
+    model.equalities.iter().find_map(|e| match e.kind {
+        EqualityKind::Mimic { joint, leader, multiplier, offset } if joint == j => {
+            Some((model.joints[leader].name.as_str(), multiplier, offset, e.name.as_str()))
+        }
+        _ => None,
+    })
+}
 
 /// The `info` JSON document: keys `nq`, `nv`, `total_mass`, `bodies`, `joints`, `stages`.
 /// `com` is in the body frame, `inertia` is the 3×3 tensor about the centre of mass in body axes.
@@ -31,8 +161,9 @@ pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
     let joints: Vec<Value> = model
         .joints
         .iter()
-        .map(|j| {
-            json!({
+        .enumerate()
+        .map(|(i, j)| {
+            let mut v = json!({
                 "name": j.name,
                 "type": j.kind.type_name(),
                 "parent": model.bodies[j.parent].name,
@@ -41,19 +172,22 @@ pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
                 "dofadr": j.dof_adr,
                 "nq": j.kind.nq(),
                 "nv": j.kind.nv(),
-            })
+            });
+            if let Some((leader, multiplier, offset, equality)) = mimic_of(model, i) {
+                v["mimic"] = json!({"joint": leader, "multiplier": multiplier, "offset": offset, "equality": equality});
+            }
+            v
         })
         .collect();
     let mut stages = Map::new();
     for s in &plan.stages {
         stages.insert(s.name.to_string(), json!({"status": s.status.as_str(), "reason": s.reason}));
     }
-    let elements: Vec<Value> = model
-        .elements
-        .iter()
+    let elements: Vec<Value> = listing(model)
+        .into_iter()
         .map(|e| {
             json!({"category": e.category, "kind": e.kind, "name": e.name, "targets": e.targets,
-                   "source": e.loc.to_string(), "status": "parsed, not simulated"})
+                   "source": e.source, "status": e.status})
         })
         .collect();
     let keyframes: Vec<Value> =
@@ -126,13 +260,14 @@ pub fn to_text(model: &Model, mode: Option<ConstraintMode>) -> String {
         "  {:<26} {:<10} {:<22} {:<22} {:>7} {:>6} {:>3} {:>3}  limits",
         "name", "type", "parent", "child", "qposadr", "dofadr", "nq", "nv"
     );
-    for j in &model.joints {
+    for (i, j) in model.joints.iter().enumerate() {
         let limits = match j.limits {
             Some([lo, hi]) => format!("[{lo:.4}, {hi:.4}]"),
             None => "-".into(),
         };
-        let mimic =
-            j.mimic.as_ref().map(|m| format!("  mimic {} (not enforced yet)", m.joint)).unwrap_or_default();
+        let mimic = mimic_of(model, i)
+            .map(|(leader, multiplier, offset, _)| format!("  mimic {leader} (× {multiplier} + {offset})"))
+            .unwrap_or_default();
         let _ = writeln!(
             s,
             "  {:<26} {:<10} {:<22} {:<22} {:>7} {:>6} {:>3} {:>3}  {limits}{mimic}",
@@ -150,18 +285,19 @@ pub fn to_text(model: &Model, mode: Option<ConstraintMode>) -> String {
         let names: Vec<&str> = model.keyframes.iter().map(|k| k.name.as_str()).collect();
         let _ = writeln!(s, "\nkeyframes (simulate --keyframe NAME): {}", names.join(", "));
     }
-    if !model.elements.is_empty() {
-        let _ = writeln!(s, "\nparsed, not simulated ({} elements):", model.elements.len());
-        let mut by_kind: Vec<(String, usize)> = Vec::new();
-        for e in &model.elements {
+    let listed = listing(model);
+    if !listed.is_empty() {
+        let _ = writeln!(s, "\nelements ({}):", listed.len());
+        let mut by_kind: Vec<(String, &str, usize)> = Vec::new();
+        for e in &listed {
             let key = format!("{} <{}>", e.category, e.kind);
-            match by_kind.iter_mut().find(|(k, _)| *k == key) {
-                Some(entry) => entry.1 += 1,
-                None => by_kind.push((key, 1)),
+            match by_kind.iter_mut().find(|(k, st, _)| *k == key && *st == e.status) {
+                Some(entry) => entry.2 += 1,
+                None => by_kind.push((key, e.status, 1)),
             }
         }
-        for (k, n) in by_kind {
-            let _ = writeln!(s, "  {n:>4} × {k}");
+        for (k, status, n) in by_kind {
+            let _ = writeln!(s, "  {n:>4} × {k:<28} {status}");
         }
     }
     let _ = writeln!(s, "\nforward plan (constraint mode: {}; {}):", plan.mode.name(), plan.mode_reason);

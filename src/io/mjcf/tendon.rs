@@ -1,0 +1,72 @@
+//! `<tendon>` → [`TendonSpec`]s in file order, MuJoCo's tendon order (MuJoCo documentation,
+//! "XML Reference → tendon"), with the defaults of `<default><tendon>`.
+//!
+//! A `<fixed>` tendon is the linear combination `L = Σ coef · q[joint]` of its `<joint joint coef>`
+//! children (`coef` is required, a joint may appear once); a `<spatial>` tendon keeps the names
+//! of its path (`site`, `geom`, `pulley`) for listing. `limited`/`range` follow `<compiler
+//! autolimits>`.
+
+use super::defaults::{Defaults, MAIN};
+use super::xml::Element;
+use crate::io::LoadError;
+use crate::model::spec::{TendonSpec, TendonSpecKind};
+
+/// Reads every `<tendon>` section.
+pub(crate) fn tendons(
+    root: &Element,
+    defaults: &Defaults,
+    autolimits: bool,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<TendonSpec>, LoadError> {
+    let mut out = Vec::new();
+    for section in root.children_named("tendon") {
+        for e in section.children.iter().filter(|e| matches!(e.tag.as_str(), "fixed" | "spatial")) {
+            let a = defaults.resolve_as(e, "tendon", MAIN)?;
+            let name = a.text("name").unwrap_or("").to_string();
+            let kind = if e.tag == "fixed" {
+                let mut joints: Vec<(String, f64, crate::model::SourceLoc)> = Vec::new();
+                for j in e.children_named("joint") {
+                    let ja = super::attrs::Attrs::plain(j);
+                    let Some(joint) = ja.text("joint") else {
+                        return Err(ja.error("joint", "is missing: name the joint of this term"));
+                    };
+                    let Some(coef) = ja.real("coef")? else {
+                        return Err(
+                            ja.error("coef", "is missing: give the joint's coefficient in the tendon length")
+                        );
+                    };
+                    if joints.iter().any(|(n, _, _)| n == joint) {
+                        return Err(ja.error(
+                            "joint",
+                            format!("'{joint}' appears twice in tendon '{name}'; add the coefficients into one term"),
+                        ));
+                    }
+                    joints.push((joint.to_string(), coef, j.loc.clone()));
+                }
+                if joints.is_empty() {
+                    return Err(LoadError::Invalid {
+                        loc: e.loc.clone(),
+                        element: e.tag.clone(),
+                        detail: format!(
+                            "tendon '{name}' has no <joint>; a fixed tendon needs at least one joint term"
+                        ),
+                    });
+                }
+                TendonSpecKind::Fixed { joints }
+            } else {
+                let path = e
+                    .children
+                    .iter()
+                    .map(|c| {
+                        let attr = if c.tag == "pulley" { "divisor" } else { c.tag.as_str() };
+                        (c.tag.clone(), c.attr(attr).unwrap_or("").to_string())
+                    })
+                    .collect();
+                TendonSpecKind::Spatial { path }
+            };
+            let range = a.limited_range("limited", "range", autolimits, warnings)?;
+            out.push(TendonSpec { name, kind, range, loc: e.loc.clone() });
+        }
+    }
+    Ok(out)
+}
