@@ -128,6 +128,11 @@ def model_set() -> list[Entry]:
 # ---------------------------------------------------------------------------------------------
 
 
+def floats(x) -> np.ndarray:
+    """A JSON list of numbers as a float array; null (lagrange's NaN) becomes NaN."""
+    return np.array([math.nan if e is None else e for e in np.ravel(np.asarray(x, dtype=object))], dtype=float)
+
+
 def rel_to_ref(a, ref) -> float:
     """max|a − ref| / max(1, max|ref|); NaN or a shape mismatch gives NaN."""
     a = np.asarray(a, dtype=float).ravel()
@@ -936,13 +941,13 @@ def _process(entry: Entry, cfg: dict, row: dict) -> None:
     for k, (r, out) in enumerate(zip(refs, results)):
         fw = out["forward"]
         nv = canon.nv
-        qacc = np.asarray(fw["qacc"], dtype=float)
+        qacc = floats(fw["qacc"])
         e_mj.append(rel_to_ref(qacc, to_canon_vec(r.qacc)))
-        M_l = np.asarray(out["M"], dtype=float).reshape(nv, nv)
-        bias_l = np.asarray(out["bias"], dtype=float)
-        pas_l = np.asarray(fw.get("qfrc_passive", [math.nan] * nv), dtype=float)
-        act_l = np.asarray(fw.get("qfrc_actuator", [0.0] * nv), dtype=float)
-        qfrc_l = np.asarray(fw.get("qfrc_constraint", [math.nan] * nv), dtype=float)
+        M_l = floats(out["M"]).reshape(nv, nv)
+        bias_l = floats(out["bias"])
+        pas_l = floats(fw.get("qfrc_passive", [math.nan] * nv))
+        act_l = floats(fw.get("qfrc_actuator", [0.0] * nv))
+        qfrc_l = floats(fw.get("qfrc_constraint", [math.nan] * nv))
         tau_c = to_canon_vec(r.tau)
         e_self.append(rel_to_ref(qfrc_l, M_l @ qacc - (tau_c + pas_l + act_l - bias_l)))
         e_ref.append(rel_to_ref(qfrc_l, to_canon_vec(r.qfrc)))
@@ -954,16 +959,20 @@ def _process(entry: Entry, cfg: dict, row: dict) -> None:
                 nrows, ", ".join("%s %s: %d" % (c.get("kind"), c.get("name") or "?", len(c.get("force", []))) for c in cons),
                 r.J.shape[0]))
         if r.manifold:
-            vals = [abs(x) for c in cons for x in c.get("violation", [])]
+            # JSON null (a NaN in lagrange) counts as NaN, i.e. a failure
+            vals = [math.nan if x is None else abs(x) for c in cons for x in c.get("violation", [])]
             if vals:
-                viol.append(max(vals))
+                viol.append(math.nan if any(math.isnan(x) for x in vals) else max(vals))
         if k in pin_qacc:
             e_pin.append(rel_to_ref(qacc, pin_qacc[k]))
     row["err_mj"] = max(e_mj)
     row["qfrc_self"] = max(e_self)
     row["qfrc_ref"] = max(e_ref)
     row["passive"] = max(e_pas)
-    row["viol_manifold"] = max(viol) if viol else math.nan
+    row["viol_manifold"] = (math.nan if any(math.isnan(x) for x in viol) else max(viol)) if viol else math.nan
+    if viol and math.isnan(row["viol_manifold"]):
+        row["fails"].append("|violation| on the manifold: NaN (null in the JSON) at %d of %d manifold states"
+                            % (sum(math.isnan(x) for x in viol), len(viol)))
     if e_pin:
         row["err_pin"] = max(e_pin)
     checks = [("qacc vs MuJoCo-KKT", row["err_mj"], QACC_TOL), ("qacc vs Pinocchio", row["err_pin"], QACC_TOL),
@@ -974,8 +983,8 @@ def _process(entry: Entry, cfg: dict, row: dict) -> None:
     for what, e, tol in checks:
         if what == "qacc vs Pinocchio" and not e_pin:
             continue
-        if what == "|violation| on the manifold" and not viol:
-            continue
+        if what == "|violation| on the manifold" and (not viol or math.isnan(e)):
+            continue  # (NaN reported above)
         if not (e <= tol):
             row["fails"].append("%s: %.2e > %.0e" % (what, e, tol))
     for b in sorted(rows_bad):
