@@ -19,7 +19,6 @@ use crate::kinematics::{
 };
 use crate::model::{Data, EqualityKind, Model, TendonKind};
 use crate::spatial::{Mat3, Transform, Vec3};
-use nalgebra::Rotation3;
 
 /// A scalar coordinate of a joint or tendon coupling: a hinge/slide joint, or a fixed tendon's
 /// length Σ coef · q.
@@ -108,9 +107,19 @@ fn poly(c: &[f64; 5], x: f64) -> (f64, f64, f64) {
     (p, dp, ddp)
 }
 
-/// log(R): the rotation vector of a rotation matrix.
+/// log(R): the rotation vector of a rotation matrix, through its quaternion (closed form) as
+/// θ n = 2 atan2(|v|, w) v/|v| — finite at and near the identity, where `acos` of the trace is
+/// not (a trace rounded above 3 gives NaN).
 fn rotation_vector(r: &Mat3) -> Vec3 {
-    Rotation3::from_matrix_unchecked(*r).scaled_axis()
+    let [w, x, y, z] = Transform::new(*r, Vec3::zeros()).quat_wxyz();
+    let v = Vec3::new(x, y, z);
+    let s = v.norm();
+    if s < 1e-8 {
+        // 2 atan2(s, w)/s = 2/w (1 − s²/(3w²) + …): the series to round-off.
+        v * (2.0 / w) * (1.0 - s * s / (3.0 * w * w))
+    } else {
+        v * (2.0 * s.atan2(w) / s)
+    }
 }
 
 impl ConstraintModel {
