@@ -6,7 +6,7 @@ mod common;
 use common::ALGO_REL;
 use lagrange::io::{load, load_spec, load_urdf_str, LoadOptions};
 use lagrange::model::spec::{JointType, Shape};
-use lagrange::model::{JointKind, Mimic};
+use lagrange::model::{EqualityKind, JointKind};
 use lagrange::spatial::{Mat3, Transform, Vec3};
 use lagrange::Model;
 use std::f64::consts::FRAC_PI_2;
@@ -180,8 +180,14 @@ fn limits_dynamics_and_mimic_are_stored() {
     assert_eq!((j("b_arm").damping, j("b_arm").friction), (0.5, 0.2));
     assert_eq!((j("c_wrist").damping, j("c_wrist").friction), (0.05, 0.0));
     assert_eq!((j("z_slide").damping, j("z_slide").friction), (0.0, 0.0));
-    assert_eq!(j("d_finger").mimic, Some(Mimic { joint: "b_arm".into(), multiplier: 2.0, offset: 0.1 }));
-    assert_eq!(j("b_arm").mimic, None);
+    // The mimic is an equality constraint (d_finger = 2 · b_arm + 0.1), the only one.
+    let (b_arm, d_finger) = (m.joint_id("b_arm").unwrap(), m.joint_id("d_finger").unwrap());
+    assert_eq!(m.equalities.len(), 1);
+    assert_eq!(m.equalities[0].name, "mimic:d_finger");
+    assert_eq!(
+        m.equalities[0].kind,
+        EqualityKind::Mimic { joint: d_finger, leader: b_arm, multiplier: 2.0, offset: 0.1 }
+    );
     assert_eq!(m.dof_damping[j("b_arm").dof_adr], 0.5);
     assert!(m.joints.iter().all(|j| j.armature == 0.0));
 
@@ -191,7 +197,10 @@ fn limits_dynamics_and_mimic_are_stored() {
         <joint name="j2" type="continuous"><parent link="a"/><child link="c"/><mimic joint="j1"/></joint>
         </robot>"#;
     let m = load_urdf_str(text, Path::new("inline.urdf"), &LoadOptions::default()).unwrap();
-    assert_eq!(m.joints[1].mimic, Some(Mimic { joint: "j1".into(), multiplier: 1.0, offset: 0.0 }));
+    assert_eq!(
+        m.equalities[0].kind,
+        EqualityKind::Mimic { joint: 1, leader: 0, multiplier: 1.0, offset: 0.0 }
+    );
 }
 
 #[test]

@@ -87,11 +87,6 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                     armature: j.armature,
                     stiffness: j.stiffness,
                     spring_ref: j.spring_ref,
-                    mimic: j.mimic.as_ref().map(|m| crate::model::Mimic {
-                        joint: m.leader.clone(),
-                        multiplier: m.multiplier,
-                        offset: m.offset,
-                    }),
                 });
                 nq += jnq;
                 nv += jnv;

@@ -68,18 +68,6 @@ pub struct Joint {
     /// `simulate` as `−stiffness·(q − spring_ref)` for hinge and slide joints.
     pub stiffness: f64,
     pub spring_ref: f64,
-    /// URDF `<mimic>`, as written. The constraint is the [`EqualityKind::Mimic`] in
-    /// [`Model::equalities`]; this copy remains only for the simulation plan (`sim::plan`) until
-    /// the plan reads the equalities.
-    pub mimic: Option<Mimic>,
-}
-
-/// URDF `<mimic joint multiplier offset>`: q = multiplier · q_joint + offset.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Mimic {
-    pub joint: String,
-    pub multiplier: f64,
-    pub offset: f64,
 }
 
 /// A rigid body of the compiled tree (the fused links included).
