@@ -307,6 +307,12 @@ def _process(entry: Entry, cfg: dict) -> dict:
     # rejects the file (ur3.urdf has no links, which MuJoCo's URDF import turns into an empty
     # world), lagrange rejecting it too is reported, not failed
     primary_loads = runs[primary].status not in ("load-error", "crash")
+    # A URDF whose mimics Pinocchio's mimic support refuses: lagrange enforces mimics, so it is
+    # measured against that refusal.
+    mimic_refusal = runs.get("pinocchio").mimic_refusal if runs.get("pinocchio") else ""
+    if mimic_refusal and lag.status != "ok":
+        primary_loads = False
+        row["notes"].append("Pinocchio with its mimic support on (mimic=True) refuses the file: " + mimic_refusal)
     rejected = valid and lag.status != "ok" and row["load"]["lagrange"] == "no" and not primary_loads
     if valid and lag.status != "ok" and not rejected:
         fails.append("lagrange loads it but `eval` fails" if row["load"]["lagrange"] == "eval error"

@@ -217,3 +217,6 @@ class EngineRun:
     seconds: float = 0.0
     cond_M: float = math.nan  # max over states of cond(M) (reported with loosened tolerances)
     note: str = ""  # how the engine was run, when it differs from the default (shown in the report)
+    # Pinocchio on a URDF with <mimic>: why its mimic support (mimic=True) refuses the file, if it
+    # does. lagrange enforces mimics, so its refusal of such a file matches the reference's.
+    mimic_refusal: str = ""
