@@ -26,14 +26,6 @@ impl Stepper for SemiImplicitEuler {
         state.v.axpy(h, &data.qacc, 1.0);
         integrate_configuration(model, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
-        let (iterations, violation) = correct_drift(model, plan, data, state);
-        StepReport {
-            accepted: true,
-            h_used: h,
-            h_next: h,
-            error_estimate: None,
-            solver_iterations: iterations,
-            constraint_violation: violation,
-        }
+        StepReport::fixed_step(h, correct_drift(model, plan, data, state))
     }
 }

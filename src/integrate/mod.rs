@@ -51,6 +51,21 @@ pub struct StepReport {
     pub constraint_violation: [f64; 2],
 }
 
+impl StepReport {
+    /// The report of an accepted fixed step `h`, with the (iterations, violation) of
+    /// [`correct_drift`].
+    pub fn fixed_step(h: f64, (iterations, violation): (u32, [f64; 2])) -> Self {
+        Self {
+            accepted: true,
+            h_used: h,
+            h_next: h,
+            error_estimate: None,
+            solver_iterations: iterations,
+            constraint_violation: violation,
+        }
+    }
+}
+
 /// A time stepper over [`forward`](crate::forward::forward).
 pub trait Stepper: Send {
     /// Short name (`euler`, `rk4`, …).

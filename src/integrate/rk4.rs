@@ -63,14 +63,6 @@ impl Stepper for RungeKutta4 {
         }
         integrate_configuration(model, state.q.as_mut_slice(), self.v_mean.as_slice(), h);
         state.time += h;
-        let (iterations, violation) = correct_drift(model, plan, data, state);
-        StepReport {
-            accepted: true,
-            h_used: h,
-            h_next: h,
-            error_estimate: None,
-            solver_iterations: iterations,
-            constraint_violation: violation,
-        }
+        StepReport::fixed_step(h, correct_drift(model, plan, data, state))
     }
 }
