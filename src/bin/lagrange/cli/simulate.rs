@@ -270,8 +270,8 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
     let mut out = String::new();
     let simulated = s.steps as f64 * s.dt;
     let wall = s.wall.as_secs_f64();
-    let from = if request.integrator.is_some() { "--integrator" } else { "the model's <option>" };
-    let dt_from = if request.dt.is_some() { "--dt" } else { "the model's <option>" };
+    let from = if request.integrator.is_some() { "requested" } else { "the model's <option>" };
+    let dt_from = if request.dt.is_some() { "requested" } else { "the model's <option>" };
     let _ = writeln!(
         out,
         "simulated {simulated:.6} s in {} steps of {} s (from {dt_from}) with {} (from {from})",
