@@ -179,8 +179,7 @@ impl Simulation {
         }
         let (q, v) = (self.state.q.as_slice(), self.state.v.as_slice());
         self.plan.constraints.evaluate(&self.model, &mut self.data, q, v);
-        let n = self.data.nefc;
-        [self.data.efc_pos.rows(0, n).amax(), self.data.efc_vel.rows(0, n).amax()]
+        crate::constraint::row_violation(&self.data)
     }
 
     /// The stepper's name.

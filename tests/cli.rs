@@ -64,7 +64,7 @@ fn info_json_has_exactly_the_documented_keys() {
     assert_eq!(v["joints"][0]["type"], "free");
     // The shipped solo12 has its meshes stripped: no collision geometry, no collision stage.
     assert_eq!(v["stages"]["collision"]["status"], "skipped");
-    assert_eq!(v["stages"]["joint limits"]["status"], "parsed, not simulated");
+    assert_eq!(v["stages"]["joint limits"]["status"], "runs");
     let total: f64 = v["total_mass"].as_f64().unwrap();
     assert!((total - 2.50000279).abs() < 1e-6, "{total}");
 }
@@ -275,4 +275,16 @@ fn info_json_shows_urdf_mimic_on_the_joint() {
     );
     let e = v["elements"].as_array().unwrap().iter().find(|e| e["kind"] == "mimic").unwrap();
     assert_eq!(e["targets"], serde_json::json!(["panda_finger_joint2", "panda_finger_joint1"]));
+}
+
+#[test]
+fn disable_switches_off_option_flags_for_both_formats() {
+    let (ok, out, err) = lagrange(&["info", "models/ur5/ur5.urdf", "--json", "--disable", "limit"]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["stages"]["joint limits"]["status"], "skipped");
+    assert!(v["stages"]["joint limits"]["reason"].as_str().unwrap().contains("flag limit"));
+    let (ok, _, err) = lagrange(&["info", "models/ur5/ur5.urdf", "--disable", "limits"]);
+    assert!(!ok);
+    assert!(err.contains("--disable limits: not a MuJoCo <flag>; use one of"), "{err}");
 }

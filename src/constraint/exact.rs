@@ -42,6 +42,92 @@ fn solve_delassus(data: &mut Data) -> usize {
     solve_psd(efc_delassus, &mut efc_rhs.as_mut_slice()[..n], efc_factor, efc_eig)
 }
 
+/// The mixed complementarity problem of bilateral and unilateral rows on A = J M⁻¹ Jᵀ (in
+/// `efc_delassus`) with b in `efc_rhs`: find μ with w = A μ − b and, per row, w = 0 (bilateral),
+/// or μ ≥ 0, w ≥ 0, μ w = 0 (unilateral: joint limits) — the KKT conditions of Signorini's law
+/// (notes §1.6 with inequality constraints; Cottle, Pang & Stone, *The Linear Complementarity
+/// Problem*, §4.1, the principal pivoting / active-set method). Unilateral rows whose `skip` is
+/// true (separating at the acceleration level) carry no force. Solves each active set exactly
+/// (minimum-norm for redundant rows), dropping the most negative force or adding the most violated
+/// row until both sign conditions hold; returns the number of active-set changes. μ is left in
+/// `efc_rhs`; without unilateral rows this is the plain solve.
+fn solve_mixed(data: &mut Data, skip: impl Fn(&Data, usize) -> bool) -> u32 {
+    let n = data.nefc;
+    if !(0..n).any(|i| data.efc_type[i].is_unilateral()) {
+        data.efc_active.clear();
+        data.efc_active.extend(0..n);
+        data.efc_rank = solve_delassus(data);
+        return 0;
+    }
+    let scale = 1.0 + (0..n).map(|i| data.efc_rhs[i].abs()).fold(0.0, f64::max);
+    let tol = 1e-11 * scale;
+    // b stays in efc_force during the iterations; μ is built in efc_rhs.
+    for i in 0..n {
+        data.efc_force[i] = data.efc_rhs[i];
+    }
+    data.efc_active.clear();
+    for i in 0..n {
+        if !(data.efc_type[i].is_unilateral() && skip(data, i)) {
+            data.efc_active.push(i);
+        }
+    }
+    let mut changes = 0;
+    for _ in 0..(4 * n + 10) {
+        // Solve the active block exactly.
+        let k = data.efc_active.len();
+        {
+            let Data {
+                efc_delassus, efc_sub, efc_sub_rhs, efc_active, efc_force, efc_factor, efc_eig, ..
+            } = data;
+            for (a, &i) in efc_active.iter().enumerate() {
+                efc_sub_rhs[a] = efc_force[i];
+                for (c, &j) in efc_active.iter().enumerate() {
+                    efc_sub[(a, c)] = efc_delassus[(i, j)];
+                }
+            }
+            data.efc_rank = solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..k], efc_factor, efc_eig);
+        }
+        data.efc_rhs.rows_mut(0, n).fill(0.0);
+        for (a, &i) in data.efc_active.iter().enumerate() {
+            data.efc_rhs[i] = data.efc_sub_rhs[a];
+        }
+        // The most negative force of an active unilateral row leaves the set.
+        let drop = data
+            .efc_active
+            .iter()
+            .enumerate()
+            .filter(|(_, &i)| data.efc_type[i].is_unilateral() && data.efc_rhs[i] < -tol)
+            .min_by(|a, b| data.efc_rhs[*a.1].total_cmp(&data.efc_rhs[*b.1]))
+            .map(|(a, _)| a);
+        if let Some(a) = drop {
+            data.efc_active.remove(a);
+            changes += 1;
+            continue;
+        }
+        // The most violated inactive unilateral row (w < 0) joins it.
+        let mut worst: Option<(usize, f64)> = None;
+        for i in 0..n {
+            if !data.efc_type[i].is_unilateral() || data.efc_active.contains(&i) || skip(data, i) {
+                continue;
+            }
+            let w: f64 =
+                (0..n).map(|j| data.efc_delassus[(i, j)] * data.efc_rhs[j]).sum::<f64>() - data.efc_force[i];
+            if w < -tol && worst.is_none_or(|(_, ww)| w < ww) {
+                worst = Some((i, w));
+            }
+        }
+        match worst {
+            Some((i, _)) => {
+                let at = data.efc_active.partition_point(|&j| j < i);
+                data.efc_active.insert(at, i);
+                changes += 1;
+            }
+            None => break,
+        }
+    }
+    changes
+}
+
 /// The constraint stage of the exact mode. Needs, at the same state: the factor of M
 /// (`mass_factor`), the rows with `efc_pos`, `efc_vel`, `efc_jdotv`, and `qacc_smooth`. Writes
 /// `efc_force` (λ), `qfrc_constraint` (Jᵀλ), `qacc` and `efc_rank`. `baumgarte = [α, β]` adds the
@@ -55,7 +141,8 @@ pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>) 
         let j_qacc: f64 = (0..nv).map(|k| data.efc_j[(i, k)] * data.qacc_smooth[k]).sum();
         data.efc_rhs[i] = -(j_qacc + data.efc_jdotv[i]) - alpha * data.efc_vel[i] - beta * data.efc_pos[i];
     }
-    data.efc_rank = solve_delassus(data);
+    // A limit row moving away from its bound (J v > 0) is separating: no force.
+    data.efc_iterations = solve_mixed(data, |d, i| d.efc_vel[i] > 0.0);
     data.qacc.copy_from(&data.qacc_smooth);
     data.qfrc_constraint.fill(0.0);
     for i in 0..n {
@@ -66,6 +153,22 @@ pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>) 
             data.qfrc_constraint[k] += data.efc_j[(i, k)] * lambda;
         }
     }
+}
+
+/// The violation of the current rows: [max |φ| (for a limit row, the penetration), max of |J v|
+/// over bilateral rows and max(0, −J v) over unilateral rows (approach speed)].
+pub fn row_violation(data: &Data) -> [f64; 2] {
+    let n = data.nefc;
+    let velocity = (0..n)
+        .map(|i| {
+            if data.efc_type[i].is_unilateral() {
+                (-data.efc_vel[i]).max(0.0)
+            } else {
+                data.efc_vel[i].abs()
+            }
+        })
+        .fold(0.0, f64::max);
+    [data.efc_pos.rows(0, n).amax(), velocity]
 }
 
 /// Moves `q` onto the constraint manifold φ(q) = 0 by Gauss–Newton steps Δ = −M⁻¹Jᵀ A⁺ φ applied
@@ -110,22 +213,33 @@ pub fn project_positions(
     }
 }
 
-/// Replaces `v` by its M-orthogonal projection onto J v = 0 at configuration `q`:
-/// v ← v − M⁻¹Jᵀ A⁺ J v. Needs the factor of M (e.g. from [`project_positions`]) and the rows at q
-/// (`positions`); returns max |J v| after the projection.
+/// Replaces `v` by its M-orthogonal projection onto {J v = 0 on bilateral rows, J v ≥ 0 on
+/// unilateral rows} at configuration `q`: v ← v + M⁻¹Jᵀ μ with the impulses μ of the mixed
+/// complementarity problem (an inelastic impact on a joint limit: restitution 0). Needs the factor
+/// of M (e.g. from [`project_positions`]) and the rows at q (`positions`); returns the largest
+/// remaining violation (|J v| bilateral, max(0, −J v) unilateral).
 pub fn project_velocities(model: &Model, data: &mut Data, v: &mut [f64]) -> f64 {
     let n = data.nefc;
     let nv = model.nv;
     delassus(model, data);
     for i in 0..n {
-        data.efc_rhs[i] = (0..nv).map(|k| data.efc_j[(i, k)] * v[k]).sum();
+        data.efc_rhs[i] = -(0..nv).map(|k| data.efc_j[(i, k)] * v[k]).sum::<f64>();
     }
-    solve_delassus(data);
+    solve_mixed(data, |_, _| false);
     for i in 0..n {
         let mu = data.efc_rhs[i];
         for k in 0..nv {
-            v[k] -= data.efc_minv_jt[(k, i)] * mu;
+            v[k] += data.efc_minv_jt[(k, i)] * mu;
         }
     }
-    (0..n).map(|i| (0..nv).map(|k| data.efc_j[(i, k)] * v[k]).sum::<f64>().abs()).fold(0.0, f64::max)
+    (0..n)
+        .map(|i| {
+            let jv: f64 = (0..nv).map(|k| data.efc_j[(i, k)] * v[k]).sum();
+            if data.efc_type[i].is_unilateral() {
+                (-jv).max(0.0)
+            } else {
+                jv.abs()
+            }
+        })
+        .fold(0.0, f64::max)
 }

@@ -4,17 +4,19 @@
 //! eq. 19–22: λ are Lagrange multipliers, `Jᵀλ` the generalized forces of constraint), plus the
 //! drift correction of the steppers (projection onto φ = 0 and J v = 0).
 //!
-//! Row kinds so far: equality constraints (connect, weld, joint coupling, fixed-tendon coupling)
-//! and URDF mimic couplings. The soft (MuJoCo-compatible) mode, limits, friction loss and
-//! contacts arrive with later issues behind the same buffers.
+//! Row kinds so far: equality constraints (connect, weld, joint coupling, fixed-tendon coupling),
+//! URDF mimic couplings, and the limits of hinge and slide joints (unilateral: Signorini's
+//! complementarity at the acceleration level, inelastic impacts at the velocity level). The soft
+//! (MuJoCo-compatible) mode, ball-joint limits, friction loss and contacts arrive with later
+//! issues behind the same buffers.
 
 mod dense;
 mod exact;
 mod rows;
 
 pub use dense::solve_psd;
-pub use exact::{project_positions, project_velocities, solve_exact};
-pub use rows::{ConstraintModel, RowGeometry, ScalarCoord};
+pub use exact::{project_positions, project_velocities, row_violation, solve_exact};
+pub use rows::{ConstraintModel, LimitRow, RowGeometry, ScalarCoord};
 
 /// Which constraint model `forward` solves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

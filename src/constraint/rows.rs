@@ -17,7 +17,7 @@ use crate::kinematics::{
     bias_accelerations, for_each_ancestor_dof, forward_kinematics, forward_velocities,
     point_bias_acceleration,
 };
-use crate::model::{Data, EqualityKind, Model, TendonKind};
+use crate::model::{Data, EfcType, EqualityKind, Model, TendonKind};
 use crate::spatial::{Mat3, Transform, Vec3};
 
 /// A scalar coordinate of a joint or tendon coupling: a hinge/slide joint, or a fixed tendon's
@@ -93,10 +93,23 @@ pub struct EqualityRows {
     pub geometry: RowGeometry,
 }
 
+/// A limited hinge or slide joint: a unilateral row when q reaches a bound (MuJoCo's
+/// `mj_instantiateLimit`: distance `q − lower` with J = +1, or `upper − q` with J = −1; negative
+/// distance is penetration).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LimitRow {
+    /// Index in `Model::joints`.
+    pub joint: usize,
+    pub qpos_adr: usize,
+    pub dof_adr: usize,
+    pub range: [f64; 2],
+}
+
 /// Which constraint rows a model has and their fixed geometry (built once per model).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ConstraintModel {
     pub equalities: Vec<EqualityRows>,
+    pub limits: Vec<LimitRow>,
 }
 
 /// P(x) and P′(x), P″(x) of MuJoCo's quartic `polycoef`.
@@ -128,8 +141,29 @@ impl ConstraintModel {
     /// the file leaves to `qpos0` are taken there (forward kinematics on a scratch `Data`).
     pub fn new(model: &Model) -> Self {
         let flags = &model.options.flags;
-        if model.equalities.is_empty() || !flags.equality || !flags.constraint {
+        if !flags.constraint {
             return Self::default();
+        }
+        let limits = if flags.limit {
+            model
+                .joints
+                .iter()
+                .enumerate()
+                .filter(|(_, j)| j.kind.nv() == 1)
+                .filter_map(|(i, j)| {
+                    j.limits.map(|range| LimitRow {
+                        joint: i,
+                        qpos_adr: j.qpos_adr,
+                        dof_adr: j.dof_adr,
+                        range,
+                    })
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        if model.equalities.is_empty() || !flags.equality {
+            return Self { equalities: Vec::new(), limits };
         }
         let mut data = Data::new(model);
         forward_kinematics(model, &mut data, &model.qpos0);
@@ -211,12 +245,19 @@ impl ConstraintModel {
             };
             equalities.push(EqualityRows { id, geometry });
         }
-        Self { equalities }
+        Self { equalities, limits }
     }
 
     /// Whether the model has any constraint rows at all.
     pub fn is_empty(&self) -> bool {
-        self.equalities.is_empty()
+        self.equalities.is_empty() && self.limits.is_empty()
+    }
+
+    /// Whether any row is active at configuration `q`: an active equality, or a joint at or
+    /// beyond a limit. Cheap (no kinematics): `forward` takes the ABA path when none is.
+    pub fn any_active(&self, data: &Data, q: &[f64]) -> bool {
+        self.equalities.iter().any(|e| data.eq_active[e.id])
+            || self.limits.iter().any(|l| limit_side(l, q[l.qpos_adr]).is_some())
     }
 
     /// Rows of the active constraints at configuration `q`: `nefc`, `efc_id`, `efc_j`, `efc_pos`.
@@ -230,6 +271,7 @@ impl ConstraintModel {
             let n = e.geometry.nrow();
             for i in r..r + n {
                 data.efc_id[i] = e.id;
+                data.efc_type[i] = EfcType::Equality;
                 data.efc_j.row_mut(i).fill(0.0);
             }
             match &e.geometry {
@@ -278,6 +320,16 @@ impl ConstraintModel {
                 }
             }
             r += n;
+        }
+        for l in &self.limits {
+            if let Some((sign, dist)) = limit_side(l, q[l.qpos_adr]) {
+                data.efc_id[r] = l.joint;
+                data.efc_type[r] = EfcType::LimitJoint;
+                data.efc_j.row_mut(r).fill(0.0);
+                data.efc_j[(r, l.dof_adr)] = sign;
+                data.efc_pos[r] = dist;
+                r += 1;
+            }
         }
         data.nefc = r;
     }
@@ -330,6 +382,13 @@ impl ConstraintModel {
             }
             r += n;
         }
+        for l in &self.limits {
+            if let Some((sign, _)) = limit_side(l, q[l.qpos_adr]) {
+                data.efc_vel[r] = sign * v[l.dof_adr];
+                data.efc_jdotv[r] = 0.0;
+                r += 1;
+            }
+        }
     }
 
     /// Rows, `J v` and `J̇ v` at (q, v) from scratch: forward kinematics, body velocities, then
@@ -339,6 +398,24 @@ impl ConstraintModel {
         forward_velocities(model, data, v);
         self.positions(model, data, q);
         self.velocities(model, data, q, v);
+    }
+}
+
+/// Distance (rad or m) within which a limit row is active: the position projection leaves q on
+/// the bound only up to round-off, and the velocity projection that follows must still see it.
+pub const LIMIT_ACTIVE_DISTANCE: f64 = 1e-10;
+
+/// The active side of a joint limit at value `q`: (J sign, distance) with distance ≤
+/// [`LIMIT_ACTIVE_DISTANCE`] at or beyond the bound (lower: +1, q − lower; upper: −1, upper − q),
+/// or None inside the range.
+fn limit_side(l: &LimitRow, q: f64) -> Option<(f64, f64)> {
+    let (lower, upper) = (q - l.range[0], l.range[1] - q);
+    if lower <= LIMIT_ACTIVE_DISTANCE {
+        Some((1.0, lower))
+    } else if upper <= LIMIT_ACTIVE_DISTANCE {
+        Some((-1.0, upper))
+    } else {
+        None
     }
 }
 

@@ -13,7 +13,8 @@
 //!
 //! Which stages run is decided once by the [`Plan`]; [`forward`] walks it. Without constraint rows
 //! the position and velocity stages are skipped and ABA gives `qacc_smooth` directly (M is never
-//! built); `qacc` = `qacc_smooth` then. `qfrc_applied` and `ctrl` are inputs set by the caller.
+//! built); `qacc` = `qacc_smooth` then. A model whose only rows are joint limits takes the same
+//! ABA path at every state where no joint is at a limit. `qfrc_applied` and `ctrl` are inputs set by the caller.
 
 mod plan;
 
@@ -26,18 +27,20 @@ use crate::model::{Data, Model};
 /// Forward dynamics at (q, v) with the model's passive forces, `data.qfrc_applied` and
 /// `data.ctrl`: every stage of `plan` that runs, in order. The result is `data.qacc`.
 pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]) {
-    let m_path = plan.has_constraints();
+    // The M path only while a constraint row is active (an equality, or a joint at a limit):
+    // otherwise ABA, as for a model without constraints.
+    let m_path = plan.has_constraints() && plan.constraints.any_active(data, q);
     for stage in &plan.stages {
         if stage.status != Status::Runs {
             continue;
         }
         match stage.kind {
-            StageKind::Position => {
+            StageKind::Position if m_path => {
                 crba(model, data, q);
                 factorize_mass_matrix(model, data);
                 plan.constraints.positions(model, data, q);
             }
-            StageKind::Velocity => {
+            StageKind::Velocity if m_path => {
                 bias_forces(model, data, q, v);
                 data.qfrc_bias.copy_from(&data.tau);
                 // RNEA left the body velocities at v in `v_body`.
@@ -45,13 +48,14 @@ pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]
             }
             StageKind::Passive => passive(model, data, q, v),
             StageKind::Acceleration => acceleration(model, data, q, v, m_path),
-            StageKind::Constraint => solve_exact(model, data, plan.drift.baumgarte),
+            StageKind::Constraint if m_path => solve_exact(model, data, plan.drift.baumgarte),
             // Row sources are built by the position stage; the rest are listings.
             _ => {}
         }
     }
-    if !plan.runs(StageKind::Constraint) {
+    if !m_path {
         data.qacc.copy_from(&data.qacc_smooth);
+        data.qfrc_constraint.fill(0.0);
         data.nefc = 0;
     }
 }

@@ -134,6 +134,14 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
     use StageKind::*;
     use Status::*;
     let nrow: usize = constraints.equalities.iter().map(|e| model.equalities[e.id].kind.nrow()).sum();
+    let nlimit = constraints.limits.len();
+    let rows = match (nrow, nlimit) {
+        (_, 0) => format!("{nrow} constraint rows"),
+        (0, _) => {
+            format!("up to {nlimit} joint-limit rows, only while a joint is at a limit (ABA otherwise)")
+        }
+        _ => format!("{nrow} equality rows and up to {nlimit} joint-limit rows"),
+    };
     let constrained = !constraints.is_empty();
     let mut out = Vec::with_capacity(13);
     out.push(if constrained {
@@ -141,10 +149,7 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
             Position,
             "position",
             Runs,
-            format!(
-                "body poses, CRBA and the tree-sparse LᵀDL factor of M (nv = {}), {nrow} constraint rows",
-                model.nv
-            ),
+            format!("body poses, CRBA and the tree-sparse LᵀDL factor of M (nv = {}), {rows}", model.nv),
         )
     } else {
         stage(
@@ -155,7 +160,7 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
         )
     });
     out.push(if constrained {
-        stage(Velocity, "velocity", Runs, format!("bias forces qfrc_bias (RNEA), J v and J̇ v of {nrow} rows"))
+        stage(Velocity, "velocity", Runs, "bias forces qfrc_bias (RNEA), J v and J̇ v of the active rows")
     } else {
         stage(
             Velocity,
@@ -204,7 +209,11 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
             Constraint,
             "constraint",
             Runs,
-            format!("{} mode: KKT system with {nrow} rows, λ by the Delassus matrix J M⁻¹ Jᵀ", mode.name()),
+            format!(
+                "{} mode: KKT system on the active rows, λ by the Delassus matrix J M⁻¹ Jᵀ{}",
+                mode.name(),
+                if nlimit > 0 { " (limits: complementarity, λ ≥ 0, by an active-set method)" } else { "" }
+            ),
         )
     } else {
         stage(Constraint, "constraint", Skipped, "no constraint rows: qacc = qacc_smooth")
@@ -228,14 +237,30 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
         let inactive = if inactive > 0 { format!(", {inactive} inactive at start") } else { String::new() };
         stage(Equality, "equality", Runs, format!("{} ({nrow} rows{inactive})", list.join(", ")))
     });
-    let limited = model.joints.iter().filter(|j| j.limits.is_some()).count();
-    out.push(kept(
-        JointLimits,
-        "joint limits",
-        limited,
-        "limited joints",
-        "stored; enforced by the limits and contact work",
-    ));
+    let other_limited = model.joints.iter().filter(|j| j.limits.is_some() && j.kind.nv() != 1).count();
+    out.push(if nlimit > 0 {
+        let ball = if other_limited > 0 {
+            format!("; {other_limited} ball-joint cone limits not simulated yet")
+        } else {
+            String::new()
+        };
+        stage(
+            JointLimits,
+            "joint limits",
+            Runs,
+            format!("{nlimit} limited hinge/slide joints: a unilateral row at a bound (exact mode){ball}"),
+        )
+    } else if !flags.limit && model.joints.iter().any(|j| j.limits.is_some()) {
+        stage(JointLimits, "joint limits", Skipped, "switched off by <option><flag limit=\"disable\">")
+    } else {
+        kept(
+            JointLimits,
+            "joint limits",
+            other_limited,
+            "limited ball joints",
+            "cone limits are not simulated yet",
+        )
+    });
     let friction = model.joints.iter().filter(|j| j.friction != 0.0).count();
     out.push(kept(
         FrictionLoss,

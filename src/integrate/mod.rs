@@ -13,7 +13,7 @@ mod rk4;
 pub use euler::SemiImplicitEuler;
 pub use rk4::RungeKutta4;
 
-use crate::constraint::{project_positions, project_velocities};
+use crate::constraint::{project_positions, project_velocities, row_violation};
 use crate::forward::{DriftCorrection, Plan};
 use crate::model::{options, Data, Model};
 use nalgebra::DVector;
@@ -86,8 +86,7 @@ pub fn correct_drift(model: &Model, plan: &Plan, data: &mut Data, state: &mut St
     let DriftCorrection { projection, tolerance, .. } = plan.drift;
     if !projection {
         plan.constraints.evaluate(model, data, state.q.as_slice(), state.v.as_slice());
-        let n = data.nefc;
-        return (0, [data.efc_pos.rows(0, n).amax(), data.efc_vel.rows(0, n).amax()]);
+        return (0, row_violation(data));
     }
     let (iterations, phi) =
         project_positions(model, &plan.constraints, data, state.q.as_mut_slice(), tolerance, 50);

@@ -29,11 +29,42 @@ pub struct LoadOptions {
     /// principal moments as written (as Pinocchio does), with a warning each, instead of
     /// rejecting the model (CLI `--accept-nonphysical-inertia`).
     pub accept_nonphysical_inertia: bool,
+    /// `<option><flag>` switches to turn off, by MJCF name (`limit`, `equality`, `constraint`,
+    /// `spring`, `damper`, `gravity`, …), for both formats (CLI `--disable FLAG`).
+    pub disabled_flags: Vec<String>,
 }
 
 /// Loads a model file, choosing the loader by extension (`.urdf`, or `.xml` for MJCF).
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Model, LoadError> {
-    compile(&load_spec(path, options)?)
+    let mut spec = load_spec(path, options)?;
+    disable_flags(&mut spec, &options.disabled_flags)?;
+    compile(&spec)
+}
+
+/// Turns off the named `<option><flag>` switches in a parsed spec (before compile, which reads
+/// `spring` and `damper`; `gravity` zeroes the gravity vector, as the MJCF loader does).
+fn disable_flags(spec: &mut ModelSpec, names: &[String]) -> Result<(), LoadError> {
+    for name in names {
+        match spec.options.flags.get_mut(name) {
+            Some(flag) => *flag = false,
+            None => {
+                return Err(LoadError::Invalid {
+                    loc: crate::model::SourceLoc {
+                        file: spec.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default(),
+                        line: 0,
+                    },
+                    element: "option".into(),
+                    detail: format!(
+                        "--disable {name}: not a MuJoCo <flag>; use one of constraint, equality, limit, frictionloss, contact, spring, damper, gravity, actuation, …"
+                    ),
+                });
+            }
+        }
+    }
+    if !spec.options.flags.gravity {
+        spec.gravity = crate::spatial::Vec3::zeros();
+    }
+    Ok(())
 }
 
 /// Parses a model file into a spec without compiling it.

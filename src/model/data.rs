@@ -11,6 +11,22 @@ use super::Model;
 use crate::spatial::{ArticulatedInertia, Force, Motion, RigidInertia, Transform};
 use nalgebra::{DMatrix, DVector, Matrix6};
 
+/// The kind of a constraint row (MuJoCo's `mjtConstraint`, for the kinds simulated so far).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EfcType {
+    /// A bilateral row of an equality constraint or mimic coupling: J q̈ + J̇v = 0, λ free.
+    Equality,
+    /// A joint limit (unilateral): the row's acceleration w ≥ 0, λ ≥ 0, w λ = 0.
+    LimitJoint,
+}
+
+impl EfcType {
+    /// Whether the row's force has a sign (λ ≥ 0).
+    pub fn is_unilateral(self) -> bool {
+        self == EfcType::LimitJoint
+    }
+}
+
 /// Buffers every algorithm writes into. `Data::new(&model)` allocates them all; afterwards the
 /// algorithms allocate nothing. Per-body arrays are indexed by body (0 = world), per-dof arrays by
 /// degree of freedom.
@@ -94,7 +110,10 @@ pub struct Data {
     pub efc_jdotv: DVector<f64>,
     /// Multiplier λ per row (MuJoCo's `efc_force`): the generalized constraint force is Jᵀλ.
     pub efc_force: DVector<f64>,
-    /// For each row, the index of its equality constraint in `Model::equalities`.
+    /// For each row, what kind of row it is (MuJoCo's `efc_type`).
+    pub efc_type: Vec<EfcType>,
+    /// For each row, the element it comes from: the equality (index in `Model::equalities`) or
+    /// the limited joint (index in `Model::joints`) (MuJoCo's `efc_id`).
     pub efc_id: Vec<usize>,
     /// M⁻¹Jᵀ, nv × nefc (columns 0..nefc used).
     pub efc_minv_jt: DMatrix<f64>,
@@ -104,6 +123,12 @@ pub struct Data {
     /// Right-hand side and eigenvalue scratch of the dense solve, length nefc.
     pub efc_rhs: DVector<f64>,
     pub efc_eig: DVector<f64>,
+    /// Scratch of the unilateral solve: the active set, its Delassus block, its right-hand side.
+    pub efc_active: Vec<usize>,
+    pub efc_sub: DMatrix<f64>,
+    pub efc_sub_rhs: DVector<f64>,
+    /// Active-set changes of the last unilateral solve (0 without unilateral rows).
+    pub efc_iterations: u32,
     /// Rank of J M⁻¹ Jᵀ at the last solve (< nefc: redundant rows, minimum-norm multipliers).
     pub efc_rank: usize,
 }
@@ -113,7 +138,9 @@ impl Data {
     pub fn new(model: &Model) -> Self {
         let nb = model.nbody();
         let nv = model.nv;
-        let nefc: usize = model.equalities.iter().map(|e| e.kind.nrow()).sum();
+        // Equality rows, and one row per limited hinge/slide joint (one side is active at a time).
+        let nefc: usize = model.equalities.iter().map(|e| e.kind.nrow()).sum::<usize>()
+            + model.joints.iter().filter(|j| j.limits.is_some() && j.kind.nv() == 1).count();
         Self {
             x_parent_body: vec![Transform::identity(); nb],
             x_world_body: vec![Transform::identity(); nb],
@@ -151,12 +178,17 @@ impl Data {
             efc_vel: DVector::zeros(nefc),
             efc_jdotv: DVector::zeros(nefc),
             efc_force: DVector::zeros(nefc),
+            efc_type: vec![EfcType::Equality; nefc],
             efc_id: vec![0; nefc],
+            efc_active: Vec::with_capacity(nefc),
+            efc_sub: DMatrix::zeros(nefc, nefc),
+            efc_sub_rhs: DVector::zeros(nefc),
             efc_minv_jt: DMatrix::zeros(nv, nefc),
             efc_delassus: DMatrix::zeros(nefc, nefc),
             efc_factor: DMatrix::zeros(nefc, nefc),
             efc_rhs: DVector::zeros(nefc),
             efc_eig: DVector::zeros(nefc),
+            efc_iterations: 0,
             efc_rank: 0,
         }
     }

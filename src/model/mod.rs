@@ -16,7 +16,7 @@ pub mod tendon;
 
 pub use actuator::Actuator;
 pub use contact::{ContactExclude, ContactPair};
-pub use data::Data;
+pub use data::{Data, EfcType};
 pub use elements::{Element, Keyframe};
 pub use equality::{Equality, EqualityKind};
 pub use joint::{axis_angle, JointKind};

@@ -495,3 +495,5 @@ pub const CONSTRAINT_REL: f64 = 1e-10;
 pub const PROJECTED_DRIFT: f64 = 1e-9;
 /// Central differences of J along v (step 1e-6) reproduce J̇v to this relative error.
 pub const JDOTV_FD_REL: f64 = 1e-6;
+/// Joints with limits stay within them to this (rad or m) in exact mode.
+pub const LIMIT_EXCURSION: f64 = 1e-6;

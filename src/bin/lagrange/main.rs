@@ -36,6 +36,10 @@ struct Cli {
     /// implemented yet: falls back to exact and says so). Default: soft for MJCF, exact for URDF.
     #[arg(long, value_enum, global = true)]
     constraints: Option<ConstraintsArg>,
+    /// Turn off an `<option><flag>` switch by its MJCF name (limit, equality, constraint,
+    /// spring, damper, gravity, …), for URDF and MJCF alike; repeatable.
+    #[arg(long = "disable", global = true, value_name = "FLAG")]
+    disabled_flags: Vec<String>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -143,6 +147,7 @@ fn main() -> ExitCode {
         package_dirs: cli.package_dirs,
         floating: cli.floating,
         accept_nonphysical_inertia: cli.accept_nonphysical_inertia,
+        disabled_flags: cli.disabled_flags,
     };
     let mode = cli.constraints.map(ConstraintMode::from);
     let result = match cli.command {

@@ -7,6 +7,7 @@ use lagrange::dynamics::{aba, bias_forces, center_of_mass, crba, kinetic_energy,
 use lagrange::forward::{forward, Plan};
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::{forward_kinematics, frame_jacobian, ReferenceFrame};
+use lagrange::model::EfcType;
 use lagrange::model::FrameKind;
 use lagrange::{Data, Model};
 use nalgebra::DMatrix;
@@ -87,10 +88,18 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
     let mut r = 0;
     while r < data.nefc {
         let id = data.efc_id[r];
-        let n = model.equalities[id].kind.nrow();
-        let eq = &model.equalities[id];
+        let (name, kind, source, n) = match data.efc_type[r] {
+            EfcType::Equality => {
+                let eq = &model.equalities[id];
+                (eq.name.clone(), eq.kind.name(), eq.loc.to_string(), eq.kind.nrow())
+            }
+            EfcType::LimitJoint => {
+                let file = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+                (model.joints[id].name.clone(), "limit", file, 1)
+            }
+        };
         constraints.push(json!({
-            "name": eq.name, "kind": eq.kind.name(), "source": eq.loc.to_string(),
+            "name": name, "kind": kind, "source": source,
             "force": data.efc_force.as_slice()[r..r + n], "violation": data.efc_pos.as_slice()[r..r + n],
         }));
         r += n;
