@@ -65,7 +65,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from crossval_common import Layout, Slot, State, layout_from_slots, model_rng, quat_wxyz_to_mat, random_states  # noqa: E402
 from crossval_corpus import REPO, Entry, corpus  # noqa: E402
-from crossval_engines import GRAVITY_URDF, Lagrange, UrdfInfo, first_line, match_slots, urdf_for_mujoco  # noqa: E402
+from crossval_engines import GRAVITY_URDF, Lagrange, UrdfInfo, first_line, index_maps, match_slots, urdf_for_mujoco  # noqa: E402
 
 SEED = 20261123
 N_STATES = 5
@@ -834,12 +834,7 @@ def _process(entry: Entry, cfg: dict, row: dict) -> None:
     if problem:
         row["fails"].append("joints differ between lagrange and MuJoCo: %s" % problem)
         return
-    qmap = np.zeros(canon.nq, dtype=int)
-    vmap = np.zeros(canon.nv, dtype=int)
-    for c in canon.slots:
-        r = mapping[c.name]
-        qmap[c.qadr : c.qadr + c.nq] = range(r.qadr, r.qadr + r.nq)
-        vmap[c.vadr : c.vadr + c.nv] = range(r.vadr, r.vadr + r.nv)
+    qmap, vmap = index_maps(canon, mapping)
 
     # states: random (v projected), then the same projected onto the manifold
     if entry.fmt == "urdf":

@@ -251,6 +251,17 @@ class Lagrange:
 # ---------------------------------------------------------------------------------------------
 
 
+def index_maps(canon: Layout, mapping: dict[str, Slot]) -> tuple[np.ndarray, np.ndarray]:
+    """Canonical q and v indices → the other engine's, from the slot mapping of `match_slots`."""
+    qmap = np.zeros(canon.nq, dtype=int)
+    vmap = np.zeros(canon.nv, dtype=int)
+    for c in canon.slots:
+        r = mapping[c.name]
+        qmap[c.qadr : c.qadr + c.nq] = range(r.qadr, r.qadr + r.nq)
+        vmap[c.vadr : c.vadr + c.nv] = range(r.vadr, r.vadr + r.nv)
+    return qmap, vmap
+
+
 def match_slots(canon: Layout, ref_slots: list[Slot], aliases=None) -> tuple[dict[str, Slot], str]:
     """Maps each canonical joint to the reference joint of the same name (or an alias) and kind.
     Returns the map and, if the joint sets differ, a description of the difference."""
@@ -402,12 +413,7 @@ class MuJoCo:
             run.status, run.detail = "incomparable", "joints differ from lagrange's: " + problem
             return
         # canonical index -> MuJoCo index
-        qmap = np.zeros(canon.nq, dtype=int)
-        vmap = np.zeros(canon.nv, dtype=int)
-        for c in canon.slots:
-            r = mapping[c.name]
-            qmap[c.qadr : c.qadr + c.nq] = range(r.qadr, r.qadr + r.nq)
-            vmap[c.vadr : c.vadr + c.nv] = range(r.vadr, r.vadr + r.nv)
+        qmap, vmap = index_maps(canon, mapping)
         moving = self.moving
         static = [i for i in range(1, m.nbody) if not moving[i]]
         body_ids = {self.body_name(i): i for i in range(m.nbody)}
