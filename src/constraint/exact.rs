@@ -42,6 +42,21 @@ fn solve_delassus(data: &mut Data) -> usize {
     solve_psd(efc_delassus, &mut efc_rhs.as_mut_slice()[..n], efc_factor, efc_eig)
 }
 
+/// J_i · x for row `i` of the current rows.
+fn row_dot(data: &Data, nv: usize, i: usize, x: &[f64]) -> f64 {
+    (0..nv).map(|k| data.efc_j[(i, k)] * x[k]).sum()
+}
+
+/// x += s · M⁻¹Jᵀ μ with μ the first nefc entries of `efc_rhs` (the result of a Delassus solve).
+fn add_minv_jt_mu(data: &Data, nv: usize, s: f64, x: &mut [f64]) {
+    for i in 0..data.nefc {
+        let mu = s * data.efc_rhs[i];
+        for k in 0..nv {
+            x[k] += data.efc_minv_jt[(k, i)] * mu;
+        }
+    }
+}
+
 /// The mixed complementarity problem of bilateral and unilateral rows on A = J M⁻¹ Jᵀ (in
 /// `efc_delassus`) with b in `efc_rhs`: find μ with w = A μ − b and, per row, w = 0 (bilateral),
 /// or μ ≥ 0, w ≥ 0, μ w = 0 (unilateral: joint limits) — the KKT conditions of Signorini's law
@@ -138,18 +153,20 @@ pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>) 
     delassus(model, data);
     let [alpha, beta] = baumgarte.unwrap_or([0.0, 0.0]);
     for i in 0..n {
-        let j_qacc: f64 = (0..nv).map(|k| data.efc_j[(i, k)] * data.qacc_smooth[k]).sum();
+        let j_qacc = row_dot(data, nv, i, data.qacc_smooth.as_slice());
         data.efc_rhs[i] = -(j_qacc + data.efc_jdotv[i]) - alpha * data.efc_vel[i] - beta * data.efc_pos[i];
     }
     // A limit row moving away from its bound (J v > 0) is separating: no force.
     data.efc_iterations = solve_mixed(data, |d, i| d.efc_vel[i] > 0.0);
     data.qacc.copy_from(&data.qacc_smooth);
+    let mut qacc = std::mem::take(&mut data.qacc);
+    add_minv_jt_mu(data, nv, 1.0, qacc.as_mut_slice());
+    data.qacc = qacc;
     data.qfrc_constraint.fill(0.0);
     for i in 0..n {
         let lambda = data.efc_rhs[i];
         data.efc_force[i] = lambda;
         for k in 0..nv {
-            data.qacc[k] += data.efc_minv_jt[(k, i)] * lambda;
             data.qfrc_constraint[k] += data.efc_j[(i, k)] * lambda;
         }
     }
@@ -201,14 +218,11 @@ pub fn project_positions(
             data.efc_rhs[i] = data.efc_pos[i];
         }
         solve_delassus(data);
-        data.scratch_v.fill(0.0);
-        for i in 0..n {
-            let mu = data.efc_rhs[i];
-            for k in 0..model.nv {
-                data.scratch_v[k] -= data.efc_minv_jt[(k, i)] * mu;
-            }
-        }
-        integrate_configuration(model, q, data.scratch_v.as_slice(), 1.0);
+        let mut dq = std::mem::take(&mut data.scratch_v);
+        dq.fill(0.0);
+        add_minv_jt_mu(data, model.nv, -1.0, dq.as_mut_slice());
+        integrate_configuration(model, q, dq.as_slice(), 1.0);
+        data.scratch_v = dq;
         iterations += 1;
     }
 }
@@ -217,29 +231,19 @@ pub fn project_positions(
 /// unilateral rows} at configuration `q`: v ← v + M⁻¹Jᵀ μ with the impulses μ of the mixed
 /// complementarity problem (an inelastic impact on a joint limit: restitution 0). Needs the factor
 /// of M (e.g. from [`project_positions`]) and the rows at q (`positions`); returns the largest
-/// remaining violation (|J v| bilateral, max(0, −J v) unilateral).
+/// remaining violation (|J v| bilateral, max(0, −J v) unilateral) and leaves J v in `efc_vel`.
 pub fn project_velocities(model: &Model, data: &mut Data, v: &mut [f64]) -> f64 {
     let n = data.nefc;
     let nv = model.nv;
     delassus(model, data);
     for i in 0..n {
-        data.efc_rhs[i] = -(0..nv).map(|k| data.efc_j[(i, k)] * v[k]).sum::<f64>();
+        data.efc_rhs[i] = -row_dot(data, nv, i, v);
     }
     solve_mixed(data, |_, _| false);
+    add_minv_jt_mu(data, nv, 1.0, v);
+    // J v of the projected velocity, measured as every row violation is.
     for i in 0..n {
-        let mu = data.efc_rhs[i];
-        for k in 0..nv {
-            v[k] += data.efc_minv_jt[(k, i)] * mu;
-        }
+        data.efc_vel[i] = row_dot(data, nv, i, v);
     }
-    (0..n)
-        .map(|i| {
-            let jv: f64 = (0..nv).map(|k| data.efc_j[(i, k)] * v[k]).sum();
-            if data.efc_type[i].is_unilateral() {
-                (-jv).max(0.0)
-            } else {
-                jv.abs()
-            }
-        })
-        .fold(0.0, f64::max)
+    row_violation(data)[1]
 }
