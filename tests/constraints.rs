@@ -123,7 +123,7 @@ fn kkt_solution_satisfies_dynamics_and_constraints() {
             plan.constraints.evaluate(&model, &mut data, &q, &v);
             crba(&model, &mut data, &q);
             lagrange::dynamics::factorize_mass_matrix(&model, &mut data);
-            lagrange::constraint::project_velocities(&model, &mut data, &mut v);
+            lagrange::constraint::project_velocities(&model, &mut data, &mut v, 0.0, Default::default());
             data.qfrc_applied.copy_from_slice(&tau);
             forward(&model, &plan, &mut data, &q, &v);
             let n = data.nefc;
@@ -142,7 +142,7 @@ fn kkt_solution_satisfies_dynamics_and_constraints() {
                 let mut qe = q.clone();
                 integrate_configuration(&model, &mut qe, &v, sign * eps);
                 forward_kinematics(&model, &mut data, &qe);
-                plan.constraints.positions(&model, &mut data, &qe);
+                plan.constraints.positions(&model, &mut data, &qe, true);
                 data.efc_j.rows(0, n).into_owned() * DVector::from_vec(v.clone())
             };
             let fd: DVector<f64> = (jv(1.0) - jv(-1.0)) / (2.0 * eps);

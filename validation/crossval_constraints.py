@@ -767,9 +767,10 @@ def lagrange_eval(lag: Lagrange, entry: Entry, states: list[dict]) -> tuple[list
         json.dump(doc, f)
         path = f.name
     try:
-        # Equality rows only, as on the MuJoCo side (its limit rows are disabled there too): the
-        # manifold states may lie outside the joint ranges.
-        args = ["eval", str(entry.path), "--states", path, "--json", "--constraints", "exact", "--disable", "limit",
+        # Equality rows only, as on the MuJoCo side (its limit, friction-loss and contact rows are
+        # disabled there too): the manifold states may lie outside the joint ranges.
+        args = ["eval", str(entry.path), "--states", path, "--json", "--constraints", "exact",
+                "--disable", "limit", "--disable", "frictionloss", "--disable", "contact",
                 *lag._args(entry)]
         try:
             p = lag._run(args)

@@ -232,7 +232,7 @@ def model_doc(m: mujoco.MjModel, path: pathlib.Path) -> dict:
         name, raw = name_or(obj.mjOBJ_JOINT, m, j, "joint")
         jtype = JOINT_TYPES[int(m.jnt_type[j])]
         qa, da = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
-        limited = bool(m.jnt_limited[j]) and jtype in ("hinge", "slide")
+        limited = bool(m.jnt_limited[j]) and jtype in ("hinge", "slide", "ball")
         joints.append(
             {
                 "id": j,

@@ -8,10 +8,12 @@
 //! M⁻¹Jᵀ, on the configuration manifold) and [`project_velocities`] (the M-orthogonal projection
 //! of v onto J v = 0).
 
-use super::{solve_psd, ConstraintModel};
+use super::active_set::{solve_delassus, solve_mixed};
+use super::coulomb::{has_friction, solve_coulomb, Level, SolverSettings, SEPARATING_VELOCITY};
+use super::ConstraintModel;
 use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
 use crate::kinematics::body_poses;
-use crate::model::{integrate_configuration, Data, Model};
+use crate::model::{integrate_configuration, Data, EfcType, Model};
 
 /// Y = M⁻¹Jᵀ into `efc_minv_jt` and A = J M⁻¹ Jᵀ into `efc_delassus` for the current rows (needs
 /// the factor of M in `mass_factor`).
@@ -35,13 +37,6 @@ fn delassus(model: &Model, data: &mut Data) {
     }
 }
 
-/// Solves A μ = `efc_rhs` (first nefc entries) in place; returns the rank of A.
-fn solve_delassus(data: &mut Data) -> usize {
-    let n = data.nefc;
-    let Data { efc_delassus, efc_rhs, efc_factor, efc_eig, .. } = data;
-    solve_psd(efc_delassus, &mut efc_rhs.as_mut_slice()[..n], efc_factor, efc_eig)
-}
-
 /// J_i · x for row `i` of the current rows.
 fn row_dot(data: &Data, nv: usize, i: usize, x: &[f64]) -> f64 {
     (0..nv).map(|k| data.efc_j[(i, k)] * x[k]).sum()
@@ -57,97 +52,11 @@ fn add_minv_jt_mu(data: &Data, nv: usize, s: f64, x: &mut [f64]) {
     }
 }
 
-/// The mixed complementarity problem of bilateral and unilateral rows on A = J M⁻¹ Jᵀ (in
-/// `efc_delassus`) with b in `efc_rhs`: find μ with w = A μ − b and, per row, w = 0 (bilateral),
-/// or μ ≥ 0, w ≥ 0, μ w = 0 (unilateral: joint limits) — the KKT conditions of Signorini's law
-/// (notes §1.6 with inequality constraints; Cottle, Pang & Stone, *The Linear Complementarity
-/// Problem*, §4.1, the principal pivoting / active-set method). Unilateral rows whose `skip` is
-/// true (separating at the acceleration level) carry no force. Solves each active set exactly
-/// (minimum-norm for redundant rows), dropping the most negative force or adding the most violated
-/// row until both sign conditions hold; returns the number of active-set changes. μ is left in
-/// `efc_rhs`; without unilateral rows this is the plain solve.
-fn solve_mixed(data: &mut Data, skip: impl Fn(&Data, usize) -> bool) -> u32 {
-    let n = data.nefc;
-    if !(0..n).any(|i| data.efc_type[i].is_unilateral()) {
-        data.efc_active.clear();
-        data.efc_active.extend(0..n);
-        data.efc_rank = solve_delassus(data);
-        return 0;
-    }
-    let scale = 1.0 + (0..n).map(|i| data.efc_rhs[i].abs()).fold(0.0, f64::max);
-    let tol = 1e-11 * scale;
-    // b stays in efc_force during the iterations; μ is built in efc_rhs.
-    for i in 0..n {
-        data.efc_force[i] = data.efc_rhs[i];
-    }
-    data.efc_active.clear();
-    for i in 0..n {
-        if !(data.efc_type[i].is_unilateral() && skip(data, i)) {
-            data.efc_active.push(i);
-        }
-    }
-    let mut changes = 0;
-    for _ in 0..(4 * n + 10) {
-        // Solve the active block exactly.
-        let k = data.efc_active.len();
-        {
-            let Data {
-                efc_delassus, efc_sub, efc_sub_rhs, efc_active, efc_force, efc_factor, efc_eig, ..
-            } = data;
-            for (a, &i) in efc_active.iter().enumerate() {
-                efc_sub_rhs[a] = efc_force[i];
-                for (c, &j) in efc_active.iter().enumerate() {
-                    efc_sub[(a, c)] = efc_delassus[(i, j)];
-                }
-            }
-            data.efc_rank = solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..k], efc_factor, efc_eig);
-        }
-        data.efc_rhs.rows_mut(0, n).fill(0.0);
-        for (a, &i) in data.efc_active.iter().enumerate() {
-            data.efc_rhs[i] = data.efc_sub_rhs[a];
-        }
-        // The most negative force of an active unilateral row leaves the set.
-        let drop = data
-            .efc_active
-            .iter()
-            .enumerate()
-            .filter(|(_, &i)| data.efc_type[i].is_unilateral() && data.efc_rhs[i] < -tol)
-            .min_by(|a, b| data.efc_rhs[*a.1].total_cmp(&data.efc_rhs[*b.1]))
-            .map(|(a, _)| a);
-        if let Some(a) = drop {
-            data.efc_active.remove(a);
-            changes += 1;
-            continue;
-        }
-        // The most violated inactive unilateral row (w < 0) joins it.
-        let mut worst: Option<(usize, f64)> = None;
-        for i in 0..n {
-            if !data.efc_type[i].is_unilateral() || data.efc_active.contains(&i) || skip(data, i) {
-                continue;
-            }
-            let w: f64 =
-                (0..n).map(|j| data.efc_delassus[(i, j)] * data.efc_rhs[j]).sum::<f64>() - data.efc_force[i];
-            if w < -tol && worst.is_none_or(|(_, ww)| w < ww) {
-                worst = Some((i, w));
-            }
-        }
-        match worst {
-            Some((i, _)) => {
-                let at = data.efc_active.partition_point(|&j| j < i);
-                data.efc_active.insert(at, i);
-                changes += 1;
-            }
-            None => break,
-        }
-    }
-    changes
-}
-
 /// The constraint stage of the exact mode. Needs, at the same state: the factor of M
 /// (`mass_factor`), the rows with `efc_pos`, `efc_vel`, `efc_jdotv`, and `qacc_smooth`. Writes
 /// `efc_force` (λ), `qfrc_constraint` (Jᵀλ), `qacc` and `efc_rank`. `baumgarte = [α, β]` adds the
 /// stabilization J q̈ + J̇v + α J v + β φ = 0 (Baumgarte 1972); `None` solves the pure KKT system.
-pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>) {
+pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>, settings: SolverSettings) {
     let n = data.nefc;
     let nv = model.nv;
     delassus(model, data);
@@ -156,36 +65,49 @@ pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>) 
         let j_qacc = row_dot(data, nv, i, data.qacc_smooth.as_slice());
         data.efc_rhs[i] = -(j_qacc + data.efc_jdotv[i]) - alpha * data.efc_vel[i] - beta * data.efc_pos[i];
     }
-    // A limit row moving away from its bound (J v > 0) is separating: no force.
-    data.efc_iterations = solve_mixed(data, |d, i| d.efc_vel[i] > 0.0);
+    if has_friction(data) {
+        solve_coulomb(model, data, Level::Acceleration, settings);
+    } else {
+        // A limit or contact row moving away from its bound (J v > 0) is separating: no force.
+        data.efc_iterations = solve_mixed(data, |d, i| !d.efc_frozen && d.efc_vel[i] > SEPARATING_VELOCITY);
+        data.efc_residual = 0.0;
+        data.efc_converged = true;
+    }
     data.qacc.copy_from(&data.qacc_smooth);
     let mut qacc = std::mem::take(&mut data.qacc);
     add_minv_jt_mu(data, nv, 1.0, qacc.as_mut_slice());
     data.qacc = qacc;
     data.qfrc_constraint.fill(0.0);
+    data.efc_warm_rows.clear();
     for i in 0..n {
         let lambda = data.efc_rhs[i];
         data.efc_force[i] = lambda;
+        data.efc_warm[i] = lambda;
+        data.efc_warm_rows.push((data.efc_type[i], data.efc_id[i]));
         for k in 0..nv {
             data.qfrc_constraint[k] += data.efc_j[(i, k)] * lambda;
         }
     }
 }
 
-/// The violation of the current rows: [max |φ| (for a limit row, the penetration), max of |J v|
-/// over bilateral rows and max(0, −J v) over unilateral rows (approach speed)].
+/// The violation of the current rows: [position, velocity] with, per row kind, |φ| and |J v| for
+/// equality rows, the penetration max(0, −φ) and approach speed max(0, −J v) for limits and
+/// contact normals; friction rows (dof friction, contact friction) have neither.
 pub fn row_violation(data: &Data) -> [f64; 2] {
-    let n = data.nefc;
-    let velocity = (0..n)
-        .map(|i| {
-            if data.efc_type[i].is_unilateral() {
-                (-data.efc_vel[i]).max(0.0)
-            } else {
-                data.efc_vel[i].abs()
+    let mut out = [0.0f64; 2];
+    for i in 0..data.nefc {
+        let (phi, jv) = (data.efc_pos[i], data.efc_vel[i]);
+        let (p, v) = match data.efc_type[i] {
+            EfcType::Equality => (phi.abs(), jv.abs()),
+            EfcType::FrictionDof => (0.0, 0.0),
+            _ if data.efc_type[i].is_unilateral() && data.efc_is_normal_or_limit(i) => {
+                ((-phi).max(0.0), (-jv).max(0.0))
             }
-        })
-        .fold(0.0, f64::max);
-    [data.efc_pos.rows(0, n).amax(), velocity]
+            _ => (0.0, 0.0),
+        };
+        out = [out[0].max(p), out[1].max(v)];
+    }
+    out
 }
 
 /// Moves `q` onto the constraint manifold φ(q) = 0 by Gauss–Newton steps Δ = −M⁻¹Jᵀ A⁺ φ applied
@@ -207,7 +129,7 @@ pub fn project_positions(
         if iterations > 0 {
             body_poses(model, data, q);
         }
-        constraints.positions(model, data, q);
+        constraints.positions(model, data, q, false);
         let n = data.nefc;
         let residual = data.efc_pos.rows(0, n).amax();
         if residual <= tolerance || iterations >= max_iterations || !residual.is_finite() {
@@ -229,17 +151,30 @@ pub fn project_positions(
 
 /// Replaces `v` by its M-orthogonal projection onto {J v = 0 on bilateral rows, J v ≥ 0 on
 /// unilateral rows} at configuration `q`: v ← v + M⁻¹Jᵀ μ with the impulses μ of the mixed
-/// complementarity problem (an inelastic impact on a joint limit: restitution 0). Needs the factor
-/// of M (e.g. from [`project_positions`]) and the rows at q (`positions`); returns the largest
+/// complementarity problem (an inelastic impact on a joint limit: restitution 0). With dry friction
+/// the impulses follow Coulomb's law at the velocity level over a step `dt` ([`Level::Velocity`]).
+/// Needs the factor of M (e.g. from [`project_positions`]) and the rows at q (`positions`); returns the largest
 /// remaining violation (|J v| bilateral, max(0, −J v) unilateral) and leaves J v in `efc_vel`.
-pub fn project_velocities(model: &Model, data: &mut Data, v: &mut [f64]) -> f64 {
+pub fn project_velocities(
+    model: &Model,
+    data: &mut Data,
+    v: &mut [f64],
+    dt: f64,
+    settings: SolverSettings,
+) -> f64 {
     let n = data.nefc;
     let nv = model.nv;
     delassus(model, data);
     for i in 0..n {
         data.efc_rhs[i] = -row_dot(data, nv, i, v);
+        data.efc_pressing[i] = data.efc_is_normal_or_limit(i) && data.efc_previous_force(i, 0) > 0.0;
     }
-    solve_mixed(data, |_, _| false);
+    if has_friction(data) {
+        solve_coulomb(model, data, Level::Velocity { dt }, settings);
+    } else {
+        solve_mixed(data, |_, _| false);
+    }
+    data.efc_pressing[..n].fill(false);
     add_minv_jt_mu(data, nv, 1.0, v);
     // J v of the projected velocity, measured as every row violation is.
     for i in 0..n {

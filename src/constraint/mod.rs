@@ -4,19 +4,30 @@
 //! eq. 19–22: λ are Lagrange multipliers, `Jᵀλ` the generalized forces of constraint), plus the
 //! drift correction of the steppers (projection onto φ = 0 and J v = 0).
 //!
-//! Row kinds so far: equality constraints (connect, weld, joint coupling, fixed-tendon coupling),
-//! URDF mimic couplings, and the limits of hinge and slide joints (unilateral: Signorini's
-//! complementarity at the acceleration level, inelastic impacts at the velocity level). The soft
-//! (MuJoCo-compatible) mode, ball-joint limits, friction loss and contacts arrive with later
-//! issues behind the same buffers.
+//! Row kinds (MuJoCo's order): equality constraints (connect, weld, joint coupling, fixed-tendon
+//! coupling) and URDF mimic couplings; dof friction loss (bounded rows); limits of hinge, slide
+//! and ball joints; contacts from the collision layer (normal + elliptic Coulomb cone). Unilateral
+//! rows obey Signorini's complementarity at the acceleration level and inelastic impacts at the
+//! velocity level; rows with dry friction are solved by [`solve_coulomb`], the others exactly by an
+//! active-set method. The soft (MuJoCo-compatible) mode arrives with a later issue behind the same
+//! buffers.
 
+mod active_set;
+mod contact;
+mod coulomb;
 mod dense;
 mod exact;
+mod friction_loss;
+mod limits;
 mod rows;
 
+pub use contact::CONTACT_ACTIVE_DISTANCE;
+pub use coulomb::{solve_coulomb, Level, SolverSettings, SEPARATING_VELOCITY, SLIP_VELOCITY};
 pub use dense::solve_psd;
 pub use exact::{project_positions, project_velocities, row_violation, solve_exact};
-pub use rows::{ConstraintModel, LimitRow, RowGeometry, ScalarCoord};
+pub use friction_loss::FrictionRow;
+pub use limits::{ball_angle_axis, LimitKind, LimitRow, LIMIT_ACTIVE_DISTANCE};
+pub use rows::{ConstraintModel, RowGeometry, ScalarCoord};
 
 /// Which constraint model `forward` solves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -13,6 +13,9 @@
 //! - joint / tendon / mimic: φ = x₁ − r₁ − P(x₂ − r₂), P(x) = a₀ + a₁x + … + a₄x⁴, with x the joint
 //!   value or fixed-tendon length and r its reference (qpos0 for MJCF, 0 for a URDF mimic).
 
+use super::contact::{contact_jdotv, contact_rows};
+use super::friction_loss::FrictionRow;
+use super::limits::LimitRow;
 use crate::kinematics::{
     bias_accelerations, for_each_ancestor_dof, forward_kinematics, forward_velocities,
     point_bias_acceleration,
@@ -93,22 +96,12 @@ pub struct EqualityRows {
     pub geometry: RowGeometry,
 }
 
-/// A limited hinge or slide joint: a unilateral row when q reaches a bound (MuJoCo's
-/// `mj_instantiateLimit`: distance `q − lower` with J = +1, or `upper − q` with J = −1; negative
-/// distance is penetration).
-#[derive(Clone, Debug, PartialEq)]
-pub struct LimitRow {
-    /// Index in `Model::joints`.
-    pub joint: usize,
-    pub qpos_adr: usize,
-    pub dof_adr: usize,
-    pub range: [f64; 2],
-}
-
 /// Which constraint rows a model has and their fixed geometry (built once per model).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ConstraintModel {
     pub equalities: Vec<EqualityRows>,
+    /// Degrees of freedom with dry friction (`frictionloss`), one row each, always active.
+    pub friction: Vec<FrictionRow>,
     pub limits: Vec<LimitRow>,
 }
 
@@ -145,25 +138,13 @@ impl ConstraintModel {
             return Self::default();
         }
         let limits = if flags.limit {
-            model
-                .joints
-                .iter()
-                .enumerate()
-                .filter(|(_, j)| j.kind.nv() == 1)
-                .filter_map(|(i, j)| {
-                    j.limits.map(|range| LimitRow {
-                        joint: i,
-                        qpos_adr: j.qpos_adr,
-                        dof_adr: j.dof_adr,
-                        range,
-                    })
-                })
-                .collect()
+            (0..model.joints.len()).filter_map(|j| LimitRow::of_joint(model, j)).collect()
         } else {
             Vec::new()
         };
+        let friction = if flags.frictionloss { FrictionRow::of_model(model) } else { Vec::new() };
         if model.equalities.is_empty() || !flags.equality {
-            return Self { equalities: Vec::new(), limits };
+            return Self { equalities: Vec::new(), friction, limits };
         }
         let mut data = Data::new(model);
         forward_kinematics(model, &mut data, &model.qpos0);
@@ -245,24 +226,30 @@ impl ConstraintModel {
             };
             equalities.push(EqualityRows { id, geometry });
         }
-        Self { equalities, limits }
+        Self { equalities, friction, limits }
     }
 
-    /// Whether the model has any constraint rows at all.
+    /// Whether the model has any constraint rows apart from contacts.
     pub fn is_empty(&self) -> bool {
-        self.equalities.is_empty() && self.limits.is_empty()
+        self.equalities.is_empty() && self.friction.is_empty() && self.limits.is_empty()
     }
 
-    /// Whether any row is active at configuration `q`: an active equality, or a joint at or
-    /// beyond a limit. Cheap (no kinematics): `forward` takes the ABA path when none is.
+    /// Whether any row other than a contact's is active at configuration `q`: an active equality,
+    /// a friction-loss row, or a joint at or beyond a limit. Cheap (no kinematics): `forward`
+    /// takes the ABA path when none is (and no contact touches).
     pub fn any_active(&self, data: &Data, q: &[f64]) -> bool {
-        self.equalities.iter().any(|e| data.eq_active[e.id])
-            || self.limits.iter().any(|l| limit_side(l, q[l.qpos_adr]).is_some())
+        !self.friction.is_empty()
+            || self.equalities.iter().any(|e| data.eq_active[e.id])
+            || self.limits.iter().any(|l| l.row(data, q).is_some())
     }
 
-    /// Rows of the active constraints at configuration `q`: `nefc`, `efc_id`, `efc_j`, `efc_pos`.
-    /// Needs body poses and motion subspaces at q (forward kinematics, or CRBA's first pass).
-    pub fn positions(&self, model: &Model, data: &mut Data, q: &[f64]) {
+    /// Rows of the active constraints at configuration `q` in MuJoCo's order — equality, dof
+    /// friction, limits, contacts (from `Data::contacts`, which the caller fills at the same q):
+    /// `nefc`, `efc_id`, `efc_type`, `efc_j`, `efc_pos`. Equality rows come first (the solvers rely
+    /// on it). With `full` false only the rows with a position meaning are written (equalities,
+    /// limits, contact normals: the position projection). Needs body poses and motion subspaces at
+    /// q (forward kinematics, or CRBA's first pass).
+    pub fn positions(&self, model: &Model, data: &mut Data, q: &[f64], full: bool) {
         let mut r = 0;
         for e in &self.equalities {
             if !data.eq_active[e.id] {
@@ -321,17 +308,19 @@ impl ConstraintModel {
             }
             r += n;
         }
-        for l in &self.limits {
-            if let Some((sign, dist)) = limit_side(l, q[l.qpos_adr]) {
-                data.efc_id[r] = l.joint;
-                data.efc_type[r] = EfcType::LimitJoint;
-                data.efc_j.row_mut(r).fill(0.0);
-                data.efc_j[(r, l.dof_adr)] = sign;
-                data.efc_pos[r] = dist;
+        if full {
+            for f in &self.friction {
+                f.write_row(data, r);
                 r += 1;
             }
         }
-        data.nefc = r;
+        for l in &self.limits {
+            if let Some((dir, dist)) = l.row(data, q) {
+                l.write_row(data, r, &dir, dist);
+                r += 1;
+            }
+        }
+        data.nefc = contact_rows(model, data, r, full);
     }
 
     /// `efc_vel` = J v and `efc_jdotv` = J̇ v of the rows of [`positions`](Self::positions) at the
@@ -382,12 +371,27 @@ impl ConstraintModel {
             }
             r += n;
         }
-        for l in &self.limits {
-            if let Some((sign, _)) = limit_side(l, q[l.qpos_adr]) {
-                data.efc_vel[r] = sign * v[l.dof_adr];
-                data.efc_jdotv[r] = 0.0;
-                r += 1;
+        // Friction, limit and contact rows: J v from the row itself, J̇ v by kind.
+        while r < data.nefc {
+            data.efc_vel[r] = (0..model.nv).map(|k| data.efc_j[(r, k)] * v[k]).sum();
+            match data.efc_type[r] {
+                EfcType::Equality | EfcType::FrictionDof => data.efc_jdotv[r] = 0.0,
+                EfcType::LimitJoint => {
+                    let joint = data.efc_id[r];
+                    let l = self.limits.iter().find(|l| l.joint == joint);
+                    data.efc_jdotv[r] = l.map_or(0.0, |l| l.jdotv(q, v));
+                }
+                EfcType::ContactFrictionless | EfcType::ContactElliptic => {
+                    let dim = data.efc_block_len(r);
+                    for i in r + 1..r + dim {
+                        data.efc_vel[i] = (0..model.nv).map(|k| data.efc_j[(i, k)] * v[k]).sum();
+                    }
+                    contact_jdotv(model, data, r, dim, data.efc_id[r]);
+                    r += dim;
+                    continue;
+                }
             }
+            r += 1;
         }
     }
 
@@ -396,26 +400,8 @@ impl ConstraintModel {
     pub fn evaluate(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         forward_kinematics(model, data, q);
         forward_velocities(model, data, v);
-        self.positions(model, data, q);
+        self.positions(model, data, q, true);
         self.velocities(model, data, q, v);
-    }
-}
-
-/// Distance (rad or m) within which a limit row is active: the position projection leaves q on
-/// the bound only up to round-off, and the velocity projection that follows must still see it.
-pub const LIMIT_ACTIVE_DISTANCE: f64 = 1e-10;
-
-/// The active side of a joint limit at value `q`: (J sign, distance) with distance ≤
-/// [`LIMIT_ACTIVE_DISTANCE`] at or beyond the bound (lower: +1, q − lower; upper: −1, upper − q),
-/// or None inside the range.
-fn limit_side(l: &LimitRow, q: f64) -> Option<(f64, f64)> {
-    let (lower, upper) = (q - l.range[0], l.range[1] - q);
-    if lower <= LIMIT_ACTIVE_DISTANCE {
-        Some((1.0, lower))
-    } else if upper <= LIMIT_ACTIVE_DISTANCE {
-        Some((-1.0, upper))
-    } else {
-        None
     }
 }
 

@@ -38,7 +38,7 @@ pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]
             StageKind::Position if m_path => {
                 crba(model, data, q);
                 factorize_mass_matrix(model, data);
-                plan.constraints.positions(model, data, q);
+                plan.constraints.positions(model, data, q, true);
             }
             StageKind::Velocity if m_path => {
                 bias_forces(model, data, q, v);
@@ -48,7 +48,7 @@ pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]
             }
             StageKind::Passive => passive(model, data, q, v),
             StageKind::Acceleration => acceleration(model, data, q, v, m_path),
-            StageKind::Constraint if m_path => solve_exact(model, data, plan.drift.baumgarte),
+            StageKind::Constraint if m_path => solve_exact(model, data, plan.drift.baumgarte, plan.solver),
             // Row sources are built by the position stage; the rest are listings.
             _ => {}
         }

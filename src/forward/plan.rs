@@ -4,7 +4,7 @@
 //! contains what it acts on: a scene without constraint rows never builds M (ABA path), a scene
 //! without damping or springs has no passive pass.
 
-use crate::constraint::{ConstraintMode, ConstraintModel};
+use crate::constraint::{ConstraintMode, ConstraintModel, LimitKind, SolverSettings};
 use crate::model::Model;
 use serde::Serialize;
 
@@ -84,6 +84,8 @@ pub struct Plan {
     /// The constraint rows of the model.
     pub constraints: ConstraintModel,
     pub drift: DriftCorrection,
+    /// Iteration limit and tolerance of the iterative solve of rows with dry friction.
+    pub solver: SolverSettings,
 }
 
 impl Plan {
@@ -93,7 +95,14 @@ impl Plan {
         let (mode, mode_reason) = resolve_mode(model, requested);
         let constraints = ConstraintModel::new(model);
         let stages = stages(model, &constraints, mode);
-        Self { stages, mode, mode_reason, constraints, drift: DriftCorrection::default() }
+        Self {
+            stages,
+            mode,
+            mode_reason,
+            constraints,
+            drift: DriftCorrection::default(),
+            solver: SolverSettings::default(),
+        }
     }
 
     /// Whether the stage of `kind` runs.
@@ -135,6 +144,7 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
     use Status::*;
     let nrow: usize = constraints.equalities.iter().map(|e| model.equalities[e.id].kind.nrow()).sum();
     let nlimit = constraints.limits.len();
+    let nfriction = constraints.friction.len();
     let rows = match (nrow, nlimit) {
         (_, 0) => format!("{nrow} constraint rows"),
         (0, _) => {
@@ -142,6 +152,7 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
         }
         _ => format!("{nrow} equality rows and up to {nlimit} joint-limit rows"),
     };
+    let rows = if nfriction > 0 { format!("{rows}, {nfriction} friction-loss rows") } else { rows };
     let constrained = !constraints.is_empty();
     let mut out = Vec::with_capacity(13);
     out.push(if constrained {
@@ -210,9 +221,14 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
             "constraint",
             Runs,
             format!(
-                "{} mode: KKT system on the active rows, λ by the Delassus matrix J M⁻¹ Jᵀ{}",
+                "{} mode: KKT system on the active rows, λ by the Delassus matrix J M⁻¹ Jᵀ{}{}",
                 mode.name(),
-                if nlimit > 0 { " (limits: complementarity, λ ≥ 0, by an active-set method)" } else { "" }
+                if nlimit > 0 { "; limits: complementarity, λ ≥ 0, by an active-set method" } else { "" },
+                if nfriction > 0 {
+                    "; rows with dry friction: projected block Gauss–Seidel (Signorini + Coulomb)"
+                } else {
+                    ""
+                }
             ),
         )
     } else {
@@ -237,38 +253,40 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
         let inactive = if inactive > 0 { format!(", {inactive} inactive at start") } else { String::new() };
         stage(Equality, "equality", Runs, format!("{} ({nrow} rows{inactive})", list.join(", ")))
     });
-    let other_limited = model.joints.iter().filter(|j| j.limits.is_some() && j.kind.nv() != 1).count();
     out.push(if nlimit > 0 {
-        let ball = if other_limited > 0 {
-            format!("; {other_limited} ball-joint cone limits not simulated yet")
-        } else {
-            String::new()
-        };
+        let ball = constraints.limits.iter().filter(|l| matches!(l.kind, LimitKind::Cone { .. })).count();
         stage(
             JointLimits,
             "joint limits",
             Runs,
-            format!("{nlimit} limited hinge/slide joints: a unilateral row at a bound (exact mode){ball}"),
+            format!(
+                "{} limited hinge/slide joints and {ball} ball-joint cone limits: a unilateral row at a bound (exact mode)",
+                nlimit - ball
+            ),
         )
     } else if !flags.limit && model.joints.iter().any(|j| j.limits.is_some()) {
         stage(JointLimits, "joint limits", Skipped, "switched off by <option><flag limit=\"disable\">")
     } else {
-        kept(
-            JointLimits,
-            "joint limits",
-            other_limited,
-            "limited ball joints",
-            "cone limits are not simulated yet",
-        )
+        stage(JointLimits, "joint limits", Skipped, "no limited joints")
     });
-    let friction = model.joints.iter().filter(|j| j.friction != 0.0).count();
-    out.push(kept(
-        FrictionLoss,
-        "friction loss",
-        friction,
-        "joints with friction loss",
-        "stored; enforced by the limits and contact work",
-    ));
+    let nfriction = constraints.friction.len();
+    out.push(if nfriction > 0 {
+        stage(
+            FrictionLoss,
+            "friction loss",
+            Runs,
+            format!("{nfriction} dofs with dry friction: bounded rows |λ| ≤ frictionloss, always active"),
+        )
+    } else if !flags.frictionloss && model.joints.iter().any(|j| j.friction > 0.0) {
+        stage(
+            FrictionLoss,
+            "friction loss",
+            Skipped,
+            "switched off by <option><flag frictionloss=\"disable\">",
+        )
+    } else {
+        stage(FrictionLoss, "friction loss", Skipped, "no joints with friction loss")
+    });
     let colliding = model.geoms.iter().filter(|g| g.collision).count();
     let pairs = model.contact_pairs.len() + model.contact_excludes.len();
     out.push(if colliding + pairs > 0 {

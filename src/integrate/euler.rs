@@ -26,6 +26,6 @@ impl Stepper for SemiImplicitEuler {
         state.v.axpy(h, &data.qacc, 1.0);
         integrate_configuration(model, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
-        StepReport::fixed_step(h, correct_drift(model, plan, data, state))
+        StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
     }
 }

@@ -53,6 +53,10 @@ impl Stepper for RungeKutta4 {
             }
             forward(model, plan, data, self.q_stage.as_slice(), self.v_stage[i].as_slice());
             self.a_stage[i].copy_from(&data.qacc);
+            if i == 0 {
+                // The later stages keep the limit and contact rows the step starts with.
+                data.freeze_rows(false);
+            }
         }
         // Weighted means (1, 2, 2, 1)/6 of stage velocities and accelerations.
         let [v1, v2, v3, v4] = &self.v_stage;
@@ -63,6 +67,6 @@ impl Stepper for RungeKutta4 {
         }
         integrate_configuration(model, state.q.as_mut_slice(), self.v_mean.as_slice(), h);
         state.time += h;
-        StepReport::fixed_step(h, correct_drift(model, plan, data, state))
+        StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
     }
 }

@@ -30,3 +30,27 @@ pub struct ContactExclude {
     pub body2: usize,
     pub loc: SourceLoc,
 }
+
+/// One contact between two geoms found by the collision layer (MuJoCo's `mjContact`), world
+/// coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// Indices in [`Model::geoms`](super::Model); `geom[0]` is MuJoCo's geom1.
+    pub geom: [usize; 2],
+    /// Midpoint between the two surfaces.
+    pub pos: crate::spatial::Vec3,
+    /// Rows: the normal (pointing from geom1 towards geom2), tangent1, tangent2.
+    pub frame: crate::spatial::Mat3,
+    /// Signed distance, negative = penetration.
+    pub dist: f64,
+    /// margin − gap.
+    pub includemargin: f64,
+    pub condim: u32,
+    /// tangent1, tangent2, torsional, rolling1, rolling2.
+    pub friction: [f64; 5],
+    pub solref: [f64; 2],
+    pub solreffriction: [f64; 2],
+    pub solimp: [f64; 5],
+    /// Index in `Model::contact_pairs` for explicit pairs.
+    pub pair: Option<usize>,
+}

@@ -7,7 +7,7 @@
 //! `qfrc_applied`, `qfrc_smooth`, `qacc_smooth`, `qfrc_constraint`, `qacc`, and the constraint rows
 //! `efc_*`. Each buffer keeps one meaning.
 
-use super::Model;
+use super::{Contact, JointKind, Model};
 use crate::spatial::{ArticulatedInertia, Force, Motion, RigidInertia, Transform};
 use nalgebra::{DMatrix, DVector, Matrix6};
 
@@ -16,14 +16,35 @@ use nalgebra::{DMatrix, DVector, Matrix6};
 pub enum EfcType {
     /// A bilateral row of an equality constraint or mimic coupling: J q̈ + J̇v = 0, λ free.
     Equality,
+    /// Dry friction of one degree of freedom (`frictionloss`): |λ| ≤ the joint's friction loss,
+    /// opposing the dof's velocity (MuJoCo's `mjCNSTR_FRICTION_DOF`).
+    FrictionDof,
     /// A joint limit (unilateral): the row's acceleration w ≥ 0, λ ≥ 0, w λ = 0.
     LimitJoint,
+    /// The normal row of a frictionless contact (condim 1), unilateral like a limit.
+    ContactFrictionless,
+    /// The rows of a frictional contact (condim 3, 4 or 6): the normal row first (unilateral),
+    /// then the friction rows, whose forces lie in the elliptic Coulomb cone
+    /// Σ (λ_i / μ_i)² ≤ λ_n² (MuJoCo's `mjCNSTR_CONTACT_ELLIPTIC`).
+    ContactElliptic,
 }
 
 impl EfcType {
-    /// Whether the row's force has a sign (λ ≥ 0).
+    /// Whether the row's force has a sign (λ ≥ 0) — true for the rows of limits and contacts
+    /// (use [`Data::efc_is_normal`] to tell a contact's normal row from its friction rows).
     pub fn is_unilateral(self) -> bool {
-        self == EfcType::LimitJoint
+        matches!(self, EfcType::LimitJoint | EfcType::ContactFrictionless | EfcType::ContactElliptic)
+    }
+
+    /// MuJoCo's name of the row kind (`mjtConstraint` without the prefix, lower case).
+    pub fn name(self) -> &'static str {
+        match self {
+            EfcType::Equality => "equality",
+            EfcType::FrictionDof => "friction_dof",
+            EfcType::LimitJoint => "limit_joint",
+            EfcType::ContactFrictionless => "contact_frictionless",
+            EfcType::ContactElliptic => "contact_elliptic",
+        }
     }
 }
 
@@ -131,6 +152,35 @@ pub struct Data {
     pub efc_iterations: u32,
     /// Rank of J M⁻¹ Jᵀ at the last solve (< nefc: redundant rows, minimum-norm multipliers).
     pub efc_rank: usize,
+    /// Residual of the last iterative (Coulomb) solve: the largest violation of the row
+    /// conditions, in the rows' acceleration (or velocity) units; 0 after a direct solve.
+    pub efc_residual: f64,
+    /// Whether the last iterative solve met its tolerance within its iteration limit.
+    pub efc_converged: bool,
+    /// Warm start of the iterative solve: the forces of the previous acceleration-level solve and
+    /// the (type, id) of each of its rows; reused when the rows are the same.
+    pub efc_warm: DVector<f64>,
+    pub efc_warm_rows: Vec<(EfcType, usize)>,
+    /// Per row, during the velocity projection: a limit or contact row that carried a compressive
+    /// force in the last acceleration-level solve. Its velocity is held at 0 (the row stays
+    /// closed) rather than allowed to grow: a small separating J v left by the integrator's error
+    /// is drift, not a lift-off.
+    pub efc_pressing: Vec<bool>,
+
+    /// Rows frozen within a step ([`Data::freeze_rows`]): while set, a limit or contact row that
+    /// was frozen exists whatever its distance (rows within the activation distance exist as
+    /// always), and no row counts as separating — the later stages of a step keep the contacts
+    /// the step started with, even where a stage's configuration lifts them off by round-off or
+    /// by the integrator's error.
+    pub efc_frozen: bool,
+    /// The limited joints (index in `Model::joints`) with a row at the step's start.
+    pub efc_frozen_limits: Vec<usize>,
+    /// The geom pairs with a contact row at the step's start.
+    pub efc_frozen_pairs: Vec<[usize; 2]>,
+
+    // --- collision ---
+    /// Contacts of the last collision pass (MuJoCo's `contact`); capacity reserved for the model.
+    pub contacts: Vec<Contact>,
 }
 
 impl Data {
@@ -139,8 +189,16 @@ impl Data {
         let nb = model.nbody();
         let nv = model.nv;
         // Equality rows, and one row per limited hinge/slide joint (one side is active at a time).
+        // Equality rows, one row per limited hinge/slide/ball joint (one side is active at a
+        // time), one per dof with friction loss, and up to 6 per contact.
         let nefc: usize = model.equalities.iter().map(|e| e.kind.nrow()).sum::<usize>()
-            + model.joints.iter().filter(|j| j.limits.is_some() && j.kind.nv() == 1).count();
+            + model
+                .joints
+                .iter()
+                .filter(|j| j.limits.is_some() && (j.kind.nv() == 1 || j.kind == JointKind::Ball))
+                .count()
+            + model.joints.iter().filter(|j| j.friction > 0.0).map(|j| j.kind.nv()).sum::<usize>()
+            + 6 * model.max_contacts();
         Self {
             x_parent_body: vec![Transform::identity(); nb],
             x_world_body: vec![Transform::identity(); nb],
@@ -190,6 +248,102 @@ impl Data {
             efc_eig: DVector::zeros(nefc),
             efc_iterations: 0,
             efc_rank: 0,
+            efc_residual: 0.0,
+            efc_converged: true,
+            efc_warm: DVector::zeros(nefc),
+            efc_warm_rows: Vec::with_capacity(nefc),
+            efc_pressing: vec![false; nefc],
+            efc_frozen: false,
+            efc_frozen_limits: Vec::with_capacity(model.joints.len()),
+            efc_frozen_pairs: Vec::with_capacity(model.max_contacts()),
+            contacts: Vec::with_capacity(model.max_contacts()),
         }
+    }
+}
+
+impl Data {
+    /// Whether row `i` starts a contact's block (its normal row) — a contact's rows are
+    /// consecutive, with the same `efc_id` and type.
+    pub fn efc_is_normal(&self, i: usize) -> bool {
+        match self.efc_type[i] {
+            EfcType::ContactFrictionless => true,
+            EfcType::ContactElliptic => {
+                i == 0
+                    || self.efc_type[i - 1] != EfcType::ContactElliptic
+                    || self.efc_id[i - 1] != self.efc_id[i]
+            }
+            _ => false,
+        }
+    }
+
+    /// Freezes the current limit and contact rows (with `pressing_only`, those whose force is
+    /// positive): until [`thaw_rows`](Self::thaw_rows) they keep a row whatever their distance
+    /// (see `efc_frozen`). Multi-stage steppers freeze all rows after the first stage's `forward`;
+    /// the drift correction freezes the rows still pressing after the last stage, so that a
+    /// sustained contact stays closed through the projection.
+    pub fn freeze_rows(&mut self, pressing_only: bool) {
+        self.efc_frozen_limits.clear();
+        self.efc_frozen_pairs.clear();
+        for i in 0..self.nefc {
+            if pressing_only && self.efc_force[i] <= 0.0 {
+                continue;
+            }
+            match self.efc_type[i] {
+                EfcType::LimitJoint => self.efc_frozen_limits.push(self.efc_id[i]),
+                EfcType::ContactFrictionless | EfcType::ContactElliptic if self.efc_is_normal(i) => {
+                    let pair = self.contacts[self.efc_id[i]].geom;
+                    if !self.efc_frozen_pairs.contains(&pair) {
+                        self.efc_frozen_pairs.push(pair);
+                    }
+                }
+                _ => {}
+            }
+        }
+        self.efc_frozen = true;
+    }
+
+    /// Ends the frozen stages of a step: rows are again chosen by distance.
+    pub fn thaw_rows(&mut self) {
+        self.efc_frozen = false;
+    }
+
+    /// The force of row i + k (the k-th row of the block starting at row i) in the last
+    /// acceleration-level solve (`efc_warm`, matched by type and element), 0 if it had no such row.
+    pub fn efc_previous_force(&self, i: usize, k: usize) -> f64 {
+        let key = (self.efc_type[i], self.efc_id[i]);
+        self.efc_warm_rows.iter().position(|w| *w == key).map_or(0.0, |j| {
+            if j + k < self.efc_warm_rows.len() && self.efc_warm_rows[j + k] == key {
+                self.efc_warm[j + k]
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// Whether row `i`'s force has a sign in the current solve: a limit or contact row that is
+    /// not held closed by `efc_pressing`.
+    pub fn efc_signed(&self, i: usize) -> bool {
+        self.efc_type[i].is_unilateral() && !self.efc_pressing[i]
+    }
+
+    /// Whether row `i` is a limit row or a contact's normal row (the rows with a gap φ ≥ 0).
+    pub fn efc_is_normal_or_limit(&self, i: usize) -> bool {
+        self.efc_type[i] == EfcType::LimitJoint || self.efc_is_normal(i)
+    }
+
+    /// Number of rows of the block starting at row `i`: a contact's dimension at its normal row,
+    /// 1 for every other row.
+    pub fn efc_block_len(&self, i: usize) -> usize {
+        if self.efc_type[i] != EfcType::ContactElliptic {
+            return 1;
+        }
+        let mut k = i + 1;
+        while k < self.nefc
+            && self.efc_type[k] == EfcType::ContactElliptic
+            && self.efc_id[k] == self.efc_id[i]
+        {
+            k += 1;
+        }
+        k - i
     }
 }

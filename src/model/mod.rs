@@ -15,7 +15,7 @@ pub mod spec;
 pub mod tendon;
 
 pub use actuator::Actuator;
-pub use contact::{ContactExclude, ContactPair};
+pub use contact::{Contact, ContactExclude, ContactPair};
 pub use data::{Data, EfcType};
 pub use elements::{Element, Keyframe};
 pub use equality::{Equality, EqualityKind};
@@ -254,6 +254,12 @@ impl Model {
         q
     }
     /// Whether any joint has viscous damping (the passive pass of `simulate`).
+    /// Upper bound on the number of contacts one collision pass can report (sizes
+    /// `Data::contacts` and the contact rows). No collision layer yet: none.
+    pub fn max_contacts(&self) -> usize {
+        0
+    }
+
     pub fn has_damping(&self) -> bool {
         self.dof_damping.iter().any(|&d| d != 0.0)
     }

@@ -376,6 +376,17 @@ impl<'a> TreeBuilder<'a> {
             }
             j.limits = Some([r[0] * scale, r[1] * scale]);
         }
+        if limited && jtype == "ball" {
+            // MuJoCo: the cone's half-angle is range[1]; range[0] must be 0.
+            let r = range.unwrap_or_default();
+            if r[0] != 0.0 || r[1] < 0.0 {
+                return Err(a.error(
+                    "range",
+                    format!("is [{}, {}]; a ball joint's range is [0, max angle] (range[0] must be 0, as MuJoCo requires)", r[0], r[1]),
+                ));
+            }
+            j.limits = Some([0.0, r[1] * deg]);
+        }
         let reference = a.real("ref")?.unwrap_or(0.0) * scale;
         let first =
             |name: &str| -> Result<f64, LoadError> { Ok(a.some_numbers(name, 1, 3)?.map_or(0.0, |v| v[0])) };

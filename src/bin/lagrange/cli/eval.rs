@@ -85,23 +85,36 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
     }
     forward(model, plan, data, &s.q, v);
     let mut constraints = Vec::new();
+    let file = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
     let mut r = 0;
     while r < data.nefc {
         let id = data.efc_id[r];
-        let (name, kind, source, n) = match data.efc_type[r] {
+        let n = data.efc_block_len(r);
+        let mut entry = match data.efc_type[r] {
             EfcType::Equality => {
                 let eq = &model.equalities[id];
-                (eq.name.clone(), eq.kind.name(), eq.loc.to_string(), eq.kind.nrow())
+                let n = eq.kind.nrow();
+                json!({"name": eq.name, "kind": eq.kind.name(), "source": eq.loc.to_string(), "rows": n})
             }
-            EfcType::LimitJoint => {
-                let file = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
-                (model.joints[id].name.clone(), "limit", file, 1)
+            EfcType::LimitJoint => json!({"name": model.joints[id].name, "kind": "limit", "source": file}),
+            EfcType::FrictionDof => {
+                let joint = model.joint_of(model.dof_body[id]);
+                json!({"name": joint.name, "kind": "friction", "source": file, "dof": id})
+            }
+            EfcType::ContactFrictionless | EfcType::ContactElliptic => {
+                let c = &data.contacts[id];
+                let names = c.geom.map(|g| geom_name(model, g));
+                json!({
+                    "name": format!("{}|{}", names[0], names[1]), "kind": "contact", "source": file,
+                    "geoms": names, "pos": c.pos.as_slice(), "normal": c.frame.row(0).transpose().as_slice(),
+                    "dist": c.dist, "condim": n,
+                })
             }
         };
-        constraints.push(json!({
-            "name": name, "kind": kind, "source": source,
-            "force": data.efc_force.as_slice()[r..r + n], "violation": data.efc_pos.as_slice()[r..r + n],
-        }));
+        let n = entry.get("rows").and_then(Value::as_u64).map_or(n, |k| k as usize);
+        entry["force"] = json!(data.efc_force.as_slice()[r..r + n]);
+        entry["violation"] = json!(data.efc_pos.as_slice()[r..r + n]);
+        constraints.push(entry);
         r += n;
     }
     let vec = |x: &nalgebra::DVector<f64>| x.as_slice().to_vec();
@@ -110,6 +123,16 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
         "qfrc_actuator": vec(&data.qfrc_actuator), "qfrc_constraint": vec(&data.qfrc_constraint),
         "constraints": constraints,
     })
+}
+
+/// A geom's name, or `<body>#<index>` for an unnamed one.
+fn geom_name(model: &Model, g: usize) -> String {
+    let geom = &model.geoms[g];
+    if geom.name.is_empty() {
+        format!("{}#{g}", geom.link)
+    } else {
+        geom.name.clone()
+    }
 }
 
 /// Checks one input state's sizes and values.

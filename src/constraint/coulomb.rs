@@ -1,0 +1,386 @@
+//! The exact mode's solver for rows with dry friction — contacts in the Coulomb cone and dof
+//! friction loss — together with equality, limit and frictionless contact rows: a projected block
+//! Gauss–Seidel iteration on the Delassus matrix A = J M⁻¹ Jᵀ (Jean & Moreau, "Unilaterality and
+//! dry friction in the dynamics of rigid body collections", 1992; Acary & Brogliato, *Numerical
+//! Methods for Nonsmooth Dynamical Systems*, 2008, §13.3 "nonsmooth Gauss–Seidel"; the same family
+//! as Pinocchio's `PGSContactSolver`).
+//!
+//! With w = A λ − b the row accelerations (or, at the velocity level, the post-impact row
+//! velocities), each block of rows is solved exactly with the others fixed:
+//! - the equality rows together (w = 0, λ free): A_EE λ_E = b_E − A_E· λ (minimum-norm when
+//!   redundant);
+//! - a limit or a contact normal (Signorini): λ ≥ 0, w ≥ 0, λ w = 0 — λ = max(0, λ − w/A_ii);
+//! - a dof's friction loss: while the dof slides λ = −f sign(q̇); at rest |λ| ≤ f and w = 0 unless
+//!   |λ| = f (box projection);
+//! - a contact's friction rows (elliptic cone Σ (λ_i/μ_i)² ≤ λ_n²): while the contact slips, the
+//!   force of maximal dissipation λ_i = −λ_n μ_i² u_i / ‖μ ∘ u‖ (u the slip velocity); at rest,
+//!   the exact minimiser of ½ λᵀ A_ff λ − gᵀ λ over the cone (w_f = 0 inside; on the boundary
+//!   w_f ∝ −λ_i/μ_i²), by the stick solve or, when that leaves the cone, Newton on the secular
+//!   equation ‖(Ã + νI)⁻¹ g̃‖ = λ_n of the scaled problem (Moré & Sorensen 1983).
+//!
+//! A fixed point satisfies Signorini's and Coulomb's laws exactly (notes §2.5: F_P ≤ μ F_N, and
+//! F_P = μ F_N while slipping). The iteration stops when no row's force changes by more than the
+//! tolerance (in the rows' units of w, relative to ‖b‖∞), or after the iteration limit; the last
+//! change is the reported residual. At the acceleration level it starts from the previous solve's
+//! forces when the rows are the same (warm start).
+
+use super::dense::solve_psd;
+use crate::model::{Data, EfcType, Model};
+
+/// Iteration limit and tolerance of the Gauss–Seidel solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolverSettings {
+    pub max_iterations: u32,
+    /// Relative tolerance on the largest change of a row's force (times A_ii) in one sweep.
+    pub tolerance: f64,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        Self { max_iterations: 2000, tolerance: 1e-13 }
+    }
+}
+
+/// Slip speed (m/s, rad/s) above which a contact or a dof with friction loss counts as sliding.
+pub const SLIP_VELOCITY: f64 = 1e-9;
+
+/// Separation speed (m/s, rad/s) above which a limit or contact row leaves its bound and carries no
+/// force at the acceleration level.
+pub const SEPARATING_VELOCITY: f64 = 1e-10;
+
+/// Whether the problem needs this solver: some row has dry friction.
+pub fn has_friction(data: &Data) -> bool {
+    (0..data.nefc).any(|i| matches!(data.efc_type[i], EfcType::FrictionDof | EfcType::ContactElliptic))
+}
+
+/// What the rows' w are.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Level {
+    /// Row accelerations (the constraint stage of `forward`): sliding laws from `efc_vel`,
+    /// separating rows skipped, warm start.
+    Acceleration,
+    /// Post-step row velocities (inelastic impacts; Moreau's velocity-level law over the step
+    /// `dt`): the friction impulse of the whole step — dt times the force λ̄ of the last
+    /// acceleration-level solve plus the projection's impulse p — obeys Coulomb's law: for a dof,
+    /// |dt λ̄ + p| ≤ f dt; for a contact, dt λ̄_f + p_f lies in the cone of dt λ̄_n + p_n. A slip that
+    /// the step's friction could have stopped thus ends at rest instead of reversing, and a slip
+    /// that friction could not stop keeps the velocity the step gave it.
+    Velocity { dt: f64 },
+}
+
+/// Solves the rows' conditions on A (`efc_delassus`) and b (`efc_rhs`, first nefc entries); λ is
+/// left in `efc_rhs`. Sets `efc_iterations`, `efc_residual`, `efc_converged`. At the acceleration
+/// level it starts from `efc_warm` when the rows are those of the last solve (the constraint stage
+/// stores it). No allocation.
+pub fn solve_coulomb(model: &Model, data: &mut Data, level: Level, settings: SolverSettings) {
+    let n = data.nefc;
+    let ne = (0..n).take_while(|&i| data.efc_type[i] == EfcType::Equality).count();
+    // b in efc_force during the iterations, λ in efc_rhs.
+    for i in 0..n {
+        data.efc_force[i] = data.efc_rhs[i];
+    }
+    let warm = level == Level::Acceleration
+        && data.efc_warm_rows.len() == n
+        && (0..n).all(|i| data.efc_warm_rows[i] == (data.efc_type[i], data.efc_id[i]));
+    for i in 0..n {
+        data.efc_rhs[i] = if warm { data.efc_warm[i] } else { 0.0 };
+    }
+    let scale = (0..n).map(|i| data.efc_force[i].abs()).fold(0.0, f64::max);
+    let tolerance = settings.tolerance * scale.max(f64::MIN_POSITIVE);
+    let mut change = 0.0;
+    let mut iterations = 0;
+    data.efc_converged = false;
+    while iterations < settings.max_iterations {
+        iterations += 1;
+        change = 0.0f64;
+        if ne > 0 {
+            change = change.max(equality_block(data, ne));
+        }
+        let mut i = ne;
+        while i < n {
+            let len = data.efc_block_len(i);
+            change = change.max(match data.efc_type[i] {
+                EfcType::Equality => scalar_update(data, i, f64::NEG_INFINITY, f64::INFINITY),
+                EfcType::FrictionDof => friction_dof(model, data, i, level),
+                EfcType::LimitJoint | EfcType::ContactFrictionless => {
+                    if separating(data, i, level) {
+                        set_zero(data, i, 1)
+                    } else {
+                        scalar_update(data, i, normal_lower_bound(data, i), f64::INFINITY)
+                    }
+                }
+                EfcType::ContactElliptic => contact_block(data, i, len, level),
+            });
+            i += len;
+        }
+        if change <= tolerance || !change.is_finite() {
+            data.efc_converged = change.is_finite();
+            break;
+        }
+    }
+    data.efc_iterations = iterations;
+    data.efc_residual = change;
+}
+
+/// w_i = (A λ)_i − b_i with the current λ.
+fn row_w(data: &Data, i: usize) -> f64 {
+    let n = data.nefc;
+    (0..n).map(|j| data.efc_delassus[(i, j)] * data.efc_rhs[j]).sum::<f64>() - data.efc_force[i]
+}
+
+/// Sets λ of rows i..i+len to 0; returns the change (times A_ii).
+fn set_zero(data: &mut Data, i: usize, len: usize) -> f64 {
+    let mut change = 0.0f64;
+    for k in i..i + len {
+        change = change.max((data.efc_rhs[k] * data.efc_delassus[(k, k)]).abs());
+        data.efc_rhs[k] = 0.0;
+    }
+    change
+}
+
+/// Whether limit/contact row i moves away from its bound (acceleration level only).
+fn separating(data: &Data, i: usize, level: Level) -> bool {
+    level == Level::Acceleration && !data.efc_frozen && data.efc_vel[i] > SEPARATING_VELOCITY
+}
+
+/// The lower bound of a limit or contact normal force: 0, or none for a row still pressing at the
+/// velocity projection (`efc_pressing`: its velocity is held at 0, as a bilateral row's).
+fn normal_lower_bound(data: &Data, i: usize) -> f64 {
+    if data.efc_pressing[i] {
+        f64::NEG_INFINITY
+    } else {
+        0.0
+    }
+}
+
+/// λ_i ← clamp(λ_i − w_i / A_ii, lo, hi); returns |Δλ_i| A_ii.
+fn scalar_update(data: &mut Data, i: usize, lo: f64, hi: f64) -> f64 {
+    let a = data.efc_delassus[(i, i)];
+    if a <= 0.0 {
+        return set_zero(data, i, 1);
+    }
+    let old = data.efc_rhs[i];
+    let new = (old - row_w(data, i) / a).clamp(lo, hi);
+    data.efc_rhs[i] = new;
+    ((new - old) * a).abs()
+}
+
+/// The equality rows 0..ne solved together with the other rows fixed (minimum-norm when
+/// redundant); returns the largest |Δλ_i| A_ii.
+fn equality_block(data: &mut Data, ne: usize) -> f64 {
+    let n = data.nefc;
+    let Data { efc_delassus, efc_sub, efc_sub_rhs, efc_rhs, efc_force, efc_factor, efc_eig, .. } = data;
+    for i in 0..ne {
+        efc_sub_rhs[i] = efc_force[i] - (ne..n).map(|j| efc_delassus[(i, j)] * efc_rhs[j]).sum::<f64>();
+        for j in 0..ne {
+            efc_sub[(i, j)] = efc_delassus[(i, j)];
+        }
+    }
+    data.efc_rank = solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..ne], efc_factor, efc_eig);
+    let mut change = 0.0f64;
+    for i in 0..ne {
+        change = change.max(((data.efc_sub_rhs[i] - data.efc_rhs[i]) * data.efc_delassus[(i, i)]).abs());
+        data.efc_rhs[i] = data.efc_sub_rhs[i];
+    }
+    change
+}
+
+/// A dof's friction loss row i.
+fn friction_dof(model: &Model, data: &mut Data, i: usize, level: Level) -> f64 {
+    let dof = data.efc_id[i];
+    let loss = model.joint_of(model.dof_body[dof]).friction;
+    if let Level::Velocity { dt } = level {
+        let spent = dt * data.efc_previous_force(i, 0);
+        return scalar_update(data, i, -loss * dt - spent, loss * dt - spent);
+    }
+    let speed = data.efc_vel[i];
+    if speed.abs() > SLIP_VELOCITY {
+        let a = data.efc_delassus[(i, i)];
+        let new = -loss * speed.signum();
+        let change = ((new - data.efc_rhs[i]) * a).abs();
+        data.efc_rhs[i] = new;
+        change
+    } else {
+        scalar_update(data, i, -loss, loss)
+    }
+}
+
+/// Friction coefficient of friction row `k` (1-based within the contact: 1, 2 sliding, 3
+/// torsional, 4, 5 rolling) from MuJoCo's 5-vector.
+fn mu(friction: &[f64; 5], k: usize) -> f64 {
+    friction[k - 1]
+}
+
+/// Largest contact dimension (condim 6).
+const MAX_DIM: usize = 6;
+
+/// A frictional contact's block: rows i (normal) .. i+len (friction).
+fn contact_block(data: &mut Data, i: usize, len: usize, level: Level) -> f64 {
+    if separating(data, i, level) {
+        return set_zero(data, i, len);
+    }
+    let mut change = scalar_update(data, i, normal_lower_bound(data, i), f64::INFINITY);
+    // The cone's radius and, at the velocity level, the friction impulse the step already
+    // applied (the cone is then solved for the step's total friction impulse).
+    let mut spent = [0.0; MAX_DIM];
+    let lambda_n = match level {
+        Level::Acceleration => data.efc_rhs[i],
+        Level::Velocity { dt } => {
+            for k in 1..len {
+                spent[k - 1] = dt * data.efc_previous_force(i, k);
+            }
+            data.efc_rhs[i].max(0.0) + dt * data.efc_previous_force(i, 0).max(0.0)
+        }
+    };
+    let friction = data.contacts[data.efc_id[i]].friction;
+    let nf = len - 1;
+    let mut new = [0.0; MAX_DIM];
+    if lambda_n > 0.0 {
+        let slip: f64 = (1..len).map(|k| data.efc_vel[i + k].powi(2)).sum::<f64>().sqrt();
+        if level == Level::Acceleration && slip > SLIP_VELOCITY {
+            // Maximal dissipation against the slip velocity u.
+            let norm = (1..len).map(|k| (mu(&friction, k) * data.efc_vel[i + k]).powi(2)).sum::<f64>().sqrt();
+            for k in 1..len {
+                let m = mu(&friction, k);
+                new[k - 1] = if norm > 0.0 { -lambda_n * m * m * data.efc_vel[i + k] / norm } else { 0.0 };
+            }
+        } else {
+            cone_solve(data, i, len, &friction, lambda_n, &spent[..nf], &mut new[..nf]);
+        }
+    }
+    for k in 1..len {
+        let r = i + k;
+        change = change.max(((new[k - 1] - data.efc_rhs[r]) * data.efc_delassus[(r, r)]).abs());
+        data.efc_rhs[r] = new[k - 1];
+    }
+    change
+}
+
+/// The friction forces `out` of the contact block at row i minimising ½ λᵀ A_ff λ − gᵀ λ with
+/// λ + `spent` in the elliptic cone of radius `lambda_n` (`spent` = 0 at the acceleration level),
+/// g = b_f − A_f,· λ without the block's own friction.
+#[allow(clippy::too_many_arguments)]
+fn cone_solve(
+    data: &Data,
+    i: usize,
+    len: usize,
+    friction: &[f64; 5],
+    lambda_n: f64,
+    spent: &[f64],
+    out: &mut [f64],
+) {
+    let n = data.nefc;
+    // Scaled problem in y_k = λ_k / μ_k over the friction rows with μ_k > 0.
+    let mut idx = [0usize; MAX_DIM];
+    let mut m = 0;
+    for k in 1..len {
+        if mu(friction, k) > 0.0 {
+            idx[m] = k;
+            m += 1;
+        }
+    }
+    out.fill(0.0);
+    if m == 0 {
+        return;
+    }
+    let mut a = [[0.0; MAX_DIM]; MAX_DIM];
+    let mut g = [0.0; MAX_DIM];
+    for p in 0..m {
+        let rp = i + idx[p];
+        let mp = mu(friction, idx[p]);
+        let own: f64 = (1..len).map(|k| data.efc_delassus[(rp, i + k)] * data.efc_rhs[i + k]).sum();
+        let w_other: f64 = (0..n).map(|j| data.efc_delassus[(rp, j)] * data.efc_rhs[j]).sum::<f64>() - own;
+        let shift: f64 = (1..len).map(|k| data.efc_delassus[(rp, i + k)] * spent[k - 1]).sum();
+        g[p] = mp * (data.efc_force[rp] - w_other + shift);
+        for q in 0..m {
+            a[p][q] = mp * mu(friction, idx[q]) * data.efc_delassus[(rp, i + idx[q])];
+        }
+    }
+    let mut y = [0.0; MAX_DIM];
+    let trace: f64 = (0..m).map(|p| a[p][p]).sum();
+    let inside = shifted_solve(&a, m, 0.0, &g, &mut y, None)
+        && (0..m).map(|p| y[p] * y[p]).sum::<f64>().sqrt() <= lambda_n;
+    if !inside {
+        // Newton on 1/R − 1/‖y(ν)‖ = 0, ν ≥ 0 (monotone from below).
+        let mut nu = if shifted_solve(&a, m, 0.0, &g, &mut y, None) { 0.0 } else { 1e-14 * trace };
+        let mut z = [0.0; MAX_DIM];
+        for _ in 0..60 {
+            if !shifted_solve(&a, m, nu, &g, &mut y, Some(&mut z)) {
+                nu = nu.max(1e-14 * trace) * 2.0;
+                continue;
+            }
+            let ny = (0..m).map(|p| y[p] * y[p]).sum::<f64>().sqrt();
+            let nz2: f64 = (0..m).map(|p| z[p] * z[p]).sum();
+            if ny == 0.0 || (ny - lambda_n).abs() <= 1e-15 * lambda_n || nz2 == 0.0 {
+                break;
+            }
+            let step = (ny * ny / nz2) * (ny - lambda_n) / lambda_n;
+            nu = (nu + step).max(0.0);
+            if step.abs() <= 1e-16 * nu.max(trace) {
+                break;
+            }
+        }
+        // Onto the cone's boundary exactly (round-off of the secular solve).
+        let ny = (0..m).map(|p| y[p] * y[p]).sum::<f64>().sqrt();
+        if ny > lambda_n {
+            for v in y.iter_mut().take(m) {
+                *v *= lambda_n / ny;
+            }
+        }
+    }
+    for p in 0..m {
+        out[idx[p] - 1] = mu(friction, idx[p]) * y[p];
+    }
+    for (o, s) in out.iter_mut().zip(spent) {
+        *o -= s;
+    }
+}
+
+/// Solves (A + νI) y = g (m × m, symmetric) by Cholesky; with `z`, also z = L⁻¹ y. False if the
+/// shifted matrix is not positive definite.
+fn shifted_solve(
+    a: &[[f64; MAX_DIM]; MAX_DIM],
+    m: usize,
+    nu: f64,
+    g: &[f64; MAX_DIM],
+    y: &mut [f64; MAX_DIM],
+    z: Option<&mut [f64; MAX_DIM]>,
+) -> bool {
+    let mut l = [[0.0; MAX_DIM]; MAX_DIM];
+    let scale = (0..m).map(|p| a[p][p]).fold(0.0, f64::max) + nu;
+    for j in 0..m {
+        let mut d = a[j][j] + nu;
+        for k in 0..j {
+            d -= l[j][k] * l[j][k];
+        }
+        if d <= 1e-14 * scale {
+            return false;
+        }
+        let d = d.sqrt();
+        l[j][j] = d;
+        for p in j + 1..m {
+            let mut s = a[p][j];
+            for k in 0..j {
+                s -= l[p][k] * l[j][k];
+            }
+            l[p][j] = s / d;
+        }
+    }
+    // L x = g, then Lᵀ y = x.
+    let mut x = [0.0; MAX_DIM];
+    for p in 0..m {
+        let s: f64 = (0..p).map(|k| l[p][k] * x[k]).sum();
+        x[p] = (g[p] - s) / l[p][p];
+    }
+    for p in (0..m).rev() {
+        let s: f64 = (p + 1..m).map(|k| l[k][p] * y[k]).sum();
+        y[p] = (x[p] - s) / l[p][p];
+    }
+    if let Some(z) = z {
+        for p in 0..m {
+            let s: f64 = (0..p).map(|k| l[p][k] * z[k]).sum();
+            z[p] = (y[p] - s) / l[p][p];
+        }
+    }
+    true
+}
