@@ -214,7 +214,10 @@ fn mjcf_info_lists_kept_elements_and_keyframes() {
     assert!(actuators.iter().all(|a| a["kind"] == "position" && a["status"] == "parsed, not simulated"));
     assert_eq!(actuators[0]["targets"][0], "FR_hip_joint");
     assert_eq!(v["stages"]["actuation"]["status"], "parsed, not simulated");
-    assert_eq!(v["stages"]["collision"]["status"], "parsed, not simulated");
+    assert_eq!(
+        v["stages"]["collision"]["status"], "runs",
+        "self-collision pairs between the legs and the trunk"
+    );
     assert_eq!(v["options"]["timestep"], 0.002, "MuJoCo's default: go1.xml sets no <option>");
 }
 

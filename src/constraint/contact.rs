@@ -43,14 +43,13 @@ fn contact_dim(condim: u32, frictional: bool) -> usize {
 }
 
 /// Appends the rows of every active contact (`dist` ≤ [`CONTACT_ACTIVE_DISTANCE`], or, while the
-/// step's rows are frozen, every contact of a frozen pair) from row `r` on: `efc_j`, `efc_pos`, `efc_id` (the contact's index in `Data::contacts`) and `efc_type`.
+/// step's rows are frozen, every frozen contact) from row `r` on: `efc_j`, `efc_pos`, `efc_id` (the contact's index in `Data::contacts`) and `efc_type`.
 /// With `frictional` false only the normal rows are written (the position projection). Returns
 /// the next free row. Needs body poses and motion subspaces at the contacts' configuration.
 pub(crate) fn contact_rows(model: &Model, data: &mut Data, mut r: usize, frictional: bool) -> usize {
     for c in 0..data.contacts.len() {
         let contact = data.contacts[c];
-        let active = contact.dist <= CONTACT_ACTIVE_DISTANCE
-            || (data.efc_frozen && data.efc_frozen_pairs.contains(&contact.geom));
+        let active = contact.dist <= CONTACT_ACTIVE_DISTANCE || data.contact_is_frozen(&contact);
         if !active {
             continue;
         }

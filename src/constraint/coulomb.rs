@@ -19,9 +19,10 @@
 //!   equation ‖(Ã + νI)⁻¹ g̃‖ = λ_n of the scaled problem (Moré & Sorensen 1983).
 //!
 //! A fixed point satisfies Signorini's and Coulomb's laws exactly (notes §2.5: F_P ≤ μ F_N, and
-//! F_P = μ F_N while slipping). The iteration stops when no row's force changes by more than the
-//! tolerance (in the rows' units of w, relative to ‖b‖∞), or after the iteration limit; the last
-//! change is the reported residual. At the acceleration level it starts from the previous solve's
+//! F_P = μ F_N while slipping). The iteration stops when a sweep changes the motion, M⁻¹Jᵀ Δλ
+//! (an acceleration, or a velocity at the velocity level), by less than the tolerance relative to
+//! the constraints' whole correction M⁻¹Jᵀ λ — redundant rows that still trade force among
+//! themselves move nothing — or after the iteration limit; the last change is the residual. At the acceleration level it starts from the previous solve's
 //! forces when the rows are the same (warm start).
 
 use super::dense::solve_psd;
@@ -31,18 +32,18 @@ use crate::model::{Data, EfcType, Model};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverSettings {
     pub max_iterations: u32,
-    /// Relative tolerance on the largest change of a row's force (times A_ii) in one sweep.
+    /// Relative tolerance on the change one sweep makes to the motion, max |M⁻¹Jᵀ Δλ|, against the
+    /// constraint forces' whole correction max |M⁻¹Jᵀ λ|.
     pub tolerance: f64,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        Self { max_iterations: 2000, tolerance: 1e-13 }
+        Self { max_iterations: 10000, tolerance: 1e-13 }
     }
 }
 
-/// Slip speed (m/s, rad/s) above which a contact or a dof with friction loss counts as sliding.
-pub const SLIP_VELOCITY: f64 = 1e-9;
+pub use crate::model::SLIP_VELOCITY;
 
 /// Separation speed (m/s, rad/s) above which a limit or contact row leaves its bound and carries no
 /// force at the acceleration level.
@@ -69,10 +70,18 @@ pub enum Level {
 }
 
 /// Solves the rows' conditions on A (`efc_delassus`) and b (`efc_rhs`, first nefc entries); λ is
-/// left in `efc_rhs`. Sets `efc_iterations`, `efc_residual`, `efc_converged`. At the acceleration
+/// left in `efc_rhs`. `motion_scale` is the size of the motion the rows act on (max |q̈_smooth|,
+/// or max |v| at the velocity level): a sweep that changes the motion by less than the tolerance
+/// relative to it or to the constraints' correction has converged. Sets `efc_iterations`, `efc_residual`, `efc_converged`. At the acceleration
 /// level it starts from `efc_warm` when the rows are those of the last solve (the constraint stage
 /// stores it). No allocation.
-pub fn solve_coulomb(model: &Model, data: &mut Data, level: Level, settings: SolverSettings) {
+pub fn solve_coulomb(
+    model: &Model,
+    data: &mut Data,
+    level: Level,
+    settings: SolverSettings,
+    motion_scale: f64,
+) {
     let n = data.nefc;
     let ne = (0..n).take_while(|&i| data.efc_type[i] == EfcType::Equality).count();
     // b in efc_force during the iterations, λ in efc_rhs.
@@ -85,21 +94,21 @@ pub fn solve_coulomb(model: &Model, data: &mut Data, level: Level, settings: Sol
     for i in 0..n {
         data.efc_rhs[i] = if warm { data.efc_warm[i] } else { 0.0 };
     }
-    let scale = (0..n).map(|i| data.efc_force[i].abs()).fold(0.0, f64::max);
-    let tolerance = settings.tolerance * scale.max(f64::MIN_POSITIVE);
     let mut change = 0.0;
     let mut iterations = 0;
     data.efc_converged = false;
     while iterations < settings.max_iterations {
         iterations += 1;
-        change = 0.0f64;
+        for i in 0..n {
+            data.efc_lambda_prev[i] = data.efc_rhs[i];
+        }
         if ne > 0 {
-            change = change.max(equality_block(data, ne));
+            equality_block(data, ne);
         }
         let mut i = ne;
         while i < n {
             let len = data.efc_block_len(i);
-            change = change.max(match data.efc_type[i] {
+            match data.efc_type[i] {
                 EfcType::Equality => scalar_update(data, i, f64::NEG_INFINITY, f64::INFINITY),
                 EfcType::FrictionDof => friction_dof(model, data, i, level),
                 EfcType::LimitJoint | EfcType::ContactFrictionless => {
@@ -110,16 +119,38 @@ pub fn solve_coulomb(model: &Model, data: &mut Data, level: Level, settings: Sol
                     }
                 }
                 EfcType::ContactElliptic => contact_block(data, i, len, level),
-            });
+            };
             i += len;
         }
-        if change <= tolerance || !change.is_finite() {
-            data.efc_converged = change.is_finite();
+        // The change of the motion this sweep made, M⁻¹Jᵀ Δλ, against the constraint's whole
+        // correction M⁻¹Jᵀ λ: redundant rows may still trade force between them (a box's corners),
+        // which moves nothing.
+        let (mut moved, mut total) = (0.0f64, 0.0f64);
+        for k in 0..model.nv {
+            let (mut dk, mut tk) = (0.0, 0.0);
+            for i in 0..n {
+                let y = data.efc_minv_jt[(k, i)];
+                dk += y * (data.efc_rhs[i] - data.efc_lambda_prev[i]);
+                tk += y * data.efc_rhs[i];
+            }
+            moved = moved.max(dk.abs());
+            total = total.max(tk.abs());
+        }
+        change = moved;
+        if moved <= settings.tolerance * total.max(motion_scale)
+            || moved <= ROUND_OFF_FLOOR
+            || !moved.is_finite()
+        {
+            data.efc_converged = moved.is_finite();
             break;
         }
     }
     data.efc_iterations = iterations;
     data.efc_residual = change;
+    if !data.efc_converged {
+        data.efc_unconverged += 1;
+        data.efc_unconverged_residual = data.efc_unconverged_residual.max(change);
+    }
 }
 
 /// w_i = (A λ)_i − b_i with the current λ.
@@ -194,7 +225,7 @@ fn friction_dof(model: &Model, data: &mut Data, i: usize, level: Level) -> f64 {
         return scalar_update(data, i, -loss * dt - spent, loss * dt - spent);
     }
     let speed = data.efc_vel[i];
-    if speed.abs() > SLIP_VELOCITY {
+    if speed.abs() > SLIP_VELOCITY && !data.efc_frozen_at_rest(i) {
         let a = data.efc_delassus[(i, i)];
         let new = -loss * speed.signum();
         let change = ((new - data.efc_rhs[i]) * a).abs();
@@ -210,6 +241,10 @@ fn friction_dof(model: &Model, data: &mut Data, i: usize, level: Level) -> f64 {
 fn mu(friction: &[f64; 5], k: usize) -> f64 {
     friction[k - 1]
 }
+
+/// A sweep that changes the motion by less than this (m/s², rad/s², or m/s, rad/s at the velocity
+/// level) has converged whatever the scale: round-off of motions at rest.
+const ROUND_OFF_FLOOR: f64 = 1e-15;
 
 /// Largest contact dimension (condim 6).
 const MAX_DIM: usize = 6;
@@ -237,7 +272,7 @@ fn contact_block(data: &mut Data, i: usize, len: usize, level: Level) -> f64 {
     let mut new = [0.0; MAX_DIM];
     if lambda_n > 0.0 {
         let slip: f64 = (1..len).map(|k| data.efc_vel[i + k].powi(2)).sum::<f64>().sqrt();
-        if level == Level::Acceleration && slip > SLIP_VELOCITY {
+        if level == Level::Acceleration && slip > SLIP_VELOCITY && !data.efc_frozen_at_rest(i) {
             // Maximal dissipation against the slip velocity u.
             let norm = (1..len).map(|k| (mu(&friction, k) * data.efc_vel[i + k]).powi(2)).sum::<f64>().sqrt();
             for k in 1..len {

@@ -11,6 +11,7 @@
 use super::active_set::{solve_delassus, solve_mixed};
 use super::coulomb::{has_friction, solve_coulomb, Level, SolverSettings, SEPARATING_VELOCITY};
 use super::ConstraintModel;
+use crate::collision::{collide, EXACT_REACH};
 use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
 use crate::kinematics::body_poses;
 use crate::model::{integrate_configuration, Data, EfcType, Model};
@@ -66,7 +67,8 @@ pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>, 
         data.efc_rhs[i] = -(j_qacc + data.efc_jdotv[i]) - alpha * data.efc_vel[i] - beta * data.efc_pos[i];
     }
     if has_friction(data) {
-        solve_coulomb(model, data, Level::Acceleration, settings);
+        let scale = data.qacc_smooth.amax();
+        solve_coulomb(model, data, Level::Acceleration, settings, scale);
     } else {
         // A limit or contact row moving away from its bound (J v > 0) is separating: no force.
         data.efc_iterations = solve_mixed(data, |d, i| !d.efc_frozen && d.efc_vel[i] > SEPARATING_VELOCITY);
@@ -113,7 +115,8 @@ pub fn row_violation(data: &Data) -> [f64; 2] {
 /// Moves `q` onto the constraint manifold φ(q) = 0 by Gauss–Newton steps Δ = −M⁻¹Jᵀ A⁺ φ applied
 /// on the configuration manifold (`q ← q ⊕ Δ`, free and ball joints included), M taken at the
 /// starting q. Stops when max |φ| ≤ `tolerance` or after `max_iterations`; returns (iterations,
-/// final max |φ|). Leaves the factor of M at the starting q in `data`.
+/// final max |φ|). Leaves the factor of M at the starting q in `data`, and the rows it corrected
+/// frozen ([`Data::add_frozen_rows`]) for the velocity projection; [`Data::thaw_rows`] ends that.
 pub fn project_positions(
     model: &Model,
     constraints: &ConstraintModel,
@@ -129,7 +132,14 @@ pub fn project_positions(
         if iterations > 0 {
             body_poses(model, data, q);
         }
+        if constraints.has_collision() {
+            collide(model, &constraints.collision, data, EXACT_REACH);
+        }
         constraints.positions(model, data, q, false);
+        if iterations == 0 {
+            // The rows corrected stay rows until they land on φ = 0.
+            data.add_frozen_rows(false);
+        }
         let n = data.nefc;
         let residual = data.efc_pos.rows(0, n).amax();
         if residual <= tolerance || iterations >= max_iterations || !residual.is_finite() {
@@ -170,7 +180,8 @@ pub fn project_velocities(
         data.efc_pressing[i] = data.efc_is_normal_or_limit(i) && data.efc_previous_force(i, 0) > 0.0;
     }
     if has_friction(data) {
-        solve_coulomb(model, data, Level::Velocity { dt }, settings);
+        let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        solve_coulomb(model, data, Level::Velocity { dt }, settings, scale);
     } else {
         solve_mixed(data, |_, _| false);
     }

@@ -13,9 +13,11 @@
 //! - joint / tendon / mimic: φ = x₁ − r₁ − P(x₂ − r₂), P(x) = a₀ + a₁x + … + a₄x⁴, with x the joint
 //!   value or fixed-tendon length and r its reference (qpos0 for MJCF, 0 for a URDF mimic).
 
-use super::contact::{contact_jdotv, contact_rows};
+use super::contact::{contact_jdotv, contact_rows, CONTACT_ACTIVE_DISTANCE};
 use super::friction_loss::FrictionRow;
 use super::limits::LimitRow;
+use crate::collision::{collide, CollisionModel, EXACT_REACH};
+use crate::kinematics::body_poses;
 use crate::kinematics::{
     bias_accelerations, for_each_ancestor_dof, forward_kinematics, forward_velocities,
     point_bias_acceleration,
@@ -97,8 +99,10 @@ pub struct EqualityRows {
 }
 
 /// Which constraint rows a model has and their fixed geometry (built once per model).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default)]
 pub struct ConstraintModel {
+    /// The geoms' collision shapes (contacts come from `Model::collision_pairs`).
+    pub collision: CollisionModel,
     pub equalities: Vec<EqualityRows>,
     /// Degrees of freedom with dry friction (`frictionloss`), one row each, always active.
     pub friction: Vec<FrictionRow>,
@@ -137,6 +141,11 @@ impl ConstraintModel {
         if !flags.constraint {
             return Self::default();
         }
+        let collision = if model.collision_pairs.is_empty() {
+            CollisionModel::default()
+        } else {
+            CollisionModel::new(model)
+        };
         let limits = if flags.limit {
             (0..model.joints.len()).filter_map(|j| LimitRow::of_joint(model, j)).collect()
         } else {
@@ -144,7 +153,7 @@ impl ConstraintModel {
         };
         let friction = if flags.frictionloss { FrictionRow::of_model(model) } else { Vec::new() };
         if model.equalities.is_empty() || !flags.equality {
-            return Self { equalities: Vec::new(), friction, limits };
+            return Self { collision, equalities: Vec::new(), friction, limits };
         }
         let mut data = Data::new(model);
         forward_kinematics(model, &mut data, &model.qpos0);
@@ -226,12 +235,32 @@ impl ConstraintModel {
             };
             equalities.push(EqualityRows { id, geometry });
         }
-        Self { equalities, friction, limits }
+        Self { collision, equalities, friction, limits }
     }
 
-    /// Whether the model has any constraint rows apart from contacts.
+    /// Whether the model has no constraint rows at all (no equality, friction loss, limit, nor
+    /// candidate collision pair).
     pub fn is_empty(&self) -> bool {
-        self.equalities.is_empty() && self.friction.is_empty() && self.limits.is_empty()
+        self.equalities.is_empty()
+            && self.friction.is_empty()
+            && self.limits.is_empty()
+            && !self.has_collision()
+    }
+
+    /// Whether the model has candidate collision pairs (a collision pass each `forward`).
+    pub fn has_collision(&self) -> bool {
+        !self.collision.shapes.is_empty()
+    }
+
+    /// The contacts at configuration `q` into `Data::contacts` (body poses first), if the model
+    /// has candidate pairs; returns whether any touches (a row in exact mode).
+    pub fn collide(&self, model: &Model, data: &mut Data, q: &[f64]) -> bool {
+        if !self.has_collision() {
+            return false;
+        }
+        body_poses(model, data, q);
+        collide(model, &self.collision, data, EXACT_REACH);
+        data.contacts.iter().any(|c| c.dist <= CONTACT_ACTIVE_DISTANCE || data.contact_is_frozen(c))
     }
 
     /// Whether any row other than a contact's is active at configuration `q`: an active equality,
@@ -398,6 +427,7 @@ impl ConstraintModel {
     /// Rows, `J v` and `J̇ v` at (q, v) from scratch: forward kinematics, body velocities, then
     /// [`positions`](Self::positions) and [`velocities`](Self::velocities).
     pub fn evaluate(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+        self.collide(model, data, q);
         forward_kinematics(model, data, q);
         forward_velocities(model, data, v);
         self.positions(model, data, q, true);

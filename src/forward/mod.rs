@@ -29,7 +29,9 @@ use crate::model::{Data, Model};
 pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]) {
     // The M path only while a constraint row is active (an equality, or a joint at a limit):
     // otherwise ABA, as for a model without constraints.
-    let m_path = plan.has_constraints() && plan.constraints.any_active(data, q);
+    let mut m_path = plan.has_constraints() && plan.constraints.any_active(data, q);
+    // Collision: contacts at q (a touching one needs the M path too).
+    m_path |= plan.constraints.collide(model, data, q);
     for stage in &plan.stages {
         if stage.status != Status::Runs {
             continue;

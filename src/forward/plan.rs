@@ -153,6 +153,8 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
         _ => format!("{nrow} equality rows and up to {nlimit} joint-limit rows"),
     };
     let rows = if nfriction > 0 { format!("{rows}, {nfriction} friction-loss rows") } else { rows };
+    let rows =
+        if constraints.has_collision() { format!("{rows}, contact rows while touching") } else { rows };
     let constrained = !constraints.is_empty();
     let mut out = Vec::with_capacity(13);
     out.push(if constrained {
@@ -288,13 +290,33 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
         stage(FrictionLoss, "friction loss", Skipped, "no joints with friction loss")
     });
     let colliding = model.geoms.iter().filter(|g| g.collision).count();
-    let pairs = model.contact_pairs.len() + model.contact_excludes.len();
-    out.push(if colliding + pairs > 0 {
+    let npairs = model.collision_pairs.len();
+    let hfields = model
+        .geoms
+        .iter()
+        .filter(|g| g.collision && matches!(g.shape, crate::model::spec::Shape::Hfield { .. }))
+        .count();
+    let hfield_note =
+        if hfields > 0 { format!("; {hfields} height fields are not collided yet") } else { String::new() };
+    out.push(if npairs > 0 {
+        let bound = model.max_contacts();
         stage(
             Collision,
             "collision",
-            NotSimulated,
-            format!("{colliding} collision geoms, {pairs} contact pair/exclude entries: contacts arrive with the collision work"),
+            Runs,
+            format!(
+                "{npairs} candidate geom pairs ({} explicit <pair>) among {colliding} collision geoms, up to {bound} contacts: bounding spheres, then closed forms (planes, spheres, capsules) or GJK/EPA; exact mode: contact rows while touching{hfield_note}",
+                model.collision_pairs.iter().filter(|p| p.pair.is_some()).count()
+            ),
+        )
+    } else if colliding > 0 && !(flags.contact && flags.constraint) {
+        stage(Collision, "collision", Skipped, "switched off by <option><flag contact|constraint=\"disable\">")
+    } else if colliding > 0 {
+        stage(
+            Collision,
+            "collision",
+            Skipped,
+            format!("{colliding} collision geoms but no candidate pair (same body, parent–child, welded to the world, bit masks or <exclude>){hfield_note}"),
         )
     } else {
         stage(Collision, "collision", Skipped, "no collision geometry")

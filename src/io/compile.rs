@@ -21,6 +21,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     }
     check_unique_names(spec)?;
     let mut meshes = crate::io::geom_mass::MeshCache::default();
+    let mut hulls = crate::io::geom_hull::HullCache::default();
     let mut warnings = spec.warnings.clone();
     // Pass 0: every link's own mass properties (explicit or from its geoms), with the compiler's
     // bounds; then `settotalmass` scales the moving links.
@@ -122,6 +123,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 shape: g.shape.clone(),
                 collision: g.collision,
                 mass,
+                contact: g.contact,
+                hull: crate::io::geom_hull::geom_hull(g, &link.name, &mut hulls)?,
             });
         }
     }
@@ -217,6 +220,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         actuators: Vec::new(),
         contact_pairs: Vec::new(),
         contact_excludes: Vec::new(),
+        collision_pairs: Vec::new(),
         elements: spec.elements.clone(),
         warnings,
     };
@@ -228,6 +232,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     model.contact_excludes = e.contact_excludes;
     model.elements.append(&mut e.kept);
     model.warnings.append(&mut e.warnings);
+    model.collision_pairs = crate::model::collision_pairs::candidate_pairs(&model);
     Ok(model)
 }
 

@@ -51,6 +51,8 @@ pub enum LoadError {
     MeshNotFound { loc: SourceLoc, link: String, path: String },
     #[error("{loc}: body '{link}': the mass properties of mesh '{path}' are needed (the body's inertia comes from its geoms) but {reason}")]
     MeshMass { loc: SourceLoc, link: String, path: String, reason: String },
+    #[error("{loc}: body '{link}': mesh '{path}' collides by its convex hull, but {reason}; give the geom contype=\"0\" conaffinity=\"0\" if it is only drawn, or fix the mesh")]
+    MeshHull { loc: SourceLoc, link: String, path: String, reason: String },
     #[error("{loc}: <include>: include cycle: {}; remove one of these includes", .chain.join(" includes "))]
     IncludeCycle { loc: SourceLoc, chain: Vec<String> },
     #[error(

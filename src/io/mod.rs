@@ -4,6 +4,7 @@
 pub mod compile;
 mod compile_elements;
 mod error;
+mod geom_hull;
 pub mod geom_mass;
 pub mod mjcf;
 pub mod package;

@@ -53,4 +53,8 @@ pub struct Contact {
     pub solimp: [f64; 5],
     /// Index in `Model::contact_pairs` for explicit pairs.
     pub pair: Option<usize>,
+    /// Which feature of the pair made the contact (a box corner, a capsule end, a hull vertex;
+    /// 0 for single-contact pairs): with `geom`, the contact's identity from one configuration to
+    /// the next (lagrange's addition to MuJoCo's fields).
+    pub feature: u32,
 }

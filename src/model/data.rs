@@ -11,6 +11,9 @@ use super::{Contact, JointKind, Model};
 use crate::spatial::{ArticulatedInertia, Force, Motion, RigidInertia, Transform};
 use nalgebra::{DMatrix, DVector, Matrix6};
 
+/// Slip speed (m/s, rad/s) above which a contact or a dof with friction loss counts as sliding.
+pub const SLIP_VELOCITY: f64 = 1e-9;
+
 /// The kind of a constraint row (MuJoCo's `mjtConstraint`, for the kinds simulated so far).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EfcType {
@@ -152,15 +155,22 @@ pub struct Data {
     pub efc_iterations: u32,
     /// Rank of J M⁻¹ Jᵀ at the last solve (< nefc: redundant rows, minimum-norm multipliers).
     pub efc_rank: usize,
-    /// Residual of the last iterative (Coulomb) solve: the largest violation of the row
-    /// conditions, in the rows' acceleration (or velocity) units; 0 after a direct solve.
+    /// Residual of the last iterative (Coulomb) solve: the largest change its last sweep made to
+    /// the motion, max |M⁻¹Jᵀ Δλ| (an acceleration, or a velocity at the velocity level); 0 after a
+    /// direct solve.
     pub efc_residual: f64,
     /// Whether the last iterative solve met its tolerance within its iteration limit.
     pub efc_converged: bool,
+    /// Iterative solves since `Data::new` that stopped at their iteration limit (or on a
+    /// non-finite value) without meeting the tolerance, and the largest residual they left.
+    pub efc_unconverged: u64,
+    pub efc_unconverged_residual: f64,
     /// Warm start of the iterative solve: the forces of the previous acceleration-level solve and
     /// the (type, id) of each of its rows; reused when the rows are the same.
     pub efc_warm: DVector<f64>,
     pub efc_warm_rows: Vec<(EfcType, usize)>,
+    /// λ at the start of a Gauss–Seidel sweep (scratch of the iterative solve).
+    pub efc_lambda_prev: DVector<f64>,
     /// Per row, during the velocity projection: a limit or contact row that carried a compressive
     /// force in the last acceleration-level solve. Its velocity is held at 0 (the row stays
     /// closed) rather than allowed to grow: a small separating J v left by the integrator's error
@@ -175,8 +185,13 @@ pub struct Data {
     pub efc_frozen: bool,
     /// The limited joints (index in `Model::joints`) with a row at the step's start.
     pub efc_frozen_limits: Vec<usize>,
-    /// The geom pairs with a contact row at the step's start.
-    pub efc_frozen_pairs: Vec<[usize; 2]>,
+    /// The contacts (geom pair and feature, see `Contact::feature`) with a row when frozen.
+    pub efc_frozen_contacts: Vec<([usize; 2], u32)>,
+    /// Of the frozen rows, the contacts and friction-loss dofs that were at rest (slip at most
+    /// [`SLIP_VELOCITY`]) when frozen: the later stages of the step keep their sticking law (a
+    /// stage's velocity carries the integrator's O(h²) slip, which is no slip).
+    pub efc_frozen_sticking: Vec<([usize; 2], u32)>,
+    pub efc_frozen_sticking_dofs: Vec<usize>,
 
     // --- collision ---
     /// Contacts of the last collision pass (MuJoCo's `contact`); capacity reserved for the model.
@@ -250,12 +265,17 @@ impl Data {
             efc_rank: 0,
             efc_residual: 0.0,
             efc_converged: true,
+            efc_unconverged: 0,
+            efc_unconverged_residual: 0.0,
             efc_warm: DVector::zeros(nefc),
             efc_warm_rows: Vec::with_capacity(nefc),
+            efc_lambda_prev: DVector::zeros(nefc),
             efc_pressing: vec![false; nefc],
             efc_frozen: false,
             efc_frozen_limits: Vec::with_capacity(model.joints.len()),
-            efc_frozen_pairs: Vec::with_capacity(model.max_contacts()),
+            efc_frozen_contacts: Vec::with_capacity(model.max_contacts()),
+            efc_frozen_sticking: Vec::with_capacity(model.max_contacts()),
+            efc_frozen_sticking_dofs: Vec::with_capacity(nv),
             contacts: Vec::with_capacity(model.max_contacts()),
         }
     }
@@ -283,23 +303,75 @@ impl Data {
     /// sustained contact stays closed through the projection.
     pub fn freeze_rows(&mut self, pressing_only: bool) {
         self.efc_frozen_limits.clear();
-        self.efc_frozen_pairs.clear();
+        self.efc_frozen_contacts.clear();
+        self.efc_frozen_sticking.clear();
+        self.efc_frozen_sticking_dofs.clear();
+        self.add_frozen_rows(pressing_only);
+        let mut i = 0;
+        while i < self.nefc {
+            let len = self.efc_block_len(i);
+            let slip = (i + 1..i + len).map(|k| self.efc_vel[k].abs()).fold(0.0, f64::max);
+            match self.efc_type[i] {
+                EfcType::FrictionDof if self.efc_vel[i].abs() <= SLIP_VELOCITY => {
+                    self.efc_frozen_sticking_dofs.push(self.efc_id[i])
+                }
+                EfcType::ContactElliptic if slip <= SLIP_VELOCITY => {
+                    let c = &self.contacts[self.efc_id[i]];
+                    if self.efc_frozen_sticking.len() < self.efc_frozen_sticking.capacity() {
+                        self.efc_frozen_sticking.push((c.geom, c.feature));
+                    }
+                }
+                _ => {}
+            }
+            i += len;
+        }
+    }
+
+    /// Whether the friction of row block `i` (a contact's normal row or a friction-loss row) keeps
+    /// its sticking law because rows are frozen and it was at rest when frozen.
+    pub fn efc_frozen_at_rest(&self, i: usize) -> bool {
+        self.efc_frozen
+            && match self.efc_type[i] {
+                EfcType::FrictionDof => self.efc_frozen_sticking_dofs.contains(&self.efc_id[i]),
+                EfcType::ContactElliptic => {
+                    let c = &self.contacts[self.efc_id[i]];
+                    self.efc_frozen_sticking.contains(&(c.geom, c.feature))
+                }
+                _ => false,
+            }
+    }
+
+    /// Adds the current limit and contact rows (with `pressing_only`, those whose force is
+    /// positive) to the frozen ones and freezes: the position projection keeps every row it
+    /// corrects until it lands on φ = 0 (a corner pushed out of the floor stays a row even where a
+    /// Gauss–Newton step overshoots), so the velocity projection that follows sees it too.
+    pub fn add_frozen_rows(&mut self, pressing_only: bool) {
         for i in 0..self.nefc {
             if pressing_only && self.efc_force[i] <= 0.0 {
                 continue;
             }
             match self.efc_type[i] {
-                EfcType::LimitJoint => self.efc_frozen_limits.push(self.efc_id[i]),
+                EfcType::LimitJoint if !self.efc_frozen_limits.contains(&self.efc_id[i]) => {
+                    self.efc_frozen_limits.push(self.efc_id[i])
+                }
                 EfcType::ContactFrictionless | EfcType::ContactElliptic if self.efc_is_normal(i) => {
-                    let pair = self.contacts[self.efc_id[i]].geom;
-                    if !self.efc_frozen_pairs.contains(&pair) {
-                        self.efc_frozen_pairs.push(pair);
+                    let c = &self.contacts[self.efc_id[i]];
+                    let key = (c.geom, c.feature);
+                    if !self.efc_frozen_contacts.contains(&key)
+                        && self.efc_frozen_contacts.len() < self.efc_frozen_contacts.capacity()
+                    {
+                        self.efc_frozen_contacts.push(key);
                     }
                 }
                 _ => {}
             }
         }
         self.efc_frozen = true;
+    }
+
+    /// Whether contact `c` keeps a row while rows are frozen.
+    pub fn contact_is_frozen(&self, c: &Contact) -> bool {
+        self.efc_frozen && self.efc_frozen_contacts.contains(&(c.geom, c.feature))
     }
 
     /// Ends the frozen stages of a step: rows are again chosen by distance.

@@ -5,6 +5,7 @@
 //! Fixed joints were fused by the compile step; every original link survives as a [`Frame`].
 
 pub mod actuator;
+pub mod collision_pairs;
 pub mod contact;
 mod data;
 mod elements;
@@ -15,8 +16,9 @@ pub mod spec;
 pub mod tendon;
 
 pub use actuator::Actuator;
+pub use collision_pairs::CollisionPair;
 pub use contact::{Contact, ContactExclude, ContactPair};
-pub use data::{Data, EfcType};
+pub use data::{Data, EfcType, SLIP_VELOCITY};
 pub use elements::{Element, Keyframe};
 pub use equality::{Equality, EqualityKind};
 pub use joint::{axis_angle, JointKind};
@@ -136,6 +138,11 @@ pub struct Geom {
     pub collision: bool,
     /// The mass it contributed to its body (0 if the body's inertia was given explicitly).
     pub mass: f64,
+    /// Contact parameters (MuJoCo's defaults for URDF collision geoms).
+    pub contact: spec::GeomContact,
+    /// For a colliding mesh: the vertices of its convex hull in the geom frame (MuJoCo collides
+    /// meshes by their hulls).
+    pub hull: Option<std::sync::Arc<Vec<Vec3>>>,
 }
 
 /// The compiled, immutable model. Build it with a loader (e.g. [`crate::io::load`]) or by
@@ -183,6 +190,9 @@ pub struct Model {
     pub contact_pairs: Vec<ContactPair>,
     /// Body pairs excluded from contact (`<contact><exclude>`).
     pub contact_excludes: Vec<ContactExclude>,
+    /// Candidate geom pairs for collision detection, fixed at compile time with their combined
+    /// contact parameters ([`collision_pairs::candidate_pairs`]).
+    pub collision_pairs: Vec<CollisionPair>,
     /// Elements parsed and kept but not simulated (sensors, …; listed by `lagrange info`).
     pub elements: Vec<Element>,
     /// What the loader ignored or could not interpret, each with file:line.
@@ -255,9 +265,9 @@ impl Model {
     }
     /// Whether any joint has viscous damping (the passive pass of `simulate`).
     /// Upper bound on the number of contacts one collision pass can report (sizes
-    /// `Data::contacts` and the contact rows). No collision layer yet: none.
+    /// `Data::contacts` and the contact rows): the sum of each candidate pair's bound.
     pub fn max_contacts(&self) -> usize {
-        0
+        self.collision_pairs.iter().map(|p| p.max_contacts).sum()
     }
 
     pub fn has_damping(&self) -> bool {

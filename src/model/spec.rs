@@ -218,11 +218,47 @@ pub struct GeomSpec {
     pub distribution: Distribution,
     /// For meshes: how MuJoCo computes its inertia (`<mesh inertia>`).
     pub mesh_inertia: crate::mass::MeshInertia,
-    /// MJCF `group`, `contype`, `conaffinity`, `friction`.
+    /// MJCF `group`.
     pub group: i32,
+    /// Contact parameters (MJCF `contype`, `conaffinity`, `condim`, `priority`, `friction`,
+    /// `solmix`, `solref`, `solimp`, `margin`, `gap`; MuJoCo's defaults for URDF).
+    pub contact: GeomContact,
+}
+
+/// A geom's contact parameters (MuJoCo documentation, "XML Reference → geom" and "Computation →
+/// Collision detection → Contact parameters").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GeomContact {
     pub contype: u32,
     pub conaffinity: u32,
+    /// 1 (frictionless), 3 (sliding), 4 (+ torsional), 6 (+ rolling).
+    pub condim: u32,
+    pub priority: i32,
+    /// Sliding, torsional, rolling.
     pub friction: [f64; 3],
+    pub solmix: f64,
+    pub solref: [f64; 2],
+    pub solimp: [f64; 5],
+    pub margin: f64,
+    pub gap: f64,
+}
+
+impl Default for GeomContact {
+    /// MuJoCo's defaults.
+    fn default() -> Self {
+        Self {
+            contype: 1,
+            conaffinity: 1,
+            condim: 3,
+            priority: 0,
+            friction: [1.0, 0.005, 0.0001],
+            solmix: 1.0,
+            solref: [0.02, 1.0],
+            solimp: [0.9, 0.95, 0.001, 0.5, 2.0],
+            margin: 0.0,
+            gap: 0.0,
+        }
+    }
 }
 
 impl GeomSpec {
@@ -238,9 +274,7 @@ impl GeomSpec {
             distribution: Distribution::Volume,
             mesh_inertia: Default::default(),
             group: 0,
-            contype: 1,
-            conaffinity: 1,
-            friction: [1.0, 0.005, 0.0001],
+            contact: GeomContact::default(),
         }
     }
 }

@@ -502,3 +502,9 @@ pub const LIMIT_EXCURSION: f64 = 1e-6;
 /// on a ball joint gains ≈ 7e-10 of the energy in 0.2 s of free flight). A constraint force or an
 /// impulse that added energy would show at the scale of the motion's kinetic energy, orders above.
 pub const ENERGY_GAIN_REL: f64 = 1e-9;
+/// Contact accelerations and forces in exact mode against the closed forms of notes §2.5 (issue
+/// 11 asks 1e-8): the solve is exact for sticking contacts (the Coulomb problem's fixed point) and
+/// iterated to 1e-13 of the right-hand side's scale otherwise.
+pub const CONTACT_REL: f64 = 1e-8;
+/// Penetration (m) of a body at rest on a floor, and of a foot below it, in exact mode.
+pub const PENETRATION_AT_REST: f64 = 1e-6;

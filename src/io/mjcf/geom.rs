@@ -10,7 +10,7 @@ use super::orientation::{rotation, z_to_matrix, AngleConvention};
 use super::Compiler;
 use crate::io::LoadError;
 use crate::mass::{Distribution, GeomMass};
-use crate::model::spec::{GeomSpec, Shape};
+use crate::model::spec::{GeomContact, GeomSpec, Shape};
 use crate::spatial::{Transform, Vec3};
 use std::collections::HashMap;
 
@@ -158,24 +158,65 @@ pub(crate) fn geom(
         }
         GeomMass::Density(rho)
     };
-    let contype = a.int("contype")?.unwrap_or(1);
-    let conaffinity = a.int("conaffinity")?.unwrap_or(1);
-    let mut friction = [1.0, 0.005, 0.0001];
-    if let Some(f) = a.some_numbers("friction", 1, 3)? {
-        friction[..f.len()].copy_from_slice(&f);
-    }
+    let contact = contact_parameters(a)?;
     Ok(GeomSpec {
         name: a.text("name").unwrap_or("").to_string(),
         loc: a.loc.clone(),
         x_link_geom: *x_link_parent * x_parent_geom,
         shape,
-        collision: contype != 0 || conaffinity != 0,
+        collision: contact.contype != 0 || contact.conaffinity != 0,
         mass,
         distribution: if shell { Distribution::Shell } else { Distribution::Volume },
         mesh_inertia,
         group: group as i32,
-        contype: contype as u32,
-        conaffinity: conaffinity as u32,
-        friction,
+        contact,
     })
+}
+
+/// A geom's contact attributes with MuJoCo's defaults and checks (condim ∈ {1, 3, 4, 6}; bit masks
+/// and margins non-negative; friction non-negative; solmix ≥ 0).
+pub(crate) fn contact_parameters(a: &Attrs) -> Result<GeomContact, LoadError> {
+    let mut c = GeomContact::default();
+    let mask = |name: &str, default: u32| -> Result<u32, LoadError> {
+        match a.int(name)? {
+            None => Ok(default),
+            Some(v) if (0..=i64::from(u32::MAX)).contains(&v) => Ok(v as u32),
+            Some(v) => {
+                Err(a.error(name, format!("is {v}; a collision bit mask is a non-negative 32-bit integer")))
+            }
+        }
+    };
+    c.contype = mask("contype", c.contype)?;
+    c.conaffinity = mask("conaffinity", c.conaffinity)?;
+    if let Some(d) = a.int("condim")? {
+        if ![1, 3, 4, 6].contains(&d) {
+            return Err(a.error("condim", format!("is {d}; MuJoCo's contact dimensions are 1, 3, 4 or 6")));
+        }
+        c.condim = d as u32;
+    }
+    c.priority = a.int("priority")?.map_or(0, |p| p as i32);
+    if let Some(f) = a.some_numbers("friction", 1, 3)? {
+        c.friction[..f.len()].copy_from_slice(&f);
+    }
+    if c.friction.iter().any(|&f| f < 0.0) {
+        return Err(a.error("friction", format!("is {:?}; friction coefficients must be ≥ 0", c.friction)));
+    }
+    if let Some(m) = a.real("solmix")? {
+        if m < 0.0 {
+            return Err(a.error("solmix", format!("is {m}; the mixing weight must be ≥ 0")));
+        }
+        c.solmix = m;
+    }
+    if let Some(r) = a.some_numbers("solref", 2, 2)? {
+        c.solref = [r[0], r[1]];
+    }
+    if let Some(i) = a.some_numbers("solimp", 1, 5)? {
+        c.solimp[..i.len()].copy_from_slice(&i);
+    }
+    c.margin = a.real("margin")?.unwrap_or(0.0);
+    c.gap = a.real("gap")?.unwrap_or(0.0);
+    if c.margin < 0.0 || c.gap < 0.0 {
+        return Err(a.error("margin", format!("is {} with gap {}; both must be ≥ 0", c.margin, c.gap)));
+    }
+    Ok(c)
 }

@@ -107,6 +107,8 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
                 json!({
                     "name": format!("{}|{}", names[0], names[1]), "kind": "contact", "source": file,
                     "geoms": names, "pos": c.pos.as_slice(), "normal": c.frame.row(0).transpose().as_slice(),
+                    "frame": [c.frame.row(0).transpose().as_slice(), c.frame.row(1).transpose().as_slice(),
+                              c.frame.row(2).transpose().as_slice()],
                     "dist": c.dist, "condim": n,
                 })
             }

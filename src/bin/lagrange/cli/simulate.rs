@@ -49,6 +49,14 @@ pub struct Summary {
     pub notes: Vec<String>,
     /// Largest max |φ| and max |J v| after any step.
     pub max_violation: [f64; 2],
+    /// Deepest contact penetration (m) and most touching contacts after any step.
+    pub max_penetration: f64,
+    pub max_contacts: usize,
+    /// Most iterations of one constraint solve at a step's end (Gauss–Seidel sweeps, or active-set
+    /// changes), and the iterative solves that
+    /// stopped at the iteration limit with the largest residual they left.
+    pub max_solver_iterations: u32,
+    pub unconverged: (u64, f64),
     /// Smallest rank deficiency seen: (rank, rows) of J M⁻¹ Jᵀ when rows were redundant.
     pub redundant: Option<(usize, usize)>,
     pub steps: u64,
@@ -160,6 +168,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     let mut violation = sim.constraint_violation();
     let mut max_violation = violation;
     let mut redundant = None;
+    let (mut max_penetration, mut max_contacts, mut max_iterations) = (0.0f64, 0usize, 0u32);
     for k in 0..=steps {
         if let Some((w, file)) = csv.as_mut() {
             write_row(w, &sim, energy, violation[0])
@@ -172,6 +181,10 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         let report = sim.step()?;
         wall += t0.elapsed();
         violation = report.constraint_violation;
+        let (contacts, penetration) = contact_summary(&sim.data);
+        max_contacts = max_contacts.max(contacts);
+        max_penetration = max_penetration.max(penetration);
+        max_iterations = max_iterations.max(sim.data.efc_iterations);
         max_violation = [max_violation[0].max(violation[0]), max_violation[1].max(violation[1])];
         let active = sim.data.efc_active.len();
         if sim.data.nefc > 0 && sim.data.efc_rank < active {
@@ -197,6 +210,10 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         dt,
         notes: sim.notes.clone(),
         max_violation,
+        max_penetration,
+        max_contacts,
+        max_solver_iterations: max_iterations,
+        unconverged: (sim.data.efc_unconverged, sim.data.efc_unconverged_residual),
         redundant,
         steps,
         wall,
@@ -213,6 +230,19 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
             .map(|(j, &e)| (j.name.clone(), e))
             .collect(),
     })
+}
+
+/// The number of touching contacts (contact normal rows) and the deepest penetration among them
+/// in the rows of the last step.
+fn contact_summary(data: &lagrange::Data) -> (usize, f64) {
+    let (mut n, mut depth) = (0, 0.0f64);
+    for i in 0..data.nefc {
+        if data.efc_is_normal(i) {
+            n += 1;
+            depth = depth.max(-data.efc_pos[i]);
+        }
+    }
+    (n, depth)
 }
 
 /// Records, per joint, how far beyond its limits the state has gone (0 if never).
@@ -262,6 +292,10 @@ pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
         "realtime_factor": if wall > 0.0 { simulated / wall } else { f64::INFINITY },
         "energy": {"initial": s.energy_start, "final": s.energy_end, "max_abs_drift": s.energy_max_dev},
         "max_constraint_violation": {"position": s.max_violation[0], "velocity": s.max_violation[1]},
+        "max_penetration": s.max_penetration,
+        "max_contacts": s.max_contacts,
+        "solver": {"max_iterations": s.max_solver_iterations, "unconverged": s.unconverged.0,
+                   "worst_unconverged_residual": s.unconverged.1},
         "q": s.final_state.q.as_slice(),
         "v": s.final_state.v.as_slice(),
     })
@@ -312,6 +346,20 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
             } else {
                 "no projection"
             }
+        );
+    }
+    if s.max_contacts > 0 {
+        let _ = writeln!(
+            out,
+            "contacts: up to {} touching, deepest penetration after a step {:.3e} m",
+            s.max_contacts, s.max_penetration
+        );
+    }
+    if s.unconverged.0 > 0 {
+        let _ = writeln!(
+            out,
+            "warning: {} friction solves stopped at the iteration limit ({} iterations) with residual up to {:.3e}: raise the limit or check the contact setup",
+            s.unconverged.0, s.max_solver_iterations, s.unconverged.1
         );
     }
     if let Some((rank, rows)) = s.redundant {

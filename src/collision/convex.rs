@@ -1,0 +1,140 @@
+//! Convex geom pairs other than planes: spheres and capsules in closed form (closest points of
+//! segments), every other pair by GJK and EPA on support maps (parry3d-f64's
+//! `contact_support_map_support_map`) — including the ellipsoid, whose exact support map is
+//! written here (a support-map shape, not a polyhedral approximation), and meshes by their hulls.
+//! One contact per pair, at the midpoint of the two witness points.
+
+use crate::spatial::{Transform, Vec3};
+use parry3d_f64::math::{Pose, Rotation, Vector};
+use parry3d_f64::query::details::contact_support_map_support_map;
+use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, SupportMap};
+
+/// An ellipsoid with semi-axes `radii` about its frame's axes.
+#[derive(Clone, Debug)]
+pub struct Ellipsoid {
+    pub radii: Vector,
+}
+
+impl SupportMap for Ellipsoid {
+    /// argmax over the surface of p·d: p = D² d / ‖D d‖ (D = diag(radii)).
+    fn local_support_point(&self, dir: Vector) -> Vector {
+        let scaled = dir * self.radii;
+        let norm = scaled.length();
+        if norm == 0.0 {
+            return Vector::ZERO;
+        }
+        scaled * self.radii / norm
+    }
+}
+
+/// A geom's shape for the support-map queries, in the geom frame (parry's cylinder axis is y, so
+/// a cylinder carries the rotation from lagrange's z axis).
+#[derive(Clone, Debug)]
+pub enum ConvexShape {
+    Ball(Ball),
+    Capsule(Capsule),
+    Cuboid(Cuboid),
+    Cylinder(Cylinder),
+    Ellipsoid(Ellipsoid),
+    Hull(ConvexPolyhedron),
+}
+
+impl SupportMap for ConvexShape {
+    fn local_support_point(&self, dir: Vector) -> Vector {
+        match self {
+            ConvexShape::Ball(s) => s.local_support_point(dir),
+            ConvexShape::Capsule(s) => s.local_support_point(dir),
+            ConvexShape::Cuboid(s) => s.local_support_point(dir),
+            // z (lagrange) ↔ y (parry): (x, y, z) → (x, z, −y) and back.
+            ConvexShape::Cylinder(s) => {
+                let p = s.local_support_point(Vector::new(dir.x, dir.z, -dir.y));
+                Vector::new(p.x, -p.z, p.y)
+            }
+            ConvexShape::Ellipsoid(s) => s.local_support_point(dir),
+            ConvexShape::Hull(s) => s.local_support_point(dir),
+        }
+    }
+}
+
+/// One contact from a convex query: world witness points on both surfaces, the normal from geom 1
+/// towards geom 2, the signed distance.
+#[derive(Clone, Copy, Debug)]
+pub struct PairPoint {
+    pub p1: Vec3,
+    pub p2: Vec3,
+    pub normal: Vec3,
+    pub dist: f64,
+}
+
+fn to_parry(x: &Transform) -> Pose {
+    let [w, qx, qy, qz] = x.quat_wxyz();
+    Pose::from_parts(Vector::new(x.pos.x, x.pos.y, x.pos.z), Rotation::from_xyzw(qx, qy, qz, w))
+}
+
+fn from_parry(v: Vector) -> Vec3 {
+    Vec3::new(v.x, v.y, v.z)
+}
+
+/// GJK/EPA between two support-map shapes at world poses `x1`, `x2`, if closer than `reach`.
+pub fn support_pair(
+    x1: &Transform,
+    s1: &ConvexShape,
+    x2: &Transform,
+    s2: &ConvexShape,
+    reach: f64,
+) -> Option<PairPoint> {
+    let pos12 = to_parry(&(x1.inverse() * *x2));
+    let c = contact_support_map_support_map(&pos12, s1, s2, reach)?;
+    // point1 and normal1 in frame 1, point2 in frame 2 (parry's convention).
+    let p1 = x1.act_point(&from_parry(c.point1));
+    let p2 = x2.act_point(&from_parry(c.point2));
+    let normal = x1.rot * from_parry(c.normal1);
+    (c.dist <= reach).then_some(PairPoint { p1, p2, normal, dist: c.dist })
+}
+
+/// Closest points of segments [a0, a1] and [b0, b1] (Ericson, *Real-Time Collision Detection*,
+/// §5.1.9).
+fn segment_closest(a0: &Vec3, a1: &Vec3, b0: &Vec3, b1: &Vec3) -> (Vec3, Vec3) {
+    let (d1, d2, r) = (a1 - a0, b1 - b0, a0 - b0);
+    let (a, e, f) = (d1.dot(&d1), d2.dot(&d2), d2.dot(&r));
+    const EPS: f64 = 1e-24;
+    let (s, t) = if a <= EPS && e <= EPS {
+        (0.0, 0.0)
+    } else if a <= EPS {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(&r);
+        if e <= EPS {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(&d2);
+            let denom = a * e - b * b;
+            let mut s = if denom > EPS { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+            let mut t = (b * s + f) / e;
+            if t < 0.0 {
+                t = 0.0;
+                s = (-c / a).clamp(0.0, 1.0);
+            } else if t > 1.0 {
+                t = 1.0;
+                s = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            (s, t)
+        }
+    };
+    (a0 + d1 * s, b0 + d2 * t)
+}
+
+/// Two "swept spheres" (a sphere is a segment of zero length): centres c1, c2 on their segments'
+/// closest points, radii r1, r2. The normal of coincident centres is x (MuJoCo picks the cross
+/// product of the z axes; any unit vector is a valid normal there).
+pub fn swept_spheres(seg1: [Vec3; 2], r1: f64, seg2: [Vec3; 2], r2: f64, reach: f64) -> Option<PairPoint> {
+    let (c1, c2) = segment_closest(&seg1[0], &seg1[1], &seg2[0], &seg2[1]);
+    let d = c2 - c1;
+    let len = d.norm();
+    let dist = len - r1 - r2;
+    if dist > reach {
+        return None;
+    }
+    let normal = if len > 1e-15 { d / len } else { Vec3::x() };
+    Some(PairPoint { p1: c1 + normal * r1, p2: c2 - normal * r2, normal, dist })
+}

@@ -1,0 +1,165 @@
+//! The collision layer (DESIGN.md, layer 6): for the candidate pairs fixed at compile time
+//! (`Model::collision_pairs`, see [`crate::model::collision_pairs`]) the contacts at the current
+//! body poses, written into `Data::contacts` in MuJoCo's form (`mjContact`: position midway
+//! between the surfaces, frame with the normal first pointing from geom 1 to geom 2, signed
+//! distance, the pair's combined friction, condim, solref and solimp; MuJoCo documentation,
+//! "Computation → Collision detection").
+//!
+//! A bounding-sphere test rejects far pairs first (MuJoCo's `mj_filterSphere`); the narrow phase
+//! is closed form for planes ([`plane`]), spheres and capsules, and GJK/EPA on support maps for
+//! the other convex pairs ([`convex`]). Meshes collide by their convex hulls; height fields are not
+//! collided yet (`info` lists them).
+//!
+//! `collide` reports the contacts closer than the pair's margin plus `reach`: MuJoCo's rule with
+//! `reach` = 0; the exact mode asks a little further ([`EXACT_REACH`]) so that a contact lifted
+//! off by round-off or within a step is still known (its rows exist only while touching, or while
+//! the step's rows are frozen).
+
+pub mod convex;
+mod frame;
+pub mod plane;
+
+pub use convex::{ConvexShape, Ellipsoid};
+pub use frame::contact_frame;
+
+use crate::model::spec::Shape;
+use crate::model::{Contact, Data, Model};
+use crate::spatial::{Transform, Vec3};
+use parry3d_f64::math::Vector;
+use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder};
+use plane::PlanePoint;
+
+/// How much farther than MuJoCo's margin the exact mode detects contacts (m).
+pub const EXACT_REACH: f64 = 1e-3;
+
+/// Per geom: its support-map shape (None for planes, height fields and non-colliding geoms) and
+/// bounding-sphere radius. Built once per model.
+#[derive(Clone, Debug, Default)]
+pub struct CollisionModel {
+    pub shapes: Vec<Option<ConvexShape>>,
+    pub rbound: Vec<f64>,
+}
+
+impl CollisionModel {
+    pub fn new(model: &Model) -> Self {
+        let mut shapes = Vec::with_capacity(model.geoms.len());
+        let mut rbound = Vec::with_capacity(model.geoms.len());
+        for g in &model.geoms {
+            let (shape, r) = match &g.shape {
+                Shape::Sphere { radius } => (Some(ConvexShape::Ball(Ball::new(*radius))), *radius),
+                Shape::Capsule { radius, length } => {
+                    (Some(ConvexShape::Capsule(Capsule::new_z(0.5 * length, *radius))), radius + 0.5 * length)
+                }
+                Shape::Cylinder { radius, length } => (
+                    Some(ConvexShape::Cylinder(Cylinder::new(0.5 * length, *radius))),
+                    radius.hypot(0.5 * length),
+                ),
+                Shape::Box { size } => {
+                    let h = size / 2.0;
+                    (Some(ConvexShape::Cuboid(Cuboid::new(Vector::new(h.x, h.y, h.z)))), h.norm())
+                }
+                Shape::Ellipsoid { radii } => (
+                    Some(ConvexShape::Ellipsoid(Ellipsoid { radii: Vector::new(radii.x, radii.y, radii.z) })),
+                    radii.max(),
+                ),
+                Shape::Mesh { .. } => match &g.hull {
+                    Some(h) => {
+                        let points: Vec<Vector> = h.iter().map(|v| Vector::new(v.x, v.y, v.z)).collect();
+                        let r = h.iter().map(|v| v.norm()).fold(0.0, f64::max);
+                        (ConvexPolyhedron::from_convex_hull(&points).map(ConvexShape::Hull), r)
+                    }
+                    None => (None, 0.0),
+                },
+                Shape::Plane { .. } | Shape::Hfield { .. } => (None, f64::INFINITY),
+            };
+            shapes.push(shape);
+            rbound.push(r);
+        }
+        Self { shapes, rbound }
+    }
+}
+
+/// The contacts of every candidate pair at the current body poses (`x_world_body`), closer than
+/// the pair's margin plus `reach`, into `data.contacts` (cleared first; no allocation: the capacity
+/// is `Model::max_contacts`).
+pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) {
+    data.contacts.clear();
+    for pair in &model.collision_pairs {
+        let [g1, g2] = pair.geom;
+        let (geom1, geom2) = (&model.geoms[g1], &model.geoms[g2]);
+        let x1 = data.x_world_body[geom1.body] * geom1.x_body_geom;
+        let x2 = data.x_world_body[geom2.body] * geom2.x_body_geom;
+        let within = pair.margin + reach;
+        // Bounding spheres (a plane: the other geom's sphere against the plane).
+        let far = match &geom1.shape {
+            Shape::Plane { .. } => x1.rot.column(2).dot(&(x2.pos - x1.pos)) > within + cm.rbound[g2],
+            _ => (x2.pos - x1.pos).norm() > within + cm.rbound[g1] + cm.rbound[g2],
+        };
+        if far {
+            continue;
+        }
+        let start = data.contacts.len();
+        let mut push = |p1: Vec3, p2: Vec3, normal: Vec3, dist: f64, hint: Option<Vec3>, feature: u32| {
+            if data.contacts.len() - start >= pair.max_contacts
+                || data.contacts.len() == data.contacts.capacity()
+            {
+                return;
+            }
+            data.contacts.push(Contact {
+                geom: pair.geom,
+                pos: (p1 + p2) * 0.5,
+                frame: contact_frame(&normal, hint.as_ref()),
+                dist,
+                includemargin: pair.margin - pair.gap,
+                condim: pair.condim,
+                friction: pair.friction,
+                solref: pair.solref,
+                solreffriction: pair.solreffriction,
+                solimp: pair.solimp,
+                pair: pair.pair,
+                feature,
+            });
+        };
+        if let Shape::Plane { .. } = geom1.shape {
+            let n = x1.rot.column(2).into_owned();
+            let mut out =
+                |p: PlanePoint| push(p.surface - n * p.dist, p.surface, n, p.dist, p.hint, p.feature);
+            match &geom2.shape {
+                Shape::Sphere { radius } => plane::sphere(&x1, &x2.pos, *radius, within, &mut out),
+                Shape::Capsule { radius, length } => {
+                    plane::capsule(&x1, &x2, *radius, 0.5 * length, within, &mut out)
+                }
+                Shape::Box { size } => plane::cuboid(&x1, &x2, &(size / 2.0), within, &mut out),
+                Shape::Cylinder { radius, length } => {
+                    plane::cylinder(&x1, &x2, *radius, 0.5 * length, within, &mut out)
+                }
+                Shape::Ellipsoid { radii } => plane::ellipsoid(&x1, &x2, radii, within, &mut out),
+                Shape::Mesh { .. } => {
+                    if let Some(h) = &geom2.hull {
+                        plane::hull(&x1, &x2, h, within, &mut out)
+                    }
+                }
+                Shape::Plane { .. } | Shape::Hfield { .. } => {}
+            }
+            continue;
+        }
+        let segment = |x: &Transform, shape: &Shape| match shape {
+            Shape::Sphere { radius } => Some(([x.pos, x.pos], *radius)),
+            Shape::Capsule { radius, length } => {
+                let a = x.rot.column(2) * (0.5 * length);
+                Some(([x.pos - a, x.pos + a], *radius))
+            }
+            _ => None,
+        };
+        let point = match (segment(&x1, &geom1.shape), segment(&x2, &geom2.shape)) {
+            (Some((s1, r1)), Some((s2, r2))) => convex::swept_spheres(s1, r1, s2, r2, within),
+            _ => match (&cm.shapes[g1], &cm.shapes[g2]) {
+                (Some(s1), Some(s2)) => convex::support_pair(&x1, s1, &x2, s2, within),
+                _ => None,
+            },
+        };
+        if let Some(p) = point {
+            push(p.p1, p.p2, p.normal, p.dist, None, 0);
+        }
+    }
+}

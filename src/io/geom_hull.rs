@@ -1,0 +1,47 @@
+//! Convex hulls of mesh geoms that take part in collisions: MuJoCo collides a mesh by its convex
+//! hull (MuJoCo documentation, "Modeling → Meshes": "the collision geometry of a mesh is its convex
+//! hull"). The hull is computed once per compile with parry's quickhull (`mass::convex_hull`, MuJoCo's degeneracy checks), in the mesh file's frame
+//! after scaling (the frame in which lagrange places a mesh geom); each file and scale is read once.
+
+use super::LoadError;
+use crate::mass;
+use crate::model::spec::{GeomSpec, Shape};
+use crate::spatial::Vec3;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// Hull vertices by (file, scale).
+#[derive(Default)]
+pub struct HullCache {
+    entries: HashMap<(PathBuf, [u64; 3]), Arc<Vec<Vec3>>>,
+}
+
+/// The hull vertices of `g` if it is a colliding mesh geom (None for primitives and for meshes
+/// with contype = conaffinity = 0). A mesh whose points span no volume (fewer than 4 points, all
+/// coplanar or collinear) has no hull: a typed error naming the geom's file and line.
+pub fn geom_hull(
+    g: &GeomSpec,
+    link: &str,
+    cache: &mut HullCache,
+) -> Result<Option<Arc<Vec<Vec3>>>, LoadError> {
+    let Shape::Mesh { path, scale } = &g.shape else { return Ok(None) };
+    if !g.collision {
+        return Ok(None);
+    }
+    let key = (path.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()]);
+    if let Some(h) = cache.entries.get(&key) {
+        return Ok(Some(h.clone()));
+    }
+    let err = |reason: String| LoadError::MeshHull {
+        loc: g.loc.clone(),
+        link: link.to_string(),
+        path: path.display().to_string(),
+        reason,
+    };
+    let mesh = mass::read_mesh(path, scale).map_err(|e| err(e.to_string()))?;
+    let hull = mass::convex_hull(&mesh.vertices).map_err(|e| err(e.to_string()))?;
+    let vertices = Arc::new(hull.vertices);
+    cache.entries.insert(key, vertices.clone());
+    Ok(Some(vertices))
+}

@@ -1,0 +1,186 @@
+//! Candidate geom pairs for collision detection, fixed at compile time (MuJoCo documentation,
+//! "Computation → Collision detection"; MuJoCo's broad-phase filters and `mj_contactParam`):
+//!
+//! - dynamic pairs: two colliding geoms on different bodies whose bit masks are compatible,
+//!   `(contype₁ & conaffinity₂) || (contype₂ & conaffinity₁)`; never two geoms of one body (fused
+//!   links are one body: welded together), never two bodies without degrees of freedom (both
+//!   welded to the world), never a parent and its child unless one is the world
+//!   (`<flag filterparent>`), never a body pair listed in `<exclude>`;
+//! - explicit `<pair>`s, with their own parameters and no filter (a geom pair that is both
+//!   explicit and dynamic is taken once, explicitly);
+//! - none when `<flag contact="disable">` (or `constraint`).
+//!
+//! Each pair carries its combined contact parameters: the geom of higher `priority` gives all of
+//! them; at equal priority condim and friction are the larger, solref and solimp the `solmix`
+//! mixture (solref the element-wise minimum when either is direct, i.e. negative), margin and gap
+//! the larger. The pair's geoms are ordered as MuJoCo orders them for its collision functions (the
+//! lower geom type first: plane, hfield, sphere, capsule, ellipsoid, cylinder, box, mesh), so that
+//! the normal points from geom 1 to geom 2 as in MuJoCo's `contact.frame`.
+
+use super::spec::{GeomContact, Shape};
+use super::Model;
+
+/// A candidate pair with its combined parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CollisionPair {
+    /// Indices in `Model::geoms`, in MuJoCo's order (lower geom type first).
+    pub geom: [usize; 2],
+    pub condim: u32,
+    /// MuJoCo's 5-vector: sliding, sliding, torsional, rolling, rolling.
+    pub friction: [f64; 5],
+    pub solref: [f64; 2],
+    pub solreffriction: [f64; 2],
+    pub solimp: [f64; 5],
+    pub margin: f64,
+    pub gap: f64,
+    /// Index in `Model::contact_pairs` for an explicit `<pair>`.
+    pub pair: Option<usize>,
+    /// The most contacts the pair's collision function makes.
+    pub max_contacts: usize,
+}
+
+/// MuJoCo's order of geom types in its collision table.
+pub fn type_rank(shape: &Shape) -> u8 {
+    match shape {
+        Shape::Plane { .. } => 0,
+        Shape::Hfield { .. } => 1,
+        Shape::Sphere { .. } => 2,
+        Shape::Capsule { .. } => 3,
+        Shape::Ellipsoid { .. } => 4,
+        Shape::Cylinder { .. } => 5,
+        Shape::Box { .. } => 6,
+        Shape::Mesh { .. } => 7,
+    }
+}
+
+/// The most contacts a pair of these shapes yields (plane against box, cylinder or mesh hull: 4;
+/// against a capsule: 2; every other pair: 1).
+fn max_contacts(a: &Shape, b: &Shape) -> usize {
+    match (a, b) {
+        (Shape::Plane { .. }, Shape::Box { .. } | Shape::Cylinder { .. } | Shape::Mesh { .. }) => 4,
+        (Shape::Plane { .. }, Shape::Capsule { .. }) => 2,
+        _ => 1,
+    }
+}
+
+/// Whether a collision function exists for the pair (planes and height fields never collide with
+/// each other; height fields are not collided yet).
+fn collidable(a: &Shape, b: &Shape) -> bool {
+    let hfield = matches!(a, Shape::Hfield { .. }) || matches!(b, Shape::Hfield { .. });
+    let planes = matches!(a, Shape::Plane { .. }) && matches!(b, Shape::Plane { .. });
+    !(hfield || planes)
+}
+
+/// MuJoCo's `mj_contactParam` for a dynamic pair.
+fn combine(g1: &GeomContact, g2: &GeomContact) -> (u32, [f64; 3], [f64; 2], [f64; 5]) {
+    if g1.priority != g2.priority {
+        let g = if g1.priority > g2.priority { g1 } else { g2 };
+        return (g.condim, g.friction, g.solref, g.solimp);
+    }
+    const MINVAL: f64 = 1e-15;
+    let mix = match (g1.solmix >= MINVAL, g2.solmix >= MINVAL) {
+        (true, true) => g1.solmix / (g1.solmix + g2.solmix),
+        (false, false) => 0.5,
+        (false, true) => 0.0,
+        (true, false) => 1.0,
+    };
+    let solref = if g1.solref[0] > 0.0 && g2.solref[0] > 0.0 {
+        [0, 1].map(|i| mix * g1.solref[i] + (1.0 - mix) * g2.solref[i])
+    } else {
+        [0, 1].map(|i| g1.solref[i].min(g2.solref[i]))
+    };
+    let solimp = [0, 1, 2, 3, 4].map(|i| mix * g1.solimp[i] + (1.0 - mix) * g2.solimp[i]);
+    let friction = [0, 1, 2].map(|i| g1.friction[i].max(g2.friction[i]));
+    (g1.condim.max(g2.condim), friction, solref, solimp)
+}
+
+/// The candidate pairs of `model` (explicit pairs first, then dynamic pairs in geom order).
+pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
+    let flags = &model.options.flags;
+    if !flags.contact || !flags.constraint {
+        return Vec::new();
+    }
+    let ordered = |a: usize, b: usize| {
+        let (ra, rb) = (type_rank(&model.geoms[a].shape), type_rank(&model.geoms[b].shape));
+        if (ra, a) <= (rb, b) {
+            [a, b]
+        } else {
+            [b, a]
+        }
+    };
+    let mut out = Vec::new();
+    for (k, p) in model.contact_pairs.iter().enumerate() {
+        let geom = ordered(p.geom1, p.geom2);
+        let (s1, s2) = (&model.geoms[geom[0]].shape, &model.geoms[geom[1]].shape);
+        if !collidable(s1, s2) {
+            continue;
+        }
+        out.push(CollisionPair {
+            geom,
+            condim: p.condim,
+            friction: p.friction,
+            solref: p.solref,
+            solreffriction: p.solreffriction,
+            solimp: p.solimp,
+            margin: p.margin,
+            gap: p.gap,
+            pair: Some(k),
+            max_contacts: max_contacts(s1, s2),
+        });
+    }
+    let explicit = out.len();
+    let has_dofs = |b: usize| b != 0;
+    let excluded = |b1: usize, b2: usize| {
+        model
+            .contact_excludes
+            .iter()
+            .any(|e| (e.body1, e.body2) == (b1, b2) || (e.body1, e.body2) == (b2, b1))
+    };
+    let n = model.geoms.len();
+    for i in 0..n {
+        let gi = &model.geoms[i];
+        if !gi.collision {
+            continue;
+        }
+        for j in i + 1..n {
+            let gj = &model.geoms[j];
+            if !gj.collision {
+                continue;
+            }
+            let (b1, b2) = (gi.body, gj.body);
+            let (c1, c2) = (&gi.contact, &gj.contact);
+            let compatible = (c1.contype & c2.conaffinity) != 0 || (c2.contype & c1.conaffinity) != 0;
+            let parent_child = flags.filterparent
+                && b1 != 0
+                && b2 != 0
+                && (model.bodies[b1].parent == b2 || model.bodies[b2].parent == b1);
+            if b1 == b2
+                || !(has_dofs(b1) || has_dofs(b2))
+                || !compatible
+                || parent_child
+                || excluded(b1, b2)
+                || !collidable(&gi.shape, &gj.shape)
+            {
+                continue;
+            }
+            let geom = ordered(i, j);
+            if out[..explicit].iter().any(|p| p.geom == geom) {
+                continue;
+            }
+            let (condim, f, solref, solimp) = combine(c1, c2);
+            out.push(CollisionPair {
+                geom,
+                condim,
+                friction: [f[0], f[0], f[1], f[2], f[2]],
+                solref,
+                solreffriction: [0.0, 0.0],
+                solimp,
+                margin: c1.margin.max(c2.margin),
+                gap: c1.gap.max(c2.gap),
+                pair: None,
+                max_contacts: max_contacts(&model.geoms[geom[0]].shape, &model.geoms[geom[1]].shape),
+            });
+        }
+    }
+    out
+}
