@@ -75,7 +75,24 @@ fn from_parry(v: Vector) -> Vec3 {
     Vec3::new(v.x, v.y, v.z)
 }
 
+impl ConvexShape {
+    /// Whether the surface is smooth (no vertices, edges or faces): spheres, capsules, ellipsoids.
+    fn smooth(&self) -> bool {
+        matches!(self, ConvexShape::Ball(_) | ConvexShape::Capsule(_) | ConvexShape::Ellipsoid(_))
+    }
+
+    /// The support point in world coordinates of the shape at pose `x` along world direction `d`.
+    fn world_support(&self, x: &Transform, d: &Vec3) -> Vec3 {
+        let local = x.rot.transpose() * d;
+        x.act_point(&from_parry(self.local_support_point(Vector::new(local.x, local.y, local.z))))
+    }
+}
+
 /// GJK/EPA between two support-map shapes at world poses `x1`, `x2`, if closer than `reach`.
+/// EPA's normal is exact on faces but only first-order accurate between two smooth surfaces; there
+/// the penetration direction is refined to the minimiser of the depth h₁(n) + h₂(−n) over unit n
+/// (support functions h; its gradient is p₁ − p₂, the difference of the support points) by Newton
+/// steps on the tangent plane.
 pub fn support_pair(
     x1: &Transform,
     s1: &ConvexShape,
@@ -86,10 +103,53 @@ pub fn support_pair(
     let pos12 = to_parry(&(x1.inverse() * *x2));
     let c = contact_support_map_support_map(&pos12, s1, s2, reach)?;
     // point1 and normal1 in frame 1, point2 in frame 2 (parry's convention).
-    let p1 = x1.act_point(&from_parry(c.point1));
-    let p2 = x2.act_point(&from_parry(c.point2));
-    let normal = x1.rot * from_parry(c.normal1);
-    (c.dist <= reach).then_some(PairPoint { p1, p2, normal, dist: c.dist })
+    let mut p1 = x1.act_point(&from_parry(c.point1));
+    let mut p2 = x2.act_point(&from_parry(c.point2));
+    let mut normal = x1.rot * from_parry(c.normal1);
+    let mut dist = c.dist;
+    if dist < 0.0 && s1.smooth() && s2.smooth() {
+        // Newton on the tangent plane: gradient g = Pₜ(q₁ − q₂), Hessian by central differences
+        // of g (the sum of the two surfaces' curvature radii), never accepting a deeper depth.
+        let depth_at = |n: &Vec3| {
+            let (q1, q2) = (s1.world_support(x1, n), s2.world_support(x2, &-n));
+            (n.dot(&(q1 - q2)), q1, q2)
+        };
+        let (mut depth, _, _) = depth_at(&normal);
+        for _ in 0..8 {
+            let t1 = crate::collision::contact_frame(&normal, None).row(1).transpose();
+            let t2 = normal.cross(&t1);
+            let grad = |n: &Vec3| {
+                let (_, q1, q2) = depth_at(n);
+                let d = q1 - q2;
+                [t1.dot(&d), t2.dot(&d)]
+            };
+            let g = grad(&normal);
+            if g[0].hypot(g[1]) <= 1e-15 * depth.abs().max(1e-300) {
+                break;
+            }
+            const EPS: f64 = 1e-6;
+            let mut h = [[0.0; 2]; 2];
+            for (j, t) in [t1, t2].iter().enumerate() {
+                let (gp, gm) = (grad(&(normal + t * EPS).normalize()), grad(&(normal - t * EPS).normalize()));
+                for i in 0..2 {
+                    h[i][j] = (gp[i] - gm[i]) / (2.0 * EPS);
+                }
+            }
+            let det = h[0][0] * h[1][1] - h[0][1] * h[1][0];
+            if det.is_nan() || det <= 0.0 || h[0][0] <= 0.0 {
+                break;
+            }
+            let step = [(-g[0] * h[1][1] + g[1] * h[0][1]) / det, (g[0] * h[1][0] - g[1] * h[0][0]) / det];
+            let candidate = (normal + t1 * step[0] + t2 * step[1]).normalize();
+            let (d_new, q1, q2) = depth_at(&candidate);
+            // Never deeper than before (NaN stops too).
+            if d_new.is_nan() || d_new > depth + 1e-15 * depth.abs() {
+                break;
+            }
+            (normal, depth, p1, p2, dist) = (candidate, d_new, q1, q2, -d_new);
+        }
+    }
+    (dist <= reach).then_some(PairPoint { p1, p2, normal, dist })
 }
 
 /// Closest points of segments [a0, a1] and [b0, b1] (Ericson, *Real-Time Collision Detection*,

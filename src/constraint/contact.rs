@@ -47,6 +47,13 @@ fn contact_dim(condim: u32, frictional: bool) -> usize {
 /// With `frictional` false only the normal rows are written (the position projection). Returns
 /// the next free row. Needs body poses and motion subspaces at the contacts' configuration.
 pub(crate) fn contact_rows(model: &Model, data: &mut Data, mut r: usize, frictional: bool) -> usize {
+    let needed: usize = data
+        .contacts
+        .iter()
+        .filter(|c| c.dist <= CONTACT_ACTIVE_DISTANCE || data.contact_is_frozen(c))
+        .map(|c| contact_dim(c.condim, frictional))
+        .sum();
+    data.reserve_rows(r + needed);
     for c in 0..data.contacts.len() {
         let contact = data.contacts[c];
         let active = contact.dist <= CONTACT_ACTIVE_DISTANCE || data.contact_is_frozen(&contact);

@@ -39,7 +39,7 @@ pub struct SolverSettings {
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        Self { max_iterations: 10000, tolerance: 1e-13 }
+        Self { max_iterations: 1000, tolerance: 1e-13 }
     }
 }
 
@@ -97,7 +97,11 @@ pub fn solve_coulomb(
     let mut change = 0.0;
     let mut iterations = 0;
     data.efc_converged = false;
-    while iterations < settings.max_iterations {
+    // A sweep costs about n² + n·nv: large problems get fewer sweeps (a work budget), so that a
+    // pile of contacts cannot stall a step; a solve stopped early is counted as unconverged.
+    let sweep = (n * n + n * model.nv).max(1) as f64;
+    let limit = settings.max_iterations.min((WORK_BUDGET / sweep).max(MIN_SWEEPS as f64) as u32);
+    while iterations < limit {
         iterations += 1;
         for i in 0..n {
             data.efc_lambda_prev[i] = data.efc_rhs[i];
@@ -142,6 +146,13 @@ pub fn solve_coulomb(
             || !moved.is_finite()
         {
             data.efc_converged = moved.is_finite();
+            break;
+        }
+        // Once the iterate has settled which rows stick, slide or lift, solve that active set
+        // exactly; accepted only if every row's law then holds.
+        if (iterations == POLISH_AFTER || iterations == limit) && polish(model, data, level) {
+            data.efc_converged = true;
+            change = 0.0;
             break;
         }
     }
@@ -245,6 +256,14 @@ fn mu(friction: &[f64; 5], k: usize) -> f64 {
 /// A sweep that changes the motion by less than this (m/s², rad/s², or m/s, rad/s at the velocity
 /// level) has converged whatever the scale: round-off of motions at rest.
 const ROUND_OFF_FLOOR: f64 = 1e-15;
+
+/// Sweeps after which the active set of the iterate is tried as an exact solve ([`polish`]).
+const POLISH_AFTER: u32 = 8;
+
+/// Multiply-adds one iterative solve may spend (sweeps × (n² + n·nv)) before it stops unconverged.
+const WORK_BUDGET: f64 = 2e7;
+/// Sweeps every solve may take whatever its size.
+const MIN_SWEEPS: u32 = 50;
 
 /// Largest contact dimension (condim 6).
 const MAX_DIM: usize = 6;
@@ -418,4 +437,195 @@ fn shifted_solve(
         }
     }
     true
+}
+
+/// The exact solve of the active set the Gauss–Seidel iterate has found (the "polish" of
+/// active-set methods, Cottle, Pang & Stone §4): equality rows, normals carrying force, sticking
+/// friction rows and friction-loss rows inside their bounds have w = 0; every other row keeps its
+/// force (0, a friction-loss bound, a sliding friction). The reduced symmetric system is solved
+/// exactly (minimum-norm for redundant rows); the result is kept only if every row's law holds
+/// (λ_n ≥ 0, w ≥ 0 off contact, friction inside its cone or box, w opposing a friction at its
+/// bound). A contact whose friction is on its cone's boundary makes the system unsymmetric: then
+/// there is no polish and the iteration goes on.
+fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
+    let n = data.nefc;
+    const TOL: f64 = 1e-9;
+    let mut i = 0;
+    data.efc_active.clear();
+    // Classify rows: Free rows go into efc_active; every other row keeps its force.
+    while i < n {
+        let len = data.efc_block_len(i);
+        match data.efc_type[i] {
+            EfcType::Equality => data.efc_active.push(i),
+            EfcType::LimitJoint | EfcType::ContactFrictionless => {
+                if data.efc_rhs[i] > 0.0 || data.efc_pressing[i] {
+                    data.efc_active.push(i);
+                }
+            }
+            EfcType::FrictionDof => {
+                let (lo, hi) = friction_dof_bounds(model, data, i, level);
+                let l = data.efc_rhs[i];
+                let sliding = level == Level::Acceleration
+                    && data.efc_vel[i].abs() > SLIP_VELOCITY
+                    && !data.efc_frozen_at_rest(i);
+                if !sliding && l > lo + TOL * (hi - lo).abs() && l < hi - TOL * (hi - lo).abs() {
+                    data.efc_active.push(i);
+                }
+            }
+            EfcType::ContactElliptic => {
+                if data.efc_rhs[i] > 0.0 || data.efc_pressing[i] {
+                    data.efc_active.push(i);
+                    let friction = data.contacts[data.efc_id[i]].friction;
+                    let (radius, spent) = cone_of(data, i, len, level);
+                    let sliding = level == Level::Acceleration
+                        && (1..len).any(|k| data.efc_vel[i + k].abs() > SLIP_VELOCITY)
+                        && !data.efc_frozen_at_rest(i);
+                    let y2: f64 = (1..len)
+                        .filter(|&k| mu(&friction, k) > 0.0)
+                        .map(|k| ((data.efc_rhs[i + k] + spent[k - 1]) / mu(&friction, k)).powi(2))
+                        .sum();
+                    if sliding || y2.sqrt() >= radius * (1.0 - TOL) && radius > 0.0 {
+                        return false;
+                    }
+                    for k in 1..len {
+                        if mu(&friction, k) > 0.0 {
+                            data.efc_active.push(i + k);
+                        }
+                    }
+                }
+            }
+        }
+        i += len;
+    }
+    // Reduced system A_FF λ_F = b_F − A_F,X λ_X.
+    let k = data.efc_active.len();
+    if k == 0 {
+        return false;
+    }
+    {
+        let Data {
+            efc_delassus,
+            efc_sub,
+            efc_sub_rhs,
+            efc_active,
+            efc_force,
+            efc_rhs,
+            efc_factor,
+            efc_eig,
+            ..
+        } = data;
+        for (a, &r) in efc_active.iter().enumerate() {
+            let mut rhs = efc_force[r];
+            for j in 0..n {
+                if !efc_active.contains(&j) {
+                    rhs -= efc_delassus[(r, j)] * efc_rhs[j];
+                }
+            }
+            efc_sub_rhs[a] = rhs;
+            for (c, &q) in efc_active.iter().enumerate() {
+                efc_sub[(a, c)] = efc_delassus[(r, q)];
+            }
+        }
+        solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..k], efc_factor, efc_eig);
+    }
+    // Candidate forces into efc_lambda_prev (efc_rhs keeps the iterate if the polish fails).
+    for j in 0..n {
+        data.efc_lambda_prev[j] = data.efc_rhs[j];
+    }
+    for (a, &r) in data.efc_active.iter().enumerate() {
+        data.efc_lambda_prev[r] = data.efc_sub_rhs[a];
+    }
+    // Verify every row's law with w = A λ − b.
+    let scale = 1.0 + (0..n).map(|j| data.efc_force[j].abs()).fold(0.0, f64::max);
+    let w = |data: &Data, r: usize| -> f64 {
+        (0..n).map(|j| data.efc_delassus[(r, j)] * data.efc_lambda_prev[j]).sum::<f64>() - data.efc_force[r]
+    };
+    let force_scale = 1.0 + (0..n).map(|j| data.efc_lambda_prev[j].abs()).fold(0.0, f64::max);
+    let mut i = 0;
+    while i < n {
+        let len = data.efc_block_len(i);
+        let l = data.efc_lambda_prev[i];
+        let ok = match data.efc_type[i] {
+            EfcType::Equality => true,
+            EfcType::LimitJoint | EfcType::ContactFrictionless | EfcType::ContactElliptic => {
+                let free = data.efc_active.contains(&i);
+                let normal_ok = if data.efc_pressing[i] {
+                    true
+                } else if free {
+                    l >= -1e-12 * force_scale
+                } else {
+                    separating(data, i, level) || w(data, i) >= -1e-12 * scale
+                };
+                normal_ok
+                    && (data.efc_type[i] != EfcType::ContactElliptic || !free || {
+                        let friction = data.contacts[data.efc_id[i]].friction;
+                        let (_, spent) = cone_of(data, i, len, level);
+                        let radius = match level {
+                            Level::Acceleration => l,
+                            Level::Velocity { dt } => {
+                                l.max(0.0) + dt * data.efc_previous_force(i, 0).max(0.0)
+                            }
+                        };
+                        let y2: f64 = (1..len)
+                            .filter(|&k| mu(&friction, k) > 0.0)
+                            .map(|k| {
+                                ((data.efc_lambda_prev[i + k] + spent[k - 1]) / mu(&friction, k)).powi(2)
+                            })
+                            .sum();
+                        y2.sqrt() <= radius * (1.0 + 1e-12) + 1e-12 * force_scale
+                    })
+            }
+            EfcType::FrictionDof => {
+                let (lo, hi) = friction_dof_bounds(model, data, i, level);
+                let slack = 1e-12 * force_scale;
+                if data.efc_active.contains(&i) {
+                    l >= lo - slack && l <= hi + slack
+                } else {
+                    let wi = w(data, i);
+                    // At the upper bound the dof must be accelerating the other way, and back.
+                    (l >= hi - slack && wi <= 1e-12 * scale) || (l <= lo + slack && wi >= -1e-12 * scale) || {
+                        level == Level::Acceleration && data.efc_vel[i].abs() > SLIP_VELOCITY
+                    }
+                }
+            }
+        };
+        if !ok {
+            return false;
+        }
+        i += len;
+    }
+    for j in 0..n {
+        data.efc_rhs[j] = data.efc_lambda_prev[j];
+    }
+    true
+}
+
+/// The box of a friction-loss row's force: ±f at the acceleration level; at the velocity level
+/// the step's remaining impulse, ±f dt less what the step already applied.
+fn friction_dof_bounds(model: &Model, data: &Data, i: usize, level: Level) -> (f64, f64) {
+    let dof = data.efc_id[i];
+    let loss = model.joint_of(model.dof_body[dof]).friction;
+    match level {
+        Level::Acceleration => (-loss, loss),
+        Level::Velocity { dt } => {
+            let spent = dt * data.efc_previous_force(i, 0);
+            (-loss * dt - spent, loss * dt - spent)
+        }
+    }
+}
+
+/// A contact block's cone radius for the current normal force, and the friction already spent
+/// (velocity level).
+fn cone_of(data: &Data, i: usize, len: usize, level: Level) -> (f64, [f64; MAX_DIM]) {
+    let mut spent = [0.0; MAX_DIM];
+    let radius = match level {
+        Level::Acceleration => data.efc_rhs[i],
+        Level::Velocity { dt } => {
+            for k in 1..len {
+                spent[k - 1] = dt * data.efc_previous_force(i, k);
+            }
+            data.efc_rhs[i].max(0.0) + dt * data.efc_previous_force(i, 0).max(0.0)
+        }
+    };
+    (radius, spent)
 }

@@ -5,8 +5,8 @@
 //! ([`compile_elements`](crate::io::compile_elements)).
 
 use crate::io::LoadError;
-use crate::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec};
-use crate::model::{Body, Frame, Geom, Joint, JointKind, Model, SourceLoc, Spring, NO_DOF};
+use crate::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec, Shape};
+use crate::model::{Body, Frame, FrameKind, Geom, Joint, JointKind, Model, SourceLoc, Spring, NO_DOF};
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
 use std::collections::HashMap;
 
@@ -47,6 +47,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let mut geoms: Vec<Geom> = Vec::new();
     // For each link: the body it belongs to and its pose in that body's frame.
     let mut link_body: Vec<(usize, Transform)> = Vec::with_capacity(spec.links.len());
+    // Per compiled body: the link (file body) it belongs to, and the first compiled body of it.
+    let (mut body_owner, mut body_root) = (vec![usize::MAX], vec![0usize]);
     let (mut nq, mut nv) = (0, 0);
 
     // Pass 1, links in depth-first order: create a body per movable joint, fuse fixed ones.
@@ -67,6 +69,20 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             None => link_body.push((parent_body, x_pbody_joint)),
             Some(kind) => {
                 let b = bodies.len();
+                // The file body this compiled body belongs to: an MJCF body with several joints is
+                // a chain of joint links followed by the body's own link.
+                let owner = if link.kind == FrameKind::Joint {
+                    (li..spec.links.len()).find(|&k| spec.links[k].kind != FrameKind::Joint).unwrap_or(li)
+                } else {
+                    li
+                };
+                let root = if parent_body != 0 && body_owner[parent_body] == owner {
+                    body_root[parent_body]
+                } else {
+                    b
+                };
+                body_owner.push(owner);
+                body_root.push(root);
                 bodies.push(Body {
                     name: link.name.clone(),
                     parent: parent_body,
@@ -115,16 +131,18 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             });
         }
         for (g, &mass) in link.geoms.iter().zip(&geom_masses[li]) {
+            let hull = crate::io::geom_hull::geom_hull(g, &link.name, &mut hulls, &mut warnings)?;
+            let unreadable = matches!(g.shape, Shape::Mesh { .. }) && hull.is_none();
             geoms.push(Geom {
                 name: g.name.clone(),
                 link: link.name.clone(),
                 body,
                 x_body_geom: x_body_link * g.x_link_geom,
                 shape: g.shape.clone(),
-                collision: g.collision,
+                collision: g.collision && !unreadable,
                 mass,
                 contact: g.contact,
-                hull: crate::io::geom_hull::geom_hull(g, &link.name, &mut hulls)?,
+                hull,
             });
         }
     }
@@ -221,6 +239,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         contact_pairs: Vec::new(),
         contact_excludes: Vec::new(),
         collision_pairs: Vec::new(),
+        body_root,
         elements: spec.elements.clone(),
         warnings,
     };

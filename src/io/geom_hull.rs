@@ -19,11 +19,15 @@ pub struct HullCache {
 
 /// The hull vertices of `g` if it is a colliding mesh geom (None for primitives and for meshes
 /// with contype = conaffinity = 0). A mesh whose points span no volume (fewer than 4 points, all
-/// coplanar or collinear) has no hull: a typed error naming the geom's file and line.
+/// coplanar or collinear) has no hull: a typed error naming the geom's file and line. A mesh file
+/// that cannot be read (missing, or a format lagrange does not decode, such as COLLADA) is a
+/// warning in `warnings` and None: the geom does not collide (a dynamics model stays loadable; the
+/// warning says what is lost).
 pub fn geom_hull(
     g: &GeomSpec,
     link: &str,
     cache: &mut HullCache,
+    warnings: &mut Vec<String>,
 ) -> Result<Option<Arc<Vec<Vec3>>>, LoadError> {
     let Shape::Mesh { path, scale } = &g.shape else { return Ok(None) };
     if !g.collision {
@@ -39,8 +43,21 @@ pub fn geom_hull(
         path: path.display().to_string(),
         reason,
     };
-    let mesh = mass::read_mesh(path, scale).map_err(|e| err(e.to_string()))?;
-    let hull = mass::convex_hull(&mesh.vertices).map_err(|e| err(e.to_string()))?;
+    let mesh = match mass::read_mesh(path, scale) {
+        Ok(m) => m,
+        Err(e) => {
+            warnings.push(format!(
+                "{}: body '{link}': collision mesh '{}' cannot be read ({e}): the geom does not collide",
+                g.loc,
+                path.display()
+            ));
+            return Ok(None);
+        }
+    };
+    let hull = mass::convex_hull(&mesh.vertices).map_err(|e| match e {
+        mass::MeshError::Hull { detail } => err(detail),
+        other => err(other.to_string()),
+    })?;
     let vertices = Arc::new(hull.vertices);
     cache.entries.insert(key, vertices.clone());
     Ok(Some(vertices))

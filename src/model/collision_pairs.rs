@@ -130,11 +130,12 @@ pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
     }
     let explicit = out.len();
     let has_dofs = |b: usize| b != 0;
+    // <exclude> names file bodies: compare their roots (a multi-joint body's chain is one body).
     let excluded = |b1: usize, b2: usize| {
-        model
-            .contact_excludes
-            .iter()
-            .any(|e| (e.body1, e.body2) == (b1, b2) || (e.body1, e.body2) == (b2, b1))
+        model.contact_excludes.iter().any(|e| {
+            let (e1, e2) = (model.body_root[e.body1], model.body_root[e.body2]);
+            (e1, e2) == (b1, b2) || (e1, e2) == (b2, b1)
+        })
     };
     let n = model.geoms.len();
     for i in 0..n {
@@ -147,13 +148,13 @@ pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
             if !gj.collision {
                 continue;
             }
-            let (b1, b2) = (gi.body, gj.body);
+            // MuJoCo's bodies: the chain of a multi-joint MJCF body is one body.
+            let (b1, b2) = (model.body_root[gi.body], model.body_root[gj.body]);
+            let parent = |b: usize| model.body_root[model.bodies[b].parent];
             let (c1, c2) = (&gi.contact, &gj.contact);
             let compatible = (c1.contype & c2.conaffinity) != 0 || (c2.contype & c1.conaffinity) != 0;
-            let parent_child = flags.filterparent
-                && b1 != 0
-                && b2 != 0
-                && (model.bodies[b1].parent == b2 || model.bodies[b2].parent == b1);
+            let parent_child =
+                flags.filterparent && b1 != 0 && b2 != 0 && (parent(b1) == b2 || parent(b2) == b1);
             if b1 == b2
                 || !(has_dofs(b1) || has_dofs(b2))
                 || !compatible

@@ -11,6 +11,11 @@ use super::{Contact, JointKind, Model};
 use crate::spatial::{ArticulatedInertia, Force, Motion, RigidInertia, Transform};
 use nalgebra::{DMatrix, DVector, Matrix6};
 
+/// Contacts whose rows `Data::new` makes room for; a scene with more touching contacts grows the
+/// row buffers once ([`Data::reserve_rows`]) — the dense Delassus matrix of every candidate pair's
+/// worst case would not fit in memory for a model with thousands of pairs.
+const INITIAL_CONTACT_ROWS: usize = 64;
+
 /// Slip speed (m/s, rad/s) above which a contact or a dof with friction loss counts as sliding.
 pub const SLIP_VELOCITY: f64 = 1e-9;
 
@@ -213,7 +218,7 @@ impl Data {
                 .filter(|j| j.limits.is_some() && (j.kind.nv() == 1 || j.kind == JointKind::Ball))
                 .count()
             + model.joints.iter().filter(|j| j.friction > 0.0).map(|j| j.kind.nv()).sum::<usize>()
-            + 6 * model.max_contacts();
+            + 6 * model.max_contacts().min(INITIAL_CONTACT_ROWS);
         Self {
             x_parent_body: vec![Transform::identity(); nb],
             x_world_body: vec![Transform::identity(); nb],
@@ -396,6 +401,45 @@ impl Data {
     /// not held closed by `efc_pressing`.
     pub fn efc_signed(&self, i: usize) -> bool {
         self.efc_type[i].is_unilateral() && !self.efc_pressing[i]
+    }
+
+    /// The number of rows the buffers hold.
+    pub fn efc_capacity(&self) -> usize {
+        self.efc_j.nrows()
+    }
+
+    /// Makes room for `n` rows (at least doubling), keeping the warm start; allocates only when a
+    /// problem is larger than any before it.
+    pub fn reserve_rows(&mut self, n: usize) {
+        let cap = self.efc_capacity();
+        if n <= cap {
+            return;
+        }
+        let new = n.max(2 * cap);
+        let nv = self.efc_j.ncols();
+        self.efc_j = DMatrix::zeros(new, nv);
+        self.efc_minv_jt = DMatrix::zeros(nv, new);
+        for m in [&mut self.efc_delassus, &mut self.efc_factor, &mut self.efc_sub] {
+            *m = DMatrix::zeros(new, new);
+        }
+        for v in [
+            &mut self.efc_pos,
+            &mut self.efc_vel,
+            &mut self.efc_jdotv,
+            &mut self.efc_force,
+            &mut self.efc_rhs,
+            &mut self.efc_eig,
+            &mut self.efc_sub_rhs,
+            &mut self.efc_lambda_prev,
+        ] {
+            *v = DVector::zeros(new);
+        }
+        self.efc_warm.resize_vertically_mut(new, 0.0);
+        self.efc_type.resize(new, EfcType::Equality);
+        self.efc_id.resize(new, 0);
+        self.efc_pressing.resize(new, false);
+        self.efc_active.reserve(new.saturating_sub(self.efc_active.len()));
+        self.efc_warm_rows.reserve(new.saturating_sub(self.efc_warm_rows.len()));
     }
 
     /// Whether row `i` is a limit row or a contact's normal row (the rows with a gap φ ≥ 0).

@@ -155,6 +155,10 @@ pub struct Model {
     pub gravity: Vec3,
     /// Bodies, world first, parents before children.
     pub bodies: Vec<Body>,
+    /// For each body, the first body of the file body it belongs to: an MJCF body with several
+    /// joints compiles to a chain of bodies, one per joint, which MuJoCo treats as one body
+    /// (collision filtering); every other body is its own root.
+    pub body_root: Vec<usize>,
     /// Movable joints: `joints[b - 1]` moves body `b`.
     pub joints: Vec<Joint>,
     pub frames: Vec<Frame>,

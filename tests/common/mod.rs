@@ -508,3 +508,6 @@ pub const ENERGY_GAIN_REL: f64 = 1e-9;
 pub const CONTACT_REL: f64 = 1e-8;
 /// Penetration (m) of a body at rest on a floor, and of a foot below it, in exact mode.
 pub const PENETRATION_AT_REST: f64 = 1e-6;
+/// Contact distances, normals and points against closed forms (m): the primitives are closed
+/// forms themselves (round-off), GJK/EPA converges to ~1e-10 on smooth support maps.
+pub const COLLISION_ABS: f64 = 1e-9;

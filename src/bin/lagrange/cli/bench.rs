@@ -6,9 +6,11 @@ use super::CliError;
 use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{aba, crba, rnea};
 use lagrange::forward::{forward, Plan};
+use lagrange::integrate::IntegratorKind;
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::forward_kinematics;
 use lagrange::model::Data;
+use lagrange::sim::{SimOptions, Simulation};
 use lagrange::Model;
 use serde_json::json;
 use std::path::Path;
@@ -67,10 +69,39 @@ pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliErro
         forward(&model, &plan, &mut data, &q, &v);
         std::hint::black_box(&data.qacc);
     });
+    let nefc = data.nefc;
+    // The collision pass alone (no candidate pairs: no work), at the same state.
+    let collide_us = median_us(budget, 100, || {
+        std::hint::black_box(plan.constraints.collide(&model, &mut data, &q));
+    });
+    // Whole steps (RK4, exact mode, drift projection included) from the first keyframe, or qpos0,
+    // at rest: a scene on its floor settles into contact.
+    let start = model.keyframes.first().and_then(|k| k.qpos.clone()).unwrap_or_else(|| model.qpos0.clone());
+    let options = SimOptions {
+        integrator: Some(IntegratorKind::Rk4),
+        constraints: Some(ConstraintMode::Exact),
+        ..Default::default()
+    };
+    let mut sim = Simulation::new(std::sync::Arc::new(model.clone()), &options);
+    let (mut step_us, mut contacts) = (f64::NAN, 0);
+    if sim.set_state(&start, &vec![0.0; model.nv]).is_ok() {
+        let steps = 500;
+        let t0 = std::time::Instant::now();
+        let mut ok = true;
+        for _ in 0..steps {
+            ok &= sim.step().is_ok();
+        }
+        if ok {
+            step_us = t0.elapsed().as_secs_f64() * 1e6 / steps as f64;
+            contacts = (0..sim.data.nefc).filter(|&i| sim.data.efc_is_normal(i)).count();
+        }
+    }
+    let pairs = model.collision_pairs.len();
     if json {
         let out = json!({"model": path.display().to_string(), "nq": model.nq, "nv": model.nv,
             "load_us": load_us, "fk_us": fk_us, "rnea_us": rnea_us, "crba_us": crba_us, "aba_us": aba_us,
-            "forward_us": forward_us, "nefc": data.nefc});
+            "forward_us": forward_us, "nefc": nefc, "collide_us": collide_us, "collision_pairs": pairs,
+            "step_us": step_us, "step_contacts": contacts, "step_dt": sim.timestep});
         println!("{out}");
     } else {
         println!("{} (nq {}, nv {}), median µs per call:", path.display(), model.nq, model.nv);
@@ -79,7 +110,13 @@ pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliErro
         println!("  RNEA                   {rnea_us:>12.3}");
         println!("  CRBA                   {crba_us:>12.3}");
         println!("  ABA                    {aba_us:>12.3}");
-        println!("  forward ({:>2} rows)      {forward_us:>12.3}", data.nefc);
+        println!("  forward ({nefc:>2} rows)      {forward_us:>12.3}");
+        println!("  collision ({pairs} pairs)  {collide_us:>12.3}");
+        println!(
+            "  RK4 step, exact, at rest from {} (dt {}, {contacts} contacts at the end) {step_us:>9.3} (mean of 500)",
+            model.keyframes.first().map_or("qpos0", |k| k.name.as_str()),
+            sim.timestep
+        );
     }
     Ok(())
 }
