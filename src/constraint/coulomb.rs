@@ -451,7 +451,9 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     let n = data.nefc;
     const TOL: f64 = 1e-9;
     let mut i = 0;
+    let mut any_sliding = false;
     data.efc_active.clear();
+    data.efc_slipping[..n].fill(false);
     // Classify rows: Free rows go into efc_active; every other row keeps its force.
     while i < n {
         let len = data.efc_block_len(i);
@@ -484,8 +486,22 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
                         .filter(|&k| mu(&friction, k) > 0.0)
                         .map(|k| ((data.efc_rhs[i + k] + spent[k - 1]) / mu(&friction, k)).powi(2))
                         .sum();
-                    if sliding || y2.sqrt() >= radius * (1.0 - TOL) && radius > 0.0 {
-                        return false;
+                    if sliding {
+                        // Friction fixed by the slip: c · λ_n, updated in the rounds below.
+                        data.efc_slipping[i] = true;
+                        any_sliding = true;
+                        i += len;
+                        continue;
+                    }
+                    if y2.sqrt() >= radius * (1.0 - TOL) && radius > 0.0 {
+                        if level != Level::Acceleration {
+                            return false;
+                        }
+                        // Starting to slip: friction on the cone, opposing the slip acceleration.
+                        data.efc_slipping[i] = true;
+                        any_sliding = true;
+                        i += len;
+                        continue;
                     }
                     for k in 1..len {
                         if mu(&friction, k) > 0.0 {
@@ -497,28 +513,34 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         }
         i += len;
     }
-    // Reduced system A_FF λ_F = b_F − A_F,X λ_X.
+    // Reduced system A_FF λ_F = b_F − A_F,X λ_X, the fixed forces λ_X taken from the candidate
+    // (efc_lambda_prev; efc_rhs keeps the iterate if the polish fails). A sliding contact's friction
+    // is c · λ_n with c = −μ² u / ‖μ ∘ u‖ from its slip u: rounds update it from the new λ_n until
+    // it settles (a contraction for μ < 1 coupling).
     let k = data.efc_active.len();
     if k == 0 {
         return false;
     }
-    {
+    for j in 0..n {
+        data.efc_lambda_prev[j] = data.efc_rhs[j];
+    }
+    for round in 0..30 {
         let Data {
             efc_delassus,
             efc_sub,
             efc_sub_rhs,
             efc_active,
             efc_force,
-            efc_rhs,
+            efc_lambda_prev,
             efc_factor,
             efc_eig,
             ..
-        } = data;
+        } = &mut *data;
         for (a, &r) in efc_active.iter().enumerate() {
             let mut rhs = efc_force[r];
             for j in 0..n {
                 if !efc_active.contains(&j) {
-                    rhs -= efc_delassus[(r, j)] * efc_rhs[j];
+                    rhs -= efc_delassus[(r, j)] * efc_lambda_prev[j];
                 }
             }
             efc_sub_rhs[a] = rhs;
@@ -527,13 +549,20 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
             }
         }
         solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..k], efc_factor, efc_eig);
-    }
-    // Candidate forces into efc_lambda_prev (efc_rhs keeps the iterate if the polish fails).
-    for j in 0..n {
-        data.efc_lambda_prev[j] = data.efc_rhs[j];
-    }
-    for (a, &r) in data.efc_active.iter().enumerate() {
-        data.efc_lambda_prev[r] = data.efc_sub_rhs[a];
+        for (a, &r) in efc_active.iter().enumerate() {
+            efc_lambda_prev[r] = efc_sub_rhs[a];
+        }
+        if !any_sliding {
+            break;
+        }
+        let change = update_sliding_friction(data);
+        let scale = 1.0 + (0..n).map(|j| data.efc_lambda_prev[j].abs()).fold(0.0, f64::max);
+        if change <= 1e-15 * scale {
+            break;
+        }
+        if round == 29 {
+            return false;
+        }
     }
     // Verify every row's law with w = A λ − b.
     let scale = 1.0 + (0..n).map(|j| data.efc_force[j].abs()).fold(0.0, f64::max);
@@ -598,6 +627,43 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         data.efc_rhs[j] = data.efc_lambda_prev[j];
     }
     true
+}
+
+/// Sets each slipping contact's friction rows in the candidate (`efc_lambda_prev`) to the
+/// maximal-dissipation force of its slip (velocity, or acceleration for a contact starting to
+/// slip) for the candidate's normal force; returns the largest change.
+fn update_sliding_friction(data: &mut Data) -> f64 {
+    let n = data.nefc;
+    let mut change = 0.0f64;
+    let mut i = 0;
+    while i < n {
+        let len = data.efc_block_len(i);
+        if data.efc_slipping[i] {
+            let friction = data.contacts[data.efc_id[i]].friction;
+            let lambda_n = data.efc_lambda_prev[i].max(0.0);
+            // The slip velocity, or for a contact starting to slip its slip acceleration w_f.
+            let moving =
+                (1..len).any(|k| data.efc_vel[i + k].abs() > SLIP_VELOCITY) && !data.efc_frozen_at_rest(i);
+            let mut slip = [0.0; MAX_DIM];
+            for k in 1..len {
+                slip[k - 1] = if moving {
+                    data.efc_vel[i + k]
+                } else {
+                    (0..n).map(|j| data.efc_delassus[(i + k, j)] * data.efc_lambda_prev[j]).sum::<f64>()
+                        - data.efc_force[i + k]
+                };
+            }
+            let norm = (1..len).map(|k| (mu(&friction, k) * slip[k - 1]).powi(2)).sum::<f64>().sqrt();
+            for k in 1..len {
+                let m = mu(&friction, k);
+                let new = if norm > 0.0 { -lambda_n * m * m * slip[k - 1] / norm } else { 0.0 };
+                change = change.max((new - data.efc_lambda_prev[i + k]).abs());
+                data.efc_lambda_prev[i + k] = new;
+            }
+        }
+        i += len;
+    }
+    change
 }
 
 /// The box of a friction-loss row's force: ±f at the acceleration level; at the velocity level

@@ -181,6 +181,9 @@ pub struct Data {
     /// closed) rather than allowed to grow: a small separating J v left by the integrator's error
     /// is drift, not a lift-off.
     pub efc_pressing: Vec<bool>,
+    /// Per row, scratch of the Coulomb solve's polish: a contact (at its normal row) whose
+    /// friction is on its cone, slipping or starting to.
+    pub efc_slipping: Vec<bool>,
 
     /// Rows frozen within a step ([`Data::freeze_rows`]): while set, a limit or contact row that
     /// was frozen exists whatever its distance (rows within the activation distance exist as
@@ -276,6 +279,7 @@ impl Data {
             efc_warm_rows: Vec::with_capacity(nefc),
             efc_lambda_prev: DVector::zeros(nefc),
             efc_pressing: vec![false; nefc],
+            efc_slipping: vec![false; nefc],
             efc_frozen: false,
             efc_frozen_limits: Vec::with_capacity(model.joints.len()),
             efc_frozen_contacts: Vec::with_capacity(model.max_contacts()),
@@ -438,6 +442,7 @@ impl Data {
         self.efc_type.resize(new, EfcType::Equality);
         self.efc_id.resize(new, 0);
         self.efc_pressing.resize(new, false);
+        self.efc_slipping.resize(new, false);
         self.efc_active.reserve(new.saturating_sub(self.efc_active.len()));
         self.efc_warm_rows.reserve(new.saturating_sub(self.efc_warm_rows.len()));
     }
