@@ -7,9 +7,8 @@ mod common;
 use common::{rel_err, CONTACT_REL, ENERGY_GAIN_REL, PENETRATION_AT_REST};
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::{forward, Plan};
-use lagrange::integrate::IntegratorKind;
 use lagrange::io::{load, LoadOptions};
-use lagrange::sim::{SimOptions, Simulation};
+use lagrange::sim::Simulation;
 use lagrange::spatial::Vec3;
 use lagrange::{Data, Model};
 use std::path::{Path, PathBuf};
@@ -139,12 +138,7 @@ fn energy(sim: &mut Simulation) -> f64 {
 #[test]
 fn dropped_bodies_come_to_rest_without_sinking_or_gaining_energy() {
     let model = Arc::new(load(Path::new("models/textbook/drop.xml"), &LoadOptions::default()).unwrap());
-    let options = SimOptions {
-        integrator: Some(IntegratorKind::Rk4),
-        timestep: Some(1e-3),
-        constraints: Some(ConstraintMode::Exact),
-        ..Default::default()
-    };
+    let options = common::exact_rk4(1e-3);
     let mut sim = Simulation::new(model.clone(), &options);
     let e0 = energy(&mut sim);
     let (mut impacted, mut e_prev, mut rise, mut depth_settled) = (false, e0, 0.0f64, 0.0f64);
@@ -184,12 +178,7 @@ fn dropped_bodies_come_to_rest_without_sinking_or_gaining_energy() {
 fn go1_settles_on_its_floor() {
     let path = Path::new("models/mjcf/unitree_go1/scene.xml");
     let model = Arc::new(load(path, &LoadOptions::default()).unwrap());
-    let options = SimOptions {
-        integrator: Some(IntegratorKind::Rk4),
-        timestep: Some(1e-3),
-        constraints: Some(ConstraintMode::Exact),
-        ..Default::default()
-    };
+    let options = common::exact_rk4(1e-3);
     let mut sim = Simulation::new(model.clone(), &options);
     let key = model.keyframe_id("home").unwrap();
     let home = model.keyframes[key].qpos.clone().unwrap();

@@ -7,10 +7,9 @@ mod common;
 use common::{rel_err, CONSTRAINT_REL, ENERGY_GAIN_REL, JDOTV_FD_REL, LIMIT_EXCURSION};
 use lagrange::constraint::{ball_angle_axis, ConstraintMode, LimitRow};
 use lagrange::forward::{forward, Plan};
-use lagrange::integrate::IntegratorKind;
 use lagrange::io::{load, LoadOptions};
 use lagrange::model::{integrate_configuration, EfcType};
-use lagrange::sim::{SimOptions, Simulation};
+use lagrange::sim::Simulation;
 use lagrange::{Data, Model};
 use std::path::Path;
 use std::sync::Arc;
@@ -97,12 +96,7 @@ fn friction_loss_dissipates_and_brings_a_pendulum_to_rest() {
     let model = Arc::new(model("friction_loss.xml"));
     let hinge = model.joint_id("hinge").unwrap();
     let (qa, d) = (model.joints[hinge].qpos_adr, model.joints[hinge].dof_adr);
-    let options = SimOptions {
-        integrator: Some(IntegratorKind::Rk4),
-        timestep: Some(1e-3),
-        constraints: Some(ConstraintMode::Exact),
-        ..Default::default()
-    };
+    let options = common::exact_rk4(1e-3);
     let mut sim = Simulation::new(model.clone(), &options);
     let mut q = model.qpos0.clone();
     q[qa] = 1.0;
@@ -178,12 +172,7 @@ fn ball_cone_jdotv_matches_finite_differences() {
 #[test]
 fn ball_cone_holds_a_spinning_rod_without_energy_gain() {
     let model = Arc::new(model("ball_cone.xml"));
-    let options = SimOptions {
-        integrator: Some(IntegratorKind::Rk4),
-        timestep: Some(1e-3),
-        constraints: Some(ConstraintMode::Exact),
-        ..Default::default()
-    };
+    let options = common::exact_rk4(1e-3);
     let mut sim = Simulation::new(model, &options);
     let tilt = 0.1f64;
     sim.set_state(&[(0.5 * tilt).cos(), (0.5 * tilt).sin(), 0.0, 0.0], &[0.0, 2.0, 0.5]).unwrap();

@@ -276,16 +276,7 @@ fn contact_block(data: &mut Data, i: usize, len: usize, level: Level) -> f64 {
     let mut change = scalar_update(data, i, normal_lower_bound(data, i), f64::INFINITY);
     // The cone's radius and, at the velocity level, the friction impulse the step already
     // applied (the cone is then solved for the step's total friction impulse).
-    let mut spent = [0.0; MAX_DIM];
-    let lambda_n = match level {
-        Level::Acceleration => data.efc_rhs[i],
-        Level::Velocity { dt } => {
-            for k in 1..len {
-                spent[k - 1] = dt * data.efc_previous_force(i, k);
-            }
-            data.efc_rhs[i].max(0.0) + dt * data.efc_previous_force(i, 0).max(0.0)
-        }
-    };
+    let (lambda_n, spent) = cone_of(data, i, len, level);
     let friction = data.contacts[data.efc_id[i]].friction;
     let nf = len - 1;
     let mut new = [0.0; MAX_DIM];
@@ -293,11 +284,7 @@ fn contact_block(data: &mut Data, i: usize, len: usize, level: Level) -> f64 {
         let slip: f64 = (1..len).map(|k| data.efc_vel[i + k].powi(2)).sum::<f64>().sqrt();
         if level == Level::Acceleration && slip > SLIP_VELOCITY && !data.efc_frozen_at_rest(i) {
             // Maximal dissipation against the slip velocity u.
-            let norm = (1..len).map(|k| (mu(&friction, k) * data.efc_vel[i + k]).powi(2)).sum::<f64>().sqrt();
-            for k in 1..len {
-                let m = mu(&friction, k);
-                new[k - 1] = if norm > 0.0 { -lambda_n * m * m * data.efc_vel[i + k] / norm } else { 0.0 };
-            }
+            max_dissipation(lambda_n, &friction, &data.efc_vel.as_slice()[i + 1..i + len], &mut new[..nf]);
         } else {
             cone_solve(data, i, len, &friction, lambda_n, &spent[..nf], &mut new[..nf]);
         }
@@ -308,6 +295,16 @@ fn contact_block(data: &mut Data, i: usize, len: usize, level: Level) -> f64 {
         data.efc_rhs[r] = new[k - 1];
     }
     change
+}
+
+/// The friction of maximal dissipation against `slip` (the friction rows' velocities or
+/// accelerations) on the elliptic cone of radius `lambda_n`: λ_k = −λ_n μ_k² s_k / ‖μ ∘ s‖.
+fn max_dissipation(lambda_n: f64, friction: &[f64; 5], slip: &[f64], out: &mut [f64]) {
+    let norm = slip.iter().enumerate().map(|(k, s)| (mu(friction, k + 1) * s).powi(2)).sum::<f64>().sqrt();
+    for (k, o) in out.iter_mut().enumerate() {
+        let m = mu(friction, k + 1);
+        *o = if norm > 0.0 { -lambda_n * m * m * slip[k] / norm } else { 0.0 };
+    }
 }
 
 /// The friction forces `out` of the contact block at row i minimising ½ λᵀ A_ff λ − gᵀ λ with
@@ -653,12 +650,11 @@ fn update_sliding_friction(data: &mut Data) -> f64 {
                         - data.efc_force[i + k]
                 };
             }
-            let norm = (1..len).map(|k| (mu(&friction, k) * slip[k - 1]).powi(2)).sum::<f64>().sqrt();
+            let mut new = [0.0; MAX_DIM];
+            max_dissipation(lambda_n, &friction, &slip[..len - 1], &mut new[..len - 1]);
             for k in 1..len {
-                let m = mu(&friction, k);
-                let new = if norm > 0.0 { -lambda_n * m * m * slip[k - 1] / norm } else { 0.0 };
-                change = change.max((new - data.efc_lambda_prev[i + k]).abs());
-                data.efc_lambda_prev[i + k] = new;
+                change = change.max((new[k - 1] - data.efc_lambda_prev[i + k]).abs());
+                data.efc_lambda_prev[i + k] = new[k - 1];
             }
         }
         i += len;

@@ -511,3 +511,13 @@ pub const PENETRATION_AT_REST: f64 = 1e-6;
 /// Contact distances, normals and points against closed forms (m): the primitives are closed
 /// forms themselves (round-off), GJK/EPA converges to ~1e-10 on smooth support maps.
 pub const COLLISION_ABS: f64 = 1e-9;
+
+/// Simulation options of the contact, limit and friction tests: RK4 at step `dt`, exact mode.
+pub fn exact_rk4(dt: f64) -> lagrange::sim::SimOptions {
+    lagrange::sim::SimOptions {
+        integrator: Some(lagrange::integrate::IntegratorKind::Rk4),
+        timestep: Some(dt),
+        constraints: Some(lagrange::constraint::ConstraintMode::Exact),
+        ..Default::default()
+    }
+}
