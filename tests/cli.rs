@@ -211,9 +211,9 @@ fn mjcf_info_lists_kept_elements_and_keyframes() {
     let actuators: Vec<&Value> =
         v["elements"].as_array().unwrap().iter().filter(|e| e["category"] == "actuator").collect();
     assert_eq!(actuators.len(), 12);
-    assert!(actuators.iter().all(|a| a["kind"] == "position" && a["status"] == "parsed, not simulated"));
+    assert!(actuators.iter().all(|a| a["kind"] == "position" && a["status"] == "simulated"));
     assert_eq!(actuators[0]["targets"][0], "FR_hip_joint");
-    assert_eq!(v["stages"]["actuation"]["status"], "parsed, not simulated");
+    assert_eq!(v["stages"]["actuation"]["status"], "runs");
     assert_eq!(
         v["stages"]["collision"]["status"], "runs",
         "self-collision pairs between the legs and the trunk"
@@ -256,10 +256,14 @@ fn info_lists_typed_elements_with_what_is_simulated() {
     assert_eq!(find("rope")["status"], "parsed, not simulated");
     assert_eq!(find("rope")["kind"], "spatial");
     let p = find("p_class");
-    assert_eq!((p["kind"].as_str(), p["status"].as_str()), (Some("position"), Some("parsed, not simulated")));
+    assert_eq!((p["kind"].as_str(), p["status"].as_str()), (Some("position"), Some("simulated")));
     assert_eq!(p["targets"], serde_json::json!(["slide"]));
     assert_eq!(find("p0")["targets"], serde_json::json!(["floor", "gc"]));
     assert_eq!(find("x")["kind"], "exclude");
+    assert_eq!(
+        (find("p0")["status"].as_str(), find("x")["status"].as_str()),
+        (Some("simulated (exact mode)"), Some("simulated (exact mode)"))
+    );
     // The text lists them grouped by kind and status.
     let (ok, out, _) = lagrange(&["info", "tests/data/elements/elements.xml"]);
     assert!(ok);

@@ -8,7 +8,7 @@ use common::{rel_err, CONTACT_REL, ENERGY_GAIN_REL, PENETRATION_AT_REST};
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::{forward, Plan};
 use lagrange::io::{load, LoadOptions};
-use lagrange::sim::Simulation;
+use lagrange::sim::{SimOptions, Simulation};
 use lagrange::spatial::Vec3;
 use lagrange::{Data, Model};
 use std::path::{Path, PathBuf};
@@ -217,4 +217,36 @@ fn no_rows_in_the_air() {
     let data = forward_at_rest(&model);
     assert_eq!((data.nefc, data.contacts.len()), (0, 0));
     assert_eq!(data.qacc, data.qacc_smooth);
+}
+
+/// go1 from its home keyframe holding its keyframe controls (position actuators) stands on its
+/// floor in exact mode: after 2 s its base is still near the keyframe's height (MuJoCo's soft
+/// contacts settle it at 0.265 m; rigid contacts do not sink) and no foot is below the floor.
+#[test]
+fn go1_stands_on_its_actuators() {
+    let model =
+        Arc::new(load(Path::new("models/mjcf/unitree_go1/scene.xml"), &LoadOptions::default()).unwrap());
+    let options = SimOptions { constraints: Some(ConstraintMode::Exact), ..Default::default() };
+    let mut sim = Simulation::new(model.clone(), &options);
+    let key = &model.keyframes[model.keyframe_id("home").unwrap()];
+    sim.set_state(key.qpos.as_ref().unwrap(), &vec![0.0; model.nv]).unwrap();
+    sim.ctrl_mut().copy_from_slice(key.ctrl.as_ref().unwrap());
+    let steps = (2.0 / sim.timestep).round() as usize;
+    let mut lowest = f64::MAX;
+    for _ in 0..steps {
+        sim.step().unwrap();
+        lowest = lowest.min(sim.state.q[2]);
+    }
+    let contacts = (0..sim.data.nefc).filter(|&i| sim.data.efc_is_normal(i)).count();
+    println!(
+        "go1 standing, {} steps of {} s ({}): base z {:.4} (lowest {lowest:.4}), {contacts} contacts, max |v| {:e}",
+        steps,
+        sim.timestep,
+        sim.integrator(),
+        sim.state.q[2],
+        sim.state.v.amax()
+    );
+    assert!(sim.state.q[2] > 0.25 && sim.state.q[2] < 0.30, "base z {}", sim.state.q[2]);
+    assert!(lowest > 0.2, "it should never fall: lowest base z {lowest}");
+    assert_eq!(contacts, 4, "standing on its four feet");
 }

@@ -69,6 +69,8 @@ pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>, 
     if has_friction(data) {
         let scale = data.qacc_smooth.amax();
         solve_coulomb(model, data, Level::Acceleration, settings, scale);
+        // No rank to report: the iterative solve gives one of the equivalent force distributions.
+        data.efc_active.clear();
     } else {
         // A limit or contact row moving away from its bound (J v > 0) is separating: no force.
         data.efc_iterations = solve_mixed(data, |d, i| !d.efc_frozen && d.efc_vel[i] > SEPARATING_VELOCITY);
@@ -182,6 +184,7 @@ pub fn project_velocities(
     if has_friction(data) {
         let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         solve_coulomb(model, data, Level::Velocity { dt }, settings, scale);
+        data.efc_active.clear();
     } else {
         solve_mixed(data, |_, _| false);
     }

@@ -7,7 +7,7 @@
 //! | position | body poses, `mass_matrix` and its factor, constraint rows `efc_j`, `efc_pos` |
 //! | velocity | `qfrc_bias` = RNEA(q, v, 0), `efc_vel` = J v, `efc_jdotv` = J̇ v |
 //! | passive | `qfrc_passive` = −damping ⊙ v − k ⊙ (q − q_spring) |
-//! | actuation | `qfrc_actuator` (zero until actuators are simulated) |
+//! | actuation | `actuator_length`, `actuator_velocity`, `actuator_force`, `qfrc_actuator` from `ctrl` |
 //! | acceleration | `qacc_smooth` (ABA, or M⁻¹`qfrc_smooth` on the M path), `qfrc_smooth` on the M path |
 //! | constraint | `efc_force` (λ), `qfrc_constraint` = Jᵀλ, `qacc` |
 //!
@@ -16,7 +16,10 @@
 //! built); `qacc` = `qacc_smooth` then. A model whose only rows are joint limits takes the same
 //! ABA path at every state where no joint is at a limit. `qfrc_applied` and `ctrl` are inputs set by the caller.
 
+mod actuation;
 mod plan;
+
+pub use actuation::{actuation, resolved_bias_velocity, unsimulated_reason};
 
 pub use plan::{DriftCorrection, Plan, Stage, StageKind, Status};
 
@@ -49,6 +52,7 @@ pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]
                 plan.constraints.velocities(model, data, q, v);
             }
             StageKind::Passive => passive(model, data, q, v),
+            StageKind::Actuation => actuation(model, data, q, v, &plan.actuator_bias_velocity),
             StageKind::Acceleration => acceleration(model, data, q, v, m_path),
             StageKind::Constraint if m_path => solve_exact(model, data, plan.drift.baumgarte, plan.solver),
             // Row sources are built by the position stage; the rest are listings.

@@ -86,6 +86,9 @@ pub struct Plan {
     pub drift: DriftCorrection,
     /// Iteration limit and tolerance of the iterative solve of rows with dry friction.
     pub solver: SolverSettings,
+    /// Each actuator's velocity bias coefficient with `dampratio` resolved at `qpos0`
+    /// ([`super::resolved_bias_velocity`]).
+    pub actuator_bias_velocity: Vec<f64>,
 }
 
 impl Plan {
@@ -102,6 +105,7 @@ impl Plan {
             constraints,
             drift: DriftCorrection::default(),
             solver: SolverSettings::default(),
+            actuator_bias_velocity: super::resolved_bias_velocity(model),
         }
     }
 
@@ -194,17 +198,40 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
     } else {
         stage(Passive, "passive", Skipped, "no joint damping or springs")
     });
-    // Typed actuators, and any the loader kept as a listing.
-    let actuators =
-        model.actuators.len() + model.elements.iter().filter(|e| e.category == "actuator").count();
-    out.push(if actuators == 0 {
+    // Typed actuators (simulated or not, and why), and any the loader kept as a listing.
+    let listed = model.elements.iter().filter(|e| e.category == "actuator").count();
+    let mut reasons: Vec<(&str, usize)> = Vec::new();
+    for a in &model.actuators {
+        if let Some(why) = super::unsimulated_reason(model, a) {
+            match reasons.iter_mut().find(|(w, _)| *w == why) {
+                Some(r) => r.1 += 1,
+                None => reasons.push((why, 1)),
+            }
+        }
+    }
+    let unsimulated: usize = reasons.iter().map(|r| r.1).sum();
+    let simulated = model.actuators.len() - unsimulated;
+    let mut missing: Vec<String> = reasons.iter().map(|(w, k)| format!("{k} with {w}")).collect();
+    if listed > 0 {
+        missing.push(format!("{listed} of kinds not typed yet"));
+    }
+    let missing = if missing.is_empty() {
+        String::new()
+    } else {
+        format!("; not simulated (no force): {}", missing.join(", "))
+    };
+    out.push(if model.actuators.is_empty() && listed == 0 {
         stage(Actuation, "actuation", Skipped, "no actuators")
+    } else if !model.options.flags.actuation {
+        stage(Actuation, "actuation", Skipped, "switched off by <option><flag actuation=\"disable\">")
+    } else if simulated == 0 {
+        stage(Actuation, "actuation", NotSimulated, format!("{} actuators{missing}", unsimulated + listed))
     } else {
         stage(
             Actuation,
             "actuation",
-            NotSimulated,
-            format!("{actuators} actuators: qfrc_actuator stays zero until actuation is simulated"),
+            Runs,
+            format!("{simulated} actuators (force = gain·ctrl + bias on joints and fixed tendons){missing}"),
         )
     });
     out.push(if constrained {

@@ -99,6 +99,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                     qpos_adr: nq,
                     dof_adr: nv,
                     limits: j.limits,
+                    actuator_force_range: j.actuator_force_range,
                     damping: j.damping,
                     friction: j.friction,
                     armature: j.armature,

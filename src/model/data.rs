@@ -113,8 +113,12 @@ pub struct Data {
     pub qfrc_bias: DVector<f64>,
     /// Passive forces: joint damping and springs.
     pub qfrc_passive: DVector<f64>,
-    /// Actuator forces (zero until actuators are simulated).
+    /// Actuator forces in joint space (the actuation stage).
     pub qfrc_actuator: DVector<f64>,
+    /// Per actuator: transmission length, velocity, and scalar force (MuJoCo's names).
+    pub actuator_length: DVector<f64>,
+    pub actuator_velocity: DVector<f64>,
+    pub actuator_force: DVector<f64>,
     /// qfrc_passive + qfrc_actuator + qfrc_applied − qfrc_bias (filled on the M path).
     pub qfrc_smooth: DVector<f64>,
     /// Unconstrained acceleration M⁻¹(qfrc_passive + qfrc_actuator + qfrc_applied − qfrc_bias).
@@ -248,6 +252,9 @@ impl Data {
             qfrc_bias: DVector::zeros(nv),
             qfrc_passive: DVector::zeros(nv),
             qfrc_actuator: DVector::zeros(nv),
+            actuator_length: DVector::zeros(model.actuators.len()),
+            actuator_velocity: DVector::zeros(model.actuators.len()),
+            actuator_force: DVector::zeros(model.actuators.len()),
             qfrc_smooth: DVector::zeros(nv),
             qacc_smooth: DVector::zeros(nv),
             qfrc_constraint: DVector::zeros(nv),

@@ -60,6 +60,8 @@ pub struct Joint {
     pub dof_adr: usize,
     /// Position limits `[lower, upper]` of a one-dof joint, if limited. Not enforced yet.
     pub limits: Option<[f64; 2]>,
+    /// The range `qfrc_actuator` is clamped to on this joint's dofs (MJCF `actuatorfrcrange`).
+    pub actuator_force_range: Option<[f64; 2]>,
     /// Viscous damping coefficient (N·m·s/rad or N·s/m) applied by `simulate` as `−damping·v`.
     pub damping: f64,
     /// Coulomb friction (stored; enforced by the constraints work, not yet).

@@ -114,6 +114,9 @@ pub struct JointSpec {
     /// Axis in the joint frame as written (the compile step normalizes it; zero is an error).
     pub axis: Vec3,
     pub limits: Option<[f64; 2]>,
+    /// MJCF `actuatorfrcrange` (with `actuatorfrclimited`): the range `qfrc_actuator` is clamped
+    /// to on this joint's dofs.
+    pub actuator_force_range: Option<[f64; 2]>,
     pub damping: f64,
     pub friction: f64,
     pub armature: f64,
@@ -147,6 +150,7 @@ impl JointSpec {
             x_parent_joint: Transform::identity(),
             axis: Vec3::x(),
             limits: None,
+            actuator_force_range: None,
             damping: 0.0,
             friction: 0.0,
             armature: 0.0,

@@ -118,6 +118,10 @@ enum Command {
         /// Initial velocity, comma-separated (nv values; default: zero).
         #[arg(long, allow_hyphen_values = true)]
         v0: Option<String>,
+        /// Constant controls, comma-separated (one per actuator, MuJoCo's order; default: the
+        /// keyframe's `ctrl`, else zero).
+        #[arg(long, allow_hyphen_values = true)]
+        ctrl: Option<String>,
         /// Write the trajectory (time, q, v, energy, constraint violation per step) to this CSV file.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -168,6 +172,7 @@ fn main() -> ExitCode {
             keyframe,
             q0,
             v0,
+            ctrl,
             out,
         }) => simulate::parse_baumgarte(baumgarte.as_deref()).and_then(|baumgarte| {
             let drift =
@@ -182,6 +187,7 @@ fn main() -> ExitCode {
                 keyframe,
                 q0,
                 v0,
+                ctrl,
                 out,
             };
             simulate::run_file(&model, &options, &request)

@@ -387,6 +387,12 @@ impl<'a> TreeBuilder<'a> {
             }
             j.limits = Some([0.0, r[1] * deg]);
         }
+        j.actuator_force_range = a.limited_range(
+            "actuatorfrclimited",
+            "actuatorfrcrange",
+            self.compiler.autolimits,
+            &mut self.warnings,
+        )?;
         let reference = a.real("ref")?.unwrap_or(0.0) * scale;
         let first =
             |name: &str| -> Result<f64, LoadError> { Ok(a.some_numbers(name, 1, 3)?.map_or(0.0, |v| v[0])) };

@@ -123,6 +123,8 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
     json!({
         "qacc": vec(&data.qacc), "qacc_smooth": vec(&data.qacc_smooth), "qfrc_passive": vec(&data.qfrc_passive),
         "qfrc_actuator": vec(&data.qfrc_actuator), "qfrc_constraint": vec(&data.qfrc_constraint),
+        "actuator_force": vec(&data.actuator_force), "actuator_length": vec(&data.actuator_length),
+        "actuator_velocity": vec(&data.actuator_velocity),
         "constraints": constraints,
     })
 }

@@ -86,13 +86,18 @@ fn listing(model: &Model) -> Vec<Listed> {
                 vec![frame(*cranksite), frame(*slidersite)]
             }
         };
+        let status = if lagrange::forward::unsimulated_reason(model, a).is_none() {
+            "simulated"
+        } else {
+            NOT_SIMULATED
+        };
         out.push(Listed {
             category: "actuator".into(),
             kind: a.shortcut.name().to_string(),
             name: a.name.clone(),
             targets,
             source: a.loc.to_string(),
-            status: NOT_SIMULATED,
+            status,
         });
     }
     for p in &model.contact_pairs {
@@ -102,7 +107,7 @@ fn listing(model: &Model) -> Vec<Listed> {
             name: p.name.clone(),
             targets: vec![model.geoms[p.geom1].name.clone(), model.geoms[p.geom2].name.clone()],
             source: p.loc.to_string(),
-            status: NOT_SIMULATED,
+            status: "simulated (exact mode)",
         });
     }
     for x in &model.contact_excludes {
@@ -112,7 +117,7 @@ fn listing(model: &Model) -> Vec<Listed> {
             name: x.name.clone(),
             targets: vec![model.bodies[x.body1].name.clone(), model.bodies[x.body2].name.clone()],
             source: x.loc.to_string(),
-            status: NOT_SIMULATED,
+            status: "simulated (exact mode)",
         });
     }
     for e in &model.elements {

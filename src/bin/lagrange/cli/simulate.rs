@@ -36,6 +36,8 @@ pub struct Request {
     pub keyframe: Option<String>,
     pub q0: Option<String>,
     pub v0: Option<String>,
+    /// Constant controls (comma-separated, one per actuator).
+    pub ctrl: Option<String>,
     pub out: Option<PathBuf>,
 }
 
@@ -113,6 +115,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     }
     // Initial state: --q0/--v0, else the keyframe's, else qpos0 at rest.
     let (mut q0, mut v0) = (model.qpos0.clone(), vec![0.0; model.nv]);
+    let mut ctrl = vec![0.0; model.actuators.len()];
     if let Some(name) = &request.keyframe {
         let Some(k) = model.keyframe_id(name).map(|k| &model.keyframes[k]) else {
             let known: Vec<&str> = model.keyframes.iter().map(|k| k.name.as_str()).collect();
@@ -127,6 +130,12 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         if let Some(v) = &k.qvel {
             v0.clone_from(v);
         }
+        if let Some(c) = k.ctrl.as_ref().filter(|c| c.len() == ctrl.len()) {
+            ctrl.clone_from(c);
+        }
+    }
+    if let Some(s) = &request.ctrl {
+        ctrl = parse_list("ctrl", s, model.actuators.len())?;
     }
     if let Some(s) = &request.q0 {
         q0 = parse_list("q0", s, model.nq)?;
@@ -135,6 +144,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         v0 = parse_list("v0", s, model.nv)?;
     }
     sim.set_state(&q0, &v0)?;
+    sim.ctrl_mut().copy_from_slice(&ctrl);
     let steps = (request.duration / dt).round() as u64;
     let mut csv = match &request.out {
         Some(path) => {
@@ -427,6 +437,7 @@ pub fn default_run() -> Result<(), CliError> {
         drift: DriftCorrection::default(),
         json: false,
         keyframe: None,
+        ctrl: None,
         q0: Some(DEFAULT_Q0.into()),
         v0: None,
         out: None,
