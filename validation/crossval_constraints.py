@@ -767,10 +767,10 @@ def lagrange_eval(lag: Lagrange, entry: Entry, states: list[dict]) -> tuple[list
         json.dump(doc, f)
         path = f.name
     try:
-        # Equality rows only, as on the MuJoCo side (its limit, friction-loss and contact rows are
-        # disabled there too): the manifold states may lie outside the joint ranges.
+        # Equality rows only, as on the MuJoCo side (its limit, friction-loss and contact rows and
+        # its actuation are disabled there too): the manifold states may lie outside the joint ranges.
         args = ["eval", str(entry.path), "--states", path, "--json", "--constraints", "exact",
-                "--disable", "limit", "--disable", "frictionloss", "--disable", "contact",
+                "--disable", "limit", "--disable", "frictionloss", "--disable", "contact", "--disable", "actuation",
                 *lag._args(entry)]
         try:
             p = lag._run(args)
