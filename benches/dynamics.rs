@@ -39,7 +39,6 @@ fn robots(c: &mut Criterion) {
         ("ur5", "models/ur5/ur5.urdf", false),
         ("panda", "models/panda/panda.urdf", false),
         ("solo12", "models/solo12/solo12.urdf", true),
-        ("talos_reduced", "models/talos_reduced/talos_reduced.urdf", true),
     ] {
         let model = load(&root.join(file), &LoadOptions { floating, ..Default::default() })
             .expect("shipped model loads");

@@ -548,7 +548,7 @@ fn mimic_needs_one_dof_joints() {
 
 #[test]
 fn mimic_on_a_fixed_joint_is_ignored_with_a_warning() {
-    // Reduced models (example-robot-data's talos_reduced) lock a gripper joint by making it fixed
+    // Reduced models (e.g. example-robot-data's talos_reduced) lock a gripper joint by making it fixed
     // and keep its <mimic>: nothing to couple, so a warning, not an error.
     let text = chain(&[("a", "revolute", ""), ("f", "fixed", "    <mimic joint=\"a\"/>")]);
     let path = write_urdf("mimic_on_fixed", &text);

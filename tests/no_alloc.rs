@@ -59,7 +59,6 @@ fn kernels_and_integrators_do_not_allocate() {
     for (file, floating) in [
         ("models/ur5/ur5.urdf", false),
         ("models/solo12/solo12.urdf", true),
-        ("models/talos_reduced/talos_reduced.urdf", true),
         // Constrained: a mimic row, and a loop with redundant rows (the minimum-norm path).
         ("models/panda/panda.urdf", false),
         ("models/textbook/four_bar.xml", false),

@@ -205,8 +205,3 @@ fn pinocchio_panda() {
 fn pinocchio_solo12() {
     check_robot("solo12");
 }
-
-#[test]
-fn pinocchio_talos_reduced() {
-    check_robot("talos_reduced");
-}

@@ -37,7 +37,6 @@ ROBOTS = {
     "ur5": ("models/ur5/ur5.urdf", False),
     "panda": ("models/panda/panda.urdf", False),
     "solo12": ("models/solo12/solo12.urdf", True),
-    "talos_reduced": ("models/talos_reduced/talos_reduced.urdf", True),
 }
 
 # Expected sizes (nq, nv) in lagrange's coordinates: a sanity check on the models.
@@ -45,7 +44,6 @@ EXPECTED = {
     "ur5": (6, 6),
     "panda": (9, 9),
     "solo12": (19, 18),
-    "talos_reduced": (39, 38),
 }
 
 

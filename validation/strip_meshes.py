@@ -33,10 +33,6 @@ ROBOTS = {
     "ur5": ("ur_description/urdf/ur5_robot.urdf", "models/ur5/ur5.urdf"),
     "panda": ("panda_description/urdf/panda.urdf", "models/panda/panda.urdf"),
     "solo12": ("solo_description/robots/solo12.urdf", "models/solo12/solo12.urdf"),
-    "talos_reduced": (
-        "talos_data/robots/talos_reduced.urdf",
-        "models/talos_reduced/talos_reduced.urdf",
-    ),
 }
 
 

@@ -465,8 +465,7 @@ pub fn rng(seed: u64) -> SmallRng {
 // ------------------------------------------------------------------------------------------------
 
 /// The shipped robots: (name, floating base).
-pub const ROBOTS: [(&str, bool); 4] =
-    [("ur5", false), ("panda", false), ("solo12", true), ("talos_reduced", true)];
+pub const ROBOTS: [(&str, bool); 3] = [("ur5", false), ("panda", false), ("solo12", true)];
 
 /// Absolute path of a file given relative to the repository root.
 pub fn repo_path(rel: &str) -> PathBuf {
