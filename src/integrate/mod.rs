@@ -7,9 +7,11 @@
 //! `forward`. With constraint rows, drift is corrected after each step ([`correct_drift`]): q is
 //! projected onto φ(q) = 0 and v onto J v = 0, as the plan's [`DriftCorrection`] says.
 
+mod adaptive;
 mod euler;
 mod rk4;
 
+pub use adaptive::{DormandPrince54, DEFAULT_ATOL, DEFAULT_RTOL};
 pub use euler::SemiImplicitEuler;
 pub use rk4::RungeKutta4;
 
@@ -99,6 +101,9 @@ pub fn correct_drift(model: &Model, plan: &Plan, data: &mut Data, state: &mut St
 pub enum IntegratorKind {
     Euler,
     Rk4,
+    /// Dormand–Prince 5(4) with error control at [`DEFAULT_RTOL`]/[`DEFAULT_ATOL`]
+    /// ([`DormandPrince54::new`] takes others).
+    Adaptive,
 }
 
 impl IntegratorKind {
@@ -107,6 +112,7 @@ impl IntegratorKind {
         match self {
             IntegratorKind::Euler => Box::new(SemiImplicitEuler::new(model)),
             IntegratorKind::Rk4 => Box::new(RungeKutta4::new(model)),
+            IntegratorKind::Adaptive => Box::new(DormandPrince54::new(model, DEFAULT_RTOL, DEFAULT_ATOL)),
         }
     }
 
@@ -131,6 +137,7 @@ impl IntegratorKind {
         match self {
             IntegratorKind::Euler => "euler",
             IntegratorKind::Rk4 => "rk4",
+            IntegratorKind::Adaptive => "adaptive",
         }
     }
 }

@@ -130,6 +130,9 @@ enum IntegratorArg {
     Euler,
     /// Classical Runge–Kutta (fourth order).
     Rk4,
+    /// Dormand–Prince 5(4) with error control (rtol 1e-8, atol 1e-10), internal steps within
+    /// each --dt interval.
+    Adaptive,
 }
 
 impl From<IntegratorArg> for IntegratorKind {
@@ -137,6 +140,7 @@ impl From<IntegratorArg> for IntegratorKind {
         match a {
             IntegratorArg::Euler => IntegratorKind::Euler,
             IntegratorArg::Rk4 => IntegratorKind::Rk4,
+            IntegratorArg::Adaptive => IntegratorKind::Adaptive,
         }
     }
 }
