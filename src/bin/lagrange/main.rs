@@ -100,6 +100,12 @@ enum Command {
         /// Integrator (default: the model's `<option integrator>`, Euler for URDF).
         #[arg(long, value_enum)]
         integrator: Option<IntegratorArg>,
+        /// Relative tolerance of `--integrator adaptive` (default 1e-8).
+        #[arg(long, allow_hyphen_values = true)]
+        rtol: Option<f64>,
+        /// Absolute tolerance of `--integrator adaptive` (default 1e-10).
+        #[arg(long, allow_hyphen_values = true)]
+        atol: Option<f64>,
         /// Print one JSON summary object instead of text.
         #[arg(long)]
         json: bool,
@@ -166,6 +172,8 @@ fn main() -> ExitCode {
             duration,
             dt,
             integrator,
+            rtol,
+            atol,
             json,
             no_projection,
             baumgarte,
@@ -174,12 +182,15 @@ fn main() -> ExitCode {
             v0,
             out,
         }) => simulate::parse_baumgarte(baumgarte.as_deref()).and_then(|baumgarte| {
+            let integrator = integrator.map(IntegratorKind::from);
+            let tolerances = simulate::parse_tolerances(integrator, rtol, atol)?;
             let drift =
                 DriftCorrection { projection: !no_projection, baumgarte, ..DriftCorrection::default() };
             let request = simulate::Request {
                 duration,
                 dt,
-                integrator: integrator.map(IntegratorKind::from),
+                integrator,
+                tolerances,
                 constraints: mode,
                 drift,
                 json,
