@@ -136,6 +136,8 @@ enum IntegratorArg {
     Euler,
     /// Classical Runge–Kutta (fourth order).
     Rk4,
+    /// MuJoCo's implicitfast (velocity-implicit in the joint-damping derivatives).
+    Implicitfast,
     /// Dormand–Prince 5(4) with error control (rtol 1e-8, atol 1e-10), internal steps within
     /// each --dt interval.
     Adaptive,
@@ -147,6 +149,7 @@ impl From<IntegratorArg> for IntegratorKind {
             IntegratorArg::Euler => IntegratorKind::Euler,
             IntegratorArg::Rk4 => IntegratorKind::Rk4,
             IntegratorArg::Adaptive => IntegratorKind::Adaptive,
+            IntegratorArg::Implicitfast => IntegratorKind::ImplicitFast,
         }
     }
 }
