@@ -9,32 +9,18 @@
 
 mod common;
 
-use common::{ADAPTIVE_TOL_FACTOR, INTEGRATOR_ORDER_BAND};
+use common::{run, ADAPTIVE_TOL_FACTOR, INTEGRATOR_ORDER_BAND};
 use lagrange::forward::Plan;
 use lagrange::integrate::{DormandPrince54, IntegratorKind, State, Stepper};
 use lagrange::io::{load, LoadOptions};
 use lagrange::model::difference_configuration;
-use lagrange::sim::{SimOptions, Simulation};
 use lagrange::Data;
 use lagrange::Model;
 use std::path::Path;
-use std::sync::Arc;
 
 fn textbook(name: &str) -> Model {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/textbook").join(name);
     load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn run(model: &Model, kind: IntegratorKind, q0: &[f64], v0: &[f64], dt: f64, n: usize) -> State {
-    let mut sim = Simulation::new(
-        Arc::new(model.clone()),
-        &SimOptions { integrator: Some(kind), timestep: Some(dt), ..Default::default() },
-    );
-    sim.set_state(q0, v0).unwrap();
-    for _ in 0..n {
-        sim.step().unwrap();
-    }
-    sim.state
 }
 
 /// max |q ⊖ q_ref| and |v − v_ref|.

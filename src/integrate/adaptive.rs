@@ -11,9 +11,10 @@
 //! coordinates and s = 1 rad for the rotation-vector coordinates of quaternion joints; a step is
 //! accepted when that is ≤ 1, and the next size is h·min(5, max(0.2, 0.9·err^(−1/5))).
 
+use super::stage::{evaluate_stage, StageInput};
 use super::{correct_drift, State, StepReport, Stepper};
-use crate::forward::{forward, Plan};
-use crate::model::{dexp_inv_configuration, integrate_configuration, Data, JointKind, Model};
+use crate::forward::Plan;
+use crate::model::{integrate_configuration, Data, JointKind, Model};
 use nalgebra::DVector;
 
 /// Matrix and the two weight rows of Dormand–Prince 5(4) (the dynamics are autonomous: the
@@ -85,15 +86,13 @@ impl DormandPrince54 {
                 self.v_stage.axpy(h * A[i][j], &self.a_stage[j], 1.0);
                 self.theta.axpy(h * A[i][j], &self.theta_rate[j], 1.0);
             }
-            self.q_stage.copy_from(&state.q);
-            integrate_configuration(model, self.q_stage.as_mut_slice(), self.theta.as_slice(), 1.0);
-            forward(model, plan, data, self.q_stage.as_slice(), self.v_stage.as_slice());
-            self.a_stage[i].copy_from(&data.qacc);
-            dexp_inv_configuration(
+            evaluate_stage(
                 model,
-                self.theta.as_slice(),
-                self.v_stage.as_slice(),
-                self.theta_rate[i].as_mut_slice(),
+                plan,
+                data,
+                StageInput { q0: &state.q, theta: &self.theta, v_stage: &self.v_stage },
+                &mut self.q_stage,
+                (&mut self.a_stage[i], &mut self.theta_rate[i]),
             );
         }
         // Stage 7 sits at the fifth-order solution (C[6] = 1, A[6] = B5): θ and v_stage hold

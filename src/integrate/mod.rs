@@ -11,6 +11,7 @@ mod adaptive;
 mod euler;
 mod implicit_fast;
 mod rk4;
+mod stage;
 
 pub use adaptive::{DormandPrince54, DEFAULT_ATOL, DEFAULT_RTOL};
 pub use euler::SemiImplicitEuler;

@@ -2,15 +2,16 @@
 //! method (Munthe-Kaas, *High order Runge–Kutta methods on manifolds*, Appl. Numer. Math. 29,
 //! 1999; Iserles et al., *Lie-group methods*, Acta Numerica 2000, §3.3): every stage is a
 //! tangent increment θᵢ from the step's base point q₀, the stage configuration is q₀ ⊕ θᵢ, and
-//! the stage slope of θ is dexp⁻¹(θᵢ) vᵢ ([`dexp_inv_configuration`]), so the Butcher tableau
+//! the stage slope of θ is dexp⁻¹(θᵢ) vᵢ ([`dexp_inv_configuration`](crate::model::dexp_inv_configuration)), so the Butcher tableau
 //! acts on a vector space and keeps its order 4 on ball and free joints too. For flat joints
 //! (hinge, slide, planar) dexp⁻¹ is the identity and the method is MuJoCo's `mj_RungeKutta`.
 //! (Averaging the body-frame stage velocities without dexp⁻¹, as before, is second order on
 //! quaternion joints: issue 15.)
 
+use super::stage::{evaluate_stage, StageInput};
 use super::{correct_drift, State, StepReport, Stepper};
-use crate::forward::{forward, Plan};
-use crate::model::{dexp_inv_configuration, integrate_configuration, Data, Model};
+use crate::forward::Plan;
+use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
 /// RK4 stepper with its stage buffers.
@@ -46,21 +47,19 @@ impl Stepper for RungeKutta4 {
         // Stage i evaluates at q₀ ⊕ θᵢ, v₀ + cᵢ h a_{i−1} with θᵢ = cᵢ h θ̇_{i−1}, c = (0, ½, ½, 1).
         const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
         for i in 0..4 {
-            self.q_stage.copy_from(&state.q);
             self.v_stage.copy_from(&state.v);
             self.theta.fill(0.0);
             if i > 0 {
                 self.v_stage.axpy(C[i] * h, &self.a_stage[i - 1], 1.0);
                 self.theta.axpy(C[i] * h, &self.theta_rate[i - 1], 0.0);
-                integrate_configuration(model, self.q_stage.as_mut_slice(), self.theta.as_slice(), 1.0);
             }
-            forward(model, plan, data, self.q_stage.as_slice(), self.v_stage.as_slice());
-            self.a_stage[i].copy_from(&data.qacc);
-            dexp_inv_configuration(
+            evaluate_stage(
                 model,
-                self.theta.as_slice(),
-                self.v_stage.as_slice(),
-                self.theta_rate[i].as_mut_slice(),
+                plan,
+                data,
+                StageInput { q0: &state.q, theta: &self.theta, v_stage: &self.v_stage },
+                &mut self.q_stage,
+                (&mut self.a_stage[i], &mut self.theta_rate[i]),
             );
         }
         // Weighted means (1, 2, 2, 1)/6 of the stage slopes of θ and v.

@@ -5,10 +5,12 @@
 //! Each test binary uses a different subset of these helpers, hence the `dead_code` allowance.
 #![allow(dead_code)]
 
+use lagrange::integrate::{IntegratorKind, State};
 use lagrange::io::compile;
 use lagrange::io::{load, LoadOptions};
 use lagrange::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, ModelSpec};
 use lagrange::model::{JointKind, SourceLoc};
+use lagrange::sim::{SimOptions, Simulation};
 use lagrange::spatial::{quat_to_matrix, Mat3, Transform, Vec3};
 use lagrange::Model;
 use nalgebra::DMatrix;
@@ -16,6 +18,7 @@ use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 // ------------------------------------------------------------------------------------------------
 // Tolerances
@@ -502,3 +505,16 @@ pub const PROJECTED_DRIFT: f64 = 1e-9;
 pub const JDOTV_FD_REL: f64 = 1e-6;
 /// Joints with limits stay within them to this (rad or m) in exact mode.
 pub const LIMIT_EXCURSION: f64 = 1e-6;
+
+/// Runs `n` steps of `dt` from (q0, v0) with zero torques; returns the final state.
+pub fn run(model: &Model, kind: IntegratorKind, q0: &[f64], v0: &[f64], dt: f64, n: usize) -> State {
+    let mut sim = Simulation::new(
+        Arc::new(model.clone()),
+        &SimOptions { integrator: Some(kind), timestep: Some(dt), ..Default::default() },
+    );
+    sim.set_state(q0, v0).unwrap();
+    for _ in 0..n {
+        sim.step().unwrap();
+    }
+    sim.state
+}
