@@ -6,7 +6,7 @@
 use crate::constraint::ConstraintMode;
 use crate::dynamics;
 use crate::forward::{DriftCorrection, Plan};
-use crate::integrate::{IntegratorKind, State, StepReport, Stepper};
+use crate::integrate::{DormandPrince54, IntegratorKind, State, StepReport, Stepper};
 use crate::kinematics::forward_kinematics;
 use crate::model::{Data, Model};
 use std::sync::Arc;
@@ -30,6 +30,8 @@ pub struct SimOptions {
     pub timestep: Option<f64>,
     pub constraints: Option<ConstraintMode>,
     pub drift: Option<DriftCorrection>,
+    /// (rtol, atol) of the adaptive integrator (default: `DEFAULT_RTOL`, `DEFAULT_ATOL`).
+    pub tolerances: Option<[f64; 2]>,
 }
 
 /// A model, its workspace and plan, a stepper and the current state.
@@ -64,7 +66,12 @@ impl Simulation {
         }
         Self {
             data: Data::new(&model),
-            stepper: integrator.build(&model),
+            stepper: match (integrator, options.tolerances) {
+                (IntegratorKind::Adaptive, Some([rtol, atol])) => {
+                    Box::new(DormandPrince54::new(&model, rtol, atol))
+                }
+                _ => integrator.build(&model),
+            },
             state: State::neutral(&model),
             timestep: options.timestep.unwrap_or(model.options.timestep),
             steps: 0,

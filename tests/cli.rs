@@ -177,6 +177,46 @@ fn simulate_rejects_bad_arguments_with_a_fix() {
     let (ok, _, err) = lagrange(&["simulate", "models/ur5/ur5.urdf", "--dt", "0"]);
     assert!(!ok);
     assert!(err.contains("dt > 0"), "{err}");
+    let (ok, _, err) = lagrange(&["simulate", "models/textbook/heavy_top.xml", "--rtol", "1e-6"]);
+    assert!(!ok);
+    assert!(
+        err.contains(
+            "--rtol/--atol set the error control of the adaptive integrator: add --integrator adaptive"
+        ),
+        "{err}"
+    );
+    let (ok, _, err) =
+        lagrange(&["simulate", "models/textbook/heavy_top.xml", "--integrator", "adaptive", "--atol", "-1"]);
+    assert!(!ok);
+    assert!(err.contains("--atol -1: give a positive tolerance, e.g. --atol 1e-8"), "{err}");
+}
+
+/// `--integrator adaptive --rtol --atol` runs and reports the adaptive integrator.
+#[test]
+fn simulate_adaptive_with_tolerances() {
+    let (ok, out, err) = lagrange(&[
+        "simulate",
+        "models/textbook/heavy_top.xml",
+        "--integrator",
+        "adaptive",
+        "--rtol",
+        "1e-10",
+        "--atol",
+        "1e-12",
+        "--duration",
+        "0.5",
+        "--dt",
+        "0.01",
+        "--v0",
+        "1,0.5,20",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["integrator"], "adaptive");
+    assert_eq!(v["steps"], 50);
+    let drift = v["energy"]["max_abs_drift"].as_f64().unwrap();
+    assert!(drift < 1e-8, "energy drift {drift} at rtol 1e-10");
 }
 
 #[test]

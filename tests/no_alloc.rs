@@ -98,7 +98,12 @@ fn kernels_and_integrators_do_not_allocate() {
         data.qfrc_applied.copy_from_slice(&tau);
         let forwards = allocations(|| forward(&model, &plan, &mut data, &q, &v));
         assert_eq!(forwards, 0, "{file}: forward allocated {forwards} times");
-        for kind in [IntegratorKind::Euler, IntegratorKind::Rk4] {
+        for kind in [
+            IntegratorKind::Euler,
+            IntegratorKind::Rk4,
+            IntegratorKind::Adaptive,
+            IntegratorKind::ImplicitFast,
+        ] {
             let mut integrator = kind.build(&model);
             let mut state =
                 State { time: 0.0, q: DVector::from_vec(q.clone()), v: DVector::from_vec(v.clone()) };
@@ -109,7 +114,7 @@ fn kernels_and_integrators_do_not_allocate() {
             });
             assert_eq!(steps, 0, "{file}: {kind:?} steps allocated {steps} times");
         }
-        println!("{file}: 0 allocations in FK, velocities, Jacobian, RNEA, bias, CRBA, LTDL, solve, ABA, Euler, RK4");
+        println!("{file}: 0 allocations in FK, velocities, Jacobian, RNEA, bias, CRBA, LTDL, solve, ABA, Euler, RK4, adaptive, implicitfast");
     }
 }
 

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{ALGO_REL, INTEGRATOR_ORDER_BAND, PERIOD_SMALL_AMPLITUDE_REL, RK4_CONSERVATION_REL};
+use common::{run, ALGO_REL, INTEGRATOR_ORDER_BAND, PERIOD_SMALL_AMPLITUDE_REL, RK4_CONSERVATION_REL};
 use lagrange::dynamics::{aba, crba, gravity_forces};
 use lagrange::integrate::{IntegratorKind, State};
 use lagrange::io::{load, LoadOptions};
@@ -24,19 +24,6 @@ fn textbook(name: &str) -> Model {
 fn uniform(seed: &mut u64) -> f64 {
     *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
     ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-}
-
-/// Runs `n` steps of `dt` from (q0, v0) with zero torques; returns the final state.
-fn run(model: &Model, kind: IntegratorKind, q0: &[f64], v0: &[f64], dt: f64, n: usize) -> State {
-    let mut sim = Simulation::new(
-        Arc::new(model.clone()),
-        &SimOptions { integrator: Some(kind), timestep: Some(dt), ..Default::default() },
-    );
-    sim.set_state(q0, v0).unwrap();
-    for _ in 0..n {
-        sim.step().unwrap();
-    }
-    sim.state
 }
 
 /// Notes eq. 14: θ̈ = −(g/l) sin θ for the simple pendulum, at many (θ, θ̇).

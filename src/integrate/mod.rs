@@ -7,10 +7,15 @@
 //! `forward`. With constraint rows, drift is corrected after each step ([`correct_drift`]): q is
 //! projected onto φ(q) = 0 and v onto J v = 0, as the plan's [`DriftCorrection`] says.
 
+mod adaptive;
 mod euler;
+mod implicit_fast;
 mod rk4;
+mod stage;
 
+pub use adaptive::{DormandPrince54, DEFAULT_ATOL, DEFAULT_RTOL};
 pub use euler::SemiImplicitEuler;
+pub use implicit_fast::{add_force_derivative, ImplicitFast};
 pub use rk4::RungeKutta4;
 
 use crate::constraint::{project_positions, project_velocities, row_violation};
@@ -116,6 +121,11 @@ pub fn correct_drift(
 pub enum IntegratorKind {
     Euler,
     Rk4,
+    /// Dormand–Prince 5(4) with error control at [`DEFAULT_RTOL`]/[`DEFAULT_ATOL`]
+    /// ([`DormandPrince54::new`] takes others).
+    Adaptive,
+    /// MuJoCo's implicitfast: implicit in the velocity derivatives of passive forces.
+    ImplicitFast,
 }
 
 impl IntegratorKind {
@@ -124,20 +134,23 @@ impl IntegratorKind {
         match self {
             IntegratorKind::Euler => Box::new(SemiImplicitEuler::new(model)),
             IntegratorKind::Rk4 => Box::new(RungeKutta4::new(model)),
+            IntegratorKind::Adaptive => Box::new(DormandPrince54::new(model, DEFAULT_RTOL, DEFAULT_ATOL)),
+            IntegratorKind::ImplicitFast => Box::new(ImplicitFast::new(model)),
         }
     }
 
     /// The stepper for a model file's `<option integrator>`, and a note when the file asks for
-    /// one that is not available yet (implicit and implicitfast fall back to Euler, the
-    /// explicit counterpart MuJoCo would use without damping derivatives).
+    /// one that is not available yet (`implicit`, whose Coriolis derivatives are not
+    /// implemented, uses implicitfast).
     pub fn from_option(integrator: options::Integrator) -> (Self, Option<String>) {
         match integrator {
             options::Integrator::Euler => (IntegratorKind::Euler, None),
             options::Integrator::Rk4 => (IntegratorKind::Rk4, None),
+            options::Integrator::ImplicitFast => (IntegratorKind::ImplicitFast, None),
             other => (
-                IntegratorKind::Euler,
+                IntegratorKind::ImplicitFast,
                 Some(format!(
-                    "the model asks for integrator '{}', which is not implemented yet: using euler",
+                    "the model asks for integrator '{}', whose Coriolis derivatives are not implemented yet: using implicitfast",
                     other.mjcf_name()
                 )),
             ),
@@ -148,6 +161,8 @@ impl IntegratorKind {
         match self {
             IntegratorKind::Euler => "euler",
             IntegratorKind::Rk4 => "rk4",
+            IntegratorKind::Adaptive => "adaptive",
+            IntegratorKind::ImplicitFast => "implicitfast",
         }
     }
 }

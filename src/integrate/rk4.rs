@@ -1,19 +1,26 @@
-//! Classical fourth-order Runge–Kutta on the configuration manifold: stage configurations are
-//! reached by `q ⊕ c·h·vᵢ` and the final update uses the weighted mean velocity, as MuJoCo's
-//! `mj_RungeKutta` does. Fourth order for joints whose configuration space is flat (hinge,
-//! slide, planar); for quaternion joints the tangent-space averaging is an approximation.
+//! Classical fourth-order Runge–Kutta on the configuration manifold as a Runge–Kutta–Munthe-Kaas
+//! method (Munthe-Kaas, *High order Runge–Kutta methods on manifolds*, Appl. Numer. Math. 29,
+//! 1999; Iserles et al., *Lie-group methods*, Acta Numerica 2000, §3.3): every stage is a
+//! tangent increment θᵢ from the step's base point q₀, the stage configuration is q₀ ⊕ θᵢ, and
+//! the stage slope of θ is dexp⁻¹(θᵢ) vᵢ ([`dexp_inv_configuration`](crate::model::dexp_inv_configuration)), so the Butcher tableau
+//! acts on a vector space and keeps its order 4 on ball and free joints too. For flat joints
+//! (hinge, slide, planar) dexp⁻¹ is the identity and the method is MuJoCo's `mj_RungeKutta`.
+//! (Averaging the body-frame stage velocities without dexp⁻¹, as before, is second order on
+//! quaternion joints: issue 15.)
 
+use super::stage::{evaluate_stage, StageInput};
 use super::{correct_drift, State, StepReport, Stepper};
-use crate::forward::{forward, Plan};
+use crate::forward::Plan;
 use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
 /// RK4 stepper with its stage buffers.
 pub struct RungeKutta4 {
     q_stage: DVector<f64>,
-    v_stage: [DVector<f64>; 4],
+    v_stage: DVector<f64>,
+    theta: DVector<f64>,
+    theta_rate: [DVector<f64>; 4],
     a_stage: [DVector<f64>; 4],
-    v_mean: DVector<f64>,
 }
 
 impl RungeKutta4 {
@@ -21,9 +28,10 @@ impl RungeKutta4 {
         let z = || DVector::zeros(model.nv);
         Self {
             q_stage: DVector::zeros(model.nq),
-            v_stage: [z(), z(), z(), z()],
+            v_stage: z(),
+            theta: z(),
+            theta_rate: [z(), z(), z(), z()],
             a_stage: [z(), z(), z(), z()],
-            v_mean: z(),
         }
     }
 }
@@ -36,36 +44,36 @@ impl Stepper for RungeKutta4 {
         4
     }
     fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
-        // Stage i evaluates at q ⊕ cᵢ h v_{i−1}, v + cᵢ h a_{i−1}, with c = (0, ½, ½, 1).
+        // Stage i evaluates at q₀ ⊕ θᵢ, v₀ + cᵢ h a_{i−1} with θᵢ = cᵢ h θ̇_{i−1}, c = (0, ½, ½, 1).
         const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
         for i in 0..4 {
-            self.q_stage.copy_from(&state.q);
-            self.v_stage[i].copy_from(&state.v);
+            self.v_stage.copy_from(&state.v);
+            self.theta.fill(0.0);
             if i > 0 {
-                let (before, after) = self.v_stage.split_at_mut(i);
-                after[0].axpy(C[i] * h, &self.a_stage[i - 1], 1.0);
-                integrate_configuration(
-                    model,
-                    self.q_stage.as_mut_slice(),
-                    before[i - 1].as_slice(),
-                    C[i] * h,
-                );
+                self.v_stage.axpy(C[i] * h, &self.a_stage[i - 1], 1.0);
+                self.theta.axpy(C[i] * h, &self.theta_rate[i - 1], 0.0);
             }
-            forward(model, plan, data, self.q_stage.as_slice(), self.v_stage[i].as_slice());
-            self.a_stage[i].copy_from(&data.qacc);
+            evaluate_stage(
+                model,
+                plan,
+                data,
+                StageInput { q0: &state.q, theta: &self.theta, v_stage: &self.v_stage },
+                &mut self.q_stage,
+                (&mut self.a_stage[i], &mut self.theta_rate[i]),
+            );
             if i == 0 {
                 // The later stages keep the limit and contact rows the step starts with.
                 data.freeze_rows(false);
             }
         }
-        // Weighted means (1, 2, 2, 1)/6 of stage velocities and accelerations.
-        let [v1, v2, v3, v4] = &self.v_stage;
+        // Weighted means (1, 2, 2, 1)/6 of the stage slopes of θ and v.
+        let [r1, r2, r3, r4] = &self.theta_rate;
         let [a1, a2, a3, a4] = &self.a_stage;
         for k in 0..model.nv {
-            self.v_mean[k] = (v1[k] + 2.0 * v2[k] + 2.0 * v3[k] + v4[k]) / 6.0;
+            self.theta[k] = h * (r1[k] + 2.0 * r2[k] + 2.0 * r3[k] + r4[k]) / 6.0;
             state.v[k] += h * (a1[k] + 2.0 * a2[k] + 2.0 * a3[k] + a4[k]) / 6.0;
         }
-        integrate_configuration(model, state.q.as_mut_slice(), self.v_mean.as_slice(), h);
+        integrate_configuration(model, state.q.as_mut_slice(), self.theta.as_slice(), 1.0);
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
     }

@@ -140,6 +140,20 @@ impl JointKind {
         }
     }
 
+    /// The rate of the tangent coordinates θ of `q = q0 ⊕ θ` for joint velocity `v` at `q`:
+    /// θ̇ = dexp⁻¹(θ) v. Flat coordinates: θ̇ = v. Quaternion parts (body-frame ω, right
+    /// trivialization): θ̇ = J_r⁻¹(θ) ω = ω + ½ θ×ω + (1/|θ|² − (1 + cos|θ|)/(2|θ| sin|θ|)) θ×(θ×ω)
+    /// (the inverse right Jacobian of SO(3); Iserles, Munthe-Kaas, Nørsett & Zanna, *Lie-group
+    /// methods*, Acta Numerica 2000, §2.3 and eq. 3.14 for the RKMK stages that need it).
+    pub fn dexp_inv(&self, theta: &[f64], v: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(v);
+        match self {
+            JointKind::Free => so3_dexp_inv(&theta[3..6], &v[3..6], &mut out[3..6]),
+            JointKind::Ball => so3_dexp_inv(&theta[0..3], &v[0..3], &mut out[0..3]),
+            _ => {}
+        }
+    }
+
     /// The tangent `v` with `q0 ⊕ v = q1` (unit time): the inverse of [`integrate`](Self::integrate).
     pub fn difference(&self, q0: &[f64], q1: &[f64], v: &mut [f64]) {
         match self {
@@ -157,6 +171,20 @@ impl JointKind {
             JointKind::Ball => quat_difference(&q0[0..4], &q1[0..4], &mut v[0..3]),
         }
     }
+}
+
+/// out = J_r⁻¹(θ) ω for a rotation vector θ (see [`JointKind::dexp_inv`]); the θ×(θ×ω)
+/// coefficient is replaced by its series 1/12 + |θ|²/720 below |θ| = 1e-4.
+fn so3_dexp_inv(theta: &[f64], omega: &[f64], out: &mut [f64]) {
+    let th = Vec3::new(theta[0], theta[1], theta[2]);
+    let w = Vec3::new(omega[0], omega[1], omega[2]);
+    let a2 = th.norm_squared();
+    let a = a2.sqrt();
+    let c2 =
+        if a < 1e-4 { 1.0 / 12.0 + a2 / 720.0 } else { 1.0 / a2 - (1.0 + a.cos()) / (2.0 * a * a.sin()) };
+    let tw = th.cross(&w);
+    let r = w + 0.5 * tw + c2 * th.cross(&tw);
+    out.copy_from_slice(r.as_slice());
 }
 
 /// Rotation matrix for angle `angle` about unit `axis` (Rodrigues).

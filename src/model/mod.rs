@@ -289,6 +289,17 @@ pub fn integrate_configuration(model: &Model, q: &mut [f64], v: &[f64], dt: f64)
     }
 }
 
+/// θ̇ = dexp⁻¹(θ) v for the whole configuration (length nv): the rate of the tangent
+/// increment θ of `q0 ⊕ θ` when the joint velocity at that configuration is `v`
+/// ([`JointKind::dexp_inv`]); the Runge–Kutta–Munthe-Kaas stages of
+/// the integrators use it.
+pub fn dexp_inv_configuration(model: &Model, theta: &[f64], v: &[f64], out: &mut [f64]) {
+    for j in &model.joints {
+        let (va, nv) = (j.dof_adr, j.kind.nv());
+        j.kind.dexp_inv(&theta[va..va + nv], &v[va..va + nv], &mut out[va..va + nv]);
+    }
+}
+
 /// The tangent `v` (length nv) with `q0 ⊕ v = q1`.
 pub fn difference_configuration(model: &Model, q0: &[f64], q1: &[f64], v: &mut [f64]) {
     for j in &model.joints {

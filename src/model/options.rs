@@ -9,9 +9,9 @@ pub enum Integrator {
     Euler,
     /// Classical fourth-order Runge–Kutta.
     Rk4,
-    /// Implicit in velocity (passive and actuator derivatives); not simulated yet.
+    /// Implicit in velocity (passive and actuator derivatives); simulated as implicitfast for now.
     Implicit,
-    /// `implicit` without the Coriolis derivatives; not simulated yet.
+    /// `implicit` without the Coriolis derivatives.
     ImplicitFast,
 }
 

@@ -5,10 +5,12 @@
 //! Each test binary uses a different subset of these helpers, hence the `dead_code` allowance.
 #![allow(dead_code)]
 
+use lagrange::integrate::{IntegratorKind, State};
 use lagrange::io::compile;
 use lagrange::io::{load, LoadOptions};
 use lagrange::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, ModelSpec};
 use lagrange::model::{JointKind, SourceLoc};
+use lagrange::sim::{SimOptions, Simulation};
 use lagrange::spatial::{quat_to_matrix, Mat3, Transform, Vec3};
 use lagrange::Model;
 use nalgebra::DMatrix;
@@ -16,6 +18,7 @@ use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 // ------------------------------------------------------------------------------------------------
 // Tolerances
@@ -56,6 +59,11 @@ pub const FD_REL: f64 = 1e-9;
 /// a few per cent of the leading one (measured RK4 ratios 14.4–15.7 for 16, Euler 2.00 and 4.00), and
 /// 1.25 keeps neighbouring orders well apart (2ᵖ·1.25 < 2ᵖ⁺¹/1.25).
 pub const INTEGRATOR_ORDER_BAND: f64 = 1.25;
+
+/// Global error of the adaptive Dormand–Prince 5(4) stepper over 0.5 s of the quaternion cases
+/// of `tests/integrator_order.rs`, in units of the requested rtol (local error control does not
+/// bound the global error; it accumulates over the steps and through the dynamics' sensitivity).
+pub const ADAPTIVE_TOL_FACTOR: f64 = 100.0;
 
 /// Relative error of the small-amplitude period of the physical pendulum (notes eq. 59) measured
 /// from an RK4 run of 4000 steps per period (`tests/physics.rs`). Model errors: the amplitude
@@ -519,4 +527,17 @@ pub fn exact_rk4(dt: f64) -> lagrange::sim::SimOptions {
         constraints: Some(lagrange::constraint::ConstraintMode::Exact),
         ..Default::default()
     }
+}
+
+/// Runs `n` steps of `dt` from (q0, v0) with zero torques; returns the final state.
+pub fn run(model: &Model, kind: IntegratorKind, q0: &[f64], v0: &[f64], dt: f64, n: usize) -> State {
+    let mut sim = Simulation::new(
+        Arc::new(model.clone()),
+        &SimOptions { integrator: Some(kind), timestep: Some(dt), ..Default::default() },
+    );
+    sim.set_state(q0, v0).unwrap();
+    for _ in 0..n {
+        sim.step().unwrap();
+    }
+    sim.state
 }

@@ -100,6 +100,12 @@ enum Command {
         /// Integrator (default: the model's `<option integrator>`, Euler for URDF).
         #[arg(long, value_enum)]
         integrator: Option<IntegratorArg>,
+        /// Relative tolerance of `--integrator adaptive` (default 1e-8).
+        #[arg(long, allow_hyphen_values = true)]
+        rtol: Option<f64>,
+        /// Absolute tolerance of `--integrator adaptive` (default 1e-10).
+        #[arg(long, allow_hyphen_values = true)]
+        atol: Option<f64>,
         /// Print one JSON summary object instead of text.
         #[arg(long)]
         json: bool,
@@ -134,6 +140,11 @@ enum IntegratorArg {
     Euler,
     /// Classical Runge–Kutta (fourth order).
     Rk4,
+    /// MuJoCo's implicitfast (velocity-implicit in the joint-damping derivatives).
+    Implicitfast,
+    /// Dormand–Prince 5(4) with error control (rtol 1e-8, atol 1e-10), internal steps within
+    /// each --dt interval.
+    Adaptive,
 }
 
 impl From<IntegratorArg> for IntegratorKind {
@@ -141,6 +152,8 @@ impl From<IntegratorArg> for IntegratorKind {
         match a {
             IntegratorArg::Euler => IntegratorKind::Euler,
             IntegratorArg::Rk4 => IntegratorKind::Rk4,
+            IntegratorArg::Adaptive => IntegratorKind::Adaptive,
+            IntegratorArg::Implicitfast => IntegratorKind::ImplicitFast,
         }
     }
 }
@@ -166,6 +179,8 @@ fn main() -> ExitCode {
             duration,
             dt,
             integrator,
+            rtol,
+            atol,
             json,
             no_projection,
             baumgarte,
@@ -175,12 +190,15 @@ fn main() -> ExitCode {
             ctrl,
             out,
         }) => simulate::parse_baumgarte(baumgarte.as_deref()).and_then(|baumgarte| {
+            let integrator = integrator.map(IntegratorKind::from);
+            let tolerances = simulate::parse_tolerances(integrator, rtol, atol)?;
             let drift =
                 DriftCorrection { projection: !no_projection, baumgarte, ..DriftCorrection::default() };
             let request = simulate::Request {
                 duration,
                 dt,
-                integrator: integrator.map(IntegratorKind::from),
+                integrator,
+                tolerances,
                 constraints: mode,
                 drift,
                 json,

@@ -26,6 +26,8 @@ pub struct Request {
     pub dt: Option<f64>,
     /// None: the model's `<option integrator>`.
     pub integrator: Option<IntegratorKind>,
+    /// (rtol, atol) of the adaptive integrator; None: its defaults.
+    pub tolerances: Option<[f64; 2]>,
     /// None: the format's default mode.
     pub constraints: Option<ConstraintMode>,
     /// Drift correction of constrained models.
@@ -95,6 +97,36 @@ fn parse_list(name: &str, s: &str, n: usize) -> Result<Vec<f64>, CliError> {
     Ok(values)
 }
 
+/// (rtol, atol) from `--rtol`/`--atol`: only with `--integrator adaptive`, positive and finite;
+/// a missing one takes the adaptive integrator's default.
+pub fn parse_tolerances(
+    integrator: Option<IntegratorKind>,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+) -> Result<Option<[f64; 2]>, CliError> {
+    if rtol.is_none() && atol.is_none() {
+        return Ok(None);
+    }
+    if integrator != Some(IntegratorKind::Adaptive) {
+        return Err(CliError::Usage(
+            "--rtol/--atol set the error control of the adaptive integrator: add --integrator adaptive"
+                .into(),
+        ));
+    }
+    let pair = [
+        rtol.unwrap_or(lagrange::integrate::DEFAULT_RTOL),
+        atol.unwrap_or(lagrange::integrate::DEFAULT_ATOL),
+    ];
+    for (name, x) in [("rtol", pair[0]), ("atol", pair[1])] {
+        if !(x > 0.0 && x.is_finite()) {
+            return Err(CliError::Usage(format!(
+                "--{name} {x}: give a positive tolerance, e.g. --{name} 1e-8"
+            )));
+        }
+    }
+    Ok(Some(pair))
+}
+
 /// Simulates `model` per `request`, writing the CSV if asked; returns the summary.
 pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     let mut sim = Simulation::new(
@@ -104,6 +136,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
             timestep: request.dt,
             constraints: request.constraints,
             drift: Some(request.drift),
+            tolerances: request.tolerances,
         },
     );
     let dt = sim.timestep;
@@ -433,6 +466,7 @@ pub fn default_run() -> Result<(), CliError> {
         duration: 5.0,
         dt: Some(1e-3),
         integrator: Some(IntegratorKind::Rk4),
+        tolerances: None,
         constraints: None,
         drift: DriftCorrection::default(),
         json: false,

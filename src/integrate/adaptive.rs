@@ -1,0 +1,178 @@
+//! Adaptive Dormand–Prince 5(4) (Dormand & Prince, *A family of embedded Runge–Kutta formulae*,
+//! J. Comput. Appl. Math. 6, 1980; Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4–5 for the
+//! error norm and step-size control) on the configuration manifold, with the same
+//! Runge–Kutta–Munthe-Kaas stages as [`RungeKutta4`](super::RungeKutta4): stage configurations
+//! q₀ ⊕ θᵢ, slopes of θ from dexp⁻¹.
+//!
+//! [`Stepper::step`] advances by exactly the requested interval `h` in as many internal steps as
+//! the error control needs (so fixed-interval callers such as `simulate` and `workprec` can use
+//! it); the internal step size carries over between calls. The error of an internal step is the
+//! max over components of |y₅ − y₄| / (atol + rtol·s), with s = max(|y₀|, |y₁|) for v and flat
+//! coordinates and s = 1 rad for the rotation-vector coordinates of quaternion joints; a step is
+//! accepted when that is ≤ 1, and the next size is h·min(5, max(0.2, 0.9·err^(−1/5))).
+
+use super::stage::{evaluate_stage, StageInput};
+use super::{correct_drift, State, StepReport, Stepper};
+use crate::forward::Plan;
+use crate::model::{integrate_configuration, Data, JointKind, Model};
+use nalgebra::DVector;
+
+/// Matrix and the two weight rows of Dormand–Prince 5(4) (the dynamics are autonomous: the
+/// nodes cᵢ are not needed).
+const A: [[f64; 6]; 7] = [
+    [0.0; 6],
+    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0, 0.0],
+    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0, 0.0],
+    [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0],
+];
+const B5: [f64; 7] = [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0, 0.0];
+const B4: [f64; 7] =
+    [5179.0 / 57600.0, 0.0, 7571.0 / 16695.0, 393.0 / 640.0, -92097.0 / 339200.0, 187.0 / 2100.0, 1.0 / 40.0];
+
+/// Default tolerances of `--integrator adaptive`.
+pub const DEFAULT_RTOL: f64 = 1e-8;
+pub const DEFAULT_ATOL: f64 = 1e-10;
+
+/// Dormand–Prince 5(4) stepper with error control.
+pub struct DormandPrince54 {
+    pub rtol: f64,
+    pub atol: f64,
+    /// The internal step size proposed for the next step (None before the first).
+    h_proposed: Option<f64>,
+    q_stage: DVector<f64>,
+    v_stage: DVector<f64>,
+    theta: DVector<f64>,
+    theta_rate: [DVector<f64>; 7],
+    a_stage: [DVector<f64>; 7],
+    /// Per dof: the qpos index of a flat coordinate, None for the rotation-vector coordinates
+    /// of quaternion joints.
+    flat_qpos: Vec<Option<usize>>,
+}
+
+impl DormandPrince54 {
+    pub fn new(model: &Model, rtol: f64, atol: f64) -> Self {
+        let z = || DVector::zeros(model.nv);
+        let mut flat_qpos = vec![None; model.nv];
+        for j in &model.joints {
+            for k in 0..j.kind.nv() {
+                let rotational =
+                    matches!(j.kind, JointKind::Ball) || matches!(j.kind, JointKind::Free if k >= 3);
+                flat_qpos[j.dof_adr + k] = (!rotational).then_some(j.qpos_adr + k);
+            }
+        }
+        Self {
+            rtol,
+            atol,
+            h_proposed: None,
+            q_stage: DVector::zeros(model.nq),
+            v_stage: z(),
+            theta: z(),
+            theta_rate: std::array::from_fn(|_| z()),
+            a_stage: std::array::from_fn(|_| z()),
+            flat_qpos,
+        }
+    }
+
+    /// One internal step of size h from `state` (left unchanged); the stages are left in the
+    /// buffers. Returns the scaled error norm.
+    fn attempt(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &State, h: f64) -> f64 {
+        // The first stage picks the limit and contact rows; the later ones keep them.
+        data.thaw_rows();
+        for i in 0..7 {
+            self.v_stage.copy_from(&state.v);
+            self.theta.fill(0.0);
+            for j in 0..i {
+                self.v_stage.axpy(h * A[i][j], &self.a_stage[j], 1.0);
+                self.theta.axpy(h * A[i][j], &self.theta_rate[j], 1.0);
+            }
+            evaluate_stage(
+                model,
+                plan,
+                data,
+                StageInput { q0: &state.q, theta: &self.theta, v_stage: &self.v_stage },
+                &mut self.q_stage,
+                (&mut self.a_stage[i], &mut self.theta_rate[i]),
+            );
+            if i == 0 {
+                data.freeze_rows(false);
+            }
+        }
+        // Stage 7 sits at the fifth-order solution (C[6] = 1, A[6] = B5): θ and v_stage hold
+        // y₅ − y₀ in θ and y₅ in v.
+        let mut err: f64 = 0.0;
+        for k in 0..model.nv {
+            let (mut e_theta, mut e_v) = (0.0, 0.0);
+            for i in 0..7 {
+                let e = B5[i] - B4[i];
+                e_theta += h * e * self.theta_rate[i][k];
+                e_v += h * e * self.a_stage[i][k];
+            }
+            let s_v = state.v[k].abs().max(self.v_stage[k].abs());
+            let s_q = match self.flat_qpos[k] {
+                Some(i) => state.q[i].abs().max((state.q[i] + self.theta[k]).abs()),
+                None => 1.0,
+            };
+            err = err.max(e_theta.abs() / (self.atol + self.rtol * s_q));
+            err = err.max(e_v.abs() / (self.atol + self.rtol * s_v));
+        }
+        err
+    }
+}
+
+impl Stepper for DormandPrince54 {
+    fn name(&self) -> &'static str {
+        "adaptive"
+    }
+    fn order(&self) -> u32 {
+        5
+    }
+    fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
+        let t_end = state.time + h;
+        let mut h_try = self.h_proposed.unwrap_or(h).min(h);
+        let mut max_err: f64 = 0.0;
+        let mut rejected = 0u32;
+        loop {
+            let remaining = t_end - state.time;
+            if remaining <= 1e-14 * t_end.abs().max(h) {
+                break;
+            }
+            let last = h_try >= remaining;
+            let h_step = if last { remaining } else { h_try };
+            let err = self.attempt(model, plan, data, state, h_step);
+            let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
+            if err <= 1.0 && err.is_finite() {
+                state.v.copy_from(&self.v_stage);
+                integrate_configuration(model, state.q.as_mut_slice(), self.theta.as_slice(), 1.0);
+                state.time = if last { t_end } else { state.time + h_step };
+                max_err = max_err.max(err);
+                if !last || self.h_proposed.is_none() {
+                    h_try = h_step * factor;
+                }
+            } else {
+                rejected += 1;
+                h_try = h_step * if err.is_finite() { factor.min(1.0) } else { 0.2 };
+                if h_try < 1e-14 * h || rejected > 100_000 {
+                    // Give up on this interval: the state stays where error control stopped,
+                    // and the report says so.
+                    self.h_proposed = Some(h_try);
+                    return StepReport {
+                        accepted: false,
+                        h_used: state.time - (t_end - h),
+                        h_next: h_try,
+                        error_estimate: Some(err),
+                        ..StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
+                    };
+                }
+            }
+        }
+        self.h_proposed = Some(h_try);
+        StepReport {
+            h_next: h_try,
+            error_estimate: Some(max_err),
+            ..StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
+        }
+    }
+}
