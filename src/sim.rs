@@ -16,10 +16,16 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum SimError {
-    #[error("the simulation diverged at t = {time} s (step {step}): {quantity} of joint '{joint}' is {value}; reduce --dt, use --integrator rk4, or check the model's inertias (a massless subtree has no finite acceleration)")]
-    Diverged { time: f64, step: u64, quantity: &'static str, joint: String, value: f64 },
+    #[error("the simulation diverged at t = {} s (step {step}): {quantity} of joint '{joint}' is {value}; {hint}", display_time(*.time))]
+    Diverged { time: f64, step: u64, quantity: &'static str, joint: String, value: f64, hint: String },
     #[error("invalid initial state: {0}")]
     BadState(String),
+}
+
+/// A simulation time for display: rounded to 12 significant digits, so that a sum of steps
+/// prints as 6.8, not 6.800000000000003 or 6.799999999999.
+pub fn display_time(t: f64) -> f64 {
+    format!("{t:.11e}").parse().unwrap_or(t)
 }
 
 /// Choices a caller may override; `None` takes the model's own (its `<option>` and the format's
@@ -119,6 +125,25 @@ impl Simulation {
         Ok(report)
     }
 
+    /// What to try after a divergence, given what is in use: the first step points at the
+    /// initial state, later ones at the step size and the integrators not yet in use.
+    fn divergence_hint(&self) -> String {
+        if self.steps <= 1 {
+            return format!(
+                "it diverged in the first step, so the step size ({} s) is unlikely the cause: check the initial state (a huge initial velocity, a configuration far outside the joint limits) and the model's inertias",
+                self.timestep
+            );
+        }
+        let mut hint = format!("reduce --dt (now {} s)", self.timestep);
+        match self.integrator() {
+            "rk4" | "adaptive" => {}
+            "euler" => hint.push_str(", or use --integrator rk4 (or implicitfast for stiff damping)"),
+            _ => hint.push_str(", or use --integrator rk4"),
+        }
+        hint.push_str("; if it persists, check the model's stiffnesses and inertias");
+        hint
+    }
+
     fn check_finite(&self) -> Result<(), SimError> {
         if self.state.q.iter().chain(self.state.v.iter()).all(|x| x.is_finite()) {
             return Ok(());
@@ -136,6 +161,7 @@ impl Simulation {
                     quantity: "articulated inertia about the axis (D⁻¹)",
                     joint: j.name.clone(),
                     value: d_inv,
+                    hint: "the joint carries no mass or inertia about its axis at this configuration, which no step size fixes: check the inertias of the bodies it moves".into(),
                 });
             }
         }
@@ -160,6 +186,7 @@ impl Simulation {
                     quantity,
                     joint,
                     value: values[i],
+                    hint: self.divergence_hint(),
                 });
             }
         }

@@ -176,7 +176,14 @@ fn simulate_rejects_bad_arguments_with_a_fix() {
     assert!(err.contains("--q0: 2 values given, the model needs 6"), "{err}");
     let (ok, _, err) = lagrange(&["simulate", "models/ur5/ur5.urdf", "--dt", "0"]);
     assert!(!ok);
-    assert!(err.contains("dt > 0"), "{err}");
+    assert!(err.contains("--dt 0: the step must be a positive"), "{err}");
+    // A negative value reaches the check (not clap's "unexpected argument '-0.01'").
+    let (ok, _, err) = lagrange(&["simulate", "models/ur5/ur5.urdf", "--dt", "-0.01"]);
+    assert!(!ok);
+    assert!(err.contains("--dt -0.01: the step must be a positive, finite number of seconds"), "{err}");
+    let (ok, _, err) = lagrange(&["simulate", "models/ur5/ur5.urdf", "--duration", "-1"]);
+    assert!(!ok);
+    assert!(err.contains("--duration -1: give a non-negative"), "{err}");
     let (ok, _, err) = lagrange(&["simulate", "models/textbook/heavy_top.xml", "--rtol", "1e-6"]);
     assert!(!ok);
     assert!(

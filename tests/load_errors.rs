@@ -246,7 +246,7 @@ fn zero_axis() {
 #[test]
 fn negative_mass() {
     let inertial = UNIT_INERTIAL.replace("<mass value=\"1\"/>", "<mass value=\"-2.5\"/>");
-    let text = two_links("fixed", "", &inertial);
+    let text = two_links("continuous", "", &inertial);
     let (e, file) = load_err("negative_mass", &text);
     assert!(matches!(e, LoadError::NegativeMass { .. }), "{e:?}");
     let line = line_of(&text, "<inertial>");

@@ -17,27 +17,74 @@ const MASSLESS_TIP: &str = r#"<robot name="r">
 </robot>"#;
 
 #[test]
-fn diverging_simulation_names_time_joint_and_fix() {
-    let model = load_urdf_str(MASSLESS_TIP, Path::new("massless_tip.urdf"), &LoadOptions::default()).unwrap();
-    let options =
-        SimOptions { integrator: Some(IntegratorKind::Euler), timestep: Some(1e-3), ..Default::default() };
-    let mut sim = Simulation::new(Arc::new(model), &options);
-    sim.set_state(&[0.3, 0.0], &[0.0, 0.0]).unwrap();
-    let err = sim.step().unwrap_err();
-    assert!(matches!(err, SimError::Diverged { .. }), "{err:?}");
+fn massless_tip_is_refused_at_load() {
+    // Its joint would have no finite acceleration (D = 0): refused when the model is compiled,
+    // naming the joint, rather than diverging in the first step.
+    let err =
+        load_urdf_str(MASSLESS_TIP, Path::new("massless_tip.urdf"), &LoadOptions::default()).unwrap_err();
     let msg = err.to_string();
-    for needle in ["diverged at t = 0.001 s (step 1)", "joint 'wrist'", "reduce --dt", "massless subtree"] {
+    for needle in ["massless_tip.urdf:5", "joint 'wrist' moves nothing", "link 'tip'", "<inertial>"] {
         assert!(msg.contains(needle), "missing '{needle}' in: {msg}");
     }
 }
 
+/// A stiff hinge spring (k = 1e6 N·m/rad on 1 kg at 1 m): semi-implicit Euler at dt = 0.01 s is
+/// far beyond its stability limit 2/ω = 2 ms and blows up.
+const STIFF_SPRING: &str = r#"<mujoco><worldbody><body><joint name="spring" type="hinge" axis="0 1 0" stiffness="1e6"/>
+  <inertial pos="0 0 -1" mass="1" diaginertia="0.01 0.01 0.01"/></body></worldbody></mujoco>"#;
+
+fn stiff_spring(integrator: IntegratorKind) -> Simulation {
+    let spec =
+        lagrange::io::mjcf::parse_str(STIFF_SPRING, Path::new("stiff.xml"), &LoadOptions::default()).unwrap();
+    let model = lagrange::io::compile(&spec).unwrap();
+    let options = SimOptions { integrator: Some(integrator), timestep: Some(1e-2), ..Default::default() };
+    Simulation::new(Arc::new(model), &options)
+}
+
+fn diverge(sim: &mut Simulation) -> String {
+    for _ in 0..100_000 {
+        if let Err(e) = sim.step() {
+            assert!(matches!(e, SimError::Diverged { .. }), "{e:?}");
+            return e.to_string();
+        }
+    }
+    panic!("no divergence");
+}
+
+#[test]
+fn diverging_simulation_names_time_joint_and_fix() {
+    let mut sim = stiff_spring(IntegratorKind::Euler);
+    sim.set_state(&[0.1], &[0.0]).unwrap();
+    let msg = diverge(&mut sim);
+    for needle in ["diverged at t = ", "joint 'spring'", "reduce --dt (now 0.01 s)", "use --integrator rk4"] {
+        assert!(msg.contains(needle), "missing '{needle}' in: {msg}");
+    }
+    // The time is printed rounded (a sum of steps, not 6.800000000000003).
+    let t = msg.split("t = ").nth(1).and_then(|r| r.split(' ').next()).unwrap();
+    assert!(t.len() <= 8, "time printed as {t}");
+    // With rk4 in use, the hint does not suggest rk4.
+    let mut sim = stiff_spring(IntegratorKind::Rk4);
+    sim.set_state(&[0.1], &[0.0]).unwrap();
+    let msg = diverge(&mut sim);
+    assert!(msg.contains("reduce --dt") && !msg.contains("use --integrator rk4"), "{msg}");
+}
+
+#[test]
+fn divergence_in_the_first_step_points_at_the_initial_state() {
+    let mut sim = stiff_spring(IntegratorKind::Euler);
+    sim.set_state(&[0.1], &[1e307]).unwrap();
+    let msg = diverge(&mut sim);
+    for needle in ["(step 1)", "first step", "initial state", "huge initial velocity"] {
+        assert!(msg.contains(needle), "missing '{needle}' in: {msg}");
+    }
+    assert!(!msg.contains("use --integrator"), "{msg}");
+}
+
 #[test]
 fn non_finite_or_wrongly_sized_state_is_rejected() {
-    let model = load_urdf_str(MASSLESS_TIP, Path::new("massless_tip.urdf"), &LoadOptions::default()).unwrap();
-    let options = SimOptions { integrator: Some(IntegratorKind::Rk4), ..Default::default() };
-    let mut sim = Simulation::new(Arc::new(model), &options);
-    let msg = sim.set_state(&[f64::NAN, 0.0], &[0.0, 0.0]).unwrap_err().to_string();
+    let mut sim = stiff_spring(IntegratorKind::Rk4);
+    let msg = sim.set_state(&[f64::NAN], &[0.0]).unwrap_err().to_string();
     assert!(msg.contains("invalid initial state") && msg.contains("not finite"), "{msg}");
     let msg = sim.set_state(&[0.0], &[0.0, 0.0]).unwrap_err().to_string();
-    assert!(msg.contains("q has 1 values and v 2, the model needs nq = 2 and nv = 2"), "{msg}");
+    assert!(msg.contains("q has 1 values and v 2, the model needs nq = 1 and nv = 1"), "{msg}");
 }

@@ -159,7 +159,8 @@ fn axes_are_normalized() {
         k => panic!("y_planar is {k:?}"),
     }
     // A missing <axis> is x.
-    let text = r#"<robot name="r"><link name="a"/><link name="b"/>
+    // (Moving links carry mass: a massless leaf is refused, see tests/compat.rs.)
+    let text = r#"<robot name="r"><link name="a"/><link name="b"><inertial><origin xyz="0 0.1 0.1"/><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
         <joint name="j" type="revolute"><parent link="a"/><child link="b"/>
         <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"#;
     let m = load_urdf_str(text, Path::new("inline.urdf"), &LoadOptions::default()).unwrap();
@@ -192,7 +193,7 @@ fn limits_dynamics_and_mimic_are_stored() {
     assert!(m.joints.iter().all(|j| j.armature == 0.0));
 
     // <mimic> defaults: multiplier 1, offset 0.
-    let text = r#"<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+    let text = r#"<robot name="r"><link name="a"/><link name="b"><inertial><origin xyz="0 0.1 0.1"/><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link><link name="c"><inertial><origin xyz="0 0.1 0.1"/><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
         <joint name="j1" type="continuous"><parent link="a"/><child link="b"/></joint>
         <joint name="j2" type="continuous"><parent link="a"/><child link="c"/><mimic joint="j1"/></joint>
         </robot>"#;

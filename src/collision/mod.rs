@@ -84,6 +84,7 @@ impl CollisionModel {
 /// is `Model::max_contacts`).
 pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) {
     data.contacts.clear();
+    let budget = model.max_contacts();
     for pair in &model.collision_pairs {
         let [g1, g2] = pair.geom;
         let (geom1, geom2) = (&model.geoms[g1], &model.geoms[g2]);
@@ -100,9 +101,11 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         }
         let start = data.contacts.len();
         let mut push = |p1: Vec3, p2: Vec3, normal: Vec3, dist: f64, hint: Option<Vec3>, feature: u32| {
-            if data.contacts.len() - start >= pair.max_contacts
-                || data.contacts.len() == data.contacts.capacity()
-            {
+            if data.contacts.len() - start >= pair.max_contacts {
+                return;
+            }
+            if data.contacts.len() >= budget {
+                data.contacts_dropped += 1;
                 return;
             }
             data.contacts.push(Contact {

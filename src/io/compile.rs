@@ -4,7 +4,7 @@
 //! constraints, mimics, tendons, actuators and contact pairs against the tree
 //! ([`compile_elements`](crate::io::compile_elements)).
 
-use crate::io::LoadError;
+use crate::io::{LinkWord, LoadError};
 use crate::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec, Shape};
 use crate::model::{Body, Frame, FrameKind, Geom, Joint, JointKind, Model, SourceLoc, Spring, NO_DOF};
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
@@ -12,6 +12,8 @@ use std::collections::HashMap;
 
 /// Relative tolerance for the symmetry, sign and triangle-inequality checks of inertia tensors.
 const INERTIA_TOL: f64 = 1e-9;
+/// Inertia (kg·m²) below which a principal moment is round-off: MuJoCo's `mjMINVAL`.
+const ROUNDOFF_MINVAL: f64 = 1e-15;
 
 /// Compiles a spec into a model.
 pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
@@ -20,6 +22,9 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         return Err(LoadError::Empty { file });
     }
     check_unique_names(spec)?;
+    crate::io::plausibility::check_spec(spec)?;
+    let word = crate::io::plausibility::link_word(spec);
+    let welded = welded_to_world(spec);
     let mut meshes = crate::io::geom_mass::MeshCache::default();
     let mut hulls = crate::io::geom_hull::HullCache::default();
     let mut warnings = spec.warnings.clone();
@@ -27,8 +32,26 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     // bounds; then `settotalmass` scales the moving links.
     let mut link_inertias = Vec::with_capacity(spec.links.len());
     let mut geom_masses = Vec::with_capacity(spec.links.len());
-    for link in &spec.links {
-        let (inertia, masses) = link_mass(link, &spec.mass_rules, &mut meshes, &mut warnings)?;
+    for (li, link) in spec.links.iter().enumerate() {
+        let computed =
+            link_mass(link, word, &spec.mass_rules, &mut meshes, &mut warnings).and_then(|(i, m)| {
+                crate::io::plausibility::check_derived(link, word, &i)?;
+                Ok((i, m))
+            });
+        let (inertia, masses) = match computed {
+            Ok(x) => x,
+            // A link welded to the world never moves: its mass never enters the dynamics, so a
+            // mass that cannot be computed (an open visual mesh, a non-physical tensor) is no
+            // reason to refuse the model.
+            Err(e) if welded[li] => {
+                warnings.push(format!(
+                    "{e} [ignored: {word} '{}' is welded to the world, so its mass never enters the dynamics; it is taken as zero]",
+                    link.name
+                ));
+                (RigidInertia::zero(), vec![0.0; link.geoms.len()])
+            }
+            Err(e) => return Err(e),
+        };
         link_inertias.push(inertia);
         geom_masses.push(masses);
     }
@@ -132,7 +155,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             });
         }
         for (g, &mass) in link.geoms.iter().zip(&geom_masses[li]) {
-            let hull = crate::io::geom_hull::geom_hull(g, &link.name, &mut hulls, &mut warnings)?;
+            let hull = crate::io::geom_hull::geom_hull(g, word, &link.name, &mut hulls, &mut warnings)?;
             let unreadable = matches!(g.shape, Shape::Mesh { .. }) && hull.is_none();
             geoms.push(Geom {
                 name: g.name.clone(),
@@ -149,7 +172,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     }
 
     if spec.mass_rules.require_moving_mass {
-        check_moving_mass(spec, &bodies, &link_body)?;
+        check_moving_mass(spec, &bodies, &link_body, &mut warnings);
     }
 
     // Pass 2: per-dof tables (λ for the sparse factorization, armature, damping).
@@ -252,7 +275,24 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     model.contact_excludes = e.contact_excludes;
     model.elements.append(&mut e.kept);
     model.warnings.append(&mut e.warnings);
+    let joint_locs: Vec<SourceLoc> = spec
+        .links
+        .iter()
+        .filter(|l| l.joint.jtype != JointType::Fixed)
+        .map(|l| l.joint.loc.clone())
+        .collect();
+    crate::io::singular::check_mass_matrix(&model, &joint_locs, word)?;
     model.collision_pairs = crate::model::collision_pairs::candidate_pairs(&model);
+    if model.collision_pairs.len() > crate::model::collision_pairs::MAX_COLLISION_PAIRS {
+        return Err(LoadError::Invalid {
+            loc: SourceLoc { file: spec.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default(), line: 0 },
+            element: "geom".into(),
+            detail: format!(
+                "more than {} candidate collision pairs (a resource limit); give geoms that need not touch contype=\"0\" conaffinity=\"0\", use <contact><exclude>, or disable contacts (--disable contact)",
+                crate::model::collision_pairs::MAX_COLLISION_PAIRS
+            ),
+        });
+    }
     Ok(model)
 }
 
@@ -312,14 +352,29 @@ fn complete_keyframes(
     Ok(out)
 }
 
+/// Which links are welded to the world: the root when fixed, and every link reached from it
+/// through fixed joints only.
+fn welded_to_world(spec: &ModelSpec) -> Vec<bool> {
+    let mut welded = vec![false; spec.links.len()];
+    for (li, l) in spec.links.iter().enumerate() {
+        let parent_welded = l.parent.is_none_or(|p| p < li && welded[p]);
+        welded[li] = l.joint.jtype == JointType::Fixed && parent_welded;
+    }
+    welded
+}
+
 /// MuJoCo's check that every moving body has mass and inertia (`CheckBodyMassInertia`: at least
-/// `mjMINVAL` = 1e-15, its welded children counted). Bodies made for joint anchors are exempt: they
-/// stand for no MJCF body.
+/// `mjMINVAL` = 1e-15, its welded children counted), as a warning: MuJoCo refuses such a body, but
+/// when its descendants give its joints inertia the dynamics are defined (Pinocchio simulates it),
+/// and a singular mass matrix is refused for both formats by
+/// [`check_mass_matrix`](crate::io::singular::check_mass_matrix). Bodies made for joint anchors
+/// are exempt: they stand for no MJCF body.
 fn check_moving_mass(
     spec: &ModelSpec,
     bodies: &[Body],
     link_body: &[(usize, Transform)],
-) -> Result<(), LoadError> {
+    warnings: &mut Vec<String>,
+) {
     const MINVAL: f64 = 1e-15;
     let mut checked = vec![false; bodies.len()];
     checked[0] = true;
@@ -332,18 +387,15 @@ fn check_moving_mass(
         let body = &bodies[b];
         let moments = body.inertia.i_com().symmetric_eigenvalues();
         if body.inertia.mass < MINVAL || moments.min() < MINVAL {
-            return Err(LoadError::NonPhysicalInertia {
-                loc: link.loc.clone(),
-                link: link.name.clone(),
-                detail: format!(
-                    "the body moves but its mass ({:e} kg) or a principal moment ({:e} kg·m²) is below 1e-15, so its acceleration is undefined (MuJoCo: \"mass and inertia of moving bodies must be larger than mjMINVAL\"); give it an <inertial> or a geom with mass",
-                    body.inertia.mass,
-                    moments.min()
-                ),
-            });
+            warnings.push(format!(
+                "{}: body '{}': it moves but its mass ({:e} kg) or a principal moment ({:e} kg·m²) is below 1e-15; MuJoCo refuses such a model (\"mass and inertia of moving bodies must be larger than mjMINVAL\"), lagrange simulates it because the bodies it carries give its joints inertia; give it an <inertial> or a geom with mass to load it in MuJoCo",
+                link.loc,
+                link.name,
+                body.inertia.mass,
+                moments.min()
+            ));
         }
     }
-    Ok(())
 }
 
 /// A link's own mass properties in link coordinates and the mass each of its geoms contributed:
@@ -351,6 +403,7 @@ fn check_moving_mass(
 /// checked `<inertial>`; then the compiler's lower bounds and inertia balancing ([`MassRules`]).
 fn link_mass(
     link: &LinkSpec,
+    word: LinkWord,
     rules: &MassRules,
     meshes: &mut crate::io::geom_mass::MeshCache,
     warnings: &mut Vec<String>,
@@ -360,22 +413,28 @@ fn link_mass(
     let rules = if is_world(link) { &world_rules } else { rules };
     // Principal moments that are not physical are an error, or, when the loader was asked to
     // accept them, a warning with the tensor kept exactly as written (`None`: no rule fired).
-    let mut settle = |loc: &SourceLoc, moments: Result<Option<Vec3>, String>| match moments {
-        Ok(bounded) => Ok(bounded),
-        Err(detail) => {
-            let e = LoadError::NonPhysicalInertia { loc: loc.clone(), link: link.name.clone(), detail };
-            if !rules.accept_nonphysical {
-                return Err(e);
+    let settle =
+        |loc: &SourceLoc, moments: Result<Option<Vec3>, String>, warnings: &mut Vec<String>| match moments {
+            Ok(bounded) => Ok(bounded),
+            Err(detail) => {
+                let e = LoadError::NonPhysicalInertia {
+                    loc: loc.clone(),
+                    what: word,
+                    link: link.name.clone(),
+                    detail,
+                };
+                if !rules.accept_nonphysical {
+                    return Err(e);
+                }
+                warnings.push(format!("{e} [kept as written: --accept-nonphysical-inertia]"));
+                Ok(None)
             }
-            warnings.push(format!("{e} [kept as written: --accept-nonphysical-inertia]"));
-            Ok(None)
-        }
-    };
+        };
     let mut geom_masses = vec![0.0; link.geoms.len()];
     if link.inertia_from_geoms {
         let mut sum = RigidInertia::zero();
         for (g, m) in link.geoms.iter().zip(geom_masses.iter_mut()) {
-            let i_geom = crate::io::geom_mass::geom_inertia(g, &link.name, meshes)?;
+            let i_geom = crate::io::geom_mass::geom_inertia(g, word, &link.name, meshes, warnings)?;
             // MuJoCo ignores geoms of negligible mass (≤ mjEPS).
             if i_geom.mass > 1e-14 {
                 *m = i_geom.mass;
@@ -385,7 +444,7 @@ fn link_mass(
         if sum.mass > 0.0 {
             let (com, i_com) = (sum.com(), sum.i_com());
             let eig = i_com.symmetric_eigen();
-            let bounded = settle(&link.loc, bounded_moments(eig.eigenvalues, rules))?;
+            let bounded = settle(&link.loc, bounded_moments(eig.eigenvalues, rules), warnings)?;
             return Ok((
                 inertia_with(sum, sum.mass.max(rules.bound_mass), com, &eig.eigenvectors, bounded),
                 geom_masses,
@@ -395,15 +454,18 @@ fn link_mass(
     let Some(i) = &link.inertial else {
         // No mass anywhere: only the bounds can give the link some, at its origin.
         let zero = RigidInertia::zero();
-        let bounded = settle(&link.loc, bounded_moments(Vec3::zeros(), rules))?;
+        let bounded = settle(&link.loc, bounded_moments(Vec3::zeros(), rules), warnings)?;
         return Ok((
             inertia_with(zero, rules.bound_mass, Vec3::zeros(), &Mat3::identity(), bounded),
             geom_masses,
         ));
     };
-    let (moments, axes) = check_inertial(&link.name, i)?;
-    let bounded =
-        settle(&i.loc, negative_moment(i, &moments).map_or_else(|| bounded_moments(moments, rules), Err))?;
+    let (moments, axes) = check_inertial(word, &link.name, i)?;
+    let bounded = settle(
+        &i.loc,
+        negative_moment(i, &moments).map_or_else(|| bounded_moments(moments, rules), Err),
+        warnings,
+    )?;
     let r = i.x_link_inertial.rot;
     let given = RigidInertia::from_com(i.mass, i.x_link_inertial.pos, r * i.inertia * r.transpose());
     Ok((
@@ -433,8 +495,8 @@ fn inertia_with(
 /// (its description) unless `balanceinertia` replaces them by their mean.
 fn bounded_moments(moments: Vec3, rules: &MassRules) -> Result<Option<Vec3>, String> {
     let mut m = moments.map(|l| l.max(rules.bound_inertia));
-    let scale = m.max().max(f64::MIN_POSITIVE);
-    let violated = (0..3).any(|k| m[k] > m[(k + 1) % 3] + m[(k + 2) % 3] + INERTIA_TOL * scale);
+    let tol = (INERTIA_TOL * m.max()).max(ROUNDOFF_MINVAL);
+    let violated = (0..3).any(|k| m[k] > m[(k + 1) % 3] + m[(k + 2) % 3] + tol);
     if violated {
         if !rules.balance_inertia {
             let mut e: Vec<f64> = m.iter().copied().collect();
@@ -529,12 +591,21 @@ fn joint_kind(j: &JointSpec) -> Result<Option<JointKind>, LoadError> {
 
 /// Checks an `<inertial>` (finite, non-negative mass; finite symmetric tensor) and returns its
 /// principal moments and axes (columns, in inertial-frame coordinates).
-fn check_inertial(link: &str, i: &InertialSpec) -> Result<(Vec3, Mat3), LoadError> {
-    let err =
-        |detail: String| LoadError::NonPhysicalInertia { loc: i.loc.clone(), link: link.to_string(), detail };
+fn check_inertial(word: LinkWord, link: &str, i: &InertialSpec) -> Result<(Vec3, Mat3), LoadError> {
+    let err = |detail: String| LoadError::NonPhysicalInertia {
+        loc: i.loc.clone(),
+        what: word,
+        link: link.to_string(),
+        detail,
+    };
     if !i.mass.is_finite() || i.mass < 0.0 {
         if i.mass.is_finite() {
-            return Err(LoadError::NegativeMass { loc: i.loc.clone(), link: link.to_string(), mass: i.mass });
+            return Err(LoadError::NegativeMass {
+                loc: i.loc.clone(),
+                what: word,
+                link: link.to_string(),
+                mass: i.mass,
+            });
         }
         return Err(err(format!("mass is {}", i.mass)));
     }
@@ -550,11 +621,13 @@ fn check_inertial(link: &str, i: &InertialSpec) -> Result<(Vec3, Mat3), LoadErro
     Ok((eig.eigenvalues, eig.eigenvectors))
 }
 
-/// The defect of an `<inertial>` whose principal `moments` include a negative one (beyond round-off
-/// relative to its largest entry), if any.
+/// The defect of an `<inertial>` whose principal `moments` include a negative one, if any. Round-off
+/// is accepted: a moment above `−max(INERTIA_TOL · scale, MINVAL)`, with `scale` the largest entry
+/// and `MINVAL` MuJoCo's `mjMINVAL` (a tensor that is zero up to round-off, e.g. off-diagonal
+/// entries of 1e-20 on a zero diagonal, is zero, not negative).
 fn negative_moment(i: &InertialSpec, moments: &Vec3) -> Option<String> {
-    let scale = i.inertia.abs().max().max(f64::MIN_POSITIVE);
-    (moments.min() < -INERTIA_TOL * scale).then(|| {
+    let scale = i.inertia.abs().max();
+    (moments.min() < -(INERTIA_TOL * scale).max(ROUNDOFF_MINVAL)).then(|| {
         let mut e: Vec<f64> = moments.iter().copied().collect();
         e.sort_by(f64::total_cmp);
         format!("principal moments {e:?} include a negative one")

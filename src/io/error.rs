@@ -34,10 +34,10 @@ pub enum LoadError {
     DuplicateName { loc: SourceLoc, element: &'static str, name: String },
     #[error("{loc}: joint '{joint}': axis is zero; give a nonzero <axis xyz=\"...\">")]
     ZeroAxis { loc: SourceLoc, joint: String },
-    #[error("{loc}: link '{link}': negative mass {mass}; mass must be ≥ 0 kg: fix <mass value=\"...\">")]
-    NegativeMass { loc: SourceLoc, link: String, mass: f64 },
-    #[error("{loc}: link '{link}': non-physical inertia: {detail}; an inertia tensor must be symmetric positive semi-definite with principal moments satisfying the triangle inequality (I1 + I2 ≥ I3): fix the <inertia> values, or pass --accept-nonphysical-inertia to use them as written (as Pinocchio does)")]
-    NonPhysicalInertia { loc: SourceLoc, link: String, detail: String },
+    #[error("{loc}: {what} '{link}': negative mass {mass}; mass must be ≥ 0 kg: fix {}", mass_attribute(.what))]
+    NegativeMass { loc: SourceLoc, what: LinkWord, link: String, mass: f64 },
+    #[error("{loc}: {what} '{link}': non-physical inertia: {detail}; an inertia tensor must be symmetric positive semi-definite with principal moments satisfying the triangle inequality (I1 + I2 ≥ I3): fix {}, or pass --accept-nonphysical-inertia to use them as written (as Pinocchio does)", inertia_attribute(.what))]
+    NonPhysicalInertia { loc: SourceLoc, what: LinkWord, link: String, detail: String },
     #[error("{loc}: link '{link}': cannot resolve '{uri}': package '{package}' not found (searched: {}); pass --package-dir DIR (the folder holding '{package}/') or add it to ROS_PACKAGE_PATH", searched_list(.searched))]
     PackageNotFound {
         loc: SourceLoc,
@@ -49,10 +49,10 @@ pub enum LoadError {
     },
     #[error("{loc}: link '{link}': mesh file '{path}' does not exist; fix the filename, or point --package-dir / ROS_PACKAGE_PATH at the right package for a package:// path")]
     MeshNotFound { loc: SourceLoc, link: String, path: String },
-    #[error("{loc}: body '{link}': the mass properties of mesh '{path}' are needed (the body's inertia comes from its geoms) but {reason}")]
-    MeshMass { loc: SourceLoc, link: String, path: String, reason: String },
-    #[error("{loc}: body '{link}': mesh '{path}' collides by its convex hull, but {reason}; give the geom contype=\"0\" conaffinity=\"0\" if it is only drawn, or fix the mesh")]
-    MeshHull { loc: SourceLoc, link: String, path: String, reason: String },
+    #[error("{loc}: {what} '{link}': the mass properties of mesh '{path}' are needed (the {what}'s inertia comes from its geoms) but {reason}")]
+    MeshMass { loc: SourceLoc, what: LinkWord, link: String, path: String, reason: String },
+    #[error("{loc}: {what} '{link}': mesh '{path}' collides by its convex hull, but {reason}; {}, or fix the mesh", hull_fix(.what))]
+    MeshHull { loc: SourceLoc, what: LinkWord, link: String, path: String, reason: String },
     #[error("{loc}: <include>: include cycle: {}; remove one of these includes", .chain.join(" includes "))]
     IncludeCycle { loc: SourceLoc, chain: Vec<String> },
     #[error(
@@ -71,6 +71,50 @@ pub enum LoadError {
     AssetNotFound { loc: SourceLoc, element: String, path: String },
     #[error("{file}: unsupported model format (expected .urdf or .xml)")]
     UnsupportedFormat { file: String },
+}
+
+/// What a link is called in its file: a URDF `<link>` or an MJCF `<body>`; messages use the file's
+/// own terms.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LinkWord {
+    Link,
+    Body,
+}
+
+impl std::fmt::Display for LinkWord {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LinkWord::Link => "link",
+            LinkWord::Body => "body",
+        })
+    }
+}
+
+/// Where a mass is written, in the file's terms.
+fn mass_attribute(what: &LinkWord) -> &'static str {
+    if *what == LinkWord::Body {
+        "<inertial mass=\"...\"> or the geom's mass/density"
+    } else {
+        "<mass value=\"...\">"
+    }
+}
+
+/// Where an inertia tensor is written, in the file's terms.
+fn inertia_attribute(what: &LinkWord) -> &'static str {
+    if *what == LinkWord::Body {
+        "<inertial diaginertia/fullinertia> (or the geoms it comes from)"
+    } else {
+        "the <inertia> values"
+    }
+}
+
+/// How to keep a mesh out of collisions, in the file's terms.
+fn hull_fix(what: &LinkWord) -> &'static str {
+    if *what == LinkWord::Body {
+        "give the geom contype=\"0\" conaffinity=\"0\" if it is only drawn"
+    } else {
+        "move it from <collision> to <visual> if it is only drawn"
+    }
 }
 
 /// `["a", "b"]` → `'a', 'b'`.

@@ -3,7 +3,7 @@
 //! hull"). The hull is computed once per compile with parry's quickhull (`mass::convex_hull`, MuJoCo's degeneracy checks), in the mesh file's frame
 //! after scaling (the frame in which lagrange places a mesh geom); each file and scale is read once.
 
-use super::LoadError;
+use super::{LinkWord, LoadError};
 use crate::mass;
 use crate::model::spec::{GeomSpec, Shape};
 use crate::spatial::Vec3;
@@ -25,6 +25,7 @@ pub struct HullCache {
 /// warning says what is lost).
 pub fn geom_hull(
     g: &GeomSpec,
+    what: LinkWord,
     link: &str,
     cache: &mut HullCache,
     warnings: &mut Vec<String>,
@@ -39,6 +40,7 @@ pub fn geom_hull(
     }
     let err = |reason: String| LoadError::MeshHull {
         loc: g.loc.clone(),
+        what,
         link: link.to_string(),
         path: path.display().to_string(),
         reason,
@@ -47,7 +49,7 @@ pub fn geom_hull(
         Ok(m) => m,
         Err(e) => {
             warnings.push(format!(
-                "{}: body '{link}': collision mesh '{}' cannot be read ({e}): the geom does not collide",
+                "{}: {what} '{link}': collision mesh '{}' cannot be read ({e}): the geom does not collide",
                 g.loc,
                 path.display()
             ));

@@ -1,7 +1,7 @@
 //! Mass properties of a spec geom (MuJoCo `inertiafromgeom`): primitives in closed form, meshes
 //! through [`crate::mass`], each mesh file read once per compile.
 
-use super::LoadError;
+use super::{LinkWord, LoadError};
 use crate::mass::{self, GeomMass, MeshInertia, Primitive};
 use crate::model::spec::{GeomSpec, Shape};
 use crate::spatial::{RigidInertia, Vec3};
@@ -16,7 +16,14 @@ pub struct MeshCache {
 }
 
 /// The mass properties a geom contributes to its link, in the geom's frame.
-pub fn geom_inertia(g: &GeomSpec, link: &str, meshes: &mut MeshCache) -> Result<RigidInertia, LoadError> {
+/// `what` is "link" (URDF) or "body" (MJCF), for messages.
+pub fn geom_inertia(
+    g: &GeomSpec,
+    what: LinkWord,
+    link: &str,
+    meshes: &mut MeshCache,
+    warnings: &mut Vec<String>,
+) -> Result<RigidInertia, LoadError> {
     // Massless geoms (visuals, `density="0"`, `mass="0"`) are never measured: a broken mesh used
     // only for drawing or collision is no error.
     if matches!(g.mass, GeomMass::None | GeomMass::Density(0.0) | GeomMass::Mass(0.0)) {
@@ -34,7 +41,9 @@ pub fn geom_inertia(g: &GeomSpec, link: &str, meshes: &mut MeshCache) -> Result<
         Shape::Ellipsoid { radii } => Primitive::Ellipsoid { radii: *radii },
         // Planes and height fields carry no mass (MuJoCo gives them zero volume in bodies).
         Shape::Plane { .. } | Shape::Hfield { .. } => return Ok(RigidInertia::zero()),
-        Shape::Mesh { path, scale } => return mesh_geom_inertia(g, link, path, scale, meshes),
+        Shape::Mesh { path, scale } => {
+            return mesh_geom_inertia(g, what, link, path, scale, meshes, warnings)
+        }
     };
     let measure = mass::primitive_measure(&primitive, g.distribution);
     let m = mass::resolve_mass(g.mass, measure);
@@ -43,10 +52,12 @@ pub fn geom_inertia(g: &GeomSpec, link: &str, meshes: &mut MeshCache) -> Result<
 
 fn mesh_geom_inertia(
     g: &GeomSpec,
+    what: LinkWord,
     link: &str,
     path: &Path,
     scale: &Vec3,
     meshes: &mut MeshCache,
+    warnings: &mut Vec<String>,
 ) -> Result<RigidInertia, LoadError> {
     let key = (path.to_path_buf(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()], g.mesh_inertia);
     let (measure, unit) = match meshes.entries.get(&key) {
@@ -54,12 +65,25 @@ fn mesh_geom_inertia(
         None => {
             let err = |e: mass::MeshError| LoadError::MeshMass {
                 loc: g.loc.clone(),
+                what,
                 link: link.to_string(),
                 path: path.display().to_string(),
                 reason: e.to_string(),
             };
             let mesh = mass::read_mesh(path, scale).map_err(err)?;
-            let e = mass::mesh_inertia(&mesh, g.mesh_inertia).map_err(err)?;
+            let (e, open) = mass::mesh_inertia_as_mujoco(&mesh, g.mesh_inertia).map_err(err)?;
+            if let Some(open) = open {
+                // MuJoCo 4.0 integrates an open surface in these modes too: so do we, and say so.
+                warnings.push(format!(
+                    "{}: {what} '{link}': mesh '{}': {open}; its mass properties are MuJoCo's volume integrals over the open surface (inertia=\"{}\"), which depend on where the holes are",
+                    g.loc,
+                    path.display(),
+                    match g.mesh_inertia {
+                        MeshInertia::Exact => "exact",
+                        _ => "legacy",
+                    }
+                ));
+            }
             meshes.entries.insert(key, e);
             e
         }

@@ -8,9 +8,11 @@ mod geom_hull;
 pub mod geom_mass;
 pub mod mjcf;
 pub mod package;
+pub mod plausibility;
+mod singular;
 pub mod urdf;
 
-pub use error::LoadError;
+pub use error::{LinkWord, LoadError};
 
 use crate::model::spec::ModelSpec;
 use crate::Model;

@@ -336,6 +336,25 @@ impl Tree {
             let p = find("parent", &j.parent)?;
             let c = find("child", &j.child)?;
             if let Some(other) = parent_joint[c] {
+                // A second parent that descends from the child closes a loop: report the cycle.
+                let mut path = vec![p];
+                let mut cur = p;
+                while let Some(pj) = parent_joint[cur] {
+                    cur = joint_parent[pj];
+                    if cur == c || path.len() > n {
+                        break;
+                    }
+                    path.push(cur);
+                }
+                if cur == c {
+                    path.push(c);
+                    path.reverse();
+                    return Err(LoadError::Cycle {
+                        loc: j.loc.clone(),
+                        joint: j.name.clone(),
+                        links: path.iter().map(|&l| index.links[l].name.clone()).collect(),
+                    });
+                }
                 return Err(LoadError::TwoParents {
                     loc: j.loc.clone(),
                     joint: j.name.clone(),

@@ -164,7 +164,28 @@ impl TriangleMesh {
 /// below MuJoCo's 1e-15 m³ or numerically flat ([`MeshError::VolumeTooSmall`]) and
 /// non-physical results ([`MeshError::NonPhysicalInertia`], MuJoCo's eigenvalue checks).
 pub fn mesh_inertia(mesh: &TriangleMesh, mode: MeshInertia) -> Result<(f64, RigidInertia), MeshError> {
+    measure(mesh, mode, false).map(|(result, _)| result)
+}
+
+/// [`mesh_inertia`] with MuJoCo 4.0's policy for open surfaces: in the `legacy` and `exact` modes
+/// MuJoCo computes the volume integrals of a surface with holes anyway (the tetrahedra about its
+/// apex), so this does too and returns the [`MeshError::Open`] defect beside the result, for the
+/// caller to report as a warning. Every other defect is still an error.
+pub fn mesh_inertia_as_mujoco(
+    mesh: &TriangleMesh,
+    mode: MeshInertia,
+) -> Result<((f64, RigidInertia), Option<MeshError>), MeshError> {
+    measure(mesh, mode, true)
+}
+
+/// [`mesh_inertia`] (`allow_open` false) and [`mesh_inertia_as_mujoco`] (true).
+fn measure(
+    mesh: &TriangleMesh,
+    mode: MeshInertia,
+    allow_open: bool,
+) -> Result<((f64, RigidInertia), Option<MeshError>), MeshError> {
     mesh.validate()?;
+    let mut open = None;
     let hull = if mesh.triangles.is_empty() { Some(convex_hull(&mesh.vertices)?) } else { None };
     // The surface: the mesh's own triangles (or the hull's when it has none).
     let surface = hull.as_ref().unwrap_or(mesh);
@@ -191,11 +212,16 @@ pub fn mesh_inertia(mesh: &TriangleMesh, mode: MeshInertia) -> Result<(f64, Rigi
             let weight = if mode == MeshInertia::Legacy { Weight::AbsVolume } else { Weight::Volume };
             let (volume, signed, com) = volume_and_centroid(solid, &face_centroid, weight);
             if let Some(t) = &topo {
-                check_defects(surface, t, mode, volume)?;
+                match check_defects(surface, t, mode, volume) {
+                    Err(e @ MeshError::Open { .. }) if allow_open => open = Some(e),
+                    other => other?,
+                }
             }
             // An inside-out mesh is refused in every mode, legacy included: its |V| per
             // tetrahedron tolerates some wrongly wound triangles, not a surface turned inside out.
-            if signed < 0.0 {
+            // An open surface has no inside: legacy mode takes |V| per tetrahedron as MuJoCo does.
+            let open_legacy = open.is_some() && mode == MeshInertia::Legacy;
+            if signed < 0.0 && !open_legacy {
                 return Err(MeshError::NegativeVolume { volume: signed });
             }
             if volume.is_nan() || volume < MINVAL || volume <= FLAT_REL * area.powf(1.5) {
@@ -208,11 +234,12 @@ pub fn mesh_inertia(mesh: &TriangleMesh, mode: MeshInertia) -> Result<(f64, Rigi
     // I = tr(S) 1 − S (notes eq. 68–69), about the centre of mass.
     let i_com = Mat3::identity() * second_moment.trace() - second_moment;
     check_physical(&i_com)?;
-    Ok((measure, RigidInertia::from_com(measure, com, i_com)))
+    Ok(((measure, RigidInertia::from_com(measure, com, i_com)), open))
 }
 
-/// Refuses a surface whose holes (any solid mode) or wrongly wound triangles (exact mode) could
-/// change its volume by more than [`DEFECT_REL`]: holes of area `A_h` by up to `d·A_h/3`, flipped
+/// Refuses a surface whose wrongly wound triangles (exact mode) or holes (any solid mode; checked
+/// last, so that [`mesh_inertia_as_mujoco`] can set that defect aside) could change its volume by
+/// more than [`DEFECT_REL`]: holes of area `A_h` by up to `d·A_h/3`, flipped
 /// triangles of area `A_f` by up to `2·d·A_f/3` (`d` the diameter).
 fn check_defects(
     surface: &TriangleMesh,
@@ -223,6 +250,13 @@ fn check_defects(
     let d = surface.diameter();
     let v = volume.abs();
     let too_large = |spread: f64| spread > 0.0 && (v.is_nan() || spread > DEFECT_REL * v);
+    if mode == MeshInertia::Exact && too_large(2.0 * d * t.misoriented_area / 3.0) {
+        let (a, b) = t.misoriented_example.unwrap_or_default();
+        return Err(MeshError::Misoriented {
+            edges: t.misoriented_edges,
+            example: (surface.point(a), surface.point(b)),
+        });
+    }
     let hole_spread = d * t.hole_area / 3.0;
     if too_large(hole_spread) {
         let (a, b) = t.boundary_example.unwrap_or_default();
@@ -231,13 +265,6 @@ fn check_defects(
             holes: t.boundary_loops,
             hole_area: t.hole_area,
             relative: hole_spread / v,
-            example: (surface.point(a), surface.point(b)),
-        });
-    }
-    if mode == MeshInertia::Exact && too_large(2.0 * d * t.misoriented_area / 3.0) {
-        let (a, b) = t.misoriented_example.unwrap_or_default();
-        return Err(MeshError::Misoriented {
-            edges: t.misoriented_edges,
             example: (surface.point(a), surface.point(b)),
         });
     }

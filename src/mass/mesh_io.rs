@@ -350,7 +350,20 @@ pub(crate) fn parse_msh(bytes: &[u8], path: &Path) -> Result<TriangleMesh, MeshE
         let mut tri = [0u32; 3];
         for (j, t) in tri.iter_mut().enumerate() {
             let idx = i32_at(face0 + 12 * k + 4 * j);
-            *t = u32::try_from(idx).unwrap_or(u32::MAX);
+            *t = match u32::try_from(idx) {
+                Ok(i) if (i as usize) < nv => i,
+                _ => {
+                    return Err(parse_error(
+                        path,
+                        F,
+                        None,
+                        format!(
+                            "face {k} refers to vertex {idx}, but the file has {nv} vertices (valid indices 0..{}); fix the face list",
+                            nv.saturating_sub(1)
+                        ),
+                    ))
+                }
+            };
         }
         triangles.push(tri);
     }

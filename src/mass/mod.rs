@@ -28,7 +28,7 @@ mod principal;
 mod topology;
 
 pub use error::MeshError;
-pub use mesh::{convex_hull, mesh_inertia, TriangleMesh};
+pub use mesh::{convex_hull, mesh_inertia, mesh_inertia_as_mujoco, TriangleMesh};
 pub use mesh_io::{read_mesh, read_mesh_with, ObjObjects, ReadOptions};
 pub use primitive::{primitive_inertia, primitive_measure, Primitive};
 pub use principal::{

@@ -94,7 +94,12 @@ fn combine(g1: &GeomContact, g2: &GeomContact) -> (u32, [f64; 3], [f64; 2], [f64
     (g1.condim.max(g2.condim), friction, solref, solimp)
 }
 
-/// The candidate pairs of `model` (explicit pairs first, then dynamic pairs in geom order).
+/// The most candidate collision pairs a model may have (a resource limit: each pair is tested
+/// every collision pass, and a file with ten thousand overlapping geoms must not exhaust memory).
+pub const MAX_COLLISION_PAIRS: usize = 1_000_000;
+
+/// The candidate pairs of `model` (explicit pairs first, then dynamic pairs in geom order); at
+/// most one beyond [`MAX_COLLISION_PAIRS`] (the compile step then refuses the model).
 pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
     let flags = &model.options.flags;
     if !flags.contact || !flags.constraint {
@@ -167,6 +172,11 @@ pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
             let geom = ordered(i, j);
             if out[..explicit].iter().any(|p| p.geom == geom) {
                 continue;
+            }
+            if out.len() > MAX_COLLISION_PAIRS {
+                // Resource limit: the compile step refuses the model (one pair over the limit
+                // is enough to say so).
+                return out;
             }
             let (condim, f, solref, solimp) = combine(c1, c2);
             out.push(CollisionPair {

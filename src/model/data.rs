@@ -208,6 +208,9 @@ pub struct Data {
     // --- collision ---
     /// Contacts of the last collision pass (MuJoCo's `contact`); capacity reserved for the model.
     pub contacts: Vec<Contact>,
+    /// Contacts dropped because a collision pass found more than [`Model::max_contacts`]
+    /// (cumulative; MuJoCo's `mjWARN_CONTACTFULL`).
+    pub contacts_dropped: u64,
 }
 
 impl Data {
@@ -293,6 +296,7 @@ impl Data {
             efc_frozen_sticking: Vec::with_capacity(model.max_contacts()),
             efc_frozen_sticking_dofs: Vec::with_capacity(nv),
             contacts: Vec::with_capacity(model.max_contacts()),
+            contacts_dropped: 0,
         }
     }
 }

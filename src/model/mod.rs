@@ -271,15 +271,20 @@ impl Model {
     }
     /// Whether any joint has viscous damping (the passive pass of `simulate`).
     /// Upper bound on the number of contacts one collision pass can report (sizes
-    /// `Data::contacts` and the contact rows): the sum of each candidate pair's bound.
+    /// `Data::contacts` and the contact rows): the sum of each candidate pair's bound, capped at
+    /// [`MAX_CONTACTS`] (a resource limit, like MuJoCo's contact arena: contacts beyond it are
+    /// dropped and counted in [`Data::contacts_dropped`]).
     pub fn max_contacts(&self) -> usize {
-        self.collision_pairs.iter().map(|p| p.max_contacts).sum()
+        self.collision_pairs.iter().map(|p| p.max_contacts).sum::<usize>().min(MAX_CONTACTS)
     }
 
     pub fn has_damping(&self) -> bool {
         self.dof_damping.iter().any(|&d| d != 0.0)
     }
 }
+
+/// The most contacts one collision pass keeps (see [`Model::max_contacts`]).
+pub const MAX_CONTACTS: usize = 500;
 
 /// `q ← q ⊕ v·dt` for the whole configuration (MuJoCo's `mj_integratePos`).
 pub fn integrate_configuration(model: &Model, q: &mut [f64], v: &[f64], dt: f64) {

@@ -92,7 +92,7 @@ enum Command {
     Simulate {
         model: PathBuf,
         /// Simulated time in seconds.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
         duration: f64,
         /// Step size in seconds (default: the model's `<option timestep>`, 0.002 for URDF).
         #[arg(long, allow_hyphen_values = true)]

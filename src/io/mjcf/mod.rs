@@ -91,8 +91,21 @@ fn check_targets(
     Ok(())
 }
 
-fn parse_root(root: &xml::Element, path: &Path, _options: &LoadOptions) -> Result<ModelSpec, LoadError> {
+fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<ModelSpec, LoadError> {
     let mut warnings = check::check_tree(root)?;
+    // The shared load options: each acts on MJCF too, or says that it does not apply.
+    if load.floating {
+        warnings.push(format!(
+            "{}: --floating applies to URDF only: an MJCF model says which bodies float with <freejoint> (ignored)",
+            path.display()
+        ));
+    }
+    if !load.package_dirs.is_empty() {
+        warnings.push(format!(
+            "{}: --package-dir applies to URDF package:// paths only: MJCF paths are relative to the model file or <compiler meshdir/assetdir> (ignored)",
+            path.display()
+        ));
+    }
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let compiler = sections::compiler(root, &dir)?;
     let (options, gravity) = sections::options(root)?;
@@ -115,7 +128,10 @@ fn parse_root(root: &xml::Element, path: &Path, _options: &LoadOptions) -> Resul
         source: Some(path.to_path_buf()),
         gravity,
         links: builder.links,
-        mass_rules: compiler.mass_rules.clone(),
+        mass_rules: MassRules {
+            accept_nonphysical: load.accept_nonphysical_inertia,
+            ..compiler.mass_rules.clone()
+        },
         options,
         keyframes,
         equalities,

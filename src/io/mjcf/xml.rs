@@ -1,12 +1,21 @@
 //! The MJCF document as one owned element tree, `<include>` files spliced in (MuJoCo semantics:
 //! the children of the included file's `<mujoco>` replace the `<include>` element; paths are
-//! relative to the including file; nesting allowed, cycles are errors). Every element remembers
-//! its file and line for messages.
+//! relative to the including file; nesting allowed, cycles are errors; the included file's root
+//! may be `<mujoco>` or MuJoCo-era `<mujocoinclude>`). Every element remembers its file and line
+//! for messages.
 
 use crate::io::LoadError;
 use crate::model::SourceLoc;
 use roxmltree::{Document, Node, ParsingOptions};
 use std::path::{Path, PathBuf};
+
+/// Resource limits: how deep includes may nest and how many files one model may include.
+pub const MAX_INCLUDE_DEPTH: usize = 32;
+pub const MAX_INCLUDE_FILES: usize = 1000;
+/// Resource limit: how deep elements may nest (a chain of nearly 400 nested bodies loads). The
+/// loader walks the tree recursively with about 3 kB of stack per level, so this keeps a load on a
+/// 2 MB thread stack (Rust's default for spawned threads) well clear of overflow.
+pub const MAX_ELEMENT_DEPTH: usize = 400;
 
 /// An XML element with its attributes (file order), children and source location.
 #[derive(Clone, Debug)]
@@ -38,7 +47,7 @@ pub fn read_document(path: &Path) -> Result<Element, LoadError> {
 /// Like [`read_document`] for text already in memory (`path` names it and anchors includes).
 pub fn read_text(text: &str, path: &Path) -> Result<Element, LoadError> {
     let mut stack = Includes { open: vec![canonical(path)], seen: Vec::new() };
-    let root = parse_file(text, path, &mut stack)?;
+    let root = parse_file(text, path, &mut stack, 0)?;
     if root.tag != "mujoco" {
         return Err(LoadError::Invalid {
             loc: root.loc.clone(),
@@ -56,11 +65,29 @@ struct Includes {
     seen: Vec<PathBuf>,
 }
 
+/// Line numbers of byte offsets by binary search over the line starts (roxmltree's `text_pos_at`
+/// scans from the start of the text each time, which made loading quadratic in file size).
+struct LineIndex {
+    starts: Vec<usize>,
+}
+
+impl LineIndex {
+    fn new(text: &str) -> Self {
+        let starts = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
+        LineIndex { starts }
+    }
+
+    /// The 1-based line of byte offset `pos`.
+    fn line(&self, pos: usize) -> u32 {
+        self.starts.partition_point(|&s| s <= pos) as u32
+    }
+}
+
 fn canonical(path: &Path) -> PathBuf {
     path.canonicalize().unwrap_or_else(|_| path.to_path_buf())
 }
 
-fn parse_file(text: &str, path: &Path, stack: &mut Includes) -> Result<Element, LoadError> {
+fn parse_file(text: &str, path: &Path, stack: &mut Includes, depth: usize) -> Result<Element, LoadError> {
     let file = path.display().to_string();
     let options = ParsingOptions { allow_dtd: true, ..ParsingOptions::default() };
     let doc = Document::parse_with_options(text, options).map_err(|e| LoadError::Xml {
@@ -69,18 +96,29 @@ fn parse_file(text: &str, path: &Path, stack: &mut Includes) -> Result<Element, 
         col: e.pos().col,
         detail: e.to_string(),
     })?;
-    convert(doc.root_element(), &doc, path, &file, stack)
+    let lines = LineIndex::new(text);
+    convert(doc.root_element(), &lines, path, &file, stack, depth)
 }
 
 /// Converts a roxmltree element, splicing includes.
 fn convert(
     node: Node,
-    doc: &Document,
+    lines: &LineIndex,
     path: &Path,
     file: &str,
     stack: &mut Includes,
+    depth: usize,
 ) -> Result<Element, LoadError> {
-    let loc = SourceLoc { file: file.to_string(), line: doc.text_pos_at(node.range().start).row };
+    let loc = SourceLoc { file: file.to_string(), line: lines.line(node.range().start) };
+    if depth > MAX_ELEMENT_DEPTH {
+        return Err(LoadError::Invalid {
+            loc,
+            element: node.tag_name().name().to_string(),
+            detail: format!(
+                "elements nest more than {MAX_ELEMENT_DEPTH} levels deep (a resource limit: the loader's walks are recursive); flatten the body tree or split the chain"
+            ),
+        });
+    }
     let mut out = Element {
         tag: node.tag_name().name().to_string(),
         attrs: node.attributes().map(|a| (a.name().to_string(), a.value().to_string())).collect(),
@@ -89,9 +127,10 @@ fn convert(
     };
     for child in node.children().filter(|n| n.is_element()) {
         if child.tag_name().name() == "include" {
-            out.children.extend(include(child, doc, path, file, stack)?);
+            // The included root takes the <include>'s place: its children nest one level deeper.
+            out.children.extend(include(child, lines, path, file, stack, depth)?);
         } else {
-            out.children.push(convert(child, doc, path, file, stack)?);
+            out.children.push(convert(child, lines, path, file, stack, depth + 1)?);
         }
     }
     Ok(out)
@@ -100,12 +139,13 @@ fn convert(
 /// The children of the `<mujoco>` root of an included file.
 fn include(
     node: Node,
-    doc: &Document,
+    lines: &LineIndex,
     path: &Path,
     file: &str,
     stack: &mut Includes,
+    depth: usize,
 ) -> Result<Vec<Element>, LoadError> {
-    let loc = SourceLoc { file: file.to_string(), line: doc.text_pos_at(node.range().start).row };
+    let loc = SourceLoc { file: file.to_string(), line: lines.line(node.range().start) };
     let Some(name) = node.attribute("file") else {
         return Err(LoadError::Invalid {
             loc,
@@ -138,16 +178,19 @@ fn include(
             ),
         });
     }
-    stack.seen.push(key.clone());
-    stack.open.push(key);
-    let root = parse_file(&text, &target, stack)?;
-    stack.open.pop();
-    if root.tag != "mujoco" {
+    if stack.open.len() > MAX_INCLUDE_DEPTH || stack.seen.len() >= MAX_INCLUDE_FILES {
         return Err(LoadError::Invalid {
-            loc: root.loc,
-            element: root.tag,
-            detail: format!("an included file must have <mujoco> as its root (included from {loc})"),
+            loc,
+            element: "include".into(),
+            detail: format!(
+                "more than {MAX_INCLUDE_DEPTH} nested includes or {MAX_INCLUDE_FILES} included files (a resource limit against hostile files); flatten the includes"
+            ),
         });
     }
+    stack.seen.push(key.clone());
+    stack.open.push(key);
+    let root = parse_file(&text, &target, stack, depth)?;
+    stack.open.pop();
+    // Any root is accepted, as MuJoCo does: `<mujoco>`, or `<mujocoinclude>` in MuJoCo-era files.
     Ok(root.children)
 }

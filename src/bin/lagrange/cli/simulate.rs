@@ -6,7 +6,7 @@ use lagrange::constraint::ConstraintMode;
 use lagrange::forward::DriftCorrection;
 use lagrange::integrate::{IntegratorKind, State};
 use lagrange::io::{load, load_urdf_str, LoadOptions};
-use lagrange::sim::{SimOptions, Simulation};
+use lagrange::sim::{display_time, SimOptions, Simulation};
 use lagrange::Model;
 use serde_json::json;
 use std::io::Write;
@@ -46,6 +46,11 @@ pub struct Request {
 /// What a run measured.
 pub struct Summary {
     pub integrator: &'static str,
+    /// Nothing adds or removes energy (no damping, friction loss, actuators or contacts): the
+    /// energy drift measures the integration error alone.
+    pub passive: bool,
+    /// Contacts dropped because a collision pass found more than the model's contact budget.
+    pub contacts_dropped: u64,
     /// Whether the model has constraint rows (equalities, mimics, joint limits).
     pub constrained: bool,
     pub dt: f64,
@@ -140,9 +145,14 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         },
     );
     let dt = sim.timestep;
-    if !(dt > 0.0 && dt.is_finite() && request.duration >= 0.0 && request.duration.is_finite()) {
+    if !(dt > 0.0 && dt.is_finite()) {
         return Err(CliError::Usage(format!(
-            "--dt {dt} and --duration {} must be finite, dt > 0, duration ≥ 0",
+            "--dt {dt}: the step must be a positive, finite number of seconds, e.g. --dt 0.001"
+        )));
+    }
+    if !(request.duration >= 0.0 && request.duration.is_finite()) {
+        return Err(CliError::Usage(format!(
+            "--duration {}: give a non-negative, finite number of seconds, e.g. --duration 5",
             request.duration
         )));
     }
@@ -247,7 +257,13 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     if let Some((mut w, file)) = csv {
         w.flush().map_err(|source| CliError::Io { file, source })?;
     }
+    let passive = !model.has_damping()
+        && model.actuators.is_empty()
+        && model.joints.iter().all(|j| j.friction == 0.0)
+        && max_contacts == 0;
     Ok(Summary {
+        passive,
+        contacts_dropped: sim.data.contacts_dropped,
         constrained: sim.plan.has_constraints(),
         integrator: sim.integrator(),
         dt,
@@ -314,7 +330,7 @@ fn write_header(w: &mut impl Write, model: &Model) -> std::io::Result<()> {
 }
 
 fn write_row(w: &mut impl Write, sim: &Simulation, energy: f64, violation: f64) -> std::io::Result<()> {
-    write!(w, "{}", sim.state.time)?;
+    write!(w, "{}", display_time(sim.state.time))?;
     for x in sim.state.q.iter().chain(sim.state.v.iter()) {
         write!(w, ",{x}")?;
     }
@@ -330,19 +346,23 @@ pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
         "integrator": s.integrator,
         "dt": s.dt,
         "steps": s.steps,
-        "time": s.final_state.time,
+        "time": display_time(s.final_state.time),
         "wall_s": wall,
         "realtime_factor": if wall > 0.0 { simulated / wall } else { f64::INFINITY },
         "energy": {"initial": s.energy_start, "final": s.energy_end, "max_abs_drift": s.energy_max_dev},
         "max_constraint_violation": {"position": s.max_violation[0], "velocity": s.max_violation[1]},
         "max_penetration": s.max_penetration,
         "max_contacts": s.max_contacts,
+        "contacts_dropped": s.contacts_dropped,
         "solver": {"max_iterations": s.max_solver_iterations, "unconverged": s.unconverged.0,
                    "worst_unconverged_residual": s.unconverged.1},
         "q": s.final_state.q.as_slice(),
         "v": s.final_state.v.as_slice(),
     })
 }
+
+/// Relative energy drift of a passive scene beyond which `simulate` warns.
+pub const ENERGY_DRIFT_WARNING: f64 = 1e-2;
 
 /// The text summary `simulate` prints.
 pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
@@ -391,11 +411,31 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
             }
         );
     }
+    let drift = s.energy_max_dev / s.energy_scale;
+    if s.passive && drift > ENERGY_DRIFT_WARNING {
+        let better = match s.integrator {
+            "rk4" | "adaptive" => String::new(),
+            _ => " or use --integrator rk4".to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "warning: the energy of this passive scene (no damping, friction, actuators or contacts) drifted by {drift:.3e} of its scale: the integration is inaccurate at this step; reduce --dt (now {} s){better}",
+            s.dt
+        );
+    }
     if s.max_contacts > 0 {
         let _ = writeln!(
             out,
             "contacts: up to {} touching, deepest penetration after a step {:.3e} m",
             s.max_contacts, s.max_penetration
+        );
+    }
+    if s.contacts_dropped > 0 {
+        let _ = writeln!(
+            out,
+            "warning: {} contacts were dropped: a collision pass found more than the budget of {} contacts (a resource limit); exclude pairs that need not touch (<contact><exclude>, contype/conaffinity)",
+            s.contacts_dropped,
+            model.max_contacts()
         );
     }
     if s.unconverged.0 > 0 {

@@ -1,0 +1,182 @@
+//! Resource limits and plausibility of a parsed model, checked before anything is computed from it
+//! (issue 16, items 2 and 4): counts of links, joints and geoms bounded so that a hostile file
+//! cannot exhaust memory; lengths, sizes, mesh scales, masses, densities and inertias that are not
+//! finite or are absurd (beyond [`ABSURD`] in SI units) refused with file and line; and the derived
+//! mass properties checked for finiteness, so that no overflow (a huge but finite input squared)
+//! loads as NaN.
+
+use crate::io::{LinkWord, LoadError};
+use crate::mass::GeomMass;
+use crate::model::spec::{JointType, LinkSpec, ModelSpec, Shape};
+use crate::model::SourceLoc;
+use crate::spatial::{RigidInertia, Transform, Vec3};
+
+/// The largest magnitude accepted for a length (m), mass (kg), density (kg/m³) or inertia entry
+/// (kg·m²): beyond it a value is a typo or an attack, and squaring it in mass properties overflows
+/// the arithmetic of anything built on it.
+pub const ABSURD: f64 = 1e12;
+
+/// Resource limits: the most links (URDF links, MJCF bodies and joint anchors), and geoms a model
+/// may have.
+pub const MAX_LINKS: usize = 10_000;
+pub const MAX_GEOMS: usize = 100_000;
+/// Resource limit on degrees of freedom: the mass matrix and its factor are dense nv × nv
+/// buffers (72 MB each at this limit).
+pub const MAX_DOFS: usize = 3_000;
+
+/// Whether the spec was read from an MJCF file (for wording messages in the file's own terms).
+pub fn is_mjcf(spec: &ModelSpec) -> bool {
+    spec.source
+        .as_ref()
+        .and_then(|p| p.extension())
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml") || e.eq_ignore_ascii_case("mjcf"))
+}
+
+/// What a link is called in its file's terms: "body" (MJCF) or "link" (URDF).
+pub fn link_word(spec: &ModelSpec) -> LinkWord {
+    if is_mjcf(spec) {
+        LinkWord::Body
+    } else {
+        LinkWord::Link
+    }
+}
+
+fn invalid(loc: &SourceLoc, element: &str, detail: String) -> LoadError {
+    LoadError::Invalid { loc: loc.clone(), element: element.into(), detail }
+}
+
+/// `Err` with the reason when `x` is not finite or beyond [`ABSURD`] in magnitude.
+fn plausible(x: f64) -> Result<(), &'static str> {
+    if !x.is_finite() {
+        Err("is not a finite number")
+    } else if x.abs() > ABSURD {
+        Err("is absurdly large (beyond 1e12 in SI units)")
+    } else {
+        Ok(())
+    }
+}
+
+fn check(loc: &SourceLoc, element: &str, what: impl Fn() -> String, values: &[f64]) -> Result<(), LoadError> {
+    for &x in values {
+        if let Err(why) = plausible(x) {
+            return Err(invalid(loc, element, format!("{} {x:e} {why}; fix the value", what())));
+        }
+    }
+    Ok(())
+}
+
+fn check_pose(loc: &SourceLoc, element: &str, owner: &str, x: &Transform) -> Result<(), LoadError> {
+    check(loc, element, || format!("{owner}: a position coordinate"), x.pos.as_slice())
+}
+
+/// Counts within the resource limits; every length, size, scale, mass, density and inertia entry
+/// finite and within [`ABSURD`].
+pub fn check_spec(spec: &ModelSpec) -> Result<(), LoadError> {
+    let file = spec.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+    let word = link_word(spec);
+    let top = SourceLoc { file, line: 0 };
+    if spec.links.len() > MAX_LINKS {
+        return Err(invalid(
+            &top,
+            &word.to_string(),
+            format!(
+                "the model has {} {word}s (joint anchors included), more than the limit of {MAX_LINKS} (a resource limit against hostile files); split the model",
+                spec.links.len()
+            ),
+        ));
+    }
+    let nv: usize = spec
+        .links
+        .iter()
+        .map(|l| match l.joint.jtype {
+            JointType::Fixed => 0,
+            JointType::Revolute | JointType::Continuous | JointType::Prismatic => 1,
+            JointType::Ball | JointType::Planar => 3,
+            JointType::Floating => 6,
+        })
+        .sum();
+    if nv > MAX_DOFS {
+        return Err(invalid(
+            &top,
+            "joint",
+            format!(
+                "the model has {nv} degrees of freedom, more than the limit of {MAX_DOFS} (a resource limit: the mass matrix is stored dense); split the model"
+            ),
+        ));
+    }
+    let geoms: usize = spec.links.iter().map(|l| l.geoms.len()).sum();
+    if geoms > MAX_GEOMS {
+        return Err(invalid(
+            &top,
+            "geom",
+            format!("the model has {geoms} geoms, more than the limit of {MAX_GEOMS} (a resource limit against hostile files)"),
+        ));
+    }
+    for link in &spec.links {
+        check_link(link, word)?;
+    }
+    Ok(())
+}
+
+fn check_link(link: &LinkSpec, word: LinkWord) -> Result<(), LoadError> {
+    let owner = format!("{word} '{}'", link.name);
+    let j = &link.joint;
+    // MJCF: the body's pos (with its joint's); URDF: the joint's <origin>.
+    check_pose(&j.loc, if word == LinkWord::Body { "body" } else { "joint" }, &owner, &j.x_parent_joint)?;
+    if let Some(i) = &link.inertial {
+        check_pose(&i.loc, "inertial", &owner, &i.x_link_inertial)?;
+        check(&i.loc, "inertial", || format!("{owner}: the mass"), &[i.mass])?;
+        check(&i.loc, "inertial", || format!("{owner}: an inertia entry"), i.inertia.as_slice())?;
+    }
+    for f in &link.frames {
+        check_pose(&f.loc, "frame", &owner, &f.x_link_frame)?;
+    }
+    for g in &link.geoms {
+        let element = "geom";
+        let name = if g.name.is_empty() { owner.clone() } else { format!("{owner}, geom '{}'", g.name) };
+        check_pose(&g.loc, element, &name, &g.x_link_geom)?;
+        let size = || format!("{name}: a size");
+        match &g.shape {
+            Shape::Box { size: s } | Shape::Ellipsoid { radii: s } | Shape::Plane { size: s } => {
+                check(&g.loc, element, size, s.as_slice())?
+            }
+            Shape::Cylinder { radius, length } | Shape::Capsule { radius, length } => {
+                check(&g.loc, element, size, &[*radius, *length])?
+            }
+            Shape::Sphere { radius } => check(&g.loc, element, size, &[*radius])?,
+            Shape::Mesh { scale, .. } => {
+                check(&g.loc, element, || format!("{name}: its mesh's scale"), scale.as_slice())?
+            }
+            Shape::Hfield { .. } => {}
+        }
+        match g.mass {
+            GeomMass::Mass(m) => check(&g.loc, element, || format!("{name}: the mass"), &[m])?,
+            GeomMass::Density(d) => check(&g.loc, element, || format!("{name}: the density"), &[d])?,
+            GeomMass::None => {}
+        }
+    }
+    Ok(())
+}
+
+/// The mass properties computed for a link are finite (an input can pass [`check_spec`] and still
+/// overflow when the parallel-axis shift squares an offset, or a mesh's volume integral sums).
+pub fn check_derived(link: &LinkSpec, word: LinkWord, inertia: &RigidInertia) -> Result<(), LoadError> {
+    let numbers =
+        [inertia.mass].into_iter().chain(inertia.h.iter().copied()).chain(inertia.i_origin.iter().copied());
+    let com: Vec3 = if inertia.mass > 0.0 { inertia.h / inertia.mass } else { Vec3::zeros() };
+    let finite = numbers.clone().all(f64::is_finite) && com.iter().all(|x| x.is_finite());
+    if finite && numbers.map(f64::abs).fold(0.0, f64::max) <= ABSURD * ABSURD {
+        return Ok(());
+    }
+    Err(LoadError::NonPhysicalInertia {
+        loc: link.loc.clone(),
+        what: word,
+        link: link.name.clone(),
+        detail: format!(
+            "its computed mass properties overflow (mass {:e} kg, inertia entries up to {:e} kg·m²); check the sizes, positions and mesh scales of its geoms and <inertial>",
+            inertia.mass,
+            inertia.i_origin.abs().max()
+        ),
+    })
+}

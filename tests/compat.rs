@@ -1,0 +1,260 @@
+//! Regression tests for issue 16's compatibility bug classes and fuzzing findings, each built from
+//! a small hand-made file (tests/data/compat/ or generated here): load what MuJoCo and Pinocchio
+//! load, refuse only what they refuse — with file, line, element and fix — and never panic, hang,
+//! or load NaN.
+
+use lagrange::io::{load, LoadOptions};
+use lagrange::mass::read_mesh;
+use lagrange::spatial::Vec3;
+use std::path::{Path, PathBuf};
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/compat").join(name)
+}
+
+fn load_ok(name: &str, options: &LoadOptions) -> lagrange::Model {
+    load(&data(name), options).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// The error message of a file that must be refused, checked for every needle.
+fn refused(path: &Path, options: &LoadOptions, needles: &[&str]) -> String {
+    let msg = match load(path, options) {
+        Ok(_) => panic!("{}: loaded, expected an error", path.display()),
+        Err(e) => e.to_string(),
+    };
+    for n in needles {
+        assert!(msg.contains(n), "missing '{n}' in: {msg}");
+    }
+    msg
+}
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("lagrange-compat-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn finite_model(m: &lagrange::Model) -> bool {
+    m.bodies.iter().all(|b| {
+        let i = &b.inertia;
+        i.mass.is_finite() && i.h.iter().chain(i.i_origin.iter()).all(|x| x.is_finite())
+    })
+}
+
+// --- 1. Compatibility bug classes -------------------------------------------------------------
+
+#[test]
+fn round_off_inertia_is_zero_not_negative() {
+    // Principal moments −2e-20, 1e-20, 1e-20: round-off (below MuJoCo's mjMINVAL), not a negative
+    // moment. Pinocchio loads this file; so do we, with the tensor as written.
+    let m = load_ok("roundoff_inertia.urdf", &LoadOptions::default());
+    assert_eq!(m.nv, 1);
+    assert!((m.bodies[1].inertia.mass - 1.5).abs() < 1e-15);
+    assert!(finite_model(&m));
+    // A genuinely negative moment is still refused (tests/load_errors.rs covers the message).
+}
+
+#[test]
+fn world_welded_body_never_needs_its_mass() {
+    // 'stand' is welded to the world and its inertia would come from a misoriented mesh in exact
+    // mode: the mass is never used, so the model loads, with a warning saying so.
+    let m = load_ok("welded_open_mesh.xml", &LoadOptions::default());
+    assert_eq!(m.nv, 1);
+    let w = m.warnings.iter().find(|w| w.contains("welded to the world")).expect("a warning");
+    assert!(w.contains("welded_open_mesh.xml:8") && w.contains("body 'stand'"), "{w}");
+}
+
+#[test]
+fn included_file_may_have_a_mujocoinclude_root() {
+    let m = load_ok("fragment_main.xml", &LoadOptions::default());
+    assert_eq!(m.nv, 1);
+    assert_eq!(m.joints[0].name, "knuckle");
+}
+
+#[test]
+fn shared_load_options_act_on_mjcf_or_say_they_do_not_apply() {
+    let path = data("nonphysical_inertia.xml");
+    refused(
+        &path,
+        &LoadOptions::default(),
+        &["nonphysical_inertia.xml:5", "body 'odd'", "triangle inequality"],
+    );
+    let accept = LoadOptions { accept_nonphysical_inertia: true, ..Default::default() };
+    let m = load(&path, &accept).unwrap();
+    assert!(m.warnings.iter().any(|w| w.contains("kept as written")), "{:?}", m.warnings);
+    let float = LoadOptions { floating: true, package_dirs: vec!["/tmp".into()], ..Default::default() };
+    let m = load(&path, &LoadOptions { accept_nonphysical_inertia: true, ..float }).unwrap();
+    for needle in ["--floating applies to URDF only", "--package-dir applies to URDF"] {
+        assert!(m.warnings.iter().any(|w| w.contains(needle)), "no '{needle}' in {:?}", m.warnings);
+    }
+}
+
+#[test]
+fn open_meshes_follow_mujoco_per_inertia_mode() {
+    // MuJoCo 4.0 on tests/data/meshes/open_cube.stl (a unit cube without its top face) at density
+    // 1000: legacy and exact integrate the open surface (mass 804.1666…, principal moments 147.083,
+    // 123.975, 123.975), convex takes the hull (1000), shell the surface (5000). We match each, with
+    // a warning where the surface is open.
+    let dir = temp_dir("open_mesh");
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes/open_cube.stl");
+    for (mode, mass, warned) in [
+        ("legacy", 804.166_666_666_666_6, true),
+        ("exact", 804.166_666_666_666_6, true),
+        ("convex", 1000.0, false),
+        ("shell", 5000.0, false),
+    ] {
+        let path = dir.join(format!("open_{mode}.xml"));
+        std::fs::write(
+            &path,
+            format!(
+                r#"<mujoco><asset><mesh name="m" file="{}" inertia="{mode}"/></asset>
+<worldbody><body name="b"><joint type="hinge"/><geom type="mesh" mesh="m"/></body></worldbody></mujoco>"#,
+                mesh.display()
+            ),
+        )
+        .unwrap();
+        let m = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{mode}: {e}"));
+        assert!(
+            (m.bodies[1].inertia.mass - mass).abs() < 1e-9 * mass,
+            "{mode}: {}",
+            m.bodies[1].inertia.mass
+        );
+        let open = m.warnings.iter().any(|w| w.contains("not closed"));
+        assert_eq!(open, warned, "{mode}: {:?}", m.warnings);
+    }
+    // The principal moments of the legacy result are MuJoCo's body_inertia.
+    let m = load(&dir.join("open_legacy.xml"), &LoadOptions::default()).unwrap();
+    let (moments, _) = lagrange::mass::principal_axes(&m.bodies[1].inertia.i_com());
+    for (got, want) in moments.iter().zip([123.975_390_62, 123.975_390_62, 147.083_333_33]) {
+        assert!((got - want).abs() < 1e-6 * want, "{moments:?}");
+    }
+}
+
+// --- 2. Found by fuzzing ----------------------------------------------------------------------
+
+#[test]
+fn msh_face_index_beyond_the_vertices_is_an_error() {
+    let dir = temp_dir("msh");
+    // A tetrahedron: 4 vertices, no normals or texture coordinates, 4 faces, one index −1.
+    let mut bytes = Vec::new();
+    for n in [4i32, 0, 0, 4] {
+        bytes.extend_from_slice(&n.to_le_bytes());
+    }
+    for v in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] {
+        v.iter().for_each(|x| bytes.extend_from_slice(&x.to_le_bytes()));
+    }
+    for f in [[0i32, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, -1]] {
+        f.iter().for_each(|x| bytes.extend_from_slice(&x.to_le_bytes()));
+    }
+    let path = dir.join("bad_index.msh");
+    std::fs::write(&path, &bytes).unwrap();
+    let msg = read_mesh(&path, &Vec3::new(1.0, 1.0, 1.0)).unwrap_err().to_string();
+    assert!(msg.contains("face 3 refers to vertex -1") && msg.contains("4 vertices"), "{msg}");
+}
+
+fn nested_bodies(depth: usize) -> String {
+    let mut s = String::from("<mujoco><worldbody>\n");
+    for _ in 0..depth {
+        s.push_str("<body><joint/><geom size=\".1\" contype=\"0\" conaffinity=\"0\"/>\n");
+    }
+    s.push_str(&"</body>".repeat(depth));
+    s.push_str("</worldbody></mujoco>\n");
+    s
+}
+
+#[test]
+fn deep_nesting_loads_up_to_the_limit_and_is_refused_beyond() {
+    let dir = temp_dir("deep");
+    // 395 nested bodies load, on a test thread's 2 MB stack too.
+    let path = dir.join("deep_395.xml");
+    std::fs::write(&path, nested_bodies(395)).unwrap();
+    let m = load(&path, &LoadOptions::default()).unwrap();
+    assert_eq!(m.nv, 395);
+    // Five thousand are refused with the limit named (before: a stack overflow at ~3000).
+    let path = dir.join("deep_5000.xml");
+    std::fs::write(&path, nested_bodies(5000)).unwrap();
+    refused(&path, &LoadOptions::default(), &["deep_5000.xml:", "nest more than 400 levels"]);
+}
+
+#[test]
+fn huge_finite_numbers_are_refused_with_file_and_line() {
+    let o = LoadOptions::default();
+    refused(
+        &data("huge_inertial_origin.urdf"),
+        &o,
+        &["huge_inertial_origin.urdf:6", "link 'arm'", "1e200", "absurdly large"],
+    );
+    refused(&data("huge_sizes.xml"), &o, &["huge_sizes.xml:4", "geom 'big'", "size 1e200"]);
+    refused(&data("huge_pos.xml"), &o, &["huge_pos.xml:4", "<body>", "body 'far'", "-1e308"]);
+    refused(&data("huge_mesh_scale.xml"), &o, &["huge_mesh_scale.xml:6", "mesh's scale 1e200"]);
+}
+
+#[test]
+fn massless_moving_links_follow_one_rule_in_both_formats() {
+    // A massless leaf's joint moves nothing: refused in URDF as in MJCF (MuJoCo refuses both).
+    let msg = refused(
+        &data("massless_leaf.urdf"),
+        &LoadOptions::default(),
+        &["massless_leaf.urdf:8", "joint 'wrist' moves nothing", "link 'tool'", "<inertial>"],
+    );
+    assert!(!msg.contains("body '"), "URDF message in MJCF terms: {msg}");
+    // A massless link between two joints whose child has mass is a gimbal: defined dynamics.
+    let m = load_ok("massless_middle.urdf", &LoadOptions::default());
+    assert_eq!(m.nv, 2);
+}
+
+#[test]
+fn identical_joints_are_named_as_singular() {
+    refused(
+        &data("two_identical_joints.xml"),
+        &LoadOptions::default(),
+        &["two_identical_joints.xml:5", "joint 'x1'", "repeats the motion of joint(s) 'x2'", "singular"],
+    );
+}
+
+#[test]
+fn messages_use_the_file_s_own_terms() {
+    // MJCF: "body", MuJoCo's attributes; URDF: "link", `<mass value>`.
+    let msg = refused(
+        &data("nonphysical_inertia.xml"),
+        &LoadOptions::default(),
+        &["body 'odd'", "<inertial diaginertia"],
+    );
+    assert!(!msg.contains("link '") && !msg.contains("<inertia> values"), "{msg}");
+    // A URDF loop is reported as a cycle, not as a second parent.
+    refused(
+        &data("cycle.urdf"),
+        &LoadOptions::default(),
+        &["cycle.urdf:7", "joint 'close'", "'a', 'b' form a cycle"],
+    );
+}
+
+// --- 4. Resource limits -----------------------------------------------------------------------
+
+#[test]
+fn include_depth_is_bounded() {
+    let dir = temp_dir("includes");
+    let n = 40;
+    for k in 0..n {
+        let body = if k + 1 < n { format!("<include file=\"inc{}.xml\"/>", k + 1) } else { String::new() };
+        std::fs::write(dir.join(format!("inc{k}.xml")), format!("<mujoco>{body}</mujoco>")).unwrap();
+    }
+    std::fs::write(dir.join("main.xml"), "<mujoco><include file=\"inc0.xml\"/></mujoco>").unwrap();
+    refused(&dir.join("main.xml"), &LoadOptions::default(), &["<include>", "more than 32 nested includes"]);
+}
+
+#[test]
+fn link_and_dof_counts_are_bounded() {
+    let dir = temp_dir("counts");
+    let mut s = String::from("<robot name=\"big\"><link name=\"l0\"/>");
+    for k in 1..=3001 {
+        s.push_str(&format!(
+            "<link name=\"l{k}\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link><joint name=\"j{k}\" type=\"continuous\"><parent link=\"l{}\"/><child link=\"l{k}\"/></joint>",
+            k - 1
+        ));
+    }
+    s.push_str("</robot>");
+    let path = dir.join("big.urdf");
+    std::fs::write(&path, s).unwrap();
+    refused(&path, &LoadOptions::default(), &["3001 degrees of freedom", "limit of 3000"]);
+}
