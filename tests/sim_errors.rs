@@ -17,13 +17,23 @@ const MASSLESS_TIP: &str = r#"<robot name="r">
 </robot>"#;
 
 #[test]
-fn massless_tip_is_refused_at_load() {
-    // Its joint would have no finite acceleration (D = 0): refused when the model is compiled,
-    // naming the joint, rather than diverging in the first step.
-    let err =
-        load_urdf_str(MASSLESS_TIP, Path::new("massless_tip.urdf"), &LoadOptions::default()).unwrap_err();
-    let msg = err.to_string();
+fn massless_tip_is_named_at_load_and_in_the_first_step() {
+    // Its joint has no finite acceleration (D = 0). The model loads (Pinocchio loads it) with a
+    // warning naming the joint; a simulation stops at its first step with an error naming it and
+    // the cause, without blaming the step size.
+    let model = load_urdf_str(MASSLESS_TIP, Path::new("massless_tip.urdf"), &LoadOptions::default()).unwrap();
+    let w = model.warnings.iter().find(|w| w.contains("moves nothing")).expect("a warning");
     for needle in ["massless_tip.urdf:5", "joint 'wrist' moves nothing", "link 'tip'", "<inertial>"] {
+        assert!(w.contains(needle), "missing '{needle}' in: {w}");
+    }
+    let options =
+        SimOptions { integrator: Some(IntegratorKind::Euler), timestep: Some(1e-3), ..Default::default() };
+    let mut sim = Simulation::new(Arc::new(model), &options);
+    sim.set_state(&[0.3, 0.0], &[0.0, 0.0]).unwrap();
+    let msg = sim.step().unwrap_err().to_string();
+    for needle in
+        ["diverged at t = 0.001 s (step 1)", "joint 'wrist'", "no mass or inertia", "no step size fixes"]
+    {
         assert!(msg.contains(needle), "missing '{needle}' in: {msg}");
     }
 }

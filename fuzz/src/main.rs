@@ -37,7 +37,7 @@ use target::{Outcome, Target};
 #[derive(Parser)]
 #[command(about = "Mutation fuzzer for lagrange's URDF, MJCF, STL, OBJ and MSH loaders")]
 struct Args {
-    /// urdf, mjcf, stl, obj, msh, or all
+    /// urdf, mjcf, stl, obj, msh, or all; or replay=FILE to rerun a saved model input
     target: String,
     /// Executions per target (the run stops at whichever of --execs and --seconds comes first)
     #[arg(long, default_value_t = u64::MAX)]
@@ -64,6 +64,10 @@ struct Args {
 
 fn main() {
     let args = Args::parse();
+    if let Some(file) = args.target.strip_prefix("replay=") {
+        replay(Path::new(file), args.seed);
+        return;
+    }
     if args.worker {
         let target = Target::parse(&args.target).expect("worker target");
         worker(&args, target);
@@ -88,6 +92,26 @@ fn main() {
         eprintln!("{total_findings} finding(s) saved under {}", args.findings.display());
         std::process::exit(1);
     }
+}
+
+/// Runs one saved input (a model file; meshes through the scenes of its folder) with 100 random
+/// states and prints what each did.
+fn replay(file: &Path, seed: u64) {
+    let mut rng = SmallRng::seed_from_u64(seed);
+    for k in 0..100 {
+        match target::run_model(file, &mut rng) {
+            Outcome::Refused(why) => {
+                println!("refused: {why}");
+                return;
+            }
+            Outcome::NonFinite(what) => {
+                println!("state {k}: {what}");
+                std::process::exit(1);
+            }
+            Outcome::Loaded => {}
+        }
+    }
+    println!("loaded; 100 random states finite");
 }
 
 /// Runs worker processes for `target` until its budget is spent; restarts a worker that dies and

@@ -84,6 +84,9 @@ pub fn solve_coulomb(
 ) {
     let n = data.nefc;
     let ne = (0..n).take_while(|&i| data.efc_type[i] == EfcType::Equality).count();
+    // A row whose diagonal is round-off next to the others' moves nothing (a contact normal no
+    // dof can move along): it gets no force rather than round-off divided by round-off.
+    data.efc_a_floor = DIAGONAL_ROUNDOFF * (0..n).map(|i| data.efc_delassus[(i, i)]).fold(0.0, f64::max);
     // b in efc_force during the iterations, λ in efc_rhs.
     for i in 0..n {
         data.efc_force[i] = data.efc_rhs[i];
@@ -198,7 +201,7 @@ fn normal_lower_bound(data: &Data, i: usize) -> f64 {
 /// λ_i ← clamp(λ_i − w_i / A_ii, lo, hi); returns |Δλ_i| A_ii.
 fn scalar_update(data: &mut Data, i: usize, lo: f64, hi: f64) -> f64 {
     let a = data.efc_delassus[(i, i)];
-    if a <= 0.0 {
+    if a <= data.efc_a_floor {
         return set_zero(data, i, 1);
     }
     let old = data.efc_rhs[i];
@@ -256,6 +259,8 @@ fn mu(friction: &[f64; 5], k: usize) -> f64 {
 /// A sweep that changes the motion by less than this (m/s², rad/s², or m/s, rad/s at the velocity
 /// level) has converged whatever the scale: round-off of motions at rest.
 const ROUND_OFF_FLOOR: f64 = 1e-15;
+/// A Delassus diagonal at most this fraction of the largest is round-off (see `efc_a_floor`).
+const DIAGONAL_ROUNDOFF: f64 = 1e-12;
 
 /// Sweeps after which the active set of the iterate is tried as an exact solve ([`polish`]).
 const POLISH_AFTER: u32 = 8;
@@ -270,7 +275,7 @@ const MAX_DIM: usize = 6;
 
 /// A frictional contact's block: rows i (normal) .. i+len (friction).
 fn contact_block(data: &mut Data, i: usize, len: usize, level: Level) -> f64 {
-    if separating(data, i, level) {
+    if separating(data, i, level) || data.efc_delassus[(i, i)] <= data.efc_a_floor {
         return set_zero(data, i, len);
     }
     let mut change = scalar_update(data, i, normal_lower_bound(data, i), f64::INFINITY);
@@ -325,7 +330,7 @@ fn cone_solve(
     let mut idx = [0usize; MAX_DIM];
     let mut m = 0;
     for k in 1..len {
-        if mu(friction, k) > 0.0 {
+        if mu(friction, k) > 0.0 && data.efc_delassus[(i + k, i + k)] > data.efc_a_floor {
             idx[m] = k;
             m += 1;
         }

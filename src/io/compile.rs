@@ -281,7 +281,9 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         .filter(|l| l.joint.jtype != JointType::Fixed)
         .map(|l| l.joint.loc.clone())
         .collect();
-    crate::io::singular::check_mass_matrix(&model, &joint_locs, word)?;
+    if let Some(w) = crate::io::singular::check_mass_matrix(&model, &joint_locs, word) {
+        model.warnings.push(w);
+    }
     model.collision_pairs = crate::model::collision_pairs::candidate_pairs(&model);
     if model.collision_pairs.len() > crate::model::collision_pairs::MAX_COLLISION_PAIRS {
         return Err(LoadError::Invalid {

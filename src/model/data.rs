@@ -164,6 +164,10 @@ pub struct Data {
     pub efc_iterations: u32,
     /// Rank of J M⁻¹ Jᵀ at the last solve (< nefc: redundant rows, minimum-norm multipliers).
     pub efc_rank: usize,
+    /// Rows whose Delassus diagonal A_ii is at most this are round-off (their force would move
+    /// nothing: J_i M⁻¹ J_iᵀ ≈ 0) and get no force: 1e-12 of the largest diagonal, set by the
+    /// frictional solve.
+    pub efc_a_floor: f64,
     /// Residual of the last iterative (Coulomb) solve: the largest change its last sweep made to
     /// the motion, max |M⁻¹Jᵀ Δλ| (an acceleration, or a velocity at the velocity level); 0 after a
     /// direct solve.
@@ -281,6 +285,7 @@ impl Data {
             efc_eig: DVector::zeros(nefc),
             efc_iterations: 0,
             efc_rank: 0,
+            efc_a_floor: 0.0,
             efc_residual: 0.0,
             efc_converged: true,
             efc_unconverged: 0,
