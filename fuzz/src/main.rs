@@ -94,6 +94,9 @@ fn main() {
     }
 }
 
+/// The largest input kept in the mutation pool (bytes).
+const MAX_POOL_INPUT: usize = 64 * 1024;
+
 /// Runs one saved input (a model file; meshes through the scenes of its folder) with 100 random
 /// states and prints what each did.
 fn replay(file: &Path, seed: u64) {
@@ -273,7 +276,14 @@ fn worker(args: &Args, target: Target) {
             None => target::run_model(&path, &mut exec_rng),
             Some(scene) => target::run_mesh(&path, scene, &mut exec_rng),
         }));
+        let took = epoch.elapsed().as_millis() as u64 + 1 - started_ms.load(Ordering::Relaxed);
         started_ms.store(0, Ordering::Relaxed);
+        if let Some(slow) = std::env::var("LAGRANGE_FUZZ_SLOW_MS").ok().and_then(|s| s.parse::<u64>().ok()) {
+            if took >= slow {
+                eprintln!("slow input: {took} ms, {} bytes, {}", input.len(), path.display());
+                let _ = std::fs::copy(&path, std::env::temp_dir().join(format!("slow-{execs}.{ext}")));
+            }
+        }
         execs += 1;
         let finding = match result {
             Err(_) => Some(("panic", last_panic.lock().unwrap().clone())),
@@ -283,7 +293,13 @@ fn worker(args: &Args, target: Target) {
                 None
             }
             Ok(Outcome::Refused(kind)) => {
-                if outcomes.len() < 2000 && outcomes.insert(kind) && pool.len() < 4000 {
+                // Small inputs only: a 4 MB chain in the pool would make every later execution
+                // of it slow (the deep-nesting mutation still makes big ones fresh each time).
+                if input.len() <= MAX_POOL_INPUT
+                    && outcomes.len() < 2000
+                    && outcomes.insert(kind)
+                    && pool.len() < 4000
+                {
                     pool.push((rel.clone(), input.clone()));
                 }
                 None

@@ -252,7 +252,8 @@ fn replace(text: &str, (a, b): (usize, usize), with: &str) -> String {
 
 /// A chain of `depth` nested bodies (MJCF) or links (URDF), for the depth limits.
 fn deep_nesting(rng: &mut SmallRng, urdf: bool) -> String {
-    let depth = *[10usize, 100, 1000, 3000, 6000, 20000].get(rng.random_range(0..6)).unwrap_or(&10);
+    // Around the loaders' limits (400 nested elements, 3000 dofs, 10000 links) and beyond.
+    let depth = *[10usize, 100, 399, 450, 3001, 12000].get(rng.random_range(0..6)).unwrap_or(&10);
     let mut s = String::new();
     if urdf {
         s.push_str("<link name=\"d0\"/>");

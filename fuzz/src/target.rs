@@ -209,7 +209,8 @@ fn check_model(model: &Model, rng: &mut SmallRng) -> Outcome {
     forward(model, &plan, &mut data, &q, &v);
     // A singular mass matrix is reported at load (a warning naming the joints) and by the
     // simulation's first step: non-finite accelerations are then expected, not a finding.
-    let singular = model.warnings.iter().any(|w| w.contains("moves nothing") || w.contains("repeats the motion"));
+    let singular =
+        model.warnings.iter().any(|w| w.contains("moves nothing") || w.contains("repeats the motion"));
     if !singular && !data.qacc.iter().all(|x| x.is_finite()) {
         return Outcome::NonFinite(format!(
             "forward: non-finite qacc at a random state q = {q:?}, v = {v:?}"

@@ -100,6 +100,13 @@ pub fn solve_coulomb(
     let mut change = 0.0;
     let mut iterations = 0;
     data.efc_converged = false;
+    // Divergence guard: the sliding law (maximal dissipation) makes the problem non-symmetric, and
+    // projected Gauss–Seidel can then grow without bound (a violent state: a body deep in the
+    // floor, joints beyond their limits, fast slips). The solve then restarts from zero with the
+    // symmetric cone projection for every contact; if that diverges too, the rows get no force
+    // and the solve counts as unconverged (reported), never NaN.
+    data.efc_safe_friction = false;
+    let mut first_total = 0.0f64;
     // A sweep costs about n² + n·nv: large problems get fewer sweeps (a work budget), so that a
     // pile of contacts cannot stall a step; a solve stopped early is counted as unconverged.
     let sweep = (n * n + n * model.nv).max(1) as f64;
@@ -143,6 +150,20 @@ pub fn solve_coulomb(
             moved = moved.max(dk.abs());
             total = total.max(tk.abs());
         }
+        if iterations == 1 {
+            first_total = total;
+        }
+        if !(total.is_finite() && total <= DIVERGED * first_total.max(motion_scale)) {
+            data.efc_rhs.as_mut_slice()[..n].fill(0.0);
+            if data.efc_safe_friction {
+                change = f64::INFINITY;
+                break;
+            }
+            data.efc_safe_friction = true;
+            first_total = 0.0;
+            iterations = 0;
+            continue;
+        }
         change = moved;
         if moved <= settings.tolerance * total.max(motion_scale)
             || moved <= ROUND_OFF_FLOOR
@@ -153,7 +174,10 @@ pub fn solve_coulomb(
         }
         // Once the iterate has settled which rows stick, slide or lift, solve that active set
         // exactly; accepted only if every row's law then holds.
-        if (iterations == POLISH_AFTER || iterations == limit) && polish(model, data, level) {
+        if (iterations == POLISH_AFTER || iterations == limit)
+            && !data.efc_safe_friction
+            && polish(model, data, level)
+        {
             data.efc_converged = true;
             change = 0.0;
             break;
@@ -261,6 +285,9 @@ fn mu(friction: &[f64; 5], k: usize) -> f64 {
 const ROUND_OFF_FLOOR: f64 = 1e-15;
 /// A Delassus diagonal at most this fraction of the largest is round-off (see `efc_a_floor`).
 const DIAGONAL_ROUNDOFF: f64 = 1e-12;
+/// A constraint correction M⁻¹Jᵀλ this many times larger than the first sweep's (or the motion
+/// scale) has diverged.
+const DIVERGED: f64 = 1e8;
 
 /// Sweeps after which the active set of the iterate is tried as an exact solve ([`polish`]).
 const POLISH_AFTER: u32 = 8;
@@ -287,7 +314,8 @@ fn contact_block(data: &mut Data, i: usize, len: usize, level: Level) -> f64 {
     let mut new = [0.0; MAX_DIM];
     if lambda_n > 0.0 {
         let slip: f64 = (1..len).map(|k| data.efc_vel[i + k].powi(2)).sum::<f64>().sqrt();
-        if level == Level::Acceleration && slip > SLIP_VELOCITY && !data.efc_frozen_at_rest(i) {
+        let sliding = level == Level::Acceleration && slip > SLIP_VELOCITY && !data.efc_frozen_at_rest(i);
+        if sliding && !data.efc_safe_friction {
             // Maximal dissipation against the slip velocity u.
             max_dissipation(lambda_n, &friction, &data.efc_vel.as_slice()[i + 1..i + len], &mut new[..nf]);
         } else {

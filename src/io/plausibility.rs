@@ -124,6 +124,22 @@ fn check_link(link: &LinkSpec, word: LinkWord) -> Result<(), LoadError> {
     let j = &link.joint;
     // MJCF: the body's pos (with its joint's); URDF: the joint's <origin>.
     check_pose(&j.loc, if word == LinkWord::Body { "body" } else { "joint" }, &owner, &j.x_parent_joint)?;
+    let joint = || format!("joint '{}'", j.name);
+    let scalars = [j.damping, j.friction, j.armature, j.stiffness, j.spring_ref];
+    check(
+        &j.loc,
+        "joint",
+        || format!("{}: a damping, friction, armature or stiffness value", joint()),
+        &scalars,
+    )?;
+    if let Some(m) = &j.mimic {
+        check(
+            &m.loc,
+            "mimic",
+            || format!("{}: the mimic multiplier or offset", joint()),
+            &[m.multiplier, m.offset],
+        )?;
+    }
     if let Some(i) = &link.inertial {
         check_pose(&i.loc, "inertial", &owner, &i.x_link_inertial)?;
         check(&i.loc, "inertial", || format!("{owner}: the mass"), &[i.mass])?;

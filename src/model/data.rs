@@ -168,6 +168,9 @@ pub struct Data {
     /// nothing: J_i M⁻¹ J_iᵀ ≈ 0) and get no force: 1e-12 of the largest diagonal, set by the
     /// frictional solve.
     pub efc_a_floor: f64,
+    /// Set by the frictional solve when it restarted after diverging: sliding contacts were then
+    /// solved with the symmetric cone projection instead of the maximal-dissipation law.
+    pub efc_safe_friction: bool,
     /// Residual of the last iterative (Coulomb) solve: the largest change its last sweep made to
     /// the motion, max |M⁻¹Jᵀ Δλ| (an acceleration, or a velocity at the velocity level); 0 after a
     /// direct solve.
@@ -286,6 +289,7 @@ impl Data {
             efc_iterations: 0,
             efc_rank: 0,
             efc_a_floor: 0.0,
+            efc_safe_friction: false,
             efc_residual: 0.0,
             efc_converged: true,
             efc_unconverged: 0,
