@@ -283,6 +283,15 @@ fn link_and_dof_counts_are_bounded() {
     let path = dir.join("big.urdf");
     std::fs::write(&path, s).unwrap();
     refused(&path, &LoadOptions::default(), &["3001 degrees of freedom", "limit of 3000"]);
+    // Links beyond the limit are refused before the second (slower) URDF parse.
+    let mut s = String::from("<robot name=\"many\"><link name=\"l0\"/>");
+    for k in 1..=10_001 {
+        s.push_str(&format!("<link name=\"l{k}\"/><joint name=\"j{k}\" type=\"fixed\"><parent link=\"l{}\"/><child link=\"l{k}\"/></joint>", k - 1));
+    }
+    s.push_str("</robot>");
+    let path = dir.join("many.urdf");
+    std::fs::write(&path, s).unwrap();
+    refused(&path, &LoadOptions::default(), &["10002 links", "limit of 10000"]);
 }
 
 #[test]
@@ -379,4 +388,36 @@ fn frictional_solve_never_diverges_to_nan() {
     assert_eq!(data.contacts.len(), 4);
     assert!(data.qacc.iter().all(|x| x.is_finite()), "{:?}", data.qacc.as_slice());
     assert!(data.efc_converged && data.efc_safe_friction);
+}
+
+#[test]
+fn absurd_coefficients_of_tendons_and_mimics_are_refused() {
+    // Found by fuzzing: a fixed-tendon coefficient of 1e308 and a mimic multiplier of 1e308 loaded
+    // and gave non-finite accelerations.
+    let dir = temp_dir("coefficients");
+    let path = dir.join("tendon.xml");
+    std::fs::write(
+        &path,
+        r#"<mujoco><worldbody><body><joint name="a"/><geom size=".1"/><body pos="0 0 -.3"><joint name="b"/><geom size=".1"/></body></body></worldbody>
+<tendon><fixed name="t"><joint joint="a" coef="1"/>
+<joint joint="b" coef="1e308"/></fixed></tendon></mujoco>"#,
+    )
+    .unwrap();
+    refused(
+        &path,
+        &LoadOptions::default(),
+        &["tendon.xml:3", "tendon 't', joint 'b'", "1e308", "absurdly large"],
+    );
+    let path = dir.join("mimic.urdf");
+    std::fs::write(
+        &path,
+        r#"<robot name="m"><link name="a"/>
+<link name="b"><inertial><origin xyz="0 0 .1"/><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<link name="c"><inertial><origin xyz="0 0 .1"/><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="j1" type="continuous"><parent link="a"/><child link="b"/></joint>
+<joint name="j2" type="continuous"><parent link="a"/><child link="c"/>
+<mimic joint="j1" multiplier="1e308"/></joint></robot>"#,
+    )
+    .unwrap();
+    refused(&path, &LoadOptions::default(), &["mimic.urdf:6", "joint 'j2'", "mimic multiplier", "1e308"]);
 }

@@ -7,7 +7,7 @@
 
 use crate::io::{LinkWord, LoadError};
 use crate::mass::GeomMass;
-use crate::model::spec::{JointType, LinkSpec, ModelSpec, Shape};
+use crate::model::spec::{EqualitySpecKind, JointType, LinkSpec, ModelSpec, Shape, TendonSpecKind};
 use crate::model::SourceLoc;
 use crate::spatial::{RigidInertia, Transform, Vec3};
 
@@ -115,6 +115,56 @@ pub fn check_spec(spec: &ModelSpec) -> Result<(), LoadError> {
     }
     for link in &spec.links {
         check_link(link, word)?;
+    }
+    check_elements(spec)
+}
+
+/// The coefficients of equalities, fixed tendons and actuators: finite and within [`ABSURD`]
+/// (ranges may be as wide as they like but finite).
+fn check_elements(spec: &ModelSpec) -> Result<(), LoadError> {
+    for e in &spec.equalities {
+        let what = || format!("equality '{}': a coefficient", e.name);
+        match &e.kind {
+            EqualitySpecKind::ConnectBodies { anchor, .. } => check(&e.loc, "connect", what, anchor)?,
+            EqualitySpecKind::WeldBodies { anchor, torquescale, relpose, .. } => {
+                check(&e.loc, "weld", what, anchor)?;
+                check(&e.loc, "weld", what, &[*torquescale])?;
+                if let Some(x) = relpose {
+                    check_pose(&e.loc, "weld", &format!("equality '{}'", e.name), x)?;
+                }
+            }
+            EqualitySpecKind::WeldSites { torquescale, .. } => check(&e.loc, "weld", what, &[*torquescale])?,
+            EqualitySpecKind::Joint { polycoef, .. } => check(&e.loc, "joint", what, polycoef)?,
+            EqualitySpecKind::Tendon { polycoef, .. } => check(&e.loc, "tendon", what, polycoef)?,
+            EqualitySpecKind::ConnectSites { .. } => {}
+        }
+    }
+    for t in &spec.tendons {
+        if let TendonSpecKind::Fixed { joints } = &t.kind {
+            for (joint, coef, loc) in joints {
+                check(
+                    loc,
+                    "joint",
+                    || format!("tendon '{}', joint '{joint}': the coefficient", t.name),
+                    &[*coef],
+                )?;
+            }
+        }
+    }
+    for a in &spec.actuators {
+        let what = || format!("actuator '{}': a gear, gain, bias or dynamics parameter", a.name);
+        for values in [&a.gear[..], &a.gainprm[..], &a.biasprm[..], &a.dynprm[..]] {
+            check(&a.loc, "actuator", what, values)?;
+        }
+        for range in [a.ctrlrange, a.forcerange, a.actrange].into_iter().flatten() {
+            if !range.iter().all(|x| x.is_finite()) {
+                return Err(invalid(
+                    &a.loc,
+                    "actuator",
+                    format!("actuator '{}': a range {range:?} is not finite; fix the value", a.name),
+                ));
+            }
+        }
     }
     Ok(())
 }
