@@ -7,7 +7,7 @@
 
 use crate::io::{LinkWord, LoadError};
 use crate::mass::GeomMass;
-use crate::model::spec::{EqualitySpecKind, JointType, LinkSpec, ModelSpec, Shape, TendonSpecKind};
+use crate::model::spec::{EqualitySpecKind, LinkSpec, ModelSpec, Shape, TendonSpecKind};
 use crate::model::SourceLoc;
 use crate::spatial::{RigidInertia, Transform, Vec3};
 
@@ -70,32 +70,19 @@ fn check_pose(loc: &SourceLoc, element: &str, owner: &str, x: &Transform) -> Res
     check(loc, element, || format!("{owner}: a position coordinate"), x.pos.as_slice())
 }
 
-/// Counts within the resource limits; every length, size, scale, mass, density and inertia entry
-/// finite and within [`ABSURD`].
-pub fn check_spec(spec: &ModelSpec) -> Result<(), LoadError> {
-    let file = spec.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
-    let word = link_word(spec);
-    let top = SourceLoc { file, line: 0 };
-    if spec.links.len() > MAX_LINKS {
+/// The link and degree-of-freedom counts within [`MAX_LINKS`] and [`MAX_DOFS`] (a loader may
+/// check them before its slower passes).
+pub fn check_counts(file: &str, word: LinkWord, links: usize, nv: usize) -> Result<(), LoadError> {
+    let top = SourceLoc { file: file.to_string(), line: 0 };
+    if links > MAX_LINKS {
         return Err(invalid(
             &top,
             &word.to_string(),
             format!(
-                "the model has {} {word}s (joint anchors included), more than the limit of {MAX_LINKS} (a resource limit against hostile files); split the model",
-                spec.links.len()
+                "the model has {links} {word}s (joint anchors included), more than the limit of {MAX_LINKS} (a resource limit against hostile files); split the model"
             ),
         ));
     }
-    let nv: usize = spec
-        .links
-        .iter()
-        .map(|l| match l.joint.jtype {
-            JointType::Fixed => 0,
-            JointType::Revolute | JointType::Continuous | JointType::Prismatic => 1,
-            JointType::Ball | JointType::Planar => 3,
-            JointType::Floating => 6,
-        })
-        .sum();
     if nv > MAX_DOFS {
         return Err(invalid(
             &top,
@@ -105,6 +92,17 @@ pub fn check_spec(spec: &ModelSpec) -> Result<(), LoadError> {
             ),
         ));
     }
+    Ok(())
+}
+
+/// Counts within the resource limits; every length, size, scale, mass, density and inertia entry
+/// finite and within [`ABSURD`].
+pub fn check_spec(spec: &ModelSpec) -> Result<(), LoadError> {
+    let file = spec.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+    let word = link_word(spec);
+    let nv = spec.links.iter().map(|l| l.joint.jtype.nv()).sum();
+    check_counts(&file, word, spec.links.len(), nv)?;
+    let top = SourceLoc { file, line: 0 };
     let geoms: usize = spec.links.iter().map(|l| l.geoms.len()).sum();
     if geoms > MAX_GEOMS {
         return Err(invalid(

@@ -52,18 +52,9 @@ pub fn parse(text: &str, path: &Path, options: &LoadOptions) -> Result<ModelSpec
         detail: e.to_string(),
     })?;
     let index = Index::build(&doc, &ctx)?;
-    // Resource limit before the second (slower) parse: the link count.
-    if index.links.len() > crate::io::plausibility::MAX_LINKS {
-        return Err(LoadError::Invalid {
-            loc: SourceLoc { file: ctx.file.clone(), line: 0 },
-            element: "link".into(),
-            detail: format!(
-                "the model has {} links, more than the limit of {} (a resource limit against hostile files); split the model",
-                index.links.len(),
-                crate::io::plausibility::MAX_LINKS
-            ),
-        });
-    }
+    // Resource limits before the second (slower) parse: the link and dof counts.
+    let nv = index.joints.iter().map(|j| j.jtype.nv()).sum();
+    crate::io::plausibility::check_counts(&ctx.file, crate::io::LinkWord::Link, index.links.len(), nv)?;
     // A material <texture> without a file name (which urdf-rs rejects) only affects drawing: it
     // is blanked out, keeping every byte offset, with a warning.
     let mut warnings = Vec::new();

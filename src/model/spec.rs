@@ -103,6 +103,18 @@ pub enum JointType {
     Ball,
 }
 
+impl JointType {
+    /// Degrees of freedom of a joint of this type.
+    pub fn nv(self) -> usize {
+        match self {
+            JointType::Fixed => 0,
+            JointType::Revolute | JointType::Continuous | JointType::Prismatic => 1,
+            JointType::Ball | JointType::Planar => 3,
+            JointType::Floating => 6,
+        }
+    }
+}
+
 /// The joint between a link and its parent.
 #[derive(Clone, Debug)]
 pub struct JointSpec {
