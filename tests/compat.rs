@@ -421,3 +421,33 @@ fn absurd_coefficients_of_tendons_and_mimics_are_refused() {
     .unwrap();
     refused(&path, &LoadOptions::default(), &["mimic.urdf:6", "joint 'j2'", "mimic multiplier", "1e308"]);
 }
+
+#[test]
+fn limits_must_be_ordered() {
+    // Found by fuzzing: a URDF <limit upper="-inf"> loaded (MuJoCo loads it too) and gave NaN at
+    // the limit; MuJoCo refuses the same thing in MJCF ("range[0] should be smaller than
+    // range[1]", and so did the MJCF loader already). URDF now follows the same rule: lower below
+    // upper, an infinite bound only on its own side.
+    let dir = temp_dir("limits");
+    let path = dir.join("limit.urdf");
+    std::fs::write(
+        &path,
+        r#"<robot name="l"><link name="a"/>
+<link name="b"><inertial><origin xyz="0 0 .1"/><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="j" type="revolute"><parent link="a"/><child link="b"/><limit lower="-1" upper="-inf" effort="1" velocity="1"/></joint></robot>"#,
+    )
+    .unwrap();
+    refused(
+        &path,
+        &LoadOptions::default(),
+        &["limit.urdf:3", "joint 'j'", "lower limit -1 is not below the upper limit -inf"],
+    );
+    let path = dir.join("range.xml");
+    std::fs::write(&path, "<mujoco><worldbody><body><joint name=\"h\" range=\"1 -1\" limited=\"true\"/><geom size=\".1\"/></body></worldbody></mujoco>")
+        .unwrap();
+    refused(
+        &path,
+        &LoadOptions::default(),
+        &["range.xml:1", "attribute 'range' is [1, -1]", "lower limit must be below the upper"],
+    );
+}

@@ -173,6 +173,25 @@ fn check_link(link: &LinkSpec, word: LinkWord) -> Result<(), LoadError> {
     // MJCF: the body's pos (with its joint's); URDF: the joint's <origin>.
     check_pose(&j.loc, if word == LinkWord::Body { "body" } else { "joint" }, &owner, &j.x_parent_joint)?;
     let joint = || format!("joint '{}'", j.name);
+    if let Some([lower, upper]) = j.limits {
+        // MuJoCo: "range[0] should be smaller than range[1]"; a bound may be infinite on its own
+        // side only (URDF 1.2's "no limit").
+        if lower.is_nan()
+            || upper.is_nan()
+            || lower > upper
+            || lower == f64::INFINITY
+            || upper == f64::NEG_INFINITY
+        {
+            return Err(invalid(
+                &j.loc,
+                "joint",
+                format!(
+                    "{}: the lower limit {lower} is not below the upper limit {upper}; give lower < upper (an infinite bound only on its own side)",
+                    joint()
+                ),
+            ));
+        }
+    }
     let scalars = [j.damping, j.friction, j.armature, j.stiffness, j.spring_ref];
     check(
         &j.loc,
