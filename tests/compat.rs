@@ -451,3 +451,16 @@ fn limits_must_be_ordered() {
         &["range.xml:1", "attribute 'range' is [1, -1]", "lower limit must be below the upper"],
     );
 }
+
+#[test]
+fn absurd_options_are_refused() {
+    // Found by fuzzing: <option gravity="0 -1e308 -9.81"> loaded and gave non-finite accelerations.
+    let dir = temp_dir("options");
+    let path = dir.join("gravity.xml");
+    std::fs::write(&path, r#"<mujoco><option gravity="0 -1e308 -9.81"/><worldbody><body><joint type="ball"/><geom size=".1" pos="0 0 .2"/></body></worldbody></mujoco>"#).unwrap();
+    refused(
+        &path,
+        &LoadOptions::default(),
+        &["gravity.xml", "<option>", "gravity", "-1e308", "absurdly large"],
+    );
+}

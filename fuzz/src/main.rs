@@ -306,7 +306,12 @@ fn worker(args: &Args, target: Target) {
             }
         };
         if let Some((kind, what)) = finding {
-            let key = format!("{kind}:{}", what.split(": ").next().unwrap_or(""));
+            // Panics once per location; non-finite models up to 20 (their causes differ).
+            let key = if kind == "panic" {
+                format!("{kind}:{}", what.split(": ").next().unwrap_or(""))
+            } else {
+                format!("{kind}:{}", seen_findings.len().min(20))
+            };
             if seen_findings.insert(key) {
                 let saved = save_finding(&args.findings, target, kind, &path, &what);
                 let _ = writeln!(stdout.lock(), "finding {kind}: {what} ({})", saved.display());

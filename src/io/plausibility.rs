@@ -103,6 +103,21 @@ pub fn check_spec(spec: &ModelSpec) -> Result<(), LoadError> {
     let nv = spec.links.iter().map(|l| l.joint.jtype.nv()).sum();
     check_counts(&file, word, spec.links.len(), nv)?;
     let top = SourceLoc { file, line: 0 };
+    let o = &spec.options;
+    check(&top, "option", || "gravity: a component".into(), spec.gravity.as_slice())?;
+    check(
+        &top,
+        "option",
+        || "timestep, tolerance, ls_tolerance or impratio".into(),
+        &[o.timestep, o.tolerance, o.ls_tolerance, o.impratio],
+    )?;
+    if o.timestep <= 0.0 {
+        return Err(invalid(
+            &top,
+            "option",
+            format!("timestep {} must be positive; e.g. timestep=\"0.002\"", o.timestep),
+        ));
+    }
     let geoms: usize = spec.links.iter().map(|l| l.geoms.len()).sum();
     if geoms > MAX_GEOMS {
         return Err(invalid(
