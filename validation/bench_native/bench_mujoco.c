@@ -1,14 +1,15 @@
 // Same-run native benchmark, MuJoCo side (validation/README.md, "Native benchmark").
 //
-//   bench_mujoco STATES ROBOT MODEL.mjb BUDGET_MS
+//   bench_mujoco STATES ROBOT MODEL.mjb     then commands on stdin: `OP BUDGET_MS`, one a line
 //
 // MODEL.mjb is the robot compiled by MuJoCo (mujoco 4.0.0 Python bindings, same library) and
 // saved by bench_native.py, with constraints, contacts, limits, equality, friction loss, springs,
 // dampers, actuation and fluid forces disabled (pure rigid-body dynamics). Only the wheel's
 // libmujoco is called here; this file's own flags hardly matter.
 //
-// Prints JSON lines: one `info`, one line per timed operation with the per-call time (µs) of
-// every batch, and `check` lines (results at the first states, MuJoCo's coordinates).
+// Prints JSON lines: `info`, `check` lines (results at the first states, MuJoCo's coordinates),
+// `ready` with the operations it knows, then for each command one line with the per-call time
+// (µs) of every batch.
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -79,7 +80,6 @@ static const mjModel* m;
 static mjData* d;
 static States S;
 static const char* robot;
-static double budget_ms;
 static double* res;  // nv
 static volatile double g_sink;
 
@@ -181,7 +181,7 @@ static void emit(const char* op, const double* us, int k) {
 // A batch is one call per state (all states in turn) or, with `prepare`, as many calls at one
 // state prepared beforehand (untimed); per-call time = batch time / calls. Two warm-up
 // batches, then batches until budget_ms has passed (at least 5).
-static void time_op(const char* op, void (*prepare)(int), double (*call)(int)) {
+static void time_op(const char* op, double budget_ms, void (*prepare)(int), double (*call)(int)) {
   int cap = 1024, k = 0;
   double* us = malloc(sizeof(double) * (size_t)cap);
   const double start = now_us();
@@ -211,12 +211,11 @@ static void emit_check(const char* what, int s, const double* x, int n) {
 }
 
 int main(int argc, char** argv) {
-  if (argc != 5) {
-    fprintf(stderr, "usage: bench_mujoco STATES ROBOT MODEL.mjb BUDGET_MS\n");
+  if (argc != 4) {
+    fprintf(stderr, "usage: bench_mujoco STATES ROBOT MODEL.mjb  (then `OP BUDGET_MS` lines on stdin)\n");
     return 2;
   }
   robot = argv[2];
-  budget_ms = atof(argv[4]);
   mjModel* model = mj_loadModel(argv[3], NULL);
   if (!model) {
     fprintf(stderr, "bench_mujoco: cannot load %s\n", argv[3]);
@@ -249,14 +248,37 @@ int main(int argc, char** argv) {
     emit_check("aba", s, d->qacc, m->nv);
   }
 
-  time_op("fk", NULL, op_fk);
-  time_op("rnea", NULL, op_rnea);
-  time_op("crba", NULL, op_crba);
-  time_op("aba", NULL, op_fd);
-  time_op("factor_solve", prep_crb, op_factor_solve);
-  time_op("rne_only", prep_crb, op_rne_only);
-  time_op("crb_only", prep_crb, op_crb_only);
-  time_op("forward", NULL, op_forward);
+  static const struct {
+    const char* name;
+    void (*prepare)(int);
+    double (*call)(int);
+  } ops[] = {
+      {"fk", NULL, op_fk},
+      {"rnea", NULL, op_rnea},
+      {"crba", NULL, op_crba},
+      {"aba", NULL, op_fd},
+      {"factor_solve", prep_crb, op_factor_solve},
+      {"rne_only", prep_crb, op_rne_only},
+      {"crb_only", prep_crb, op_crb_only},
+      {"forward", NULL, op_forward},
+  };
+  const int nops = (int)(sizeof ops / sizeof ops[0]);
+  printf("{\"ready\":[");
+  for (int i = 0; i < nops; ++i) printf("%s\"%s\"", i ? "," : "", ops[i].name);
+  printf("]}\n");
+  fflush(stdout);
+  char op[64];
+  double budget_ms;
+  while (scanf("%63s %lf", op, &budget_ms) == 2) {
+    int i = 0;
+    while (i < nops && strcmp(ops[i].name, op) != 0) ++i;
+    if (i == nops) {
+      fprintf(stderr, "bench_mujoco: unknown operation %s\n", op);
+      return 2;
+    }
+    time_op(ops[i].name, budget_ms, ops[i].prepare, ops[i].call);
+    fflush(stdout);
+  }
 
   free(full);
   free(res);

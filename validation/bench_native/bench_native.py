@@ -4,7 +4,7 @@
 Run through `validation/bench_native/run` (which builds the programs first); by hand:
 
     python validation/bench_native/bench_native.py --build validation/bench_native/build \\
-        --lagrange target/release/lagrange [--rounds 5] [--budget-ms 20] [--cpu 0] [--out validation/bench.md]
+        --lagrange target/release/lagrange [--rounds 15] [--budget-ms 8] [--cpu 0] [--out validation/bench.md]
 
 1. Loads each robot with the three engines (crossval_engines: lagrange `info`, MuJoCo, Pinocchio),
    saves the references' compiled models (MuJoCo `.mjb` with every non-smooth feature disabled,
@@ -13,9 +13,10 @@ Run through `validation/bench_native/run` (which builds the programs first); by 
    plus a random acceleration), converts them into each engine's coordinates (joint order by name,
    quaternion order, free-joint velocity frame) and writes them all to one plain-text file that the
    three programs read.
-3. Runs the three programs pinned to one core (`taskset -c CPU`), interleaved: for every round,
-   for every robot, Pinocchio, MuJoCo, lagrange in turn. Each program times every operation in
-   batches over the 64 states; the median over all batches of all rounds is reported.
+3. Per robot, starts the three programs side by side, pinned to one core (`taskset -c CPU`), and
+   runs rounds: in each, every operation is timed by Pinocchio, MuJoCo and lagrange in turn
+   (commands on their stdin; the idle ones wait), in batches over the 64 states. The median over
+   all batches of all rounds is reported.
 4. Checks that the engines computed the same thing (RNEA, M, the LᵀDL solve and forward dynamics at
    the first four states, converted back to lagrange's coordinates) and writes the report.
 
@@ -35,6 +36,7 @@ import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -230,13 +232,11 @@ def to_canonical(r: Robot, engine: str, what: str, state: int, x: np.ndarray) ->
 
 
 def command(engine: str, r: Robot, args, states: Path) -> list[str]:
-    budget = "%g" % args.budget_ms
     if engine == "pinocchio":
-        return [str(args.build / "bench_pinocchio"), str(states), r.name, str(r.pin_model), budget]
+        return [str(args.build / "bench_pinocchio"), str(states), r.name, str(r.pin_model)]
     if engine == "mujoco":
-        return [str(args.build / "bench_mujoco"), str(states), r.name, str(r.mj_model), budget]
-    cmd = [str(args.lagrange), "bench-native", str(r.entry.path), "--states", str(states), "--robot", r.name,
-           "--budget-ms", budget]
+        return [str(args.build / "bench_mujoco"), str(states), r.name, str(r.mj_model)]
+    cmd = [str(args.lagrange), "bench-native", str(r.entry.path), "--states", str(states), "--robot", r.name]
     for d in r.entry.package_dirs:
         cmd += ["--package-dir", str(d)]
     if r.entry.floating:
@@ -244,32 +244,79 @@ def command(engine: str, r: Robot, args, states: Path) -> list[str]:
     return cmd
 
 
+class Program:
+    """One engine's benchmark process for one robot: loads, prints info and checks, then answers
+    `OP BUDGET_MS` commands on stdin with one JSON line each."""
+
+    def __init__(self, engine: str, cmd: list[str]):
+        self.engine, self.cmd = engine, cmd
+        self.stderr = tempfile.TemporaryFile("w+")
+        self.p = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.stderr,
+                                  text=True, bufsize=1)
+        self.lines: list[dict] = []
+        while True:
+            o = self._read()
+            if "ready" in o:
+                self.ops = list(o["ready"])
+                break
+            self.lines.append(o)
+
+    def _read(self) -> dict:
+        line = self.p.stdout.readline()
+        if not line:
+            self.p.wait()
+            self.stderr.seek(0)
+            raise SystemExit("bench_native: %s failed (exit %s):\n  %s\n%s" % (
+                self.engine, self.p.returncode, " ".join(self.cmd), self.stderr.read().strip()[-2000:]))
+        return json.loads(line)
+
+    def time(self, op: str, budget_ms: float) -> list[float]:
+        self.p.stdin.write("%s %g\n" % (op, budget_ms))
+        self.p.stdin.flush()
+        o = self._read()
+        assert o.get("op") == op, o
+        return o["us"]
+
+    def close(self):
+        self.p.stdin.close()
+        self.p.wait()
+        self.stderr.close()
+        if self.p.returncode != 0:
+            raise SystemExit("bench_native: %s exited with %d: %s" % (self.engine, self.p.returncode, " ".join(self.cmd)))
+
+
 def run_all(rbs: list[Robot], args, states: Path):
-    samples: dict[tuple[str, str, str], list[float]] = {}
+    """Per robot: the three programs started side by side (all pinned to the same core, idle
+    while another one is timed), then `--rounds` rounds of every operation, each sent to
+    Pinocchio, MuJoCo and lagrange in turn."""
+    samples: dict[tuple[str, str, str], list[float]] = {}  # all batches of all rounds
+    by_round: dict[tuple[str, str, str], list[float]] = {}  # the median of each round
     checks: dict[tuple[str, str, str, int], np.ndarray] = {}
     taskset = ["taskset", "-c", str(args.cpu)] if shutil.which("taskset") and args.cpu >= 0 else []
-    for rnd in range(args.rounds):
-        for r in rbs:
-            for engine in ENGINES:
-                if engine in r.skip:
-                    continue
-                cmd = taskset + command(engine, r, args, states)
-                p = subprocess.run(cmd, capture_output=True, text=True)
-                if p.returncode != 0:
-                    raise SystemExit("bench_native: %s failed on %s (exit %d):\n  %s\n%s" % (
-                        engine, r.name, p.returncode, " ".join(cmd), (p.stderr or p.stdout).strip()[-2000:]))
-                for line in p.stdout.splitlines():
-                    if not line.startswith("{"):
-                        continue
-                    o = json.loads(line)
-                    if "op" in o:
-                        samples.setdefault((r.name, engine, o["op"]), []).extend(o["us"])
-                    elif "check" in o and rnd == 0:
-                        checks[(r.name, engine, o["check"], o["state"])] = np.array(o["x"], dtype=float)
-                    elif "info" in o and rnd == 0:
-                        r.info[engine] = o["info"]
-        print("bench_native: round %d/%d done" % (rnd + 1, args.rounds), file=sys.stderr)
-    return samples, checks
+    for r in rbs:
+        for generation in range(args.processes):
+            # fresh processes every rounds/processes rounds: their memory layout differs too
+            rounds = range(generation * args.rounds // args.processes, (generation + 1) * args.rounds // args.processes)
+            progs = [Program(e, taskset + command(e, r, args, states)) for e in ENGINES if e not in r.skip]
+            for prog in progs:
+                for o in prog.lines:
+                    if "check" in o and generation == 0:
+                        checks[(r.name, prog.engine, o["check"], o["state"])] = np.array(o["x"], dtype=float)
+                    elif "info" in o:
+                        r.info[prog.engine] = o["info"]
+            ops = [op for op, _ in OPS]
+            ops += [op for prog in progs for op in prog.ops if op not in ops]
+            for _ in rounds:
+                for op in ops:
+                    for prog in progs:
+                        if op in prog.ops:
+                            us = prog.time(op, args.budget_ms)
+                            samples.setdefault((r.name, prog.engine, op), []).extend(us)
+                            by_round.setdefault((r.name, prog.engine, op), []).append(statistics.median(us))
+            for prog in progs:
+                prog.close()
+        print("bench_native: %s done" % r.name, file=sys.stderr)
+    return samples, by_round, checks
 
 
 def compare(rbs: list[Robot], checks) -> tuple[dict[str, float], list[str]]:
@@ -346,10 +393,15 @@ def git_commit() -> str:
         return "?"
 
 
-def ratio_cell(ours, theirs) -> str:
+def ratio_cell(ours, theirs, ours_rounds, theirs_rounds) -> str:
+    """The ratio of the medians, and the range of the per-round ratios (each round's lagrange
+    median over the reference's median in the same round, run seconds apart)."""
     if math.isnan(ours) or math.isnan(theirs) or theirs <= 0:
         return "—"
-    return "%.2f" % (ours / theirs)
+    per_round = [a / b for a, b in zip(ours_rounds, theirs_rounds) if b > 0]
+    if len(per_round) < 2:
+        return "%.2f" % (ours / theirs)
+    return "%.2f (%.2f–%.2f)" % (ours / theirs, min(per_round), max(per_round))
 
 
 def us_cell(xs) -> str:
@@ -359,7 +411,7 @@ def us_cell(xs) -> str:
     return "%.3f" % median(xs) + ("" if math.isnan(sp) else " (±%.0f%%)" % sp)
 
 
-def report(rbs, samples, worst, failures, args, seconds: float) -> str:
+def report(rbs, samples, by_round, worst, failures, args, seconds: float) -> str:
     def med(robot, engine, op):
         return median(samples.get((robot, engine, op), []))
 
@@ -382,10 +434,12 @@ def report(rbs, samples, worst, failures, args, seconds: float) -> str:
         "- Method: %d random states per robot, drawn once in lagrange's coordinates (seed %d) and converted "
         "into each engine's (joint order, quaternion order, free-joint velocity frame); the same states "
         "for the three engines. A batch = one call per state, all %d states in turn; per-call time = "
-        "batch time / %d. Two warm-up batches, then batches for %g ms per operation; %d rounds, each "
-        "running Pinocchio, MuJoCo, lagrange in turn per robot (interleaved). Figures: median over all "
-        "batches of all rounds, µs per call; (±x%%) is half the interquartile range over the median." % (
-            N_STATES, SEED, N_STATES, N_STATES, args.budget_ms, args.rounds),
+        "batch time / %d. Per robot the three programs run side by side on the same core; %d rounds (over "
+        "%d successive sets of processes), in each of which every operation is timed by Pinocchio, "
+        "MuJoCo, lagrange in turn (interleaved), each for two warm-up batches and then batches for %g ms. "
+        "Figures: median over all batches of all rounds, µs per call; (±x%%) is half the interquartile "
+        "range over the median." % (N_STATES, SEED, N_STATES, N_STATES, args.rounds, args.processes,
+                                    args.budget_ms),
         "- Results cross-checked before timing: RNEA, M, the LᵀDL solve and forward dynamics at %d states "
         "agree with lagrange's to %.0e relative (worst: %s)." % (
             N_CHECK, CHECK_TOL, ", ".join("%s %.0e" % (k, v) for k, v in worst.items())),
@@ -400,9 +454,14 @@ def report(rbs, samples, worst, failures, args, seconds: float) -> str:
     head = "| robot | nv | " + " | ".join(t for _, t in OPS) + " |"
     rule = "| --- | ---: | " + " | ".join("---:" for _ in OPS) + " |"
     for ref, title in (("pinocchio", "Pinocchio"), ("mujoco", "MuJoCo")):
-        lines += ["## lagrange time / %s time (below 1: lagrange is faster)" % title, "", head, rule]
+        lines += ["## lagrange time / %s time (below 1: lagrange is faster)" % title, "",
+                  "Ratio of the medians; in brackets the lowest and highest ratio of one round's medians "
+                  "(the two programs timed the operation within a few tens of ms of each other).", "", head,
+                  rule]
         for r in rbs:
-            cells = [ratio_cell(med(r.name, "lagrange", op), med(r.name, ref, op)) for op, _ in OPS]
+            cells = [ratio_cell(med(r.name, "lagrange", op), med(r.name, ref, op),
+                                by_round.get((r.name, "lagrange", op), []), by_round.get((r.name, ref, op), []))
+                     for op, _ in OPS]
             lines.append("| %s | %d | %s |" % (r.name, r.nv, " | ".join(cells)))
         lines.append("")
 
@@ -469,8 +528,9 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", type=Path, default=HERE / "build")
     ap.add_argument("--lagrange", type=Path, default=REPO / "target" / "release" / "lagrange")
-    ap.add_argument("--rounds", type=int, default=5)
-    ap.add_argument("--budget-ms", type=float, default=20.0, help="per operation, program and round")
+    ap.add_argument("--rounds", type=int, default=15)
+    ap.add_argument("--processes", type=int, default=3, help="fresh program processes per robot (rounds split among them)")
+    ap.add_argument("--budget-ms", type=float, default=8.0, help="per operation, program and round")
     ap.add_argument("--cpu", type=int, default=0, help="core to pin to (-1: no pinning)")
     ap.add_argument("--out", type=Path, default=VALIDATION / "bench.md")
     ap.add_argument("--cxxflags", default="?")
@@ -479,13 +539,14 @@ def main() -> int:
     ap.add_argument("--build-note", default="not reported", help="how long the build took (from `run`)")
     args = ap.parse_args()
     args.build = args.build.resolve()
+    args.processes = max(1, min(args.processes, args.rounds))
     args.loadavg = " ".join("%.2f" % x for x in os.getloadavg())
     t0 = time.perf_counter()
     rbs = robots()
     states = prepare(rbs, args.build, args.lagrange)
-    samples, checks = run_all(rbs, args, states)
+    samples, by_round, checks = run_all(rbs, args, states)
     worst, failures = compare(rbs, checks)
-    text = report(rbs, samples, worst, failures, args, time.perf_counter() - t0)
+    text = report(rbs, samples, by_round, worst, failures, args, time.perf_counter() - t0)
     args.out.write_text(text)
     print(text)
     if failures:

@@ -1,7 +1,6 @@
-// Same-run native benchmark, Pinocchio side (validation/bench_native/README: see
-// validation/README.md, "Native benchmark").
+// Same-run native benchmark, Pinocchio side (validation/README.md, "Native benchmark").
 //
-//   bench_pinocchio STATES ROBOT MODEL.txt BUDGET_MS
+//   bench_pinocchio STATES ROBOT MODEL.txt     then commands on stdin: `OP BUDGET_MS`, one a line
 //
 // MODEL.txt is the robot's pinocchio::Model as a Boost text archive, written by bench_native.py
 // with Pinocchio's own parsers (Python bindings of the same pinned version) and read back by
@@ -10,9 +9,10 @@
 // with this file's flags (-O3 -march=native -DNDEBUG); code built with other -march flags (the
 // wheel's libraries) could disagree with it on Eigen's alignment, so none is mixed in.
 //
-// Prints JSON lines: one `info`, one line per timed operation with the per-call time (µs) of
-// every batch, and `check` lines (results at the first states, for bench_native.py to compare
-// across engines in common coordinates).
+// Prints JSON lines: `info`, `check` lines (results at the first states, for bench_native.py to
+// compare across engines in common coordinates), then `ready` with the operations it knows; then
+// for each command one line with the per-call time (µs) of every batch. The driver sends the
+// same operation to the three programs in turn (interleaved), many times.
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/cholesky.hpp>
@@ -75,8 +75,8 @@ static double now_us() {
   return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// Median method shared by the three programs: a batch is one call per state (all states in
-// turn) for `per_state` operations, or, for `fixed` ones, as many calls at one state prepared
+// Timing method shared by the three programs: a batch is one call per state (all states in turn)
+// for `per_state` operations, or, for `fixed` ones, as many calls at one state prepared
 // beforehand (untimed); per-call time = batch time / calls. Two warm-up batches, then batches
 // until budget_ms has passed (at least 5).
 static volatile double g_sink = 0.0;
@@ -125,12 +125,11 @@ static void emit_check(const char* robot, const char* what, size_t state, const 
 }
 
 int main(int argc, char** argv) {
-  if (argc != 5) {
-    std::fprintf(stderr, "usage: bench_pinocchio STATES ROBOT MODEL.txt BUDGET_MS\n");
+  if (argc != 4) {
+    std::fprintf(stderr, "usage: bench_pinocchio STATES ROBOT MODEL.txt  (then `OP BUDGET_MS` lines on stdin)\n");
     return 2;
   }
   const char* robot = argv[2];
-  const double budget_ms = std::atof(argv[4]);
   Model model;
   try {
     bench_native_load_model(argv[3], model);
@@ -168,37 +167,55 @@ int main(int argc, char** argv) {
     emit_check(robot, "aba", s, qacc.data(), nv);
   }
 
-  time_per_state(robot, "fk", n, budget_ms, [&](size_t s) {
-    pinocchio::framesForwardKinematics(model, data, states[s].q);
-    return data.oMf.back().translation()[0];
-  });
-  time_per_state(robot, "rnea", n, budget_ms, [&](size_t s) {
-    const State& st = states[s];
-    return pinocchio::rnea(model, data, st.q, st.v, st.a)[0];
-  });
-  time_per_state(robot, "crba", n, budget_ms, [&](size_t s) {
-    return pinocchio::crba(model, data, states[s].q)(0, nv - 1);
-  });
-  time_per_state(robot, "crba_world", n, budget_ms, [&](size_t s) {
-    return pinocchio::crba(model, data, states[s].q, pinocchio::Convention::WORLD)(0, nv - 1);
-  });
-  time_per_state(robot, "aba", n, budget_ms, [&](size_t s) {
-    const State& st = states[s];
-    return pinocchio::aba(model, data, st.q, st.v, st.tau)[0];
-  });
-  time_per_state(robot, "aba_world", n, budget_ms, [&](size_t s) {
-    const State& st = states[s];
-    return pinocchio::aba(model, data, st.q, st.v, st.tau, pinocchio::Convention::WORLD)[0];
-  });
-  // Factor + solve of the M of one state per batch (CRBA untimed), one right-hand side per call.
   Vec x(nv);
-  time_fixed(
-      robot, "factor_solve", n, budget_ms, [&](size_t s) { pinocchio::crba(model, data, states[s].q); },
-      [&](size_t s) {
-        x = states[s].tau;
-        pinocchio::cholesky::decompose(model, data);
-        pinocchio::cholesky::solve(model, data, x);
-        return x[0];
+  std::printf("{\"ready\":[\"fk\",\"rnea\",\"crba\",\"crba_world\",\"aba\",\"aba_world\",\"factor_solve\"]}\n");
+  std::fflush(stdout);
+  char op_buf[64];
+  double budget_ms = 0.0;
+  while (std::scanf("%63s %lf", op_buf, &budget_ms) == 2) {
+    const std::string op(op_buf);
+    if (op == "fk") {
+      time_per_state(robot, "fk", n, budget_ms, [&](size_t s) {
+        pinocchio::framesForwardKinematics(model, data, states[s].q);
+        return data.oMf.back().translation()[0];
       });
+    } else if (op == "rnea") {
+      time_per_state(robot, "rnea", n, budget_ms, [&](size_t s) {
+        const State& st = states[s];
+        return pinocchio::rnea(model, data, st.q, st.v, st.a)[0];
+      });
+    } else if (op == "crba") {
+      time_per_state(robot, "crba", n, budget_ms,
+                     [&](size_t s) { return pinocchio::crba(model, data, states[s].q)(0, nv - 1); });
+    } else if (op == "crba_world") {
+      time_per_state(robot, "crba_world", n, budget_ms, [&](size_t s) {
+        return pinocchio::crba(model, data, states[s].q, pinocchio::Convention::WORLD)(0, nv - 1);
+      });
+    } else if (op == "aba") {
+      time_per_state(robot, "aba", n, budget_ms, [&](size_t s) {
+        const State& st = states[s];
+        return pinocchio::aba(model, data, st.q, st.v, st.tau)[0];
+      });
+    } else if (op == "aba_world") {
+      time_per_state(robot, "aba_world", n, budget_ms, [&](size_t s) {
+        const State& st = states[s];
+        return pinocchio::aba(model, data, st.q, st.v, st.tau, pinocchio::Convention::WORLD)[0];
+      });
+    } else if (op == "factor_solve") {
+      // Factor + solve of the M of one state per batch (CRBA untimed), one right-hand side per call.
+      time_fixed(
+          robot, "factor_solve", n, budget_ms, [&](size_t s) { pinocchio::crba(model, data, states[s].q); },
+          [&](size_t s) {
+            x = states[s].tau;
+            pinocchio::cholesky::decompose(model, data);
+            pinocchio::cholesky::solve(model, data, x);
+            return x[0];
+          });
+    } else {
+      std::fprintf(stderr, "bench_pinocchio: unknown operation %s\n", op_buf);
+      return 2;
+    }
+    std::fflush(stdout);
+  }
   return 0;
 }

@@ -67,7 +67,8 @@ enum Command {
         json: bool,
     },
     /// Side-by-side native benchmark, lagrange's part (run by validation/bench_native/run):
-    /// per-batch times of FK, RNEA, CRBA, ABA and LᵀDL factor + solve over a states file.
+    /// per-batch times of FK, RNEA, CRBA, ABA and LᵀDL factor + solve over a states file, for
+    /// `OP BUDGET_MS` commands read from stdin.
     #[command(hide = true)]
     BenchNative {
         model: PathBuf,
@@ -77,9 +78,6 @@ enum Command {
         /// Which block of the states file (its `robot` name).
         #[arg(long)]
         robot: String,
-        /// Time budget per operation in milliseconds (at least 5 batches are timed).
-        #[arg(long, default_value_t = 20.0)]
-        budget_ms: f64,
     },
     /// Print bodies, joints, sizes and the simulation plan.
     Info {
@@ -186,8 +184,8 @@ fn main() -> ExitCode {
         None => simulate::default_run(),
         Some(Command::Info { model, json }) => info::run(&model, &options, json, mode),
         Some(Command::Bench { model, json }) => bench::run(&model, &options, json),
-        Some(Command::BenchNative { model, states, robot, budget_ms }) => {
-            bench_native::run(&model, &options, &states, &robot, budget_ms)
+        Some(Command::BenchNative { model, states, robot }) => {
+            bench_native::run(&model, &options, &states, &robot)
         }
         Some(Command::Eval { model, states, json: _, jacobians }) => {
             eval::run(&model, &options, &states, &jacobians, mode)

@@ -1,11 +1,13 @@
-//! `lagrange bench-native STATES --robot NAME MODEL` (hidden): lagrange's side of the same-run
-//! native benchmark `validation/bench_native/run`, which times Pinocchio (C++) and MuJoCo (C) on
-//! the same states with the same method (validation/README.md, "Native benchmark").
+//! `lagrange bench-native MODEL --states FILE --robot NAME` (hidden): lagrange's side of the
+//! same-run native benchmark `validation/bench_native/run`, which times Pinocchio (C++) and MuJoCo
+//! (C) on the same states with the same method (validation/README.md, "Native benchmark").
 //!
 //! Reads the block `robot NAME engine lagrange` of the plain-text states file written by
 //! `validation/bench_native/bench_native.py` (`nq`, `nv`, `nstates`, then per state q, v, a, tau)
-//! and prints JSON lines: `info`, one line per operation with the per-call time (µs) of every
-//! batch, and `check` lines (results at the first states, for the script's cross-check).
+//! and prints JSON lines: `info`, `check` lines (results at the first states, for the script's
+//! cross-check) and `ready` with the operations it knows. Then it reads commands `OP BUDGET_MS`
+//! from stdin, one a line, and answers each with one line: the per-call time (µs) of every batch.
+//! The driver sends the same operation to the three programs in turn (interleaved), many times.
 
 use super::CliError;
 use lagrange::dynamics::{aba, crba, factorize_mass_matrix, rnea, solve_mass_matrix};
@@ -15,6 +17,7 @@ use lagrange::{Data, Model};
 use nalgebra::DVector;
 use serde_json::json;
 use std::hint::black_box;
+use std::io::BufRead;
 use std::path::Path;
 use std::time::Instant;
 
@@ -101,13 +104,7 @@ fn emit_check(robot: &str, what: &str, state: usize, x: &[f64]) {
 }
 
 /// Runs `bench-native`.
-pub fn run(
-    path: &Path,
-    options: &LoadOptions,
-    states_file: &Path,
-    robot: &str,
-    budget_ms: f64,
-) -> Result<(), CliError> {
+pub fn run(path: &Path, options: &LoadOptions, states_file: &Path, robot: &str) -> Result<(), CliError> {
     let model: Model = load(path, options)?;
     let states = read_states(states_file, robot)?;
     if states.is_empty() || states[0].q.len() != model.nq || states[0].v.len() != model.nv {
@@ -134,40 +131,51 @@ pub fn run(
         emit_check(robot, "solve", s, x.as_slice());
         emit_check(robot, "aba", s, aba(&model, &mut data, &st.q, &st.v, &st.tau).as_slice());
     }
-    let emit = |op: &str, us: Vec<f64>| {
-        println!("{}", json!({"engine": "lagrange", "robot": robot, "op": op, "us": us}));
-    };
     let none = |_: &mut Data, _: usize| {};
     let last_frame = model.frames.len().checked_sub(1);
     let st = &states;
     let m = &model;
-    emit(
-        "fk",
-        time_op(&mut data, n, budget_ms, none, |d, s| {
-            forward_kinematics(m, d, &st[s].q);
-            last_frame.map_or(0.0, |f| d.x_world_frame[f].pos[0])
-        }),
-    );
-    emit("rnea", time_op(&mut data, n, budget_ms, none, |d, s| rnea(m, d, &st[s].q, &st[s].v, &st[s].a)[0]));
-    emit("crba", time_op(&mut data, n, budget_ms, none, |d, s| crba(m, d, &st[s].q)[(0, nv - 1)]));
-    emit("aba", time_op(&mut data, n, budget_ms, none, |d, s| aba(m, d, &st[s].q, &st[s].v, &st[s].tau)[0]));
-    // Factor + solve of the M of one state per batch (CRBA untimed), one right-hand side per call.
-    emit(
-        "factor_solve",
-        time_op(
-            &mut (&mut data, &mut x),
-            n,
-            budget_ms,
-            |(d, _), s| {
-                crba(m, d, &st[s].q);
-            },
-            |(d, x), s| {
-                x.copy_from_slice(&st[s].tau);
-                factorize_mass_matrix(m, d);
-                solve_mass_matrix(m, d, x);
-                x[0]
-            },
-        ),
-    );
+    println!("{}", json!({"ready": ["fk", "rnea", "crba", "aba", "factor_solve"]}));
+    for line in std::io::stdin().lock().lines() {
+        let line = line.map_err(|source| CliError::Io { file: "stdin".into(), source })?;
+        let mut words = line.split_ascii_whitespace();
+        let (Some(op), Some(budget)) = (words.next(), words.next()) else {
+            continue;
+        };
+        let budget_ms: f64 = budget
+            .parse()
+            .map_err(|_| CliError::Usage(format!("bench-native: not a budget in ms: {budget}")))?;
+        let us = match op {
+            "fk" => time_op(&mut data, n, budget_ms, none, |d, s| {
+                forward_kinematics(m, d, &st[s].q);
+                last_frame.map_or(0.0, |f| d.x_world_frame[f].pos[0])
+            }),
+            "rnea" => {
+                time_op(&mut data, n, budget_ms, none, |d, s| rnea(m, d, &st[s].q, &st[s].v, &st[s].a)[0])
+            }
+            "crba" => time_op(&mut data, n, budget_ms, none, |d, s| crba(m, d, &st[s].q)[(0, nv - 1)]),
+            "aba" => {
+                time_op(&mut data, n, budget_ms, none, |d, s| aba(m, d, &st[s].q, &st[s].v, &st[s].tau)[0])
+            }
+            // Factor + solve of the M of one state per batch (CRBA untimed), one right-hand side
+            // per call.
+            "factor_solve" => time_op(
+                &mut (&mut data, &mut x),
+                n,
+                budget_ms,
+                |(d, _), s| {
+                    crba(m, d, &st[s].q);
+                },
+                |(d, x), s| {
+                    x.copy_from_slice(&st[s].tau);
+                    factorize_mass_matrix(m, d);
+                    solve_mass_matrix(m, d, x);
+                    x[0]
+                },
+            ),
+            _ => return Err(CliError::Usage(format!("bench-native: unknown operation {op}"))),
+        };
+        println!("{}", json!({"engine": "lagrange", "robot": robot, "op": op, "us": us}));
+    }
     Ok(())
 }
