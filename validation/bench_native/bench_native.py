@@ -393,15 +393,15 @@ def git_commit() -> str:
         return "?"
 
 
-def ratio_cell(ours, theirs, ours_rounds, theirs_rounds) -> str:
-    """The ratio of the medians, and the range of the per-round ratios (each round's lagrange
-    median over the reference's median in the same round, run seconds apart)."""
-    if math.isnan(ours) or math.isnan(theirs) or theirs <= 0:
-        return "—"
+def ratio_cell(ours_rounds, theirs_rounds) -> str:
+    """Paired ratios: each round's lagrange median over the reference's median in the same round
+    (timed tens of ms apart, so slow drifts of the machine's load cancel); their median and range."""
     per_round = [a / b for a, b in zip(ours_rounds, theirs_rounds) if b > 0]
+    if not per_round:
+        return "—"
     if len(per_round) < 2:
-        return "%.2f" % (ours / theirs)
-    return "%.2f (%.2f–%.2f)" % (ours / theirs, min(per_round), max(per_round))
+        return "%.2f" % per_round[0]
+    return "%.2f (%.2f–%.2f)" % (statistics.median(per_round), min(per_round), max(per_round))
 
 
 def us_cell(xs) -> str:
@@ -412,9 +412,6 @@ def us_cell(xs) -> str:
 
 
 def report(rbs, samples, by_round, worst, failures, args, seconds: float) -> str:
-    def med(robot, engine, op):
-        return median(samples.get((robot, engine, op), []))
-
     today = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")
     import mujoco
     import pinocchio
@@ -455,12 +452,11 @@ def report(rbs, samples, by_round, worst, failures, args, seconds: float) -> str
     rule = "| --- | ---: | " + " | ".join("---:" for _ in OPS) + " |"
     for ref, title in (("pinocchio", "Pinocchio"), ("mujoco", "MuJoCo")):
         lines += ["## lagrange time / %s time (below 1: lagrange is faster)" % title, "",
-                  "Ratio of the medians; in brackets the lowest and highest ratio of one round's medians "
-                  "(the two programs timed the operation within a few tens of ms of each other).", "", head,
-                  rule]
+                  "Per round, lagrange's median time over the reference's median time in the same round "
+                  "(the two programs timed the operation within a few tens of ms of each other): the median "
+                  "of these %d ratios, in brackets the lowest and the highest." % args.rounds, "", head, rule]
         for r in rbs:
-            cells = [ratio_cell(med(r.name, "lagrange", op), med(r.name, ref, op),
-                                by_round.get((r.name, "lagrange", op), []), by_round.get((r.name, ref, op), []))
+            cells = [ratio_cell(by_round.get((r.name, "lagrange", op), []), by_round.get((r.name, ref, op), []))
                      for op, _ in OPS]
             lines.append("| %s | %d | %s |" % (r.name, r.nv, " | ".join(cells)))
         lines.append("")
