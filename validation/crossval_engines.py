@@ -527,11 +527,14 @@ class Pinocchio:
         run.status = "ok"
         return run
 
-    def evaluate(self, run: EngineRun, canon: Layout, states: list[State], jac_frames: list[str],
-                 joint_body: dict[str, str] | None = None) -> None:
-        """``joint_body`` maps joint names to their MJCF body (from MuJoCo): lagrange's layout
-        names a multi-joint body's intermediate frames `<body>/<joint>` instead."""
-        pin, model, data = self.pin, self.model, self.data
+    def coordinates(self, canon: Layout, joint_body: dict[str, str] | None = None):
+        """Maps the canonical layout onto the loaded Pinocchio model. Returns ``(entries, vmap,
+        problem)``: per canonical joint ``(slot, pin jid, idx_q, idx_v, pin nq, kind)``, the
+        Pinocchio velocity index of each canonical velocity index, and a description of the
+        difference when the joints do not match (then entries and vmap are not usable).
+        ``joint_body`` maps joint names to their MJCF body (from MuJoCo): lagrange's layout names
+        a multi-joint body's intermediate frames `<body>/<joint>` instead."""
+        model = self.model
         canon_by_name = canon.by_name()
         body_of = {c.name: (joint_body or {}).get(c.name, c.body) for c in canon.slots}
         # Expand Pinocchio joints into per-coordinate entries: (canonical slot, pin jid, idx_q,
@@ -589,41 +592,68 @@ class Pinocchio:
         if missing:
             problems.append("no joint %s" % ", ".join("'%s'" % n for n in missing[:6]) + (" …" if len(missing) > 6 else ""))
         if problems or model.nv != canon.nv:
-            run.status = "incomparable"
-            run.detail = "joints differ from lagrange's: " + "; ".join(problems[:4]) if problems else \
+            problem = "joints differ from lagrange's: " + "; ".join(problems[:4]) if problems else \
                 "nv %d, lagrange %d" % (model.nv, canon.nv)
-            return
-
-        nv = model.nv
-        vmap = np.zeros(nv, dtype=int)  # canonical velocity index -> Pinocchio velocity index
+            return entries, None, problem
+        vmap = np.zeros(model.nv, dtype=int)  # canonical velocity index -> Pinocchio velocity index
         for c, jid, iq, iv, nq, kind in entries:
             for k in range(c.nv):
                 vmap[c.vadr + k] = iv + k
+        return entries, vmap, ""
+
+    def configuration(self, entries, q) -> tuple[np.ndarray, np.ndarray]:
+        """Pinocchio's configuration for the canonical ``q``, and T = blockdiag(R, I) per free
+        joint (Pinocchio's velocity order), with canonical v = T v_pin (after permutation)."""
+        pin, model = self.pin, self.model
+        qp = pin.neutral(model)
+        T = np.eye(model.nv)
+        for c, jid, iq, iv, nq, kind in entries:
+            if kind == "free":
+                p = q[c.qadr : c.qadr + 3]
+                R = quat_wxyz_to_mat(q[c.qadr + 3 : c.qadr + 7])
+                # MuJoCo's free q is the body's world pose; Pinocchio's is relative to the
+                # joint placement.
+                Mj = model.jointPlacements[jid].inverse() * pin.SE3(R, np.asarray(p))
+                qp[iq : iq + 3] = Mj.translation
+                qp[iq + 3 : iq + 7] = pin.Quaternion(Mj.rotation).coeffs()  # x y z w
+                T[iv : iv + 3, iv : iv + 3] = R
+            elif kind == "ball":
+                w, x, y, z = q[c.qadr : c.qadr + 4]
+                qp[iq : iq + 4] = [x, y, z, w]
+            elif nq == 2:
+                qp[iq], qp[iq + 1] = math.cos(q[c.qadr]), math.sin(q[c.qadr])
+            else:
+                qp[iq] = q[c.qadr]
+        return qp, T
+
+    @staticmethod
+    def free_joint_drift(entries, T, v_pin) -> np.ndarray:
+        """c = (dT/dt) v_pin = [R (ω × v_local); 0] per free joint: canonical qacc = T a_pin + c."""
+        cvec = np.zeros(len(v_pin))
+        for c, jid, iq, iv, nq, kind in entries:
+            if kind == "free":
+                cvec[iv : iv + 3] = T[iv : iv + 3, iv : iv + 3] @ np.cross(v_pin[iv + 3 : iv + 6], v_pin[iv : iv + 3])
+        return cvec
+
+    def evaluate(self, run: EngineRun, canon: Layout, states: list[State], jac_frames: list[str],
+                 joint_body: dict[str, str] | None = None) -> None:
+        """``joint_body`` maps joint names to their MJCF body (from MuJoCo): lagrange's layout
+        names a multi-joint body's intermediate frames `<body>/<joint>` instead."""
+        pin, model, data = self.pin, self.model, self.data
+        entries, vmap, problem = self.coordinates(canon, joint_body)
+        if problem:
+            run.status = "incomparable"
+            run.detail = problem
+            return
+
+        nv = model.nv
         frame_ids = {}
         for name in set(run.bodies) | set(jac_frames):
             if model.existFrame(name, pin.FrameType.BODY):
                 frame_ids[name] = model.getFrameId(name, pin.FrameType.BODY)
 
         for s in states:
-            qp = pin.neutral(model)
-            T = np.eye(nv)
-            for c, jid, iq, iv, nq, kind in entries:
-                if kind == "free":
-                    p = s.q[c.qadr : c.qadr + 3]
-                    R = quat_wxyz_to_mat(s.q[c.qadr + 3 : c.qadr + 7])
-                    # MuJoCo's free q is the body's world pose; Pinocchio's is relative to the
-                    # joint placement.
-                    Mj = model.jointPlacements[jid].inverse() * pin.SE3(R, np.asarray(p))
-                    qp[iq : iq + 3] = Mj.translation
-                    qp[iq + 3 : iq + 7] = pin.Quaternion(Mj.rotation).coeffs()  # x y z w
-                    T[iv : iv + 3, iv : iv + 3] = R
-                elif kind == "ball":
-                    w, x, y, z = s.q[c.qadr : c.qadr + 4]
-                    qp[iq : iq + 4] = [x, y, z, w]
-                elif nq == 2:
-                    qp[iq], qp[iq + 1] = math.cos(s.q[c.qadr]), math.sin(s.q[c.qadr])
-                else:
-                    qp[iq] = s.q[c.qadr]
+            qp, T = self.configuration(entries, s.q)
             Tinv = np.linalg.inv(T)
             v_o = np.zeros(nv)
             v_o[vmap] = s.v
@@ -643,11 +673,7 @@ class Pinocchio:
             potential = pin.computePotentialEnergy(model, data, qp)
             com = pin.centerOfMass(model, data, qp).copy()
             mass = float(data.mass[0])
-            # c = (dT/dt) v_pin = [R (ω × v_local); 0] per free joint
-            cvec = np.zeros(nv)
-            for c, jid, iq, iv, nq, kind in entries:
-                if kind == "free":
-                    cvec[iv : iv + 3] = T[iv : iv + 3, iv : iv + 3] @ np.cross(v_pin[iv + 3 : iv + 6], v_pin[iv : iv + 3])
+            cvec = self.free_joint_drift(entries, T, v_pin)
             M_o = Tinv.T @ M_pin @ Tinv
             qacc_o = T @ a_pin + cvec
             bias_o = Tinv.T @ b_pin - M_o @ cvec

@@ -3,7 +3,7 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 mod cli;
-use cli::{bench, eval, info, simulate};
+use cli::{bench, bench_native, eval, info, simulate};
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::DriftCorrection;
 use lagrange::integrate::IntegratorKind;
@@ -65,6 +65,19 @@ enum Command {
         /// One JSON line instead of text.
         #[arg(long)]
         json: bool,
+    },
+    /// Side-by-side native benchmark, lagrange's part (run by validation/bench_native/run):
+    /// per-batch times of FK, RNEA, CRBA, ABA and LᵀDL factor + solve over a states file, for
+    /// `OP BUDGET_MS` commands read from stdin.
+    #[command(hide = true)]
+    BenchNative {
+        model: PathBuf,
+        /// Plain-text states file written by validation/bench_native/bench_native.py.
+        #[arg(long)]
+        states: PathBuf,
+        /// Which block of the states file (its `robot` name).
+        #[arg(long)]
+        robot: String,
     },
     /// Print bodies, joints, sizes and the simulation plan.
     Info {
@@ -171,6 +184,9 @@ fn main() -> ExitCode {
         None => simulate::default_run(),
         Some(Command::Info { model, json }) => info::run(&model, &options, json, mode),
         Some(Command::Bench { model, json }) => bench::run(&model, &options, json),
+        Some(Command::BenchNative { model, states, robot }) => {
+            bench_native::run(&model, &options, &states, &robot)
+        }
         Some(Command::Eval { model, states, json: _, jacobians }) => {
             eval::run(&model, &options, &states, &jacobians, mode)
         }

@@ -2,6 +2,7 @@
 //! binary, not in the library: argument types are not part of the library API.
 
 pub mod bench;
+pub mod bench_native;
 pub mod eval;
 pub mod info;
 pub mod simulate;
