@@ -6,6 +6,7 @@ mod compile_elements;
 mod error;
 mod geom_hull;
 pub mod geom_mass;
+mod lines;
 pub mod mjcf;
 pub mod package;
 pub mod plausibility;

@@ -15,6 +15,7 @@
 
 use super::package::{base_dir, package_search_dirs, resolve_uri, ResolveError};
 use super::{LoadError, LoadOptions};
+use crate::io::lines::LineIndex;
 use crate::model::spec::{
     GeomSpec, InertialSpec, JointSpec, JointType, LinkSpec, MassRules, MimicSpec, ModelSpec, Shape,
 };
@@ -82,19 +83,16 @@ pub fn parse(text: &str, path: &Path, options: &LoadOptions) -> Result<ModelSpec
 /// File name and line table for locating byte offsets.
 struct Ctx {
     file: String,
-    /// Byte offset of the start of every line.
-    line_starts: Vec<usize>,
+    lines: LineIndex,
 }
 
 impl Ctx {
     fn new(text: &str, path: &Path) -> Self {
-        let mut line_starts = vec![0];
-        line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
-        Self { file: path.display().to_string(), line_starts }
+        Self { file: path.display().to_string(), lines: LineIndex::new(text) }
     }
     /// 1-based line of a byte offset.
     fn line(&self, pos: usize) -> u32 {
-        u32::try_from(self.line_starts.partition_point(|&s| s <= pos)).unwrap_or(u32::MAX)
+        self.lines.line(pos)
     }
     fn loc(&self, node: Node) -> SourceLoc {
         SourceLoc { file: self.file.clone(), line: self.line(node.range().start) }

@@ -4,6 +4,7 @@
 //! may be `<mujoco>` or MuJoCo-era `<mujocoinclude>`). Every element remembers its file and line
 //! for messages.
 
+use crate::io::lines::LineIndex;
 use crate::io::LoadError;
 use crate::model::SourceLoc;
 use roxmltree::{Document, Node, ParsingOptions};
@@ -63,24 +64,6 @@ pub fn read_text(text: &str, path: &Path) -> Result<Element, LoadError> {
 struct Includes {
     open: Vec<PathBuf>,
     seen: Vec<PathBuf>,
-}
-
-/// Line numbers of byte offsets by binary search over the line starts (roxmltree's `text_pos_at`
-/// scans from the start of the text each time, which made loading quadratic in file size).
-struct LineIndex {
-    starts: Vec<usize>,
-}
-
-impl LineIndex {
-    fn new(text: &str) -> Self {
-        let starts = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
-        LineIndex { starts }
-    }
-
-    /// The 1-based line of byte offset `pos`.
-    fn line(&self, pos: usize) -> u32 {
-        self.starts.partition_point(|&s| s <= pos) as u32
-    }
 }
 
 fn canonical(path: &Path) -> PathBuf {
