@@ -52,7 +52,18 @@ pub struct Simulation {
     pub steps: u64,
     /// What was chosen for the caller and why (integrator fallbacks, constraint mode).
     pub notes: Vec<String>,
+    /// Called before each step to set the controls ([`set_controller`](Self::set_controller)).
+    controller: Option<Controller>,
+    /// Called before each step to set the applied joint forces
+    /// ([`set_torque_controller`](Self::set_torque_controller)).
+    torque_controller: Option<Controller>,
 }
+
+/// A control law `f(time, q, v, out)`: it reads the state at the start of a step and writes the
+/// controls (or, for a torque controller, the applied generalized forces), which are then held
+/// for the whole step — every stage of RK4 and of the adaptive method sees the same values (a
+/// zero-order hold, MuJoCo's `mjcb_control` called once per `mj_step`).
+pub type Controller = Box<dyn FnMut(f64, &[f64], &[f64], &mut [f64]) + Send>;
 
 impl Simulation {
     /// A simulation from the model's `qpos0` at rest, with `options` over the model's own.
@@ -84,7 +95,23 @@ impl Simulation {
             notes,
             plan,
             model,
+            controller: None,
+            torque_controller: None,
         }
+    }
+
+    /// Installs a controller `f(time, q, v, ctrl)` that sets the controls, one per actuator in
+    /// MuJoCo's order, before each step (see [`Controller`]).
+    pub fn set_controller(&mut self, f: impl FnMut(f64, &[f64], &[f64], &mut [f64]) + Send + 'static) {
+        self.controller = Some(Box::new(f));
+    }
+
+    /// Installs a controller `f(time, q, v, qfrc_applied)` that sets the applied generalized
+    /// forces (joint torques, nv values) before each step: torque control of models without
+    /// actuators, such as URDF robots (bounded by `<limit effort>` when loaded with
+    /// `clamp_effort`).
+    pub fn set_torque_controller(&mut self, f: impl FnMut(f64, &[f64], &[f64], &mut [f64]) + Send + 'static) {
+        self.torque_controller = Some(Box::new(f));
     }
 
     /// Sets the state; rejects wrong lengths and non-finite values.
@@ -118,6 +145,13 @@ impl Simulation {
 
     /// Advances one step of `timestep`; a non-finite result is reported, never propagated.
     pub fn step(&mut self) -> Result<StepReport, SimError> {
+        let (t, q, v) = (self.state.time, self.state.q.as_slice(), self.state.v.as_slice());
+        if let Some(f) = self.controller.as_mut() {
+            f(t, q, v, self.data.ctrl.as_mut_slice());
+        }
+        if let Some(f) = self.torque_controller.as_mut() {
+            f(t, q, v, self.data.qfrc_applied.as_mut_slice());
+        }
         let report =
             self.stepper.step(&self.model, &self.plan, &mut self.data, &mut self.state, self.timestep);
         self.steps += 1;

@@ -342,3 +342,23 @@ fn disable_switches_off_option_flags_for_both_formats() {
     assert!(!ok);
     assert!(err.contains("--disable limits: not a MuJoCo <flag>; use one of"), "{err}");
 }
+
+#[test]
+fn info_lists_urdf_transmissions_and_effort_limits() {
+    let (ok, out, err) = lagrange(&["info", "models/ur5/ur5.urdf", "--json"]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let transmissions: Vec<&Value> =
+        v["elements"].as_array().unwrap().iter().filter(|e| e["category"] == "transmission").collect();
+    assert_eq!(transmissions.len(), 6);
+    assert_eq!(transmissions[0]["name"], "shoulder_pan_trans");
+    assert_eq!(transmissions[0]["kind"], "transmission_interface/SimpleTransmission");
+    assert_eq!(transmissions[0]["targets"], serde_json::json!(["shoulder_pan_joint", "shoulder_pan_motor"]));
+    assert!(transmissions[0]["source"].as_str().unwrap().starts_with("models/ur5/ur5.urdf:"));
+    let (ok, out, _) = lagrange(&["info", "models/ur5/ur5.urdf", "--clamp-effort"]);
+    assert!(ok);
+    assert!(
+        out.contains("|torque| ≤ 150 (--clamp-effort)") && out.contains("|torque| ≤ 28 (--clamp-effort)"),
+        "{out}"
+    );
+}

@@ -77,14 +77,20 @@ pub fn passive(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     }
 }
 
-/// The unconstrained acceleration. ABA path: `qacc_smooth` = ABA(q, v, passive + actuator +
-/// applied). M path: `qfrc_smooth` = passive + actuator + applied − bias, `qacc_smooth` = M⁻¹
-/// `qfrc_smooth` with the factor of the position stage.
+/// The driving force on dof k: actuator plus applied, clamped to the dof's effort limit (URDF
+/// `<limit effort>` with `--clamp-effort`; +∞ otherwise).
+fn drive(model: &Model, data: &Data, k: usize) -> f64 {
+    let limit = model.dof_effort_limit[k];
+    (data.qfrc_actuator[k] + data.qfrc_applied[k]).clamp(-limit, limit)
+}
+
+/// The unconstrained acceleration. ABA path: `qacc_smooth` = ABA(q, v, passive + drive). M path:
+/// `qfrc_smooth` = passive + drive − bias, `qacc_smooth` = M⁻¹ `qfrc_smooth` with the factor of
+/// the position stage. The drive is actuator + applied, clamped to the effort limits ([`drive`]).
 fn acceleration(model: &Model, data: &mut Data, q: &[f64], v: &[f64], m_path: bool) {
     if m_path {
         for k in 0..model.nv {
-            data.qfrc_smooth[k] =
-                data.qfrc_passive[k] + data.qfrc_actuator[k] + data.qfrc_applied[k] - data.qfrc_bias[k];
+            data.qfrc_smooth[k] = data.qfrc_passive[k] + drive(model, data, k) - data.qfrc_bias[k];
         }
         data.qacc_smooth.copy_from(&data.qfrc_smooth);
         let mut x = std::mem::take(&mut data.qacc_smooth);
@@ -93,7 +99,7 @@ fn acceleration(model: &Model, data: &mut Data, q: &[f64], v: &[f64], m_path: bo
     } else {
         let mut tau = std::mem::take(&mut data.scratch_v);
         for k in 0..model.nv {
-            tau[k] = data.qfrc_passive[k] + data.qfrc_actuator[k] + data.qfrc_applied[k];
+            tau[k] = data.qfrc_passive[k] + drive(model, data, k);
         }
         aba(model, data, q, v, tau.as_slice());
         data.scratch_v = tau;

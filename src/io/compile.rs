@@ -123,6 +123,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                     dof_adr: nv,
                     limits: j.limits,
                     actuator_force_range: j.actuator_force_range,
+                    effort_limit: j.effort_limit,
                     damping: j.damping,
                     friction: j.friction,
                     armature: j.armature,
@@ -180,6 +181,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let mut dof_body = vec![0; nv];
     let mut dof_armature = vec![0.0; nv];
     let mut dof_damping = vec![0.0; nv];
+    let mut dof_effort_limit = vec![f64::INFINITY; nv];
     for j in &joints {
         let parent_last = if j.parent == 0 {
             NO_DOF
@@ -193,6 +195,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             dof_body[d] = j.body;
             dof_armature[d] = j.armature;
             dof_damping[d] = j.damping;
+            dof_effort_limit[d] = j.effort_limit.unwrap_or(f64::INFINITY);
         }
     }
 
@@ -253,6 +256,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         dof_body,
         dof_armature,
         dof_damping,
+        dof_effort_limit,
         springs,
         qpos0,
         options: spec.options.clone(),

@@ -36,6 +36,9 @@ pub struct LoadOptions {
     /// `<option><flag>` switches to turn off, by MJCF name (`limit`, `equality`, `constraint`,
     /// `spring`, `damper`, `gravity`, …), for both formats (CLI `--disable FLAG`).
     pub disabled_flags: Vec<String>,
+    /// Clamp the joint torques applied to each URDF joint (actuator plus applied forces) to its
+    /// `<limit effort>` (CLI `--clamp-effort`). MJCF models say it with `actuatorfrcrange`.
+    pub clamp_effort: bool,
 }
 
 /// Loads a model file, choosing the loader by extension (`.urdf`, or `.xml` for MJCF).

@@ -75,6 +75,7 @@ pub fn parse(text: &str, path: &Path, options: &LoadOptions) -> Result<ModelSpec
     index.check_matches(&robot, &ctx, &doc)?;
     let tree = Tree::build(&index, &ctx)?;
     let mut spec = build_spec(&robot, &index, &tree, path, options)?;
+    spec.elements.extend(transmissions(&doc, &ctx));
     warnings.append(&mut spec.warnings);
     spec.warnings = warnings;
     Ok(spec)
@@ -428,6 +429,45 @@ impl Tree {
     }
 }
 
+/// The `<transmission>` elements, kept for `lagrange info` (ros_control hardware descriptions: the
+/// engine applies joint torques directly, so they are listed, not simulated): kind from `<type>`
+/// (or the old `type` attribute), targets the joints then the actuators, attributes the
+/// mechanical reductions and hardware interfaces.
+fn transmissions(doc: &Document, ctx: &Ctx) -> Vec<crate::model::Element> {
+    let text = |n: Node| n.text().unwrap_or("").trim().to_string();
+    let root = doc.root_element();
+    elements(root)
+        .filter(|n| is(n, "transmission"))
+        .map(|t| {
+            let kind = elements(t)
+                .find(|c| is(c, "type"))
+                .map(text)
+                .or_else(|| t.attribute("type").map(str::to_string))
+                .unwrap_or_default();
+            let mut targets = Vec::new();
+            let mut attributes = Vec::new();
+            for role in ["joint", "actuator"] {
+                for c in elements(t).filter(|c| is(c, role)) {
+                    let name = c.attribute("name").unwrap_or("").to_string();
+                    for detail in elements(c) {
+                        attributes
+                            .push((format!("{role} {name}: {}", detail.tag_name().name()), text(detail)));
+                    }
+                    targets.push(name);
+                }
+            }
+            crate::model::Element {
+                category: "transmission".into(),
+                kind,
+                name: t.attribute("name").unwrap_or("").to_string(),
+                targets,
+                attributes,
+                loc: ctx.loc(t),
+            }
+        })
+        .collect()
+}
+
 /// Turns the urdf-rs data into the spec, in tree order.
 fn build_spec(
     robot: &urdf_rs::Robot,
@@ -450,7 +490,7 @@ fn build_spec(
         let (parent, joint) = match tree.parent_joint[li] {
             Some(ji) => {
                 let parent = spec_index[tree.joint_parent[ji]];
-                (Some(parent), joint_spec(&robot.joints[ji], &index.joints[ji], index)?)
+                (Some(parent), joint_spec(&robot.joints[ji], &index.joints[ji], index, options)?)
             }
             None => (None, root_joint(link_index, index, options)?),
         };
@@ -518,7 +558,12 @@ fn finite_pose(p: &urdf_rs::Pose) -> bool {
     p.xyz.iter().chain(p.rpy.iter()).all(|x| x.is_finite())
 }
 
-fn joint_spec(j: &urdf_rs::Joint, ji: &JointIndex, index: &Index) -> Result<JointSpec, LoadError> {
+fn joint_spec(
+    j: &urdf_rs::Joint,
+    ji: &JointIndex,
+    index: &Index,
+    options: &LoadOptions,
+) -> Result<JointSpec, LoadError> {
     let invalid = |loc: &SourceLoc, element: &str, detail: String| LoadError::Invalid {
         loc: loc.clone(),
         element: element.into(),
@@ -553,6 +598,10 @@ fn joint_spec(j: &urdf_rs::Joint, ji: &JointIndex, index: &Index) -> Result<Join
         if !unlimited {
             spec.limits = Some([lower, upper]);
         }
+    }
+    // `--clamp-effort`: a positive, finite effort bounds the joint's torque (0 or none: unbounded).
+    if options.clamp_effort && ji.has_limit && j.limit.effort.is_finite() && j.limit.effort > 0.0 {
+        spec.effort_limit = Some(j.limit.effort);
     }
     if let Some(d) = &j.dynamics {
         for (what, v) in [("damping", d.damping), ("friction", d.friction)] {

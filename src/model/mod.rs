@@ -62,6 +62,8 @@ pub struct Joint {
     pub limits: Option<[f64; 2]>,
     /// The range `qfrc_actuator` is clamped to on this joint's dofs (MJCF `actuatorfrcrange`).
     pub actuator_force_range: Option<[f64; 2]>,
+    /// URDF `<limit effort>` loaded with `--clamp-effort` (see [`Model::dof_effort_limit`]).
+    pub effort_limit: Option<f64>,
     /// Viscous damping coefficient (N·m·s/rad or N·s/m) applied by `simulate` as `−damping·v`.
     pub damping: f64,
     /// Coulomb friction (stored; enforced by the constraints work, not yet).
@@ -176,6 +178,9 @@ pub struct Model {
     pub dof_armature: Vec<f64>,
     /// Damping per degree of freedom.
     pub dof_damping: Vec<f64>,
+    /// The bound on |actuator + applied| generalized force per degree of freedom: a URDF
+    /// `<limit effort>` loaded with `--clamp-effort`, else +∞.
+    pub dof_effort_limit: Vec<f64>,
     /// Joint springs of hinge and slide joints (`−stiffness·(q − rest)`), empty when the file
     /// disables springs (`<flag spring="disable">`).
     pub springs: Vec<Spring>,

@@ -129,6 +129,9 @@ pub struct JointSpec {
     /// MJCF `actuatorfrcrange` (with `actuatorfrclimited`): the range `qfrc_actuator` is clamped
     /// to on this joint's dofs.
     pub actuator_force_range: Option<[f64; 2]>,
+    /// URDF `<limit effort>` when the loader was asked to clamp to it (`--clamp-effort`): the
+    /// largest |actuator + applied| generalized force on the joint's dofs.
+    pub effort_limit: Option<f64>,
     pub damping: f64,
     pub friction: f64,
     pub armature: f64,
@@ -163,6 +166,7 @@ impl JointSpec {
             axis: Vec3::x(),
             limits: None,
             actuator_force_range: None,
+            effort_limit: None,
             damping: 0.0,
             friction: 0.0,
             armature: 0.0,

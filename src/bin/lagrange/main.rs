@@ -40,6 +40,10 @@ struct Cli {
     /// spring, damper, gravity, …), for URDF and MJCF alike; repeatable.
     #[arg(long = "disable", global = true, value_name = "FLAG")]
     disabled_flags: Vec<String>,
+    /// Clamp the torque applied to each URDF joint (actuator plus applied forces, e.g. a
+    /// controller's) to its `<limit effort>`; MJCF models use `actuatorfrcrange` instead.
+    #[arg(long, global = true)]
+    clamp_effort: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -178,6 +182,7 @@ fn main() -> ExitCode {
         floating: cli.floating,
         accept_nonphysical_inertia: cli.accept_nonphysical_inertia,
         disabled_flags: cli.disabled_flags,
+        clamp_effort: cli.clamp_effort,
     };
     let mode = cli.constraints.map(ConstraintMode::from);
     let result = match cli.command {

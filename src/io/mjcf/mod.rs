@@ -100,6 +100,12 @@ fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<Mo
             path.display()
         ));
     }
+    if load.clamp_effort {
+        warnings.push(format!(
+            "{}: --clamp-effort applies to URDF <limit effort> only: MJCF joints bound actuator forces with actuatorfrcrange (ignored)",
+            path.display()
+        ));
+    }
     if !load.package_dirs.is_empty() {
         warnings.push(format!(
             "{}: --package-dir applies to URDF package:// paths only: MJCF paths are relative to the model file or <compiler meshdir/assetdir> (ignored)",

@@ -23,6 +23,8 @@ struct Listed {
 
 /// Status of elements the engine keeps without simulating them.
 const NOT_SIMULATED: &str = "parsed, not simulated";
+/// Status of URDF `<transmission>`s: ros_control hardware descriptions; torques act on the joints.
+const TRANSMISSION: &str = "listed: joint torques act directly (--clamp-effort bounds them)";
 
 /// Every equality constraint, tendon, actuator, contact pair and exclusion, then the untyped
 /// elements (sensors, ...), with what the engine does with each.
@@ -127,7 +129,7 @@ fn listing(model: &Model) -> Vec<Listed> {
             name: e.name.clone(),
             targets: e.targets.clone(),
             source: e.loc.to_string(),
-            status: NOT_SIMULATED,
+            status: if e.category == "transmission" { TRANSMISSION } else { NOT_SIMULATED },
         });
     }
     out
@@ -273,9 +275,10 @@ pub fn to_text(model: &Model, mode: Option<ConstraintMode>) -> String {
         let mimic = mimic_of(model, i)
             .map(|(leader, multiplier, offset, _)| format!("  mimic {leader} (× {multiplier} + {offset})"))
             .unwrap_or_default();
+        let effort = j.effort_limit.map(|e| format!("  |torque| ≤ {e} (--clamp-effort)")).unwrap_or_default();
         let _ = writeln!(
             s,
-            "  {:<26} {:<10} {:<22} {:<22} {:>7} {:>6} {:>3} {:>3}  {limits}{mimic}",
+            "  {:<26} {:<10} {:<22} {:<22} {:>7} {:>6} {:>3} {:>3}  {limits}{mimic}{effort}",
             j.name,
             j.kind.type_name(),
             model.bodies[j.parent].name,
