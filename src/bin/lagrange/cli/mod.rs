@@ -5,6 +5,8 @@ pub mod bench;
 pub mod eval;
 pub mod info;
 pub mod simulate;
+pub mod workprec;
+pub mod workprec_plot;
 
 use thiserror::Error;
 
