@@ -816,8 +816,8 @@ fn definitions(samples: Option<(usize, f64)>, repeats: Option<u32>, rows: &[Row]
         out,
         "energy: max over the sample times of |E − E_ref| / max(|E_ref(0)|, max T_ref) (conservative model: relative drift |E − E0|)"
     );
-    let repeats = repeats.map_or_else(|| "--repeats".to_string(), |n| n.to_string());
-    let _ = writeln!(out, "cpu_s: thread CPU time of the stepping loop, min of {repeats} repeats");
+    let repeats = repeats.map_or_else(|| "the repeated runs".to_string(), |n| format!("{n} repeats"));
+    let _ = writeln!(out, "cpu_s: thread CPU time of the stepping loop, min of {repeats}");
     if rows.iter().any(|r| r.integrator == "adaptive") {
         let _ = writeln!(
             out,
