@@ -115,8 +115,13 @@ impl DormandPrince54 {
                 Some(i) => state.q[i].abs().max((state.q[i] + self.theta[k]).abs()),
                 None => 1.0,
             };
-            err = err.max(e_theta.abs() / (self.atol + self.rtol * s_q));
-            err = err.max(e_v.abs() / (self.atol + self.rtol * s_v));
+            let e = (e_theta.abs() / (self.atol + self.rtol * s_q))
+                .max(e_v.abs() / (self.atol + self.rtol * s_v));
+            if e.is_nan() || !e_theta.is_finite() || !e_v.is_finite() {
+                // A non-finite stage (f64::max would drop a NaN): reject the attempt.
+                return f64::INFINITY;
+            }
+            err = err.max(e);
         }
         err
     }
@@ -133,7 +138,7 @@ impl Stepper for DormandPrince54 {
         let t_end = state.time + h;
         let mut h_try = self.h_proposed.unwrap_or(h).min(h);
         let mut max_err: f64 = 0.0;
-        let mut rejected = 0u32;
+        let (mut accepted, mut rejected) = (0u32, 0u32);
         loop {
             let remaining = t_end - state.time;
             if remaining <= 1e-14 * t_end.abs().max(h) {
@@ -148,6 +153,7 @@ impl Stepper for DormandPrince54 {
                 integrate_configuration(model, state.q.as_mut_slice(), self.theta.as_slice(), 1.0);
                 state.time = if last { t_end } else { state.time + h_step };
                 max_err = max_err.max(err);
+                accepted += 1;
                 if !last || self.h_proposed.is_none() {
                     h_try = h_step * factor;
                 }
@@ -163,6 +169,8 @@ impl Stepper for DormandPrince54 {
                         h_used: state.time - (t_end - h),
                         h_next: h_try,
                         error_estimate: Some(err),
+                        substeps: accepted,
+                        rejected,
                         ..StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
                     };
                 }
@@ -172,6 +180,8 @@ impl Stepper for DormandPrince54 {
         StepReport {
             h_next: h_try,
             error_estimate: Some(max_err),
+            substeps: accepted,
+            rejected,
             ..StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
         }
     }

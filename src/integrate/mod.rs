@@ -54,6 +54,12 @@ pub struct StepReport {
     pub solver_iterations: u32,
     /// max |φ| and max |J v| after the step (0 without constraint rows).
     pub constraint_violation: [f64; 2],
+    /// Internal steps accepted within the interval (1 for fixed-step methods; an adaptive
+    /// method may take several, or none if it gave up).
+    pub substeps: u32,
+    /// Internal steps rejected by the error control within the interval (0 for fixed-step
+    /// methods).
+    pub rejected: u32,
 }
 
 impl StepReport {
@@ -67,6 +73,8 @@ impl StepReport {
             error_estimate: None,
             solver_iterations: iterations,
             constraint_violation: violation,
+            substeps: 1,
+            rejected: 0,
         }
     }
 }

@@ -60,6 +60,11 @@ pub const FD_REL: f64 = 1e-9;
 /// 1.25 keeps neighbouring orders well apart (2ᵖ·1.25 < 2ᵖ⁺¹/1.25).
 pub const INTEGRATOR_ORDER_BAND: f64 = 1.25;
 
+/// `lagrange workprec` on the double pendulum (`tests/workprec.rs`): the least-squares slope of
+/// log(error) against log(dt) must lie within this distance of the method's order (measured:
+/// RK4 4.04, Euler 1.01 over dt = 8, 4, 2, 1 ms).
+pub const WORKPREC_SLOPE_TOL: f64 = 0.25;
+
 /// Global error of the adaptive Dormand–Prince 5(4) stepper over 0.5 s of the quaternion cases
 /// of `tests/integrator_order.rs`, in units of the requested rtol (local error control does not
 /// bound the global error; it accumulates over the steps and through the dynamics' sensitivity).

@@ -1,9 +1,9 @@
-//! The `lagrange` command line: `info`, `eval`, `simulate`, `bench`; with no arguments it simulates the
+//! The `lagrange` command line: `info`, `eval`, `simulate`, `bench`, `workprec`; with no arguments it simulates the
 //! embedded default model (a UR5 arm released under gravity) and prints the summary.
 
 use clap::{Parser, Subcommand, ValueEnum};
 mod cli;
-use cli::{bench, bench_native, eval, info, simulate};
+use cli::{bench, bench_native, eval, info, simulate, workprec};
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::DriftCorrection;
 use lagrange::integrate::IntegratorKind;
@@ -149,6 +149,56 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Work-precision: each integrator's error against a reference solution (adaptive, rtol
+    /// 1e-13) and its CPU time, over step sizes and tolerances; table, JSON, log-log plot.
+    Workprec {
+        /// The model (not needed with --from-json).
+        #[arg(required_unless_present = "from_json")]
+        model: Option<PathBuf>,
+        /// Integrators, comma-separated: euler, rk4, implicitfast, adaptive (default: all).
+        #[arg(long, allow_hyphen_values = true)]
+        integrators: Option<String>,
+        /// Step sizes of the fixed-step integrators, comma-separated; each must divide the
+        /// largest (default: the model's timestep × 4, 2, 1, 1/2, 1/4, 1/8).
+        #[arg(long, allow_hyphen_values = true)]
+        dts: Option<String>,
+        /// Relative tolerances of the adaptive integrator, comma-separated (atol = rtol/100;
+        /// default 1e-4,1e-6,1e-8,1e-10).
+        #[arg(long, allow_hyphen_values = true)]
+        rtols: Option<String>,
+        /// Simulated time in seconds, a whole number of the largest step (default: 2 s).
+        #[arg(long, allow_hyphen_values = true)]
+        duration: Option<f64>,
+        /// Timed repeats of each run; the CPU time is their minimum.
+        #[arg(long, default_value_t = 3)]
+        repeats: u32,
+        /// Print the JSON object {model, duration, reference, rows} instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Write a log-log plot of error against CPU time (.svg or .png).
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
+        /// Start from this keyframe (default: the model's first keyframe, else qpos0 at rest).
+        #[arg(long)]
+        keyframe: Option<String>,
+        /// Initial configuration, comma-separated (overrides the keyframe's).
+        #[arg(long, allow_hyphen_values = true)]
+        q0: Option<String>,
+        /// Initial velocity, comma-separated (overrides the keyframe's).
+        #[arg(long, allow_hyphen_values = true)]
+        v0: Option<String>,
+        /// Write the reference trajectory at the sample times and the run's settings to this
+        /// JSON file (input of validation/workprec_mujoco.py).
+        #[arg(long, value_name = "FILE")]
+        dump_reference: Option<PathBuf>,
+        /// Add the rows of another `workprec --json` file (e.g. MuJoCo's) to the table, JSON and
+        /// plot; repeatable.
+        #[arg(long = "extra-rows", value_name = "FILE")]
+        extra_rows: Vec<PathBuf>,
+        /// Take the rows from a saved `workprec --json` output instead of measuring a model.
+        #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "integrators", "dts", "rtols", "duration", "keyframe", "q0", "v0", "dump_reference"])]
+        from_json: Option<PathBuf>,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -191,6 +241,41 @@ fn main() -> ExitCode {
         Some(Command::Bench { model, json }) => bench::run(&model, &options, json),
         Some(Command::BenchNative { model, states, robot }) => {
             bench_native::run(&model, &options, &states, &robot)
+        }
+        Some(Command::Workprec {
+            model,
+            integrators,
+            dts,
+            rtols,
+            duration,
+            repeats,
+            json,
+            plot,
+            keyframe,
+            q0,
+            v0,
+            dump_reference,
+            extra_rows,
+            from_json,
+        }) => {
+            let request = workprec::Request {
+                model,
+                from_json,
+                integrators,
+                dts,
+                rtols,
+                duration,
+                repeats,
+                json,
+                plot,
+                keyframe,
+                q0,
+                v0,
+                dump_reference,
+                extra_rows,
+                constraints: mode,
+            };
+            workprec::run(&options, &request)
         }
         Some(Command::Eval { model, states, json: _, jacobians }) => {
             eval::run(&model, &options, &states, &jacobians, mode)

@@ -6,6 +6,8 @@ pub mod bench_native;
 pub mod eval;
 pub mod info;
 pub mod simulate;
+pub mod workprec;
+pub mod workprec_plot;
 
 use thiserror::Error;
 
