@@ -57,6 +57,13 @@ fn actuator_forces_follow_mujocos_formulas() {
     for (a, b) in qfrc.iter().zip(want_qfrc) {
         assert!((a - b).abs() <= ALGO_REL * (1.0 + b.abs()));
     }
+    // actuator_moment (MuJoCo's): the gear on the joint's dof, gear · coef on the tendon's dofs;
+    // zero for the actuator not simulated; and qfrc_actuator = momentᵀ · actuator_force.
+    let moment = &data.actuator_moment;
+    assert_eq!((moment[(1, 1)], moment[(4, 0)], moment[(4, 1)]), (2.5, 1.5 * 2.0, 1.5 * -0.5));
+    assert!(moment.row(5).iter().all(|&x| x == 0.0));
+    let from_moment = moment.transpose() * &data.actuator_force;
+    assert!((from_moment - &data.qfrc_actuator).amax() <= ALGO_REL * data.qfrc_actuator.amax());
     // The accelerations include them (no gravity, no other force; diagonal M).
     assert!(data.qacc.iter().zip(qfrc).all(|(a, f)| a.signum() == f.signum() || f.abs() < 1e-12));
 }

@@ -34,6 +34,8 @@ fn controller_sets_the_controls_once_per_step() {
     // actuator_force, before the gear), the joint torque gear · 1 = 2 N·m.
     assert_eq!(sim.data.actuator_force[0], 1.0);
     assert_eq!(sim.data.qfrc_actuator[0], 2.0);
+    // The moment arm (MuJoCo's actuator_moment) is the gear: qfrc_actuator = momentᵀ force.
+    assert_eq!(sim.data.actuator_moment[(0, 0)], 2.0);
     let after_5 = sim.state.v[0];
     for _ in 0..5 {
         sim.step().unwrap();

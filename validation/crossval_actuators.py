@@ -114,7 +114,7 @@ def main() -> int:
             continue
         d = mj.MjData(m)
         m.opt.disableflags |= int(mj.mjtDisableBit.mjDSBL_CONTACT)
-        worst_f = worst_q = 0.0
+        worst_f = worst_q = worst_m = 0.0
         for (q, v, c), r in zip(sts, results):
             d.qpos[:], d.qvel[:], d.ctrl[:] = q, v, c
             mj.mj_forward(m, d)
@@ -122,11 +122,16 @@ def main() -> int:
             ref = d.actuator_force[mask]
             if mask.any():
                 worst_f = max(worst_f, np.abs(ours - ref).max() / max(1.0, np.abs(ref).max()))
+                # actuator_moment (MuJoCo 4.0 stores it sparse): the simulated actuators' rows.
+                dense = np.zeros((m.nu, m.nv))
+                mj.mju_sparse2dense(dense, d.actuator_moment, d.moment_rownnz, d.moment_rowadr, d.moment_colind)
+                mom = np.asarray(r["forward"]["actuator_moment"]).reshape(m.nu, m.nv)[mask]
+                worst_m = max(worst_m, np.abs(mom - dense[mask]).max() / max(1.0, np.abs(dense[mask]).max()))
             if mask.all():
                 qa = np.asarray(r["forward"]["qfrc_actuator"])
                 worst_q = max(worst_q, np.abs(qa - d.qfrc_actuator).max() / max(1.0, np.abs(d.qfrc_actuator).max()))
         missing = sorted({r for r in reasons if r})
-        ok = worst_f <= TOL and worst_q <= TOL
+        ok = worst_f <= TOL and worst_q <= TOL and worst_m <= TOL
         status = "PASS" if ok else "FAIL"
         if not mask.any():
             status, ok = "SKIP", True
@@ -136,8 +141,8 @@ def main() -> int:
             compared_actuators += int(mask.sum())
         else:
             failed += 1
-        print("%s %-60s nu %3d, compared %3d: actuator_force %.1e, qfrc_actuator %s%s"
-              % (status, e.name, m.nu, int(mask.sum()), worst_f, "%.1e" % worst_q if mask.all() else "— (not all simulated)",
+        print("%s %-60s nu %3d, compared %3d: actuator_force %.1e, actuator_moment %.1e, qfrc_actuator %s%s"
+              % (status, e.name, m.nu, int(mask.sum()), worst_f, worst_m, "%.1e" % worst_q if mask.all() else "— (not all simulated)",
                  ("; not simulated: " + ", ".join(missing)) if missing else ""))
     print("actuators: %d models, %d actuators compared" % (passed + failed, compared_actuators))
     print("actuators: %d passed, %d failed, %d skipped" % (passed, failed, skipped))

@@ -1,5 +1,6 @@
 //! The actuation stage (MuJoCo's `mj_fwdActuation`, MuJoCo documentation "Computation →
-//! Actuation model"): for each simulated actuator, its length and velocity through the
+//! Actuation model"): for each simulated actuator, its moment arms (`actuator_moment`), length and
+//! velocity through the
 //! transmission (`actuator_length` = gear · x, `actuator_velocity` = gear · ẋ with x a hinge or
 //! slide coordinate, or a fixed tendon's length Σ coef · q), the control clamped to `ctrlrange`
 //! (unless `<flag clampctrl="disable">`), the force
@@ -99,6 +100,7 @@ pub fn actuation(model: &Model, data: &mut Data, q: &[f64], v: &[f64], bias_velo
     data.qfrc_actuator.fill(0.0);
     let clamp = model.options.flags.clampctrl;
     for (i, a) in model.actuators.iter().enumerate() {
+        data.actuator_moment.row_mut(i).fill(0.0);
         if unsimulated_reason(model, a).is_some() {
             data.actuator_length[i] = 0.0;
             data.actuator_velocity[i] = 0.0;
@@ -108,9 +110,11 @@ pub fn actuation(model: &Model, data: &mut Data, q: &[f64], v: &[f64], bias_velo
         // Length and velocity: gear · (joint coordinate or tendon length), through the moment
         // (a joint's coordinate is its q; a fixed tendon is linear in q).
         let (mut length, mut velocity) = (0.0, 0.0);
+        let Data { actuator_moment, .. } = data;
         for_each_moment(model, a, |dof, qpos, m| {
             length += m * q[qpos];
             velocity += m * v[dof];
+            actuator_moment[(i, dof)] += m;
         });
         let mut ctrl = data.ctrl[i];
         if let (true, Some([lo, hi])) = (clamp, a.ctrlrange) {

@@ -119,6 +119,10 @@ pub struct Data {
     pub actuator_length: DVector<f64>,
     pub actuator_velocity: DVector<f64>,
     pub actuator_force: DVector<f64>,
+    /// Per actuator (rows) and dof (columns): the moment arm ∂actuator_length/∂q̇ (MuJoCo's
+    /// `actuator_moment`, stored dense here), so that qfrc_actuator = momentᵀ · actuator_force
+    /// before the joints' `actuatorfrcrange`. Zero rows for actuators not simulated.
+    pub actuator_moment: DMatrix<f64>,
     /// qfrc_passive + qfrc_actuator + qfrc_applied − qfrc_bias (filled on the M path).
     pub qfrc_smooth: DVector<f64>,
     /// Unconstrained acceleration M⁻¹(qfrc_passive + qfrc_actuator + qfrc_applied − qfrc_bias).
@@ -264,6 +268,7 @@ impl Data {
             qfrc_actuator: DVector::zeros(nv),
             actuator_length: DVector::zeros(model.actuators.len()),
             actuator_velocity: DVector::zeros(model.actuators.len()),
+            actuator_moment: DMatrix::zeros(model.actuators.len(), model.nv),
             actuator_force: DVector::zeros(model.actuators.len()),
             qfrc_smooth: DVector::zeros(nv),
             qacc_smooth: DVector::zeros(nv),

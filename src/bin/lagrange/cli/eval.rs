@@ -125,6 +125,9 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
         "qfrc_actuator": vec(&data.qfrc_actuator), "qfrc_constraint": vec(&data.qfrc_constraint),
         "actuator_force": vec(&data.actuator_force), "actuator_length": vec(&data.actuator_length),
         "actuator_velocity": vec(&data.actuator_velocity),
+        "actuator_moment": (0..data.actuator_moment.nrows())
+            .map(|i| data.actuator_moment.row(i).iter().copied().collect::<Vec<f64>>())
+            .collect::<Vec<_>>(),
         "constraints": constraints,
     })
 }
