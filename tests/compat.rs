@@ -464,3 +464,32 @@ fn absurd_options_are_refused() {
         &["gravity.xml", "<option>", "gravity", "-1e308", "absurdly large"],
     );
 }
+
+#[test]
+fn negative_and_negative_zero_sizes() {
+    // Found by fuzzing: a URDF <cylinder radius="-0"> reached parry's cylinder, which asserts a
+    // positive sign (a panic). −0 is zero (and loads); a negative size is refused (as before).
+    let dir = temp_dir("sizes");
+    let robot = |radius: &str| {
+        format!(
+            r#"<robot name="s"><link name="a"/>
+<link name="b"><inertial><origin xyz="0 0 .1"/><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
+<collision><geometry><cylinder radius="{radius}" length="0.4"/></geometry></collision></link>
+<joint name="j" type="continuous"><parent link="a"/><child link="b"/></joint></robot>"#
+        )
+    };
+    let path = dir.join("zero.urdf");
+    std::fs::write(&path, robot("-0")).unwrap();
+    let m = load(&path, &LoadOptions::default()).unwrap();
+    let plan = lagrange::forward::Plan::new(&m, None);
+    let mut data = lagrange::Data::new(&m);
+    lagrange::forward::forward(&m, &plan, &mut data, &[0.3], &[0.0]);
+    assert!(data.qacc[0].is_finite());
+    let path = dir.join("negative.urdf");
+    std::fs::write(&path, robot("-0.1")).unwrap();
+    refused(
+        &path,
+        &LoadOptions::default(),
+        &["negative.urdf:3", "link 'b'", "negative or non-finite size [-0.1, 0.4]"],
+    );
+}

@@ -46,17 +46,22 @@ impl CollisionModel {
         let mut rbound = Vec::with_capacity(model.geoms.len());
         for g in &model.geoms {
             let (shape, r) = match &g.shape {
-                Shape::Sphere { radius } => (Some(ConvexShape::Ball(Ball::new(*radius))), *radius),
-                Shape::Capsule { radius, length } => {
-                    (Some(ConvexShape::Capsule(Capsule::new_z(0.5 * length, *radius))), radius + 0.5 * length)
-                }
+                // (`+ 0.0` turns a size written as −0 into +0: parry asserts a positive sign.)
+                Shape::Sphere { radius } => (Some(ConvexShape::Ball(Ball::new(radius + 0.0))), *radius),
+                Shape::Capsule { radius, length } => (
+                    Some(ConvexShape::Capsule(Capsule::new_z(0.5 * length + 0.0, radius + 0.0))),
+                    radius + 0.5 * length,
+                ),
                 Shape::Cylinder { radius, length } => (
-                    Some(ConvexShape::Cylinder(Cylinder::new(0.5 * length, *radius))),
+                    Some(ConvexShape::Cylinder(Cylinder::new(0.5 * length + 0.0, radius + 0.0))),
                     radius.hypot(0.5 * length),
                 ),
                 Shape::Box { size } => {
                     let h = size / 2.0;
-                    (Some(ConvexShape::Cuboid(Cuboid::new(Vector::new(h.x, h.y, h.z)))), h.norm())
+                    (
+                        Some(ConvexShape::Cuboid(Cuboid::new(Vector::new(h.x + 0.0, h.y + 0.0, h.z + 0.0)))),
+                        h.norm(),
+                    )
                 }
                 Shape::Ellipsoid { radii } => (
                     Some(ConvexShape::Ellipsoid(Ellipsoid { radii: Vector::new(radii.x, radii.y, radii.z) })),

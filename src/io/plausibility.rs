@@ -235,6 +235,19 @@ fn check_link(link: &LinkSpec, word: LinkWord) -> Result<(), LoadError> {
         let name = if g.name.is_empty() { owner.clone() } else { format!("{owner}, geom '{}'", g.name) };
         check_pose(&g.loc, element, &name, &g.x_link_geom)?;
         let size = || format!("{name}: a size");
+        let sizes: &[f64] = match &g.shape {
+            Shape::Box { size: s } | Shape::Ellipsoid { radii: s } => s.as_slice(),
+            Shape::Cylinder { radius, length } | Shape::Capsule { radius, length } => &[*radius, *length],
+            Shape::Sphere { radius } => std::slice::from_ref(radius),
+            _ => &[],
+        };
+        if let Some(x) = sizes.iter().find(|&&x| x < 0.0) {
+            return Err(invalid(
+                &g.loc,
+                element,
+                format!("{}: a size {x} is negative; sizes are lengths ≥ 0", size()),
+            ));
+        }
         match &g.shape {
             Shape::Box { size: s } | Shape::Ellipsoid { radii: s } | Shape::Plane { size: s } => {
                 check(&g.loc, element, size, s.as_slice())?
