@@ -362,3 +362,31 @@ fn info_lists_urdf_transmissions_and_effort_limits() {
         "{out}"
     );
 }
+
+#[test]
+fn simulate_warns_when_a_passive_scene_gains_or_loses_energy() {
+    // Semi-implicit Euler at 50 ms on a pendulum released at 1.5 rad: energy drifts by 7 %.
+    let args = [
+        "simulate",
+        "models/textbook/simple_pendulum.urdf",
+        "--dt",
+        "0.05",
+        "--duration",
+        "10",
+        "--q0",
+        "1.5",
+    ];
+    let (ok, out, err) = lagrange(&args);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("warning: the energy of this passive scene")
+            && out.contains("reduce --dt (now 0.05 s) or use --integrator rk4"),
+        "{out}"
+    );
+    // RK4 at 1 ms: no warning; nor for a scene whose limits end impacts inelastically.
+    let (_, out, _) =
+        lagrange(&["simulate", "models/textbook/simple_pendulum.urdf", "--integrator", "rk4", "--q0", "1.5"]);
+    assert!(!out.contains("warning"), "{out}");
+    let (_, out, _) = lagrange(&["simulate", "models/ur5/ur5.urdf", "--duration", "2"]);
+    assert!(!out.contains("energy of this passive scene"), "{out}");
+}

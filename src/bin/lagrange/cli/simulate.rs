@@ -46,8 +46,8 @@ pub struct Request {
 /// What a run measured.
 pub struct Summary {
     pub integrator: &'static str,
-    /// Nothing adds or removes energy (no damping, friction loss, actuators or contacts): the
-    /// energy drift measures the integration error alone.
+    /// Nothing adds or removes energy (no damping, friction loss, actuators, joint limits or
+    /// contacts): the energy drift measures the integration error alone.
     pub passive: bool,
     /// Contacts dropped because a collision pass found more than the model's contact budget.
     pub contacts_dropped: u64,
@@ -257,9 +257,12 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     if let Some((mut w, file)) = csv {
         w.flush().map_err(|source| CliError::Io { file, source })?;
     }
+    // Joint limits and contacts end impacts inelastically: their energy loss is physics.
+    let limited = model.options.flags.limit && model.joints.iter().any(|j| j.limits.is_some());
     let passive = !model.has_damping()
         && model.actuators.is_empty()
         && model.joints.iter().all(|j| j.friction == 0.0)
+        && !limited
         && max_contacts == 0;
     Ok(Summary {
         passive,
@@ -419,7 +422,7 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
         };
         let _ = writeln!(
             out,
-            "warning: the energy of this passive scene (no damping, friction, actuators or contacts) drifted by {drift:.3e} of its scale: the integration is inaccurate at this step; reduce --dt (now {} s){better}",
+            "warning: the energy of this passive scene (no damping, friction, actuators, limits or contacts) drifted by {drift:.3e} of its scale: the integration is inaccurate at this step; reduce --dt (now {} s){better}",
             s.dt
         );
     }
