@@ -14,6 +14,23 @@ pub struct Keyframe {
     pub ctrl: Option<Vec<f64>>,
 }
 
+impl Keyframe {
+    /// Writes the parts of the state this keyframe gives into `q`, `v` and `ctrl` (its `ctrl` only
+    /// when it has one value per actuator, as MuJoCo's `mj_resetDataKeyframe`); the rest is left
+    /// as it is.
+    pub fn apply(&self, q: &mut Vec<f64>, v: &mut Vec<f64>, ctrl: &mut Vec<f64>) {
+        if let Some(x) = &self.qpos {
+            q.clone_from(x);
+        }
+        if let Some(x) = &self.qvel {
+            v.clone_from(x);
+        }
+        if let Some(x) = self.ctrl.as_ref().filter(|c| c.len() == ctrl.len()) {
+            ctrl.clone_from(x);
+        }
+    }
+}
+
 /// An element parsed and kept, not simulated yet: an actuator, sensor, equality constraint,
 /// tendon, contact pair or exclusion.
 #[derive(Clone, Debug, PartialEq)]

@@ -167,15 +167,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
                 if known.is_empty() { "none".to_string() } else { known.join(", ") }
             )));
         };
-        if let Some(q) = &k.qpos {
-            q0.clone_from(q);
-        }
-        if let Some(v) = &k.qvel {
-            v0.clone_from(v);
-        }
-        if let Some(c) = k.ctrl.as_ref().filter(|c| c.len() == ctrl.len()) {
-            ctrl.clone_from(c);
-        }
+        k.apply(&mut q0, &mut v0, &mut ctrl);
     }
     if let Some(s) = &request.ctrl {
         ctrl = parse_list("ctrl", s, model.actuators.len())?;

@@ -264,15 +264,7 @@ fn initial_state(model: &Model, request: &Request) -> Result<Start, CliError> {
         None => None,
     };
     if let Some(k) = key.map(|k| &model.keyframes[k]) {
-        if let Some(q) = &k.qpos {
-            q0.clone_from(q);
-        }
-        if let Some(v) = &k.qvel {
-            v0.clone_from(v);
-        }
-        if let Some(c) = k.ctrl.as_ref().filter(|c| c.len() == ctrl.len()) {
-            ctrl.clone_from(c);
-        }
+        k.apply(&mut q0, &mut v0, &mut ctrl);
     }
     if let Some(s) = &request.q0 {
         q0 = parse_state("q0", s, model.nq)?;
