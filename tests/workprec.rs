@@ -6,25 +6,11 @@
 
 mod common;
 
-use common::{INTEGRATOR_ORDER_BAND, WORKPREC_SLOPE_TOL};
+use common::{lagrange, INTEGRATOR_ORDER_BAND, WORKPREC_SLOPE_TOL};
 use serde_json::Value;
 use std::path::PathBuf;
-use std::process::Command;
 
 const MODEL: &str = "models/textbook/double_pendulum.xml";
-
-fn lagrange(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_lagrange"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the binary runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
 
 fn temp_path(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("lagrange-workprec-{}-{name}", std::process::id()))
