@@ -493,3 +493,28 @@ fn negative_and_negative_zero_sizes() {
         &["negative.urdf:3", "link 'b'", "negative or non-finite size [-0.1, 0.4]"],
     );
 }
+
+#[test]
+fn huge_quaternion_components_and_contact_parameters() {
+    // Found by fuzzing: quat="3 1 -2 1e200" and a weld relpose quaternion with -1e308 overflowed
+    // their norm (NaN qpos0, NaN weld rows); friction="1e200" loaded. Quaternions are now scaled
+    // before normalizing (MuJoCo normalizes them too); absurd contact parameters are refused.
+    let dir = temp_dir("quaternions");
+    let path = dir.join("quat.xml");
+    std::fs::write(
+        &path,
+        r#"<mujoco><worldbody><body quat="3 1 -2 1e200"><freejoint/><geom size=".1"/></body></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    let m = load(&path, &LoadOptions::default()).unwrap();
+    assert!(m.qpos0.iter().all(|x| x.is_finite()), "{:?}", m.qpos0);
+    // The quaternion is (0, 0, 0, 1) to round-off: a half turn about z.
+    assert!((m.qpos0[6].abs() - 1.0).abs() < 1e-15, "{:?}", m.qpos0);
+    let path = dir.join("friction.xml");
+    std::fs::write(
+        &path,
+        r#"<mujoco><worldbody><geom type="plane" size="1 1 .1"/><body><freejoint/><geom size=".1" friction="1e200 0 0"/></body></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    refused(&path, &LoadOptions::default(), &["friction.xml:1", "contact parameter", "1e200"]);
+}

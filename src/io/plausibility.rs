@@ -261,6 +261,16 @@ fn check_link(link: &LinkSpec, word: LinkWord) -> Result<(), LoadError> {
             }
             Shape::Hfield { .. } => {}
         }
+        let c = &g.contact;
+        let contact =
+            [c.friction.as_slice(), c.solref.as_slice(), c.solimp.as_slice(), &[c.solmix, c.margin, c.gap]]
+                .concat();
+        check(
+            &g.loc,
+            element,
+            || format!("{name}: a contact parameter (friction, solref, solimp, solmix, margin, gap)"),
+            &contact,
+        )?;
         match g.mass {
             GeomMass::Mass(m) => check(&g.loc, element, || format!("{name}: the mass"), &[m])?,
             GeomMass::Density(d) => check(&g.loc, element, || format!("{name}: the density"), &[d])?,

@@ -159,15 +159,8 @@ fn weld(a: &Attrs) -> Result<EqualitySpecKind, LoadError> {
     // An all-zero quaternion (MuJoCo's default) means: the relative pose at qpos0; the
     // position part is then ignored, as in MuJoCo.
     let relpose = match a.array::<7>("relpose")? {
-        Some(r) => {
-            let n = (r[3] * r[3] + r[4] * r[4] + r[5] * r[5] + r[6] * r[6]).sqrt();
-            (n > 0.0).then(|| {
-                Transform::new(
-                    quat_to_matrix(r[3] / n, r[4] / n, r[5] / n, r[6] / n),
-                    Vec3::new(r[0], r[1], r[2]),
-                )
-            })
-        }
+        Some(r) => super::orientation::unit_quaternion([r[3], r[4], r[5], r[6]])
+            .map(|[w, x, y, z]| Transform::new(quat_to_matrix(w, x, y, z), Vec3::new(r[0], r[1], r[2]))),
         None => None,
     };
     Ok(EqualitySpecKind::WeldBodies {

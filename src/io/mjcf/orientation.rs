@@ -41,15 +41,15 @@ pub fn rotation(a: &Attrs, angles: &AngleConvention) -> Result<Mat3, LoadError> 
     match which {
         "quat" => {
             let q = a.array::<4>("quat")?.unwrap_or([1.0, 0.0, 0.0, 0.0]);
-            let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
-            if n < 1e-14 {
+            let Some([w, x, y, z]) = unit_quaternion(q) else {
                 return Err(a.error("quat", "is zero; give a nonzero quaternion (w x y z)"));
-            }
-            Ok(quat_to_matrix(q[0] / n, q[1] / n, q[2] / n, q[3] / n))
+            };
+            Ok(quat_to_matrix(w, x, y, z))
         }
         "axisangle" => {
             let v = a.array::<4>("axisangle")?.unwrap_or_default();
             let axis = Vec3::new(v[0], v[1], v[2]);
+            let axis = axis / axis.amax().max(f64::MIN_POSITIVE);
             if axis.norm() < 1e-14 {
                 return Err(a.error("axisangle", "has a zero axis"));
             }
@@ -63,6 +63,7 @@ pub fn rotation(a: &Attrs, angles: &AngleConvention) -> Result<Mat3, LoadError> 
             let v = a.array::<6>("xyaxes")?.unwrap_or_default();
             let x = Vec3::new(v[0], v[1], v[2]);
             let y = Vec3::new(v[3], v[4], v[5]);
+            let (x, y) = (x / x.amax().max(f64::MIN_POSITIVE), y / y.amax().max(f64::MIN_POSITIVE));
             let (nx, x) = (x.norm(), x.normalize());
             if nx < 1e-14 {
                 return Err(a.error("xyaxes", "has a zero x axis"));
@@ -77,12 +78,22 @@ pub fn rotation(a: &Attrs, angles: &AngleConvention) -> Result<Mat3, LoadError> 
         }
         _ => {
             let z = a.vec3("zaxis")?.unwrap_or_default();
+            let z = z / z.amax().max(f64::MIN_POSITIVE);
             if z.norm() < 1e-14 {
                 return Err(a.error("zaxis", "is zero"));
             }
             Ok(z_to_matrix(&z))
         }
     }
+}
+
+/// `q` normalized, or `None` when it is zero (below 1e-14 after scaling). It is scaled by its
+/// largest component first, so that huge finite components cannot overflow the norm.
+pub fn unit_quaternion(q: [f64; 4]) -> Option<[f64; 4]> {
+    let largest = q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let q = if largest > 0.0 && largest.is_finite() { q.map(|x| x / largest) } else { q };
+    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+    (n >= 1e-14).then(|| q.map(|x| x / n))
 }
 
 /// Rotation about a unit axis.
