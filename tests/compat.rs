@@ -518,3 +518,18 @@ fn huge_quaternion_components_and_contact_parameters() {
     .unwrap();
     refused(&path, &LoadOptions::default(), &["friction.xml:1", "contact parameter", "1e200"]);
 }
+
+#[test]
+fn lengths_beyond_a_thousand_kilometres_are_refused() {
+    // Found by fuzzing: a capsule fromto 4.3e9 m long and a joint anchored 4.3e9 m away (below the
+    // 1e12 bound on other quantities) loaded and gave NaN accelerations.
+    let dir = temp_dir("lengths");
+    let path = dir.join("long.xml");
+    std::fs::write(
+        &path,
+        r#"<mujoco><worldbody><body><joint/>
+<geom type="capsule" fromto="0 0 0 0.2 4294967295 0" size="0.02" mass="0.4"/></body></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    refused(&path, &LoadOptions::default(), &["long.xml:2", "<geom>", "2.1474836475e9", "beyond 1e6"]);
+}

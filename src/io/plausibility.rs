@@ -1,7 +1,8 @@
 //! Resource limits and plausibility of a parsed model, checked before anything is computed from it
 //! (issue 16, items 2 and 4): counts of links, joints and geoms bounded so that a hostile file
 //! cannot exhaust memory; lengths, sizes, mesh scales, masses, densities and inertias that are not
-//! finite or are absurd (beyond [`ABSURD`] in SI units) refused with file and line; and the derived
+//! finite or are absurd (lengths beyond [`ABSURD_LENGTH`], other quantities beyond [`ABSURD`], in
+//! SI units) refused with file and line; and the derived
 //! mass properties checked for finiteness, so that no overflow (a huge but finite input squared)
 //! loads as NaN.
 
@@ -15,6 +16,9 @@ use crate::spatial::{RigidInertia, Transform, Vec3};
 /// (kg·m²): beyond it a value is a typo or an attack, and squaring it in mass properties overflows
 /// the arithmetic of anything built on it.
 pub const ABSURD: f64 = 1e12;
+/// The largest length accepted (m): a thousand kilometres. A robot link or anchor 4e9 m long
+/// (found by fuzzing) squares into inertias and lever arms that round the dynamics to NaN.
+pub const ABSURD_LENGTH: f64 = 1e6;
 
 /// Resource limits: the most links (URDF links, MJCF bodies and joint anchors), and geoms a model
 /// may have.
@@ -46,28 +50,49 @@ fn invalid(loc: &SourceLoc, element: &str, detail: String) -> LoadError {
     LoadError::Invalid { loc: loc.clone(), element: element.into(), detail }
 }
 
-/// `Err` with the reason when `x` is not finite or beyond [`ABSURD`] in magnitude.
-fn plausible(x: f64) -> Result<(), &'static str> {
+/// `Err` with the reason when `x` is not finite or beyond `limit` in magnitude.
+fn plausible(x: f64, limit: f64) -> Result<(), String> {
     if !x.is_finite() {
-        Err("is not a finite number")
-    } else if x.abs() > ABSURD {
-        Err("is absurdly large (beyond 1e12 in SI units)")
+        Err("is not a finite number".into())
+    } else if x.abs() > limit {
+        Err(format!("is absurdly large (beyond {limit:e} in SI units)"))
     } else {
         Ok(())
     }
 }
 
-fn check(loc: &SourceLoc, element: &str, what: impl Fn() -> String, values: &[f64]) -> Result<(), LoadError> {
+fn check_within(
+    loc: &SourceLoc,
+    element: &str,
+    what: impl Fn() -> String,
+    values: &[f64],
+    limit: f64,
+) -> Result<(), LoadError> {
     for &x in values {
-        if let Err(why) = plausible(x) {
+        if let Err(why) = plausible(x, limit) {
             return Err(invalid(loc, element, format!("{} {x:e} {why}; fix the value", what())));
         }
     }
     Ok(())
 }
 
+/// Masses, densities, inertias, coefficients: finite and within [`ABSURD`].
+fn check(loc: &SourceLoc, element: &str, what: impl Fn() -> String, values: &[f64]) -> Result<(), LoadError> {
+    check_within(loc, element, what, values, ABSURD)
+}
+
+/// Lengths (positions, sizes, anchors): finite and within [`ABSURD_LENGTH`].
+fn check_length(
+    loc: &SourceLoc,
+    element: &str,
+    what: impl Fn() -> String,
+    values: &[f64],
+) -> Result<(), LoadError> {
+    check_within(loc, element, what, values, ABSURD_LENGTH)
+}
+
 fn check_pose(loc: &SourceLoc, element: &str, owner: &str, x: &Transform) -> Result<(), LoadError> {
-    check(loc, element, || format!("{owner}: a position coordinate"), x.pos.as_slice())
+    check_length(loc, element, || format!("{owner}: a position coordinate"), x.pos.as_slice())
 }
 
 /// The link and degree-of-freedom counts within [`MAX_LINKS`] and [`MAX_DOFS`] (a loader may
@@ -138,9 +163,9 @@ fn check_elements(spec: &ModelSpec) -> Result<(), LoadError> {
     for e in &spec.equalities {
         let what = || format!("equality '{}': a coefficient", e.name);
         match &e.kind {
-            EqualitySpecKind::ConnectBodies { anchor, .. } => check(&e.loc, "connect", what, anchor)?,
+            EqualitySpecKind::ConnectBodies { anchor, .. } => check_length(&e.loc, "connect", what, anchor)?,
             EqualitySpecKind::WeldBodies { anchor, torquescale, relpose, .. } => {
-                check(&e.loc, "weld", what, anchor)?;
+                check_length(&e.loc, "weld", what, anchor)?;
                 check(&e.loc, "weld", what, &[*torquescale])?;
                 if let Some(x) = relpose {
                     check_pose(&e.loc, "weld", &format!("equality '{}'", e.name), x)?;
@@ -249,13 +274,15 @@ fn check_link(link: &LinkSpec, word: LinkWord) -> Result<(), LoadError> {
             ));
         }
         match &g.shape {
-            Shape::Box { size: s } | Shape::Ellipsoid { radii: s } | Shape::Plane { size: s } => {
-                check(&g.loc, element, size, s.as_slice())?
+            Shape::Box { size: s } | Shape::Ellipsoid { radii: s } => {
+                check_length(&g.loc, element, size, s.as_slice())?
             }
+            // A plane's size is for drawing only.
+            Shape::Plane { size: s } => check(&g.loc, element, size, s.as_slice())?,
             Shape::Cylinder { radius, length } | Shape::Capsule { radius, length } => {
-                check(&g.loc, element, size, &[*radius, *length])?
+                check_length(&g.loc, element, size, &[*radius, *length])?
             }
-            Shape::Sphere { radius } => check(&g.loc, element, size, &[*radius])?,
+            Shape::Sphere { radius } => check_length(&g.loc, element, size, &[*radius])?,
             Shape::Mesh { scale, .. } => {
                 check(&g.loc, element, || format!("{name}: its mesh's scale"), scale.as_slice())?
             }
