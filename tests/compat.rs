@@ -533,3 +533,17 @@ fn lengths_beyond_a_thousand_kilometres_are_refused() {
     .unwrap();
     refused(&path, &LoadOptions::default(), &["long.xml:2", "<geom>", "2.1474836475e9", "beyond 1e6"]);
 }
+
+#[test]
+fn mesh_files_are_bounded() {
+    // A hostile mesh must not exhaust memory: files over 512 MB are refused before they are read
+    // (a sparse file here, so the test costs nothing), and so are meshes over 1e7 vertices or 2e7
+    // triangles once parsed.
+    let dir = temp_dir("mesh_limits");
+    let path = dir.join("huge.stl");
+    let f = std::fs::File::create(&path).unwrap();
+    f.set_len(600 * 1024 * 1024).unwrap();
+    let msg = read_mesh(&path, &Vec3::new(1.0, 1.0, 1.0)).unwrap_err().to_string();
+    assert!(msg.contains("629145600 bytes") && msg.contains("limit of 536870912"), "{msg}");
+    let _ = std::fs::remove_file(&path);
+}

@@ -60,11 +60,39 @@ pub fn read_mesh_with(path: &Path, scale: &Vec3, options: &ReadOptions) -> Resul
             return Err(MeshError::UnsupportedFormat { path: path.to_path_buf(), extension });
         }
     };
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
+    let io = |source| MeshError::Io { path: path.to_path_buf(), source };
+    let size = std::fs::metadata(path).map_err(io)?.len();
+    if size > MAX_MESH_BYTES {
+        return Err(parse_error(
+            path,
+            "mesh",
+            None,
+            format!("the file has {size} bytes, more than the limit of {MAX_MESH_BYTES} (a resource limit against hostile files); simplify the mesh"),
+        ));
+    }
+    let bytes = std::fs::read(path).map_err(io)?;
     let mut mesh = reader(&bytes, path, options)?;
+    if mesh.vertices.len() > MAX_MESH_VERTICES || mesh.triangles.len() > MAX_MESH_TRIANGLES {
+        return Err(parse_error(
+            path,
+            "mesh",
+            None,
+            format!(
+                "{} vertices and {} triangles, more than the limits of {MAX_MESH_VERTICES} and {MAX_MESH_TRIANGLES} (a resource limit); simplify the mesh",
+                mesh.vertices.len(),
+                mesh.triangles.len()
+            ),
+        ));
+    }
     mesh.apply_scale(scale);
     Ok(mesh)
 }
+
+/// Resource limits on a mesh file: its size, and the vertices and triangles it may hold (a
+/// hostile file must not exhaust memory; MuJoCo Menagerie's largest meshes have ~1e5 faces).
+pub const MAX_MESH_BYTES: u64 = 512 * 1024 * 1024;
+pub const MAX_MESH_VERTICES: usize = 10_000_000;
+pub const MAX_MESH_TRIANGLES: usize = 20_000_000;
 
 /// A decimal coordinate as the nearest `f32`, widened: MuJoCo stores mesh vertices as `float`
 /// (and tinyobjloader parses them so), and STL is single precision by definition. Keeping the
