@@ -463,6 +463,10 @@ fn absurd_options_are_refused() {
         &LoadOptions::default(),
         &["gravity.xml", "<option>", "gravity", "-1e308", "absurdly large"],
     );
+    // And <compiler settotalmass="1e308"> (a later finding).
+    let path = dir.join("total.xml");
+    std::fs::write(&path, r#"<mujoco><compiler settotalmass="1e308"/><worldbody><body><joint/><geom size=".1" pos="0 0 .2"/></body></worldbody></mujoco>"#).unwrap();
+    refused(&path, &LoadOptions::default(), &["total.xml", "<compiler>", "settotalmass", "1e308"]);
 }
 
 #[test]

@@ -128,6 +128,9 @@ pub fn check_spec(spec: &ModelSpec) -> Result<(), LoadError> {
     let nv = spec.links.iter().map(|l| l.joint.jtype.nv()).sum();
     check_counts(&file, word, spec.links.len(), nv)?;
     let top = SourceLoc { file, line: 0 };
+    let r = &spec.mass_rules;
+    let rules = [r.bound_mass, r.bound_inertia, r.total_mass.unwrap_or(0.0)];
+    check(&top, "compiler", || "boundmass, boundinertia or settotalmass".into(), &rules)?;
     let o = &spec.options;
     check(&top, "option", || "gravity: a component".into(), spec.gravity.as_slice())?;
     check(
