@@ -152,8 +152,11 @@ impl Simulation {
         if let Some(f) = self.torque_controller.as_mut() {
             f(t, q, v, self.data.qfrc_applied.as_mut_slice());
         }
-        let report =
+        let mut report =
             self.stepper.step(&self.model, &self.plan, &mut self.data, &mut self.state, self.timestep);
+        if self.plan.soft.is_some() && self.data.nefc > 0 {
+            report.solver_improvement = self.data.solver_improvement;
+        }
         self.steps += 1;
         self.check_finite()?;
         Ok(report)

@@ -382,7 +382,7 @@ fn frictional_solve_never_diverges_to_nan() {
         0.07704165357650794,
         0.8557783079830759,
     ];
-    let plan = Plan::new(&model, None);
+    let plan = Plan::new(&model, Some(lagrange::constraint::ConstraintMode::Exact));
     let mut data = lagrange::Data::new(&model);
     forward(&model, &plan, &mut data, &q, &v);
     assert_eq!(data.contacts.len(), 4);

@@ -64,7 +64,11 @@ fn pendulum_on_movable_support_conserves_horizontal_momentum_notes_1_4() {
     let key = &model.keyframes[0];
     let mut sim = Simulation::new(
         model.clone(),
-        &SimOptions { integrator: Some(IntegratorKind::Rk4), ..Default::default() },
+        &SimOptions {
+            integrator: Some(IntegratorKind::Rk4),
+            constraints: Some(ConstraintMode::Exact),
+            ..Default::default()
+        },
     );
     sim.set_state(key.qpos.as_ref().unwrap(), key.qvel.as_ref().unwrap()).unwrap();
     let momentum = |sim: &mut Simulation| {
@@ -161,8 +165,14 @@ fn kkt_solution_satisfies_dynamics_and_constraints() {
 fn four_bar_stays_closed_with_projection() {
     let model = Arc::new(model("models/textbook/four_bar.xml"));
     let run = |drift: DriftCorrection| {
-        let mut sim =
-            Simulation::new(model.clone(), &SimOptions { drift: Some(drift), ..Default::default() });
+        let mut sim = Simulation::new(
+            model.clone(),
+            &SimOptions {
+                drift: Some(drift),
+                constraints: Some(ConstraintMode::Exact),
+                ..Default::default()
+            },
+        );
         assert_eq!(sim.integrator(), "rk4", "the file's <option integrator>");
         let key = &model.keyframes[0];
         sim.set_state(key.qpos.as_ref().unwrap(), key.qvel.as_ref().unwrap()).unwrap();

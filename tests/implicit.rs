@@ -19,8 +19,14 @@ const MUJOCO_QPOS: [f64; 2] = [0.06620957738097963, -0.49725546233466694];
 const MUJOCO_QVEL: [f64; 2] = [-0.14331466887977284, 0.011152003337331715];
 
 fn damped_double_pendulum(kind: Option<IntegratorKind>) -> Simulation {
+    damped_double_pendulum_with(kind, true)
+}
+
+/// The scene with `<flag eulerdamp>` on (MuJoCo's default) or off.
+fn damped_double_pendulum_with(kind: Option<IntegratorKind>, eulerdamp: bool) -> Simulation {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/textbook/damped_double_pendulum.xml");
-    let model = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let mut model = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    model.options.flags.eulerdamp = eulerdamp;
     let mut sim = Simulation::new(Arc::new(model), &SimOptions { integrator: kind, ..Default::default() });
     sim.set_state(&[1.0, -0.5], &[0.0, 0.0]).unwrap();
     sim
@@ -40,12 +46,27 @@ fn implicitfast_matches_mujoco_mj_step_on_damped_double_pendulum() {
     assert!(eq <= REF_REL && ev <= REF_REL, "q {eq}, v {ev}");
 }
 
-/// The same scene and step with semi-implicit Euler (explicit in the damping): the lower damper
-/// (40 N m s/rad) at h = 0.01 s is beyond explicit Euler's stability limit, and the simulation
-/// stops with the divergence error naming the step, time and joint.
+/// MuJoCo's Euler integrates joint damping implicitly (`<flag eulerdamp>`, on by default): on this
+/// scene (damping its only velocity-dependent force) it takes the same steps as implicitfast, so
+/// `mj_step` with `integrator="Euler"` gives the same golden values.
+#[test]
+fn euler_with_eulerdamp_matches_mujoco_mj_step_on_damped_double_pendulum() {
+    let mut sim = damped_double_pendulum(Some(IntegratorKind::Euler));
+    for _ in 0..100 {
+        sim.step().unwrap();
+    }
+    let eq = rel_err_vec(sim.state.q.as_slice(), &MUJOCO_QPOS);
+    let ev = rel_err_vec(sim.state.v.as_slice(), &MUJOCO_QVEL);
+    println!("Euler (eulerdamp) vs MuJoCo after 100 steps: q rel {eq:.2e}, v rel {ev:.2e}");
+    assert!(eq <= REF_REL && ev <= REF_REL, "q {eq}, v {ev}");
+}
+
+/// The same scene and step with semi-implicit Euler explicit in the damping (`eulerdamp` off):
+/// the lower damper (40 N m s/rad) at h = 0.01 s is beyond explicit Euler's stability limit, and
+/// the simulation stops with the divergence error naming the step, time and joint.
 #[test]
 fn explicit_euler_diverges_where_implicitfast_is_stable() {
-    let mut sim = damped_double_pendulum(Some(IntegratorKind::Euler));
+    let mut sim = damped_double_pendulum_with(Some(IntegratorKind::Euler), false);
     let err =
         (0..10_000).find_map(|_| sim.step().err()).expect("explicit Euler should diverge at h = 0.01 s");
     let msg = err.to_string();

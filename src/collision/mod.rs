@@ -10,8 +10,9 @@
 //! the other convex pairs ([`convex`]). Meshes collide by their convex hulls; height fields are not
 //! collided yet (`info` lists them).
 //!
-//! `collide` reports the contacts closer than the pair's margin plus `reach`: MuJoCo's rule with
-//! `reach` = 0; the exact mode asks a little further ([`EXACT_REACH`]) so that a contact lifted
+//! `collide` reports the contacts closer than the pair's margin + gap plus `reach`: MuJoCo's rule
+//! with `reach` = 0 (contacts in the gap are reported without rows: rows exist below the margin,
+//! the contact's `includemargin`); the exact mode asks a little further ([`EXACT_REACH`]) so that a contact lifted
 //! off by round-off or within a step is still known (its rows exist only while touching, or while
 //! the step's rows are frozen).
 
@@ -85,7 +86,7 @@ impl CollisionModel {
 }
 
 /// The contacts of every candidate pair at the current body poses (`x_world_body`), closer than
-/// the pair's margin plus `reach`, into `data.contacts` (cleared first; no allocation: the capacity
+/// the pair's margin + gap plus `reach`, into `data.contacts` (cleared first; no allocation: the capacity
 /// is `Model::max_contacts`).
 pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) {
     data.contacts.clear();
@@ -95,7 +96,7 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         let (geom1, geom2) = (&model.geoms[g1], &model.geoms[g2]);
         let x1 = data.x_world_body[geom1.body] * geom1.x_body_geom;
         let x2 = data.x_world_body[geom2.body] * geom2.x_body_geom;
-        let within = pair.margin + reach;
+        let within = pair.margin + pair.gap + reach;
         // Bounding spheres (a plane: the other geom's sphere against the plane).
         let far = match &geom1.shape {
             Shape::Plane { .. } => x1.rot.column(2).dot(&(x2.pos - x1.pos)) > within + cm.rbound[g2],
@@ -118,7 +119,7 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
                 pos: (p1 + p2) * 0.5,
                 frame: contact_frame(&normal, hint.as_ref()),
                 dist,
-                includemargin: pair.margin - pair.gap,
+                includemargin: pair.margin,
                 condim: pair.condim,
                 friction: pair.friction,
                 solref: pair.solref,

@@ -125,7 +125,11 @@ pub fn solve_coulomb(
             match data.efc_type[i] {
                 EfcType::Equality => scalar_update(data, i, f64::NEG_INFINITY, f64::INFINITY),
                 EfcType::FrictionDof => friction_dof(model, data, i, level),
-                EfcType::LimitJoint | EfcType::ContactFrictionless => {
+                // Pyramidal rows are the soft mode's; the exact mode never makes them.
+                EfcType::LimitJoint
+                | EfcType::LimitTendon
+                | EfcType::ContactFrictionless
+                | EfcType::ContactPyramidal => {
                     if separating(data, i, level) {
                         set_zero(data, i, 1)
                     } else {
@@ -489,7 +493,10 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         let len = data.efc_block_len(i);
         match data.efc_type[i] {
             EfcType::Equality => data.efc_active.push(i),
-            EfcType::LimitJoint | EfcType::ContactFrictionless => {
+            EfcType::LimitJoint
+            | EfcType::LimitTendon
+            | EfcType::ContactFrictionless
+            | EfcType::ContactPyramidal => {
                 if data.efc_rhs[i] > 0.0 || data.efc_pressing[i] {
                     data.efc_active.push(i);
                 }
@@ -606,7 +613,11 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         let l = data.efc_lambda_prev[i];
         let ok = match data.efc_type[i] {
             EfcType::Equality => true,
-            EfcType::LimitJoint | EfcType::ContactFrictionless | EfcType::ContactElliptic => {
+            EfcType::LimitJoint
+            | EfcType::LimitTendon
+            | EfcType::ContactFrictionless
+            | EfcType::ContactElliptic
+            | EfcType::ContactPyramidal => {
                 let free = data.efc_active.contains(&i);
                 let normal_ok = if data.efc_pressing[i] {
                     true

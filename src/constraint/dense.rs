@@ -34,7 +34,7 @@ pub fn solve_psd(
 }
 
 /// Lower Cholesky factor of A into `l`; false if a pivot is not above `tol`.
-fn cholesky(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f64) -> bool {
+pub(crate) fn cholesky(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f64) -> bool {
     for j in 0..n {
         let mut d = a[(j, j)];
         for k in 0..j {
@@ -56,7 +56,7 @@ fn cholesky(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f64) -> bool 
     true
 }
 
-fn cholesky_solve(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
+pub(crate) fn cholesky_solve(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
     for i in 0..n {
         let mut s = b[i];
         for k in 0..i {

@@ -104,6 +104,8 @@ pub fn row_violation(data: &Data) -> [f64; 2] {
         let (p, v) = match data.efc_type[i] {
             EfcType::Equality => (phi.abs(), jv.abs()),
             EfcType::FrictionDof => (0.0, 0.0),
+            // A pyramidal contact's rows all carry the contact's distance (soft mode).
+            EfcType::ContactPyramidal => ((-phi).max(0.0), 0.0),
             _ if data.efc_type[i].is_unilateral() && data.efc_is_normal_or_limit(i) => {
                 ((-phi).max(0.0), (-jv).max(0.0))
             }

@@ -9,8 +9,8 @@
 //! and ball joints; contacts from the collision layer (normal + elliptic Coulomb cone). Unilateral
 //! rows obey Signorini's complementarity at the acceleration level and inelastic impacts at the
 //! velocity level; rows with dry friction are solved by [`solve_coulomb`], the others exactly by an
-//! active-set method. The soft (MuJoCo-compatible) mode arrives with a later issue behind the same
-//! buffers.
+//! active-set method. The soft (MuJoCo-compatible) mode ([`soft`]) writes the same buffers with
+//! MuJoCo's rows, regularization and solvers.
 
 mod active_set;
 mod contact;
@@ -20,6 +20,7 @@ mod exact;
 mod friction_loss;
 mod limits;
 mod rows;
+pub mod soft;
 
 pub use contact::CONTACT_ACTIVE_DISTANCE;
 pub use coulomb::{solve_coulomb, Level, SolverSettings, SEPARATING_VELOCITY, SLIP_VELOCITY};
@@ -34,8 +35,7 @@ pub use rows::{ConstraintModel, RowGeometry, ScalarCoord};
 pub enum ConstraintMode {
     /// Rigid constraints: the KKT solution (Lagrange multipliers).
     Exact,
-    /// MuJoCo's soft convex model (solref/solimp); not implemented yet — plans built with it fall
-    /// back to `Exact` and say so.
+    /// MuJoCo's soft convex model (solref/solimp, [`soft`]).
     Soft,
 }
 

@@ -279,6 +279,26 @@ impl ConstraintModel {
     /// limits, contact normals: the position projection). Needs body poses and motion subspaces at
     /// q (forward kinematics, or CRBA's first pass).
     pub fn positions(&self, model: &Model, data: &mut Data, q: &[f64], full: bool) {
+        let mut r = self.equality_rows(model, data, q);
+        if full {
+            for f in &self.friction {
+                f.write_row(data, r);
+                r += 1;
+            }
+        }
+        for l in &self.limits {
+            if let Some((dir, dist)) = l.row(data, q) {
+                l.write_row(data, r, &dir, dist);
+                r += 1;
+            }
+        }
+        data.nefc = contact_rows(model, data, r, full);
+    }
+
+    /// The rows of the active equality constraints from row 0 on (`efc_id`, `efc_type`, `efc_j`,
+    /// `efc_pos`); returns the number of rows. Weld rotation rows in rotation-vector form (module
+    /// doc).
+    pub(crate) fn equality_rows(&self, model: &Model, data: &mut Data, q: &[f64]) -> usize {
         let mut r = 0;
         for e in &self.equalities {
             if !data.eq_active[e.id] {
@@ -337,19 +357,7 @@ impl ConstraintModel {
             }
             r += n;
         }
-        if full {
-            for f in &self.friction {
-                f.write_row(data, r);
-                r += 1;
-            }
-        }
-        for l in &self.limits {
-            if let Some((dir, dist)) = l.row(data, q) {
-                l.write_row(data, r, &dir, dist);
-                r += 1;
-            }
-        }
-        data.nefc = contact_rows(model, data, r, full);
+        r
     }
 
     /// `efc_vel` = J v and `efc_jdotv` = J̇ v of the rows of [`positions`](Self::positions) at the
@@ -404,13 +412,13 @@ impl ConstraintModel {
         while r < data.nefc {
             data.efc_vel[r] = (0..model.nv).map(|k| data.efc_j[(r, k)] * v[k]).sum();
             match data.efc_type[r] {
-                EfcType::Equality | EfcType::FrictionDof => data.efc_jdotv[r] = 0.0,
+                EfcType::Equality | EfcType::FrictionDof | EfcType::LimitTendon => data.efc_jdotv[r] = 0.0,
                 EfcType::LimitJoint => {
                     let joint = data.efc_id[r];
                     let l = self.limits.iter().find(|l| l.joint == joint);
                     data.efc_jdotv[r] = l.map_or(0.0, |l| l.jdotv(q, v));
                 }
-                EfcType::ContactFrictionless | EfcType::ContactElliptic => {
+                EfcType::ContactFrictionless | EfcType::ContactElliptic | EfcType::ContactPyramidal => {
                     let dim = data.efc_block_len(r);
                     for i in r + 1..r + dim {
                         data.efc_vel[i] = (0..model.nv).map(|k| data.efc_j[(i, k)] * v[k]).sum();
@@ -437,7 +445,7 @@ impl ConstraintModel {
 
 /// Velocity and bias acceleration (world) of point `r_body` of body `b`, and the body's world
 /// angular velocity and angular bias acceleration.
-fn point_motion(data: &Data, b: usize, r_body: &Vec3) -> (Vec3, Vec3, (Vec3, Vec3)) {
+pub(crate) fn point_motion(data: &Data, b: usize, r_body: &Vec3) -> (Vec3, Vec3, (Vec3, Vec3)) {
     let vb = &data.v_body[b];
     let rot = &data.x_world_body[b].rot;
     let v_point = rot * (vb.lin + vb.ang.cross(r_body));

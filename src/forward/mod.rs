@@ -23,18 +23,25 @@ pub use actuation::{actuation, resolved_bias_velocity, unsimulated_reason};
 
 pub use plan::{DriftCorrection, Plan, Stage, StageKind, Status};
 
-use crate::constraint::solve_exact;
+use crate::constraint::{soft, solve_exact};
 use crate::dynamics::{aba, bias_forces, crba, factorize_mass_matrix, solve_mass_matrix};
 use crate::model::{Data, Model};
 
 /// Forward dynamics at (q, v) with the model's passive forces, `data.qfrc_applied` and
 /// `data.ctrl`: every stage of `plan` that runs, in order. The result is `data.qacc`.
 pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]) {
-    // The M path only while a constraint row is active (an equality, or a joint at a limit):
-    // otherwise ABA, as for a model without constraints.
-    let mut m_path = plan.has_constraints() && plan.constraints.any_active(data, q);
-    // Collision: contacts at q (a touching one needs the M path too).
-    m_path |= plan.constraints.collide(model, data, q);
+    let cm = &plan.constraints;
+    let m_path = match &plan.soft {
+        // Soft: collision with MuJoCo's margins, rows by MuJoCo's activation rules.
+        Some(_) => plan.has_constraints() && soft::rows::soft_active(cm, model, data, q),
+        // Exact: the M path only while a constraint row is active (an equality, a joint at a
+        // limit, a touching contact): otherwise ABA, as for a model without constraints.
+        None => {
+            let active = plan.has_constraints() && cm.any_active(data, q);
+            // Collision: contacts at q (a touching one needs the M path too).
+            cm.collide(model, data, q) || active
+        }
+    };
     for stage in &plan.stages {
         if stage.status != Status::Runs {
             continue;
@@ -43,18 +50,27 @@ pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]
             StageKind::Position if m_path => {
                 crba(model, data, q);
                 factorize_mass_matrix(model, data);
-                plan.constraints.positions(model, data, q, true);
+                match &plan.soft {
+                    Some(_) => soft::soft_positions(cm, model, data, q, model.options.cone),
+                    None => cm.positions(model, data, q, true),
+                }
             }
             StageKind::Velocity if m_path => {
                 bias_forces(model, data, q, v);
                 data.qfrc_bias.copy_from(&data.tau);
                 // RNEA left the body velocities at v in `v_body`.
-                plan.constraints.velocities(model, data, q, v);
+                match &plan.soft {
+                    Some(_) => soft::soft_velocities(cm, model, data, v),
+                    None => cm.velocities(model, data, q, v),
+                }
             }
             StageKind::Passive => passive(model, data, q, v),
             StageKind::Actuation => actuation(model, data, q, v, &plan.actuator_bias_velocity),
             StageKind::Acceleration => acceleration(model, data, q, v, m_path),
-            StageKind::Constraint if m_path => solve_exact(model, data, plan.drift.baumgarte, plan.solver),
+            StageKind::Constraint if m_path => match &plan.soft {
+                Some(weights) => soft::solve_soft(model, weights, data),
+                None => solve_exact(model, data, plan.drift.baumgarte, plan.solver),
+            },
             // Row sources are built by the position stage; the rest are listings.
             _ => {}
         }
@@ -63,6 +79,8 @@ pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]
         data.qacc.copy_from(&data.qacc_smooth);
         data.qfrc_constraint.fill(0.0);
         data.nefc = 0;
+        data.ne = 0;
+        data.nf = 0;
     }
 }
 

@@ -4,6 +4,7 @@
 //! contains what it acts on: a scene without constraint rows never builds M (ABA path), a scene
 //! without damping or springs has no passive pass.
 
+use crate::constraint::soft::InverseWeights;
 use crate::constraint::{ConstraintMode, ConstraintModel, LimitKind, SolverSettings};
 use crate::model::Model;
 use serde::Serialize;
@@ -83,6 +84,9 @@ pub struct Plan {
     pub mode_reason: String,
     /// The constraint rows of the model.
     pub constraints: ConstraintModel,
+    /// In soft mode, the inverse weights at `qpos0` the regularizer is built from (None in exact
+    /// mode, or when the model has no constraint rows).
+    pub soft: Option<InverseWeights>,
     pub drift: DriftCorrection,
     /// Iteration limit and tolerance of the iterative solve of rows with dry friction.
     pub solver: SolverSettings,
@@ -98,12 +102,21 @@ impl Plan {
         let (mode, mode_reason) = resolve_mode(model, requested);
         let constraints = ConstraintModel::new(model);
         let stages = stages(model, &constraints, mode);
+        let soft =
+            (mode == ConstraintMode::Soft && !constraints.is_empty()).then(|| InverseWeights::new(model));
+        // The soft model allows its own drift (MuJoCo projects nothing after a step).
+        let drift = if mode == ConstraintMode::Soft {
+            DriftCorrection { projection: false, ..DriftCorrection::default() }
+        } else {
+            DriftCorrection::default()
+        };
         Self {
             stages,
             mode,
             mode_reason,
             constraints,
-            drift: DriftCorrection::default(),
+            soft,
+            drift,
             solver: SolverSettings::default(),
             actuator_bias_velocity: super::resolved_bias_velocity(model),
         }
@@ -130,13 +143,7 @@ fn resolve_mode(model: &Model, requested: Option<ConstraintMode>) -> (Constraint
         None if is_mjcf(model) => (ConstraintMode::Soft, "soft is the default for MJCF".to_string()),
         None => (ConstraintMode::Exact, "exact is the default for URDF".to_string()),
     };
-    match wanted {
-        ConstraintMode::Exact => (ConstraintMode::Exact, why),
-        ConstraintMode::Soft => (
-            ConstraintMode::Exact,
-            format!("{why}, but the soft (MuJoCo-compatible) mode is not implemented yet: using exact"),
-        ),
-    }
+    (wanted, why)
 }
 
 fn stage(kind: StageKind, name: &'static str, status: Status, reason: impl Into<String>) -> Stage {
@@ -244,7 +251,9 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
             format!("articulated-body algorithm over {} bodies, nv = {}", model.nbody() - 1, model.nv),
         )
     });
-    out.push(if constrained {
+    out.push(if constrained && mode == ConstraintMode::Soft {
+        stage(Constraint, "constraint", Runs, soft_description(model))
+    } else if constrained {
         stage(
             Constraint,
             "constraint",
@@ -289,8 +298,13 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
             "joint limits",
             Runs,
             format!(
-                "{} limited hinge/slide joints and {ball} ball-joint cone limits: a unilateral row at a bound (exact mode)",
-                nlimit - ball
+                "{} limited hinge/slide joints and {ball} ball-joint cone limits: {}",
+                nlimit - ball,
+                if mode == ConstraintMode::Soft {
+                    "a soft row per bound within the joint's margin (solreflimit, solimplimit)"
+                } else {
+                    "a unilateral row at a bound (exact mode)"
+                }
             ),
         )
     } else if !flags.limit && model.joints.iter().any(|j| j.limits.is_some()) {
@@ -332,8 +346,13 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
             "collision",
             Runs,
             format!(
-                "{npairs} candidate geom pairs ({} explicit <pair>) among {colliding} collision geoms, up to {bound} contacts: bounding spheres, then closed forms (planes, spheres, capsules) or GJK/EPA; exact mode: contact rows while touching{hfield_note}",
-                model.collision_pairs.iter().filter(|p| p.pair.is_some()).count()
+                "{npairs} candidate geom pairs ({} explicit <pair>) among {colliding} collision geoms, up to {bound} contacts: bounding spheres, then closed forms (planes, spheres, capsules) or GJK/EPA; {}{hfield_note}",
+                model.collision_pairs.iter().filter(|p| p.pair.is_some()).count(),
+                if mode == ConstraintMode::Soft {
+                    "soft mode: rows for contacts closer than margin − gap"
+                } else {
+                    "exact mode: contact rows while touching"
+                }
             ),
         )
     } else if colliding > 0 && !(flags.contact && flags.constraint) {
@@ -374,4 +393,60 @@ fn kept(kind: StageKind, name: &'static str, n: usize, what: &str, why: &str) ->
     } else {
         stage(kind, name, Status::Skipped, format!("no {what}"))
     }
+}
+
+/// The constraint stage in soft mode: solver, cone and the `<option>` settings honoured, and the
+/// MuJoCo features of the model the soft mode does not simulate yet.
+fn soft_description(model: &Model) -> String {
+    use crate::model::options::{Cone, Solver};
+    let o = &model.options;
+    let solver = match o.solver {
+        Solver::Newton => "Newton (exact line search)",
+        Solver::Cg => "CG (Polak–Ribière, M⁻¹-preconditioned, exact line search)",
+        Solver::Pgs => "PGS on the dual",
+    };
+    let cone = match o.cone {
+        Cone::Pyramidal => "pyramidal",
+        Cone::Elliptic => "elliptic",
+    };
+    let mut missing = soft_unsupported(model);
+    let missing = if missing.is_empty() {
+        String::new()
+    } else {
+        missing.sort();
+        format!("; not simulated in soft mode: {}", missing.join(", "))
+    };
+    format!(
+        "soft mode (MuJoCo's convex model): solref/solimp impedance, R from the diagonal approximation, aref = −b·Jv − k·d·r; {solver}, {cone} cones, impratio {}, iterations {}, tolerance {:e}, ls_iterations {}, ls_tolerance {:e}, warm start {}{missing}",
+        o.impratio,
+        o.iterations,
+        o.tolerance,
+        o.ls_iterations,
+        o.ls_tolerance,
+        if o.flags.warmstart { "on" } else { "off" }
+    )
+}
+
+/// MuJoCo features present in `model` that the soft mode does not simulate (listed by `info`).
+pub fn soft_unsupported(model: &Model) -> Vec<String> {
+    let o = &model.options;
+    let mut out = Vec::new();
+    if o.noslip_iterations > 0 {
+        out.push(format!("noslip_iterations = {} (the no-slip post-process)", o.noslip_iterations));
+    }
+    if o.flags.override_contacts {
+        out.push("<flag override> (o_margin, o_solref, o_solimp, o_friction)".to_string());
+    }
+    if o.flags.island {
+        out.push("<flag island> (islands are solved as one problem: same solution)".to_string());
+    }
+    let spatial_limits = model
+        .tendons
+        .iter()
+        .filter(|t| t.range.is_some() && matches!(t.kind, crate::model::TendonKind::Spatial { .. }))
+        .count();
+    if spatial_limits > 0 {
+        out.push(format!("{spatial_limits} spatial-tendon limits"));
+    }
+    out
 }

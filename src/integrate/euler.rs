@@ -1,16 +1,22 @@
 //! Semi-implicit (symplectic) Euler: v ← v + h·v̇(q, v); q ← q ⊕ h·v (first order; MuJoCo's
-//! default `Euler` without implicit damping).
+//! default `Euler`). As MuJoCo's (`<flag eulerdamp>`, on by default; MuJoCo documentation,
+//! "Computation → Numerical integration"), joint damping is integrated implicitly:
+//! v ← v + h (M + h·diag(damping))⁻¹ M v̇, which keeps strongly damped joints stable.
 
+use super::implicit_fast::implicit_acceleration;
 use super::{correct_drift, State, StepReport, Stepper};
 use crate::forward::{forward, Plan};
 use crate::model::{integrate_configuration, Data, Model};
+use nalgebra::DVector;
 
-/// Semi-implicit Euler stepper.
-pub struct SemiImplicitEuler;
+/// Semi-implicit Euler stepper, with its buffer for the implicitly damped acceleration.
+pub struct SemiImplicitEuler {
+    damped: DVector<f64>,
+}
 
 impl SemiImplicitEuler {
-    pub fn new(_model: &Model) -> Self {
-        Self
+    pub fn new(model: &Model) -> Self {
+        Self { damped: DVector::zeros(model.nv) }
     }
 }
 
@@ -23,7 +29,13 @@ impl Stepper for SemiImplicitEuler {
     }
     fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         forward(model, plan, data, state.q.as_slice(), state.v.as_slice());
-        state.v.axpy(h, &data.qacc, 1.0);
+        let flags = &model.options.flags;
+        if flags.eulerdamp && flags.damper && model.has_damping() {
+            implicit_acceleration(model, data, state.q.as_slice(), &mut self.damped, h);
+            state.v.axpy(h, &self.damped, 1.0);
+        } else {
+            state.v.axpy(h, &data.qacc, 1.0);
+        }
         integrate_configuration(model, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))

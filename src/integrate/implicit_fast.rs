@@ -38,6 +38,23 @@ pub fn add_force_derivative(model: &Model, matrix: &mut [f64], h: f64) {
     }
 }
 
+/// The velocity-implicit acceleration a = (M − h D)⁻¹ M qacc after `forward` at configuration
+/// `q`, into `out` (M and its factor in `data` are recomputed; M is left as CRBA gives it).
+pub(super) fn implicit_acceleration(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    out: &mut DVector<f64>,
+    h: f64,
+) {
+    crba(model, data, q);
+    out.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
+    add_force_derivative(model, data.mass_matrix.as_mut_slice(), h);
+    factorize_mass_matrix(model, data);
+    solve_with_factor(model, &data.mass_factor, out.as_mut_slice());
+    add_force_derivative(model, data.mass_matrix.as_mut_slice(), -h);
+}
+
 impl Stepper for ImplicitFast {
     fn name(&self) -> &'static str {
         "implicitfast"
@@ -48,13 +65,7 @@ impl Stepper for ImplicitFast {
     fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         forward(model, plan, data, state.q.as_slice(), state.v.as_slice());
         if model.has_damping() {
-            crba(model, data, state.q.as_slice());
-            self.force.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
-            add_force_derivative(model, data.mass_matrix.as_mut_slice(), h);
-            factorize_mass_matrix(model, data);
-            solve_with_factor(model, &data.mass_factor, self.force.as_mut_slice());
-            // Leave M as crba computed it.
-            add_force_derivative(model, data.mass_matrix.as_mut_slice(), -h);
+            implicit_acceleration(model, data, state.q.as_slice(), &mut self.force, h);
             state.v.axpy(h, &self.force, 1.0);
         } else {
             state.v.axpy(h, &data.qacc, 1.0);

@@ -50,8 +50,12 @@ pub struct StepReport {
     /// Local error estimate, if the method has one.
     pub error_estimate: Option<f64>,
     /// Iterations of constraint solvers in this step (the exact solver is direct: 0; the
-    /// Gauss–Newton iterations of the position projection are counted here).
+    /// Gauss–Newton iterations of the position projection are counted here; in soft mode the
+    /// last soft solve's Newton/CG/PGS iterations, MuJoCo's `solver_niter`).
     pub solver_iterations: u32,
+    /// Soft mode: the last solve's final improvement of the cost, scaled as MuJoCo scales it
+    /// (1 / (meaninertia · nv)); set by `Simulation::step`, 0 otherwise.
+    pub solver_improvement: f64,
     /// max |φ| and max |J v| after the step (0 without constraint rows).
     pub constraint_violation: [f64; 2],
     /// Internal steps accepted within the interval (1 for fixed-step methods; an adaptive
@@ -72,6 +76,7 @@ impl StepReport {
             h_next: h,
             error_estimate: None,
             solver_iterations: iterations,
+            solver_improvement: 0.0,
             constraint_violation: violation,
             substeps: 1,
             rejected: 0,
@@ -91,7 +96,8 @@ pub trait Stepper: Send {
 
 /// After a step `h` of a constrained model: project q onto φ(q) = 0 (Gauss–Newton on the
 /// manifold) and v onto J v = 0 (M-orthogonally; impacts inelastic, dry friction as impulses over
-/// the step), if `drift.projection`. Returns (iterations, [max |φ|,
+/// the step), if `drift.projection`. In soft mode nothing is projected (as in MuJoCo); the soft
+/// solve's iterations and its rows' violation at the last stage are returned. Returns (iterations, [max |φ|,
 /// max |J v|]) after the correction; no work without constraint rows.
 pub fn correct_drift(
     model: &Model,
@@ -103,6 +109,12 @@ pub fn correct_drift(
     if !plan.has_constraints() {
         data.thaw_rows();
         return (0, [0.0, 0.0]);
+    }
+    if plan.soft.is_some() {
+        // The soft model is not projected (MuJoCo's steps are not): the report carries the last
+        // solve's iterations and the violation of its rows.
+        data.thaw_rows();
+        return (data.solver_niter, row_violation(data));
     }
     // Rows still pressing after the step's last stage stay closed through the projection (a
     // sustained contact drifted open by the integrator's error is closed again, not released).

@@ -129,6 +129,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                     armature: j.armature,
                     stiffness: j.stiffness,
                     spring_ref: j.spring_ref,
+                    soft: j.soft,
                 });
                 nq += jnq;
                 nv += jnv;

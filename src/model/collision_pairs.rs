@@ -13,7 +13,7 @@
 //! Each pair carries its combined contact parameters: the geom of higher `priority` gives all of
 //! them; at equal priority condim and friction are the larger, solref and solimp the `solmix`
 //! mixture (solref the element-wise minimum when either is direct, i.e. negative), margin and gap
-//! the larger. The pair's geoms are ordered as MuJoCo orders them for its collision functions (the
+//! the sums of the geoms' (MuJoCo 4.0's `getMargin`, `getGap`). The pair's geoms are ordered as MuJoCo orders them for its collision functions (the
 //! lower geom type first: plane, hfield, sphere, capsule, ellipsoid, cylinder, box, mesh), so that
 //! the normal points from geom 1 to geom 2 as in MuJoCo's `contact.frame`.
 
@@ -186,8 +186,8 @@ pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
                 solref,
                 solreffriction: [0.0, 0.0],
                 solimp,
-                margin: c1.margin.max(c2.margin),
-                gap: c1.gap.max(c2.gap),
+                margin: c1.margin + c2.margin,
+                gap: c1.gap + c2.gap,
                 pair: None,
                 max_contacts: max_contacts(&model.geoms[geom[0]].shape, &model.geoms[geom[1]].shape),
             });

@@ -43,7 +43,9 @@ pub struct Contact {
     pub frame: crate::spatial::Mat3,
     /// Signed distance, negative = penetration.
     pub dist: f64,
-    /// margin − gap.
+    /// The distance below which the contact has constraint rows: the pair's margin (MuJoCo 4.0:
+    /// the geoms' margins add up, and contacts are detected up to margin + gap, the gap's
+    /// contacts being kept without rows).
     pub includemargin: f64,
     pub condim: u32,
     /// tangent1, tangent2, torsional, rolling1, rolling2.

@@ -35,13 +35,26 @@ pub enum EfcType {
     /// then the friction rows, whose forces lie in the elliptic Coulomb cone
     /// Σ (λ_i / μ_i)² ≤ λ_n² (MuJoCo's `mjCNSTR_CONTACT_ELLIPTIC`).
     ContactElliptic,
+    /// Soft mode: a fixed tendon's length limit (MuJoCo's `mjCNSTR_LIMIT_TENDON`), unilateral.
+    LimitTendon,
+    /// Soft mode, pyramidal cone (MuJoCo's `mjCNSTR_CONTACT_PYRAMIDAL`): a contact of dimension
+    /// d gives 2(d − 1) rows J_n ± μ_i J_i, each with a force ≥ 0 (MuJoCo documentation,
+    /// "Computation → Constraint model → Contact").
+    ContactPyramidal,
 }
 
 impl EfcType {
     /// Whether the row's force has a sign (λ ≥ 0) — true for the rows of limits and contacts
     /// (use [`Data::efc_is_normal`] to tell a contact's normal row from its friction rows).
     pub fn is_unilateral(self) -> bool {
-        matches!(self, EfcType::LimitJoint | EfcType::ContactFrictionless | EfcType::ContactElliptic)
+        matches!(
+            self,
+            EfcType::LimitJoint
+                | EfcType::LimitTendon
+                | EfcType::ContactFrictionless
+                | EfcType::ContactElliptic
+                | EfcType::ContactPyramidal
+        )
     }
 
     /// MuJoCo's name of the row kind (`mjtConstraint` without the prefix, lower case).
@@ -52,6 +65,89 @@ impl EfcType {
             EfcType::LimitJoint => "limit_joint",
             EfcType::ContactFrictionless => "contact_frictionless",
             EfcType::ContactElliptic => "contact_elliptic",
+            EfcType::ContactPyramidal => "contact_pyramidal",
+            EfcType::LimitTendon => "limit_tendon",
+        }
+    }
+
+    /// Whether the row belongs to a contact.
+    pub fn is_contact(self) -> bool {
+        matches!(self, EfcType::ContactFrictionless | EfcType::ContactElliptic | EfcType::ContactPyramidal)
+    }
+}
+
+/// The state of a row in the soft cost (MuJoCo's `mjtConstraintState`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EfcState {
+    /// No force: a unilateral row that is not pressed, or an elliptic cone's top zone.
+    #[default]
+    Satisfied,
+    /// Quadratic cost ½ D (J a − aref)²: equality rows, pressed unilateral rows, friction within
+    /// its bound, an elliptic cone's bottom zone.
+    Quadratic,
+    /// Friction loss at its bound, force +frictionloss.
+    LinearNeg,
+    /// Friction loss at its bound, force −frictionloss.
+    LinearPos,
+    /// An elliptic contact on the surface of its cone (middle zone).
+    Cone,
+}
+
+impl EfcState {
+    /// MuJoCo's name of the state (`mjtConstraintState` without the prefix, lower case).
+    pub fn name(self) -> &'static str {
+        match self {
+            EfcState::Satisfied => "satisfied",
+            EfcState::Quadratic => "quadratic",
+            EfcState::LinearNeg => "linearneg",
+            EfcState::LinearPos => "linearpos",
+            EfcState::Cone => "cone",
+        }
+    }
+}
+
+/// Scratch of the soft solvers (`crate::constraint::soft`).
+#[derive(Clone, Debug)]
+pub struct SoftWork {
+    /// J a − aref per row, and J d along a search direction d.
+    pub jar: DVector<f64>,
+    pub jv: DVector<f64>,
+    /// J a − aref at a trial point of the line search.
+    pub jar_trial: DVector<f64>,
+    /// The cost's gradient, its preconditioned form, the search direction, M a, M d, and the
+    /// previous gradient and direction (CG) — length nv.
+    pub grad: DVector<f64>,
+    pub mgrad: DVector<f64>,
+    pub dir: DVector<f64>,
+    pub ma: DVector<f64>,
+    pub mdir: DVector<f64>,
+    pub grad_prev: DVector<f64>,
+    pub mgrad_prev: DVector<f64>,
+    /// The cost's Hessian M + Jᵀ D J (+ cone blocks) and its Cholesky factor, nv × nv.
+    pub hessian: DMatrix<f64>,
+    pub factor: DMatrix<f64>,
+    /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
+    pub ar: DMatrix<f64>,
+    pub minv_jt: DMatrix<f64>,
+}
+
+impl SoftWork {
+    fn new(nv: usize, nefc: usize) -> Self {
+        Self {
+            jar: DVector::zeros(nefc),
+            jv: DVector::zeros(nefc),
+            jar_trial: DVector::zeros(nefc),
+            grad: DVector::zeros(nv),
+            mgrad: DVector::zeros(nv),
+            dir: DVector::zeros(nv),
+            ma: DVector::zeros(nv),
+            mdir: DVector::zeros(nv),
+            grad_prev: DVector::zeros(nv),
+            mgrad_prev: DVector::zeros(nv),
+            hessian: DMatrix::zeros(nv, nv),
+            factor: DMatrix::zeros(nv, nv),
+            ar: DMatrix::zeros(0, 0),
+            minv_jt: DMatrix::zeros(0, 0),
         }
     }
 }
@@ -216,6 +312,37 @@ pub struct Data {
     pub efc_frozen_sticking: Vec<([usize; 2], u32)>,
     pub efc_frozen_sticking_dofs: Vec<usize>,
 
+    // --- soft (MuJoCo-compatible) constraint model, MuJoCo's buffer names ---
+    /// Rows of equality constraints and of friction loss in the soft solve (MuJoCo's `ne`, `nf`;
+    /// the rows come in MuJoCo's order: equality, friction, limits, contacts).
+    pub ne: usize,
+    pub nf: usize,
+    /// Per row: the margin within which it is active (MuJoCo's `efc_margin`), its friction loss
+    /// (`efc_frictionloss`), the approximate diagonal of J M⁻¹ Jᵀ (`efc_diagA`), the regularizer
+    /// R and D = 1/R (`efc_R`, `efc_D`), stiffness, damping, impedance and its derivative
+    /// (`efc_KBIP`), the reference acceleration (`efc_aref`) and the row's state in the cost
+    /// (`efc_state`).
+    pub efc_margin: DVector<f64>,
+    pub efc_frictionloss: DVector<f64>,
+    pub efc_diag_a: DVector<f64>,
+    pub efc_r: DVector<f64>,
+    pub efc_d: DVector<f64>,
+    pub efc_kbip: Vec<[f64; 4]>,
+    pub efc_aref: DVector<f64>,
+    pub efc_state: Vec<EfcState>,
+    /// Per contact (index in `contacts`): the friction coefficient of the regularized cone
+    /// (MuJoCo's `mjContact.mu`), set by the soft mode.
+    pub contact_mu: Vec<f64>,
+    /// The previous soft solve's acceleration (MuJoCo's `qacc_warmstart`).
+    pub qacc_warmstart: DVector<f64>,
+    /// Iterations of the last soft solve and its final scaled improvement and gradient
+    /// (MuJoCo's `solver_niter` and `solver` statistics).
+    pub solver_niter: u32,
+    pub solver_improvement: f64,
+    pub solver_gradient: f64,
+    /// Scratch of the soft solvers (sized nv, nefc or nv × nv).
+    pub soft: SoftWork,
+
     // --- collision ---
     /// Contacts of the last collision pass (MuJoCo's `contact`); capacity reserved for the model.
     pub contacts: Vec<Contact>,
@@ -309,6 +436,22 @@ impl Data {
             efc_frozen_contacts: Vec::with_capacity(model.max_contacts()),
             efc_frozen_sticking: Vec::with_capacity(model.max_contacts()),
             efc_frozen_sticking_dofs: Vec::with_capacity(nv),
+            ne: 0,
+            nf: 0,
+            efc_margin: DVector::zeros(nefc),
+            efc_frictionloss: DVector::zeros(nefc),
+            efc_diag_a: DVector::zeros(nefc),
+            efc_r: DVector::zeros(nefc),
+            efc_d: DVector::zeros(nefc),
+            efc_kbip: vec![[0.0; 4]; nefc],
+            efc_aref: DVector::zeros(nefc),
+            efc_state: vec![EfcState::Satisfied; nefc],
+            contact_mu: vec![0.0; model.max_contacts()],
+            qacc_warmstart: DVector::zeros(nv),
+            solver_niter: 0,
+            solver_improvement: 0.0,
+            solver_gradient: 0.0,
+            soft: SoftWork::new(nv, nefc),
             contacts: Vec::with_capacity(model.max_contacts()),
             contacts_dropped: 0,
         }
@@ -460,6 +603,15 @@ impl Data {
             &mut self.efc_eig,
             &mut self.efc_sub_rhs,
             &mut self.efc_lambda_prev,
+            &mut self.efc_margin,
+            &mut self.efc_frictionloss,
+            &mut self.efc_diag_a,
+            &mut self.efc_r,
+            &mut self.efc_d,
+            &mut self.efc_aref,
+            &mut self.soft.jar,
+            &mut self.soft.jv,
+            &mut self.soft.jar_trial,
         ] {
             *v = DVector::zeros(new);
         }
@@ -468,6 +620,8 @@ impl Data {
         self.efc_id.resize(new, 0);
         self.efc_pressing.resize(new, false);
         self.efc_slipping.resize(new, false);
+        self.efc_kbip.resize(new, [0.0; 4]);
+        self.efc_state.resize(new, EfcState::Satisfied);
         self.efc_active.reserve(new.saturating_sub(self.efc_active.len()));
         self.efc_warm_rows.reserve(new.saturating_sub(self.efc_warm_rows.len()));
     }
@@ -477,17 +631,15 @@ impl Data {
         self.efc_type[i] == EfcType::LimitJoint || self.efc_is_normal(i)
     }
 
-    /// Number of rows of the block starting at row `i`: a contact's dimension at its normal row,
-    /// 1 for every other row.
+    /// Number of rows of the block starting at row `i`: a contact's dimension at its normal row
+    /// (2(dim − 1) for a pyramidal contact), 1 for every other row.
     pub fn efc_block_len(&self, i: usize) -> usize {
-        if self.efc_type[i] != EfcType::ContactElliptic {
+        let kind = self.efc_type[i];
+        if !matches!(kind, EfcType::ContactElliptic | EfcType::ContactPyramidal) {
             return 1;
         }
         let mut k = i + 1;
-        while k < self.nefc
-            && self.efc_type[k] == EfcType::ContactElliptic
-            && self.efc_id[k] == self.efc_id[i]
-        {
+        while k < self.nefc && self.efc_type[k] == kind && self.efc_id[k] == self.efc_id[i] {
             k += 1;
         }
         k - i

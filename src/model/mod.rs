@@ -18,7 +18,7 @@ pub mod tendon;
 pub use actuator::Actuator;
 pub use collision_pairs::CollisionPair;
 pub use contact::{Contact, ContactExclude, ContactPair};
-pub use data::{Data, EfcType, SLIP_VELOCITY};
+pub use data::{Data, EfcState, EfcType, SoftWork, SLIP_VELOCITY};
 pub use elements::{Element, Keyframe};
 pub use equality::{Equality, EqualityKind};
 pub use joint::{axis_angle, JointKind};
@@ -74,6 +74,8 @@ pub struct Joint {
     /// `simulate` as `−stiffness·(q − spring_ref)` for hinge and slide joints.
     pub stiffness: f64,
     pub spring_ref: f64,
+    /// Soft-constraint parameters of the limit and friction-loss rows (soft mode only).
+    pub soft: spec::SoftParams,
 }
 
 /// A rigid body of the compiled tree (the fused links included).

@@ -142,6 +142,35 @@ pub struct JointSpec {
     pub qpos0: Vec<f64>,
     /// URDF `<mimic>`: this joint follows another one.
     pub mimic: Option<MimicSpec>,
+    /// Soft-constraint parameters of its limit and friction-loss rows (MJCF `solreflimit`,
+    /// `solimplimit`, `solreffriction`, `solimpfriction`, `margin`).
+    pub soft: SoftParams,
+}
+
+/// The soft-constraint parameters of a joint's or a tendon's limit and friction-loss rows
+/// (MuJoCo's `jnt_solref`, `jnt_solimp`, `jnt_margin`, `dof_solref`, `dof_solimp`, and the
+/// tendon's `tendon_solref_lim`, …; MuJoCo documentation, "XML Reference → joint / tendon").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SoftParams {
+    pub solref_limit: [f64; 2],
+    pub solimp_limit: [f64; 5],
+    pub solref_friction: [f64; 2],
+    pub solimp_friction: [f64; 5],
+    /// Distance from a bound within which the limit row is active (MuJoCo's `jnt_margin`).
+    pub margin: f64,
+}
+
+impl Default for SoftParams {
+    fn default() -> Self {
+        use crate::model::equality::{DEFAULT_SOLIMP, DEFAULT_SOLREF};
+        Self {
+            solref_limit: DEFAULT_SOLREF,
+            solimp_limit: DEFAULT_SOLIMP,
+            solref_friction: DEFAULT_SOLREF,
+            solimp_friction: DEFAULT_SOLIMP,
+            margin: 0.0,
+        }
+    }
 }
 
 /// URDF `<mimic joint multiplier offset>`: `q = multiplier · q[leader] + offset`.
@@ -174,6 +203,7 @@ impl JointSpec {
             spring_ref: 0.0,
             qpos0: Vec::new(),
             mimic: None,
+            soft: SoftParams::default(),
         }
     }
 }
@@ -343,6 +373,8 @@ pub struct TendonSpec {
     pub kind: TendonSpecKind,
     /// Length limits if limited (`limited`/`range`, resolved with `autolimits`).
     pub range: Option<[f64; 2]>,
+    /// Soft-constraint parameters of its limit rows (`solreflimit`, `solimplimit`, `margin`).
+    pub soft: SoftParams,
     pub loc: SourceLoc,
 }
 

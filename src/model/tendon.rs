@@ -10,6 +10,8 @@ pub struct Tendon {
     pub kind: TendonKind,
     /// Length limits `[lower, upper]` if limited (stored; enforced by the limits work).
     pub range: Option<[f64; 2]>,
+    /// Soft-constraint parameters of its limit rows (soft mode).
+    pub soft: super::spec::SoftParams,
     pub loc: SourceLoc,
 }
 

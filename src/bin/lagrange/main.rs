@@ -32,8 +32,9 @@ struct Cli {
     /// moments as written (as Pinocchio does), with a warning each, instead of refusing the model.
     #[arg(long, global = true)]
     accept_nonphysical_inertia: bool,
-    /// Constraint model: `exact` (rigid, Lagrange multipliers) or `soft` (MuJoCo's; not
-    /// implemented yet: falls back to exact and says so). Default: soft for MJCF, exact for URDF.
+    /// Constraint model: `exact` (rigid, Lagrange multipliers) or `soft` (MuJoCo's convex model:
+    /// solref/solimp, pyramidal or elliptic cones, Newton/CG/PGS). Default: soft for MJCF, exact
+    /// for URDF.
     #[arg(long, value_enum, global = true)]
     constraints: Option<ConstraintsArg>,
     /// Turn off an `<option><flag>` switch by its MJCF name (limit, equality, constraint,

@@ -400,6 +400,7 @@ impl<'a> TreeBuilder<'a> {
         j.stiffness = first("stiffness")?;
         j.armature = a.real("armature")?.unwrap_or(0.0);
         j.friction = a.real("frictionloss")?.unwrap_or(0.0);
+        j.soft = soft_params(&a)?;
         if a.has("springdamper") {
             self.keep("joint", "springdamper", &name, &a);
         }
@@ -459,4 +460,26 @@ fn inertial(
     };
     let x_body_inertial = *x_frame * Transform::new(rot, pos);
     Ok(InertialSpec { mass, x_link_inertial: x_body_inertial, inertia, loc: e.loc.clone() })
+}
+
+/// A joint's or tendon's soft-constraint parameters (`solreflimit`, `solimplimit`,
+/// `solreffriction`, `solimpfriction`, `margin`), over MuJoCo's defaults; `solimp` may give its first 1 to 5 values.
+pub(super) fn soft_params(a: &Attrs) -> Result<crate::model::spec::SoftParams, LoadError> {
+    let mut soft = crate::model::spec::SoftParams::default();
+    for (name, out) in
+        [("solreflimit", &mut soft.solref_limit), ("solreffriction", &mut soft.solref_friction)]
+    {
+        if let Some(r) = a.some_numbers(name, 2, 2)? {
+            out.copy_from_slice(&r[..2]);
+        }
+    }
+    for (name, out) in
+        [("solimplimit", &mut soft.solimp_limit), ("solimpfriction", &mut soft.solimp_friction)]
+    {
+        if let Some(i) = a.some_numbers(name, 1, 5)? {
+            out[..i.len()].copy_from_slice(&i);
+        }
+    }
+    soft.margin = a.real("margin")?.unwrap_or(0.0);
+    Ok(soft)
 }

@@ -65,7 +65,8 @@ pub(crate) fn tendons(
                 TendonSpecKind::Spatial { path }
             };
             let range = a.limited_range("limited", "range", autolimits, warnings)?;
-            out.push(TendonSpec { name, kind, range, loc: e.loc.clone() });
+            let soft = super::body::soft_params(&a)?;
+            out.push(TendonSpec { name, kind, range, soft, loc: e.loc.clone() });
         }
     }
     Ok(out)

@@ -96,12 +96,15 @@ pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliErro
             contacts = (0..sim.data.nefc).filter(|&i| sim.data.efc_is_normal(i)).count();
         }
     }
+    let (soft_step_us, soft_rows) = soft_step(&model);
     let pairs = model.collision_pairs.len();
     if json {
         let out = json!({"model": path.display().to_string(), "nq": model.nq, "nv": model.nv,
             "load_us": load_us, "fk_us": fk_us, "rnea_us": rnea_us, "crba_us": crba_us, "aba_us": aba_us,
             "forward_us": forward_us, "nefc": nefc, "collide_us": collide_us, "collision_pairs": pairs,
-            "step_us": step_us, "step_contacts": contacts, "step_dt": sim.timestep});
+            "step_us": step_us, "step_contacts": contacts, "step_dt": sim.timestep,
+            "soft_step_us": soft_step_us, "soft_step_rows": soft_rows,
+            "soft_steps": SOFT_STEPS, "soft_integrator": model.options.integrator.mjcf_name()});
         println!("{out}");
     } else {
         println!("{} (nq {}, nv {}), median µs per call:", path.display(), model.nq, model.nv);
@@ -117,6 +120,39 @@ pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliErro
             model.keyframes.first().map_or("qpos0", |k| k.name.as_str()),
             sim.timestep
         );
+        println!(
+            "  step, soft mode, the model's <option> ({}, dt {}), from {} with its ctrl, {soft_rows} rows at the end {soft_step_us:>9.3} (mean of {SOFT_STEPS})",
+            model.options.integrator.mjcf_name(),
+            model.options.timestep,
+            model.keyframes.first().map_or("qpos0", |k| k.name.as_str()),
+        );
     }
     Ok(())
+}
+
+/// Steps of the soft-mode timing (`validation/bench_soft_step.py` times as many `mj_step`).
+const SOFT_STEPS: u32 = 1000;
+
+/// Mean µs of one step in soft mode with the model's own `<option>` (integrator, timestep,
+/// solver), from the first keyframe with its ctrl (as MuJoCo's `mj_resetDataKeyframe`), and the
+/// rows at the end; NaN if the simulation stops with an error.
+fn soft_step(model: &Model) -> (f64, usize) {
+    let (mut q, mut v, mut ctrl) =
+        (model.qpos0.clone(), vec![0.0; model.nv], vec![0.0; model.actuators.len()]);
+    if let Some(k) = model.keyframes.first() {
+        k.apply(&mut q, &mut v, &mut ctrl);
+    }
+    let options = SimOptions { constraints: Some(ConstraintMode::Soft), ..Default::default() };
+    let mut sim = Simulation::new(std::sync::Arc::new(model.clone()), &options);
+    if sim.set_state(&q, &v).is_err() {
+        return (f64::NAN, 0);
+    }
+    sim.ctrl_mut().copy_from_slice(&ctrl);
+    let t0 = Instant::now();
+    for _ in 0..SOFT_STEPS {
+        if sim.step().is_err() {
+            return (f64::NAN, 0);
+        }
+    }
+    (t0.elapsed().as_secs_f64() * 1e6 / f64::from(SOFT_STEPS), sim.data.nefc)
 }

@@ -97,11 +97,14 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
                 json!({"name": eq.name, "kind": eq.kind.name(), "source": eq.loc.to_string(), "rows": n})
             }
             EfcType::LimitJoint => json!({"name": model.joints[id].name, "kind": "limit", "source": file}),
+            EfcType::LimitTendon => {
+                json!({"name": model.tendons[id].name, "kind": "tendon_limit", "source": model.tendons[id].loc.to_string()})
+            }
             EfcType::FrictionDof => {
                 let joint = model.joint_of(model.dof_body[id]);
                 json!({"name": joint.name, "kind": "friction", "source": file, "dof": id})
             }
-            EfcType::ContactFrictionless | EfcType::ContactElliptic => {
+            EfcType::ContactFrictionless | EfcType::ContactElliptic | EfcType::ContactPyramidal => {
                 let c = &data.contacts[id];
                 let names = c.geom.map(|g| geom_name(model, g));
                 json!({
@@ -109,7 +112,7 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
                     "geoms": names, "pos": c.pos.as_slice(), "normal": c.frame.row(0).transpose().as_slice(),
                     "frame": [c.frame.row(0).transpose().as_slice(), c.frame.row(1).transpose().as_slice(),
                               c.frame.row(2).transpose().as_slice()],
-                    "dist": c.dist, "condim": n,
+                    "dist": c.dist, "condim": c.condim,
                 })
             }
         };
@@ -120,7 +123,8 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
         r += n;
     }
     let vec = |x: &nalgebra::DVector<f64>| x.as_slice().to_vec();
-    json!({
+    let efc = plan.soft.is_some().then(|| soft_rows_json(model, data));
+    let mut out = json!({
         "qacc": vec(&data.qacc), "qacc_smooth": vec(&data.qacc_smooth), "qfrc_passive": vec(&data.qfrc_passive),
         "qfrc_actuator": vec(&data.qfrc_actuator), "qfrc_constraint": vec(&data.qfrc_constraint),
         "actuator_force": vec(&data.actuator_force), "actuator_length": vec(&data.actuator_length),
@@ -129,6 +133,58 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
             .map(|i| data.actuator_moment.row(i).iter().copied().collect::<Vec<f64>>())
             .collect::<Vec<_>>(),
         "constraints": constraints,
+    });
+    if let Some(efc) = efc {
+        out["efc"] = efc;
+    }
+    out
+}
+
+/// Soft mode: every row with MuJoCo's per-row quantities (`efc_type`, `efc_id` as the element's
+/// name, `efc_pos`, `efc_margin`, `efc_vel`, `efc_diagA`, `efc_R`, `efc_D`, `efc_aref`,
+/// `efc_force`, `efc_state`, the Jacobian row), the contacts, and the solver's statistics.
+fn soft_rows_json(model: &Model, data: &Data) -> Value {
+    let n = data.nefc;
+    let element = |r: usize| -> String {
+        let id = data.efc_id[r];
+        match data.efc_type[r] {
+            EfcType::Equality => model.equalities[id].name.clone(),
+            EfcType::LimitJoint => model.joints[id].name.clone(),
+            EfcType::LimitTendon => model.tendons[id].name.clone(),
+            EfcType::FrictionDof => format!("dof{id}"),
+            _ => {
+                let c = &data.contacts[id];
+                format!("{}|{}", geom_name(model, c.geom[0]), geom_name(model, c.geom[1]))
+            }
+        }
+    };
+    let col = |x: &nalgebra::DVector<f64>| x.as_slice()[..n].to_vec();
+    let contacts: Vec<Value> = data
+        .contacts
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            json!({
+                "geoms": c.geom.map(|g| geom_name(model, g)), "geom_ids": c.geom, "pos": c.pos.as_slice(), "dist": c.dist,
+                "frame": [c.frame.row(0).transpose().as_slice(), c.frame.row(1).transpose().as_slice(),
+                          c.frame.row(2).transpose().as_slice()],
+                "condim": c.condim, "includemargin": c.includemargin, "mu": data.contact_mu[i],
+                "friction": c.friction,
+            })
+        })
+        .collect();
+    json!({
+        "type": data.efc_type[..n].iter().map(|t| t.name()).collect::<Vec<_>>(),
+        "id": data.efc_id[..n].to_vec(),
+        "element": (0..n).map(element).collect::<Vec<_>>(),
+        "pos": col(&data.efc_pos), "margin": col(&data.efc_margin), "vel": col(&data.efc_vel),
+        "diagA": col(&data.efc_diag_a), "R": col(&data.efc_r), "D": col(&data.efc_d),
+        "aref": col(&data.efc_aref), "force": col(&data.efc_force),
+        "state": data.efc_state[..n].iter().map(|s| s.name()).collect::<Vec<_>>(),
+        "J": (0..n).map(|r| data.efc_j.row(r).iter().copied().collect::<Vec<f64>>()).collect::<Vec<_>>(),
+        "ne": data.ne, "nf": data.nf, "contacts": contacts,
+        "solver_niter": data.solver_niter, "solver_improvement": data.solver_improvement,
+        "solver_gradient": data.solver_gradient,
     })
 }
 

@@ -1,0 +1,244 @@
+//! The soft constraint cost of MuJoCo's convex formulation (MuJoCo documentation, "Computation →
+//! Constraint model" and "Solver"; Todorov 2014, "Convex and analytically-invertible dynamics
+//! with contacts and constraints"): with jar = J a − aref per row,
+//!
+//! s(jar) = Σ over rows of
+//! - equality: ½ D jar²;
+//! - friction loss f: ½ D jar² while |jar| < R f, else f |jar| − ½ R f² (force ∓f);
+//! - limit, frictionless or pyramidal contact: ½ D jar² while jar < 0, else 0;
+//! - elliptic contact (per contact, U₀ = μ jar₀, U_j = μ_j jar_j, N = U₀, T = |U_t|): 0 in the
+//!   top zone N ≥ μ T, ½ Σ D jar² in the bottom zone μ N + T ≤ 0, and
+//!   ½ D₀/(μ²(1 + μ²)) (N − μ T)² on the cone's surface between them,
+//!
+//! with μ the regularized cone's friction (`contact_mu`). The force of a row is −∂s/∂jar. The
+//! solvers minimize ½ (a − a₀)ᵀ M (a − a₀) + s(J a − aref) over the acceleration a (a₀ =
+//! `qacc_smooth`).
+
+use crate::model::{Contact, EfcState, EfcType};
+use nalgebra::DVector;
+
+/// The rows of the soft problem, read-only.
+pub struct Rows<'a> {
+    pub ne: usize,
+    pub nf: usize,
+    pub nefc: usize,
+    pub kind: &'a [EfcType],
+    pub id: &'a [usize],
+    pub d: &'a DVector<f64>,
+    pub r: &'a DVector<f64>,
+    pub floss: &'a DVector<f64>,
+    pub contacts: &'a [Contact],
+    pub mu: &'a [f64],
+}
+
+impl Rows<'_> {
+    /// The number of rows of the block at row i (a whole contact for elliptic cones).
+    fn block(&self, i: usize) -> usize {
+        if self.kind[i] != EfcType::ContactElliptic {
+            return 1;
+        }
+        self.contacts[self.id[i]].condim.clamp(1, 6) as usize
+    }
+
+    /// Forces and states at `jar` into `force` and `state`; returns the cost s(jar).
+    pub fn update(&self, jar: &DVector<f64>, force: &mut DVector<f64>, state: &mut [EfcState]) -> f64 {
+        let mut cost = 0.0;
+        let mut i = 0;
+        while i < self.nefc {
+            let (x, d) = (jar[i], self.d[i]);
+            if i < self.ne {
+                force[i] = -d * x;
+                state[i] = EfcState::Quadratic;
+                cost += 0.5 * d * x * x;
+                i += 1;
+                continue;
+            }
+            if i < self.ne + self.nf {
+                let (f, r) = (self.floss[i], self.r[i]);
+                if x <= -r * f {
+                    force[i] = f;
+                    state[i] = EfcState::LinearNeg;
+                    cost += -0.5 * r * f * f - f * x;
+                } else if x >= r * f {
+                    force[i] = -f;
+                    state[i] = EfcState::LinearPos;
+                    cost += -0.5 * r * f * f + f * x;
+                } else {
+                    force[i] = -d * x;
+                    state[i] = EfcState::Quadratic;
+                    cost += 0.5 * d * x * x;
+                }
+                i += 1;
+                continue;
+            }
+            if self.kind[i] != EfcType::ContactElliptic {
+                if x >= 0.0 {
+                    force[i] = 0.0;
+                    state[i] = EfcState::Satisfied;
+                } else {
+                    force[i] = -d * x;
+                    state[i] = EfcState::Quadratic;
+                    cost += 0.5 * d * x * x;
+                }
+                i += 1;
+                continue;
+            }
+            let dim = self.block(i);
+            let c = &self.contacts[self.id[i]];
+            let mu = self.mu[self.id[i]];
+            let (n, t, _) = cone_coordinates(jar, i, dim, mu, &c.friction);
+            let zone = if n >= mu * t || (t <= 0.0 && n >= 0.0) {
+                EfcState::Satisfied
+            } else if mu * n + t <= 0.0 || (t <= 0.0 && n < 0.0) {
+                EfcState::Quadratic
+            } else {
+                EfcState::Cone
+            };
+            match zone {
+                EfcState::Satisfied => force.rows_mut(i, dim).fill(0.0),
+                EfcState::Quadratic => {
+                    for j in i..i + dim {
+                        force[j] = -self.d[j] * jar[j];
+                        cost += 0.5 * self.d[j] * jar[j] * jar[j];
+                    }
+                }
+                _ => {
+                    let dm = d / (mu * mu * (1.0 + mu * mu));
+                    let nmt = n - mu * t;
+                    cost += 0.5 * dm * nmt * nmt;
+                    force[i] = -dm * nmt * mu;
+                    for j in 1..dim {
+                        let u = jar[i + j] * c.friction[j - 1];
+                        force[i + j] = -force[i] / t * u * c.friction[j - 1];
+                    }
+                }
+            }
+            state[i..i + dim].fill(zone);
+            i += dim;
+        }
+        cost
+    }
+
+    /// The first and second derivative of s(jar + α jv) in α, at α given by `jar` (already
+    /// moved) along `jv`.
+    pub fn directional(&self, jar: &DVector<f64>, jv: &DVector<f64>) -> (f64, f64) {
+        let (mut d1, mut d2) = (0.0, 0.0);
+        let mut i = 0;
+        while i < self.nefc {
+            let (x, v, d) = (jar[i], jv[i], self.d[i]);
+            let quadratic = if i < self.ne {
+                true
+            } else if i < self.ne + self.nf {
+                let rf = self.r[i] * self.floss[i];
+                if x <= -rf {
+                    d1 -= self.floss[i] * v;
+                    false
+                } else if x >= rf {
+                    d1 += self.floss[i] * v;
+                    false
+                } else {
+                    true
+                }
+            } else if self.kind[i] != EfcType::ContactElliptic {
+                x < 0.0
+            } else {
+                let dim = self.block(i);
+                let c = &self.contacts[self.id[i]];
+                let mu = self.mu[self.id[i]];
+                let (n, t, _) = cone_coordinates(jar, i, dim, mu, &c.friction);
+                if n >= mu * t || (t <= 0.0 && n >= 0.0) {
+                } else if mu * n + t <= 0.0 || (t <= 0.0 && n < 0.0) {
+                    for j in i..i + dim {
+                        d1 += self.d[j] * jar[j] * jv[j];
+                        d2 += self.d[j] * jv[j] * jv[j];
+                    }
+                } else {
+                    let dm = d / (mu * mu * (1.0 + mu * mu));
+                    let dn = mu * v;
+                    let (mut tu, mut tt) = (0.0, 0.0);
+                    for j in 1..dim {
+                        let f = c.friction[j - 1];
+                        let (u, du) = (jar[i + j] * f, jv[i + j] * f);
+                        tu += u * du;
+                        tt += du * du;
+                    }
+                    let dt = tu / t;
+                    let ddt = (tt - dt * dt) / t;
+                    let nmt = n - mu * t;
+                    let dnmt = dn - mu * dt;
+                    d1 += dm * nmt * dnmt;
+                    d2 += dm * (dnmt * dnmt - nmt * mu * ddt);
+                }
+                i += dim;
+                continue;
+            };
+            if quadratic {
+                d1 += d * x * v;
+                d2 += d * v * v;
+            }
+            i += 1;
+        }
+        (d1, d2)
+    }
+
+    /// Calls `add(i, j, h)` for the Hessian of s in jar on the rows that have one: D_i on
+    /// quadratic rows (i = j), and the dense dim × dim block of an elliptic contact on its cone.
+    pub fn hessian(&self, jar: &DVector<f64>, state: &[EfcState], mut add: impl FnMut(usize, usize, f64)) {
+        let mut i = 0;
+        while i < self.nefc {
+            if self.kind[i] == EfcType::ContactElliptic && i >= self.ne + self.nf {
+                let dim = self.block(i);
+                match state[i] {
+                    EfcState::Quadratic => (i..i + dim).for_each(|j| add(j, j, self.d[j])),
+                    EfcState::Cone => {
+                        let c = &self.contacts[self.id[i]];
+                        let mu = self.mu[self.id[i]];
+                        let (n, t, u) = cone_coordinates(jar, i, dim, mu, &c.friction);
+                        let dm = self.d[i] / (mu * mu * (1.0 + mu * mu));
+                        let scale = |k: usize| if k == 0 { mu } else { c.friction[k - 1] };
+                        // In U: (1, −μ/T U_t) outer product plus μ N/T³ U_t U_tᵀ + (μ² − μN/T) I_t.
+                        for a in 0..dim {
+                            for b in 0..dim {
+                                let h = match (a, b) {
+                                    (0, 0) => 1.0,
+                                    (0, _) => -mu / t * u[b],
+                                    (_, 0) => -mu / t * u[a],
+                                    _ => {
+                                        mu * n / (t * t * t) * u[a] * u[b]
+                                            + if a == b { mu * mu - mu * n / t } else { 0.0 }
+                                    }
+                                };
+                                add(i + a, i + b, dm * scale(a) * scale(b) * h);
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+                i += dim;
+                continue;
+            }
+            if state[i] == EfcState::Quadratic {
+                add(i, i, self.d[i]);
+            }
+            i += 1;
+        }
+    }
+}
+
+/// N, T and U (U₀ = μ jar₀, U_j = μ_j jar_j) of the elliptic contact at row i.
+fn cone_coordinates(
+    jar: &DVector<f64>,
+    i: usize,
+    dim: usize,
+    mu: f64,
+    friction: &[f64; 5],
+) -> (f64, f64, [f64; 6]) {
+    let mut u = [0.0; 6];
+    u[0] = jar[i] * mu;
+    let mut t2 = 0.0;
+    for j in 1..dim {
+        u[j] = jar[i + j] * friction[j - 1];
+        t2 += u[j] * u[j];
+    }
+    (u[0], t2.sqrt(), u)
+}

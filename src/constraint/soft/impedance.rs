@@ -1,0 +1,256 @@
+//! Per-row parameters of the soft constraint model (MuJoCo documentation, "Computation → Soft
+//! constraints" and "XML Reference → solref / solimp"; MuJoCo's `mj_diagApprox` and
+//! `mj_makeImpedance`):
+//!
+//! - the impedance d(r) ∈ (0, 1) from `solimp` = (dmin, dmax, width, midpoint, power): d = dmin
+//!   at r = 0 rising to dmax at |r| ≥ width along two power-law halves joined at the midpoint,
+//!   with r the row's violation (pos − margin; the norm of the 3 or 6 rows of a connect or weld);
+//! - stiffness k and damping b from `solref`: (timeconst, dampratio) > 0 gives
+//!   b = 2 / (dmax · timeconst), k = 1 / (dmax² · timeconst² · dampratio²) (timeconst raised to
+//!   2 · timestep unless `refsafe` is off); negative values are (−stiffness, −damping) directly,
+//!   k = stiffness / dmax², b = damping / dmax. Friction rows have k = 0;
+//! - the regularizer R = (1 − d)/d · Â with Â the diagonal approximation of J M⁻¹ Jᵀ from the
+//!   inverse weights ([`InverseWeights`]); for frictional contacts R of the first tangent row is
+//!   R_normal / impratio, the other friction rows keep R_i μ_i² equal, the regularized cone's
+//!   μ = μ₁ √(R₁/R₀), and a pyramidal contact's rows all get 2 μ² R_normal; D = 1/R;
+//! - the reference acceleration aref = −b · J v − k · d · (pos − margin), minus J̇ v for connect
+//!   and weld rows.
+
+use super::weights::InverseWeights;
+use crate::model::{Data, EfcType, EqualityKind, Model};
+
+/// MuJoCo's `mjMINVAL`, `mjMINIMP` and `mjMAXIMP`.
+const MINVAL: f64 = 1e-15;
+const MINIMP: f64 = 0.0001;
+const MAXIMP: f64 = 0.9999;
+
+/// Impedance d and its derivative at violation `x` = pos − margin (MuJoCo's `getimpedance`).
+pub fn impedance(solimp: &[f64; 5], x: f64) -> (f64, f64) {
+    let [dmin, dmax, width, mid, power] = *solimp;
+    if dmin == dmax || width <= MINVAL {
+        return (0.5 * (dmin + dmax), 0.0);
+    }
+    let (mut y, sgn) = (x / width, if x < 0.0 { -1.0 } else { 1.0 });
+    y = y.abs();
+    if y >= 1.0 || y <= 0.0 {
+        return (if y >= 1.0 { dmax } else { dmin }, 0.0);
+    }
+    let (f, df) = if power == 1.0 {
+        (y, 1.0)
+    } else if y <= mid {
+        let a = 1.0 / mid.powf(power - 1.0);
+        (a * y.powf(power), power * a * y.powf(power - 1.0))
+    } else {
+        let b = 1.0 / (1.0 - mid).powf(power - 1.0);
+        (1.0 - b * (1.0 - y).powf(power), power * b * (1.0 - y).powf(power - 1.0))
+    };
+    (dmin + f * (dmax - dmin), df * sgn * (dmax - dmin) / width)
+}
+
+/// `solref` and `solimp` as MuJoCo uses them: mixed-sign `solref` replaced by the default, the
+/// time constant raised to 2 · timestep (`refsafe`), `solimp` clamped to its valid range.
+fn sanitize(model: &Model, solref: [f64; 2], solimp: [f64; 5], friction: bool) -> ([f64; 2], [f64; 5]) {
+    let mut solref = solref;
+    if (solref[0] > 0.0) != (solref[1] > 0.0) {
+        solref = if friction { [0.0, 0.0] } else { crate::model::equality::DEFAULT_SOLREF };
+    }
+    if model.options.flags.refsafe && solref[0] > 0.0 {
+        solref[0] = solref[0].max(2.0 * model.options.timestep);
+    }
+    let mut s = solimp;
+    s[0] = s[0].clamp(MINIMP, MAXIMP);
+    s[1] = s[1].clamp(MINIMP, MAXIMP);
+    s[2] = s[2].max(0.0);
+    s[3] = s[3].clamp(MINIMP, MAXIMP);
+    s[4] = s[4].max(1.0);
+    (solref, s)
+}
+
+/// (k, b) of `solref` for impedance width dmax (module doc).
+fn stiffness_damping(solref: &[f64; 2], dmax: f64) -> (f64, f64) {
+    let k = if solref[0] > 0.0 {
+        1.0 / (dmax * dmax * solref[0] * solref[0] * solref[1] * solref[1]).max(MINVAL)
+    } else {
+        -solref[0] / (dmax * dmax).max(MINVAL)
+    };
+    let b =
+        if solref[1] > 0.0 { 2.0 / (dmax * solref[0]).max(MINVAL) } else { -solref[1] / dmax.max(MINVAL) };
+    (k, b)
+}
+
+/// `efc_diag_a`: MuJoCo's diagonal approximation of J M⁻¹ Jᵀ per row (`mj_diagApprox`).
+fn diag_approx(model: &Model, w: &InverseWeights, data: &mut Data) {
+    let mut i = 0;
+    while i < data.nefc {
+        let id = data.efc_id[i];
+        let len = data.efc_block_len(i);
+        match data.efc_type[i] {
+            EfcType::Equality => {
+                let eq = &model.equalities[id];
+                let n = eq.kind.nrow();
+                let frames = |f1: usize, f2: usize| (w.of_frame(model, f1), w.of_frame(model, f2));
+                for k in 0..n {
+                    data.efc_diag_a[i + k] = match &eq.kind {
+                        EqualityKind::Connect { frame1, frame2, .. } => {
+                            let (a, b) = frames(*frame1, *frame2);
+                            a[0] + b[0]
+                        }
+                        EqualityKind::Weld { frame1, frame2, .. } => {
+                            let (a, b) = frames(*frame1, *frame2);
+                            let rot = usize::from(k > 2);
+                            a[rot] + b[rot]
+                        }
+                        EqualityKind::Joint { joint1, joint2, .. } => {
+                            let dof = |j: usize| w.dof_invweight0[model.joints[j].dof_adr];
+                            dof(*joint1) + joint2.map_or(0.0, dof)
+                        }
+                        EqualityKind::Mimic { joint, leader, .. } => {
+                            let dof = |j: usize| w.dof_invweight0[model.joints[j].dof_adr];
+                            dof(*joint) + dof(*leader)
+                        }
+                        EqualityKind::Tendon { tendon1, tendon2, .. } => {
+                            w.tendon_invweight0[*tendon1] + tendon2.map_or(0.0, |t| w.tendon_invweight0[t])
+                        }
+                    };
+                }
+                i += n;
+                continue;
+            }
+            EfcType::FrictionDof => data.efc_diag_a[i] = w.dof_invweight0[id],
+            EfcType::LimitJoint => data.efc_diag_a[i] = w.dof_invweight0[model.joints[id].dof_adr],
+            EfcType::LimitTendon => data.efc_diag_a[i] = w.tendon_invweight0[id],
+            kind => {
+                let c = &data.contacts[id];
+                let (mut tran, mut rot) = (0.0, 0.0);
+                for g in c.geom {
+                    let iw = w.frame_invweight0[w.geom_frame[g]];
+                    tran += iw[0];
+                    rot += iw[1];
+                }
+                let dim = c.condim.clamp(1, 6) as usize;
+                match kind {
+                    EfcType::ContactFrictionless => data.efc_diag_a[i] = tran,
+                    EfcType::ContactElliptic => {
+                        for j in 0..dim {
+                            data.efc_diag_a[i + j] = if j < 3 { tran } else { rot };
+                        }
+                    }
+                    _ => {
+                        for j in 0..dim - 1 {
+                            let f = c.friction[j];
+                            let v = tran + f * f * if j < 2 { tran } else { rot };
+                            data.efc_diag_a[i + 2 * j] = v;
+                            data.efc_diag_a[i + 2 * j + 1] = v;
+                        }
+                    }
+                }
+            }
+        }
+        i += len;
+    }
+}
+
+/// `solref`, `solreffriction` (contacts only, else zero) and `solimp` of row `i`.
+fn parameters(model: &Model, data: &Data, i: usize) -> ([f64; 2], [f64; 2], [f64; 5]) {
+    let id = data.efc_id[i];
+    match data.efc_type[i] {
+        EfcType::Equality => {
+            let e = &model.equalities[id];
+            (e.solref, [0.0; 2], e.solimp)
+        }
+        EfcType::LimitJoint => {
+            let s = &model.joints[id].soft;
+            (s.solref_limit, [0.0; 2], s.solimp_limit)
+        }
+        EfcType::LimitTendon => {
+            let s = &model.tendons[id].soft;
+            (s.solref_limit, [0.0; 2], s.solimp_limit)
+        }
+        EfcType::FrictionDof => {
+            let s = &model.joint_of(model.dof_body[id]).soft;
+            (s.solref_friction, [0.0; 2], s.solimp_friction)
+        }
+        _ => {
+            let c = &data.contacts[id];
+            (c.solref, c.solreffriction, c.solimp)
+        }
+    }
+}
+
+/// The row's violation for the impedance and the number of rows sharing it (module doc).
+fn violation(model: &Model, data: &Data, i: usize) -> (f64, usize) {
+    let len = data.efc_block_len(i);
+    match data.efc_type[i] {
+        EfcType::Equality => match model.equalities[data.efc_id[i]].kind {
+            EqualityKind::Connect { .. } => (data.efc_pos.rows(i, 3).norm(), 3),
+            EqualityKind::Weld { .. } => {
+                let n = model.equalities[data.efc_id[i]].kind.nrow();
+                (data.efc_pos.rows(i, n).norm(), n)
+            }
+            _ => (data.efc_pos[i], 1),
+        },
+        _ => (data.efc_pos[i], len),
+    }
+}
+
+/// `efc_diag_a`, `efc_kbip`, `efc_r`, `efc_d`, `contact_mu` and `efc_aref` of the rows of
+/// [`soft_positions`](super::soft_positions) with `efc_vel` and `efc_jdotv`.
+pub fn make_impedance(model: &Model, w: &InverseWeights, data: &mut Data) {
+    diag_approx(model, w, data);
+    let mut i = 0;
+    while i < data.nefc {
+        let kind = data.efc_type[i];
+        let frictional_dof = kind == EfcType::FrictionDof;
+        let (solref, solreffriction, solimp) = parameters(model, data, i);
+        let (solref, solimp) = sanitize(model, solref, solimp, false);
+        let (solreffriction, _) = sanitize(model, solreffriction, solimp, true);
+        let (x, dim) = violation(model, data, i);
+        let (imp, imp_d) = impedance(&solimp, x - data.efc_margin[i]);
+        for j in 0..dim {
+            let r = i + j;
+            data.efc_r[r] = ((1.0 - imp) * data.efc_diag_a[r] / imp).max(MINVAL);
+            let elliptic_friction = kind == EfcType::ContactElliptic && j > 0;
+            let sref = if elliptic_friction && (solreffriction[0] != 0.0 || solreffriction[1] != 0.0) {
+                &solreffriction
+            } else {
+                &solref
+            };
+            let (mut k, b) = stiffness_damping(sref, solimp[1]);
+            if frictional_dof || elliptic_friction {
+                k = 0.0;
+            }
+            data.efc_kbip[r] = [k, b, imp, imp_d];
+        }
+        i += dim;
+    }
+    // Frictional contacts: R of the friction rows and the regularized cone's μ.
+    let mut i = data.ne + data.nf;
+    while i < data.nefc {
+        let kind = data.efc_type[i];
+        let len = data.efc_block_len(i);
+        if matches!(kind, EfcType::ContactElliptic | EfcType::ContactPyramidal) {
+            let c = data.contacts[data.efc_id[i]];
+            let r1 = data.efc_r[i] / model.options.impratio.max(MINVAL);
+            let mu = c.friction[0] * (r1 / data.efc_r[i]).sqrt();
+            data.contact_mu[data.efc_id[i]] = mu;
+            if kind == EfcType::ContactElliptic {
+                data.efc_r[i + 1] = r1;
+                for j in 1..len - 1 {
+                    data.efc_r[i + j + 1] =
+                        r1 * c.friction[0] * c.friction[0] / (c.friction[j] * c.friction[j]);
+                }
+            } else {
+                let rpy = 2.0 * mu * mu * data.efc_r[i];
+                data.efc_r.rows_mut(i, len).fill(rpy);
+            }
+        }
+        i += len;
+    }
+    for i in 0..data.nefc {
+        data.efc_d[i] = 1.0 / data.efc_r[i];
+        let [k, b, imp, _] = data.efc_kbip[i];
+        data.efc_diag_a[i] = data.efc_r[i] * imp / (1.0 - imp);
+        data.efc_aref[i] =
+            -b * data.efc_vel[i] - k * imp * (data.efc_pos[i] - data.efc_margin[i]) - data.efc_jdotv[i];
+    }
+}

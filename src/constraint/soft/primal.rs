@@ -1,0 +1,285 @@
+//! MuJoCo's primal solvers of the soft problem (MuJoCo documentation, "Computation → Solver"):
+//! minimize ½ (a − a₀)ᵀ M (a − a₀) + s(J a − aref) over the acceleration a, with s the piecewise
+//! quadratic constraint cost of [`Rows`]. The problem is convex (strictly, since M ≻ 0), so its
+//! minimizer — and with it every row's force −∂s/∂jar — is unique; any convergent method gives the
+//! same answer to its tolerance.
+//!
+//! - **Newton**: the search direction −H⁻¹ g with H = M + Jᵀ (∂²s) J (D on quadratic rows, the
+//!   cone's block on elliptic contacts in their middle zone), factored by dense Cholesky;
+//! - **CG**: Polak–Ribière conjugate gradients preconditioned by M⁻¹ (the LᵀDL factor of M);
+//!
+//! both with an exact line search along the direction: Newton's method on the convex,
+//! piecewise-smooth one-dimensional cost, safeguarded by bisection of a sign-change bracket.
+//! Termination as MuJoCo's: the scaled improvement of the cost or the scaled gradient norm below
+//! `tolerance`, the scale being 1 / (meaninertia · max(1, nv)).
+
+use super::cost::Rows;
+use crate::constraint::dense::{cholesky, cholesky_solve};
+use crate::dynamics::solve_with_factor;
+use crate::model::{Data, Model};
+use nalgebra::{DMatrix, DVector};
+
+/// Which primal method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Primal {
+    Newton,
+    Cg,
+}
+
+/// Iteration limits and tolerances (MJCF `<option>`).
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    pub iterations: u32,
+    pub tolerance: f64,
+    pub ls_iterations: u32,
+    pub ls_tolerance: f64,
+    pub warmstart: bool,
+    /// 1 / (meaninertia · max(1, nv)).
+    pub scale: f64,
+}
+
+/// r ← J x (rows 0..nefc).
+fn mul_j(j: &DMatrix<f64>, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
+    for i in 0..nefc {
+        let row = j.row(i);
+        r[i] = (0..x.len()).filter(|&k| row[k] != 0.0).map(|k| row[k] * x[k]).sum();
+    }
+}
+
+/// r ← M x for the dense symmetric M.
+fn mul_m(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
+    m.mul_to(x, r);
+}
+
+/// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
+/// `qfrc_smooth`, `qacc_smooth`, the mass matrix and its factor: writes `qacc`, `efc_force`,
+/// `efc_state`, `qfrc_constraint`, `solver_niter`, `solver_improvement`, `solver_gradient`.
+pub fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings) {
+    let nv = model.nv;
+    let nefc = data.nefc;
+    let Data {
+        efc_j,
+        efc_type,
+        efc_id,
+        efc_d,
+        efc_r,
+        efc_frictionloss,
+        efc_aref,
+        efc_force,
+        efc_state,
+        contacts,
+        contact_mu,
+        soft,
+        mass_matrix,
+        mass_factor,
+        qacc,
+        qacc_smooth,
+        qacc_warmstart,
+        qfrc_smooth,
+        qfrc_constraint,
+        ne,
+        nf,
+        ..
+    } = data;
+    let rows = Rows {
+        ne: *ne,
+        nf: *nf,
+        nefc,
+        kind: efc_type,
+        id: efc_id,
+        d: efc_d,
+        r: efc_r,
+        floss: efc_frictionloss,
+        contacts,
+        mu: contact_mu,
+    };
+    // The total cost at x (fills ma, jar, force, state).
+    let total = |x: &DVector<f64>,
+                 ma: &mut DVector<f64>,
+                 jar: &mut DVector<f64>,
+                 force: &mut DVector<f64>,
+                 state: &mut [_]| {
+        mul_m(mass_matrix, x, ma);
+        mul_j(efc_j, nefc, x, jar);
+        for i in 0..nefc {
+            jar[i] -= efc_aref[i];
+        }
+        let gauss: f64 = (0..nv).map(|k| 0.5 * (x[k] - qacc_smooth[k]) * (ma[k] - qfrc_smooth[k])).sum();
+        gauss + rows.update(jar, force, state)
+    };
+    // Start: the warm start (the previous solution) if it costs less than qacc_smooth.
+    qacc.copy_from(qacc_smooth);
+    let mut cost = total(qacc, &mut soft.ma, &mut soft.jar, efc_force, efc_state);
+    if s.warmstart {
+        let c = total(qacc_warmstart, &mut soft.mdir, &mut soft.jv, &mut soft.jar_trial, efc_state);
+        if c < cost {
+            qacc.copy_from(qacc_warmstart);
+            cost = total(qacc, &mut soft.ma, &mut soft.jar, efc_force, efc_state);
+        } else {
+            cost = total(qacc, &mut soft.ma, &mut soft.jar, efc_force, efc_state);
+        }
+    }
+    let mut improvement = f64::INFINITY;
+    let mut gradient;
+    let mut iter = 0;
+    let mut have_dir = false;
+    loop {
+        // g = M a − qfrc_smooth − Jᵀ f.
+        for k in 0..nv {
+            soft.grad[k] = soft.ma[k] - qfrc_smooth[k];
+        }
+        for i in 0..nefc {
+            let f = efc_force[i];
+            if f != 0.0 {
+                let row = efc_j.row(i);
+                for k in 0..nv {
+                    soft.grad[k] -= row[k] * f;
+                }
+            }
+        }
+        gradient = s.scale * soft.grad.norm();
+        if gradient < s.tolerance || improvement < s.tolerance || iter >= s.iterations {
+            break;
+        }
+        iter += 1;
+        match method {
+            Primal::Newton => {
+                let h = &mut soft.hessian;
+                h.copy_from(mass_matrix);
+                rows.hessian(&soft.jar, efc_state, |a, b, w| {
+                    let (ra, rb) = (efc_j.row(a), efc_j.row(b));
+                    for p in 0..nv {
+                        let x = w * ra[p];
+                        if x != 0.0 {
+                            for q in 0..nv {
+                                h[(p, q)] += x * rb[q];
+                            }
+                        }
+                    }
+                });
+                soft.dir.copy_from(&soft.grad);
+                if cholesky(&soft.hessian, nv, &mut soft.factor, 0.0) {
+                    cholesky_solve(&soft.factor, nv, soft.dir.as_mut_slice());
+                } else {
+                    solve_with_factor(model, mass_factor, soft.dir.as_mut_slice());
+                }
+                soft.dir.neg_mut();
+            }
+            Primal::Cg => {
+                soft.mgrad.copy_from(&soft.grad);
+                solve_with_factor(model, mass_factor, soft.mgrad.as_mut_slice());
+                let beta = if have_dir {
+                    let den = soft.grad_prev.dot(&soft.mgrad_prev);
+                    let num: f64 = (0..nv).map(|k| soft.grad[k] * (soft.mgrad[k] - soft.mgrad_prev[k])).sum();
+                    if den > 0.0 {
+                        (num / den).max(0.0)
+                    } else {
+                        0.0
+                    }
+                } else {
+                    0.0
+                };
+                for k in 0..nv {
+                    soft.dir[k] = -soft.mgrad[k] + beta * soft.dir[k];
+                }
+                soft.grad_prev.copy_from(&soft.grad);
+                soft.mgrad_prev.copy_from(&soft.mgrad);
+                have_dir = true;
+            }
+        }
+        mul_j(efc_j, nefc, &soft.dir, &mut soft.jv);
+        mul_m(mass_matrix, &soft.dir, &mut soft.mdir);
+        let g0: f64 = (0..nv).map(|k| (soft.ma[k] - qfrc_smooth[k]) * soft.dir[k]).sum();
+        let dmd = soft.dir.dot(&soft.mdir);
+        let alpha = line_search(&rows, &soft.jar, &soft.jv, &mut soft.jar_trial, g0, dmd, s);
+        if alpha == 0.0 {
+            // No descent along the direction (the minimum to round-off).
+            break;
+        }
+        qacc.axpy(alpha, &soft.dir, 1.0);
+        let new_cost = total(qacc, &mut soft.ma, &mut soft.jar, efc_force, efc_state);
+        improvement = s.scale * (cost - new_cost);
+        cost = new_cost;
+    }
+    // qfrc_constraint = Jᵀ f.
+    qfrc_constraint.fill(0.0);
+    for i in 0..nefc {
+        let f = efc_force[i];
+        if f != 0.0 {
+            for k in 0..nv {
+                qfrc_constraint[k] += f * efc_j[(i, k)];
+            }
+        }
+    }
+    data.solver_niter = iter;
+    data.solver_improvement = if improvement.is_finite() { improvement } else { 0.0 };
+    data.solver_gradient = gradient;
+}
+
+/// The step α ≥ 0 minimizing the cost along the direction: g0 + α dmd + ds/dα = 0 with ds/dα
+/// from [`Rows::directional`] at jar + α jv (`trial` is scratch). Returns 0 if the direction does
+/// not descend.
+fn line_search(
+    rows: &Rows,
+    jar: &DVector<f64>,
+    jv: &DVector<f64>,
+    trial: &mut DVector<f64>,
+    g0: f64,
+    dmd: f64,
+    s: Settings,
+) -> f64 {
+    let n = rows.nefc;
+    let mut deriv = |alpha: f64| {
+        for i in 0..n {
+            trial[i] = jar[i] + alpha * jv[i];
+        }
+        let (d1, d2) = rows.directional(trial, jv);
+        (g0 + alpha * dmd + d1, dmd + d2)
+    };
+    let (f0, h0) = deriv(0.0);
+    if f0 >= 0.0 || !f0.is_finite() {
+        return 0.0;
+    }
+    let tol = s.ls_tolerance * f0.abs();
+    let (mut lo, mut f_lo) = (0.0, f0);
+    let (mut hi, mut f_hi) = (f64::INFINITY, f64::NAN);
+    let mut alpha = if h0 > 0.0 { -f0 / h0 } else { 1.0 };
+    for _ in 0..s.ls_iterations.max(1) {
+        let (f, h) = deriv(alpha);
+        if f.abs() <= tol {
+            return alpha;
+        }
+        if f < 0.0 {
+            lo = alpha;
+            f_lo = f;
+        } else {
+            hi = alpha;
+            f_hi = f;
+        }
+        let newton = if h > 0.0 { alpha - f / h } else { f64::NAN };
+        alpha = if newton > lo && newton < hi {
+            newton
+        } else if hi.is_finite() {
+            let secant = lo - f_lo * (hi - lo) / (f_hi - f_lo);
+            if secant > lo && secant < hi {
+                secant
+            } else {
+                0.5 * (lo + hi)
+            }
+        } else {
+            2.0 * alpha.max(lo)
+        };
+        if hi.is_finite() && hi - lo <= 1e-15 * hi {
+            break;
+        }
+    }
+    if lo > 0.0 {
+        lo
+    } else if hi.is_finite() {
+        // Every trial overshot: the smallest tried step still lowers the cost of a convex
+        // function whose slope at 0 is negative only if the minimum lies beyond; keep hi/2 steps.
+        0.5 * hi
+    } else {
+        alpha
+    }
+}

@@ -1,0 +1,356 @@
+//! The rows of the soft (MuJoCo-compatible) mode, in MuJoCo's order and with MuJoCo's activation
+//! rules (MuJoCo documentation, "Computation → Constraint model"; MuJoCo's
+//! `mj_instantiateEquality`, `mj_instantiateFriction`, `mj_instantiateLimit`,
+//! `mj_instantiateContact`):
+//!
+//! - equality: the rows of the exact mode, except that a weld's rotation rows are MuJoCo's
+//!   quaternion error r = s · imag(q_B⁻¹ q_A) with J = s · ½ imag(q_B⁻¹ (0, ω_A − ω_B) q_A)
+//!   (s = `torquescale`, q_A the orientation frame A must have, q_B that of frame B);
+//! - friction loss: one row per dof, always present, its bound in `efc_frictionloss`;
+//! - limits: a hinge or slide row for each bound with distance below the joint's `margin` (both
+//!   bounds can be active at once), a ball joint's cone row likewise; `efc_margin` = margin;
+//! - contacts: every contact closer than its `includemargin` (margin − gap). condim 1 gives one
+//!   frictionless row; with friction, the pyramidal cone (`<option cone="pyramidal">`, MuJoCo's
+//!   default) gives 2(d − 1) rows J_n ± μ_i J_i, the elliptic cone d rows (normal, tangents,
+//!   torsion, rolling). The normal (or every pyramidal) row has `efc_pos` = dist.
+//!
+//! `efc_vel` = J v for every row; `efc_jdotv` is J̇ v of connect and weld rows (MuJoCo 4
+//! subtracts it from their reference acceleration), 0 elsewhere.
+
+use crate::constraint::limits::{ball_angle_axis, LimitKind};
+use crate::constraint::rows::{point_motion, RowGeometry};
+use crate::constraint::ConstraintModel;
+use crate::kinematics::{bias_accelerations, for_each_ancestor_dof};
+use crate::model::{options::Cone, Data, EfcType, Model, TendonKind};
+use crate::spatial::{Mat3, Transform, Vec3};
+
+/// A quaternion [w, x, y, z] and the Hamilton product.
+type Quat = [f64; 4];
+
+fn qmul(a: &Quat, b: &Quat) -> Quat {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+fn conj(q: &Quat) -> Quat {
+    [q[0], -q[1], -q[2], -q[3]]
+}
+
+fn pure(v: &Vec3) -> Quat {
+    [0.0, v[0], v[1], v[2]]
+}
+
+/// The world orientations (quaternions) of a weld's frames A (where frame B must be) and B.
+fn weld_quats(data: &Data, a: usize, x_a: &Transform, b: usize, x_b: &Transform) -> (Quat, Quat) {
+    let qa = (data.x_world_body[a] * *x_a).quat_wxyz();
+    let qb = (data.x_world_body[b] * *x_b).quat_wxyz();
+    (qa, qb)
+}
+
+/// The 3 × 3 map ω ↦ ½ imag(q_B⁻¹ (0, ω) q_A) of a weld's rotation Jacobian.
+fn weld_rotation_map(qa: &Quat, qb_inv: &Quat) -> Mat3 {
+    let mut t = Mat3::zeros();
+    for k in 0..3 {
+        let mut e = Vec3::zeros();
+        e[k] = 1.0;
+        let p = qmul(&qmul(qb_inv, &pure(&e)), qa);
+        for i in 0..3 {
+            t[(i, k)] = 0.5 * p[i + 1];
+        }
+    }
+    t
+}
+
+/// Upper bound on the soft rows at the current contacts.
+fn row_bound(cm: &ConstraintModel, model: &Model, data: &Data) -> usize {
+    let eq: usize = cm
+        .equalities
+        .iter()
+        .filter(|e| data.eq_active[e.id])
+        .map(|e| model.equalities[e.id].kind.nrow())
+        .sum();
+    let contacts: usize = data.contacts.iter().map(|c| 2 * (c.condim.clamp(1, 6) as usize)).sum();
+    let tendons = 2 * model.tendons.iter().filter(|t| t.range.is_some()).count();
+    eq + cm.friction.len() + 2 * cm.limits.len() + tendons + contacts
+}
+
+/// Writes the soft rows at configuration `q` (body poses and motion subspaces at q, and
+/// `Data::contacts` from a collision pass at q): `nefc`, `ne`, `nf`, `efc_type`, `efc_id`,
+/// `efc_j`, `efc_pos`, `efc_margin`, `efc_frictionloss`.
+pub fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f64], cone: Cone) {
+    data.reserve_rows(row_bound(cm, model, data));
+    let ne = cm.equality_rows(model, data, q);
+    data.efc_margin.rows_mut(0, ne).fill(0.0);
+    data.efc_frictionloss.rows_mut(0, ne).fill(0.0);
+    // MuJoCo's weld rotation rows.
+    let mut r = 0;
+    for e in &cm.equalities {
+        if !data.eq_active[e.id] {
+            continue;
+        }
+        let n = model.equalities[e.id].kind.nrow();
+        if let RowGeometry::Frames { a, x_a, b, x_b, torquescale } = &e.geometry {
+            if n == 6 {
+                let (qa, qb) = weld_quats(data, *a, x_a, *b, x_b);
+                let qb_inv = conj(&qb);
+                let err = qmul(&qb_inv, &qa);
+                for k in 0..3 {
+                    data.efc_pos[r + 3 + k] = torquescale * err[k + 1];
+                }
+                // The rows hold s (J_ω,A − J_ω,B): map each column.
+                let t = weld_rotation_map(&qa, &qb_inv);
+                for c in 0..model.nv {
+                    let w = Vec3::new(data.efc_j[(r + 3, c)], data.efc_j[(r + 4, c)], data.efc_j[(r + 5, c)]);
+                    if w != Vec3::zeros() {
+                        let m = t * w;
+                        for k in 0..3 {
+                            data.efc_j[(r + 3 + k, c)] = m[k];
+                        }
+                    }
+                }
+            }
+        }
+        r += n;
+    }
+    let mut r = ne;
+    for f in &cm.friction {
+        f.write_row(data, r);
+        data.efc_margin[r] = 0.0;
+        data.efc_frictionloss[r] = f.loss;
+        r += 1;
+    }
+    let nf = r - ne;
+    for l in &cm.limits {
+        let margin = model.joints[l.joint].soft.margin;
+        let push = |data: &mut Data, r: &mut usize, dist: f64, dofs: &[(usize, f64)]| {
+            data.efc_id[*r] = l.joint;
+            data.efc_type[*r] = EfcType::LimitJoint;
+            data.efc_j.row_mut(*r).fill(0.0);
+            for &(d, c) in dofs {
+                data.efc_j[(*r, d)] = c;
+            }
+            data.efc_pos[*r] = dist;
+            data.efc_margin[*r] = margin;
+            data.efc_frictionloss[*r] = 0.0;
+            *r += 1;
+        };
+        match l.kind {
+            LimitKind::Scalar { range } => {
+                let x = q[l.qpos_adr];
+                if x - range[0] < margin {
+                    push(data, &mut r, x - range[0], &[(l.dof_adr, 1.0)]);
+                }
+                if range[1] - x < margin {
+                    push(data, &mut r, range[1] - x, &[(l.dof_adr, -1.0)]);
+                }
+            }
+            LimitKind::Cone { max_angle } => {
+                let qq = &q[l.qpos_adr..l.qpos_adr + 4];
+                let norm = qq.iter().map(|x| x * x).sum::<f64>().sqrt();
+                let unit = [qq[0] / norm, qq[1] / norm, qq[2] / norm, qq[3] / norm];
+                let (angle, axis) = ball_angle_axis(&unit);
+                let dist = max_angle - angle;
+                if dist < margin {
+                    let d = l.dof_adr;
+                    push(data, &mut r, dist, &[(d, -axis[0]), (d + 1, -axis[1]), (d + 2, -axis[2])]);
+                }
+            }
+        }
+    }
+    if model.options.flags.limit {
+        r = tendon_limit_rows(model, data, q, r);
+    }
+    data.nefc = contact_rows(model, data, r, cone);
+    data.ne = ne;
+    data.nf = nf;
+}
+
+/// The limit rows of fixed tendons from row `r` on (MuJoCo's `mj_instantiateLimit`: a row per
+/// bound closer than the tendon's margin, J = ±∂L/∂q); returns the next free row.
+fn tendon_limit_rows(model: &Model, data: &mut Data, q: &[f64], mut r: usize) -> usize {
+    for (t, tendon) in model.tendons.iter().enumerate() {
+        let (Some(range), TendonKind::Fixed { joints }) = (tendon.range, &tendon.kind) else { continue };
+        let length = fixed_length(model, joints, q);
+        let margin = tendon.soft.margin;
+        for (dist, sign) in [(length - range[0], 1.0), (range[1] - length, -1.0)] {
+            if dist < margin {
+                data.efc_id[r] = t;
+                data.efc_type[r] = EfcType::LimitTendon;
+                data.efc_j.row_mut(r).fill(0.0);
+                for &(j, c) in joints {
+                    data.efc_j[(r, model.joints[j].dof_adr)] += sign * c;
+                }
+                data.efc_pos[r] = dist;
+                data.efc_margin[r] = margin;
+                data.efc_frictionloss[r] = 0.0;
+                r += 1;
+            }
+        }
+    }
+    r
+}
+
+/// The length Σ coef · q of a fixed tendon.
+fn fixed_length(model: &Model, joints: &[(usize, f64)], q: &[f64]) -> f64 {
+    joints.iter().map(|&(j, c)| c * q[model.joints[j].qpos_adr]).sum()
+}
+
+/// The contact rows from row `r` on; returns the next free row.
+fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usize {
+    for c in 0..data.contacts.len() {
+        let contact = data.contacts[c];
+        if contact.dist >= contact.includemargin {
+            continue;
+        }
+        let dim = contact.condim.clamp(1, 6) as usize;
+        // The contact-frame Jacobian rows (normal, tangents, torsion, rolling) in rows r..r+dim.
+        let f = contact.frame;
+        let dirs = [f.row(0).transpose(), f.row(1).transpose(), f.row(2).transpose()];
+        let bodies = [model.geoms[contact.geom[0]].body, model.geoms[contact.geom[1]].body];
+        let rows = if dim == 1 || cone == Cone::Elliptic { dim } else { 2 * (dim - 1) };
+        for i in r..r + rows.max(dim) {
+            data.efc_j.row_mut(i).fill(0.0);
+        }
+        {
+            let p = contact.pos;
+            let Data { efc_j, x_world_body, s_body, .. } = data;
+            for (body, sign) in bodies.into_iter().zip([-1.0, 1.0]) {
+                for_each_ancestor_dof(model, x_world_body, s_body, body, |k, s_world| {
+                    let lin = s_world.lin + s_world.ang.cross(&p);
+                    for i in 0..dim {
+                        let value = if i < 3 { dirs[i].dot(&lin) } else { dirs[i - 3].dot(&s_world.ang) };
+                        efc_j[(r + i, k)] += sign * value;
+                    }
+                });
+            }
+        }
+        let kind = if dim == 1 {
+            EfcType::ContactFrictionless
+        } else if cone == Cone::Elliptic {
+            EfcType::ContactElliptic
+        } else {
+            // Pyramid edges J_n ± μ_i J_i, in place from the last pair down (row r + 2k − 2 and
+            // r + 2k − 1 for friction direction k; direction k ≥ 1 sits in row r + k, which the
+            // pairs below it have not overwritten yet).
+            for k in (1..dim).rev() {
+                let mu = contact.friction[k - 1];
+                for col in 0..model.nv {
+                    let (n, t) = (data.efc_j[(r, col)], data.efc_j[(r + k, col)]);
+                    data.efc_j[(r + 2 * k - 2, col)] = n + mu * t;
+                    data.efc_j[(r + 2 * k - 1, col)] = n - mu * t;
+                }
+            }
+            EfcType::ContactPyramidal
+        };
+        for i in r..r + rows {
+            data.efc_id[i] = c;
+            data.efc_type[i] = kind;
+            let first = i == r || kind == EfcType::ContactPyramidal;
+            data.efc_pos[i] = if first { contact.dist } else { 0.0 };
+            data.efc_margin[i] = if first { contact.includemargin } else { 0.0 };
+            data.efc_frictionloss[i] = 0.0;
+        }
+        r += rows;
+    }
+    r
+}
+
+/// `efc_vel` = J v of every row and `efc_jdotv` of connect and weld rows (0 elsewhere), at the
+/// state of [`soft_positions`]. Needs the body velocities (`v_body`).
+pub fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Data, v: &[f64]) {
+    for r in 0..data.nefc {
+        let row = data.efc_j.row(r);
+        data.efc_vel[r] = (0..model.nv).filter(|&k| row[k] != 0.0).map(|k| row[k] * v[k]).sum();
+    }
+    data.efc_jdotv.rows_mut(0, data.nefc).fill(0.0);
+    if data.ne == 0 {
+        return;
+    }
+    bias_accelerations(model, data, v);
+    let mut r = 0;
+    for e in &cm.equalities {
+        if !data.eq_active[e.id] {
+            continue;
+        }
+        let n = model.equalities[e.id].kind.nrow();
+        match &e.geometry {
+            RowGeometry::Points { a, r_a, b, r_b } => {
+                let (_, aa, _) = point_motion(data, *a, r_a);
+                let (_, ab, _) = point_motion(data, *b, r_b);
+                for k in 0..3 {
+                    data.efc_jdotv[r + k] = aa[k] - ab[k];
+                }
+            }
+            RowGeometry::Frames { a, x_a, b, x_b, torquescale } => {
+                let (_, aa, (wa, alpha_a)) = point_motion(data, *a, &x_a.pos);
+                let (_, ab, (wb, alpha_b)) = point_motion(data, *b, &x_b.pos);
+                for k in 0..3 {
+                    data.efc_jdotv[r + k] = aa[k] - ab[k];
+                }
+                if n == 6 {
+                    // d/dt of ½ imag(q_B⁻¹ (ω_A − ω_B) q_A), the quaternion rates of world
+                    // angular velocities being q̇ = ½ (0, ω) q (MuJoCo 4.0's J̇v is this exact
+                    // derivative: it matches central differences of its Jacobian).
+                    let (qa, qb) = weld_quats(data, *a, x_a, *b, x_b);
+                    let qb_inv = conj(&qb);
+                    let dw = pure(&(wa - wb));
+                    let dalpha = pure(&(alpha_a - alpha_b));
+                    let half = |q: &Quat, w: &Vec3| qmul(&pure(&(w * 0.5)), q);
+                    let qa_dot = half(&qa, &wa);
+                    let qb_inv_dot = conj(&half(&qb, &wb));
+                    let t1 = qmul(&qmul(&qb_inv_dot, &dw), &qa);
+                    let t2 = qmul(&qmul(&qb_inv, &dalpha), &qa);
+                    let t3 = qmul(&qmul(&qb_inv, &dw), &qa_dot);
+                    for k in 0..3 {
+                        data.efc_jdotv[r + 3 + k] = 0.5 * torquescale * (t1[k + 1] + t2[k + 1] + t3[k + 1]);
+                    }
+                }
+            }
+            RowGeometry::Scalar { .. } => {}
+        }
+        r += n;
+    }
+}
+
+/// Collision at `q` with MuJoCo's reach (contacts within each pair's margin) and whether any soft
+/// row exists there: an active equality, a friction-loss dof, a joint within its margin of a
+/// bound, or a contact closer than its `includemargin`. `forward` takes the ABA path when none
+/// does.
+pub fn soft_active(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f64]) -> bool {
+    let mut active = !cm.friction.is_empty() || cm.equalities.iter().any(|e| data.eq_active[e.id]);
+    if cm.has_collision() {
+        crate::kinematics::body_poses(model, data, q);
+        crate::collision::collide(model, &cm.collision, data, 0.0);
+        active |= data.contacts.iter().any(|c| c.dist < c.includemargin);
+    }
+    let tendon_limit = model.options.flags.limit
+        && model.tendons.iter().any(|t| match (&t.kind, t.range) {
+            (TendonKind::Fixed { joints }, Some(range)) => {
+                let length = fixed_length(model, joints, q);
+                length - range[0] < t.soft.margin || range[1] - length < t.soft.margin
+            }
+            _ => false,
+        });
+    active
+        || tendon_limit
+        || cm.limits.iter().any(|l| {
+            let margin = model.joints[l.joint].soft.margin;
+            match l.kind {
+                LimitKind::Scalar { range } => {
+                    let x = q[l.qpos_adr];
+                    x - range[0] < margin || range[1] - x < margin
+                }
+                LimitKind::Cone { max_angle } => {
+                    let qq = &q[l.qpos_adr..l.qpos_adr + 4];
+                    let norm = qq.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    let (angle, _) =
+                        ball_angle_axis(&[qq[0] / norm, qq[1] / norm, qq[2] / norm, qq[3] / norm]);
+                    max_angle - angle < margin
+                }
+            }
+        })
+}
