@@ -349,7 +349,7 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
                 "{npairs} candidate geom pairs ({} explicit <pair>) among {colliding} collision geoms, up to {bound} contacts: bounding spheres, then closed forms (planes, spheres, capsules) or GJK/EPA; {}{hfield_note}",
                 model.collision_pairs.iter().filter(|p| p.pair.is_some()).count(),
                 if mode == ConstraintMode::Soft {
-                    "soft mode: rows for contacts closer than margin − gap"
+                    "soft mode: rows for contacts closer than their margin (detected to margin + gap)"
                 } else {
                     "exact mode: contact rows while touching"
                 }

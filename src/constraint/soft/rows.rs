@@ -9,7 +9,7 @@
 //! - friction loss: one row per dof, always present, its bound in `efc_frictionloss`;
 //! - limits: a hinge or slide row for each bound with distance below the joint's `margin` (both
 //!   bounds can be active at once), a ball joint's cone row likewise; `efc_margin` = margin;
-//! - contacts: every contact closer than its `includemargin` (margin − gap). condim 1 gives one
+//! - contacts: every contact closer than its `includemargin` (the pair's margin). condim 1 gives one
 //!   frictionless row; with friction, the pyramidal cone (`<option cone="pyramidal">`, MuJoCo's
 //!   default) gives 2(d − 1) rows J_n ± μ_i J_i, the elliptic cone d rows (normal, tangents,
 //!   torsion, rolling). The normal (or every pyramidal) row has `efc_pos` = dist.

@@ -65,6 +65,8 @@ pub struct Summary {
     /// changes), and the iterative solves that
     /// stopped at the iteration limit with the largest residual they left.
     pub max_solver_iterations: u32,
+    /// Whether the soft (MuJoCo-compatible) constraint model ran (nothing is projected then).
+    pub soft: bool,
     pub unconverged: (u64, f64),
     /// Smallest rank deficiency seen: (rank, rows) of J M⁻¹ Jᵀ when rows were redundant.
     pub redundant: Option<(usize, usize)>,
@@ -229,10 +231,12 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         let (contacts, penetration) = contact_summary(&sim.data);
         max_contacts = max_contacts.max(contacts);
         max_penetration = max_penetration.max(penetration);
-        max_iterations = max_iterations.max(sim.data.efc_iterations);
+        let soft = sim.plan.soft.is_some();
+        max_iterations =
+            max_iterations.max(if soft { report.solver_iterations } else { sim.data.efc_iterations });
         max_violation = [max_violation[0].max(violation[0]), max_violation[1].max(violation[1])];
         let active = sim.data.efc_active.len();
-        if sim.data.nefc > 0 && sim.data.efc_rank < active {
+        if !soft && sim.data.nefc > 0 && sim.data.efc_rank < active {
             redundant = Some((sim.data.efc_rank, active));
         }
         // Energy monitoring is outside the timed step.
@@ -267,6 +271,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         max_penetration,
         max_contacts,
         max_solver_iterations: max_iterations,
+        soft: sim.plan.soft.is_some(),
         unconverged: (sim.data.efc_unconverged, sim.data.efc_unconverged_residual),
         redundant,
         steps,
@@ -399,7 +404,9 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
             "constraint violation: max |φ| {:.3e} (limits: penetration), max |J v| {:.3e} (limits: approach speed) after each step ({})",
             s.max_violation[0],
             s.max_violation[1],
-            if request.drift.projection {
+            if s.soft {
+                "soft constraints: nothing is projected, as in MuJoCo"
+            } else if request.drift.projection {
                 "projected onto φ = 0, J v = 0 after each step"
             } else {
                 "no projection"
