@@ -32,18 +32,23 @@ fn damped_double_pendulum_with(kind: Option<IntegratorKind>, eulerdamp: bool) ->
     sim
 }
 
-#[test]
-fn implicitfast_matches_mujoco_mj_step_on_damped_double_pendulum() {
-    let mut sim = damped_double_pendulum(None);
-    assert_eq!(sim.stepper.name(), "implicitfast", "notes: {:?}", sim.notes);
-    assert_eq!(sim.timestep, 0.01);
+/// 100 steps of `sim`, then q and v against MuJoCo's golden values.
+fn assert_matches_mujoco(mut sim: Simulation, label: &str) {
     for _ in 0..100 {
         sim.step().unwrap();
     }
     let eq = rel_err_vec(sim.state.q.as_slice(), &MUJOCO_QPOS);
     let ev = rel_err_vec(sim.state.v.as_slice(), &MUJOCO_QVEL);
-    println!("implicitfast vs MuJoCo after 100 steps: q rel {eq:.2e}, v rel {ev:.2e}");
-    assert!(eq <= REF_REL && ev <= REF_REL, "q {eq}, v {ev}");
+    println!("{label} vs MuJoCo after 100 steps: q rel {eq:.2e}, v rel {ev:.2e}");
+    assert!(eq <= REF_REL && ev <= REF_REL, "{label}: q {eq}, v {ev}");
+}
+
+#[test]
+fn implicitfast_matches_mujoco_mj_step_on_damped_double_pendulum() {
+    let sim = damped_double_pendulum(None);
+    assert_eq!(sim.stepper.name(), "implicitfast", "notes: {:?}", sim.notes);
+    assert_eq!(sim.timestep, 0.01);
+    assert_matches_mujoco(sim, "implicitfast");
 }
 
 /// MuJoCo's Euler integrates joint damping implicitly (`<flag eulerdamp>`, on by default): on this
@@ -51,14 +56,7 @@ fn implicitfast_matches_mujoco_mj_step_on_damped_double_pendulum() {
 /// `mj_step` with `integrator="Euler"` gives the same golden values.
 #[test]
 fn euler_with_eulerdamp_matches_mujoco_mj_step_on_damped_double_pendulum() {
-    let mut sim = damped_double_pendulum(Some(IntegratorKind::Euler));
-    for _ in 0..100 {
-        sim.step().unwrap();
-    }
-    let eq = rel_err_vec(sim.state.q.as_slice(), &MUJOCO_QPOS);
-    let ev = rel_err_vec(sim.state.v.as_slice(), &MUJOCO_QVEL);
-    println!("Euler (eulerdamp) vs MuJoCo after 100 steps: q rel {eq:.2e}, v rel {ev:.2e}");
-    assert!(eq <= REF_REL && ev <= REF_REL, "q {eq}, v {ev}");
+    assert_matches_mujoco(damped_double_pendulum(Some(IntegratorKind::Euler)), "Euler (eulerdamp)");
 }
 
 /// The same scene and step with semi-implicit Euler explicit in the damping (`eulerdamp` off):

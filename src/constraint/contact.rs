@@ -26,7 +26,7 @@
 
 use crate::kinematics::{for_each_ancestor_dof, point_bias_acceleration};
 use crate::model::spec::Shape;
-use crate::model::{Data, EfcType, Model};
+use crate::model::{Contact, Data, EfcType, Model};
 use crate::spatial::Vec3;
 
 /// Distance (m) up to which a contact carries a row in exact mode: touching, up to the round-off
@@ -69,23 +69,31 @@ pub(crate) fn contact_rows(model: &Model, data: &mut Data, mut r: usize, frictio
             data.efc_j.row_mut(i).fill(0.0);
         }
         data.efc_pos[r] = contact.dist;
-        let p = contact.pos;
-        let f = contact.frame;
-        let dirs = [f.row(0).transpose(), f.row(1).transpose(), f.row(2).transpose()];
-        let bodies = [model.geoms[contact.geom[0]].body, model.geoms[contact.geom[1]].body];
-        let Data { efc_j, x_world_body, s_body, .. } = data;
-        for (body, sign) in bodies.into_iter().zip([-1.0, 1.0]) {
-            for_each_ancestor_dof(model, x_world_body, s_body, body, |k, s_world| {
-                let lin = s_world.lin + s_world.ang.cross(&p);
-                for i in 0..dim {
-                    let value = if i < 3 { dirs[i].dot(&lin) } else { dirs[i - 3].dot(&s_world.ang) };
-                    efc_j[(r + i, k)] += sign * value;
-                }
-            });
-        }
+        add_contact_jacobian(model, data, &contact, r, dim);
         r += dim;
     }
     r
+}
+
+/// Adds the contact-frame Jacobian of `contact` (normal, tangents, then torsion and rolling: the
+/// relative velocity of geom 2's body over geom 1's at the contact point, in the contact frame)
+/// to rows r..r+dim of `efc_j` (MuJoCo's `mj_contactJacobian`). Needs body poses and motion
+/// subspaces.
+pub(crate) fn add_contact_jacobian(model: &Model, data: &mut Data, contact: &Contact, r: usize, dim: usize) {
+    let p = contact.pos;
+    let f = contact.frame;
+    let dirs = [f.row(0).transpose(), f.row(1).transpose(), f.row(2).transpose()];
+    let bodies = [model.geoms[contact.geom[0]].body, model.geoms[contact.geom[1]].body];
+    let Data { efc_j, x_world_body, s_body, .. } = data;
+    for (body, sign) in bodies.into_iter().zip([-1.0, 1.0]) {
+        for_each_ancestor_dof(model, x_world_body, s_body, body, |k, s_world| {
+            let lin = s_world.lin + s_world.ang.cross(&p);
+            for i in 0..dim {
+                let value = if i < 3 { dirs[i].dot(&lin) } else { dirs[i - 3].dot(&s_world.ang) };
+                efc_j[(r + i, k)] += sign * value;
+            }
+        });
+    }
 }
 
 /// `efc_jdotv` of the contact rows r..r+dim of contact `c` (needs `bias_accelerations` at the

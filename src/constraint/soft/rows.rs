@@ -17,10 +17,11 @@
 //! `efc_vel` = J v for every row; `efc_jdotv` is J̇ v of connect and weld rows (MuJoCo 4
 //! subtracts it from their reference acceleration), 0 elsewhere.
 
+use crate::constraint::contact::add_contact_jacobian;
 use crate::constraint::limits::{ball_angle_axis, LimitKind};
 use crate::constraint::rows::{point_motion, RowGeometry};
 use crate::constraint::ConstraintModel;
-use crate::kinematics::{bias_accelerations, for_each_ancestor_dof};
+use crate::kinematics::bias_accelerations;
 use crate::model::{options::Cone, Data, EfcType, Model, TendonKind};
 use crate::spatial::{Mat3, Transform, Vec3};
 
@@ -208,26 +209,11 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
         }
         let dim = contact.condim.clamp(1, 6) as usize;
         // The contact-frame Jacobian rows (normal, tangents, torsion, rolling) in rows r..r+dim.
-        let f = contact.frame;
-        let dirs = [f.row(0).transpose(), f.row(1).transpose(), f.row(2).transpose()];
-        let bodies = [model.geoms[contact.geom[0]].body, model.geoms[contact.geom[1]].body];
         let rows = if dim == 1 || cone == Cone::Elliptic { dim } else { 2 * (dim - 1) };
         for i in r..r + rows.max(dim) {
             data.efc_j.row_mut(i).fill(0.0);
         }
-        {
-            let p = contact.pos;
-            let Data { efc_j, x_world_body, s_body, .. } = data;
-            for (body, sign) in bodies.into_iter().zip([-1.0, 1.0]) {
-                for_each_ancestor_dof(model, x_world_body, s_body, body, |k, s_world| {
-                    let lin = s_world.lin + s_world.ang.cross(&p);
-                    for i in 0..dim {
-                        let value = if i < 3 { dirs[i].dot(&lin) } else { dirs[i - 3].dot(&s_world.ang) };
-                        efc_j[(r + i, k)] += sign * value;
-                    }
-                });
-            }
-        }
+        add_contact_jacobian(model, data, &contact, r, dim);
         let kind = if dim == 1 {
             EfcType::ContactFrictionless
         } else if cone == Cone::Elliptic {
