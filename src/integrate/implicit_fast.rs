@@ -14,7 +14,7 @@
 
 use super::{correct_drift, State, StepReport, Stepper};
 use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
-use crate::forward::{forward, Plan};
+use crate::forward::{advance_activations, forward, Plan};
 use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
@@ -46,7 +46,10 @@ impl Stepper for ImplicitFast {
         1
     }
     fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
+        data.act.copy_from(&state.act);
         forward(model, plan, data, state.q.as_slice(), state.v.as_slice());
+        // Activations as in MuJoCo's `mj_advance` (explicit in act_dot; filterexact exact).
+        advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         if model.has_damping() {
             crba(model, data, state.q.as_slice());
             self.force.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);

@@ -279,6 +279,17 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     model.contact_excludes = e.contact_excludes;
     model.elements.append(&mut e.kept);
     model.warnings.append(&mut e.warnings);
+    // Actuators of kinds the actuation stage does not simulate: listed by `info`, no force.
+    for a in &model.actuators {
+        if let Some(why) = crate::model::actuator::unsimulated_reason(&model, a) {
+            let name = if a.name.is_empty() { String::new() } else { format!(" '{}'", a.name) };
+            model.warnings.push(format!(
+                "{}: <{}>{name}: {why} is not simulated; the actuator is listed by `info` and exerts no force",
+                a.loc,
+                a.shortcut.name()
+            ));
+        }
+    }
     let joint_locs: Vec<SourceLoc> = spec
         .links
         .iter()
@@ -288,6 +299,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     if let Some(w) = crate::io::singular::check_mass_matrix(&model, &joint_locs, word) {
         model.warnings.push(w);
     }
+    check_keyframe_act(&model)?;
     model.collision_pairs = crate::model::collision_pairs::candidate_pairs(&model);
     if model.collision_pairs.len() > crate::model::collision_pairs::MAX_COLLISION_PAIRS {
         return Err(LoadError::Invalid {
@@ -300,6 +312,26 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         });
     }
     Ok(model)
+}
+
+/// A keyframe's `act` must have one value per activation state (MuJoCo's `na`), as MuJoCo's
+/// compiler requires.
+fn check_keyframe_act(model: &Model) -> Result<(), LoadError> {
+    let na = model.na();
+    for k in &model.keyframes {
+        if let Some(act) = k.act.as_ref().filter(|a| a.len() != na) {
+            return Err(LoadError::Invalid {
+                loc: k.loc.clone(),
+                element: "key".into(),
+                detail: format!(
+                    "keyframe '{}': act has {} values, the model has {na} activation states (one per actuator with a dyntype other than 'none'); give {na} values or remove 'act'",
+                    k.name,
+                    act.len()
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Keyframes with full vectors, as MuJoCo completes them: a missing `qpos` is `qpos0` and a short
