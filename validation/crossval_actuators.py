@@ -82,6 +82,69 @@ def states(m, rng):
     return out
 
 
+STEP_TOL = 1e-9
+# (model, lagrange integrator, MuJoCo integrator, steps): activations integrated by the steppers
+# against mj_step from the same state — Euler everywhere, RK4 where every joint is flat (lagrange's
+# RK4 differs from MuJoCo's on quaternion joints by design: it is fourth order there).
+STEP_CASES = [
+    ("tests/data/mjcf/actuators/activation.xml", "euler", "mjINT_EULER", 100),
+    ("tests/data/mjcf/actuators/activation.xml", "rk4", "mjINT_RK4", 100),
+    ("tests/data/mjcf/actuators/transmissions.xml", "euler", "mjINT_EULER", 100),
+]
+
+
+def step_checks(binary: Path) -> int:
+    """Trajectories with activations: final qpos, qvel and act after N steps, ours against mj_step
+    (joint limits and contacts disabled on both sides), from a random state, control and act."""
+    import mujoco as mj
+
+    failed = 0
+    rng = np.random.default_rng(SEED + 1)
+    for rel, ours_int, mj_int, n in STEP_CASES:
+        path = REPO / rel
+        m = mj.MjModel.from_xml_path(str(path))
+        m.opt.integrator = int(getattr(mj.mjtIntegrator, mj_int))
+        m.opt.disableflags |= int(mj.mjtDisableBit.mjDSBL_CONTACT) | int(mj.mjtDisableBit.mjDSBL_LIMIT)
+        q, v, c, a = states(m, rng)[0]
+        # Moderate velocities and controls: the light finger of transmissions.xml must stay stable.
+        v, c = v / 10.0, c / 5.0
+        d = mj.MjData(m)
+        d.qpos[:], d.qvel[:], d.ctrl[:] = q, v, c
+        d.act[:] = a
+        # lagrange takes the initial act from a keyframe: write one into a copy of the model.
+        text = path.read_text()
+        key = '<keyframe><key name="xv" qpos="%s" qvel="%s" ctrl="%s" act="%s"/></keyframe>' % tuple(
+            " ".join(repr(float(x)) for x in arr) for arr in (q, v, c, a))
+        text = text.replace("<keyframe>", "<!--").replace("</keyframe>", "-->")
+        text = text.replace("</mujoco>", key + "\n</mujoco>")
+        with tempfile.NamedTemporaryFile("w", suffix=".xml", dir=path.parent, delete=False) as f:
+            f.write(text)
+            tmp = f.name
+        try:
+            p = subprocess.run([str(binary), "simulate", tmp, "--keyframe", "xv", "--integrator", ours_int,
+                                "--duration", repr(n * m.opt.timestep), "--json", "--disable", "contact",
+                                "--disable", "limit", "--constraints", "exact"],
+                               capture_output=True, text=True, timeout=300)
+        finally:
+            os.unlink(tmp)
+        for _ in range(n):
+            mj.mj_step(m, d)
+        if p.returncode != 0:
+            print("FAIL step %-45s %s: %s" % (rel, ours_int, (p.stderr or p.stdout).strip()[:200]))
+            failed += 1
+            continue
+        r = json.loads(p.stdout)
+        errs = {}
+        for name, ours, ref in (("qpos", r["q"], d.qpos), ("qvel", r["v"], d.qvel), ("act", r["act"], d.act)):
+            ours, ref = np.asarray(ours), np.asarray(ref)
+            errs[name] = np.abs(ours - ref).max() / max(1.0, np.abs(ref).max()) if len(ref) else 0.0
+        ok = max(errs.values()) <= STEP_TOL
+        failed += 0 if ok else 1
+        print("%s step %-45s %-5s %d steps: qpos %.1e, qvel %.1e, act %.1e (na %d)"
+              % ("PASS" if ok else "FAIL", rel, ours_int, n, errs["qpos"], errs["qvel"], errs["act"], m.na))
+    return failed
+
+
 def main() -> int:
     import mujoco as mj
 
@@ -183,7 +246,9 @@ def main() -> int:
           % (passed + failed, compared_actuators, compared_act))
     print("actuators: worst relative errors: " + ", ".join("%s %.1e" % kv for kv in worst.items()))
     print("actuators: %d passed, %d failed, %d skipped" % (passed, failed, skipped))
-    return 1 if failed else 0
+    step_failed = step_checks(binary)
+    print("actuator steps: %d cases, %d failed" % (len(STEP_CASES), step_failed))
+    return 1 if failed or step_failed else 0
 
 
 if __name__ == "__main__":

@@ -428,6 +428,35 @@ fn finish(
             "is given but the actuator has no activation (dyntype 'none'); remove it or give a dyntype",
         ));
     }
+    // `actdim`: the number of activations, one with activation dynamics and none without (the
+    // larger counts of `user` dynamics are not typed here).
+    if let Some(n) = a.int("actdim")?.filter(|&n| n >= 0) {
+        let stateful = p.dyntype != DynType::None;
+        if n != i64::from(stateful) && !(n > 1 && p.dyntype == DynType::User) {
+            return Err(a.error(
+                "actdim",
+                format!(
+                    "is {n}; an actuator with dyntype '{}' has {} activation: give actdim=\"{}\" or remove it",
+                    match p.dyntype {
+                        DynType::None => "none",
+                        DynType::Integrator => "integrator",
+                        DynType::Filter => "filter",
+                        DynType::FilterExact => "filterexact",
+                        DynType::Muscle => "muscle",
+                        DynType::User => "user",
+                    },
+                    if stateful { "one" } else { "no" },
+                    i64::from(stateful)
+                ),
+            ));
+        }
+        if n > 1 {
+            return Err(a.error(
+                "actdim",
+                format!("is {n}; user dynamics with several activations are not supported: use actdim=\"1\""),
+            ));
+        }
+    }
     if p.inheritrange.is_some() {
         let (range, attr) = if shortcut == ActuatorShortcut::IntVelocity {
             (actrange, "actrange")
