@@ -468,3 +468,54 @@ fn eval_and_simulate_carry_act() {
     let summary: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(summary["act"][3], 0.4, "integrated and clamped to actrange: {}", summary["act"]);
 }
+
+/// Actuator `damping` and `armature` on a hinge transmission are the joint's gear² · damping and
+/// gear² · armature (MuJoCo 4.0's `actuator_damping`, `actuator_armature`); on other
+/// transmissions they are not simulated, with a warning.
+#[test]
+fn actuator_damping_and_armature_reflect_through_the_gear() {
+    let model = load_mjcf_str(
+        r#"<mujoco><worldbody><body><joint name="j" armature="0.1" damping="0.2"/><geom size=".1" mass="1"/>
+        <site name="s"/></body></worldbody><actuator>
+        <motor joint="j" gear="3" damping="0.5" armature="0.02"/>
+        <motor name="on_site" site="s" damping="1"/>
+        </actuator></mujoco>"#,
+    )
+    .unwrap();
+    assert!((model.dof_damping[0] - (0.2 + 9.0 * 0.5)).abs() < 1e-15, "{}", model.dof_damping[0]);
+    assert!((model.dof_armature[0] - (0.1 + 9.0 * 0.02)).abs() < 1e-15, "{}", model.dof_armature[0]);
+    assert!(
+        model.warnings.iter().any(|w| w.contains("inline.xml:4: <motor>: actuator damping and armature are simulated on hinge and slide joint transmissions only")),
+        "{:?}",
+        model.warnings
+    );
+    let err = load_mjcf_str(
+        r#"<mujoco><worldbody><body><joint name="j"/><geom size=".1"/></body></worldbody>
+        <actuator><motor joint="j" armature="-1"/></actuator></mujoco>"#,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("'armature' is -1; it cannot be negative"), "{err}");
+}
+
+/// implicitfast is implicit in the actuators' velocity derivatives (MuJoCo's `mjd_actuator_vel`):
+/// a velocity servo of gain kv on a free hinge of inertia I, commanded to 0, steps
+/// v₁ = v₀ − h kv v₀ / (I + h kv), where explicit Euler gives v₀ − h kv v₀ / I.
+#[test]
+fn implicitfast_is_implicit_in_actuator_velocity_derivatives() {
+    let text = r#"<mujoco><option gravity="0 0 0"/><worldbody><body><joint name="j"/>
+        <geom size=".1" mass="1"/></body></worldbody><actuator><velocity joint="j" kv="10"/></actuator></mujoco>"#;
+    let step = |kind| {
+        let model = Arc::new(load_mjcf_str(text).unwrap());
+        let mut sim = Simulation::new(model, &SimOptions { integrator: Some(kind), ..Default::default() });
+        sim.set_state(&[0.0], &[2.0]).unwrap();
+        sim.step().unwrap();
+        sim.state.v[0]
+    };
+    let (h, kv, i) = (0.002, 10.0, 0.4 * 0.01);
+    let implicit = step(IntegratorKind::ImplicitFast);
+    let explicit = step(IntegratorKind::Euler);
+    println!("implicitfast {implicit}, Euler {explicit}");
+    assert!((implicit - (2.0 - h * kv * 2.0 / (i + h * kv))).abs() < 1e-13, "{implicit}");
+    assert!((explicit - (2.0 - h * kv * 2.0 / i)).abs() < 1e-12, "{explicit}");
+}

@@ -84,12 +84,18 @@ def states(m, rng):
 
 STEP_TOL = 1e-9
 # (model, lagrange integrator, MuJoCo integrator, steps): activations integrated by the steppers
-# against mj_step from the same state — Euler everywhere, RK4 where every joint is flat (lagrange's
-# RK4 differs from MuJoCo's on quaternion joints by design: it is fourth order there).
+# against mj_step from the same state — Euler and implicitfast everywhere, RK4 where every joint is
+# flat (lagrange's RK4 differs from MuJoCo's on quaternion joints by design: it is fourth order
+# there). Euler only on models without joint damping (MuJoCo's Euler is implicit in it).
 STEP_CASES = [
     ("tests/data/mjcf/actuators/activation.xml", "euler", "mjINT_EULER", 100),
     ("tests/data/mjcf/actuators/activation.xml", "rk4", "mjINT_RK4", 100),
     ("tests/data/mjcf/actuators/transmissions.xml", "euler", "mjINT_EULER", 100),
+    # implicitfast: implicit in joint damping, actuator damping/armature and the actuators'
+    # velocity derivatives (MuJoCo's mjd_actuator_vel).
+    ("tests/data/mjcf/actuators/activation.xml", "implicitfast", "mjINT_IMPLICITFAST", 100),
+    ("tests/data/mjcf/actuators/damping_armature.xml", "implicitfast", "mjINT_IMPLICITFAST", 100),
+    ("tests/data/mjcf/actuators/transmissions.xml", "implicitfast", "mjINT_IMPLICITFAST", 100),
 ]
 
 
@@ -140,7 +146,7 @@ def step_checks(binary: Path) -> int:
             errs[name] = np.abs(ours - ref).max() / max(1.0, np.abs(ref).max()) if len(ref) else 0.0
         ok = max(errs.values()) <= STEP_TOL
         failed += 0 if ok else 1
-        print("%s step %-45s %-5s %d steps: qpos %.1e, qvel %.1e, act %.1e (na %d)"
+        print("%s step %-50s %-12s %d steps: qpos %.1e, qvel %.1e, act %.1e (na %d)"
               % ("PASS" if ok else "FAIL", rel, ours_int, n, errs["qpos"], errs["qvel"], errs["act"], m.na))
     return failed
 

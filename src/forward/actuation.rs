@@ -137,3 +137,63 @@ pub fn actuation(model: &Model, data: &mut Data, q: &[f64], v: &[f64], bias_velo
         }
     }
 }
+
+/// Adds −h · Σᵢ momentᵢᵀ (∂forceᵢ/∂velocityᵢ) momentᵢ to `matrix` (column-major nv × nv): the
+/// actuators' part of M − h ∂qfrc/∂v in the implicitfast step (MuJoCo's `mjd_actuator_vel`).
+/// ∂force/∂velocity = b₂ (affine bias, `dampratio` resolved: `bias_velocity`) + g₂ · x (affine
+/// gain; x the control as given, or the activation — the next one with `actearly`), zero for an
+/// actuator whose force is at its `forcerange` bound. Reads the actuation stage's buffers at the
+/// same state. Returns whether any actuator contributed.
+pub fn add_actuator_velocity_derivative(
+    model: &Model,
+    data: &Data,
+    bias_velocity: &[f64],
+    matrix: &mut [f64],
+    h: f64,
+) -> bool {
+    if !model.options.flags.actuation {
+        return false;
+    }
+    let nv = model.nv;
+    let mut any = false;
+    let mut act_adr = 0;
+    for (i, a) in model.actuators.iter().enumerate() {
+        let act_index = (a.actnum() == 1).then_some(act_adr);
+        act_adr += a.actnum();
+        if unsimulated_reason(model, a).is_some() {
+            continue;
+        }
+        if let Some([lo, hi]) = a.forcerange {
+            let f = data.actuator_force[i];
+            if f <= lo || f >= hi {
+                continue;
+            }
+        }
+        let mut d = if a.biastype == BiasType::Affine { bias_velocity[i] } else { 0.0 };
+        if a.gaintype == GainType::Affine && a.gainprm[2] != 0.0 {
+            let x = match act_index {
+                None => data.ctrl[i],
+                Some(j) if a.actearly => {
+                    next_activation(a, data.act[j], data.act_dot[j], model.options.timestep)
+                }
+                Some(j) => data.act[j],
+            };
+            d += a.gainprm[2] * x;
+        }
+        if d == 0.0 {
+            continue;
+        }
+        any = true;
+        let moment = data.actuator_moment.row(i);
+        for c in 0..nv {
+            let mc = moment[c];
+            if mc == 0.0 {
+                continue;
+            }
+            for r in 0..nv {
+                matrix[r + c * nv] -= h * d * moment[r] * mc;
+            }
+        }
+    }
+    any
+}

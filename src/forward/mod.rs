@@ -23,7 +23,9 @@ mod plan;
 mod transmission;
 
 pub use activation::{activation_rate, advance_activations, clamp_activations, next_activation};
-pub use actuation::{actuation, resolved_bias_velocity, unsimulated_reason};
+pub use actuation::{
+    actuation, add_actuator_velocity_derivative, resolved_bias_velocity, unsimulated_reason,
+};
 
 pub use plan::{DriftCorrection, Plan, Stage, StageKind, Status};
 

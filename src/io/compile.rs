@@ -279,6 +279,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     model.contact_excludes = e.contact_excludes;
     model.elements.append(&mut e.kept);
     model.warnings.append(&mut e.warnings);
+    reflect_actuator_damping_armature(spec, &mut model);
     // Actuators of kinds the actuation stage does not simulate: listed by `info`, no force.
     for a in &model.actuators {
         if let Some(why) = crate::model::actuator::unsimulated_reason(&model, a) {
@@ -312,6 +313,36 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         });
     }
     Ok(model)
+}
+
+/// Actuator `damping` and `armature` (MuJoCo 4's `actuator_damping`, `actuator_armature`): on a
+/// hinge or slide joint the transmission's moment is the constant gear, so they are the joint's
+/// damping gear² · damping (a passive force, off with `<flag damper="disable">`) and armature
+/// gear² · armature, added to `dof_damping` and `dof_armature` (checked against MuJoCo 4.0.0's
+/// `qfrc_passive` and M). On other transmissions they are not simulated, with a warning.
+fn reflect_actuator_damping_armature(spec: &ModelSpec, model: &mut Model) {
+    use crate::model::actuator::Transmission;
+    for (s, a) in spec.actuators.iter().zip(&model.actuators) {
+        if s.damping == 0.0 && s.armature == 0.0 {
+            continue;
+        }
+        let joint = match a.transmission {
+            Transmission::Joint(j) | Transmission::JointInParent(j) if model.joints[j].kind.nv() == 1 => j,
+            _ => {
+                model.warnings.push(format!(
+                    "{}: <{}>: actuator damping and armature are simulated on hinge and slide joint transmissions only; ignored here",
+                    s.loc,
+                    s.shortcut.name()
+                ));
+                continue;
+            }
+        };
+        let (dof, g2) = (model.joints[joint].dof_adr, a.gear[0] * a.gear[0]);
+        if spec.options.flags.damper {
+            model.dof_damping[dof] += g2 * s.damping;
+        }
+        model.dof_armature[dof] += g2 * s.armature;
+    }
 }
 
 /// A keyframe's `act` must have one value per activation state (MuJoCo's `na`), as MuJoCo's

@@ -389,6 +389,10 @@ pub struct ActuatorSpec {
     /// `intvelocity`) is this fraction of the target joint's or tendon's range, about its middle;
     /// set by the compile step, which knows the target.
     pub inheritrange: Option<f64>,
+    /// Actuator-level passive damping and armature (MuJoCo's `actuator_damping`,
+    /// `actuator_armature`): reflected through the transmission onto its dofs.
+    pub damping: f64,
+    pub armature: f64,
     pub loc: SourceLoc,
 }
 

@@ -486,8 +486,34 @@ fn finish(
         actrange,
         actearly: a.bool("actearly")?.unwrap_or(false),
         inheritrange: p.inheritrange,
+        damping: damping(a, warnings)?,
+        armature: nonnegative_attr(a, "armature")?,
         loc: e.loc.clone(),
     })
+}
+
+/// An attribute that cannot be negative (0 if absent).
+fn nonnegative_attr(a: &Attrs, name: &str) -> Result<f64, LoadError> {
+    match a.real(name)? {
+        Some(v) if v < 0.0 => Err(a.error(name, format!("is {v}; it cannot be negative"))),
+        v => Ok(v.unwrap_or(0.0)),
+    }
+}
+
+/// The linear actuator damping (`damping`'s first value); higher polynomial terms are not
+/// simulated and warned about.
+fn damping(a: &Attrs, warnings: &mut Vec<String>) -> Result<f64, LoadError> {
+    let Some(d) = a.some_numbers("damping", 1, 3)? else { return Ok(0.0) };
+    if d[0] < 0.0 {
+        return Err(a.error("damping", format!("is {}; it cannot be negative", d[0])));
+    }
+    if d[1..].iter().any(|&c| c != 0.0) {
+        warnings.push(format!(
+            "{}: <{}>: the polynomial terms of 'damping' are not simulated (only the linear coefficient {})",
+            a.loc, a.tag, d[0]
+        ));
+    }
+    Ok(d[0])
 }
 
 /// The transmission: MuJoCo reads `joint`, `jointinparent`, `tendon`, `cranksite`, `site`, `body`
