@@ -519,3 +519,26 @@ fn implicitfast_is_implicit_in_actuator_velocity_derivatives() {
     assert!((implicit - (2.0 - h * kv * 2.0 / (i + h * kv))).abs() < 1e-13, "{implicit}");
     assert!((explicit - (2.0 - h * kv * 2.0 / i)).abs() < 1e-12, "{explicit}");
 }
+
+/// A tendon's `actuatorfrcrange` scales the forces of its actuators together into the range
+/// (bound / total), before each actuator's own `forcerange` (MuJoCo 4.0.0's order: checked
+/// against it by `validation/crossval_actuators`).
+#[test]
+fn tendon_actuator_force_range_scales_its_actuators() {
+    let model =
+        load(Path::new("tests/data/mjcf/actuators/tendon_force_range.xml"), &LoadOptions::default()).unwrap();
+    assert_eq!(model.tendons[0].actuator_force_range, Some([-1.0, 1.0]));
+    let plan = Plan::new(&model, None);
+    let mut data = Data::new(&model);
+    data.ctrl.copy_from_slice(&[3.0, 1.0, 0.0, 7.0, 5.0]);
+    forward(&model, &plan, &mut data, &[0.0, 0.0], &[0.0, 0.0]);
+    // Total on t: 3 + 1 + 0 = 4 > 1: scaled by 1/4 (clamping m1 to its forcerange 2.5 first would
+    // give 2.5/3.5 instead).
+    let f = data.actuator_force.as_slice();
+    println!("actuator_force {f:?}");
+    assert_eq!(f, [0.75, 0.25, 0.0, 7.0, 5.0]);
+    // Within the range: unchanged; a total of 0 is left alone.
+    data.ctrl.copy_from_slice(&[0.5, -0.2, 0.0, 0.0, 0.0]);
+    forward(&model, &plan, &mut data, &[0.0, 0.0], &[0.0, 0.0]);
+    assert_eq!(&data.actuator_force.as_slice()[..3], [0.5, -0.2, 0.0]);
+}

@@ -9,8 +9,10 @@
 //!   gain = g₀ (fixed) or g₀ + g₁ length + g₂ velocity (affine),
 //!   bias = 0 (none) or b₀ + b₁ length + b₂ velocity (affine),
 //!
-//! clamped to `forcerange` (`actuator_force`), and the generalized force `qfrc_actuator` = Σ
-//! momentᵀ force, clamped on each joint with an `actuatorfrcrange`.
+//! scaled down together with the other actuators on the same tendon when their total is outside
+//! the tendon's `actuatorfrcrange`, then clamped to `forcerange` (`actuator_force`; MuJoCo 4.0's
+//! order, checked against it), and the generalized force `qfrc_actuator` = Σ momentᵀ force,
+//! clamped on each joint with an `actuatorfrcrange`.
 //!
 //! Simulated: dyntype none, integrator, filter, filterexact; fixed or affine gain; none or affine
 //! bias; joint (hinge, slide, ball, free), jointinparent, fixed-tendon and site (with or without
@@ -22,7 +24,7 @@ use super::activation::{activation_rate, next_activation};
 use super::transmission::{needs_poses, transmission, Poses};
 use crate::kinematics::forward_kinematics;
 pub use crate::model::actuator::unsimulated_reason;
-use crate::model::actuator::{BiasType, GainType};
+use crate::model::actuator::{BiasType, GainType, Transmission};
 use crate::model::{Data, Model};
 
 /// Each actuator's `biasprm[2]` as MuJoCo 4.0's `mj_setConst` resolves it: a position-like
@@ -116,13 +118,20 @@ pub fn actuation(model: &Model, data: &mut Data, q: &[f64], v: &[f64], bias_velo
             BiasType::Affine => a.biasprm[0] + a.biasprm[1] * length + bias_velocity[i] * velocity,
             _ => 0.0,
         };
-        let mut force = gain * input + bias;
+        data.actuator_length[i] = length;
+        data.actuator_velocity[i] = velocity;
+        data.actuator_force[i] = gain * input + bias;
+    }
+    scale_tendon_forces(model, data);
+    for (i, a) in model.actuators.iter().enumerate() {
+        let mut force = data.actuator_force[i];
         if let Some([lo, hi]) = a.forcerange {
             force = force.clamp(lo, hi);
         }
-        data.actuator_length[i] = length;
-        data.actuator_velocity[i] = velocity;
         data.actuator_force[i] = force;
+        if force == 0.0 {
+            continue;
+        }
         let Data { qfrc_actuator, actuator_moment, .. } = data;
         for (f, m) in qfrc_actuator.iter_mut().zip(actuator_moment.row(i).iter()) {
             *f += m * force;
@@ -133,6 +142,37 @@ pub fn actuation(model: &Model, data: &mut Data, q: &[f64], v: &[f64], bias_velo
         if let Some([lo, hi]) = j.actuator_force_range {
             for dof in j.dof_adr..j.dof_adr + j.kind.nv() {
                 data.qfrc_actuator[dof] = data.qfrc_actuator[dof].clamp(lo, hi);
+            }
+        }
+    }
+}
+
+/// Tendons' `actuatorfrcrange`: when the total force of the actuators on a limited tendon is
+/// outside its range, each of their forces is scaled by bound / total (MuJoCo's
+/// `mj_fwdActuation`, before the actuators' own `forcerange`).
+fn scale_tendon_forces(model: &Model, data: &mut Data) {
+    for (t, tendon) in model.tendons.iter().enumerate() {
+        let Some([lo, hi]) = tendon.actuator_force_range else { continue };
+        let on_tendon = |a: &crate::model::Actuator| a.transmission == Transmission::Tendon(t);
+        let total: f64 = model
+            .actuators
+            .iter()
+            .zip(data.actuator_force.iter())
+            .filter(|(a, _)| on_tendon(a))
+            .map(|(_, f)| f)
+            .sum();
+        let scale = if total == 0.0 {
+            continue;
+        } else if total < lo {
+            lo / total
+        } else if total > hi {
+            hi / total
+        } else {
+            continue;
+        };
+        for (a, f) in model.actuators.iter().zip(data.actuator_force.iter_mut()) {
+            if on_tendon(a) {
+                *f *= scale;
             }
         }
     }

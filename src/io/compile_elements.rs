@@ -530,7 +530,13 @@ fn tendon(t: &TendonSpec, n: &Names) -> Result<Tendon, LoadError> {
             }
         }
     };
-    Ok(Tendon { name: t.name.clone(), kind, range: t.range, loc: t.loc.clone() })
+    Ok(Tendon {
+        name: t.name.clone(),
+        kind,
+        range: t.range,
+        actuator_force_range: t.actuator_force_range,
+        loc: t.loc.clone(),
+    })
 }
 
 /// One actuator: its transmission resolved, and `inheritrange` turned into a control (or, for

@@ -343,6 +343,8 @@ pub struct TendonSpec {
     pub kind: TendonSpecKind,
     /// Length limits if limited (`limited`/`range`, resolved with `autolimits`).
     pub range: Option<[f64; 2]>,
+    /// Total actuator force range if limited (`actuatorfrclimited`/`actuatorfrcrange`).
+    pub actuator_force_range: Option<[f64; 2]>,
     pub loc: SourceLoc,
 }
 

@@ -10,6 +10,9 @@ pub struct Tendon {
     pub kind: TendonKind,
     /// Length limits `[lower, upper]` if limited (stored; enforced by the limits work).
     pub range: Option<[f64; 2]>,
+    /// The range of the total force of the actuators on this tendon (MJCF `actuatorfrcrange`
+    /// with `actuatorfrclimited`): outside it, their forces are scaled down together.
+    pub actuator_force_range: Option<[f64; 2]>,
     pub loc: SourceLoc,
 }
 

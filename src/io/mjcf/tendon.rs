@@ -65,7 +65,9 @@ pub(crate) fn tendons(
                 TendonSpecKind::Spatial { path }
             };
             let range = a.limited_range("limited", "range", autolimits, warnings)?;
-            out.push(TendonSpec { name, kind, range, loc: e.loc.clone() });
+            let actuator_force_range =
+                a.limited_range("actuatorfrclimited", "actuatorfrcrange", autolimits, warnings)?;
+            out.push(TendonSpec { name, kind, range, actuator_force_range, loc: e.loc.clone() });
         }
     }
     Ok(out)
