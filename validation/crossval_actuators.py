@@ -8,10 +8,11 @@ limited, with some outside it).
 
 Compared: the actuators lagrange simulates (dyntype none, integrator, filter or filterexact,
 `actearly` included; fixed or affine gain; none or affine bias; joint — hinge, slide, ball, free —,
-jointinparent, fixed-tendon or site transmission, with or without refsite); qfrc_actuator when
-every actuator of the model is simulated. Others are counted as skipped with the reason.
-Tolerance 1e-9 relative (max|Δ| / max(1, max|ref|)). Contacts are off on both sides (forces
-only).
+jointinparent, fixed-tendon, slider-crank or site transmission, with or without refsite);
+qfrc_actuator when every actuator of the model is simulated. Others are counted as skipped with
+the reason. Tolerance 1e-9 relative (max|Δ| / max(1, max|ref|)). Contacts are off on both sides
+(forces only). Then activations (and q, v) are stepped against mj_step on the test models
+(STEP_CASES).
 
     validation/crossval_actuators            # table; exit 1 on a difference
 """
@@ -49,13 +50,14 @@ def simulated(m, i) -> str | None:
     if I(m.actuator_biastype[i]) not in (I(mj.mjtBias.mjBIAS_NONE), I(mj.mjtBias.mjBIAS_AFFINE)):
         return "muscle or user bias"
     t, obj = I(m.actuator_trntype[i]), I(m.actuator_trnid[i][0])
-    if t in (I(mj.mjtTrn.mjTRN_JOINT), I(mj.mjtTrn.mjTRN_JOINTINPARENT), I(mj.mjtTrn.mjTRN_SITE)):
+    if t in (I(mj.mjtTrn.mjTRN_JOINT), I(mj.mjtTrn.mjTRN_JOINTINPARENT), I(mj.mjtTrn.mjTRN_SITE),
+             I(mj.mjtTrn.mjTRN_SLIDERCRANK)):
         return None
     if t == I(mj.mjtTrn.mjTRN_TENDON):
         adr, num = I(m.tendon_adr[obj]), I(m.tendon_num[obj])
         fixed = all(I(m.wrap_type[adr + k]) == I(mj.mjtWrap.mjWRAP_JOINT) for k in range(num))
         return None if fixed else "spatial tendon"
-    return "body or slider-crank transmission"
+    return "body (adhesion) transmission"
 
 
 def states(m, rng):

@@ -15,8 +15,8 @@
 //! clamped on each joint with an `actuatorfrcrange`.
 //!
 //! Simulated: dyntype none, integrator, filter, filterexact; fixed or affine gain; none or affine
-//! bias; joint (hinge, slide, ball, free), jointinparent, fixed-tendon and site (with or without
-//! refsite) transmissions — MuJoCo's `motor`, `position`, `velocity`, `intvelocity`, `damper`,
+//! bias; joint (hinge, slide, ball, free), jointinparent, fixed-tendon, slider-crank and site
+//! (with or without refsite) transmissions — MuJoCo's `motor`, `position`, `velocity`, `intvelocity`, `damper`,
 //! `cylinder` and such `general` ones. Every other kind is kept, listed by `info` as not
 //! simulated, and contributes no force ([`unsimulated_reason`]).
 

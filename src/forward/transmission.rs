@@ -12,6 +12,7 @@
 //! | fixed tendon | gear₀ · Σ coef · q | gear₀ · coef |
 //! | site | 0 | J_siteᵀ (R_site gear) |
 //! | site with refsite | Rᵣᵀ(p_site − pᵣ) · gear₀₋₂ + log(Rᵣᵀ R_site) · gear₃₋₅ | (J_site − Jᵣ)ᵀ (Rᵣ gear), 0 on common ancestor dofs |
+//! | slider-crank | gear₀ (a·d − √((a·d)² + r² − d·d)) | gear₀ ∂length/∂q through d and a |
 //!
 //! g is gear₀₋₂ (ball) or gear₃₋₅ (free) for `joint`; for `jointinparent` the same vector given in
 //! the parent frame, i.e. Rᵀ g with R the joint's rotation. J are world-aligned Jacobians (linear
@@ -21,6 +22,11 @@
 //! sites move both together and get no moment, as in MuJoCo; the rotational rows use the angular
 //! velocity in the reference frame, which is the derivative of the rotation-vector length only at
 //! small relative rotations (MuJoCo's definition, kept for equality with it).
+//!
+//! Slider-crank (`cranksite`, `slidersite`, `cranklength` r): d = p_crank − p_slider, a the
+//! slider site's z axis; the length is the slider's position along a at which the rod of length
+//! r reaches the crank pin. When the rod cannot reach (the square root's argument ≤ 0) MuJoCo
+//! takes length a·d and derivatives d (w.r.t. a) and a (w.r.t. d); so does this.
 
 use crate::kinematics::for_each_ancestor_dof;
 use crate::model::actuator::{Actuator, Transmission};
@@ -38,7 +44,7 @@ pub(crate) struct Poses<'a> {
 
 /// Whether the transmission needs body and site poses (a site transmission).
 pub(crate) fn needs_poses(a: &Actuator) -> bool {
-    matches!(a.transmission, Transmission::Site { .. })
+    matches!(a.transmission, Transmission::Site { .. } | Transmission::SliderCrank { .. })
 }
 
 /// The rotation vector (axis · angle, angle in (−π, π]) of the unit quaternion (w, x, y, z):
@@ -112,7 +118,7 @@ fn add_projected_jacobian(
 
 /// The length of actuator `i` at q; adds its moment arms to row `i` of `moment` (the caller
 /// zeroes it). `poses` must hold forward kinematics at q when [`needs_poses`]. Transmissions not
-/// simulated (spatial tendons, planar joints, body, slider-crank) give length 0 and no moment.
+/// simulated (spatial tendons, planar joints, body) give length 0 and no moment.
 pub(crate) fn transmission(
     model: &Model,
     a: &Actuator,
@@ -183,6 +189,31 @@ pub(crate) fn transmission(
             add_projected_jacobian(model, poses, ref_body, &xr.pos, w, -1.0, Some(body), moment, i);
             length
         }
-        Transmission::Body(_) | Transmission::SliderCrank { .. } => 0.0,
+        Transmission::SliderCrank { cranksite, slidersite, cranklength } => {
+            let (xc, xs) = (&poses.x_world_frame[*cranksite], &poses.x_world_frame[*slidersite]);
+            let axis = xs.rot.column(2).into_owned();
+            let d = xc.pos - xs.pos;
+            let ad = axis.dot(&d);
+            let det = ad * ad + cranklength * cranklength - d.dot(&d);
+            let (length, dl_da, dl_dd) = if det > 0.0 {
+                let s = det.sqrt();
+                (ad - s, d * (1.0 - ad / s), axis * (1.0 - ad / s) + d / s)
+            } else {
+                (ad, d, axis)
+            };
+            let g = gear[0];
+            // Through d: + the crank pin's Jacobian, − the slider site's; through a: ω × a.
+            let crank_body = model.frames[*cranksite].body;
+            for_each_ancestor_dof(model, poses.x_world_body, poses.s_body, crank_body, |k, s| {
+                moment[(i, k)] += g * dl_dd.dot(&(s.lin + s.ang.cross(&xc.pos)));
+            });
+            let slider_body = model.frames[*slidersite].body;
+            for_each_ancestor_dof(model, poses.x_world_body, poses.s_body, slider_body, |k, s| {
+                let lin = s.lin + s.ang.cross(&xs.pos);
+                moment[(i, k)] += g * (dl_da.dot(&s.ang.cross(&axis)) - dl_dd.dot(&lin));
+            });
+            g * length
+        }
+        Transmission::Body(_) => 0.0,
     }
 }

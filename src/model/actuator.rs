@@ -122,7 +122,7 @@ impl Actuator {
 }
 
 /// Why actuator `a` of `model` is not simulated, or None if it is: muscle and user dynamics, gains
-/// and biases; planar-joint, spatial-tendon, body (adhesion) and slider-crank transmissions.
+/// and biases; planar-joint, spatial-tendon and body (adhesion) transmissions.
 pub fn unsimulated_reason(model: &Model, a: &Actuator) -> Option<&'static str> {
     if matches!(a.dyntype, DynType::Muscle | DynType::User) {
         return Some("muscle or user activation dynamics");
@@ -139,8 +139,7 @@ pub fn unsimulated_reason(model: &Model, a: &Actuator) -> Option<&'static str> {
         }
         Transmission::Tendon(t) => matches!(model.tendons[*t].kind, TendonKind::Spatial { .. })
             .then_some("a spatial tendon transmission"),
-        Transmission::Site { .. } => None,
+        Transmission::Site { .. } | Transmission::SliderCrank { .. } => None,
         Transmission::Body(_) => Some("a body (adhesion) transmission"),
-        Transmission::SliderCrank { .. } => Some("a slider-crank transmission"),
     }
 }
