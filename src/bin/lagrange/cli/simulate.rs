@@ -472,6 +472,12 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
             .collect();
         let _ = writeln!(out, "  {:<24} q = [{}]  v = [{}]", j.name, q.join(", "), v.join(", "));
     }
+    // Activations, one per actuator with activation dynamics.
+    let mut act = state.act.iter();
+    for (i, a) in model.actuators.iter().enumerate().filter(|(_, a)| a.actnum() == 1) {
+        let name = if a.name.is_empty() { format!("actuator{i}") } else { a.name.clone() };
+        let _ = writeln!(out, "  {name:<24} act = {:+.6}", act.next().copied().unwrap_or(0.0));
+    }
     out
 }
 
