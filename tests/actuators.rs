@@ -419,6 +419,13 @@ fn activation_input_errors_name_the_fix() {
     assert!(err.contains("'actdim' is 0") && err.contains("give actdim=\"1\" or remove it"), "{err}");
     let err = load_mjcf_str(&base(r#"<motor joint="j" actdim="1"/>"#)).unwrap_err().to_string();
     assert!(err.contains("dyntype 'none' has no activation"), "{err}");
+    let err = load_mjcf_str(
+        &base(r#"<general joint="j" dyntype="filter"/><general joint="j" dyntype="filter"/>"#)
+            .replace("0.1 0.2", "0.1 1e300"),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("keyframe 'k': an activation (act) 1e300 is absurdly large"), "{err}");
     // The API refuses an act of the wrong length.
     let model = load(Path::new(ACTIVATION), &LoadOptions::default()).unwrap();
     let mut sim = Simulation::new(Arc::new(model), &SimOptions::default());
