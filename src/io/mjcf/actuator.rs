@@ -420,6 +420,12 @@ fn finish(
     {
         return Err(a.error("ctrlrange", format!("cannot be negative for <{}>: the control scales a dissipative or adhesive force; use a range in [0, ∞)", e.tag)));
     }
+    if a.real("delay")?.is_some_and(|d| d > 0.0) {
+        warnings.push(format!(
+            "{}: <{}>: 'delay' (MuJoCo's control history buffer) is not simulated: the control acts without delay",
+            e.loc, e.tag
+        ));
+    }
     let forcerange = a.limited_range("forcelimited", "forcerange", autolimits, warnings)?;
     let actrange = a.limited_range("actlimited", "actrange", autolimits, warnings)?;
     if actrange.is_some() && p.dyntype == DynType::None {
