@@ -133,6 +133,28 @@ impl Simulation {
         Ok(())
     }
 
+    /// Sets the actuator activations (MuJoCo's `act`, one per actuator with activation dynamics,
+    /// in actuator order); rejects a wrong length and non-finite values.
+    pub fn set_act(&mut self, act: &[f64]) -> Result<(), SimError> {
+        let na = self.model.na();
+        if act.len() != na {
+            return Err(SimError::BadState(format!(
+                "act has {} values, the model has na = {na} activation states (one per actuator with a dyntype other than 'none')",
+                act.len()
+            )));
+        }
+        if let Some(i) = act.iter().position(|x| !x.is_finite()) {
+            return Err(SimError::BadState(format!("value {i} of act is not finite")));
+        }
+        self.state.act.copy_from_slice(act);
+        Ok(())
+    }
+
+    /// The actuator activations of the current state (MuJoCo's `act`).
+    pub fn act(&self) -> &[f64] {
+        self.state.act.as_slice()
+    }
+
     /// Controls, one per actuator (MuJoCo's `ctrl`).
     pub fn ctrl_mut(&mut self) -> &mut [f64] {
         self.data.ctrl.as_mut_slice()

@@ -63,6 +63,9 @@ fn kernels_and_integrators_do_not_allocate() {
         ("models/panda/panda.urdf", false),
         ("models/textbook/four_bar.xml", false),
         ("tests/data/mjcf/constraints/connect_free_sites.xml", false),
+        // Actuators: activation dynamics (act in the state), site, ball and free transmissions.
+        ("tests/data/mjcf/actuators/activation.xml", false),
+        ("tests/data/mjcf/actuators/transmissions.xml", false),
     ] {
         let model = load(&root.join(file), &LoadOptions { floating, ..Default::default() }).unwrap();
         let mut data = Data::new(&model);
@@ -96,6 +99,8 @@ fn kernels_and_integrators_do_not_allocate() {
         // The staged pipeline with the model's constraint rows (projection included in the steps).
         let plan = Plan::new(&model, Some(ConstraintMode::Exact));
         data.qfrc_applied.copy_from_slice(&tau);
+        data.ctrl.fill(0.5);
+        data.act.fill(0.1);
         let forwards = allocations(|| forward(&model, &plan, &mut data, &q, &v));
         assert_eq!(forwards, 0, "{file}: forward allocated {forwards} times");
         for kind in [
@@ -105,8 +110,7 @@ fn kernels_and_integrators_do_not_allocate() {
             IntegratorKind::ImplicitFast,
         ] {
             let mut integrator = kind.build(&model);
-            let mut state =
-                State { time: 0.0, q: DVector::from_vec(q.clone()), v: DVector::from_vec(v.clone()) };
+            let mut state = State::new(&model, q.clone(), v.clone());
             let steps = allocations(|| {
                 for _ in 0..10 {
                     integrator.step(&model, &plan, &mut data, &mut state, 1e-3);
@@ -138,8 +142,7 @@ fn contact_scenes_do_not_allocate() {
             let plan = Plan::new(&model, Some(mode));
             // Warm up: the warm-start record of the first solve is the only growth (in soft mode,
             // a few steps first, so that the bodies sink into their contacts and the rows exist).
-            let mut state =
-                State { time: 0.0, q: DVector::from_vec(q.clone()), v: DVector::from_vec(v.clone()) };
+            let mut state = State::new(&model, q.clone(), v.clone());
             let mut warm = IntegratorKind::Euler.build(&model);
             for _ in 0..20 {
                 warm.step(&model, &plan, &mut data, &mut state, 1e-3);
@@ -150,8 +153,7 @@ fn contact_scenes_do_not_allocate() {
             assert_eq!(forwards, 0, "{file} {mode:?}: forward allocated {forwards} times");
             for kind in [IntegratorKind::Euler, IntegratorKind::Rk4] {
                 let mut integrator = kind.build(&model);
-                let mut state =
-                    State { time: 0.0, q: DVector::from_vec(qs.clone()), v: DVector::from_vec(vs.clone()) };
+                let mut state = State::new(&model, qs.clone(), vs.clone());
                 let steps = allocations(|| {
                     for _ in 0..50 {
                         integrator.step(&model, &plan, &mut data, &mut state, 1e-3);

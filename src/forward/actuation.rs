@@ -1,63 +1,31 @@
 //! The actuation stage (MuJoCo's `mj_fwdActuation`, MuJoCo documentation "Computation →
-//! Actuation model"): for each simulated actuator, its moment arms (`actuator_moment`), length and
-//! velocity through the
-//! transmission (`actuator_length` = gear · x, `actuator_velocity` = gear · ẋ with x a hinge or
-//! slide coordinate, or a fixed tendon's length Σ coef · q), the control clamped to `ctrlrange`
-//! (unless `<flag clampctrl="disable">`), the force
+//! Actuation model"): for each simulated actuator, its length and moment arms through the
+//! transmission ([`transmission`](super::transmission), `actuator_length`, `actuator_moment`),
+//! its velocity `actuator_velocity` = moment · v, the control clamped to `ctrlrange` (unless
+//! `<flag clampctrl="disable">`), the activation derivative `act_dot`
+//! ([`activation`](super::activation)), the force
 //!
-//!   force = gain · ctrl + bias,  gain = g₀ (fixed) or g₀ + g₁ length + g₂ velocity (affine),
+//!   force = gain · x + bias,  x = ctrl (dyntype none) or act (or, with `actearly`, the next act),
+//!   gain = g₀ (fixed) or g₀ + g₁ length + g₂ velocity (affine),
 //!   bias = 0 (none) or b₀ + b₁ length + b₂ velocity (affine),
 //!
-//! clamped to `forcerange` (`actuator_force`), and the generalized force `qfrc_actuator` = Σ
-//! momentᵀ force, the moment being ∂length/∂q (gear on the joint's dof, gear · coef on a tendon's),
+//! scaled down together with the other actuators on the same tendon when their total is outside
+//! the tendon's `actuatorfrcrange`, then clamped to `forcerange` (`actuator_force`; MuJoCo 4.0's
+//! order, checked against it), and the generalized force `qfrc_actuator` = Σ momentᵀ force,
 //! clamped on each joint with an `actuatorfrcrange`.
 //!
-//! Simulated: actuators without activation state (`dyntype` none) with fixed or affine gain and
-//! none or affine bias (MuJoCo's `motor`, `position`, `velocity`, `damper` and such `general`
-//! ones) on hinge or slide joints (`joint`, `jointinparent`) and fixed tendons. Every other kind is
-//! kept, listed by `info` as not simulated, and contributes no force ([`unsimulated_reason`]).
+//! Simulated: dyntype none, integrator, filter, filterexact; fixed or affine gain; none or affine
+//! bias; joint (hinge, slide, ball, free), jointinparent, fixed-tendon, slider-crank and site
+//! (with or without refsite) transmissions — MuJoCo's `motor`, `position`, `velocity`, `intvelocity`, `damper`,
+//! `cylinder` and such `general` ones. Every other kind is kept, listed by `info` as not
+//! simulated, and contributes no force ([`unsimulated_reason`]).
 
-use crate::model::actuator::{Actuator, BiasType, DynType, GainType, Transmission};
-use crate::model::{Data, Model, TendonKind};
-
-/// Why `a` is not simulated yet, or None if it is.
-pub fn unsimulated_reason(model: &Model, a: &Actuator) -> Option<&'static str> {
-    if a.dyntype != DynType::None {
-        return Some("activation dynamics");
-    }
-    if !matches!(a.gaintype, GainType::Fixed | GainType::Affine) {
-        return Some("muscle or user gain");
-    }
-    if !matches!(a.biastype, BiasType::None | BiasType::Affine) {
-        return Some("muscle or user bias");
-    }
-    match &a.transmission {
-        Transmission::Joint(j) | Transmission::JointInParent(j) if model.joints[*j].kind.nv() == 1 => None,
-        Transmission::Joint(_) | Transmission::JointInParent(_) => Some("a ball or free joint transmission"),
-        Transmission::Tendon(t) if matches!(model.tendons[*t].kind, TendonKind::Fixed { .. }) => None,
-        Transmission::Tendon(_) => Some("a spatial tendon transmission"),
-        Transmission::Site { .. } => Some("a site transmission"),
-        Transmission::Body(_) => Some("a body (adhesion) transmission"),
-        Transmission::SliderCrank { .. } => Some("a slider-crank transmission"),
-    }
-}
-
-/// Calls `term(dof, qpos address, d length / d q)` for each (hinge or slide) coordinate of the
-/// transmission, gear included.
-fn for_each_moment(model: &Model, a: &Actuator, mut term: impl FnMut(usize, usize, f64)) {
-    let mut joint = |j: usize, m: f64| term(model.joints[j].dof_adr, model.joints[j].qpos_adr, m);
-    match &a.transmission {
-        Transmission::Joint(j) | Transmission::JointInParent(j) => joint(*j, a.gear[0]),
-        Transmission::Tendon(t) => {
-            if let TendonKind::Fixed { joints } = &model.tendons[*t].kind {
-                for &(j, coef) in joints {
-                    joint(j, a.gear[0] * coef);
-                }
-            }
-        }
-        _ => {}
-    }
-}
+use super::activation::{activation_rate, next_activation};
+use super::transmission::{needs_poses, transmission, Poses};
+use crate::kinematics::forward_kinematics;
+pub use crate::model::actuator::unsimulated_reason;
+use crate::model::actuator::{BiasType, GainType, Transmission};
+use crate::model::{Data, Model};
 
 /// Each actuator's `biasprm[2]` as MuJoCo 4.0's `mj_setConst` resolves it: a position-like
 /// actuator (gain₀ = −bias₁) with a positive `biasprm[2]` holds a `dampratio`, which becomes the
@@ -66,22 +34,26 @@ fn for_each_moment(model: &Model, a: &Actuator, mut term: impl FnMut(usize, usiz
 /// Menagerie g1 by `validation/crossval_actuators`); every other value is kept.
 pub fn resolved_bias_velocity(model: &Model) -> Vec<f64> {
     let mut data: Option<Data> = None;
-    model
-        .actuators
-        .iter()
-        .map(|a| {
+    let q0 = &model.qpos0;
+    (0..model.actuators.len())
+        .map(|i| {
+            let a = &model.actuators[i];
             let (kp, b2) = (a.gainprm[0], a.biasprm[2]);
             if kp != -a.biasprm[1] || b2 <= 0.0 || unsimulated_reason(model, a).is_some() {
                 return b2;
             }
             let data = data.get_or_insert_with(|| {
                 let mut data = Data::new(model);
-                crate::dynamics::crba(model, &mut data, &model.qpos0);
+                crate::dynamics::crba(model, &mut data, q0);
                 crate::dynamics::factorize_mass_matrix(model, &mut data);
+                forward_kinematics(model, &mut data, q0);
                 data
             });
-            let mut moment = nalgebra::DVector::zeros(model.nv);
-            for_each_moment(model, a, |dof, _, m| moment[dof] += m);
+            let Data { actuator_moment, x_world_body, s_body, x_world_frame, .. } = data;
+            let poses = Poses { x_world_body, s_body, x_world_frame };
+            actuator_moment.row_mut(i).fill(0.0);
+            transmission(model, a, q0, poses, actuator_moment, i);
+            let moment = actuator_moment.row(i).transpose();
             let mut x = moment.clone();
             crate::dynamics::solve_mass_matrix(model, data, &mut x);
             let inverse_mass = moment.dot(&x);
@@ -93,33 +65,51 @@ pub fn resolved_bias_velocity(model: &Model) -> Vec<f64> {
         .collect()
 }
 
-/// The actuation stage at (q, v) with `data.ctrl`: `actuator_length`, `actuator_velocity`,
-/// `actuator_force` and `qfrc_actuator` (zero for actuators not simulated); `bias_velocity` is
-/// [`resolved_bias_velocity`] (the plan holds it).
+/// The actuation stage at (q, v) with `data.ctrl` and `data.act`: `actuator_length`,
+/// `actuator_velocity`, `actuator_moment`, `act_dot`, `actuator_force` and `qfrc_actuator` (zero
+/// for actuators not simulated); `bias_velocity` is [`resolved_bias_velocity`] (the plan holds
+/// it). `actearly` looks one step of the model's `<option timestep>` ahead, as MuJoCo does.
 pub fn actuation(model: &Model, data: &mut Data, q: &[f64], v: &[f64], bias_velocity: &[f64]) {
     data.qfrc_actuator.fill(0.0);
     let clamp = model.options.flags.clampctrl;
+    if model.actuators.iter().any(|a| needs_poses(a) && unsimulated_reason(model, a).is_none()) {
+        forward_kinematics(model, data, q);
+    }
+    let mut act_adr = 0;
     for (i, a) in model.actuators.iter().enumerate() {
+        let act_index = (a.actnum() == 1).then_some(act_adr);
+        act_adr += a.actnum();
         data.actuator_moment.row_mut(i).fill(0.0);
         if unsimulated_reason(model, a).is_some() {
             data.actuator_length[i] = 0.0;
             data.actuator_velocity[i] = 0.0;
             data.actuator_force[i] = 0.0;
+            if let Some(j) = act_index {
+                data.act_dot[j] = 0.0;
+            }
             continue;
         }
-        // Length and velocity: gear · (joint coordinate or tendon length), through the moment
-        // (a joint's coordinate is its q; a fixed tendon is linear in q).
-        let (mut length, mut velocity) = (0.0, 0.0);
-        let Data { actuator_moment, .. } = data;
-        for_each_moment(model, a, |dof, qpos, m| {
-            length += m * q[qpos];
-            velocity += m * v[dof];
-            actuator_moment[(i, dof)] += m;
-        });
+        let Data { actuator_moment, x_world_body, s_body, x_world_frame, .. } = data;
+        let poses = Poses { x_world_body, s_body, x_world_frame };
+        let length = transmission(model, a, q, poses, actuator_moment, i);
+        let velocity = actuator_moment.row(i).iter().zip(v).map(|(m, v)| m * v).sum::<f64>();
         let mut ctrl = data.ctrl[i];
         if let (true, Some([lo, hi])) = (clamp, a.ctrlrange) {
             ctrl = ctrl.clamp(lo, hi);
         }
+        // The input of the gain: the control, or the activation (the next one with actearly).
+        let input = match act_index {
+            None => ctrl,
+            Some(j) => {
+                let act_dot = activation_rate(a, ctrl, data.act[j]);
+                data.act_dot[j] = act_dot;
+                if a.actearly {
+                    next_activation(a, data.act[j], act_dot, model.options.timestep)
+                } else {
+                    data.act[j]
+                }
+            }
+        };
         let gain = match a.gaintype {
             GainType::Affine => a.gainprm[0] + a.gainprm[1] * length + a.gainprm[2] * velocity,
             _ => a.gainprm[0],
@@ -128,15 +118,24 @@ pub fn actuation(model: &Model, data: &mut Data, q: &[f64], v: &[f64], bias_velo
             BiasType::Affine => a.biasprm[0] + a.biasprm[1] * length + bias_velocity[i] * velocity,
             _ => 0.0,
         };
-        let mut force = gain * ctrl + bias;
+        data.actuator_length[i] = length;
+        data.actuator_velocity[i] = velocity;
+        data.actuator_force[i] = gain * input + bias;
+    }
+    scale_tendon_forces(model, data);
+    for (i, a) in model.actuators.iter().enumerate() {
+        let mut force = data.actuator_force[i];
         if let Some([lo, hi]) = a.forcerange {
             force = force.clamp(lo, hi);
         }
-        data.actuator_length[i] = length;
-        data.actuator_velocity[i] = velocity;
         data.actuator_force[i] = force;
-        let Data { qfrc_actuator, .. } = data;
-        for_each_moment(model, a, |dof, _, m| qfrc_actuator[dof] += m * force);
+        if force == 0.0 {
+            continue;
+        }
+        let Data { qfrc_actuator, actuator_moment, .. } = data;
+        for (f, m) in qfrc_actuator.iter_mut().zip(actuator_moment.row(i).iter()) {
+            *f += m * force;
+        }
     }
     // Joints' `actuatorfrcrange`: the total actuator force on each of their dofs is clamped.
     for j in &model.joints {
@@ -146,4 +145,95 @@ pub fn actuation(model: &Model, data: &mut Data, q: &[f64], v: &[f64], bias_velo
             }
         }
     }
+}
+
+/// Tendons' `actuatorfrcrange`: when the total force of the actuators on a limited tendon is
+/// outside its range, each of their forces is scaled by bound / total (MuJoCo's
+/// `mj_fwdActuation`, before the actuators' own `forcerange`).
+fn scale_tendon_forces(model: &Model, data: &mut Data) {
+    for (t, tendon) in model.tendons.iter().enumerate() {
+        let Some([lo, hi]) = tendon.actuator_force_range else { continue };
+        let on_tendon = |a: &crate::model::Actuator| a.transmission == Transmission::Tendon(t);
+        let total: f64 = model
+            .actuators
+            .iter()
+            .zip(data.actuator_force.iter())
+            .filter(|(a, _)| on_tendon(a))
+            .map(|(_, f)| f)
+            .sum();
+        let scale = if total == 0.0 {
+            continue;
+        } else if total < lo {
+            lo / total
+        } else if total > hi {
+            hi / total
+        } else {
+            continue;
+        };
+        for (a, f) in model.actuators.iter().zip(data.actuator_force.iter_mut()) {
+            if on_tendon(a) {
+                *f *= scale;
+            }
+        }
+    }
+}
+
+/// Adds −h · Σᵢ momentᵢᵀ (∂forceᵢ/∂velocityᵢ) momentᵢ to `matrix` (column-major nv × nv): the
+/// actuators' part of M − h ∂qfrc/∂v in the implicitfast step (MuJoCo's `mjd_actuator_vel`).
+/// ∂force/∂velocity = b₂ (affine bias, `dampratio` resolved: `bias_velocity`) + g₂ · x (affine
+/// gain; x the control as given, or the activation — the next one with `actearly`), zero for an
+/// actuator whose force is at its `forcerange` bound. Reads the actuation stage's buffers at the
+/// same state. Returns whether any actuator contributed.
+pub fn add_actuator_velocity_derivative(
+    model: &Model,
+    data: &Data,
+    bias_velocity: &[f64],
+    matrix: &mut [f64],
+    h: f64,
+) -> bool {
+    if !model.options.flags.actuation {
+        return false;
+    }
+    let nv = model.nv;
+    let mut any = false;
+    let mut act_adr = 0;
+    for (i, a) in model.actuators.iter().enumerate() {
+        let act_index = (a.actnum() == 1).then_some(act_adr);
+        act_adr += a.actnum();
+        if unsimulated_reason(model, a).is_some() {
+            continue;
+        }
+        if let Some([lo, hi]) = a.forcerange {
+            let f = data.actuator_force[i];
+            if f <= lo || f >= hi {
+                continue;
+            }
+        }
+        let mut d = if a.biastype == BiasType::Affine { bias_velocity[i] } else { 0.0 };
+        if a.gaintype == GainType::Affine && a.gainprm[2] != 0.0 {
+            let x = match act_index {
+                None => data.ctrl[i],
+                Some(j) if a.actearly => {
+                    next_activation(a, data.act[j], data.act_dot[j], model.options.timestep)
+                }
+                Some(j) => data.act[j],
+            };
+            d += a.gainprm[2] * x;
+        }
+        if d == 0.0 {
+            continue;
+        }
+        any = true;
+        let moment = data.actuator_moment.row(i);
+        for c in 0..nv {
+            let mc = moment[c];
+            if mc == 0.0 {
+                continue;
+            }
+            for r in 0..nv {
+                matrix[r + c * nv] -= h * d * moment[r] * mc;
+            }
+        }
+    }
+    any
 }

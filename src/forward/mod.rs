@@ -7,19 +7,25 @@
 //! | position | body poses, `mass_matrix` and its factor, constraint rows `efc_j`, `efc_pos` |
 //! | velocity | `qfrc_bias` = RNEA(q, v, 0), `efc_vel` = J v, `efc_jdotv` = J̇ v |
 //! | passive | `qfrc_passive` = −damping ⊙ v − k ⊙ (q − q_spring) |
-//! | actuation | `actuator_length`, `actuator_velocity`, `actuator_force`, `qfrc_actuator` from `ctrl` |
+//! | actuation | `actuator_length`, `actuator_velocity`, `actuator_force`, `act_dot`, `qfrc_actuator` from `ctrl` and `act` |
 //! | acceleration | `qacc_smooth` (ABA, or M⁻¹`qfrc_smooth` on the M path), `qfrc_smooth` on the M path |
 //! | constraint | `efc_force` (λ), `qfrc_constraint` = Jᵀλ, `qacc` |
 //!
 //! Which stages run is decided once by the [`Plan`]; [`forward`] walks it. Without constraint rows
 //! the position and velocity stages are skipped and ABA gives `qacc_smooth` directly (M is never
 //! built); `qacc` = `qacc_smooth` then. A model whose only rows are joint limits takes the same
-//! ABA path at every state where no joint is at a limit. `qfrc_applied` and `ctrl` are inputs set by the caller.
+//! ABA path at every state where no joint is at a limit. `qfrc_applied`, `ctrl` and `act` are
+//! inputs set by the caller (`act` by the integrators, from their state).
 
+mod activation;
 mod actuation;
 mod plan;
+mod transmission;
 
-pub use actuation::{actuation, resolved_bias_velocity, unsimulated_reason};
+pub use activation::{activation_rate, advance_activations, clamp_activations, next_activation};
+pub use actuation::{
+    actuation, add_actuator_velocity_derivative, resolved_bias_velocity, unsimulated_reason,
+};
 
 pub use plan::{DriftCorrection, Plan, Stage, StageKind, Status};
 

@@ -238,7 +238,7 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
             Actuation,
             "actuation",
             Runs,
-            format!("{simulated} actuators (force = gain·ctrl + bias on joints and fixed tendons){missing}"),
+            format!("{simulated} actuators (force = gain·(ctrl or act) + bias on joints, fixed tendons, sites and slider-cranks){missing}"),
         )
     });
     out.push(if constrained {

@@ -10,10 +10,12 @@
 //! max over components of |y₅ − y₄| / (atol + rtol·s), with s = max(|y₀|, |y₁|) for v and flat
 //! coordinates and s = 1 rad for the rotation-vector coordinates of quaternion joints; a step is
 //! accepted when that is ≤ 1, and the next size is h·min(5, max(0.2, 0.9·err^(−1/5))).
+//! Actuator activations are components of the same ODE (their rates `act_dot`, their error in the
+//! norm with s = max(|w₀|, |w₁|)), clamped to `actrange` after each accepted internal step.
 
 use super::stage::{evaluate_stage, StageInput};
 use super::{correct_drift, State, StepReport, Stepper};
-use crate::forward::Plan;
+use crate::forward::{clamp_activations, Plan};
 use crate::model::{integrate_configuration, Data, JointKind, Model};
 use nalgebra::DVector;
 
@@ -47,6 +49,9 @@ pub struct DormandPrince54 {
     theta: DVector<f64>,
     theta_rate: [DVector<f64>; 7],
     a_stage: [DVector<f64>; 7],
+    /// Stage rates of the activations (`act_dot`) and the stage activations (na each).
+    act_rate: [DVector<f64>; 7],
+    act_stage: DVector<f64>,
     /// Per dof: the qpos index of a flat coordinate, None for the rotation-vector coordinates
     /// of quaternion joints.
     flat_qpos: Vec<Option<usize>>,
@@ -72,6 +77,8 @@ impl DormandPrince54 {
             theta: z(),
             theta_rate: std::array::from_fn(|_| z()),
             a_stage: std::array::from_fn(|_| z()),
+            act_rate: std::array::from_fn(|_| DVector::zeros(model.na())),
+            act_stage: DVector::zeros(model.na()),
             flat_qpos,
         }
     }
@@ -84,9 +91,11 @@ impl DormandPrince54 {
         for i in 0..7 {
             self.v_stage.copy_from(&state.v);
             self.theta.fill(0.0);
+            data.act.copy_from(&state.act);
             for j in 0..i {
                 self.v_stage.axpy(h * A[i][j], &self.a_stage[j], 1.0);
                 self.theta.axpy(h * A[i][j], &self.theta_rate[j], 1.0);
+                data.act.axpy(h * A[i][j], &self.act_rate[j], 1.0);
             }
             evaluate_stage(
                 model,
@@ -96,6 +105,7 @@ impl DormandPrince54 {
                 &mut self.q_stage,
                 (&mut self.a_stage[i], &mut self.theta_rate[i]),
             );
+            self.act_rate[i].copy_from(&data.act_dot);
             if i == 0 {
                 data.freeze_rows(false);
             }
@@ -119,6 +129,17 @@ impl DormandPrince54 {
                 .max(e_v.abs() / (self.atol + self.rtol * s_v));
             if e.is_nan() || !e_theta.is_finite() || !e_v.is_finite() {
                 // A non-finite stage (f64::max would drop a NaN): reject the attempt.
+                return f64::INFINITY;
+            }
+            err = err.max(e);
+        }
+        // Stage 7's activations are the fifth-order solution too.
+        self.act_stage.copy_from(&data.act);
+        for k in 0..self.act_stage.len() {
+            let e_act: f64 = (0..7).map(|i| h * (B5[i] - B4[i]) * self.act_rate[i][k]).sum();
+            let s = state.act[k].abs().max(self.act_stage[k].abs());
+            let e = e_act.abs() / (self.atol + self.rtol * s);
+            if !e.is_finite() {
                 return f64::INFINITY;
             }
             err = err.max(e);
@@ -150,6 +171,8 @@ impl Stepper for DormandPrince54 {
             let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
             if err <= 1.0 && err.is_finite() {
                 state.v.copy_from(&self.v_stage);
+                state.act.copy_from(&self.act_stage);
+                clamp_activations(model, state.act.as_mut_slice());
                 integrate_configuration(model, state.q.as_mut_slice(), self.theta.as_slice(), 1.0);
                 state.time = if last { t_end } else { state.time + h_step };
                 max_err = max_err.max(err);

@@ -5,7 +5,7 @@
 
 use super::implicit_fast::implicit_acceleration;
 use super::{correct_drift, State, StepReport, Stepper};
-use crate::forward::{forward, Plan};
+use crate::forward::{advance_activations, forward, Plan};
 use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
@@ -28,7 +28,9 @@ impl Stepper for SemiImplicitEuler {
         1
     }
     fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
+        data.act.copy_from(&state.act);
         forward(model, plan, data, state.q.as_slice(), state.v.as_slice());
+        advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         let flags = &model.options.flags;
         if flags.eulerdamp && flags.damper && model.has_damping() {
             implicit_acceleration(model, data, state.q.as_slice(), &mut self.damped, h);

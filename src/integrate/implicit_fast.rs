@@ -6,15 +6,16 @@
 //!
 //! where qacc is `forward`'s acceleration (constraint forces included) and M qacc the total
 //! force it balances. Today D = −diag(`dof_damping`), joint damping being the only
-//! velocity-dependent passive force; actuator derivatives add to D in [`add_force_derivative`]
-//! when actuators exist. With only joint damping this is also what MuJoCo's `Euler` does
+//! velocity-dependent passive force; actuators add their velocity derivatives
+//! ([`add_actuator_velocity_derivative`], MuJoCo's `mjd_actuator_vel`: position servos' kv, velocity
+//! servos, affine gains). With only joint damping this is also what MuJoCo's `Euler` does
 //! (implicit damping), so its `mj_step` is the reference on damped passive scenes.
 //! `implicit` (with the Coriolis derivatives, Featherstone-style RNE derivative) is not
 //! implemented: `<option integrator="implicit">` uses this one, with a note.
 
 use super::{correct_drift, State, StepReport, Stepper};
 use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
-use crate::forward::{forward, Plan};
+use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward, Plan};
 use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
@@ -29,8 +30,9 @@ impl ImplicitFast {
     }
 }
 
-/// Adds −h·D (D = ∂qfrc/∂v, without Coriolis terms) to `matrix` (column-major nv×nv): joint
-/// damping today; the place where actuator velocity derivatives (−∂qfrc_actuator/∂v) plug in.
+/// Adds −h·D (D = ∂qfrc/∂v, without Coriolis terms) to `matrix` (column-major nv×nv): the joint
+/// damping part (the actuators' part is
+/// [`add_actuator_velocity_derivative`](crate::forward::add_actuator_velocity_derivative)).
 pub fn add_force_derivative(model: &Model, matrix: &mut [f64], h: f64) {
     let nv = model.nv;
     for k in 0..nv {
@@ -63,9 +65,33 @@ impl Stepper for ImplicitFast {
         1
     }
     fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
+        data.act.copy_from(&state.act);
         forward(model, plan, data, state.q.as_slice(), state.v.as_slice());
-        if model.has_damping() {
-            implicit_acceleration(model, data, state.q.as_slice(), &mut self.force, h);
+        // Activations as in MuJoCo's `mj_advance` (explicit in act_dot; filterexact exact).
+        advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
+        let actuated = !model.actuators.is_empty() && model.options.flags.actuation;
+        let mut implicit = model.has_damping();
+        if implicit || actuated {
+            crba(model, data, state.q.as_slice());
+            self.force.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
+            add_force_derivative(model, data.mass_matrix.as_mut_slice(), h);
+            let mut m = std::mem::take(&mut data.mass_matrix);
+            let bias_velocity = &plan.actuator_bias_velocity;
+            let from_actuators =
+                add_actuator_velocity_derivative(model, data, bias_velocity, m.as_mut_slice(), h);
+            if implicit || from_actuators {
+                data.mass_matrix = m;
+                factorize_mass_matrix(model, data);
+                solve_with_factor(model, &data.mass_factor, self.force.as_mut_slice());
+                m = std::mem::take(&mut data.mass_matrix);
+            }
+            // Leave M as crba computed it.
+            add_actuator_velocity_derivative(model, data, bias_velocity, m.as_mut_slice(), -h);
+            data.mass_matrix = m;
+            add_force_derivative(model, data.mass_matrix.as_mut_slice(), -h);
+            implicit |= from_actuators;
+        }
+        if implicit {
             state.v.axpy(h, &self.force, 1.0);
         } else {
             state.v.axpy(h, &data.qacc, 1.0);

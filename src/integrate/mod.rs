@@ -23,18 +23,27 @@ use crate::forward::{DriftCorrection, Plan};
 use crate::model::{options, Data, Model};
 use nalgebra::DVector;
 
-/// The state advanced by a stepper, in MuJoCo's qpos/qvel layout.
+/// The state advanced by a stepper, in MuJoCo's qpos/qvel/act layout: `act` holds the actuator
+/// activations (MuJoCo's `act`, `na` values; empty without activation dynamics), integrated from
+/// the actuation stage's `act_dot` as MuJoCo does (`filterexact` exactly, then clamped to
+/// `actrange`; [`advance_activations`](crate::forward::advance_activations)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct State {
     pub time: f64,
     pub q: DVector<f64>,
     pub v: DVector<f64>,
+    pub act: DVector<f64>,
 }
 
 impl State {
     /// The model's reference configuration (`qpos0`) at rest, time 0.
     pub fn neutral(model: &Model) -> Self {
-        Self { time: 0.0, q: DVector::from_vec(model.qpos0.clone()), v: DVector::zeros(model.nv) }
+        Self::new(model, model.qpos0.clone(), vec![0.0; model.nv])
+    }
+
+    /// The state (q, v) at time 0 with zero activations.
+    pub fn new(model: &Model, q: Vec<f64>, v: Vec<f64>) -> Self {
+        Self { time: 0.0, q: DVector::from_vec(q), v: DVector::from_vec(v), act: DVector::zeros(model.na()) }
     }
 }
 

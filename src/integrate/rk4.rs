@@ -6,11 +6,13 @@
 //! acts on a vector space and keeps its order 4 on ball and free joints too. For flat joints
 //! (hinge, slide, planar) dexp⁻¹ is the identity and the method is MuJoCo's `mj_RungeKutta`.
 //! (Averaging the body-frame stage velocities without dexp⁻¹, as before, is second order on
-//! quaternion joints: issue 15.)
+//! quaternion joints: issue 15.) Activations are stages of the same tableau, and the step applies
+//! their weighted mean rate as MuJoCo's `mj_RungeKutta` does (through `mj_advance`: `filterexact`
+//! with its exponential factor, then clamped to `actrange`).
 
 use super::stage::{evaluate_stage, StageInput};
 use super::{correct_drift, State, StepReport, Stepper};
-use crate::forward::Plan;
+use crate::forward::{advance_activations, Plan};
 use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
@@ -21,6 +23,9 @@ pub struct RungeKutta4 {
     theta: DVector<f64>,
     theta_rate: [DVector<f64>; 4],
     a_stage: [DVector<f64>; 4],
+    /// Stage rates of the activations (`act_dot`) and their weighted mean (na each).
+    act_rate: [DVector<f64>; 4],
+    act_mean: DVector<f64>,
 }
 
 impl RungeKutta4 {
@@ -32,6 +37,8 @@ impl RungeKutta4 {
             theta: z(),
             theta_rate: [z(), z(), z(), z()],
             a_stage: [z(), z(), z(), z()],
+            act_rate: std::array::from_fn(|_| DVector::zeros(model.na())),
+            act_mean: DVector::zeros(model.na()),
         }
     }
 }
@@ -53,6 +60,10 @@ impl Stepper for RungeKutta4 {
                 self.v_stage.axpy(C[i] * h, &self.a_stage[i - 1], 1.0);
                 self.theta.axpy(C[i] * h, &self.theta_rate[i - 1], 0.0);
             }
+            data.act.copy_from(&state.act);
+            if i > 0 {
+                data.act.axpy(C[i] * h, &self.act_rate[i - 1], 1.0);
+            }
             evaluate_stage(
                 model,
                 plan,
@@ -61,6 +72,7 @@ impl Stepper for RungeKutta4 {
                 &mut self.q_stage,
                 (&mut self.a_stage[i], &mut self.theta_rate[i]),
             );
+            self.act_rate[i].copy_from(&data.act_dot);
             if i == 0 {
                 // The later stages keep the limit and contact rows the step starts with.
                 data.freeze_rows(false);
@@ -73,6 +85,11 @@ impl Stepper for RungeKutta4 {
             self.theta[k] = h * (r1[k] + 2.0 * r2[k] + 2.0 * r3[k] + r4[k]) / 6.0;
             state.v[k] += h * (a1[k] + 2.0 * a2[k] + 2.0 * a3[k] + a4[k]) / 6.0;
         }
+        let [w1, w2, w3, w4] = &self.act_rate;
+        for k in 0..self.act_mean.len() {
+            self.act_mean[k] = (w1[k] + 2.0 * w2[k] + 2.0 * w3[k] + w4[k]) / 6.0;
+        }
+        advance_activations(model, state.act.as_mut_slice(), self.act_mean.as_slice(), h);
         integrate_configuration(model, state.q.as_mut_slice(), self.theta.as_slice(), 1.0);
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))

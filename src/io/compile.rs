@@ -280,6 +280,18 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     model.contact_excludes = e.contact_excludes;
     model.elements.append(&mut e.kept);
     model.warnings.append(&mut e.warnings);
+    reflect_actuator_damping_armature(spec, &mut model);
+    // Actuators of kinds the actuation stage does not simulate: listed by `info`, no force.
+    for a in &model.actuators {
+        if let Some(why) = crate::model::actuator::unsimulated_reason(&model, a) {
+            let name = if a.name.is_empty() { String::new() } else { format!(" '{}'", a.name) };
+            model.warnings.push(format!(
+                "{}: <{}>{name}: {why} is not simulated; the actuator is listed by `info` and exerts no force",
+                a.loc,
+                a.shortcut.name()
+            ));
+        }
+    }
     let joint_locs: Vec<SourceLoc> = spec
         .links
         .iter()
@@ -289,6 +301,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     if let Some(w) = crate::io::singular::check_mass_matrix(&model, &joint_locs, word) {
         model.warnings.push(w);
     }
+    check_keyframe_act(&model)?;
     model.collision_pairs = crate::model::collision_pairs::candidate_pairs(&model);
     if model.collision_pairs.len() > crate::model::collision_pairs::MAX_COLLISION_PAIRS {
         return Err(LoadError::Invalid {
@@ -301,6 +314,56 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         });
     }
     Ok(model)
+}
+
+/// Actuator `damping` and `armature` (MuJoCo 4's `actuator_damping`, `actuator_armature`): on a
+/// hinge or slide joint the transmission's moment is the constant gear, so they are the joint's
+/// damping gear² · damping (a passive force, off with `<flag damper="disable">`) and armature
+/// gear² · armature, added to `dof_damping` and `dof_armature` (checked against MuJoCo 4.0.0's
+/// `qfrc_passive` and M). On other transmissions they are not simulated, with a warning.
+fn reflect_actuator_damping_armature(spec: &ModelSpec, model: &mut Model) {
+    use crate::model::actuator::Transmission;
+    for (s, a) in spec.actuators.iter().zip(&model.actuators) {
+        if s.damping == 0.0 && s.armature == 0.0 {
+            continue;
+        }
+        let joint = match a.transmission {
+            Transmission::Joint(j) | Transmission::JointInParent(j) if model.joints[j].kind.nv() == 1 => j,
+            _ => {
+                model.warnings.push(format!(
+                    "{}: <{}>: actuator damping and armature are simulated on hinge and slide joint transmissions only; ignored here",
+                    s.loc,
+                    s.shortcut.name()
+                ));
+                continue;
+            }
+        };
+        let (dof, g2) = (model.joints[joint].dof_adr, a.gear[0] * a.gear[0]);
+        if spec.options.flags.damper {
+            model.dof_damping[dof] += g2 * s.damping;
+        }
+        model.dof_armature[dof] += g2 * s.armature;
+    }
+}
+
+/// A keyframe's `act` must have one value per activation state (MuJoCo's `na`), as MuJoCo's
+/// compiler requires.
+fn check_keyframe_act(model: &Model) -> Result<(), LoadError> {
+    let na = model.na();
+    for k in &model.keyframes {
+        if let Some(act) = k.act.as_ref().filter(|a| a.len() != na) {
+            return Err(LoadError::Invalid {
+                loc: k.loc.clone(),
+                element: "key".into(),
+                detail: format!(
+                    "keyframe '{}': act has {} values, the model has {na} activation states (one per actuator with a dyntype other than 'none'); give {na} values or remove 'act'",
+                    k.name,
+                    act.len()
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Keyframes with full vectors, as MuJoCo completes them: a missing `qpos` is `qpos0` and a short

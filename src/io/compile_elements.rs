@@ -530,7 +530,14 @@ fn tendon(t: &TendonSpec, n: &Names) -> Result<Tendon, LoadError> {
             }
         }
     };
-    Ok(Tendon { name: t.name.clone(), kind, range: t.range, soft: t.soft, loc: t.loc.clone() })
+    Ok(Tendon {
+        name: t.name.clone(),
+        kind,
+        range: t.range,
+        soft: t.soft,
+        actuator_force_range: t.actuator_force_range,
+        loc: t.loc.clone(),
+    })
 }
 
 /// One actuator: its transmission resolved, and `inheritrange` turned into a control (or, for

@@ -160,8 +160,8 @@ pub fn check_spec(spec: &ModelSpec) -> Result<(), LoadError> {
     check_elements(spec)
 }
 
-/// The coefficients of equalities, fixed tendons and actuators: finite and within [`ABSURD`]
-/// (ranges may be as wide as they like but finite).
+/// The coefficients of equalities, fixed tendons and actuators, and keyframes' activations: finite
+/// and within [`ABSURD`] (ranges may be as wide as they like but finite).
 fn check_elements(spec: &ModelSpec) -> Result<(), LoadError> {
     for e in &spec.equalities {
         let what = || format!("equality '{}': a coefficient", e.name);
@@ -180,7 +180,19 @@ fn check_elements(spec: &ModelSpec) -> Result<(), LoadError> {
             EqualitySpecKind::ConnectSites { .. } => {}
         }
     }
+    for k in &spec.keyframes {
+        if let Some(act) = &k.act {
+            check(&k.loc, "key", || format!("keyframe '{}': an activation (act)", k.name), act)?;
+        }
+    }
     for t in &spec.tendons {
+        if let Some(range) = t.actuator_force_range.filter(|r| !r.iter().all(|x| x.is_finite())) {
+            return Err(invalid(
+                &t.loc,
+                "tendon",
+                format!("tendon '{}': actuatorfrcrange {range:?} is not finite; fix the value", t.name),
+            ));
+        }
         if let TendonSpecKind::Fixed { joints } = &t.kind {
             for (joint, coef, loc) in joints {
                 check(
@@ -194,7 +206,7 @@ fn check_elements(spec: &ModelSpec) -> Result<(), LoadError> {
     }
     for a in &spec.actuators {
         let what = || format!("actuator '{}': a gear, gain, bias or dynamics parameter", a.name);
-        for values in [&a.gear[..], &a.gainprm[..], &a.biasprm[..], &a.dynprm[..]] {
+        for values in [&a.gear[..], &a.gainprm[..], &a.biasprm[..], &a.dynprm[..], &[a.damping, a.armature]] {
             check(&a.loc, "actuator", what, values)?;
         }
         for range in [a.ctrlrange, a.forcerange, a.actrange].into_iter().flatten() {

@@ -1,10 +1,11 @@
 //! Actuators (MJCF `<actuator>`, MuJoCo's `actuator_*` arrays) in MuJoCo's general form: every
 //! shortcut (`motor`, `position`, `velocity`, …) is stored as the gain, bias and dynamics
 //! parameters MuJoCo expands it to (MuJoCo documentation, "Actuation model"). Typed here so that
-//! nothing is read back out of strings; simulated by the actuation work (until then `info` lists
-//! them as not simulated and `qfrc_actuator` stays zero).
+//! nothing is read back out of strings; simulated by the actuation stage (`forward::actuation`)
+//! except the kinds [`unsimulated_reason`] names, which `info` lists as not simulated, the loader
+//! warns about, and which exert no force.
 
-use super::SourceLoc;
+use super::{JointKind, Model, SourceLoc, TendonKind};
 
 /// The MJCF element the actuator was written as.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -117,5 +118,28 @@ impl Actuator {
     /// Number of activation states this actuator adds (MuJoCo's `actuator_actnum`: 0 or 1 here).
     pub fn actnum(&self) -> usize {
         usize::from(self.dyntype != DynType::None)
+    }
+}
+
+/// Why actuator `a` of `model` is not simulated, or None if it is: muscle and user dynamics, gains
+/// and biases; planar-joint, spatial-tendon and body (adhesion) transmissions.
+pub fn unsimulated_reason(model: &Model, a: &Actuator) -> Option<&'static str> {
+    if matches!(a.dyntype, DynType::Muscle | DynType::User) {
+        return Some("muscle or user activation dynamics");
+    }
+    if !matches!(a.gaintype, GainType::Fixed | GainType::Affine) {
+        return Some("muscle or user gain");
+    }
+    if !matches!(a.biastype, BiasType::None | BiasType::Affine) {
+        return Some("muscle or user bias");
+    }
+    match &a.transmission {
+        Transmission::Joint(j) | Transmission::JointInParent(j) => {
+            matches!(model.joints[*j].kind, JointKind::Planar { .. }).then_some("a planar joint transmission")
+        }
+        Transmission::Tendon(t) => matches!(model.tendons[*t].kind, TendonKind::Spatial { .. })
+            .then_some("a spatial tendon transmission"),
+        Transmission::Site { .. } | Transmission::SliderCrank { .. } => None,
+        Transmission::Body(_) => Some("a body (adhesion) transmission"),
     }
 }

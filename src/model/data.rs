@@ -202,6 +202,11 @@ pub struct Data {
     // --- forward pipeline (MuJoCo's names) ---
     /// Controls, one per actuator (MuJoCo's `ctrl`).
     pub ctrl: DVector<f64>,
+    /// Actuator activations, one per activation state (MuJoCo's `act`, `na` values in actuator
+    /// order): an input of `forward` like `ctrl`, set from the integrator's state.
+    pub act: DVector<f64>,
+    /// Time derivative of `act` (MuJoCo's `act_dot`), written by the actuation stage.
+    pub act_dot: DVector<f64>,
     /// Generalized forces applied by the user (MuJoCo's `qfrc_applied`).
     pub qfrc_applied: DVector<f64>,
     /// Bias forces c(q, v) = RNEA(q, v, 0) (Coriolis, centrifugal, gravity). Filled by the velocity
@@ -389,6 +394,8 @@ impl Data {
             scratch_v: DVector::zeros(nv),
             a_bias_body: vec![Motion::zero(); nb],
             ctrl: DVector::zeros(model.actuators.len()),
+            act: DVector::zeros(model.na()),
+            act_dot: DVector::zeros(model.na()),
             qfrc_applied: DVector::zeros(nv),
             qfrc_bias: DVector::zeros(nv),
             qfrc_passive: DVector::zeros(nv),

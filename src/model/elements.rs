@@ -12,13 +12,15 @@ pub struct Keyframe {
     pub qpos: Option<Vec<f64>>,
     pub qvel: Option<Vec<f64>>,
     pub ctrl: Option<Vec<f64>>,
+    /// Actuator activations (MuJoCo's `act`, one per activation state, `na`).
+    pub act: Option<Vec<f64>>,
 }
 
 impl Keyframe {
-    /// Writes the parts of the state this keyframe gives into `q`, `v` and `ctrl` (its `ctrl` only
-    /// when it has one value per actuator, as MuJoCo's `mj_resetDataKeyframe`); the rest is left
-    /// as it is.
-    pub fn apply(&self, q: &mut Vec<f64>, v: &mut Vec<f64>, ctrl: &mut Vec<f64>) {
+    /// Writes the parts of the state this keyframe gives into `q`, `v`, `ctrl` and `act` (its
+    /// `ctrl` and `act` only when they have one value per actuator and per activation, as
+    /// MuJoCo's `mj_resetDataKeyframe`); the rest is left as it is.
+    pub fn apply(&self, q: &mut Vec<f64>, v: &mut Vec<f64>, ctrl: &mut Vec<f64>, act: &mut Vec<f64>) {
         if let Some(x) = &self.qpos {
             q.clone_from(x);
         }
@@ -27,6 +29,9 @@ impl Keyframe {
         }
         if let Some(x) = self.ctrl.as_ref().filter(|c| c.len() == ctrl.len()) {
             ctrl.clone_from(x);
+        }
+        if let Some(x) = self.act.as_ref().filter(|a| a.len() == act.len()) {
+            act.clone_from(x);
         }
     }
 }

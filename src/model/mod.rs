@@ -226,6 +226,11 @@ pub struct Spring {
 pub const NO_DOF: usize = usize::MAX;
 
 impl Model {
+    /// Number of actuator activation states (MuJoCo's `na`): one per actuator with activation
+    /// dynamics, in actuator order.
+    pub fn na(&self) -> usize {
+        self.actuators.iter().map(|a| a.actnum()).sum()
+    }
     /// Number of bodies including the world.
     pub fn nbody(&self) -> usize {
         self.bodies.len()

@@ -375,6 +375,8 @@ pub struct TendonSpec {
     pub range: Option<[f64; 2]>,
     /// Soft-constraint parameters of its limit rows (`solreflimit`, `solimplimit`, `margin`).
     pub soft: SoftParams,
+    /// Total actuator force range if limited (`actuatorfrclimited`/`actuatorfrcrange`).
+    pub actuator_force_range: Option<[f64; 2]>,
     pub loc: SourceLoc,
 }
 
@@ -421,6 +423,10 @@ pub struct ActuatorSpec {
     /// `intvelocity`) is this fraction of the target joint's or tendon's range, about its middle;
     /// set by the compile step, which knows the target.
     pub inheritrange: Option<f64>,
+    /// Actuator-level passive damping and armature (MuJoCo's `actuator_damping`,
+    /// `actuator_armature`): reflected through the transmission onto its dofs.
+    pub damping: f64,
+    pub armature: f64,
     pub loc: SourceLoc,
 }
 

@@ -12,6 +12,9 @@ pub struct Tendon {
     pub range: Option<[f64; 2]>,
     /// Soft-constraint parameters of its limit rows (soft mode).
     pub soft: super::spec::SoftParams,
+    /// The range of the total force of the actuators on this tendon (MJCF `actuatorfrcrange`
+    /// with `actuatorfrclimited`): outside it, their forces are scaled down together.
+    pub actuator_force_range: Option<[f64; 2]>,
     pub loc: SourceLoc,
 }
 

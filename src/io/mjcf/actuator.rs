@@ -420,6 +420,12 @@ fn finish(
     {
         return Err(a.error("ctrlrange", format!("cannot be negative for <{}>: the control scales a dissipative or adhesive force; use a range in [0, ∞)", e.tag)));
     }
+    if a.real("delay")?.is_some_and(|d| d > 0.0) {
+        warnings.push(format!(
+            "{}: <{}>: 'delay' (MuJoCo's control history buffer) is not simulated: the control acts without delay",
+            e.loc, e.tag
+        ));
+    }
     let forcerange = a.limited_range("forcelimited", "forcerange", autolimits, warnings)?;
     let actrange = a.limited_range("actlimited", "actrange", autolimits, warnings)?;
     if actrange.is_some() && p.dyntype == DynType::None {
@@ -427,6 +433,35 @@ fn finish(
             "actrange",
             "is given but the actuator has no activation (dyntype 'none'); remove it or give a dyntype",
         ));
+    }
+    // `actdim`: the number of activations, one with activation dynamics and none without (the
+    // larger counts of `user` dynamics are not typed here).
+    if let Some(n) = a.int("actdim")?.filter(|&n| n >= 0) {
+        let stateful = p.dyntype != DynType::None;
+        if n != i64::from(stateful) && !(n > 1 && p.dyntype == DynType::User) {
+            return Err(a.error(
+                "actdim",
+                format!(
+                    "is {n}; an actuator with dyntype '{}' has {} activation: give actdim=\"{}\" or remove it",
+                    match p.dyntype {
+                        DynType::None => "none",
+                        DynType::Integrator => "integrator",
+                        DynType::Filter => "filter",
+                        DynType::FilterExact => "filterexact",
+                        DynType::Muscle => "muscle",
+                        DynType::User => "user",
+                    },
+                    if stateful { "one" } else { "no" },
+                    i64::from(stateful)
+                ),
+            ));
+        }
+        if n > 1 {
+            return Err(a.error(
+                "actdim",
+                format!("is {n}; user dynamics with several activations are not supported: use actdim=\"1\""),
+            ));
+        }
     }
     if p.inheritrange.is_some() {
         let (range, attr) = if shortcut == ActuatorShortcut::IntVelocity {
@@ -457,8 +492,34 @@ fn finish(
         actrange,
         actearly: a.bool("actearly")?.unwrap_or(false),
         inheritrange: p.inheritrange,
+        damping: damping(a, warnings)?,
+        armature: nonnegative_attr(a, "armature")?,
         loc: e.loc.clone(),
     })
+}
+
+/// An attribute that cannot be negative (0 if absent).
+fn nonnegative_attr(a: &Attrs, name: &str) -> Result<f64, LoadError> {
+    match a.real(name)? {
+        Some(v) if v < 0.0 => Err(a.error(name, format!("is {v}; it cannot be negative"))),
+        v => Ok(v.unwrap_or(0.0)),
+    }
+}
+
+/// The linear actuator damping (`damping`'s first value); higher polynomial terms are not
+/// simulated and warned about.
+fn damping(a: &Attrs, warnings: &mut Vec<String>) -> Result<f64, LoadError> {
+    let Some(d) = a.some_numbers("damping", 1, 3)? else { return Ok(0.0) };
+    if d[0] < 0.0 {
+        return Err(a.error("damping", format!("is {}; it cannot be negative", d[0])));
+    }
+    if d[1..].iter().any(|&c| c != 0.0) {
+        warnings.push(format!(
+            "{}: <{}>: the polynomial terms of 'damping' are not simulated (only the linear coefficient {})",
+            a.loc, a.tag, d[0]
+        ));
+    }
+    Ok(d[0])
 }
 
 /// The transmission: MuJoCo reads `joint`, `jointinparent`, `tendon`, `cranksite`, `site`, `body`

@@ -182,6 +182,7 @@ pub(crate) fn keyframes(root: &Element) -> Result<Vec<Keyframe>, LoadError> {
                 qpos: a.numbers("qpos")?,
                 qvel: a.numbers("qvel")?,
                 ctrl: a.numbers("ctrl")?,
+                act: a.numbers("act")?,
             });
         }
     }

@@ -66,7 +66,9 @@ pub(crate) fn tendons(
             };
             let range = a.limited_range("limited", "range", autolimits, warnings)?;
             let soft = super::body::soft_params(&a)?;
-            out.push(TendonSpec { name, kind, range, soft, loc: e.loc.clone() });
+            let actuator_force_range =
+                a.limited_range("actuatorfrclimited", "actuatorfrcrange", autolimits, warnings)?;
+            out.push(TendonSpec { name, kind, range, soft, actuator_force_range, loc: e.loc.clone() });
         }
     }
     Ok(out)

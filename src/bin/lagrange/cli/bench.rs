@@ -139,8 +139,9 @@ const SOFT_STEPS: u32 = 1000;
 fn soft_step(model: &Model) -> (f64, usize) {
     let (mut q, mut v, mut ctrl) =
         (model.qpos0.clone(), vec![0.0; model.nv], vec![0.0; model.actuators.len()]);
+    let mut act = vec![0.0; model.na()];
     if let Some(k) = model.keyframes.first() {
-        k.apply(&mut q, &mut v, &mut ctrl);
+        k.apply(&mut q, &mut v, &mut ctrl, &mut act);
     }
     let options = SimOptions { constraints: Some(ConstraintMode::Soft), ..Default::default() };
     let mut sim = Simulation::new(std::sync::Arc::new(model.clone()), &options);
@@ -148,6 +149,9 @@ fn soft_step(model: &Model) -> (f64, usize) {
         return (f64::NAN, 0);
     }
     sim.ctrl_mut().copy_from_slice(&ctrl);
+    if sim.set_act(&act).is_err() {
+        return (f64::NAN, 0);
+    }
     let t0 = Instant::now();
     for _ in 0..SOFT_STEPS {
         if sim.step().is_err() {

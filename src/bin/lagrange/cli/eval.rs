@@ -26,6 +26,10 @@ pub struct StateIn {
     /// Controls, one per actuator (default zero).
     #[serde(default)]
     pub ctrl: Option<Vec<f64>>,
+    /// Actuator activations, one per actuator with activation dynamics (MuJoCo's `act`, `na`
+    /// values; default zero).
+    #[serde(default)]
+    pub act: Option<Vec<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -83,6 +87,10 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
     if let Some(ctrl) = &s.ctrl {
         data.ctrl.copy_from_slice(ctrl);
     }
+    data.act.fill(0.0);
+    if let Some(act) = &s.act {
+        data.act.copy_from_slice(act);
+    }
     forward(model, plan, data, &s.q, v);
     let mut constraints = Vec::new();
     let file = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
@@ -128,7 +136,7 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
         "qacc": vec(&data.qacc), "qacc_smooth": vec(&data.qacc_smooth), "qfrc_passive": vec(&data.qfrc_passive),
         "qfrc_actuator": vec(&data.qfrc_actuator), "qfrc_constraint": vec(&data.qfrc_constraint),
         "actuator_force": vec(&data.actuator_force), "actuator_length": vec(&data.actuator_length),
-        "actuator_velocity": vec(&data.actuator_velocity),
+        "actuator_velocity": vec(&data.actuator_velocity), "act_dot": vec(&data.act_dot),
         "actuator_moment": (0..data.actuator_moment.nrows())
             .map(|i| data.actuator_moment.row(i).iter().copied().collect::<Vec<f64>>())
             .collect::<Vec<_>>(),
@@ -210,7 +218,8 @@ fn check_state(model: &Model, file: &str, i: usize, s: &StateIn) -> Result<(), C
     check("q", &Some(s.q.clone()), model.nq)?;
     check("v", &s.v, model.nv)?;
     check("tau", &s.tau, model.nv)?;
-    check("ctrl", &s.ctrl, model.actuators.len())
+    check("ctrl", &s.ctrl, model.actuators.len())?;
+    check("act", &s.act, model.na())
 }
 
 /// Runs `eval`, printing `{"results": [...]}`.
@@ -229,7 +238,7 @@ pub fn run(
     let input: StatesFile = serde_json::from_str(&text).map_err(|e| CliError::Input {
         file: file.clone(),
         detail: format!(
-            "line {}: {e}; expected {{\"states\": [{{\"q\": [...], \"v\": [...], \"tau\": [...], \"ctrl\": [...]}}]}}",
+            "line {}: {e}; expected {{\"states\": [{{\"q\": [...], \"v\": [...], \"tau\": [...], \"ctrl\": [...], \"act\": [...]}}]}}",
             e.line()
         ),
     })?;

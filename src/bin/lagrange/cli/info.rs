@@ -209,6 +209,8 @@ pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
     json!({
         "nq": model.nq,
         "nv": model.nv,
+        "nu": model.actuators.len(),
+        "na": model.na(),
         "total_mass": model.total_mass(),
         "bodies": bodies,
         "joints": joints,
@@ -241,6 +243,14 @@ pub fn to_text(model: &Model, mode: Option<ConstraintMode>) -> String {
         model.frames.len(),
         model.total_mass()
     );
+    if !model.actuators.is_empty() {
+        let _ = writeln!(
+            s,
+            "nu = {} actuators (ctrl), na = {} activation states (act)",
+            model.actuators.len(),
+            model.na()
+        );
+    }
     let _ = writeln!(s, "\nbodies (com in body frame; inertia about com, body axes):");
     let _ = writeln!(s, "  {:<28} {:<24} {:>10}  {:<30} diag(I)", "name", "parent", "mass", "com");
     for (b, body) in model.bodies.iter().enumerate() {

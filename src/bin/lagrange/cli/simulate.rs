@@ -161,6 +161,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     // Initial state: --q0/--v0, else the keyframe's, else qpos0 at rest.
     let (mut q0, mut v0) = (model.qpos0.clone(), vec![0.0; model.nv]);
     let mut ctrl = vec![0.0; model.actuators.len()];
+    let mut act = vec![0.0; model.na()];
     if let Some(name) = &request.keyframe {
         let Some(k) = model.keyframe_id(name).map(|k| &model.keyframes[k]) else {
             let known: Vec<&str> = model.keyframes.iter().map(|k| k.name.as_str()).collect();
@@ -169,7 +170,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
                 if known.is_empty() { "none".to_string() } else { known.join(", ") }
             )));
         };
-        k.apply(&mut q0, &mut v0, &mut ctrl);
+        k.apply(&mut q0, &mut v0, &mut ctrl, &mut act);
     }
     if let Some(s) = &request.ctrl {
         ctrl = parse_list("ctrl", s, model.actuators.len())?;
@@ -182,6 +183,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     }
     sim.set_state(&q0, &v0)?;
     sim.ctrl_mut().copy_from_slice(&ctrl);
+    sim.set_act(&act)?;
     let steps = (request.duration / dt).round() as u64;
     let mut csv = match &request.out {
         Some(path) => {
@@ -326,12 +328,20 @@ fn write_header(w: &mut impl Write, model: &Model) -> std::io::Result<()> {
             write!(w, ",v:{}[{k}]", j.name)?;
         }
     }
+    // Actuator activations (MuJoCo's act), one column per actuator with activation dynamics.
+    for (i, a) in model.actuators.iter().enumerate().filter(|(_, a)| a.actnum() == 1) {
+        if a.name.is_empty() {
+            write!(w, ",act:actuator{i}")?;
+        } else {
+            write!(w, ",act:{}", a.name)?;
+        }
+    }
     writeln!(w, ",energy,constraint_violation")
 }
 
 fn write_row(w: &mut impl Write, sim: &Simulation, energy: f64, violation: f64) -> std::io::Result<()> {
     write!(w, "{}", display_time(sim.state.time))?;
-    for x in sim.state.q.iter().chain(sim.state.v.iter()) {
+    for x in sim.state.q.iter().chain(sim.state.v.iter()).chain(sim.state.act.iter()) {
         write!(w, ",{x}")?;
     }
     writeln!(w, ",{energy},{violation}")
@@ -358,6 +368,7 @@ pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
                    "worst_unconverged_residual": s.unconverged.1},
         "q": s.final_state.q.as_slice(),
         "v": s.final_state.v.as_slice(),
+        "act": s.final_state.act.as_slice(),
     })
 }
 
@@ -467,6 +478,12 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
             .map(|x| format!("{x:+.6}"))
             .collect();
         let _ = writeln!(out, "  {:<24} q = [{}]  v = [{}]", j.name, q.join(", "), v.join(", "));
+    }
+    // Activations, one per actuator with activation dynamics.
+    let mut act = state.act.iter();
+    for (i, a) in model.actuators.iter().enumerate().filter(|(_, a)| a.actnum() == 1) {
+        let name = if a.name.is_empty() { format!("actuator{i}") } else { a.name.clone() };
+        let _ = writeln!(out, "  {name:<24} act = {:+.6}", act.next().copied().unwrap_or(0.0));
     }
     out
 }

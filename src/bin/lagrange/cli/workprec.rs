@@ -117,6 +117,8 @@ struct Setup {
     q0: Vec<f64>,
     v0: Vec<f64>,
     ctrl: Vec<f64>,
+    /// Initial actuator activations (na; the keyframe's `act`, else zero).
+    act: Vec<f64>,
     /// How the initial state was chosen, for the output.
     start: String,
     /// Spacing of the sample times (the coarsest step) and their number after t = 0.
@@ -233,6 +235,7 @@ struct Start {
     q0: Vec<f64>,
     v0: Vec<f64>,
     ctrl: Vec<f64>,
+    act: Vec<f64>,
     description: String,
 }
 
@@ -241,6 +244,7 @@ struct Start {
 fn initial_state(model: &Model, request: &Request) -> Result<Start, CliError> {
     let (mut q0, mut v0) = (model.qpos0.clone(), vec![0.0; model.nv]);
     let mut ctrl = vec![0.0; model.actuators.len()];
+    let mut act = vec![0.0; model.na()];
     let mut start = String::from("qpos0 at rest (the model has no keyframe; --q0/--v0 set a state)");
     let key = match &request.keyframe {
         Some(name) => {
@@ -264,7 +268,7 @@ fn initial_state(model: &Model, request: &Request) -> Result<Start, CliError> {
         None => None,
     };
     if let Some(k) = key.map(|k| &model.keyframes[k]) {
-        k.apply(&mut q0, &mut v0, &mut ctrl);
+        k.apply(&mut q0, &mut v0, &mut ctrl, &mut act);
     }
     if let Some(s) = &request.q0 {
         q0 = parse_state("q0", s, model.nq)?;
@@ -276,7 +280,7 @@ fn initial_state(model: &Model, request: &Request) -> Result<Start, CliError> {
             start += " with --v0";
         }
     }
-    Ok(Start { q0, v0, ctrl, description: start })
+    Ok(Start { q0, v0, ctrl, act, description: start })
 }
 
 impl Setup {
@@ -293,6 +297,7 @@ impl Setup {
         );
         sim.set_state(&self.q0, &self.v0)?;
         sim.ctrl_mut().copy_from_slice(&self.ctrl);
+        sim.set_act(&self.act)?;
         Ok(sim)
     }
 
@@ -495,7 +500,7 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
             k
         }
     };
-    let Start { q0, v0, ctrl, description: start } = initial_state(&model, request)?;
+    let Start { q0, v0, ctrl, act, description: start } = initial_state(&model, request)?;
     let model_label = path.display().to_string();
     if !model.collision_pairs.is_empty() {
         notes.push(format!(
@@ -510,6 +515,7 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
         q0,
         v0,
         ctrl,
+        act,
         start,
         sample_dt,
         samples,
