@@ -103,6 +103,7 @@ fn kernels_and_integrators_do_not_allocate() {
             IntegratorKind::Rk4,
             IntegratorKind::Adaptive,
             IntegratorKind::ImplicitFast,
+            IntegratorKind::Implicit,
         ] {
             let mut integrator = kind.build(&model);
             let mut state =
@@ -114,7 +115,7 @@ fn kernels_and_integrators_do_not_allocate() {
             });
             assert_eq!(steps, 0, "{file}: {kind:?} steps allocated {steps} times");
         }
-        println!("{file}: 0 allocations in FK, velocities, Jacobian, RNEA, bias, CRBA, LTDL, solve, ABA, Euler, RK4, adaptive, implicitfast");
+        println!("{file}: 0 allocations in FK, velocities, Jacobian, RNEA, bias, CRBA, LTDL, solve, ABA, Euler, RK4, adaptive, implicitfast, implicit");
     }
 }
 

@@ -9,8 +9,7 @@
 //! velocity-dependent passive force; actuator derivatives add to D in [`add_force_derivative`]
 //! when actuators exist. With only joint damping this is also what MuJoCo's `Euler` does
 //! (implicit damping), so its `mj_step` is the reference on damped passive scenes.
-//! `implicit` (with the Coriolis derivatives, Featherstone-style RNE derivative) is not
-//! implemented: `<option integrator="implicit">` uses this one, with a note.
+//! [`Implicit`](super::Implicit) adds the Coriolis derivatives −∂c/∂v to D.
 
 use super::{correct_drift, State, StepReport, Stepper};
 use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};

@@ -8,13 +8,17 @@
 //! projected onto φ(q) = 0 and v onto J v = 0, as the plan's [`DriftCorrection`] says.
 
 mod adaptive;
+mod bias_derivative;
 mod euler;
+mod implicit;
 mod implicit_fast;
 mod rk4;
 mod stage;
 
 pub use adaptive::{DormandPrince54, DEFAULT_ATOL, DEFAULT_RTOL};
+pub use bias_derivative::BiasDerivative;
 pub use euler::SemiImplicitEuler;
+pub use implicit::Implicit;
 pub use implicit_fast::{add_force_derivative, ImplicitFast};
 pub use rk4::RungeKutta4;
 
@@ -134,6 +138,8 @@ pub enum IntegratorKind {
     Adaptive,
     /// MuJoCo's implicitfast: implicit in the velocity derivatives of passive forces.
     ImplicitFast,
+    /// MuJoCo's implicit: implicitfast plus the Coriolis/centrifugal derivatives ∂c/∂v.
+    Implicit,
 }
 
 impl IntegratorKind {
@@ -144,24 +150,18 @@ impl IntegratorKind {
             IntegratorKind::Rk4 => Box::new(RungeKutta4::new(model)),
             IntegratorKind::Adaptive => Box::new(DormandPrince54::new(model, DEFAULT_RTOL, DEFAULT_ATOL)),
             IntegratorKind::ImplicitFast => Box::new(ImplicitFast::new(model)),
+            IntegratorKind::Implicit => Box::new(Implicit::new(model)),
         }
     }
 
-    /// The stepper for a model file's `<option integrator>`, and a note when the file asks for
-    /// one that is not available yet (`implicit`, whose Coriolis derivatives are not
-    /// implemented, uses implicitfast).
+    /// The stepper for a model file's `<option integrator>` (each of MuJoCo's four has its
+    /// twin here; the note is for integrators that are not).
     pub fn from_option(integrator: options::Integrator) -> (Self, Option<String>) {
         match integrator {
             options::Integrator::Euler => (IntegratorKind::Euler, None),
             options::Integrator::Rk4 => (IntegratorKind::Rk4, None),
             options::Integrator::ImplicitFast => (IntegratorKind::ImplicitFast, None),
-            other => (
-                IntegratorKind::ImplicitFast,
-                Some(format!(
-                    "the model asks for integrator '{}', whose Coriolis derivatives are not implemented yet: using implicitfast",
-                    other.mjcf_name()
-                )),
-            ),
+            options::Integrator::Implicit => (IntegratorKind::Implicit, None),
         }
     }
 
@@ -171,6 +171,7 @@ impl IntegratorKind {
             IntegratorKind::Rk4 => "rk4",
             IntegratorKind::Adaptive => "adaptive",
             IntegratorKind::ImplicitFast => "implicitfast",
+            IntegratorKind::Implicit => "implicit",
         }
     }
 }
