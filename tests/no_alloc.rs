@@ -104,6 +104,7 @@ fn kernels_and_integrators_do_not_allocate() {
             IntegratorKind::Adaptive,
             IntegratorKind::ImplicitFast,
             IntegratorKind::Implicit,
+            IntegratorKind::Variational,
         ] {
             let mut integrator = kind.build(&model);
             let mut state =
@@ -115,7 +116,7 @@ fn kernels_and_integrators_do_not_allocate() {
             });
             assert_eq!(steps, 0, "{file}: {kind:?} steps allocated {steps} times");
         }
-        println!("{file}: 0 allocations in FK, velocities, Jacobian, RNEA, bias, CRBA, LTDL, solve, ABA, Euler, RK4, adaptive, implicitfast, implicit");
+        println!("{file}: 0 allocations in FK, velocities, Jacobian, RNEA, bias, CRBA, LTDL, solve, ABA, Euler, RK4, adaptive, implicitfast, implicit, variational");
     }
 }
 

@@ -211,7 +211,7 @@ fn workprec_refuses_bad_input_naming_the_flag() {
         (&["--dts", "1e-2,3e-3"], "--dts: 0.003 does not divide the coarsest step 0.01"),
         (
             &["--integrators", "rk4,leapfrog"],
-            "--integrators: unknown integrator 'leapfrog'; known: euler, rk4, implicitfast, implicit, adaptive",
+            "--integrators: unknown integrator 'leapfrog'; known: euler, rk4, implicitfast, implicit, variational, adaptive",
         ),
         (&["--rtols", "0"], "--rtols: 0 is not a positive finite relative tolerance"),
         (&["--duration", "1.001"], "--duration 1.001 is not a whole number of the coarsest step 0.008"),

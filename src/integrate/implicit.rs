@@ -34,38 +34,39 @@ impl Implicit {
     }
 }
 
-/// In-place LU factorization without pivoting of the column-major n × n `a` (Doolittle: unit
-/// lower L below the diagonal, U on and above it).
-pub(crate) fn lu_factor_in_place(a: &mut [f64], n: usize) {
+/// In-place LU factorization without pivoting of the n × n leading block of the column-major
+/// `a` with leading dimension `ld` (entry (i, j) at i + j·ld). Doolittle: unit lower L below the
+/// diagonal, U on and above it.
+pub(crate) fn lu_factor_in_place(a: &mut [f64], n: usize, ld: usize) {
     for k in 0..n {
-        let pivot = a[k + k * n];
+        let pivot = a[k + k * ld];
         for i in k + 1..n {
-            a[i + k * n] /= pivot;
+            a[i + k * ld] /= pivot;
         }
         for j in k + 1..n {
-            let akj = a[k + j * n];
+            let akj = a[k + j * ld];
             if akj != 0.0 {
                 for i in k + 1..n {
-                    a[i + j * n] -= a[i + k * n] * akj;
+                    a[i + j * ld] -= a[i + k * ld] * akj;
                 }
             }
         }
     }
 }
 
-/// Solves L U x = b in place (`x` holds b) with the factor of [`lu_factor_in_place`].
-pub(crate) fn lu_solve_in_place(a: &[f64], n: usize, x: &mut [f64]) {
+/// Solves L U x = b in place (`x` holds b, length n) with the factor of [`lu_factor_in_place`].
+pub(crate) fn lu_solve_in_place(a: &[f64], n: usize, ld: usize, x: &mut [f64]) {
     for j in 0..n {
         let xj = x[j];
         for i in j + 1..n {
-            x[i] -= a[i + j * n] * xj;
+            x[i] -= a[i + j * ld] * xj;
         }
     }
     for j in (0..n).rev() {
-        x[j] /= a[j + j * n];
+        x[j] /= a[j + j * ld];
         let xj = x[j];
         for i in 0..j {
-            x[i] -= a[i + j * n] * xj;
+            x[i] -= a[i + j * ld] * xj;
         }
     }
 }
@@ -90,8 +91,8 @@ impl Stepper for Implicit {
             *l = m + h * d;
         }
         add_force_derivative(model, self.lu.as_mut_slice(), h);
-        lu_factor_in_place(self.lu.as_mut_slice(), nv);
-        lu_solve_in_place(self.lu.as_slice(), nv, self.force.as_mut_slice());
+        lu_factor_in_place(self.lu.as_mut_slice(), nv, nv);
+        lu_solve_in_place(self.lu.as_slice(), nv, nv, self.force.as_mut_slice());
         state.v.axpy(h, &self.force, 1.0);
         integrate_configuration(model, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
