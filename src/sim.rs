@@ -194,7 +194,7 @@ impl Simulation {
         let mut hint = format!("reduce --dt (now {} s)", self.timestep);
         match self.integrator() {
             "rk4" | "adaptive" => {}
-            "euler" => hint.push_str(", or use --integrator rk4 (or implicitfast for stiff damping)"),
+            "euler" => hint.push_str(", or use --integrator rk4 (or implicit for stiff damping)"),
             _ => hint.push_str(", or use --integrator rk4"),
         }
         hint.push_str("; if it persists, check the model's stiffnesses and inertias");
