@@ -395,7 +395,11 @@ impl Stepper for Variational {
             // at round-off, or stagnates near it, or the update of ξ is; and φ is within tolerance.
             let update = self.dxi.amax();
             let residual = self.residual.amax();
-            let p_scale = self.p_k.amax().max(self.tmp.amax());
+            // The momentum scale: the momenta and the impulse of the forces over the step (so
+            // that a state at rest under round-off forces converges too).
+            let impulse =
+                0.5 * h * (self.terms0.gravity_gen.amax() + data.qfrc_passive.amax() + self.drive.amax());
+            let p_scale = self.p_k.amax().max(self.tmp.amax()).max(impulse);
             let scale = self.xi.amax().max(state.v.amax());
             let finite = self.residual.iter().chain(self.dxi.iter()).all(|x| x.is_finite());
             let converged = finite
