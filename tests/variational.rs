@@ -79,7 +79,7 @@ fn lagrangian_terms_match_crba_rnea_and_finite_differences() {
 
 /// A free asymmetric body tumbling without gravity (dt = 1 ms, 20 s): the spatial momentum (linear,
 /// and angular about the world origin) is conserved at every step (the discrete
-/// momentum maps of translations and rotations, Marsden & West §1.3.3) to 1e-10 relative — the
+/// momentum maps of translations and rotations, discrete Noether theorem) to 1e-10 relative — the
 /// round-off of p → v = M⁻¹p → p each step, a random walk of ~cond(M) ε per step; the energy error stays
 /// below 1e-5 relative and shows no trend (second half's max no larger than 1.5× the first's).
 #[test]

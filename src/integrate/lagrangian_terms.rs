@@ -17,13 +17,16 @@
 //! ξ is a velocity in the model's v layout (body-frame angular velocity for ball and free joints,
 //! parent-frame linear velocity for free joints).
 
-use crate::kinematics::{joint_velocity, update_joint};
+use crate::kinematics::update_joint;
 use crate::model::{Data, JointKind, Model};
-use crate::spatial::{Force, Motion, Vec3};
+use crate::spatial::{Force, Motion, Transform, Vec3};
 use nalgebra::DVector;
 
 /// Buffers of the pass and its three results.
 pub struct LagrangianTerms {
+    /// Joint transforms and motion subspaces at the q of the last `compute`.
+    x_parent_body: Vec<Transform>,
+    s_body: Vec<Motion>,
     v_joint: Vec<Motion>,
     v_body: Vec<Motion>,
     a_gravity: Vec<Motion>,
@@ -41,6 +44,8 @@ impl LagrangianTerms {
     pub fn new(model: &Model) -> Self {
         let nb = model.nbody();
         Self {
+            x_parent_body: vec![Transform::identity(); nb],
+            s_body: vec![Motion::zero(); model.nv],
             v_joint: vec![Motion::zero(); nb],
             v_body: vec![Motion::zero(); nb],
             a_gravity: vec![Motion::zero(); nb],
@@ -52,48 +57,78 @@ impl LagrangianTerms {
         }
     }
 
-    /// Evaluates the three terms at (q, ξ); updates the joint transforms and subspaces of `data`.
+    /// Evaluates the three terms at (q, ξ); updates the joint transforms and subspaces of `data`
+    /// and keeps a copy for [`recompute_velocity_terms`](Self::recompute_velocity_terms).
     pub fn compute(&mut self, model: &Model, data: &mut Data, q: &[f64], xi: &[f64]) {
+        for b in 1..model.nbody() {
+            update_joint(model, data, b, q);
+            self.x_parent_body[b] = data.x_parent_body[b];
+            let j = model.joint_of(b);
+            for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+                self.s_body[k] = data.s_body[k];
+            }
+        }
+        self.pass(model, xi, true);
+    }
+
+    /// M(q) ξ and ∂T/∂q for a new ξ at the q of the last [`compute`](Self::compute) (its joint
+    /// transforms reused; g(q) unchanged).
+    pub fn recompute_velocity_terms(&mut self, model: &Model, xi: &[f64]) {
+        self.pass(model, xi, false);
+    }
+
+    fn pass(&mut self, model: &Model, xi: &[f64], with_gravity: bool) {
         let nb = model.nbody();
         self.v_body[0] = Motion::zero();
         self.a_gravity[0] = Motion::new(Vec3::zeros(), -model.gravity);
         for b in 1..nb {
-            update_joint(model, data, b, q);
             let p = model.bodies[b].parent;
-            let x = &data.x_parent_body[b];
-            let v_j = joint_velocity(model, data, b, xi);
+            let x = &self.x_parent_body[b];
+            let j = model.joint_of(b);
+            let mut v_j = Motion::zero();
+            for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+                v_j += self.s_body[k] * xi[k];
+            }
             let v_b = x.inv_act_motion(&self.v_body[p]) + v_j;
-            let a_b = x.inv_act_motion(&self.a_gravity[p]);
             let inertia = &model.bodies[b].inertia;
             self.momentum[b] = inertia.mul_motion(&v_b);
-            self.gravity_wrench[b] = inertia.mul_motion(&a_b);
+            if with_gravity {
+                let a_b = x.inv_act_motion(&self.a_gravity[p]);
+                self.gravity_wrench[b] = inertia.mul_motion(&a_b);
+                self.a_gravity[b] = a_b;
+            }
             self.v_joint[b] = v_j;
             self.v_body[b] = v_b;
-            self.a_gravity[b] = a_b;
         }
         for b in (1..nb).rev() {
             let j = model.joint_of(b);
             let turning = matches!(j.kind, JointKind::Free | JointKind::Planar { .. });
-            let (h_c, g_c) = (self.momentum[b], self.gravity_wrench[b]);
+            let h_c = self.momentum[b];
             let v_j = self.v_joint[b];
             let w = self.v_body[b] - v_j;
             for k in j.dof_adr..j.dof_adr + j.kind.nv() {
-                let s = &data.s_body[k];
+                let s = &self.s_body[k];
                 self.momentum_gen[k] = s.dot(&h_c) + model.dof_armature[k] * xi[k];
-                self.gravity_gen[k] = s.dot(&g_c);
-                let mut dv = s.cross_motion(&w);
-                dv = Motion::new(-dv.ang, -dv.lin);
+                let mut dv = -s.cross_motion(&w);
                 if turning {
                     dv.lin -= s.ang.cross(&v_j.lin);
                 }
                 self.dkinetic_dq[k] = dv.dot(&h_c);
             }
+            if with_gravity {
+                let g_c = self.gravity_wrench[b];
+                for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+                    self.gravity_gen[k] = self.s_body[k].dot(&g_c);
+                }
+            }
             let p = model.bodies[b].parent;
             if p != 0 {
-                let x = &data.x_parent_body[b];
-                let (hp, gp) = (x.act_force(&h_c), x.act_force(&g_c));
-                self.momentum[p] += hp;
-                self.gravity_wrench[p] += gp;
+                let x = &self.x_parent_body[b];
+                self.momentum[p] += x.act_force(&h_c);
+                if with_gravity {
+                    let gp = x.act_force(&self.gravity_wrench[b]);
+                    self.gravity_wrench[p] += gp;
+                }
             }
         }
     }

@@ -1,9 +1,11 @@
 //! A variational integrator: the discrete Euler–Lagrange (DEL) equations of the trapezoidal
 //! discrete Lagrangian on the configuration manifold, solved by Newton's method, with holonomic
 //! equality constraints held by multipliers (Marsden & West, *Discrete mechanics and variational
-//! integrators*, Acta Numerica 10, 2001: §1.3, §2.1 and §3.2 (forced, Lagrange–d'Alembert), §3.5
-//! (constraints, RATTLE); on Lie groups and multibody trees: Lee, Liu, Park & Srinivasa, *A
-//! Linear-Time Variational Integrator for Multibody Systems*, WAFR 2016).
+//! integrators*, Acta Numerica 10, 2001: the discrete Euler–Lagrange equations and discrete
+//! Legendre transforms, discrete Noether's theorem, forced systems by the discrete
+//! Lagrange–d'Alembert principle, holonomic constraints and RATTLE; on Lie groups and multibody
+//! trees: Lee, Liu, Park & Srinivasa, *A Linear-Time Variational Integrator for Multibody
+//! Systems*, WAFR 2016).
 //!
 //! Configurations step as q_{k+1} = q_k ⊕ h ξ_k (ξ in the model's velocity layout: the curve
 //! q_k ⊕ t ξ has the constant velocity ξ on every joint type, ball and free joints included), and
@@ -16,7 +18,7 @@
 //!   D₁L_d = h/2 ∂_qL(q_k, ξ) − J_r⁻¹(hξ) μ̄,   D₂L_d = h/2 ∂_qL(q_{k+1}, ξ) + J_r⁻¹(−hξ) μ̄,
 //!   μ̄ = ½ [M(q_k) + M(q_{k+1})] ξ,   ∂_qL = ∂T/∂q − g(q)   ([`LagrangianTerms`]).
 //!
-//! In position–momentum form (the discrete Legendre transforms, Marsden & West §1.5), one step
+//! In position–momentum form (the discrete Legendre transforms), one step
 //! from (q_k, v_k) with p_k = M(q_k) v_k solves for ξ (and the equality multipliers λ)
 //!
 //!   p_k + D₁L_d(q_k, q_k ⊕ hξ) + f⁻ + J(q_k)ᵀ λ = 0,   φ(q_k ⊕ hξ) = 0,
@@ -28,14 +30,16 @@
 //! evaluated at both ends are exactly a trapezoidal potential, so they keep the method
 //! symplectic; damping and drives make it a discrete Lagrange–d'Alembert method.
 //!
-//! Newton: the chord method with the matrix M(q_k) + h/2 diag(damping) (its tree-sparse LᵀDL
-//! factor) for ξ, and the Schur complement h J(q_{k+1}) C⁻¹ J(q_k)ᵀ for λ; iterated until the
-//! update is at round-off. A step whose iteration does not converge is not taken: the state is
-//! left as it was and [`Stepper::failure`] says why (the simulation returns a `SimError`).
+//! Newton: the chord method with the matrix C = M(q_k) + h/2 diag(damping) (its tree-sparse LᵀDL
+//! factor) for ξ, and the Schur complement h J(q_{k+1}) C⁻¹ J(q_k)ᵀ for λ, from the predictor
+//! ξ = 2 v_k − ξ_{k−1}, with Anderson acceleration (without equality rows); iterated until the
+//! residual of the momentum balance is at round-off (`StepReport::solver_iterations` counts the
+//! iterations). A step whose iteration does not converge is not taken: the state is left as it
+//! was and [`Stepper::failure`] says why (the simulation returns a `SimError`).
 //!
 //! Properties (tested in `tests/variational.rs` and `tests/stress.rs`): second order; symplectic;
-//! the discrete momentum maps of symmetries of L_d are conserved to round-off (Noether, Marsden &
-//! West §1.3.3): for the heavy symmetric top L_z and L_z′ (notes eq. 104–106); the energy error
+//! the discrete momentum maps of symmetries of L_d are conserved to round-off (discrete Noether
+//! theorem): for the heavy symmetric top L_z and L_z′ (notes eq. 104–106); the energy error
 //! stays bounded, without secular drift. Limits, friction rows and contacts, if the model has
 //! them, are left to the drift projection after the step ([`correct_drift`]), outside the
 //! variational structure.
@@ -338,7 +342,11 @@ impl Stepper for Variational {
             iterations += 1;
             self.q1.copy_from(&state.q);
             integrate_configuration(model, self.q1.as_mut_slice(), self.xi.as_slice(), h);
-            self.terms0.compute(model, data, q0, self.xi.as_slice());
+            if iterations == 1 {
+                self.terms0.compute(model, data, q0, self.xi.as_slice());
+            } else {
+                self.terms0.recompute_velocity_terms(model, self.xi.as_slice());
+            }
             self.terms1.compute(model, data, self.q1.as_slice(), self.xi.as_slice());
             passive(model, data, q0, self.xi.as_slice());
             for k in 0..nv {
