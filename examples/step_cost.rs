@@ -2,15 +2,18 @@
 //! with callgrind (issue 15 item 4; `validation/step_cost.sh` runs it at two N and takes the
 //! difference, so loading and warm-up cancel):
 //!
-//!     cargo run --release --example step_cost -- MODEL {aba|euler|rk4|implicit|implicitfast|variational|adaptive} N
+//!     cargo run --release --example step_cost -- MODEL {aba|euler|rk4|implicit|implicitfast|variational|variational:TOL|adaptive} N [TILT]
 //!
-//! The state starts at the model's `qpos0` tilted by 0.3 rad per hinge, with a small velocity;
+//! (`variational:1e-10`: Newton's residual tolerance 1e-10 instead of round-off.)
+//!
+//! The state starts at the model's `qpos0` tilted by TILT rad (default 0.3) per hinge and slide,
+//! with a small velocity (0.1·((k mod 5) − 2) on dof k, scaled by TILT/0.3);
 //! the step is the model's timestep. Prints the final state's first coordinate (so the work is
 //! not optimized away).
 
 use lagrange::dynamics::aba;
 use lagrange::forward::Plan;
-use lagrange::integrate::{IntegratorKind, State};
+use lagrange::integrate::{IntegratorKind, State, Variational};
 use lagrange::io::{load, LoadOptions};
 use lagrange::Data;
 use std::hint::black_box;
@@ -18,20 +21,23 @@ use std::path::Path;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() != 4 {
-        eprintln!("usage: step_cost MODEL {{aba|euler|rk4|implicit|implicitfast|variational|adaptive}} N");
+    if args.len() != 4 && args.len() != 5 {
+        eprintln!(
+            "usage: step_cost MODEL {{aba|euler|rk4|implicit|implicitfast|variational|adaptive}} N [TILT]"
+        );
         std::process::exit(2);
     }
     let model = load(Path::new(&args[1]), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let n: usize = args[3].parse().expect("N is a count");
+    let tilt: f64 = args.get(4).map_or(0.3, |t| t.parse().expect("TILT is a number"));
     let mut state = State::neutral(&model);
     for j in &model.joints {
         if j.kind.nq() == 1 {
-            state.q[j.qpos_adr] += 0.3;
+            state.q[j.qpos_adr] += tilt;
         }
     }
     for k in 0..model.nv {
-        state.v[k] = 0.1 * ((k % 5) as f64 - 2.0);
+        state.v[k] = 0.1 * ((k % 5) as f64 - 2.0) * tilt / 0.3;
     }
     let mut data = Data::new(&model);
     let h = model.options.timestep;
@@ -43,10 +49,13 @@ fn main() {
         "implicitfast" => Some(IntegratorKind::ImplicitFast),
         "variational" => Some(IntegratorKind::Variational),
         "adaptive" => Some(IntegratorKind::Adaptive),
+        other if other.starts_with("variational:") => None,
         other => panic!("unknown mode {other}"),
     };
+    let variational_tol: Option<f64> =
+        args[2].strip_prefix("variational:").map(|t| t.parse().expect("variational:TOL takes a number"));
     match kind {
-        None => {
+        None if variational_tol.is_none() => {
             let tau = vec![0.0; model.nv];
             for _ in 0..n {
                 let qacc = aba(&model, &mut data, black_box(state.q.as_slice()), state.v.as_slice(), &tau);
@@ -54,9 +63,13 @@ fn main() {
                 state.v[0] += 1e-9 * qacc[0];
             }
         }
-        Some(kind) => {
+        _ => {
             let plan = Plan::new(&model, None);
-            let mut stepper = kind.build(&model);
+            let mut stepper: Box<dyn lagrange::integrate::Stepper> = match (kind, variational_tol) {
+                (Some(kind), _) => kind.build(&model),
+                (None, Some(tol)) => Box::new(Variational::with_tolerance(&model, tol)),
+                (None, None) => unreachable!(),
+            };
             let mut iterations = 0u64;
             for _ in 0..n {
                 iterations += stepper.step(&model, &plan, &mut data, &mut state, h).solver_iterations as u64;

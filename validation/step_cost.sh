@@ -3,9 +3,10 @@
 # counted by callgrind (wall-clock is unreliable on a shared machine). Each mode runs at N1 and N2
 # steps; (I(N2) − I(N1)) / (N2 − N1) is the cost of one step (loading and warm-up cancel).
 #
-#     validation/step_cost.sh [MODEL] [MODES...]
+#     [TILT=0.3] validation/step_cost.sh [MODEL] [MODES...]
 #
-# Default: models/textbook/chain30.xml, modes aba variational rk4 euler implicit.
+# Default: models/textbook/chain30.xml, modes aba variational rk4 euler implicit; the initial
+# state is qpos0 tilted by TILT rad per hinge (see examples/step_cost.rs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 model=${1:-models/textbook/chain30.xml}
@@ -18,7 +19,7 @@ n2=1200
 count() {
   local out
   out=$(mktemp)
-  valgrind --tool=callgrind --callgrind-out-file="$out" "$bin" "$model" "$1" "$2" >/dev/null 2>&1
+  valgrind --tool=callgrind --callgrind-out-file="$out" "$bin" "$model" "$1" "$2" "${TILT:-0.3}" >/dev/null 2>&1
   grep -m1 '^summary:' "$out" | awk '{print $2}'
   rm -f "$out"
 }
@@ -29,7 +30,7 @@ for m in $modes; do
   per[$m]=$(( (b - a) / (n2 - n1) ))
 done
 aba=${per[aba]:-}
-echo "model: $model (instructions per step, callgrind, difference of $n2 and $n1 steps)"
+echo "model: $model, tilt ${TILT:-0.3} rad (instructions per step, callgrind, difference of $n2 and $n1 steps)"
 for m in $modes; do
   if [ -n "$aba" ]; then
     printf '%-14s %10d instructions  %6.2f ABA-equivalents\n' "$m" "${per[$m]}" "$(echo "${per[$m]} / $aba" | bc -l)"

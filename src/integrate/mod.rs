@@ -24,7 +24,7 @@ pub use implicit::Implicit;
 pub use implicit_fast::{add_force_derivative, ImplicitFast};
 pub use lagrangian_terms::LagrangianTerms;
 pub use rk4::RungeKutta4;
-pub use variational::{Variational, CONSTRAINT_TOL};
+pub use variational::{Variational, CONSTRAINT_TOL, RESIDUAL_TOL};
 
 use crate::constraint::{project_positions, project_velocities, row_violation};
 use crate::forward::{DriftCorrection, Plan};

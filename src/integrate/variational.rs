@@ -53,8 +53,8 @@ use crate::model::{dexp_inv_configuration, integrate_configuration, Data, EfcTyp
 use nalgebra::{DMatrix, DVector};
 
 /// Newton stops when the residual of the DEL equations is below this relative to the momentum
-/// scale (round-off),
-const RESIDUAL_TOL: f64 = 2e-16;
+/// scale (round-off; [`Variational::with_tolerance`] sets another),
+pub const RESIDUAL_TOL: f64 = 2e-16;
 /// … or its update of ξ below this relative to the velocity scale,
 const UPDATE_TOL: f64 = 1e-15;
 /// … or the residual stagnates (round-off) below this.
@@ -136,6 +136,7 @@ pub struct Variational {
     dlambda: DVector<f64>,
     has_equalities: bool,
     failure: Option<StepFailure>,
+    residual_tol: f64,
     /// The last step's ξ and end configuration (for the predictor).
     last_xi: DVector<f64>,
     last_q1: DVector<f64>,
@@ -251,11 +252,19 @@ impl Variational {
             dlambda: DVector::zeros(rows),
             has_equalities: rows > 0,
             failure: None,
+            residual_tol: RESIDUAL_TOL,
             last_xi: z(),
             last_q1: DVector::zeros(nq),
             last_valid: false,
             anderson: Anderson::new(nv),
         }
+    }
+
+    /// The stepper with Newton's residual tolerance `tol` relative to the momentum scale instead
+    /// of round-off ([`RESIDUAL_TOL`]): fewer iterations, but the discrete momenta are then
+    /// conserved only to about `tol` per step.
+    pub fn with_tolerance(model: &Model, tol: f64) -> Self {
+        Self { residual_tol: tol.max(RESIDUAL_TOL), ..Self::new(model) }
     }
 
     /// M(q) and its factor, reused when q is the configuration of the last call.
@@ -411,7 +420,7 @@ impl Stepper for Variational {
             let scale = self.xi.amax().max(state.v.amax());
             let finite = self.residual.iter().chain(self.dxi.iter()).all(|x| x.is_finite());
             let converged = finite
-                && (residual <= RESIDUAL_TOL * p_scale
+                && (residual <= self.residual_tol * p_scale
                     || update <= UPDATE_TOL * scale
                     || (iterations > 2 && residual >= 0.5 * previous && residual <= STALL_TOL * p_scale))
                 && phi_max <= CONSTRAINT_TOL;
