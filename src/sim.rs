@@ -18,6 +18,17 @@ use thiserror::Error;
 pub enum SimError {
     #[error("the simulation diverged at t = {} s (step {step}): {quantity} of joint '{joint}' is {value}; {hint}", display_time(*.time))]
     Diverged { time: f64, step: u64, quantity: &'static str, joint: String, value: f64, hint: String },
+    #[error("the {integrator} integrator's Newton iteration did not converge in step {step} (t = {} s → {} s, dt = {dt} s): residual {residual:.3e} after {iterations} iterations (last update {update:.3e}, constraint violation {constraint:.3e}); the state is left at the start of the step; reduce --dt", display_time(*.time), display_time(*.time + *.dt))]
+    NotConverged {
+        integrator: &'static str,
+        time: f64,
+        step: u64,
+        dt: f64,
+        iterations: u32,
+        residual: f64,
+        update: f64,
+        constraint: f64,
+    },
     #[error("invalid initial state: {0}")]
     BadState(String),
 }
@@ -179,6 +190,18 @@ impl Simulation {
         if self.plan.soft.is_some() && self.data.nefc > 0 {
             report.solver_improvement = self.data.solver_improvement;
         }
+        if let Some(f) = self.stepper.failure() {
+            return Err(SimError::NotConverged {
+                integrator: self.stepper.name(),
+                time: self.state.time,
+                step: self.steps + 1,
+                dt: self.timestep,
+                iterations: f.iterations,
+                residual: f.residual,
+                update: f.update,
+                constraint: f.constraint,
+            });
+        }
         self.steps += 1;
         self.check_finite()?;
         Ok(report)
@@ -196,7 +219,7 @@ impl Simulation {
         let mut hint = format!("reduce --dt (now {} s)", self.timestep);
         match self.integrator() {
             "rk4" | "adaptive" => {}
-            "euler" => hint.push_str(", or use --integrator rk4 (or implicitfast for stiff damping)"),
+            "euler" => hint.push_str(", or use --integrator rk4 (or implicit for stiff damping)"),
             _ => hint.push_str(", or use --integrator rk4"),
         }
         hint.push_str("; if it persists, check the model's stiffnesses and inertias");

@@ -4,7 +4,7 @@
 //! (h_ref = 0.004 s / 32, whose own error is ≥ 32⁴ ≈ 1e6 times below RK4's smallest) is the max-norm
 //! of the manifold difference q ⊖ q_ref and of v − v_ref; the observed order log₂(e(h)/e(h/2))
 //! must lie in the band of `common::INTEGRATOR_ORDER_BAND` around the method's order (euler,
-//! implicitfast: 1 — without damping implicitfast is explicit Euler; rk4: 4). The adaptive method
+//! implicitfast: 1 — without damping implicitfast is explicit Euler; implicit: 1; variational: 2; rk4: 4). The adaptive method
 //! is checked against its tolerance instead (its step size is not the caller's).
 
 mod common;
@@ -85,6 +85,8 @@ fn ball_joint_heavy_top_converges_at_integrator_order() {
     };
     check_order(&case, IntegratorKind::Euler, 1, 1e-3);
     check_order(&case, IntegratorKind::ImplicitFast, 1, 1e-3);
+    check_order(&case, IntegratorKind::Implicit, 1, 1e-3);
+    check_order(&case, IntegratorKind::Variational, 2, 4e-3);
     check_order(&case, IntegratorKind::Rk4, 4, 4e-3);
 }
 
@@ -98,6 +100,8 @@ fn free_joint_tumbling_body_converges_at_integrator_order() {
     let case = Case { name: "tumbling body (free)", model, q0: &q0, v0: &v0, t: 0.5 };
     check_order(&case, IntegratorKind::Euler, 1, 1e-3);
     check_order(&case, IntegratorKind::ImplicitFast, 1, 1e-3);
+    check_order(&case, IntegratorKind::Implicit, 1, 1e-3);
+    check_order(&case, IntegratorKind::Variational, 2, 4e-3);
     check_order(&case, IntegratorKind::Rk4, 4, 1e-2);
 }
 

@@ -108,6 +108,8 @@ fn kernels_and_integrators_do_not_allocate() {
             IntegratorKind::Rk4,
             IntegratorKind::Adaptive,
             IntegratorKind::ImplicitFast,
+            IntegratorKind::Implicit,
+            IntegratorKind::Variational,
         ] {
             let mut integrator = kind.build(&model);
             let mut state = State::new(&model, q.clone(), v.clone());
@@ -118,7 +120,7 @@ fn kernels_and_integrators_do_not_allocate() {
             });
             assert_eq!(steps, 0, "{file}: {kind:?} steps allocated {steps} times");
         }
-        println!("{file}: 0 allocations in FK, velocities, Jacobian, RNEA, bias, CRBA, LTDL, solve, ABA, Euler, RK4, adaptive, implicitfast");
+        println!("{file}: 0 allocations in FK, velocities, Jacobian, RNEA, bias, CRBA, LTDL, solve, ABA, Euler, RK4, adaptive, implicitfast, implicit, variational");
     }
 }
 

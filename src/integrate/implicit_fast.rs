@@ -10,8 +10,7 @@
 //! ([`add_actuator_velocity_derivative`], MuJoCo's `mjd_actuator_vel`: position servos' kv, velocity
 //! servos, affine gains). With only joint damping this is also what MuJoCo's `Euler` does
 //! (implicit damping), so its `mj_step` is the reference on damped passive scenes.
-//! `implicit` (with the Coriolis derivatives, Featherstone-style RNE derivative) is not
-//! implemented: `<option integrator="implicit">` uses this one, with a note.
+//! [`Implicit`](super::Implicit) adds the Coriolis derivatives −∂c/∂v to D.
 
 use super::{correct_drift, State, StepReport, Stepper};
 use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};

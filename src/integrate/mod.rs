@@ -8,15 +8,23 @@
 //! projected onto φ(q) = 0 and v onto J v = 0, as the plan's [`DriftCorrection`] says.
 
 mod adaptive;
+mod bias_derivative;
 mod euler;
+mod implicit;
 mod implicit_fast;
+mod lagrangian_terms;
 mod rk4;
 mod stage;
+mod variational;
 
 pub use adaptive::{DormandPrince54, DEFAULT_ATOL, DEFAULT_RTOL};
+pub use bias_derivative::BiasDerivative;
 pub use euler::SemiImplicitEuler;
+pub use implicit::Implicit;
 pub use implicit_fast::{add_force_derivative, ImplicitFast};
+pub use lagrangian_terms::LagrangianTerms;
 pub use rk4::RungeKutta4;
+pub use variational::{Variational, CONSTRAINT_TOL, RESIDUAL_TOL};
 
 use crate::constraint::{project_positions, project_velocities, row_violation};
 use crate::forward::{DriftCorrection, Plan};
@@ -93,6 +101,21 @@ impl StepReport {
     }
 }
 
+/// Why a step was not taken: an implicit method's Newton iteration that did not converge (the
+/// state is left at the start of the step).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepFailure {
+    /// Newton iterations done.
+    pub iterations: u32,
+    /// Max-norm of the equations' residual at the last iterate (momentum units for the
+    /// variational integrator's discrete Euler–Lagrange equations).
+    pub residual: f64,
+    /// max |φ| of the equality constraints at the last iterate (0 without them).
+    pub constraint: f64,
+    /// Max-norm of the last Newton update.
+    pub update: f64,
+}
+
 /// A time stepper over [`forward`](crate::forward::forward).
 pub trait Stepper: Send {
     /// Short name (`euler`, `rk4`, …).
@@ -101,6 +124,10 @@ pub trait Stepper: Send {
     fn order(&self) -> u32;
     /// Advances `state` by `h` with the inputs in `data` (`qfrc_applied`, `ctrl`).
     fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport;
+    /// Why the last step was not taken, if it was not (a Newton iteration that failed).
+    fn failure(&self) -> Option<StepFailure> {
+        None
+    }
 }
 
 /// After a step `h` of a constrained model: project q onto φ(q) = 0 (Gauss–Newton on the
@@ -155,6 +182,11 @@ pub enum IntegratorKind {
     Adaptive,
     /// MuJoCo's implicitfast: implicit in the velocity derivatives of passive forces.
     ImplicitFast,
+    /// MuJoCo's implicit: implicitfast plus the Coriolis/centrifugal derivatives ∂c/∂v.
+    Implicit,
+    /// The variational integrator (discrete Euler–Lagrange equations, trapezoidal discrete
+    /// Lagrangian, Newton): symplectic, momentum-preserving.
+    Variational,
 }
 
 impl IntegratorKind {
@@ -165,24 +197,19 @@ impl IntegratorKind {
             IntegratorKind::Rk4 => Box::new(RungeKutta4::new(model)),
             IntegratorKind::Adaptive => Box::new(DormandPrince54::new(model, DEFAULT_RTOL, DEFAULT_ATOL)),
             IntegratorKind::ImplicitFast => Box::new(ImplicitFast::new(model)),
+            IntegratorKind::Implicit => Box::new(Implicit::new(model)),
+            IntegratorKind::Variational => Box::new(Variational::new(model)),
         }
     }
 
-    /// The stepper for a model file's `<option integrator>`, and a note when the file asks for
-    /// one that is not available yet (`implicit`, whose Coriolis derivatives are not
-    /// implemented, uses implicitfast).
+    /// The stepper for a model file's `<option integrator>` (each of MuJoCo's four has its
+    /// twin here; the note is for integrators that are not).
     pub fn from_option(integrator: options::Integrator) -> (Self, Option<String>) {
         match integrator {
             options::Integrator::Euler => (IntegratorKind::Euler, None),
             options::Integrator::Rk4 => (IntegratorKind::Rk4, None),
             options::Integrator::ImplicitFast => (IntegratorKind::ImplicitFast, None),
-            other => (
-                IntegratorKind::ImplicitFast,
-                Some(format!(
-                    "the model asks for integrator '{}', whose Coriolis derivatives are not implemented yet: using implicitfast",
-                    other.mjcf_name()
-                )),
-            ),
+            options::Integrator::Implicit => (IntegratorKind::Implicit, None),
         }
     }
 
@@ -192,6 +219,8 @@ impl IntegratorKind {
             IntegratorKind::Rk4 => "rk4",
             IntegratorKind::Adaptive => "adaptive",
             IntegratorKind::ImplicitFast => "implicitfast",
+            IntegratorKind::Implicit => "implicit",
+            IntegratorKind::Variational => "variational",
         }
     }
 }

@@ -9,7 +9,7 @@ pub enum Integrator {
     Euler,
     /// Classical fourth-order Runge–Kutta.
     Rk4,
-    /// Implicit in velocity (passive and actuator derivatives); simulated as implicitfast for now.
+    /// Implicit in velocity (passive, actuator and Coriolis/centrifugal derivatives).
     Implicit,
     /// `implicit` without the Coriolis derivatives.
     ImplicitFast,

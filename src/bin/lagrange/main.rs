@@ -210,6 +210,11 @@ enum IntegratorArg {
     Rk4,
     /// MuJoCo's implicitfast (velocity-implicit in the joint-damping derivatives).
     Implicitfast,
+    /// MuJoCo's implicit (implicitfast plus the Coriolis/centrifugal velocity derivatives).
+    Implicit,
+    /// Variational (discrete Euler–Lagrange, trapezoidal; second order, symplectic,
+    /// momentum-preserving; equality constraints held by multipliers).
+    Variational,
     /// Dormand–Prince 5(4) with error control (rtol 1e-8, atol 1e-10), internal steps within
     /// each --dt interval.
     Adaptive,
@@ -222,6 +227,8 @@ impl From<IntegratorArg> for IntegratorKind {
             IntegratorArg::Rk4 => IntegratorKind::Rk4,
             IntegratorArg::Adaptive => IntegratorKind::Adaptive,
             IntegratorArg::Implicitfast => IntegratorKind::ImplicitFast,
+            IntegratorArg::Implicit => IntegratorKind::Implicit,
+            IntegratorArg::Variational => IntegratorKind::Variational,
         }
     }
 }

@@ -49,10 +49,12 @@ const DEFAULT_DURATION: f64 = 2.0;
 const DEFAULT_DT_FACTORS: [f64; 6] = [4.0, 2.0, 1.0, 0.5, 0.25, 0.125];
 const DEFAULT_RTOLS: [f64; 4] = [1e-4, 1e-6, 1e-8, 1e-10];
 /// Integrators `--integrators` knows, in the default order.
-const KNOWN: [(&str, IntegratorKind); 4] = [
+const KNOWN: [(&str, IntegratorKind); 6] = [
     ("euler", IntegratorKind::Euler),
     ("rk4", IntegratorKind::Rk4),
     ("implicitfast", IntegratorKind::ImplicitFast),
+    ("implicit", IntegratorKind::Implicit),
+    ("variational", IntegratorKind::Variational),
     ("adaptive", IntegratorKind::Adaptive),
 ];
 
@@ -199,12 +201,8 @@ fn parse_integrators(s: &str) -> Result<Vec<IntegratorKind>, CliError> {
     let mut out = Vec::new();
     for item in s.split(',').map(str::trim) {
         let Some((_, kind)) = KNOWN.iter().find(|(n, _)| n.eq_ignore_ascii_case(item)) else {
-            let hint = match item {
-                "implicit" | "variational" => " (not implemented yet)",
-                _ => "",
-            };
             return Err(usage(format!(
-                "--integrators: unknown integrator '{item}'{hint}; known: {}",
+                "--integrators: unknown integrator '{item}'; known: {}",
                 names.join(", ")
             )));
         };

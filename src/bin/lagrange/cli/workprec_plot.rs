@@ -106,7 +106,8 @@ fn series(rows: &[Row]) -> Vec<Series<'_>> {
                 Series {
                     name: &r.integrator,
                     points: Vec::new(),
-                    extra: !["euler", "rk4", "implicitfast", "adaptive"].contains(&r.integrator.as_str()),
+                    extra: !["euler", "rk4", "implicitfast", "implicit", "variational", "adaptive"]
+                        .contains(&r.integrator.as_str()),
                 },
                 vec![r],
             )),
