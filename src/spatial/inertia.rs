@@ -52,16 +52,30 @@ impl RigidInertia {
         }
     }
     /// The same inertia expressed in frame a, given the pose `x_a_b` of its current frame b.
+    ///
+    /// I_a = R I_b Rᵀ − ([h']×[p]× + [p]×[h']×) − m [p]×² with h' = R h (RBDA eq. 2.66 on the
+    /// 10 parameters); with [a]×[b]× = b aᵀ − (a·b) 1 the shift is
+    /// −p h'ᵀ − h' pᵀ − m p pᵀ + (2 h'·p + m p·p) 1, and only the 6 entries of the symmetric
+    /// result are computed.
     #[inline]
     pub fn transformed(&self, x_a_b: &Transform) -> RigidInertia {
         let r = &x_a_b.rot;
         let p = &x_a_b.pos;
-        let h_rot = r * self.h;
-        let px = skew(p);
-        let hx = skew(&h_rot);
-        // I_a = R I_b Rᵀ − ([h']×[p]× + [p]×[h']×) − m [p]×², with h' = R h.
-        let i_origin = r * self.i_origin * r.transpose() - (hx * px + px * hx) - px * px * self.mass;
-        RigidInertia { mass: self.mass, h: h_rot + p * self.mass, i_origin }
+        let m = self.mass;
+        let h = r * self.h;
+        // T = R I (I symmetric); (R I Rᵀ)(i, j) = row i of T · row j of R.
+        let t = r * self.i_origin;
+        let diag = 2.0 * h.dot(p) + m * p.dot(p);
+        let entry = |i: usize, j: usize| {
+            t[(i, 0)] * r[(j, 0)] + t[(i, 1)] * r[(j, 1)] + t[(i, 2)] * r[(j, 2)]
+                - p[i] * h[j]
+                - h[i] * p[j]
+                - m * p[i] * p[j]
+        };
+        let (xx, yy, zz) = (entry(0, 0) + diag, entry(1, 1) + diag, entry(2, 2) + diag);
+        let (xy, xz, yz) = (entry(0, 1), entry(0, 2), entry(1, 2));
+        let i_origin = Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+        RigidInertia { mass: m, h: h + p * m, i_origin }
     }
     /// The same body with its density multiplied by `s` (mass, first moment and inertia scale
     /// together; the centre of mass stays).
