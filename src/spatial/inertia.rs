@@ -137,13 +137,25 @@ impl ArticulatedInertia {
     }
     /// Adds this inertia, currently in frame b, to `target` expressed in frame a, given `x_a_b`
     /// (the congruence ᵃX*_b I ᵇXₐ, RBDA eq. 2.66): first rotate, then shift the origin by `pos`.
+    ///
+    /// A rotation about one coordinate axis (a hinge about a principal axis with an unrotated
+    /// placement, the common case) is applied as a plane rotation of two rows and two columns
+    /// ([`coordinate_rotation`]), 24 products per 3×3 block instead of 54.
     #[inline]
     pub fn add_transformed_to(&self, x_a_b: &Transform, target: &mut ArticulatedInertia) {
         let r = &x_a_b.rot;
-        let rt = r.transpose();
-        let a = r * self.a * rt;
-        let b = r * self.b * rt;
-        let c = r * self.c * rt;
+        let turn = |f: fn(&Mat3, f64, f64) -> Mat3, cos: f64, sin: f64| {
+            (f(&self.a, cos, sin), f(&self.b, cos, sin), f(&self.c, cos, sin))
+        };
+        let (a, b, c) = match coordinate_rotation(r) {
+            Some((2, cos, sin)) => turn(plane_rotate::<0, 1>, cos, sin),
+            Some((0, cos, sin)) => turn(plane_rotate::<1, 2>, cos, sin),
+            Some((_, cos, sin)) => turn(plane_rotate::<2, 0>, cos, sin),
+            None => {
+                let rt = r.transpose();
+                (r * self.a * rt, r * self.b * rt, r * self.c * rt)
+            }
+        };
         let px = skew(&x_a_b.pos);
         // Shift: A'' = A + [p]× Bᵀ + ([p]× Bᵀ)ᵀ + [p]× C [p]×ᵀ,  B'' = B + [p]× C,  C'' = C.
         let pxc = px * c;
@@ -152,4 +164,34 @@ impl ArticulatedInertia {
         target.b += b + pxc;
         target.c += c;
     }
+}
+
+/// If `r` is a rotation about coordinate axis k (column k and row k are eₖ): (k, cos, sin) of its
+/// angle, with R eᵢ = cos eᵢ + sin eⱼ for (i, j) = (k + 1, k + 2) mod 3.
+#[inline]
+fn coordinate_rotation(r: &Mat3) -> Option<(usize, f64, f64)> {
+    for (k, i, j) in [(2, 0, 1), (0, 1, 2), (1, 2, 0)] {
+        if r[(k, k)] == 1.0 && r[(i, k)] == 0.0 && r[(j, k)] == 0.0 && r[(k, i)] == 0.0 && r[(k, j)] == 0.0 {
+            return Some((k, r[(i, i)], r[(j, i)]));
+        }
+    }
+    None
+}
+
+/// R M Rᵀ for the plane rotation R of [`coordinate_rotation`] in the plane (I, J): rows I, J of
+/// M turn, then columns I, J of the result (RBDA eq. 2.66 with a sparse R).
+#[inline]
+fn plane_rotate<const I: usize, const J: usize>(m: &Mat3, cos: f64, sin: f64) -> Mat3 {
+    let mut out = *m;
+    for col in 0..3 {
+        let (mi, mj) = (m[(I, col)], m[(J, col)]);
+        out[(I, col)] = cos * mi - sin * mj;
+        out[(J, col)] = sin * mi + cos * mj;
+    }
+    for row in 0..3 {
+        let (mi, mj) = (out[(row, I)], out[(row, J)]);
+        out[(row, I)] = cos * mi - sin * mj;
+        out[(row, J)] = sin * mi + cos * mj;
+    }
+    out
 }
