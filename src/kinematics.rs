@@ -10,7 +10,7 @@ use nalgebra::DMatrix;
 /// Dispatched once on the joint type: a hinge or slide (the common case) composes the placement
 /// with the joint's rotation or translation directly ([`revolute_placement`]), without forming
 /// X_J(q) and multiplying two general transforms.
-#[inline]
+#[inline(always)]
 pub(crate) fn update_joint(model: &Model, data: &mut Data, b: usize, q: &[f64]) {
     let body = &model.bodies[b];
     let j = model.joint_of(b);
@@ -37,7 +37,7 @@ pub(crate) fn update_joint(model: &Model, data: &mut Data, b: usize, q: &[f64]) 
 /// the translation is the placement's, the rotation `R_pj · R(axis, angle)` (RBDA Table 4.1,
 /// revolute row). About a principal axis ±x, ±y, ±z only two columns of `R_pj` turn (12
 /// products); any other axis goes through Rodrigues' formula R = I + s[a]× + (1 − c)[a]×².
-#[inline]
+#[inline(always)]
 pub(crate) fn revolute_placement(x_pj: &Transform, axis: &Vec3, angle: f64) -> Transform {
     let (s, c) = angle.sin_cos();
     let r = &x_pj.rot;

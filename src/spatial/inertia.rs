@@ -57,7 +57,7 @@ impl RigidInertia {
     /// 10 parameters); with [a]×[b]× = b aᵀ − (a·b) 1 the shift is
     /// −p h'ᵀ − h' pᵀ − m p pᵀ + (2 h'·p + m p·p) 1, and only the 6 entries of the symmetric
     /// result are computed.
-    #[inline]
+    #[inline(always)]
     pub fn transformed(&self, x_a_b: &Transform) -> RigidInertia {
         let r = &x_a_b.rot;
         let p = &x_a_b.pos;
