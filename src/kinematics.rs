@@ -1,19 +1,62 @@
 //! Forward kinematics, body velocities and frame Jacobians (RBDA §4.1, §8.1).
 
-use crate::model::{Data, Model};
-use crate::spatial::{Motion, Transform, Vec3};
+use crate::model::{Data, JointKind, Model};
+use crate::spatial::{Mat3, Motion, Transform, Vec3};
 use nalgebra::DMatrix;
 
 /// Updates one body's joint: `x_parent_body[b]` = placement · X_J(q) and its motion-subspace
 /// columns `s_body` (body coordinates). Shared first step of every recursive algorithm.
-#[inline]
+///
+/// Dispatched once on the joint type: a hinge or slide (the common case) composes the placement
+/// with the joint's rotation or translation directly ([`revolute_placement`]), without forming
+/// X_J(q) and multiplying two general transforms.
+#[inline(always)]
 pub(crate) fn update_joint(model: &Model, data: &mut Data, b: usize, q: &[f64]) {
     let body = &model.bodies[b];
     let j = model.joint_of(b);
     let (qa, da) = (j.qpos_adr, j.dof_adr);
-    let x_joint = j.kind.transform(&q[qa..qa + j.kind.nq()]);
-    data.x_parent_body[b] = body.x_parent_joint * x_joint;
-    j.kind.motion_subspace(&x_joint, &mut data.s_body[da..da + j.kind.nv()]);
+    match &j.kind {
+        JointKind::Revolute { axis, .. } => {
+            data.x_parent_body[b] = revolute_placement(&body.x_parent_joint, axis, q[qa]);
+            data.s_body[da] = Motion::new(*axis, Vec3::zeros());
+        }
+        JointKind::Prismatic { axis } => {
+            let x_pj = &body.x_parent_joint;
+            data.x_parent_body[b] = Transform::new(x_pj.rot, x_pj.pos + x_pj.rot * (axis * q[qa]));
+            data.s_body[da] = Motion::new(Vec3::zeros(), *axis);
+        }
+        kind => {
+            let x_joint = kind.transform(&q[qa..qa + kind.nq()]);
+            data.x_parent_body[b] = body.x_parent_joint * x_joint;
+            kind.motion_subspace(&x_joint, &mut data.s_body[da..da + kind.nv()]);
+        }
+    }
+}
+
+/// `x_parent_joint · X_J(angle)` for a rotation by `angle` about the unit `axis` (joint frame):
+/// the translation is the placement's, the rotation `R_pj · R(axis, angle)` (RBDA Table 4.1,
+/// revolute row). About a principal axis ±x, ±y, ±z only two columns of `R_pj` turn (12
+/// products); any other axis goes through Rodrigues' formula R = I + s[a]× + (1 − c)[a]×².
+#[inline(always)]
+pub(crate) fn revolute_placement(x_pj: &Transform, axis: &Vec3, angle: f64) -> Transform {
+    let (s, c) = angle.sin_cos();
+    let r = &x_pj.rot;
+    let (c0, c1, c2) = (r.column(0).into_owned(), r.column(1).into_owned(), r.column(2).into_owned());
+    // Columns (u, w) rotated by the angle whose sine is `s`: (c u + s w, −s u + c w).
+    let turn = |u: Vec3, w: Vec3, s: f64| (u * c + w * s, w * c - u * s);
+    let rot = if axis.y == 0.0 && axis.z == 0.0 && axis.x.abs() == 1.0 {
+        let (n1, n2) = turn(c1, c2, s * axis.x);
+        Mat3::from_columns(&[c0, n1, n2])
+    } else if axis.x == 0.0 && axis.z == 0.0 && axis.y.abs() == 1.0 {
+        let (n2, n0) = turn(c2, c0, s * axis.y);
+        Mat3::from_columns(&[n0, c1, n2])
+    } else if axis.x == 0.0 && axis.y == 0.0 && axis.z.abs() == 1.0 {
+        let (n0, n1) = turn(c0, c1, s * axis.z);
+        Mat3::from_columns(&[n0, n1, c2])
+    } else {
+        r * crate::model::axis_angle(axis, angle)
+    };
+    Transform::new(rot, x_pj.pos)
 }
 
 /// Joint velocity `v_J = S q̇` of body `b`, body coordinates (needs `update_joint` first).

@@ -11,6 +11,7 @@
 // zips over four slices would hide the RBDA table they transcribe.
 #![allow(clippy::needless_range_loop)]
 
+pub mod batch;
 pub mod collision;
 pub mod constraint;
 pub mod dynamics;

@@ -253,6 +253,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         geoms,
         nq,
         nv,
+        dof_run_start: crate::model::dof_run_starts(&dof_parent),
         dof_parent,
         dof_body,
         dof_armature,

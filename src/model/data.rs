@@ -185,9 +185,11 @@ pub struct Data {
     pub u_tau: DVector<f64>,
     /// `D⁻¹ = (Sᵀ U)⁻¹` of each body's joint, top-left nv×nv block (ABA).
     pub d_inv: Vec<Matrix6<f64>>,
-    /// Joint-space inertia matrix M(q) (CRBA), armature included.
+    /// Joint-space inertia matrix M(q) (CRBA), armature included. CRBA writes the entries of
+    /// dofs on one ancestor chain; the others are zero from `Data::new` and stay so.
     pub mass_matrix: DMatrix<f64>,
-    /// Tree-sparse LᵀDL factor of M (RBDA §6.3): unit L strictly below the diagonal, D on it.
+    /// Tree-sparse LᵀDL factor of M (RBDA §6.3): D on the diagonal, row k of the unit L in
+    /// column k (`L[k][j]` at (j, k), j an ancestor of k); other entries are not used.
     pub mass_factor: DMatrix<f64>,
     /// Generalized forces from RNEA (the kernel's output).
     pub tau: DVector<f64>,

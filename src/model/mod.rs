@@ -174,6 +174,10 @@ pub struct Model {
     /// For each degree of freedom, the previous degree of freedom on the path to the root
     /// (Featherstone's λ for the tree-sparse factorization, RBDA §6.3), or `usize::MAX`.
     pub dof_parent: Vec<usize>,
+    /// For each degree of freedom k, the first index s of the run s..=k of consecutive ancestors
+    /// (λ(j) = j − 1 for s < j ≤ k) that ends at k: the ancestor chain of k is such runs, each a
+    /// contiguous slice (the LᵀDL factorization walks it run by run). See [`dof_run_starts`].
+    pub dof_run_start: Vec<usize>,
     /// For each degree of freedom, the body it moves.
     pub dof_body: Vec<usize>,
     /// Armature per degree of freedom.
@@ -293,6 +297,17 @@ impl Model {
     pub fn has_damping(&self) -> bool {
         self.dof_damping.iter().any(|&d| d != 0.0)
     }
+}
+
+/// [`Model::dof_run_start`] of a λ table: s(k) = s(k − 1) if λ(k) = k − 1, else k.
+pub fn dof_run_starts(dof_parent: &[usize]) -> Vec<usize> {
+    let mut start: Vec<usize> = (0..dof_parent.len()).collect();
+    for k in 1..dof_parent.len() {
+        if dof_parent[k] == k - 1 {
+            start[k] = start[k - 1];
+        }
+    }
+    start
 }
 
 /// The most contacts one collision pass keeps (see [`Model::max_contacts`]).

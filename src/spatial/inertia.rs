@@ -52,16 +52,30 @@ impl RigidInertia {
         }
     }
     /// The same inertia expressed in frame a, given the pose `x_a_b` of its current frame b.
-    #[inline]
+    ///
+    /// I_a = R I_b Rᵀ − ([h']×[p]× + [p]×[h']×) − m [p]×² with h' = R h (RBDA eq. 2.66 on the
+    /// 10 parameters); with [a]×[b]× = b aᵀ − (a·b) 1 the shift is
+    /// −p h'ᵀ − h' pᵀ − m p pᵀ + (2 h'·p + m p·p) 1, and only the 6 entries of the symmetric
+    /// result are computed.
+    #[inline(always)]
     pub fn transformed(&self, x_a_b: &Transform) -> RigidInertia {
         let r = &x_a_b.rot;
         let p = &x_a_b.pos;
-        let h_rot = r * self.h;
-        let px = skew(p);
-        let hx = skew(&h_rot);
-        // I_a = R I_b Rᵀ − ([h']×[p]× + [p]×[h']×) − m [p]×², with h' = R h.
-        let i_origin = r * self.i_origin * r.transpose() - (hx * px + px * hx) - px * px * self.mass;
-        RigidInertia { mass: self.mass, h: h_rot + p * self.mass, i_origin }
+        let m = self.mass;
+        let h = r * self.h;
+        // T = R I (I symmetric); (R I Rᵀ)(i, j) = row i of T · row j of R.
+        let t = r * self.i_origin;
+        let diag = 2.0 * h.dot(p) + m * p.dot(p);
+        let entry = |i: usize, j: usize| {
+            t[(i, 0)] * r[(j, 0)] + t[(i, 1)] * r[(j, 1)] + t[(i, 2)] * r[(j, 2)]
+                - p[i] * h[j]
+                - h[i] * p[j]
+                - m * p[i] * p[j]
+        };
+        let (xx, yy, zz) = (entry(0, 0) + diag, entry(1, 1) + diag, entry(2, 2) + diag);
+        let (xy, xz, yz) = (entry(0, 1), entry(0, 2), entry(1, 2));
+        let i_origin = Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+        RigidInertia { mass: m, h: h + p * m, i_origin }
     }
     /// The same body with its density multiplied by `s` (mass, first moment and inertia scale
     /// together; the centre of mass stays).
@@ -123,13 +137,25 @@ impl ArticulatedInertia {
     }
     /// Adds this inertia, currently in frame b, to `target` expressed in frame a, given `x_a_b`
     /// (the congruence ᵃX*_b I ᵇXₐ, RBDA eq. 2.66): first rotate, then shift the origin by `pos`.
+    ///
+    /// A rotation about one coordinate axis (a hinge about a principal axis with an unrotated
+    /// placement, the common case) is applied as a plane rotation of two rows and two columns
+    /// ([`coordinate_rotation`]), 24 products per 3×3 block instead of 54.
     #[inline]
     pub fn add_transformed_to(&self, x_a_b: &Transform, target: &mut ArticulatedInertia) {
         let r = &x_a_b.rot;
-        let rt = r.transpose();
-        let a = r * self.a * rt;
-        let b = r * self.b * rt;
-        let c = r * self.c * rt;
+        let turn = |f: fn(&Mat3, f64, f64) -> Mat3, cos: f64, sin: f64| {
+            (f(&self.a, cos, sin), f(&self.b, cos, sin), f(&self.c, cos, sin))
+        };
+        let (a, b, c) = match coordinate_rotation(r) {
+            Some((2, cos, sin)) => turn(plane_rotate::<0, 1>, cos, sin),
+            Some((0, cos, sin)) => turn(plane_rotate::<1, 2>, cos, sin),
+            Some((_, cos, sin)) => turn(plane_rotate::<2, 0>, cos, sin),
+            None => {
+                let rt = r.transpose();
+                (r * self.a * rt, r * self.b * rt, r * self.c * rt)
+            }
+        };
         let px = skew(&x_a_b.pos);
         // Shift: A'' = A + [p]× Bᵀ + ([p]× Bᵀ)ᵀ + [p]× C [p]×ᵀ,  B'' = B + [p]× C,  C'' = C.
         let pxc = px * c;
@@ -138,4 +164,34 @@ impl ArticulatedInertia {
         target.b += b + pxc;
         target.c += c;
     }
+}
+
+/// If `r` is a rotation about coordinate axis k (column k and row k are eₖ): (k, cos, sin) of its
+/// angle, with R eᵢ = cos eᵢ + sin eⱼ for (i, j) = (k + 1, k + 2) mod 3.
+#[inline]
+fn coordinate_rotation(r: &Mat3) -> Option<(usize, f64, f64)> {
+    for (k, i, j) in [(2, 0, 1), (0, 1, 2), (1, 2, 0)] {
+        if r[(k, k)] == 1.0 && r[(i, k)] == 0.0 && r[(j, k)] == 0.0 && r[(k, i)] == 0.0 && r[(k, j)] == 0.0 {
+            return Some((k, r[(i, i)], r[(j, i)]));
+        }
+    }
+    None
+}
+
+/// R M Rᵀ for the plane rotation R of [`coordinate_rotation`] in the plane (I, J): rows I, J of
+/// M turn, then columns I, J of the result (RBDA eq. 2.66 with a sparse R).
+#[inline]
+fn plane_rotate<const I: usize, const J: usize>(m: &Mat3, cos: f64, sin: f64) -> Mat3 {
+    let mut out = *m;
+    for col in 0..3 {
+        let (mi, mj) = (m[(I, col)], m[(J, col)]);
+        out[(I, col)] = cos * mi - sin * mj;
+        out[(J, col)] = sin * mi + cos * mj;
+    }
+    for row in 0..3 {
+        let (mi, mj) = (out[(row, I)], out[(row, J)]);
+        out[(row, I)] = cos * mi - sin * mj;
+        out[(row, J)] = sin * mi + cos * mj;
+    }
+    out
 }
