@@ -218,7 +218,15 @@ fn simulate_adaptive_with_tolerances() {
 fn default_run_simulates_the_embedded_model() {
     let (ok, out, err) = lagrange(&[]);
     assert!(ok, "{err}");
-    for needle in ["embedded default model", "model 'ur5'", "forward plan", "5000 steps", "energy: start"] {
+    for needle in [
+        "embedded default scene",
+        "Unitree Go1",
+        "forward plan",
+        "soft mode",
+        "2500 steps",
+        "energy: start",
+        "base height",
+    ] {
         assert!(out.contains(needle), "missing '{needle}' in {out}");
     }
 }

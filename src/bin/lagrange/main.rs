@@ -1,5 +1,5 @@
 //! The `lagrange` command line: `info`, `eval`, `simulate`, `bench`, `workprec`; with no arguments it simulates the
-//! embedded default model (a UR5 arm released under gravity) and prints the summary.
+//! embedded default scene (the Go1 quadruped standing on its servos, soft contacts) and prints the summary.
 
 use clap::{Parser, Subcommand, ValueEnum};
 mod cli;

@@ -5,7 +5,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::DriftCorrection;
 use lagrange::integrate::{IntegratorKind, State};
-use lagrange::io::{load, load_urdf_str, LoadOptions};
+use lagrange::io::{load, LoadOptions};
 use lagrange::sim::{display_time, SimOptions, Simulation};
 use lagrange::Model;
 use serde_json::json;
@@ -14,10 +14,13 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// The model `lagrange` simulates when run without arguments: the UR5 arm of `models/ur5`.
-pub const DEFAULT_MODEL_URDF: &str = include_str!("../../../../models/ur5/ur5.urdf");
-/// Initial configuration of the default run: the arm held out and released under gravity.
-pub const DEFAULT_Q0: &str = "0.0,-1.2,1.0,-0.6,1.5,0.0";
+/// The scene `lagrange` simulates when run without arguments: the Unitree Go1 of
+/// `models/mjcf/unitree_go1` on its floor (`scene.xml` includes `go1.xml`).
+pub const DEFAULT_SCENE_XML: &str = include_str!("../../../../models/mjcf/unitree_go1/scene.xml");
+pub const DEFAULT_ROBOT_XML: &str = include_str!("../../../../models/mjcf/unitree_go1/go1.xml");
+/// go1's base height after 5 s from keyframe `home` in MuJoCo 4.0.0 (`mj_resetDataKeyframe`, then
+/// 2500 × `mj_step` with the scene's own options), measured for comparison in the default run.
+pub const DEFAULT_MUJOCO_HEIGHT: f64 = 0.2648645591;
 
 /// What to simulate.
 pub struct Request {
@@ -507,34 +510,53 @@ pub fn run_file(path: &Path, options: &LoadOptions, request: &Request) -> Result
     run_model(&model, request)
 }
 
-/// `lagrange` with no arguments: the embedded UR5, released from [`DEFAULT_Q0`], 5 s with RK4.
+/// `lagrange` with no arguments: the embedded Unitree Go1 scene (MuJoCo Menagerie, BSD-3-Clause,
+/// `models/mjcf/unitree_go1`) standing on its floor on its own position servos from keyframe
+/// `home`, 5 s with the model's `<option>` (Euler, 2 ms) and soft (MuJoCo-compatible) contacts.
 pub fn default_run() -> Result<(), CliError> {
-    let model = load_urdf_str(
-        DEFAULT_MODEL_URDF,
-        Path::new("embedded:models/ur5/ur5.urdf"),
-        &LoadOptions::default(),
-    )?;
+    // The two embedded files go to a fresh temporary folder (scene.xml includes go1.xml).
+    let dir = std::env::temp_dir().join(format!("lagrange-default-{}", std::process::id()));
+    let io = |source| CliError::Io { file: dir.display().to_string(), source };
+    std::fs::create_dir_all(&dir).map_err(io)?;
+    std::fs::write(dir.join("scene.xml"), DEFAULT_SCENE_XML).map_err(io)?;
+    std::fs::write(dir.join("go1.xml"), DEFAULT_ROBOT_XML).map_err(io)?;
+    let loaded = load(&dir.join("scene.xml"), &LoadOptions::default());
+    let _ = std::fs::remove_dir_all(&dir);
+    let model = loaded?;
     println!(
-        "lagrange {}: no arguments given, so simulating the embedded default model.",
+        "lagrange {}: no arguments given, so simulating the embedded default scene: the Unitree Go1",
         env!("CARGO_PKG_VERSION")
     );
+    println!("quadruped (MuJoCo Menagerie, models/mjcf/unitree_go1) standing on its floor on its own");
+    println!("position servos, from keyframe 'home' holding its controls, with soft (MuJoCo-compatible)");
+    println!("contacts, joint limits and friction loss.");
     println!("(Run `lagrange --help` for info/eval/simulate on your own URDF or MJCF.)\n");
     print!("{}", super::info::to_text(&model, None));
     println!();
     let request = Request {
         duration: 5.0,
-        dt: Some(1e-3),
-        integrator: Some(IntegratorKind::Rk4),
+        dt: None,
+        integrator: None,
         tolerances: None,
         constraints: None,
         drift: DriftCorrection::default(),
         json: false,
-        keyframe: None,
+        keyframe: Some("home".into()),
         ctrl: None,
-        q0: Some(DEFAULT_Q0.into()),
+        q0: None,
         v0: None,
         out: None,
     };
-    println!("released from q0 = [{DEFAULT_Q0}] at rest under gravity, zero torques:");
-    run_model(&model, &request)
+    let summary = simulate(&model, &request)?;
+    print!("{}", summary_text(&model, &request, &summary));
+    let z0 =
+        model.keyframes.iter().find(|k| k.name == "home").and_then(|k| k.qpos.as_ref()).map_or(0.0, |q| q[2]);
+    println!(
+        "base height: {z0:.4} m at the start, {:.6} m after {} s (MuJoCo 4.0's mj_step from the same keyframe: {DEFAULT_MUJOCO_HEIGHT} m); at most {} contacts, deepest penetration {:.2} mm",
+        summary.final_state.q[2],
+        display_time(summary.final_state.time),
+        summary.max_contacts,
+        summary.max_penetration * 1e3
+    );
+    Ok(())
 }
