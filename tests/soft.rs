@@ -166,3 +166,31 @@ fn mjcf_defaults_to_soft_and_urdf_to_exact() {
     let r = Plan::new(&mjcf, Some(ConstraintMode::Exact));
     assert_eq!((r.mode, r.mode_reason.as_str()), (ConstraintMode::Exact, "exact requested"));
 }
+
+/// Issue 13's standing robot in soft mode: go1 from keyframe `home`, holding the keyframe's
+/// position-servo controls, 5 s with the scene's own options (Euler, 2 ms, Newton). MuJoCo 4.0.0
+/// (`mj_resetDataKeyframe`, 2500 × `mj_step`) ends with the base at 0.2648645591 m.
+#[test]
+fn go1_stands_on_its_servos_as_in_mujoco() {
+    const MUJOCO_HEIGHT: f64 = 0.2648645591;
+    let model =
+        Arc::new(load(Path::new("models/mjcf/unitree_go1/scene.xml"), &LoadOptions::default()).unwrap());
+    let key = &model.keyframes[model.keyframe_id("home").unwrap()];
+    let (mut q, mut v, mut ctrl, mut act) =
+        (model.qpos0.clone(), vec![0.0; model.nv], vec![0.0; model.actuators.len()], vec![0.0; model.na()]);
+    key.apply(&mut q, &mut v, &mut ctrl, &mut act);
+    let mut sim = Simulation::new(model.clone(), &SimOptions::default());
+    assert_eq!(sim.plan.mode, ConstraintMode::Soft, "MJCF defaults to soft");
+    sim.set_state(&q, &v).unwrap();
+    sim.ctrl_mut().copy_from_slice(&ctrl);
+    for _ in 0..2500 {
+        sim.step().unwrap();
+    }
+    let z = sim.state.q[2];
+    println!(
+        "go1 base after 5 s: {z:.10} m, MuJoCo {MUJOCO_HEIGHT} m, difference {:.2e} m",
+        z - MUJOCO_HEIGHT
+    );
+    assert!((z - MUJOCO_HEIGHT).abs() < 0.01, "issue 13: within 1 cm of MuJoCo's; got {z}");
+    assert!(sim.state.v.amax() < 1e-2, "standing still: |v| = {}", sim.state.v.amax());
+}
