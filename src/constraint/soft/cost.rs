@@ -46,40 +46,27 @@ impl Rows<'_> {
         let mut i = 0;
         while i < self.nefc {
             let (x, d) = (jar[i], self.d[i]);
-            if i < self.ne {
-                force[i] = -d * x;
-                state[i] = EfcState::Quadratic;
-                cost += 0.5 * d * x * x;
-                i += 1;
-                continue;
-            }
-            if i < self.ne + self.nf {
-                let (f, r) = (self.floss[i], self.r[i]);
-                if x <= -r * f {
-                    force[i] = f;
-                    state[i] = EfcState::LinearNeg;
-                    cost += -0.5 * r * f * f - f * x;
-                } else if x >= r * f {
-                    force[i] = -f;
-                    state[i] = EfcState::LinearPos;
-                    cost += -0.5 * r * f * f + f * x;
+            if i < self.ne || self.kind[i] != EfcType::ContactElliptic {
+                // One scalar row: its state, force and cost.
+                let (st, f, c) = if i < self.ne {
+                    (EfcState::Quadratic, -d * x, 0.5 * d * x * x)
+                } else if i < self.ne + self.nf {
+                    let (f, r) = (self.floss[i], self.r[i]);
+                    if x <= -r * f {
+                        (EfcState::LinearNeg, f, -0.5 * r * f * f - f * x)
+                    } else if x >= r * f {
+                        (EfcState::LinearPos, -f, -0.5 * r * f * f + f * x)
+                    } else {
+                        (EfcState::Quadratic, -d * x, 0.5 * d * x * x)
+                    }
+                } else if x >= 0.0 {
+                    (EfcState::Satisfied, 0.0, 0.0)
                 } else {
-                    force[i] = -d * x;
-                    state[i] = EfcState::Quadratic;
-                    cost += 0.5 * d * x * x;
-                }
-                i += 1;
-                continue;
-            }
-            if self.kind[i] != EfcType::ContactElliptic {
-                if x >= 0.0 {
-                    force[i] = 0.0;
-                    state[i] = EfcState::Satisfied;
-                } else {
-                    force[i] = -d * x;
-                    state[i] = EfcState::Quadratic;
-                    cost += 0.5 * d * x * x;
-                }
+                    (EfcState::Quadratic, -d * x, 0.5 * d * x * x)
+                };
+                state[i] = st;
+                force[i] = f;
+                cost += c;
                 i += 1;
                 continue;
             }
