@@ -194,3 +194,24 @@ fn go1_stands_on_its_servos_as_in_mujoco() {
     assert!((z - MUJOCO_HEIGHT).abs() < 0.01, "issue 13: within 1 cm of MuJoCo's; got {z}");
     assert!(sim.state.v.amax() < 1e-2, "standing still: |v| = {}", sim.state.v.amax());
 }
+
+/// Fluid forces (`<option density viscosity wind>`) are not simulated: the plan says so.
+#[test]
+fn fluid_options_are_listed_as_not_simulated() {
+    let path = std::env::temp_dir().join(format!("lagrange-fluid-{}.xml", std::process::id()));
+    std::fs::write(
+        &path,
+        r#"<mujoco><option viscosity="0.1" wind="1 0 0"/><worldbody><body><freejoint/><geom size="0.1"/></body></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    let model = load(&path, &LoadOptions::default()).unwrap();
+    let _ = std::fs::remove_file(&path);
+    let plan = Plan::new(&model, None);
+    let fluid = plan.stages.iter().find(|s| s.name == "fluid forces").expect("a fluid stage");
+    assert_eq!(fluid.status, lagrange::forward::Status::NotSimulated);
+    assert!(
+        fluid.reason.contains("viscosity=\"0.1\"") && fluid.reason.contains("wind=\"1 0 0\""),
+        "{}",
+        fluid.reason
+    );
+}

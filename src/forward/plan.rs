@@ -375,6 +375,18 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
     let multi_dof_springs = model.joints.iter().filter(|j| j.stiffness != 0.0 && j.kind.nq() > 1).count();
     let other = model.elements.iter().filter(|e| matches!(e.category.as_str(), "body" | "joint")).count()
         + multi_dof_springs;
+    let o = &model.options;
+    if o.density > 0.0 || o.viscosity > 0.0 {
+        out.push(stage(
+            PassiveOther,
+            "fluid forces",
+            NotSimulated,
+            format!(
+                "<option density=\"{}\" viscosity=\"{}\" wind=\"{} {} {}\">: MuJoCo's fluid drag and viscous forces are not simulated",
+                o.density, o.viscosity, o.wind[0], o.wind[1], o.wind[2]
+            ),
+        ));
+    }
     if other > 0 {
         out.push(stage(
             PassiveOther,

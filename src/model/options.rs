@@ -207,6 +207,11 @@ pub struct Options {
     pub noslip_iterations: u32,
     /// Ratio of frictional to normal constraint impedance (1).
     pub impratio: f64,
+    /// The medium's density, viscosity and wind (MuJoCo's fluid forces act when density or
+    /// viscosity is positive; not simulated, listed by `info`).
+    pub density: f64,
+    pub viscosity: f64,
+    pub wind: [f64; 3],
     pub flags: Flags,
 }
 
@@ -224,6 +229,9 @@ impl Default for Options {
             ls_tolerance: 0.01,
             noslip_iterations: 0,
             impratio: 1.0,
+            density: 0.0,
+            viscosity: 0.0,
+            wind: [0.0; 3],
             flags: Flags::default(),
         }
     }

@@ -90,6 +90,9 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
         if let Some(v) = a.vec3("gravity")? {
             gravity = v;
         }
+        if let Some(v) = a.vec3("wind")? {
+            o.wind = [v.x, v.y, v.z];
+        }
         if let Some(v) = a.keyword("integrator", &["Euler", "RK4", "implicit", "implicitfast"])? {
             o.integrator = match v.as_str() {
                 "Euler" => Integrator::Euler,
@@ -131,6 +134,8 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
             ("tolerance", &mut o.tolerance),
             ("ls_tolerance", &mut o.ls_tolerance),
             ("impratio", &mut o.impratio),
+            ("density", &mut o.density),
+            ("viscosity", &mut o.viscosity),
         ] {
             if let Some(v) = a.real(attr)? {
                 if v < 0.0 {
