@@ -39,6 +39,18 @@ pub const EXACT_REACH: f64 = 1e-3;
 pub struct CollisionModel {
     pub shapes: Vec<Option<ConvexShape>>,
     pub rbound: Vec<f64>,
+    /// Per candidate pair (`Model::collision_pairs` order), what the bounding-sphere test needs,
+    /// packed: the two geoms, the pair's margin + gap plus both bounding radii (geom 2's alone
+    /// against a plane), and whether geom 1 is a plane.
+    pub broad: Vec<BroadPair>,
+}
+
+/// The bounding-sphere test of one candidate pair (see [`CollisionModel::broad`]).
+#[derive(Clone, Copy, Debug)]
+pub struct BroadPair {
+    pub geom: [u32; 2],
+    pub reach: f64,
+    pub plane: bool,
 }
 
 impl CollisionModel {
@@ -81,7 +93,17 @@ impl CollisionModel {
             shapes.push(shape);
             rbound.push(r);
         }
-        Self { shapes, rbound }
+        let broad = model
+            .collision_pairs
+            .iter()
+            .map(|p| {
+                let [g1, g2] = p.geom;
+                let plane = matches!(model.geoms[g1].shape, Shape::Plane { .. });
+                let radii = if plane { rbound[g2] } else { rbound[g1] + rbound[g2] };
+                BroadPair { geom: [g1 as u32, g2 as u32], reach: p.margin + p.gap + radii, plane }
+            })
+            .collect();
+        Self { shapes, rbound, broad }
     }
 }
 
@@ -91,20 +113,28 @@ impl CollisionModel {
 pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) {
     data.contacts.clear();
     let budget = model.max_contacts();
-    for pair in &model.collision_pairs {
-        let [g1, g2] = pair.geom;
-        let (geom1, geom2) = (&model.geoms[g1], &model.geoms[g2]);
-        let x1 = data.x_world_body[geom1.body] * geom1.x_body_geom;
-        let x2 = data.x_world_body[geom2.body] * geom2.x_body_geom;
-        let within = pair.margin + pair.gap + reach;
+    // World poses of the colliding geoms, once per pass (MuJoCo's geom_xpos, geom_xmat).
+    for (g, geom) in model.geoms.iter().enumerate() {
+        if cm.shapes[g].is_some() || geom.collision {
+            data.x_world_geom[g] = data.x_world_body[geom.body] * geom.x_body_geom;
+        }
+    }
+    for (pair, b) in model.collision_pairs.iter().zip(&cm.broad) {
         // Bounding spheres (a plane: the other geom's sphere against the plane).
-        let far = match &geom1.shape {
-            Shape::Plane { .. } => x1.rot.column(2).dot(&(x2.pos - x1.pos)) > within + cm.rbound[g2],
-            _ => (x2.pos - x1.pos).norm() > within + cm.rbound[g1] + cm.rbound[g2],
+        let (x1, x2) = (&data.x_world_geom[b.geom[0] as usize], &data.x_world_geom[b.geom[1] as usize]);
+        let d = x2.pos - x1.pos;
+        let far = if b.plane {
+            x1.rot.column(2).dot(&d) > b.reach + reach
+        } else {
+            d.norm_squared() > (b.reach + reach) * (b.reach + reach)
         };
         if far {
             continue;
         }
+        let [g1, g2] = pair.geom;
+        let (geom1, geom2) = (&model.geoms[g1], &model.geoms[g2]);
+        let (x1, x2) = (data.x_world_geom[g1], data.x_world_geom[g2]);
+        let within = pair.margin + pair.gap + reach;
         let start = data.contacts.len();
         let mut push = |p1: Vec3, p2: Vec3, normal: Vec3, dist: f64, hint: Option<Vec3>, feature: u32| {
             if data.contacts.len() - start >= pair.max_contacts {

@@ -351,6 +351,9 @@ pub struct Data {
     pub soft: SoftWork,
 
     // --- collision ---
+    /// World pose of each geom that collides, from the last collision pass (MuJoCo's `geom_xpos`,
+    /// `geom_xmat`).
+    pub x_world_geom: Vec<Transform>,
     /// Contacts of the last collision pass (MuJoCo's `contact`); capacity reserved for the model.
     pub contacts: Vec<Contact>,
     /// Contacts dropped because a collision pass found more than [`Model::max_contacts`]
@@ -461,6 +464,7 @@ impl Data {
             solver_improvement: 0.0,
             solver_gradient: 0.0,
             soft: SoftWork::new(nv, nefc),
+            x_world_geom: vec![Transform::identity(); model.geoms.len()],
             contacts: Vec::with_capacity(model.max_contacts()),
             contacts_dropped: 0,
         }
