@@ -86,6 +86,19 @@ impl Simulation {
             kind
         });
         let mut plan = Plan::new(&model, options.constraints);
+        if integrator == IntegratorKind::Variational
+            && plan.mode == ConstraintMode::Soft
+            && plan.has_constraints()
+        {
+            // The variational integrator holds constraints itself (equality multipliers, limits and
+            // contacts by projection): the soft model's forces would be left out of its equations.
+            let why = format!(
+                "{}, but the variational integrator holds constraints exactly (multipliers and projection), so exact is used",
+                plan.mode_reason
+            );
+            plan = Plan::new(&model, Some(ConstraintMode::Exact));
+            plan.mode_reason = why;
+        }
         if let Some(drift) = options.drift {
             plan.drift = drift;
         }

@@ -215,3 +215,22 @@ fn fluid_options_are_listed_as_not_simulated() {
         fluid.reason
     );
 }
+
+/// The variational integrator holds constraints exactly: on an MJCF model (soft by default) it
+/// runs the exact mode and says why.
+#[test]
+fn variational_integrator_uses_the_exact_mode() {
+    let model =
+        Arc::new(load(Path::new("models/textbook/incline_box.xml"), &LoadOptions::default()).unwrap());
+    let options = SimOptions {
+        integrator: Some(lagrange::integrate::IntegratorKind::Variational),
+        ..Default::default()
+    };
+    let sim = Simulation::new(model, &options);
+    assert_eq!(sim.plan.mode, ConstraintMode::Exact);
+    assert!(
+        sim.notes.iter().any(|n| n.contains("variational integrator holds constraints exactly")),
+        "{:?}",
+        sim.notes
+    );
+}
