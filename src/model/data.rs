@@ -126,6 +126,9 @@ pub struct SoftWork {
     /// The cost's Hessian M + Jᵀ D J (+ cone blocks) and its Cholesky factor, nv × nv.
     pub hessian: DMatrix<f64>,
     pub factor: DMatrix<f64>,
+    /// The nonzero columns of each row of J: row i's are `nz_index[nz_start[i]..nz_start[i + 1]]`.
+    pub nz_start: Vec<usize>,
+    pub nz_index: Vec<usize>,
     /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
     pub ar: DMatrix<f64>,
     pub minv_jt: DMatrix<f64>,
@@ -146,6 +149,8 @@ impl SoftWork {
             mgrad_prev: DVector::zeros(nv),
             hessian: DMatrix::zeros(nv, nv),
             factor: DMatrix::zeros(nv, nv),
+            nz_start: Vec::with_capacity(nefc + 1),
+            nz_index: Vec::with_capacity(nefc * nv),
             ar: DMatrix::zeros(0, 0),
             minv_jt: DMatrix::zeros(0, 0),
         }

@@ -38,11 +38,35 @@ pub struct Settings {
     pub scale: f64,
 }
 
-/// r ← J x (rows 0..nefc).
-fn mul_j(j: &DMatrix<f64>, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
+/// The nonzero columns of each row of J (rows enter the solve through their ancestor dofs only):
+/// row i's columns are `index[start[i]..start[i + 1]]`.
+struct Sparsity<'a> {
+    start: &'a [usize],
+    index: &'a [usize],
+}
+
+impl Sparsity<'_> {
+    fn row(&self, i: usize) -> &[usize] {
+        &self.index[self.start[i]..self.start[i + 1]]
+    }
+}
+
+/// Fills the sparsity of rows 0..nefc of `j` into `start` and `index` (grown only when a problem is
+/// larger than any before it).
+fn sparsity(j: &DMatrix<f64>, nefc: usize, start: &mut Vec<usize>, index: &mut Vec<usize>) {
+    start.clear();
+    index.clear();
+    start.push(0);
     for i in 0..nefc {
-        let row = j.row(i);
-        r[i] = (0..x.len()).filter(|&k| row[k] != 0.0).map(|k| row[k] * x[k]).sum();
+        index.extend((0..j.ncols()).filter(|&k| j[(i, k)] != 0.0));
+        start.push(index.len());
+    }
+}
+
+/// r ← J x (rows 0..nefc).
+fn mul_j(j: &DMatrix<f64>, s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
+    for i in 0..nefc {
+        r[i] = s.row(i).iter().map(|&k| j[(i, k)] * x[k]).sum();
     }
 }
 
@@ -57,6 +81,10 @@ fn mul_m(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
 pub fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings) {
     let nv = model.nv;
     let nefc = data.nefc;
+    {
+        let Data { efc_j, soft, .. } = &mut *data;
+        sparsity(efc_j, nefc, &mut soft.nz_start, &mut soft.nz_index);
+    }
     let Data {
         efc_j,
         efc_type,
@@ -81,6 +109,8 @@ pub fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings)
         nf,
         ..
     } = data;
+    let (nz_start, nz_index) = (std::mem::take(&mut soft.nz_start), std::mem::take(&mut soft.nz_index));
+    let nz = Sparsity { start: &nz_start, index: &nz_index };
     let rows = Rows {
         ne: *ne,
         nf: *nf,
@@ -100,7 +130,7 @@ pub fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings)
                  force: &mut DVector<f64>,
                  state: &mut [_]| {
         mul_m(mass_matrix, x, ma);
-        mul_j(efc_j, nefc, x, jar);
+        mul_j(efc_j, &nz, nefc, x, jar);
         for i in 0..nefc {
             jar[i] -= efc_aref[i];
         }
@@ -131,9 +161,8 @@ pub fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings)
         for i in 0..nefc {
             let f = efc_force[i];
             if f != 0.0 {
-                let row = efc_j.row(i);
-                for k in 0..nv {
-                    soft.grad[k] -= row[k] * f;
+                for &k in nz.row(i) {
+                    soft.grad[k] -= efc_j[(i, k)] * f;
                 }
             }
         }
@@ -147,13 +176,10 @@ pub fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings)
                 let h = &mut soft.hessian;
                 h.copy_from(mass_matrix);
                 rows.hessian(&soft.jar, efc_state, |a, b, w| {
-                    let (ra, rb) = (efc_j.row(a), efc_j.row(b));
-                    for p in 0..nv {
-                        let x = w * ra[p];
-                        if x != 0.0 {
-                            for q in 0..nv {
-                                h[(p, q)] += x * rb[q];
-                            }
+                    for &p in nz.row(a) {
+                        let x = w * efc_j[(a, p)];
+                        for &q in nz.row(b) {
+                            h[(p, q)] += x * efc_j[(b, q)];
                         }
                     }
                 });
@@ -187,7 +213,7 @@ pub fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings)
                 have_dir = true;
             }
         }
-        mul_j(efc_j, nefc, &soft.dir, &mut soft.jv);
+        mul_j(efc_j, &nz, nefc, &soft.dir, &mut soft.jv);
         mul_m(mass_matrix, &soft.dir, &mut soft.mdir);
         let g0: f64 = (0..nv).map(|k| (soft.ma[k] - qfrc_smooth[k]) * soft.dir[k]).sum();
         let dmd = soft.dir.dot(&soft.mdir);
@@ -206,11 +232,13 @@ pub fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings)
     for i in 0..nefc {
         let f = efc_force[i];
         if f != 0.0 {
-            for k in 0..nv {
+            for &k in nz.row(i) {
                 qfrc_constraint[k] += f * efc_j[(i, k)];
             }
         }
     }
+    data.soft.nz_start = nz_start;
+    data.soft.nz_index = nz_index;
     data.solver_niter = iter;
     data.solver_improvement = if improvement.is_finite() { improvement } else { 0.0 };
     data.solver_gradient = gradient;
