@@ -27,29 +27,29 @@ CASES = [
 ]
 
 
+def run(m, q0, v0, steps, integrator):
+    """`steps` mj_steps of `integrator` from (q0, v0); returns the final MjData."""
+    m.opt.integrator = integrator
+    d = mujoco.MjData(m)
+    d.qpos[:] = q0
+    d.qvel[:] = v0
+    mujoco.mj_normalizeQuat(m, d.qpos)
+    for _ in range(steps):
+        mujoco.mj_step(m, d)
+    return d
+
+
 def main():
     print(f"// mujoco {mujoco.__version__}")
     for name, file, q0, v0, steps in CASES:
         m = mujoco.MjModel.from_xml_path(os.path.join(TEXTBOOK, file))
-        m.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICIT
-        d = mujoco.MjData(m)
-        d.qpos[:] = q0
-        d.qvel[:] = v0
-        mujoco.mj_normalizeQuat(m, d.qpos)
-        for _ in range(steps):
-            mujoco.mj_step(m, d)
+        d = run(m, q0, v0, steps, mujoco.mjtIntegrator.mjINT_IMPLICIT)
         fmt = lambda a: "[" + ", ".join(repr(float(x)) for x in a) + "]"
         print(f"// {file}: {steps} steps of {m.opt.timestep} s, implicit")
         print(f"const {name}_QPOS: [f64; {m.nq}] = {fmt(d.qpos)};")
         print(f"const {name}_QVEL: [f64; {m.nv}] = {fmt(d.qvel)};")
         # implicitfast on the same state, to show the Coriolis derivatives change the result.
-        m.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-        d2 = mujoco.MjData(m)
-        d2.qpos[:] = q0
-        d2.qvel[:] = v0
-        mujoco.mj_normalizeQuat(m, d2.qpos)
-        for _ in range(steps):
-            mujoco.mj_step(m, d2)
+        d2 = run(m, q0, v0, steps, mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
         diff = max(np.abs(d2.qpos - d.qpos).max(), np.abs(d2.qvel - d.qvel).max())
         print(f"// implicitfast differs from implicit by {diff:.3e} (max abs, qpos and qvel)")
 
