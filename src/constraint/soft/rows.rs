@@ -18,7 +18,7 @@
 //! subtracts it from their reference acceleration), 0 elsewhere.
 
 use crate::constraint::contact::add_contact_jacobian;
-use crate::constraint::limits::{ball_angle_axis, LimitKind};
+use crate::constraint::limits::{ball_angle_axis, LimitKind, LimitRow};
 use crate::constraint::rows::{point_motion, RowGeometry};
 use crate::constraint::ConstraintModel;
 use crate::kinematics::bias_accelerations;
@@ -127,39 +127,18 @@ pub fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &
     let nf = r - ne;
     for l in &cm.limits {
         let margin = model.joints[l.joint].soft.margin;
-        let push = |data: &mut Data, r: &mut usize, dist: f64, dofs: &[(usize, f64)]| {
-            data.efc_id[*r] = l.joint;
-            data.efc_type[*r] = EfcType::LimitJoint;
-            data.efc_j.row_mut(*r).fill(0.0);
-            for &(d, c) in dofs {
-                data.efc_j[(*r, d)] = c;
+        let ndof = if matches!(l.kind, LimitKind::Cone { .. }) { 3 } else { 1 };
+        for (dist, dir) in joint_limit_sides(l, q, margin).into_iter().flatten() {
+            data.efc_id[r] = l.joint;
+            data.efc_type[r] = EfcType::LimitJoint;
+            data.efc_j.row_mut(r).fill(0.0);
+            for k in 0..ndof {
+                data.efc_j[(r, l.dof_adr + k)] = dir[k];
             }
-            data.efc_pos[*r] = dist;
-            data.efc_margin[*r] = margin;
-            data.efc_frictionloss[*r] = 0.0;
-            *r += 1;
-        };
-        match l.kind {
-            LimitKind::Scalar { range } => {
-                let x = q[l.qpos_adr];
-                if x - range[0] < margin {
-                    push(data, &mut r, x - range[0], &[(l.dof_adr, 1.0)]);
-                }
-                if range[1] - x < margin {
-                    push(data, &mut r, range[1] - x, &[(l.dof_adr, -1.0)]);
-                }
-            }
-            LimitKind::Cone { max_angle } => {
-                let qq = &q[l.qpos_adr..l.qpos_adr + 4];
-                let norm = qq.iter().map(|x| x * x).sum::<f64>().sqrt();
-                let unit = [qq[0] / norm, qq[1] / norm, qq[2] / norm, qq[3] / norm];
-                let (angle, axis) = ball_angle_axis(&unit);
-                let dist = max_angle - angle;
-                if dist < margin {
-                    let d = l.dof_adr;
-                    push(data, &mut r, dist, &[(d, -axis[0]), (d + 1, -axis[1]), (d + 2, -axis[2])]);
-                }
-            }
+            data.efc_pos[r] = dist;
+            data.efc_margin[r] = margin;
+            data.efc_frictionloss[r] = 0.0;
+            r += 1;
         }
     }
     if model.options.flags.limit {
@@ -174,30 +153,52 @@ pub fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &
 /// bound closer than the tendon's margin, J = ±∂L/∂q); returns the next free row.
 fn tendon_limit_rows(model: &Model, data: &mut Data, q: &[f64], mut r: usize) -> usize {
     for (t, tendon) in model.tendons.iter().enumerate() {
-        let (Some(range), TendonKind::Fixed { joints }) = (tendon.range, &tendon.kind) else { continue };
-        let length = fixed_length(model, joints, q);
-        let margin = tendon.soft.margin;
-        for (dist, sign) in [(length - range[0], 1.0), (range[1] - length, -1.0)] {
-            if dist < margin {
-                data.efc_id[r] = t;
-                data.efc_type[r] = EfcType::LimitTendon;
-                data.efc_j.row_mut(r).fill(0.0);
-                for &(j, c) in joints {
-                    data.efc_j[(r, model.joints[j].dof_adr)] += sign * c;
-                }
-                data.efc_pos[r] = dist;
-                data.efc_margin[r] = margin;
-                data.efc_frictionloss[r] = 0.0;
-                r += 1;
+        let TendonKind::Fixed { joints } = &tendon.kind else { continue };
+        for (dist, sign) in tendon_limit_sides(model, t, q).into_iter().flatten() {
+            data.efc_id[r] = t;
+            data.efc_type[r] = EfcType::LimitTendon;
+            data.efc_j.row_mut(r).fill(0.0);
+            for &(j, c) in joints {
+                data.efc_j[(r, model.joints[j].dof_adr)] += sign * c;
             }
+            data.efc_pos[r] = dist;
+            data.efc_margin[r] = tendon.soft.margin;
+            data.efc_frictionloss[r] = 0.0;
+            r += 1;
         }
     }
     r
 }
 
-/// The length Σ coef · q of a fixed tendon.
-fn fixed_length(model: &Model, joints: &[(usize, f64)], q: &[f64]) -> f64 {
-    joints.iter().map(|&(j, c)| c * q[model.joints[j].qpos_adr]).sum()
+/// The bounds of joint limit `l` closer than `margin` at `q` (MuJoCo's `mj_instantiateLimit`),
+/// each as (distance, J over the joint's dofs): hinge/slide (q − lower, +1) and (upper − q, −1),
+/// the first entry of the vector used; a ball its cone, (θmax − θ, −n) over its three dofs.
+fn joint_limit_sides(l: &LimitRow, q: &[f64], margin: f64) -> [Option<(f64, Vec3)>; 2] {
+    let within = |dist: f64, dir: Vec3| (dist < margin).then_some((dist, dir));
+    match l.kind {
+        LimitKind::Scalar { range } => {
+            let x = q[l.qpos_adr];
+            [within(x - range[0], Vec3::x()), within(range[1] - x, -Vec3::x())]
+        }
+        LimitKind::Cone { max_angle } => {
+            let qq = &q[l.qpos_adr..l.qpos_adr + 4];
+            let norm = qq.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let (angle, axis) = ball_angle_axis(&[qq[0] / norm, qq[1] / norm, qq[2] / norm, qq[3] / norm]);
+            [within(max_angle - angle, -axis), None]
+        }
+    }
+}
+
+/// The bounds of fixed tendon `t`'s length limit closer than its margin at `q`, each as
+/// (distance, sign of J = ±∂L/∂q); none for an unlimited or spatial tendon.
+fn tendon_limit_sides(model: &Model, t: usize, q: &[f64]) -> [Option<(f64, f64)>; 2] {
+    let tendon = &model.tendons[t];
+    let (Some(range), TendonKind::Fixed { joints }) = (tendon.range, &tendon.kind) else {
+        return [None, None];
+    };
+    let length: f64 = joints.iter().map(|&(j, c)| c * q[model.joints[j].qpos_adr]).sum();
+    let within = |dist: f64, sign: f64| (dist < tendon.soft.margin).then_some((dist, sign));
+    [within(length - range[0], 1.0), within(range[1] - length, -1.0)]
 }
 
 /// The contact rows from row `r` on; returns the next free row.
@@ -314,29 +315,11 @@ pub fn soft_active(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f6
         active |= data.contacts.iter().any(|c| c.dist < c.includemargin);
     }
     let tendon_limit = model.options.flags.limit
-        && model.tendons.iter().any(|t| match (&t.kind, t.range) {
-            (TendonKind::Fixed { joints }, Some(range)) => {
-                let length = fixed_length(model, joints, q);
-                length - range[0] < t.soft.margin || range[1] - length < t.soft.margin
-            }
-            _ => false,
-        });
+        && (0..model.tendons.len()).any(|t| tendon_limit_sides(model, t, q).iter().any(Option::is_some));
     active
         || tendon_limit
-        || cm.limits.iter().any(|l| {
-            let margin = model.joints[l.joint].soft.margin;
-            match l.kind {
-                LimitKind::Scalar { range } => {
-                    let x = q[l.qpos_adr];
-                    x - range[0] < margin || range[1] - x < margin
-                }
-                LimitKind::Cone { max_angle } => {
-                    let qq = &q[l.qpos_adr..l.qpos_adr + 4];
-                    let norm = qq.iter().map(|x| x * x).sum::<f64>().sqrt();
-                    let (angle, _) =
-                        ball_angle_axis(&[qq[0] / norm, qq[1] / norm, qq[2] / norm, qq[3] / norm]);
-                    max_angle - angle < margin
-                }
-            }
-        })
+        || cm
+            .limits
+            .iter()
+            .any(|l| joint_limit_sides(l, q, model.joints[l.joint].soft.margin).iter().any(Option::is_some))
 }
