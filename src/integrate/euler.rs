@@ -32,8 +32,10 @@ impl Stepper for SemiImplicitEuler {
         forward(model, plan, data, state.q.as_slice(), state.v.as_slice());
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         let flags = &model.options.flags;
-        if flags.eulerdamp && flags.damper && model.has_damping() {
-            implicit_acceleration(model, data, state.q.as_slice(), &mut self.damped, h);
+        if flags.eulerdamp
+            && flags.damper
+            && implicit_acceleration(model, data, state.q.as_slice(), &mut self.damped, h, None)
+        {
             state.v.axpy(h, &self.damped, 1.0);
         } else {
             state.v.axpy(h, &data.qacc, 1.0);

@@ -40,20 +40,40 @@ pub fn add_force_derivative(model: &Model, matrix: &mut [f64], h: f64) {
 }
 
 /// The velocity-implicit acceleration a = (M − h D)⁻¹ M qacc after `forward` at configuration
-/// `q`, into `out` (M and its factor in `data` are recomputed; M is left as CRBA gives it).
+/// `q`, into `out`, with D the joint damping and, given `actuator_bias_velocity`, the actuators'
+/// velocity derivatives. Returns false (and leaves `out` alone) when D is zero: the explicit
+/// `qacc` is the step's acceleration then. M is left as CRBA gives it; its factor is of M − h D.
 pub(super) fn implicit_acceleration(
     model: &Model,
     data: &mut Data,
     q: &[f64],
     out: &mut DVector<f64>,
     h: f64,
-) {
+    actuator_bias_velocity: Option<&[f64]>,
+) -> bool {
+    let damped = model.has_damping();
+    if !damped && actuator_bias_velocity.is_none() {
+        return false;
+    }
     crba(model, data, q);
     out.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
     add_force_derivative(model, data.mass_matrix.as_mut_slice(), h);
-    factorize_mass_matrix(model, data);
-    solve_with_factor(model, &data.mass_factor, out.as_mut_slice());
+    let mut m = std::mem::take(&mut data.mass_matrix);
+    let from_actuators = actuator_bias_velocity
+        .is_some_and(|b| add_actuator_velocity_derivative(model, data, b, m.as_mut_slice(), h));
+    let implicit = damped || from_actuators;
+    if implicit {
+        data.mass_matrix = m;
+        factorize_mass_matrix(model, data);
+        solve_with_factor(model, &data.mass_factor, out.as_mut_slice());
+        m = std::mem::take(&mut data.mass_matrix);
+    }
+    if let Some(b) = actuator_bias_velocity {
+        add_actuator_velocity_derivative(model, data, b, m.as_mut_slice(), -h);
+    }
+    data.mass_matrix = m;
     add_force_derivative(model, data.mass_matrix.as_mut_slice(), -h);
+    implicit
 }
 
 impl Stepper for ImplicitFast {
@@ -69,28 +89,8 @@ impl Stepper for ImplicitFast {
         // Activations as in MuJoCo's `mj_advance` (explicit in act_dot; filterexact exact).
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         let actuated = !model.actuators.is_empty() && model.options.flags.actuation;
-        let mut implicit = model.has_damping();
-        if implicit || actuated {
-            crba(model, data, state.q.as_slice());
-            self.force.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
-            add_force_derivative(model, data.mass_matrix.as_mut_slice(), h);
-            let mut m = std::mem::take(&mut data.mass_matrix);
-            let bias_velocity = &plan.actuator_bias_velocity;
-            let from_actuators =
-                add_actuator_velocity_derivative(model, data, bias_velocity, m.as_mut_slice(), h);
-            if implicit || from_actuators {
-                data.mass_matrix = m;
-                factorize_mass_matrix(model, data);
-                solve_with_factor(model, &data.mass_factor, self.force.as_mut_slice());
-                m = std::mem::take(&mut data.mass_matrix);
-            }
-            // Leave M as crba computed it.
-            add_actuator_velocity_derivative(model, data, bias_velocity, m.as_mut_slice(), -h);
-            data.mass_matrix = m;
-            add_force_derivative(model, data.mass_matrix.as_mut_slice(), -h);
-            implicit |= from_actuators;
-        }
-        if implicit {
+        let bias_velocity = actuated.then_some(plan.actuator_bias_velocity.as_slice());
+        if implicit_acceleration(model, data, state.q.as_slice(), &mut self.force, h, bias_velocity) {
             state.v.axpy(h, &self.force, 1.0);
         } else {
             state.v.axpy(h, &data.qacc, 1.0);
