@@ -38,8 +38,9 @@ use crate::model::{Data, Model};
 pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]) {
     let cm = &plan.constraints;
     let m_path = match &plan.soft {
-        // Soft: collision with MuJoCo's margins, rows by MuJoCo's activation rules.
-        Some(_) => plan.has_constraints() && soft::rows::soft_active(cm, model, data, q),
+        // Soft (the plan has its weights only when the model has constraint rows): collision with
+        // MuJoCo's margins, rows by MuJoCo's activation rules.
+        Some(_) => soft::soft_active(cm, model, data, q),
         // Exact: the M path only while a constraint row is active (an equality, a joint at a
         // limit, a touching contact): otherwise ABA, as for a model without constraints.
         None => {

@@ -19,7 +19,7 @@ pub mod rows;
 pub mod weights;
 
 pub use primal::{solve_primal, Primal, Settings};
-pub use rows::{soft_positions, soft_velocities};
+pub use rows::{soft_active, soft_positions, soft_velocities};
 pub use weights::InverseWeights;
 
 use crate::model::options::Solver;
