@@ -8,6 +8,7 @@
 //! [`Transform`] is a rigid pose `x_a_b` of frame b in frame a (`p_a = rot * p_b + pos`); it moves
 //! motion and force vectors between the two coordinate systems (RBDA eq. 2.24–2.27).
 
+pub mod fused;
 mod inertia;
 mod motion;
 mod transform;
