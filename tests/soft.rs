@@ -75,7 +75,7 @@ fn against_golden(name: &str, solver: Solver) -> (f64, f64) {
 
 #[test]
 fn newton_matches_mujoco_forward_on_contact_limit_and_equality_scenes() {
-    for name in ["go1", "humanoid", "incline_box", "weld_bodies_torquescale"] {
+    for name in ["go1", "humanoid", "incline_box", "weld_bodies_torquescale", "tendon_limit"] {
         let (acc, frc) = against_golden(name, Solver::Newton);
         println!("{name}: qacc {acc:.1e}, qfrc_constraint {frc:.1e} (tolerance {SOFT_REL:e})");
         assert!(acc <= SOFT_REL && frc <= SOFT_REL, "{name}: qacc {acc:e}, qfrc_constraint {frc:e}");
@@ -85,7 +85,7 @@ fn newton_matches_mujoco_forward_on_contact_limit_and_equality_scenes() {
 /// CG and PGS (given the iterations) reach the optimum Newton and MuJoCo reach.
 #[test]
 fn cg_and_pgs_reach_the_same_optimum() {
-    for name in ["go1", "humanoid", "incline_box"] {
+    for name in ["go1", "humanoid", "incline_box", "tendon_limit"] {
         for solver in [Solver::Cg, Solver::Pgs] {
             let (acc, frc) = against_golden(name, solver);
             println!("{name} {solver:?}: qacc {acc:.1e}, qfrc_constraint {frc:.1e}");
@@ -232,5 +232,42 @@ fn variational_integrator_uses_the_exact_mode() {
         sim.notes.iter().any(|n| n.contains("variational integrator holds constraints exactly")),
         "{:?}",
         sim.notes
+    );
+}
+
+/// A fixed-tendon limit that is the model's only constraint is simulated in soft mode (the plan
+/// once took such a model for unconstrained and dropped the limit), and listed as not simulated
+/// in exact mode.
+#[test]
+fn a_tendon_limit_alone_constrains_the_model() {
+    let model =
+        load(Path::new("tests/data/mjcf/constraints/tendon_limit.xml"), &LoadOptions::default()).unwrap();
+    let plan = Plan::new(&model, None);
+    assert!(plan.has_constraints(), "soft mode has the tendon's limit rows");
+    // Released horizontal, the chain falls (qa grows) until the tendon L = qa + 0.5 qb + 0.3 qc
+    // reaches its upper bound 0.25; the soft limit holds it there within a small penetration.
+    let highest = |model: &Model| {
+        let mut sim = Simulation::new(Arc::new(model.clone()), &SimOptions::default());
+        let mut highest = f64::NEG_INFINITY;
+        for _ in 0..2000 {
+            sim.step().unwrap();
+            let q = &sim.state.q;
+            highest = highest.max(q[0] + 0.5 * q[1] + 0.3 * q[2]);
+        }
+        highest
+    };
+    let mut free = model.clone();
+    free.options.flags.limit = false;
+    let (held, unheld) = (highest(&model), highest(&free));
+    println!("highest tendon length {held:.4} with the limit, {unheld:.4} without (range −0.25..0.25)");
+    assert!(unheld > 0.5, "without the limit the chain swings far past it: {unheld}");
+    assert!(held < 0.25 + 0.02 && held > 0.2, "the limit is reached and holds: {held}");
+    let exact = Plan::new(&model, Some(ConstraintMode::Exact));
+    assert!(!exact.has_constraints());
+    let listed = exact.stages.iter().find(|s| s.name == "joint limits").unwrap();
+    assert!(
+        listed.reason.contains("1 fixed-tendon length limits kept, not simulated in exact mode"),
+        "{}",
+        listed.reason
     );
 }

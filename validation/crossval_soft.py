@@ -265,7 +265,8 @@ def compare(mj, m, d, res: dict) -> dict:
 
 
 TRAJECTORY_SCENES = ("go1", "humanoid", "incline_cylinder", "incline_box", "drop", "pendulum_on_cart_loop",
-                     "weld_bodies_torquescale", "fourbar_connect", "features_elliptic", "features_pyramidal")
+                     "weld_bodies_torquescale", "fourbar_connect", "features_elliptic", "features_pyramidal",
+                     "tendon_limit")
 TRAJECTORY_STEPS = 200
 ABS_TRAJECTORY = 1e-6
 

@@ -26,6 +26,7 @@ SCENES = {
     "humanoid": "models/mjcf/humanoid/humanoid.xml",
     "incline_box": "models/textbook/incline_box.xml",
     "weld_bodies_torquescale": "tests/data/mjcf/constraints/weld_bodies_torquescale.xml",
+    "tendon_limit": "tests/data/mjcf/constraints/tendon_limit.xml",
 }
 
 

@@ -107,6 +107,10 @@ pub struct ConstraintModel {
     /// Degrees of freedom with dry friction (`frictionloss`), one row each, always active.
     pub friction: Vec<FrictionRow>,
     pub limits: Vec<LimitRow>,
+    /// Fixed tendons with a length range: a row per bound within the tendon's margin, soft mode
+    /// only (the exact mode has no tendon rows: `Plan::new` empties this list there and lists the
+    /// limits as not simulated).
+    pub tendon_limits: Vec<usize>,
 }
 
 /// P(x) and P′(x), P″(x) of MuJoCo's quartic `polycoef`.
@@ -151,9 +155,16 @@ impl ConstraintModel {
         } else {
             Vec::new()
         };
+        let tendon_limits = if flags.limit {
+            let limited =
+                |t: &crate::model::Tendon| t.range.is_some() && matches!(t.kind, TendonKind::Fixed { .. });
+            (0..model.tendons.len()).filter(|&t| limited(&model.tendons[t])).collect()
+        } else {
+            Vec::new()
+        };
         let friction = if flags.frictionloss { FrictionRow::of_model(model) } else { Vec::new() };
         if model.equalities.is_empty() || !flags.equality {
-            return Self { collision, equalities: Vec::new(), friction, limits };
+            return Self { collision, equalities: Vec::new(), friction, limits, tendon_limits };
         }
         let mut data = Data::new(model);
         forward_kinematics(model, &mut data, &model.qpos0);
@@ -235,15 +246,16 @@ impl ConstraintModel {
             };
             equalities.push(EqualityRows { id, geometry });
         }
-        Self { collision, equalities, friction, limits }
+        Self { collision, equalities, friction, limits, tendon_limits }
     }
 
-    /// Whether the model has no constraint rows at all (no equality, friction loss, limit, nor
-    /// candidate collision pair).
+    /// Whether the model has no constraint rows at all (no equality, friction loss, joint or
+    /// tendon limit, nor candidate collision pair).
     pub fn is_empty(&self) -> bool {
         self.equalities.is_empty()
             && self.friction.is_empty()
             && self.limits.is_empty()
+            && self.tendon_limits.is_empty()
             && !self.has_collision()
     }
 

@@ -100,8 +100,14 @@ impl Plan {
     /// models exact, as DESIGN.md fixes).
     pub fn new(model: &Model, requested: Option<ConstraintMode>) -> Self {
         let (mode, mode_reason) = resolve_mode(model, requested);
-        let constraints = ConstraintModel::new(model);
-        let stages = stages(model, &constraints, mode);
+        let mut constraints = ConstraintModel::new(model);
+        // The exact mode has no tendon rows: its fixed-tendon limits are listed as not simulated.
+        let exact_tendon_limits = if mode == ConstraintMode::Exact {
+            std::mem::take(&mut constraints.tendon_limits).len()
+        } else {
+            0
+        };
+        let stages = stages(model, &constraints, mode, exact_tendon_limits);
         let soft =
             (mode == ConstraintMode::Soft && !constraints.is_empty()).then(|| InverseWeights::new(model));
         // The soft model allows its own drift (MuJoCo projects nothing after a step).
@@ -150,18 +156,26 @@ fn stage(kind: StageKind, name: &'static str, status: Status, reason: impl Into<
     Stage { kind, name, status, reason: reason.into() }
 }
 
-fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) -> Vec<Stage> {
+/// The stages of the plan; `exact_tendon_limits` fixed-tendon limits are kept but not simulated
+/// (exact mode).
+fn stages(
+    model: &Model,
+    constraints: &ConstraintModel,
+    mode: ConstraintMode,
+    exact_tendon_limits: usize,
+) -> Vec<Stage> {
     use StageKind::*;
     use Status::*;
     let nrow: usize = constraints.equalities.iter().map(|e| model.equalities[e.id].kind.nrow()).sum();
-    let nlimit = constraints.limits.len();
+    let ntendon = constraints.tendon_limits.len();
+    let nlimit = constraints.limits.len() + ntendon;
     let nfriction = constraints.friction.len();
     let rows = match (nrow, nlimit) {
         (_, 0) => format!("{nrow} constraint rows"),
         (0, _) => {
-            format!("up to {nlimit} joint-limit rows, only while a joint is at a limit (ABA otherwise)")
+            format!("up to {nlimit} limit rows, only while a joint or tendon is at a limit (ABA otherwise)")
         }
-        _ => format!("{nrow} equality rows and up to {nlimit} joint-limit rows"),
+        _ => format!("{nrow} equality rows and up to {nlimit} limit rows"),
     };
     let rows = if nfriction > 0 { format!("{rows}, {nfriction} friction-loss rows") } else { rows };
     let rows =
@@ -291,22 +305,36 @@ fn stages(model: &Model, constraints: &ConstraintModel, mode: ConstraintMode) ->
         let inactive = if inactive > 0 { format!(", {inactive} inactive at start") } else { String::new() };
         stage(Equality, "equality", Runs, format!("{} ({nrow} rows{inactive})", list.join(", ")))
     });
+    let tendons_kept = if exact_tendon_limits > 0 {
+        format!("; {exact_tendon_limits} fixed-tendon length limits kept, not simulated in exact mode (soft mode has them)")
+    } else {
+        String::new()
+    };
     out.push(if nlimit > 0 {
         let ball = constraints.limits.iter().filter(|l| matches!(l.kind, LimitKind::Cone { .. })).count();
+        let counts = [
+            (nlimit - ntendon - ball, "limited hinge/slide joints"),
+            (ball, "ball-joint cone limits"),
+            (ntendon, "fixed-tendon length limits"),
+        ];
+        let what: Vec<String> =
+            counts.iter().filter(|(n, _)| *n > 0).map(|(n, w)| format!("{n} {w}")).collect();
         stage(
             JointLimits,
             "joint limits",
             Runs,
             format!(
-                "{} limited hinge/slide joints and {ball} ball-joint cone limits: {}",
-                nlimit - ball,
+                "{}: {}{tendons_kept}",
+                what.join(", "),
                 if mode == ConstraintMode::Soft {
-                    "a soft row per bound within the joint's margin (solreflimit, solimplimit)"
+                    "a soft row per bound within the joint's or tendon's margin (solreflimit, solimplimit)"
                 } else {
                     "a unilateral row at a bound (exact mode)"
                 }
             ),
         )
+    } else if exact_tendon_limits > 0 {
+        stage(JointLimits, "joint limits", NotSimulated, format!("no limited joints{tendons_kept}"))
     } else if !flags.limit && model.joints.iter().any(|j| j.limits.is_some()) {
         stage(JointLimits, "joint limits", Skipped, "switched off by <option><flag limit=\"disable\">")
     } else {
