@@ -190,7 +190,7 @@ fn so3_dexp_inv(theta: &[f64], omega: &[f64], out: &mut [f64]) {
 /// Rotation matrix for angle `angle` about unit `axis` (Rodrigues).
 #[inline]
 pub fn axis_angle(axis: &Vec3, angle: f64) -> Mat3 {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = libm::sincos(angle);
     let k = crate::spatial::skew(axis);
     Mat3::identity() + k * s + k * k * (1.0 - c)
 }
