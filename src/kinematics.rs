@@ -1,6 +1,9 @@
 //! Forward kinematics, body velocities and frame Jacobians (RBDA §4.1, §8.1).
 
 use crate::model::{Data, JointKind, Model};
+#[cfg(target_arch = "x86_64")]
+use crate::spatial::fused::Fused;
+use crate::spatial::fused::{self, MulAdd, Separate};
 use crate::spatial::{Mat3, Motion, Transform, Vec3};
 use nalgebra::DMatrix;
 
@@ -77,20 +80,47 @@ pub(crate) fn joint_velocity(model: &Model, data: &Data, b: usize, v: &[f64]) ->
 /// `x_world_body = x_world_parent · x_parent_body`. The first pass of FK and of CRBA.
 #[inline]
 pub(crate) fn body_poses(model: &Model, data: &mut Data, q: &[f64]) {
+    body_poses_with::<Separate>(model, data, q);
+}
+
+#[inline(always)]
+fn body_poses_with<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64]) {
     for b in 1..model.nbody() {
         update_joint(model, data, b, q);
         let p = model.bodies[b].parent;
-        data.x_world_body[b] = data.x_world_body[p] * data.x_parent_body[b];
+        data.x_world_body[b] = fused::compose::<A>(&data.x_world_body[p], &data.x_parent_body[b]);
     }
 }
 
 /// Forward kinematics: pose of every body (`x_parent_body`, `x_world_body`) and of every named
 /// frame (`x_world_frame`) at configuration `q`, and the motion subspaces (`s_body`).
+///
+/// On x86-64 CPUs with AVX2 and FMA3 it runs compiled for them, the compositions' products and
+/// sums fused ([`fused`]), as CRBA does.
 pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
-    body_poses(model, data, q);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU has AVX2 and FMA (checked just above), all `forward_kinematics_fma`
+        // requires.
+        unsafe { forward_kinematics_fma(model, data, q) };
+        return;
+    }
+    forward_kinematics_with::<Separate>(model, data, q);
+}
+
+/// [`forward_kinematics_with`] compiled for AVX2 and FMA3, its multiply–adds fused.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn forward_kinematics_fma(model: &Model, data: &mut Data, q: &[f64]) {
+    forward_kinematics_with::<Fused>(model, data, q);
+}
+
+#[inline(always)]
+fn forward_kinematics_with<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64]) {
+    body_poses_with::<A>(model, data, q);
     // Frames rigidly attached to bodies.
     for (f, frame) in model.frames.iter().enumerate() {
-        data.x_world_frame[f] = data.x_world_body[frame.body] * frame.x_body_frame;
+        data.x_world_frame[f] = fused::compose::<A>(&data.x_world_body[frame.body], &frame.x_body_frame);
     }
 }
 

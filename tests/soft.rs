@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{rel_err, SOFT_REL};
+use common::{rel_err, SOFT_CG_REL, SOFT_REL};
 use lagrange::constraint::soft::impedance::impedance;
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::{forward, Plan};
@@ -88,11 +88,9 @@ fn cg_and_pgs_reach_the_same_optimum() {
     for name in ["go1", "humanoid", "incline_box", "tendon_limit"] {
         for solver in [Solver::Cg, Solver::Pgs] {
             let (acc, frc) = against_golden(name, solver);
-            println!("{name} {solver:?}: qacc {acc:.1e}, qfrc_constraint {frc:.1e}");
-            assert!(
-                acc <= SOFT_REL && frc <= SOFT_REL,
-                "{name} {solver:?}: qacc {acc:e}, qfrc_constraint {frc:e}"
-            );
+            let tol = if solver == Solver::Cg { SOFT_CG_REL } else { SOFT_REL };
+            println!("{name} {solver:?}: qacc {acc:.1e}, qfrc_constraint {frc:.1e} (tolerance {tol:e})");
+            assert!(acc <= tol && frc <= tol, "{name} {solver:?}: qacc {acc:e}, qfrc_constraint {frc:e}");
         }
     }
 }
