@@ -2,7 +2,7 @@
 //! factorization and solve (RBDA §6.3, Tables 6.3–6.4).
 
 use crate::kinematics::update_joint;
-use crate::model::{Data, Model, NO_DOF};
+use crate::model::{Data, JointKind, Model, NO_DOF};
 #[cfg(target_arch = "x86_64")]
 use crate::spatial::fused::Fused;
 use crate::spatial::fused::{self, MulAdd, Separate};
@@ -48,8 +48,12 @@ fn crba_kernel<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64]) {
         let x_world_body = fused::compose::<A>(&data.x_world_body[p], &data.x_parent_body[b]);
         data.x_world_body[b] = x_world_body;
         let j = model.joint_of(b);
-        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
-            data.s_world[k] = fused::act_motion::<A>(&x_world_body, &data.s_body[k]);
+        if let JointKind::Revolute { axis, .. } = &j.kind {
+            data.s_world[j.dof_adr] = fused::act_rotation::<A>(&x_world_body, axis);
+        } else {
+            for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+                data.s_world[k] = fused::act_motion::<A>(&x_world_body, &data.s_body[k]);
+            }
         }
         data.i_composite[b] = fused::transformed::<A>(&model.bodies[b].inertia, &x_world_body);
     }

@@ -85,6 +85,13 @@ pub fn act_motion<A: MulAdd>(x_a_b: &Transform, m_b: &Motion) -> Motion {
     Motion { lin: cross_add::<A>(&x_a_b.pos, &ang, &lin), ang }
 }
 
+/// [`act_motion`] of a pure rotation (ω, 0), a hinge's motion subspace: (R ω, p × R ω).
+#[inline(always)]
+pub fn act_rotation<A: MulAdd>(x_a_b: &Transform, ang_b: &Vec3) -> Motion {
+    let ang = mat_vec::<A>(&x_a_b.rot, ang_b);
+    Motion { lin: cross_add::<A>(&x_a_b.pos, &ang, &Vec3::zeros()), ang }
+}
+
 /// The power `m · f` (as [`Motion::dot`]).
 #[inline(always)]
 pub fn dot<A: MulAdd>(m: &Motion, f: &Force) -> f64 {
