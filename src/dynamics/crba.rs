@@ -21,25 +21,38 @@ use nalgebra::{DMatrix, DVector};
 /// separate multiplies and adds; the two agree to round-off
 /// (`fma_kernel_matches_separate_multiply_adds`).
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64> {
+    crba_dispatch::<true>(model, data, q);
+    &data.mass_matrix
+}
+
+/// [`crba`] writing only the upper triangle of `data.mass_matrix` (the entries M[l][k], l ≤ k, on
+/// the tree's ancestor chains), as Pinocchio's `crba` does: what [`factorize_mass_matrix`] reads.
+/// The strictly lower triangle keeps whatever it held (after [`crba`], an older M's mirror).
+pub fn crba_upper<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64> {
+    crba_dispatch::<false>(model, data, q);
+    &data.mass_matrix
+}
+
+#[inline(always)]
+fn crba_dispatch<const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU has AVX2 and FMA (checked just above), all `crba_fma` requires.
-        unsafe { crba_fma(model, data, q) };
-        return &data.mass_matrix;
+        unsafe { crba_fma::<MIRROR>(model, data, q) };
+        return;
     }
-    crba_kernel::<Separate>(model, data, q);
-    &data.mass_matrix
+    crba_kernel::<Separate, MIRROR>(model, data, q);
 }
 
 /// [`crba_kernel`] compiled for AVX2 and FMA3, its multiply–adds fused (rounded once).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn crba_fma(model: &Model, data: &mut Data, q: &[f64]) {
-    crba_kernel::<Fused>(model, data, q);
+unsafe fn crba_fma<const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64]) {
+    crba_kernel::<Fused, MIRROR>(model, data, q);
 }
 
 #[inline(always)]
-fn crba_kernel<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64]) {
+fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64]) {
     // Pass 1, root to leaves: body poses, then world-frame motion subspaces and body inertias
     // (the 10 parameters moved by RBDA eq. 2.66; a hinge's column is (R a, p × R a)).
     for b in 1..model.nbody() {
@@ -77,8 +90,10 @@ fn crba_kernel<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64]) {
             while l != NO_DOF {
                 let m_lk = fused::dot::<A>(&s_world[l], &f_world);
                 col_k[l] = m_lk;
-                // Row k of the earlier column l (M is symmetric).
-                before[k + l * nv] = m_lk;
+                if MIRROR {
+                    // Row k of the earlier column l (M is symmetric).
+                    before[k + l * nv] = m_lk;
+                }
                 l = dof_parent[l];
             }
         }
@@ -183,6 +198,30 @@ mod tests {
     use super::*;
     use crate::io::{load, LoadOptions};
 
+    /// `crba_upper` writes exactly `crba`'s upper triangle and leaves the lower one alone.
+    #[test]
+    fn upper_triangle_is_crbas() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let model =
+            load(&root.join("models/solo12/solo12.urdf"), &LoadOptions { floating: true, ..Default::default() })
+                .unwrap();
+        let mut data = Data::new(&model);
+        let q: Vec<f64> = model.neutral().iter().enumerate().map(|(i, x)| x + 0.2 * (i as f64).cos()).collect();
+        let full = crba(&model, &mut data, &q).clone();
+        data.mass_matrix.fill(7.0);
+        let upper = crba_upper(&model, &mut data, &q);
+        for k in 0..model.nv {
+            let mut chain = vec![k];
+            while let Some(&l) = chain.last().filter(|&&l| model.dof_parent[l] != NO_DOF) {
+                chain.push(model.dof_parent[l]);
+            }
+            for l in 0..model.nv {
+                let want = if chain.contains(&l) { full[(l, k)] } else { 7.0 };
+                assert_eq!(upper[(l, k)].to_bits(), want.to_bits(), "({l}, {k})");
+            }
+        }
+    }
+
     /// The FMA build of the kernel gives the M of the separate multiply–adds to round-off
     /// (cross-check tolerance), and M stays symmetric bit for bit.
     #[test]
@@ -200,11 +239,11 @@ mod tests {
             for (i, x) in q.iter_mut().enumerate() {
                 *x += 0.1 + 0.37 * (i as f64).sin();
             }
-            crba_kernel::<Separate>(&model, &mut data, &q);
+            crba_kernel::<Separate, true>(&model, &mut data, &q);
             let baseline = data.mass_matrix.clone();
             data.mass_matrix.fill(0.0);
             // SAFETY: AVX2 and FMA are present (checked above).
-            unsafe { crba_fma(&model, &mut data, &q) };
+            unsafe { crba_fma::<true>(&model, &mut data, &q) };
             let m = &data.mass_matrix;
             let scale = baseline.amax();
             assert!((m - &baseline).amax() <= 1e-12 * scale, "{file}: {:e}", (m - &baseline).amax());

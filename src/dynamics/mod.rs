@@ -8,6 +8,6 @@ mod energy;
 mod rnea;
 
 pub use aba::aba;
-pub use crba::{crba, factorize_mass_matrix, solve_mass_matrix, solve_with_factor};
+pub use crba::{crba, crba_upper, factorize_mass_matrix, solve_mass_matrix, solve_with_factor};
 pub use energy::{center_of_mass, kinetic_energy, potential_energy, spatial_momentum};
 pub use rnea::{bias_forces, gravity_forces, rnea};

@@ -503,7 +503,7 @@ def report(rbs, samples, by_round, worst, failures, args, seconds: float) -> str
         "(joints and every frame) | `mj_kinematics` (bodies, geoms, sites) |",
         "| RNEA | `rnea(q, v, a)` | `rnea(q, v, a)` | `mj_kinematics`, `mj_comPos`, `mj_comVel`, "
         "`mj_rne(flg_acc = 1)` |",
-        "| CRBA | `crba(q)`: full symmetric M | `crba(q)` (LOCAL): upper triangle of `data.M` | "
+        "| CRBA | `crba_upper(q)`: upper triangle of M (`crba` mirrors it too) | `crba(q)` (LOCAL): upper triangle of `data.M` | "
         "`mj_kinematics`, `mj_comPos`, `mj_crb`: sparse M |",
         "| ABA | `aba(q, v, tau)` | `aba(q, v, tau)` (LOCAL) | forward dynamics without ABA: `mj_kinematics`, "
         "`mj_comPos`, `mj_crb`, `mj_factorM`, `mj_comVel`, `mj_rne(flg_acc = 0)`, `mj_solveM(tau − bias)` |",
