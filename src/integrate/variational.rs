@@ -32,7 +32,8 @@
 //!
 //! Newton: the chord method with the matrix C = M(q_k) + h/2 diag(damping) (its tree-sparse LᵀDL
 //! factor) for ξ, and the Schur complement h J(q_{k+1}) C⁻¹ J(q_k)ᵀ for λ, from the predictor
-//! ξ = 2 v_k − ξ_{k−1}, with Anderson acceleration (without equality rows); iterated until the
+//! ξ = 2 v_k − ξ_{k−1} + (2 e_{k−1} − e_{k−2}) (below), with Anderson acceleration (without
+//! equality rows); iterated until the
 //! residual of the momentum balance is at round-off (`StepReport::solver_iterations` counts the
 //! iterations). A step whose iteration does not converge is not taken: the state is left as it
 //! was and [`Stepper::failure`] says why (the simulation returns a `SimError`).
@@ -137,15 +138,24 @@ pub struct Variational {
     has_equalities: bool,
     failure: Option<StepFailure>,
     residual_tol: f64,
-    /// The last step's ξ and end configuration (for the predictor).
+    /// The last step's ξ, end configuration, end velocity and step (for the predictor).
     last_xi: DVector<f64>,
     last_q1: DVector<f64>,
+    last_v1: DVector<f64>,
+    last_h: f64,
     last_valid: bool,
+    /// The predictor's base 2 v_k − ξ_{k−1} of this step, and the errors e = ξ − base of the
+    /// last two steps (`errors` of them valid: steps that continued each other at the same h).
+    base: DVector<f64>,
+    error1: DVector<f64>,
+    error2: DVector<f64>,
+    errors: usize,
     anderson: Anderson,
 }
 
-/// Depth of the Anderson acceleration of the chord iteration.
-const ANDERSON_DEPTH: usize = 3;
+/// Depth of the Anderson acceleration of the chord iteration (on chain30, depth 3 → 5 saves
+/// ~0.5 iterations per step; more saves nothing).
+const ANDERSON_DEPTH: usize = 5;
 
 /// Anderson acceleration (type II; Walker & Ni, *Anderson acceleration for fixed-point
 /// iterations*, SIAM J. Numer. Anal. 49, 2011) of the chord iteration x ← x + f(x),
@@ -158,6 +168,8 @@ struct Anderson {
     f_prev: DVector<f64>,
     dx: [DVector<f64>; ANDERSON_DEPTH],
     df: [DVector<f64>; ANDERSON_DEPTH],
+    /// The Gram matrix df_i · df_j of the stored differences (column-major, updated by slot).
+    gram: [f64; ANDERSON_DEPTH * ANDERSON_DEPTH],
     /// Differences stored (≤ depth) and the slot of the next one.
     count: usize,
     next: usize,
@@ -170,8 +182,9 @@ impl Anderson {
         Self {
             x_prev: z(),
             f_prev: z(),
-            dx: [z(), z(), z()],
-            df: [z(), z(), z()],
+            dx: std::array::from_fn(|_| z()),
+            df: std::array::from_fn(|_| z()),
+            gram: [0.0; ANDERSON_DEPTH * ANDERSON_DEPTH],
             count: 0,
             next: 0,
             started: false,
@@ -194,6 +207,12 @@ impl Anderson {
             self.df[slot] -= &self.f_prev;
             self.next = (slot + 1) % ANDERSON_DEPTH;
             self.count = (self.count + 1).min(ANDERSON_DEPTH);
+            // Only the new difference's row and column of the Gram matrix change.
+            for j in 0..self.count {
+                let g = self.df[slot].dot(&self.df[j]);
+                self.gram[slot + j * ANDERSON_DEPTH] = g;
+                self.gram[j + slot * ANDERSON_DEPTH] = g;
+            }
         }
         self.x_prev.copy_from(x);
         self.f_prev.copy_from(f);
@@ -201,12 +220,9 @@ impl Anderson {
         let mk = self.count;
         let mut gamma = [0.0; ANDERSON_DEPTH];
         if mk > 0 {
-            let mut normal = [0.0; ANDERSON_DEPTH * ANDERSON_DEPTH];
+            let mut normal = self.gram;
             for i in 0..mk {
                 gamma[i] = self.df[i].dot(f);
-                for j in 0..mk {
-                    normal[i + j * ANDERSON_DEPTH] = self.df[i].dot(&self.df[j]);
-                }
             }
             guarded_lu_solve(&mut normal, mk, ANDERSON_DEPTH, &mut gamma[..mk]);
             if gamma[..mk].iter().any(|g| !g.is_finite()) {
@@ -255,7 +271,13 @@ impl Variational {
             residual_tol: RESIDUAL_TOL,
             last_xi: z(),
             last_q1: DVector::zeros(nq),
+            last_v1: z(),
+            last_h: 0.0,
             last_valid: false,
+            base: z(),
+            error1: z(),
+            error2: z(),
+            errors: 0,
             anderson: Anderson::new(nv),
         }
     }
@@ -339,10 +361,28 @@ impl Stepper for Variational {
         }
         self.lambda.fill(0.0);
 
-        // Predictor: ξ ≈ v_k + h/2 a ≈ 2 v_k − ξ_{k−1} when this step continues the last one.
+        // Predictor: ξ ≈ v_k + h/2 a ≈ 2 v_k − ξ_{k−1} when this step continues the last one
+        // (exact for a constant M and forces of q alone: M ξ_{k−1} = p_k − h/2 F(q_k),
+        // M ξ_k = p_k + h/2 F(q_k)). Its error e_k = ξ_k − (2 v_k − ξ_{k−1}), from the
+        // velocity-dependent terms, is O(h²) and smooth along the trajectory, so it is
+        // extrapolated linearly from the last two steps when they continued each other at the
+        // same h with the velocity this stepper left (error O(h⁴)): on chain30, 11.7 → 10.2
+        // iterations per step at round-off, 7.7 → 6.2 at 1e-10.
         self.xi.copy_from(&state.v);
-        if self.last_valid && self.last_q1 == state.q {
+        let continuing = self.last_valid && self.last_q1 == state.q;
+        if !(continuing && self.last_v1 == state.v && self.last_h == h) {
+            self.errors = 0;
+        }
+        if continuing {
             self.xi.axpy(-1.0, &self.last_xi, 2.0);
+            self.base.copy_from(&self.xi);
+            if self.errors >= 1 {
+                self.xi += &self.error1;
+            }
+            if self.errors >= 2 {
+                self.xi += &self.error1;
+                self.xi -= &self.error2;
+            }
         }
         self.anderson.reset();
         let mut previous = f64::INFINITY;
@@ -457,8 +497,15 @@ impl Stepper for Variational {
             }
             previous = residual;
         }
+        if continuing {
+            std::mem::swap(&mut self.error1, &mut self.error2);
+            self.error1.copy_from(&self.xi);
+            self.error1 -= &self.base;
+            self.errors = (self.errors + 1).min(2);
+        }
         self.last_xi.copy_from(&self.xi);
         self.last_q1.copy_from(&self.q1);
+        self.last_h = h;
         self.last_valid = true;
         // p_{k+1} = h/2 [∂_qL(q_{k+1}, ξ) + passive(q_{k+1}, ξ) + drive] + J_r⁻¹(−hξ) μ̄.
         passive(model, data, self.q1.as_slice(), self.xi.as_slice());
@@ -524,6 +571,7 @@ impl Stepper for Variational {
                 || plan.constraints.has_collision());
         let (extra_iterations, violation) =
             if others { correct_drift(model, plan, data, state, h) } else { (0, [phi_max, jv_max]) };
+        self.last_v1.copy_from(&state.v);
         StepReport::fixed_step(h, (iterations + extra_iterations, violation))
     }
 }
