@@ -50,7 +50,7 @@ use super::{correct_drift, State, StepFailure, StepReport, Stepper};
 use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
 use crate::forward::{actuation, advance_activations, passive, Plan};
 use crate::kinematics::forward_kinematics;
-use crate::model::{dexp_inv_configuration, integrate_configuration, Data, EfcType, Model};
+use crate::model::{dexp_inv_configuration, integrate_configuration, Data, EfcType, JointKind, Model};
 use nalgebra::{DMatrix, DVector};
 
 /// Newton stops when the residual of the DEL equations is below this relative to the momentum
@@ -136,6 +136,8 @@ pub struct Variational {
     lambda: DVector<f64>,
     dlambda: DVector<f64>,
     has_equalities: bool,
+    /// Whether the model has ball or free joints (J_r⁻¹ ≠ 1); otherwise `dexp_inv` is skipped.
+    has_rotations: bool,
     failure: Option<StepFailure>,
     residual_tol: f64,
     /// The last step's ξ, end configuration, end velocity and step (for the predictor).
@@ -267,6 +269,7 @@ impl Variational {
             lambda: DVector::zeros(rows),
             dlambda: DVector::zeros(rows),
             has_equalities: rows > 0,
+            has_rotations: model.joints.iter().any(|j| matches!(j.kind, JointKind::Free | JointKind::Ball)),
             failure: None,
             residual_tol: RESIDUAL_TOL,
             last_xi: z(),
@@ -386,6 +389,10 @@ impl Stepper for Variational {
         }
         self.anderson.reset();
         let mut previous = f64::INFINITY;
+        // The parts of the convergence scales that are fixed over the step: max |p_k|, the
+        // impulse of gravity at q_k and of the drive, max |v_k|.
+        let mut fixed_scales = (0.0, 0.0);
+        let v_scale = state.v.amax();
         let mut iterations = 0;
         let mut phi_max = 0.0;
         loop {
@@ -403,12 +410,16 @@ impl Stepper for Variational {
                 self.mu_bar[k] = 0.5 * (self.terms0.momentum_gen[k] + self.terms1.momentum_gen[k]);
                 self.theta[k] = h * self.xi[k];
             }
-            dexp_inv_configuration(
-                model,
-                self.theta.as_slice(),
-                self.mu_bar.as_slice(),
-                self.tmp.as_mut_slice(),
-            );
+            if self.has_rotations {
+                dexp_inv_configuration(
+                    model,
+                    self.theta.as_slice(),
+                    self.mu_bar.as_slice(),
+                    self.tmp.as_mut_slice(),
+                );
+            } else {
+                self.tmp.copy_from(&self.mu_bar);
+            }
             let t0 = &self.terms0;
             for k in 0..nv {
                 let mut r = self.p_k[k]
@@ -455,10 +466,13 @@ impl Stepper for Variational {
             let residual = self.residual.amax();
             // The momentum scale: the momenta and the impulse of the forces over the step (so
             // that a state at rest under round-off forces converges too).
-            let impulse =
-                0.5 * h * (self.terms0.gravity_gen.amax() + data.qfrc_passive.amax() + self.drive.amax());
-            let p_scale = self.p_k.amax().max(self.tmp.amax()).max(impulse);
-            let scale = self.xi.amax().max(state.v.amax());
+            if iterations == 1 {
+                fixed_scales =
+                    (self.p_k.amax(), 0.5 * h * (self.terms0.gravity_gen.amax() + self.drive.amax()));
+            }
+            let impulse = fixed_scales.1 + 0.5 * h * data.qfrc_passive.amax();
+            let p_scale = fixed_scales.0.max(self.tmp.amax()).max(impulse);
+            let scale = self.xi.amax().max(v_scale);
             let finite = self.residual.iter().chain(self.dxi.iter()).all(|x| x.is_finite());
             let converged = finite
                 && (residual <= self.residual_tol * p_scale
@@ -510,7 +524,16 @@ impl Stepper for Variational {
         // p_{k+1} = h/2 [∂_qL(q_{k+1}, ξ) + passive(q_{k+1}, ξ) + drive] + J_r⁻¹(−hξ) μ̄.
         passive(model, data, self.q1.as_slice(), self.xi.as_slice());
         self.theta.neg_mut();
-        dexp_inv_configuration(model, self.theta.as_slice(), self.mu_bar.as_slice(), self.tmp.as_mut_slice());
+        if self.has_rotations {
+            dexp_inv_configuration(
+                model,
+                self.theta.as_slice(),
+                self.mu_bar.as_slice(),
+                self.tmp.as_mut_slice(),
+            );
+        } else {
+            self.tmp.copy_from(&self.mu_bar);
+        }
         let t1 = &self.terms1;
         for k in 0..nv {
             self.residual[k] =
