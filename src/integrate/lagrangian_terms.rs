@@ -12,7 +12,11 @@
 //!   joints (their translation columns turn with the body) and 0 otherwise; every descendant's
 //!   velocity changes by the same motion carried to it. So ∂T/∂q_k = H_c · δV_c with H_c the
 //!   subtree momentum in c's coordinates;
-//! - the generalized gravity g(q) = ∂V/∂q = RNEA(q, 0, 0) (the world accelerating upwards).
+//! - the generalized gravity g(q) = ∂V/∂q = RNEA(q, 0, 0) (the world accelerating upwards),
+//!   which needs of each subtree only its mass m and first moment c (= m × centre of mass) in the
+//!   joint's body frame: the subtree's gravity wrench there is (c × a, m a) with a the body-frame
+//!   upward acceleration, and c carries to the parent as R c + m p (RBDA eq. 2.66's first-moment
+//!   part), 3-vectors where the spatial recursion moves 6-vectors and inertias.
 //!
 //! ξ is a velocity in the model's v layout (body-frame angular velocity for ball and free joints,
 //! parent-frame linear velocity for free joints).
@@ -29,9 +33,12 @@ pub struct LagrangianTerms {
     s_body: Vec<Motion>,
     v_joint: Vec<Motion>,
     v_body: Vec<Motion>,
-    a_gravity: Vec<Motion>,
+    /// The world's upward acceleration −g in each body's frame.
+    a_gravity: Vec<Vec3>,
     momentum: Vec<Force>,
-    gravity_wrench: Vec<Force>,
+    /// Subtree masses and first moments (body frame).
+    subtree_mass: Vec<f64>,
+    subtree_moment: Vec<Vec3>,
     /// M(q) ξ.
     pub momentum_gen: DVector<f64>,
     /// ∂T/∂q (q, ξ), right-trivialized.
@@ -48,9 +55,10 @@ impl LagrangianTerms {
             s_body: vec![Motion::zero(); model.nv],
             v_joint: vec![Motion::zero(); nb],
             v_body: vec![Motion::zero(); nb],
-            a_gravity: vec![Motion::zero(); nb],
+            a_gravity: vec![Vec3::zeros(); nb],
             momentum: vec![Force::zero(); nb],
-            gravity_wrench: vec![Force::zero(); nb],
+            subtree_mass: vec![0.0; nb],
+            subtree_moment: vec![Vec3::zeros(); nb],
             momentum_gen: DVector::zeros(model.nv),
             dkinetic_dq: DVector::zeros(model.nv),
             gravity_gen: DVector::zeros(model.nv),
@@ -80,7 +88,7 @@ impl LagrangianTerms {
     fn pass(&mut self, model: &Model, xi: &[f64], with_gravity: bool) {
         let nb = model.nbody();
         self.v_body[0] = Motion::zero();
-        self.a_gravity[0] = Motion::new(Vec3::zeros(), -model.gravity);
+        self.a_gravity[0] = -model.gravity;
         for b in 1..nb {
             let p = model.bodies[b].parent;
             let x = &self.x_parent_body[b];
@@ -93,9 +101,9 @@ impl LagrangianTerms {
             let inertia = &model.bodies[b].inertia;
             self.momentum[b] = inertia.mul_motion(&v_b);
             if with_gravity {
-                let a_b = x.inv_act_motion(&self.a_gravity[p]);
-                self.gravity_wrench[b] = inertia.mul_motion(&a_b);
-                self.a_gravity[b] = a_b;
+                self.a_gravity[b] = x.rot.tr_mul(&self.a_gravity[p]);
+                self.subtree_mass[b] = inertia.mass;
+                self.subtree_moment[b] = inertia.h;
             }
             self.v_joint[b] = v_j;
             self.v_body[b] = v_b;
@@ -116,7 +124,8 @@ impl LagrangianTerms {
                 self.dkinetic_dq[k] = dv.dot(&h_c);
             }
             if with_gravity {
-                let g_c = self.gravity_wrench[b];
+                let a = self.a_gravity[b];
+                let g_c = Force { ang: self.subtree_moment[b].cross(&a), lin: a * self.subtree_mass[b] };
                 for k in j.dof_adr..j.dof_adr + j.kind.nv() {
                     self.gravity_gen[k] = self.s_body[k].dot(&g_c);
                 }
@@ -126,8 +135,9 @@ impl LagrangianTerms {
                 let x = &self.x_parent_body[b];
                 self.momentum[p] += x.act_force(&h_c);
                 if with_gravity {
-                    let gp = x.act_force(&self.gravity_wrench[b]);
-                    self.gravity_wrench[p] += gp;
+                    let (m, c) = (self.subtree_mass[b], self.subtree_moment[b]);
+                    self.subtree_moment[p] += x.rot * c + x.pos * m;
+                    self.subtree_mass[p] += m;
                 }
             }
         }
