@@ -202,11 +202,14 @@ mod tests {
     #[test]
     fn upper_triangle_is_crbas() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-        let model =
-            load(&root.join("models/solo12/solo12.urdf"), &LoadOptions { floating: true, ..Default::default() })
-                .unwrap();
+        let model = load(
+            &root.join("models/solo12/solo12.urdf"),
+            &LoadOptions { floating: true, ..Default::default() },
+        )
+        .unwrap();
         let mut data = Data::new(&model);
-        let q: Vec<f64> = model.neutral().iter().enumerate().map(|(i, x)| x + 0.2 * (i as f64).cos()).collect();
+        let q: Vec<f64> =
+            model.neutral().iter().enumerate().map(|(i, x)| x + 0.2 * (i as f64).cos()).collect();
         let full = crba(&model, &mut data, &q).clone();
         data.mass_matrix.fill(7.0);
         let upper = crba_upper(&model, &mut data, &q);
