@@ -6,6 +6,7 @@ use crate::model::{Data, JointKind, Model, NO_DOF};
 #[cfg(target_arch = "x86_64")]
 use crate::spatial::fused::Fused;
 use crate::spatial::fused::{self, MulAdd, Separate};
+use crate::spatial::{Mat3, Transform};
 use nalgebra::{DMatrix, DVector};
 
 /// Joint-space inertia matrix M(q), armature included, into `data.mass_matrix` (and returned).
@@ -71,6 +72,15 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
         data.i_composite[b] = fused::transformed::<A>(&model.bodies[b].inertia, &x_world_body);
     }
     let nv = model.nv;
+    // A floating base (a free joint on the world, numbered first, with an unrotated placement):
+    // its six columns are (0, eᵢ) and (R eᵢ, p × R eᵢ) in world coordinates (R, p its pose), so
+    // the six entries of a descendant's F are F_lin and Rᵀ (F_ang − p × F_lin), the moment about
+    // the base origin in base axes: one block instead of six products along the chain.
+    let floating_base = matches!(model.joints.first(), Some(j) if matches!(j.kind, JointKind::Free)
+        && j.dof_adr == 0
+        && model.bodies[1].parent == 0
+        && model.bodies[1].x_parent_joint.rot == Mat3::identity());
+    let x_world_base = if floating_base { data.x_world_body[1] } else { Transform::identity() };
     // Only the entries (k, l) of l on the ancestor chain of k (and their mirror) are written: the
     // others are zero from `Data::new` and never change (RBDA §6.3, the tree's sparsity).
     let m = data.mass_matrix.as_mut_slice();
@@ -88,6 +98,19 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
             col_k[k] = fused::dot::<A>(&s_world[k], &f_world) + model.dof_armature[k];
             let mut l = dof_parent[k];
             while l != NO_DOF {
+                if floating_base && l == 5 {
+                    let moment = fused::cross_add::<A>(&f_world.lin, &x_world_base.pos, &f_world.ang);
+                    let base_axes = fused::mat_tr_vec::<A>(&x_world_base.rot, &moment);
+                    let entries =
+                        [f_world.lin.x, f_world.lin.y, f_world.lin.z, base_axes.x, base_axes.y, base_axes.z];
+                    col_k[..6].copy_from_slice(&entries);
+                    if MIRROR {
+                        for (i, m_ki) in entries.iter().enumerate() {
+                            before[k + i * nv] = *m_ki;
+                        }
+                    }
+                    break;
+                }
                 let m_lk = fused::dot::<A>(&s_world[l], &f_world);
                 col_k[l] = m_lk;
                 if MIRROR {

@@ -49,6 +49,13 @@ pub fn mat_vec<A: MulAdd>(r: &Mat3, v: &Vec3) -> Vec3 {
     Vec3::new(row(0), row(1), row(2))
 }
 
+/// `rᵀ v`.
+#[inline(always)]
+pub fn mat_tr_vec<A: MulAdd>(r: &Mat3, v: &Vec3) -> Vec3 {
+    let col = |j: usize| A::madd(r[(2, j)], v.z, A::madd(r[(1, j)], v.y, r[(0, j)] * v.x));
+    Vec3::new(col(0), col(1), col(2))
+}
+
 /// `r v + c`.
 #[inline(always)]
 fn mat_vec_add<A: MulAdd>(r: &Mat3, v: &Vec3, c: &Vec3) -> Vec3 {
@@ -58,7 +65,7 @@ fn mat_vec_add<A: MulAdd>(r: &Mat3, v: &Vec3, c: &Vec3) -> Vec3 {
 
 /// `a × b + c`.
 #[inline(always)]
-fn cross_add<A: MulAdd>(a: &Vec3, b: &Vec3, c: &Vec3) -> Vec3 {
+pub fn cross_add<A: MulAdd>(a: &Vec3, b: &Vec3, c: &Vec3) -> Vec3 {
     Vec3::new(
         A::madd(a.y, b.z, A::madd(-a.z, b.y, c.x)),
         A::madd(a.z, b.x, A::madd(-a.x, b.z, c.y)),
