@@ -57,6 +57,9 @@ fn aba_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], tau: &[f64])
         let p_a = data.f_body[b];
         let mut i_handed = i_a;
         let mut p_handed = p_a;
+        // A body on the world hands nothing on: only D⁻¹, U and u are needed (pass 3).
+        let p = model.bodies[b].parent;
+        let hands_on = p != 0;
         if nv_j == 1 {
             let u_col = i_a.mul_motion(&data.s_body[da]);
             let d = data.s_body[da].dot(&u_col) + model.dof_armature[da];
@@ -65,8 +68,10 @@ fn aba_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], tau: &[f64])
             data.u_dof[da] = u_col;
             data.u_tau[da] = u;
             data.d_inv[b][(0, 0)] = d_inv;
-            i_handed.sub_rank_one(&u_col, d_inv);
-            p_handed += u_col * (d_inv * u);
+            if hands_on {
+                i_handed.sub_rank_one(&u_col, d_inv);
+                p_handed += u_col * (d_inv * u);
+            }
         } else {
             let mut d = Matrix6::<f64>::identity();
             for k in 0..nv_j {
@@ -82,7 +87,7 @@ fn aba_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], tau: &[f64])
             // D is embedded in an identity so that the fixed-size inverse holds D⁻¹ top-left.
             let d_inv = d.try_inverse().unwrap_or_else(|| Matrix6::from_element(f64::NAN));
             data.d_inv[b] = d_inv;
-            for k in 0..nv_j {
+            for k in 0..if hands_on { nv_j } else { 0 } {
                 let mut coeff_u = 0.0;
                 for l in 0..nv_j {
                     i_handed.sub_outer(&data.u_dof[da + k], &data.u_dof[da + l], d_inv[(k, l)]);
@@ -91,8 +96,7 @@ fn aba_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], tau: &[f64])
                 p_handed += data.u_dof[da + k] * coeff_u;
             }
         }
-        let p = model.bodies[b].parent;
-        if p != 0 {
+        if hands_on {
             p_handed += i_handed.mul_motion(&data.c_body[b]);
             let x = data.x_parent_body[b];
             let mut target = data.i_articulated[p];
