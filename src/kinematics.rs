@@ -242,25 +242,17 @@ pub fn frame_velocity(model: &Model, data: &Data, frame: usize, reference: Refer
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::{load, LoadOptions};
 
     /// The fused (FMA3) build of forward kinematics gives the body and frame poses of the separate
     /// multiply–adds to round-off (cross-check tolerance).
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn fma_kernel_matches_separate_multiply_adds() {
-        if !(std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")) {
-            eprintln!("skipped: this CPU has no AVX2+FMA, the FMA kernel is never used here");
+        if !crate::kernel_test_states::fma_available() {
             return;
         }
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-        for (file, floating) in [("models/panda/panda.urdf", false), ("models/solo12/solo12.urdf", true)] {
-            let model = load(&root.join(file), &LoadOptions { floating, ..Default::default() }).unwrap();
+        for (file, model, q) in crate::kernel_test_states::robots() {
             let mut data = Data::new(&model);
-            let mut q = model.neutral();
-            for (i, x) in q.iter_mut().enumerate() {
-                *x += 0.1 + 0.37 * (i as f64).sin();
-            }
             forward_kinematics_with::<Separate>(&model, &mut data, &q);
             let (bodies, frames) = (data.x_world_body.clone(), data.x_world_frame.clone());
             // SAFETY: AVX2 and FMA are present (checked above).

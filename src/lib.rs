@@ -18,6 +18,8 @@ pub mod dynamics;
 pub mod forward;
 pub mod integrate;
 pub mod io;
+#[cfg(test)]
+mod kernel_test_states;
 pub mod kinematics;
 pub mod mass;
 pub mod model;

@@ -145,7 +145,6 @@ impl ArticulatedInertia {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::{load, LoadOptions};
 
     /// The AVX2 build of the kernel gives q̈ bit for bit (no fused multiply–add, no reordering).
     #[test]
@@ -155,14 +154,8 @@ mod tests {
             eprintln!("skipped: this CPU has no AVX2, the AVX2 kernel is never used here");
             return;
         }
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-        for (file, floating) in [("models/panda/panda.urdf", false), ("models/solo12/solo12.urdf", true)] {
-            let model = load(&root.join(file), &LoadOptions { floating, ..Default::default() }).unwrap();
+        for (file, model, q) in crate::kernel_test_states::robots() {
             let mut data = Data::new(&model);
-            let mut q = model.neutral();
-            for (i, x) in q.iter_mut().enumerate() {
-                *x += 0.1 + 0.37 * (i as f64).sin();
-            }
             let v: Vec<f64> = (0..model.nv).map(|k| 0.5 * (k as f64).cos()).collect();
             let tau: Vec<f64> = (0..model.nv).map(|k| 0.3 - 0.1 * k as f64).collect();
             aba_kernel(&model, &mut data, &q, &v, &tau);

@@ -253,18 +253,11 @@ mod tests {
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn fma_kernel_matches_separate_multiply_adds() {
-        if !(std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")) {
-            eprintln!("skipped: this CPU has no AVX2+FMA, the FMA kernel is never used here");
+        if !crate::kernel_test_states::fma_available() {
             return;
         }
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-        for (file, floating) in [("models/panda/panda.urdf", false), ("models/solo12/solo12.urdf", true)] {
-            let model = load(&root.join(file), &LoadOptions { floating, ..Default::default() }).unwrap();
+        for (file, model, q) in crate::kernel_test_states::robots() {
             let mut data = Data::new(&model);
-            let mut q = model.neutral();
-            for (i, x) in q.iter_mut().enumerate() {
-                *x += 0.1 + 0.37 * (i as f64).sin();
-            }
             crba_kernel::<Separate, true>(&model, &mut data, &q);
             let baseline = data.mass_matrix.clone();
             data.mass_matrix.fill(0.0);

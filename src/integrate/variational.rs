@@ -296,6 +296,20 @@ impl Variational {
         Self { residual_tol: tol.max(RESIDUAL_TOL), ..Self::new(model) }
     }
 
+    /// `tmp` = J_r⁻¹(θ) μ̄ (`theta`, `mu_bar`): the identity on models without ball or free joints.
+    fn dexp_inv_mu_bar(&mut self, model: &Model) {
+        if self.has_rotations {
+            dexp_inv_configuration(
+                model,
+                self.theta.as_slice(),
+                self.mu_bar.as_slice(),
+                self.tmp.as_mut_slice(),
+            );
+        } else {
+            self.tmp.copy_from(&self.mu_bar);
+        }
+    }
+
     /// M(q) and its factor, reused when q is the configuration of the last call.
     fn ensure_mass(&mut self, model: &Model, data: &mut Data, q: &DVector<f64>) {
         if self.mass_valid && self.mass_q == *q {
@@ -414,16 +428,7 @@ impl Stepper for Variational {
                 self.mu_bar[k] = 0.5 * (self.terms0.momentum_gen[k] + self.terms1.momentum_gen[k]);
                 self.theta[k] = h * self.xi[k];
             }
-            if self.has_rotations {
-                dexp_inv_configuration(
-                    model,
-                    self.theta.as_slice(),
-                    self.mu_bar.as_slice(),
-                    self.tmp.as_mut_slice(),
-                );
-            } else {
-                self.tmp.copy_from(&self.mu_bar);
-            }
+            self.dexp_inv_mu_bar(model);
             let t0 = &self.terms0;
             for k in 0..nv {
                 let mut r = self.p_k[k]
@@ -528,16 +533,7 @@ impl Stepper for Variational {
         // p_{k+1} = h/2 [∂_qL(q_{k+1}, ξ) + passive(q_{k+1}, ξ) + drive] + J_r⁻¹(−hξ) μ̄.
         passive(model, data, self.q1.as_slice(), self.xi.as_slice());
         self.theta.neg_mut();
-        if self.has_rotations {
-            dexp_inv_configuration(
-                model,
-                self.theta.as_slice(),
-                self.mu_bar.as_slice(),
-                self.tmp.as_mut_slice(),
-            );
-        } else {
-            self.tmp.copy_from(&self.mu_bar);
-        }
+        self.dexp_inv_mu_bar(model);
         let t1 = &self.terms1;
         for k in 0..nv {
             self.residual[k] =
