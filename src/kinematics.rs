@@ -41,8 +41,8 @@ pub(crate) fn update_joint(model: &Model, data: &mut Data, b: usize, q: &[f64]) 
 /// revolute row). About a principal axis ±x, ±y, ±z only two columns of `R_pj` turn (12
 /// products); any other axis goes through Rodrigues' formula R = I + s[a]× + (1 − c)[a]×².
 /// Sine and cosine come from the `libm` crate's `sincos` (musl's kernels, one range reduction
-/// for both, < 1 ulp): compiled into the caller, it takes ~40% fewer instructions than the
-/// system library's call, a measurable share of CRBA and FK on hinge chains.
+/// for both, < 1 ulp), compiled into lagrange: ~40% fewer instructions than the system library's
+/// call, a measurable share of CRBA and FK on hinge chains.
 #[inline(always)]
 pub(crate) fn revolute_placement(x_pj: &Transform, axis: &Vec3, angle: f64) -> Transform {
     let (s, c) = libm::sincos(angle);
