@@ -461,6 +461,21 @@ fn equality_on_a_spatial_tendon_is_listed_with_a_warning() {
     assert!(m.warnings.iter().any(|w| w.contains("spatial tendon") && w.contains("'e'")), "{:?}", m.warnings);
 }
 
+/// Tendon stiffness, damping, frictionloss and armature are not simulated: a nonzero value is a
+/// warning naming file, line, tendon and attribute (never silently dropped); zeros say nothing.
+#[test]
+fn unsimulated_tendon_terms_are_warnings() {
+    let m = compile_mjcf(&model_with(
+        "",
+        r#"  <tendon><fixed name="u" stiffness="10" damping="0" frictionloss="0.5 "><joint joint="hinge" coef="1"/></fixed></tendon>"#,
+    ))
+    .unwrap();
+    let about_u: Vec<&String> = m.warnings.iter().filter(|w| w.contains("'u'")).collect();
+    assert_eq!(about_u.len(), 2, "{:?}", m.warnings);
+    assert!(about_u[0].contains("inline.xml:") && about_u[0].contains("stiffness=\"10\" is not simulated"));
+    assert!(about_u[1].contains("frictionloss=\"0.5\"") && about_u[1].contains("friction_tendon"));
+}
+
 #[test]
 fn tendon_errors() {
     let tendon = |body: &str| format!("  <tendon>\n    {body}\n  </tendon>");

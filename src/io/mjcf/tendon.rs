@@ -64,6 +64,26 @@ pub(crate) fn tendons(
                     .collect();
                 TendonSpecKind::Spatial { path }
             };
+            // MuJoCo's passive tendon terms and tendon friction/armature: not simulated yet, so a
+            // nonzero value is said, never silently dropped.
+            for (attr, what) in [
+                ("stiffness", "a spring along the tendon (qfrc_passive)"),
+                ("damping", "a damper along the tendon (qfrc_passive)"),
+                ("frictionloss", "a dry-friction row on the tendon (friction_tendon)"),
+                ("armature", "an inertia added along the tendon to M"),
+            ] {
+                if let Some(values) = a.numbers(attr)? {
+                    if values.iter().any(|&x| x != 0.0) {
+                        let shown: Vec<String> = values.iter().map(f64::to_string).collect();
+                        warnings.push(format!(
+                            "{}: <{}> '{name}': {attr}=\"{}\" is not simulated (MuJoCo applies {what}); lagrange's motion will differ from MuJoCo's",
+                            e.loc,
+                            e.tag,
+                            shown.join(" ")
+                        ));
+                    }
+                }
+            }
             let range = a.limited_range("limited", "range", autolimits, warnings)?;
             let soft = super::body::soft_params(&a)?;
             let actuator_force_range =
