@@ -219,31 +219,24 @@ pub fn solve_with_factor(model: &Model, factor: &DMatrix<f64>, x: &mut [f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::{load, LoadOptions};
 
     /// `crba_upper` writes exactly `crba`'s upper triangle and leaves the lower one alone.
     #[test]
     fn upper_triangle_is_crbas() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-        let model = load(
-            &root.join("models/solo12/solo12.urdf"),
-            &LoadOptions { floating: true, ..Default::default() },
-        )
-        .unwrap();
-        let mut data = Data::new(&model);
-        let q: Vec<f64> =
-            model.neutral().iter().enumerate().map(|(i, x)| x + 0.2 * (i as f64).cos()).collect();
-        let full = crba(&model, &mut data, &q).clone();
-        data.mass_matrix.fill(7.0);
-        let upper = crba_upper(&model, &mut data, &q);
-        for k in 0..model.nv {
-            let mut chain = vec![k];
-            while let Some(&l) = chain.last().filter(|&&l| model.dof_parent[l] != NO_DOF) {
-                chain.push(model.dof_parent[l]);
-            }
-            for l in 0..model.nv {
-                let want = if chain.contains(&l) { full[(l, k)] } else { 7.0 };
-                assert_eq!(upper[(l, k)].to_bits(), want.to_bits(), "({l}, {k})");
+        for (file, model, q) in crate::kernel_test_states::robots() {
+            let mut data = Data::new(&model);
+            let full = crba(&model, &mut data, &q).clone();
+            data.mass_matrix.fill(7.0);
+            let upper = crba_upper(&model, &mut data, &q);
+            for k in 0..model.nv {
+                let mut chain = vec![k];
+                while let Some(&l) = chain.last().filter(|&&l| model.dof_parent[l] != NO_DOF) {
+                    chain.push(model.dof_parent[l]);
+                }
+                for l in 0..model.nv {
+                    let want = if chain.contains(&l) { full[(l, k)] } else { 7.0 };
+                    assert_eq!(upper[(l, k)].to_bits(), want.to_bits(), "{file} ({l}, {k})");
+                }
             }
         }
     }

@@ -57,25 +57,10 @@ impl RigidInertia {
     /// 10 parameters); with [a]×[b]× = b aᵀ − (a·b) 1 the shift is
     /// −p h'ᵀ − h' pᵀ − m p pᵀ + (2 h'·p + m p·p) 1, and only the 6 entries of the symmetric
     /// result are computed.
-    #[inline(always)]
+    /// One formula with the kernels' ([`super::fused::transformed`], separate multiply–adds).
+    #[inline]
     pub fn transformed(&self, x_a_b: &Transform) -> RigidInertia {
-        let r = &x_a_b.rot;
-        let p = &x_a_b.pos;
-        let m = self.mass;
-        let h = r * self.h;
-        // T = R I (I symmetric); (R I Rᵀ)(i, j) = row i of T · row j of R.
-        let t = r * self.i_origin;
-        let diag = 2.0 * h.dot(p) + m * p.dot(p);
-        let entry = |i: usize, j: usize| {
-            t[(i, 0)] * r[(j, 0)] + t[(i, 1)] * r[(j, 1)] + t[(i, 2)] * r[(j, 2)]
-                - p[i] * h[j]
-                - h[i] * p[j]
-                - m * p[i] * p[j]
-        };
-        let (xx, yy, zz) = (entry(0, 0) + diag, entry(1, 1) + diag, entry(2, 2) + diag);
-        let (xy, xz, yz) = (entry(0, 1), entry(0, 2), entry(1, 2));
-        let i_origin = Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
-        RigidInertia { mass: m, h: h + p * m, i_origin }
+        super::fused::transformed::<super::fused::Separate>(self, x_a_b)
     }
     /// The same body with its density multiplied by `s` (mass, first moment and inertia scale
     /// together; the centre of mass stays).

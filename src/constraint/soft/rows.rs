@@ -75,8 +75,7 @@ fn row_bound(cm: &ConstraintModel, model: &Model, data: &Data) -> usize {
         .map(|e| model.equalities[e.id].kind.nrow())
         .sum();
     let contacts: usize = data.contacts.iter().map(|c| 2 * (c.condim.clamp(1, 6) as usize)).sum();
-    let tendons = 2 * model.tendons.iter().filter(|t| t.range.is_some()).count();
-    eq + cm.friction.len() + 2 * cm.limits.len() + tendons + contacts
+    eq + cm.friction.len() + 2 * cm.limits.len() + 2 * cm.tendon_limits.len() + contacts
 }
 
 /// Writes the soft rows at configuration `q` (body poses and motion subspaces at q, and
@@ -141,18 +140,18 @@ pub fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &
             r += 1;
         }
     }
-    if model.options.flags.limit {
-        r = tendon_limit_rows(model, data, q, r);
-    }
+    r = tendon_limit_rows(model, &cm.tendon_limits, data, q, r);
     data.nefc = contact_rows(model, data, r, cone);
     data.ne = ne;
     data.nf = nf;
 }
 
-/// The limit rows of fixed tendons from row `r` on (MuJoCo's `mj_instantiateLimit`: a row per
-/// bound closer than the tendon's margin, J = ±∂L/∂q); returns the next free row.
-fn tendon_limit_rows(model: &Model, data: &mut Data, q: &[f64], mut r: usize) -> usize {
-    for (t, tendon) in model.tendons.iter().enumerate() {
+/// The limit rows of the limited fixed tendons `tendons` (`ConstraintModel::tendon_limits`) from
+/// row `r` on (MuJoCo's `mj_instantiateLimit`: a row per bound closer than the tendon's margin,
+/// J = ±∂L/∂q); returns the next free row.
+fn tendon_limit_rows(model: &Model, tendons: &[usize], data: &mut Data, q: &[f64], mut r: usize) -> usize {
+    for &t in tendons {
+        let tendon = &model.tendons[t];
         let TendonKind::Fixed { joints } = &tendon.kind else { continue };
         for (dist, sign) in tendon_limit_sides(model, t, q).into_iter().flatten() {
             data.efc_id[r] = t;
@@ -314,8 +313,8 @@ pub fn soft_active(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f6
         crate::collision::collide(model, &cm.collision, data, 0.0);
         active |= data.contacts.iter().any(|c| c.dist < c.includemargin);
     }
-    let tendon_limit = model.options.flags.limit
-        && (0..model.tendons.len()).any(|t| tendon_limit_sides(model, t, q).iter().any(Option::is_some));
+    let tendon_limit =
+        cm.tendon_limits.iter().any(|&t| tendon_limit_sides(model, t, q).iter().any(Option::is_some));
     active
         || tendon_limit
         || cm
