@@ -1,6 +1,6 @@
 //! Forward kinematics, body velocities and frame Jacobians (RBDA §4.1, §8.1).
 
-use crate::model::{Data, JointKind, Model};
+use crate::model::{Data, HingeAxis, JointKind, Model};
 #[cfg(target_arch = "x86_64")]
 use crate::spatial::fused::Fused;
 use crate::spatial::fused::{self, MulAdd, Separate};
@@ -20,8 +20,12 @@ pub(crate) fn update_joint(model: &Model, data: &mut Data, b: usize, q: &[f64]) 
     let (qa, da) = (j.qpos_adr, j.dof_adr);
     match &j.kind {
         JointKind::Revolute { axis, .. } => {
-            data.x_parent_body[b] = revolute_placement(&body.x_parent_joint, axis, q[qa]);
-            data.s_body[da] = Motion::new(*axis, Vec3::zeros());
+            data.x_parent_body[b] =
+                revolute_placement(&body.x_parent_joint, axis, model.hinge_axis[b], q[qa]);
+            // Field by field: a whole-`Motion` store is staged through the stack.
+            let s = &mut data.s_body[da];
+            s.ang = *axis;
+            s.lin = Vec3::zeros();
         }
         JointKind::Prismatic { axis } => {
             let x_pj = &body.x_parent_joint;
@@ -38,29 +42,38 @@ pub(crate) fn update_joint(model: &Model, data: &mut Data, b: usize, q: &[f64]) 
 
 /// `x_parent_joint · X_J(angle)` for a rotation by `angle` about the unit `axis` (joint frame):
 /// the translation is the placement's, the rotation `R_pj · R(axis, angle)` (RBDA Table 4.1,
-/// revolute row). About a principal axis ±x, ±y, ±z only two columns of `R_pj` turn (12
+/// revolute row). About a principal axis ±x, ±y, ±z (`principal`, the body's
+/// [`Model::hinge_axis`](crate::Model::hinge_axis)) only two columns of `R_pj` turn (12
 /// products); any other axis goes through Rodrigues' formula R = I + s[a]× + (1 − c)[a]×².
 /// Sine and cosine come from the `libm` crate's `sincos` (musl's kernels, one range reduction
 /// for both, < 1 ulp), compiled into lagrange: ~40% fewer instructions than the system library's
 /// call, a measurable share of CRBA and FK on hinge chains.
 #[inline(always)]
-pub(crate) fn revolute_placement(x_pj: &Transform, axis: &Vec3, angle: f64) -> Transform {
+pub(crate) fn revolute_placement(
+    x_pj: &Transform,
+    axis: &Vec3,
+    principal: HingeAxis,
+    angle: f64,
+) -> Transform {
     let (s, c) = libm::sincos(angle);
     let r = &x_pj.rot;
     let (c0, c1, c2) = (r.column(0).into_owned(), r.column(1).into_owned(), r.column(2).into_owned());
     // Columns (u, w) rotated by the angle whose sine is `s`: (c u + s w, −s u + c w).
     let turn = |u: Vec3, w: Vec3, s: f64| (u * c + w * s, w * c - u * s);
-    let rot = if axis.y == 0.0 && axis.z == 0.0 && axis.x.abs() == 1.0 {
-        let (n1, n2) = turn(c1, c2, s * axis.x);
-        Mat3::from_columns(&[c0, n1, n2])
-    } else if axis.x == 0.0 && axis.z == 0.0 && axis.y.abs() == 1.0 {
-        let (n2, n0) = turn(c2, c0, s * axis.y);
-        Mat3::from_columns(&[n0, c1, n2])
-    } else if axis.x == 0.0 && axis.y == 0.0 && axis.z.abs() == 1.0 {
-        let (n0, n1) = turn(c0, c1, s * axis.z);
-        Mat3::from_columns(&[n0, n1, c2])
-    } else {
-        r * crate::model::axis_angle(axis, angle)
+    let rot = match principal {
+        HingeAxis::X => {
+            let (n1, n2) = turn(c1, c2, s * axis.x);
+            Mat3::from_columns(&[c0, n1, n2])
+        }
+        HingeAxis::Y => {
+            let (n2, n0) = turn(c2, c0, s * axis.y);
+            Mat3::from_columns(&[n0, c1, n2])
+        }
+        HingeAxis::Z => {
+            let (n0, n1) = turn(c0, c1, s * axis.z);
+            Mat3::from_columns(&[n0, n1, c2])
+        }
+        HingeAxis::Other => r * crate::model::axis_angle(axis, angle),
     };
     Transform::new(rot, x_pj.pos)
 }

@@ -2,12 +2,12 @@
 //! factorization and solve (RBDA §6.3, Tables 6.3–6.4).
 
 use crate::kinematics::update_joint;
-use crate::model::{Data, JointKind, Model, NO_DOF};
+use crate::model::{Data, HingeAxis, JointKind, Model, NO_DOF};
 #[cfg(target_arch = "x86_64")]
 use crate::spatial::fused::Fused;
 use crate::spatial::fused::{self, MulAdd, Separate};
 use crate::spatial::{Mat3, Transform};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Vector3};
 
 /// Joint-space inertia matrix M(q), armature included, into `data.mass_matrix` (and returned).
 ///
@@ -54,32 +54,27 @@ unsafe fn crba_fma<const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64]
 
 #[inline(always)]
 fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64]) {
-    // Pass 1, root to leaves: body poses, then world-frame motion subspaces and body inertias
-    // (the 10 parameters moved by RBDA eq. 2.66; a hinge's column is (R a, p × R a)).
-    for b in 1..model.nbody() {
-        update_joint(model, data, b, q);
-        let p = model.bodies[b].parent;
-        let x_world_body = fused::compose::<A>(&data.x_world_body[p], &data.x_parent_body[b]);
-        data.x_world_body[b] = x_world_body;
-        let j = model.joint_of(b);
-        if let JointKind::Revolute { axis, .. } = &j.kind {
-            data.s_world[j.dof_adr] = fused::act_rotation::<A>(&x_world_body, axis);
-        } else {
-            for k in j.dof_adr..j.dof_adr + j.kind.nv() {
-                data.s_world[k] = fused::act_motion::<A>(&x_world_body, &data.s_body[k]);
-            }
-        }
-        data.i_composite[b] = fused::transformed::<A>(&model.bodies[b].inertia, &x_world_body);
-    }
-    let nv = model.nv;
     // A floating base (a free joint on the world, numbered first, with an unrotated placement):
     // its six columns are (0, eᵢ) and (R eᵢ, p × R eᵢ) in world coordinates (R, p its pose), so
     // the six entries of a descendant's F are F_lin and Rᵀ (F_ang − p × F_lin), the moment about
-    // the base origin in base axes: one block instead of six products along the chain.
+    // the base origin in base axes: one block instead of six products along the chain; and its
+    // own 6×6 block comes from the whole robot's composite inertia ([`floating_base_block`]).
     let floating_base = matches!(model.joints.first(), Some(j) if matches!(j.kind, JointKind::Free)
         && j.dof_adr == 0
         && model.bodies[1].parent == 0
         && model.bodies[1].x_parent_joint.rot == Mat3::identity());
+    // Pass 1, root to leaves: body poses, then world-frame motion subspaces and body inertias
+    // (the 10 parameters moved by RBDA eq. 2.66; a hinge's column is (R a, p × R a)).
+    for b in 1..model.nbody() {
+        // Hinges apart, each arm with its own copy of the body's work: a shared body with a
+        // branch in the middle spills the pose to the stack.
+        if model.hinge_axis[b] != HingeAxis::Other {
+            body_pass::<A, true>(model, data, b, q, false);
+        } else {
+            body_pass::<A, false>(model, data, b, q, floating_base && b == 1);
+        }
+    }
+    let nv = model.nv;
     let x_world_base = if floating_base { data.x_world_body[1] } else { Transform::identity() };
     // Only the entries (k, l) of l on the ancestor chain of k (and their mirror) are written: the
     // others are zero from `Data::new` and never change (RBDA §6.3, the tree's sparsity).
@@ -90,34 +85,28 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
     for b in (1..model.nbody()).rev() {
         let j = model.joint_of(b);
         let i_c = data.i_composite[b];
-        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
-            let f_world = fused::mul_motion::<A>(&i_c, &s_world[k]);
-            // Column-major storage: (row l, col k) at l + k·nv; column k holds the chain of k.
-            let (before, rest) = m.split_at_mut(k * nv);
-            let col_k = &mut rest[..nv];
-            col_k[k] = fused::dot::<A>(&s_world[k], &f_world) + model.dof_armature[k];
-            let mut l = dof_parent[k];
-            while l != NO_DOF {
-                if floating_base && l == 5 {
-                    let moment = fused::cross_add::<A>(&f_world.lin, &x_world_base.pos, &f_world.ang);
-                    let base_axes = fused::mat_tr_vec::<A>(&x_world_base.rot, &moment);
-                    let entries =
-                        [f_world.lin.x, f_world.lin.y, f_world.lin.z, base_axes.x, base_axes.y, base_axes.z];
-                    col_k[..6].copy_from_slice(&entries);
-                    if MIRROR {
-                        for (i, m_ki) in entries.iter().enumerate() {
-                            before[k + i * nv] = *m_ki;
-                        }
-                    }
-                    break;
-                }
-                let m_lk = fused::dot::<A>(&s_world[l], &f_world);
-                col_k[l] = m_lk;
+        if floating_base && b == 1 {
+            let block = floating_base_block::<A>(&i_c, &x_world_base);
+            for (k, col) in block.iter().enumerate() {
+                m[k * nv..k * nv + k + 1].copy_from_slice(&col[..=k]);
+                m[k * nv + k] += model.dof_armature[k];
                 if MIRROR {
-                    // Row k of the earlier column l (M is symmetric).
-                    before[k + l * nv] = m_lk;
+                    for l in 0..k {
+                        m[k + l * nv] = col[l];
+                    }
                 }
-                l = dof_parent[l];
+            }
+            continue;
+        }
+        // A hinge or slide (one column) apart: the loop's set-up around a single column costs as
+        // much as the column.
+        let base = if floating_base { Some(&x_world_base) } else { None };
+        let (k0, n) = (j.dof_adr, j.kind.nv());
+        if n == 1 {
+            column::<A, MIRROR>(k0, &i_c, s_world, dof_parent, m, nv, model.dof_armature[k0], base);
+        } else {
+            for k in k0..k0 + n {
+                column::<A, MIRROR>(k, &i_c, s_world, dof_parent, m, nv, model.dof_armature[k], base);
             }
         }
         let p = model.bodies[b].parent;
@@ -125,6 +114,120 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
             data.i_composite[p] += &i_c;
         }
     }
+}
+
+/// Pass 1 of [`crba_kernel`] for body b: its joint, its world pose, the world-frame columns of
+/// its degrees of freedom (none for a floating base, `no_columns`) and its world-frame inertia.
+/// `HINGE`: b's joint is a hinge about a coordinate axis, whose column is (R a, p × R a).
+#[inline(always)]
+fn body_pass<A: MulAdd, const HINGE: bool>(
+    model: &Model,
+    data: &mut Data,
+    b: usize,
+    q: &[f64],
+    no_columns: bool,
+) {
+    update_joint(model, data, b, q);
+    let p = model.bodies[b].parent;
+    let x_world_body = fused::compose::<A>(&data.x_world_body[p], &data.x_parent_body[b]);
+    data.x_world_body[b] = x_world_body;
+    let j = model.joint_of(b);
+    if HINGE {
+        data.s_world[j.dof_adr] = fused::act_rotation::<A>(&x_world_body, &data.s_body[j.dof_adr].ang);
+    } else if !no_columns {
+        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+            data.s_world[k] = fused::act_motion::<A>(&x_world_body, &data.s_body[k]);
+        }
+    }
+    data.i_composite[b] = fused::transformed::<A>(&model.bodies[b].inertia, &x_world_body);
+}
+
+/// Column k of M (and with `MIRROR` row k): F = Iᶜ S_k, then S_l · F for k and the ancestors l
+/// of k (the diagonal with the armature `armature`); at a floating base (`base`, its pose) the
+/// base's six entries as one block.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn column<A: MulAdd, const MIRROR: bool>(
+    k: usize,
+    i_c: &crate::spatial::RigidInertia,
+    s_world: &[crate::spatial::Motion],
+    dof_parent: &[usize],
+    m: &mut [f64],
+    nv: usize,
+    armature: f64,
+    base: Option<&Transform>,
+) {
+    let f_world = fused::mul_motion::<A>(i_c, &s_world[k]);
+    // Column-major storage: (row l, col k) at l + k·nv; column k holds the chain of k.
+    let (before, rest) = m.split_at_mut(k * nv);
+    let col_k = &mut rest[..nv];
+    col_k[k] = fused::dot::<A>(&s_world[k], &f_world) + armature;
+    let mut l = dof_parent[k];
+    while l != NO_DOF {
+        if let (Some(x_world_base), 5) = (base, l) {
+            let moment = fused::cross_add::<A>(&f_world.lin, &x_world_base.pos, &f_world.ang);
+            let base_axes = fused::mat_tr_vec::<A>(&x_world_base.rot, &moment);
+            let entries =
+                [f_world.lin.x, f_world.lin.y, f_world.lin.z, base_axes.x, base_axes.y, base_axes.z];
+            col_k[..6].copy_from_slice(&entries);
+            if MIRROR {
+                for (i, m_ki) in entries.iter().enumerate() {
+                    before[k + i * nv] = *m_ki;
+                }
+            }
+            break;
+        }
+        let m_lk = fused::dot::<A>(&s_world[l], &f_world);
+        col_k[l] = m_lk;
+        if MIRROR {
+            // Row k of the earlier column l (M is symmetric).
+            before[k + l * nv] = m_lk;
+        }
+        l = dof_parent[l];
+    }
+}
+
+/// The 6×6 block of M on a floating base's own degrees of freedom, from the whole robot's
+/// composite inertia `i_c` (world coordinates: mass m, first moment h and rotational inertia I_O
+/// about the world origin) and the base pose (R, p); `block[k][l]` = M[l][k] (l ≤ k filled).
+///
+/// The base's columns are (0, eᵢ) (linear velocity, world axes) and (uᵢ, p × uᵢ) with uᵢ = R eᵢ
+/// (angular velocity, base axes). With h_p = h − m p the first moment about the base origin and
+/// I_p = I_O + p h_pᵀ + h pᵀ − (h + h_p)·p 1 the rotational inertia about it (RBDA eq. 2.66, the
+/// shift by −p), the block is m 1 (linear–linear), (uᵢ × h_p)ₖ (linear k, angular i) and
+/// uᵢᵀ I_p uⱼ (angular–angular): ~100 multiply–adds instead of forming six world columns, six
+/// products I S and 21 dot products.
+#[inline(always)]
+fn floating_base_block<A: MulAdd>(
+    i_c: &crate::spatial::RigidInertia,
+    x_world_base: &Transform,
+) -> [[f64; 6]; 6] {
+    let (r, p, m, h) = (&x_world_base.rot, &x_world_base.pos, i_c.mass, &i_c.h);
+    let h_p = Vector3::new(A::madd(-m, p.x, h.x), A::madd(-m, p.y, h.y), A::madd(-m, p.z, h.z));
+    // Rᵀ p, Rᵀ h_p, Rᵀ h: the rank-two shift in base axes.
+    let a = fused::mat_tr_vec::<A>(r, p);
+    let b = fused::mat_tr_vec::<A>(r, &h_p);
+    let c = fused::mat_tr_vec::<A>(r, h);
+    let diag = -(fused::dot3::<A>(h, p) + fused::dot3::<A>(&h_p, p));
+    // T = I_O R, then (Rᵀ I_O R)(i, j) = column i of R · column j of T.
+    let t = [
+        fused::mat_vec::<A>(&i_c.i_origin, &r.column(0).into_owned()),
+        fused::mat_vec::<A>(&i_c.i_origin, &r.column(1).into_owned()),
+        fused::mat_vec::<A>(&i_c.i_origin, &r.column(2).into_owned()),
+    ];
+    let mut block = [[0.0; 6]; 6];
+    for i in 0..3 {
+        block[i][i] = m;
+        let u_i = r.column(i).into_owned();
+        let n = fused::cross_add::<A>(&u_i, &h_p, &Vector3::zeros());
+        block[3 + i][..3].copy_from_slice(n.as_slice());
+        for j in 0..=i {
+            let g = fused::dot3::<A>(&r.column(j).into_owned(), &t[i]);
+            block[3 + i][3 + j] = A::madd(a[j], b[i], A::madd(c[j], a[i], g));
+        }
+        block[3 + i][3 + i] += diag;
+    }
+    block
 }
 
 /// Calls `run(s, e)` for the runs `s..=e` of consecutive indices that make up the ancestor chain

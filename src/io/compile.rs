@@ -6,7 +6,9 @@
 
 use crate::io::{LinkWord, LoadError};
 use crate::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec, Shape};
-use crate::model::{Body, Frame, FrameKind, Geom, Joint, JointKind, Model, SourceLoc, Spring, NO_DOF};
+use crate::model::{
+    Body, Frame, FrameKind, Geom, HingeAxis, Joint, JointKind, Model, SourceLoc, Spring, NO_DOF,
+};
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
 use std::collections::HashMap;
 
@@ -243,6 +245,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
 
     let keyframes = complete_keyframes(spec, &joints, &qpos0, nv)?;
 
+    let hinge_axis =
+        std::iter::once(HingeAxis::Other).chain(joints.iter().map(|j| j.kind.hinge_axis())).collect();
     let mut model = Model {
         name: spec.name.clone(),
         source: spec.source.clone(),
@@ -254,6 +258,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         nq,
         nv,
         dof_run_start: crate::model::dof_run_starts(&dof_parent),
+        hinge_axis,
         dof_parent,
         dof_body,
         dof_armature,

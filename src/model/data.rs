@@ -170,7 +170,8 @@ pub struct Data {
     pub x_world_frame: Vec<Transform>,
     /// Motion subspace column of each degree of freedom, in its body's coordinates.
     pub s_body: Vec<Motion>,
-    /// Motion subspace column of each degree of freedom in world coordinates (CRBA).
+    /// Motion subspace column of each degree of freedom in world coordinates (CRBA's; not formed
+    /// for a floating base, whose block of M CRBA takes from the composite inertia directly).
     pub s_world: Vec<Motion>,
     /// Spatial velocity of each body, body coordinates.
     pub v_body: Vec<Motion>,

@@ -23,7 +23,38 @@ pub enum JointKind {
     Planar { axis1: Vec3, axis2: Vec3, normal: Vec3 },
 }
 
+/// Which coordinate axis a hinge turns about, decided once when the model is compiled so that the
+/// kernels dispatch on it instead of comparing the axis's components at every call
+/// ([`Model::hinge_axis`](crate::Model::hinge_axis)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HingeAxis {
+    /// ±x: only the joint frame's y and z columns turn.
+    X,
+    /// ±y.
+    Y,
+    /// ±z.
+    Z,
+    /// Any other axis, or not a hinge.
+    Other,
+}
+
 impl JointKind {
+    /// The coordinate axis a hinge's unit axis lies along (exactly: ±1 there, 0 elsewhere), if any.
+    pub fn hinge_axis(&self) -> HingeAxis {
+        match self {
+            JointKind::Revolute { axis, .. } if axis.y == 0.0 && axis.z == 0.0 && axis.x.abs() == 1.0 => {
+                HingeAxis::X
+            }
+            JointKind::Revolute { axis, .. } if axis.x == 0.0 && axis.z == 0.0 && axis.y.abs() == 1.0 => {
+                HingeAxis::Y
+            }
+            JointKind::Revolute { axis, .. } if axis.x == 0.0 && axis.y == 0.0 && axis.z.abs() == 1.0 => {
+                HingeAxis::Z
+            }
+            _ => HingeAxis::Other,
+        }
+    }
+
     /// Number of position coordinates.
     pub fn nq(&self) -> usize {
         match self {
@@ -215,4 +246,24 @@ fn quat_difference(q0: &[f64], q1: &[f64], v: &mut [f64]) {
     let d = to_unit_quat(q0).inverse() * to_unit_quat(q1);
     let w = d.scaled_axis();
     v.copy_from_slice(w.as_slice());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A hinge is classed by the coordinate axis it lies along (either sign); a tilted axis, a
+    /// near-axis one and every other joint kind are `Other` (they take the general formulas).
+    #[test]
+    fn hinge_axes_are_classed_exactly() {
+        let hinge =
+            |x: f64, y: f64, z: f64| JointKind::Revolute { axis: Vec3::new(x, y, z), continuous: false };
+        assert_eq!(hinge(1.0, 0.0, 0.0).hinge_axis(), HingeAxis::X);
+        assert_eq!(hinge(0.0, -1.0, 0.0).hinge_axis(), HingeAxis::Y);
+        assert_eq!(hinge(0.0, 0.0, -1.0).hinge_axis(), HingeAxis::Z);
+        assert_eq!(hinge(0.0, 0.6, 0.8).hinge_axis(), HingeAxis::Other);
+        assert_eq!(hinge(1e-17, 0.0, 1.0).hinge_axis(), HingeAxis::Other);
+        assert_eq!(JointKind::Prismatic { axis: Vec3::z() }.hinge_axis(), HingeAxis::Other);
+        assert_eq!(JointKind::Ball.hinge_axis(), HingeAxis::Other);
+    }
 }

@@ -21,7 +21,7 @@ pub use contact::{Contact, ContactExclude, ContactPair};
 pub use data::{Data, EfcState, EfcType, SoftWork, SLIP_VELOCITY};
 pub use elements::{Element, Keyframe};
 pub use equality::{Equality, EqualityKind};
-pub use joint::{axis_angle, JointKind};
+pub use joint::{axis_angle, HingeAxis, JointKind};
 pub use options::{Flags, Options};
 pub use tendon::{Tendon, TendonKind};
 
@@ -180,6 +180,9 @@ pub struct Model {
     pub dof_run_start: Vec<usize>,
     /// For each degree of freedom, the body it moves.
     pub dof_body: Vec<usize>,
+    /// For each body, the coordinate axis its hinge turns about ([`JointKind::hinge_axis`];
+    /// [`HingeAxis::Other`] for the world and every other joint), for the kernels' dispatch.
+    pub hinge_axis: Vec<HingeAxis>,
     /// Armature per degree of freedom.
     pub dof_armature: Vec<f64>,
     /// Damping per degree of freedom.

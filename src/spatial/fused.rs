@@ -42,6 +42,12 @@ fn dot3_acc<A: MulAdd>(a: &Vec3, b: &Vec3, c: f64) -> f64 {
     A::madd(a.z, b.z, A::madd(a.y, b.y, A::madd(a.x, b.x, c)))
 }
 
+/// `a · b` for 3-vectors.
+#[inline(always)]
+pub fn dot3<A: MulAdd>(a: &Vec3, b: &Vec3) -> f64 {
+    A::madd(a.z, b.z, A::madd(a.y, b.y, a.x * b.x))
+}
+
 /// `r v`.
 #[inline(always)]
 pub fn mat_vec<A: MulAdd>(r: &Mat3, v: &Vec3) -> Vec3 {
