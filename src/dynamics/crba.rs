@@ -1,7 +1,7 @@
 //! Composite-rigid-body algorithm for M(q) (RBDA §6.2, Table 6.2) and the tree-sparse LᵀDL
 //! factorization and solve (RBDA §6.3, Tables 6.3–6.4).
 
-use crate::kinematics::update_joint;
+use crate::kinematics::{hinge_world_pose, update_joint};
 use crate::model::{Data, HingeAxis, JointKind, Model, NO_DOF};
 #[cfg(target_arch = "x86_64")]
 use crate::spatial::fused::Fused;
@@ -127,9 +127,12 @@ fn body_pass<A: MulAdd, const HINGE: bool>(
     q: &[f64],
     no_columns: bool,
 ) {
-    update_joint(model, data, b, q);
-    let p = model.bodies[b].parent;
-    let x_world_body = fused::compose::<A>(&data.x_world_body[p], &data.x_parent_body[b]);
+    let x_world_body = if HINGE {
+        hinge_world_pose::<A>(model, data, b, q)
+    } else {
+        update_joint(model, data, b, q);
+        fused::compose::<A>(&data.x_world_body[model.bodies[b].parent], &data.x_parent_body[b])
+    };
     data.x_world_body[b] = x_world_body;
     let j = model.joint_of(b);
     if HINGE {

@@ -247,6 +247,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
 
     let hinge_axis =
         std::iter::once(HingeAxis::Other).chain(joints.iter().map(|j| j.kind.hinge_axis())).collect();
+    let placement_unrotated = bodies.iter().map(|b| b.x_parent_joint.rot == Mat3::identity()).collect();
     let mut model = Model {
         name: spec.name.clone(),
         source: spec.source.clone(),
@@ -259,6 +260,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         nv,
         dof_run_start: crate::model::dof_run_starts(&dof_parent),
         hinge_axis,
+        placement_unrotated,
         dof_parent,
         dof_body,
         dof_armature,

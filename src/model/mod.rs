@@ -183,6 +183,10 @@ pub struct Model {
     /// For each body, the coordinate axis its hinge turns about ([`JointKind::hinge_axis`];
     /// [`HingeAxis::Other`] for the world and every other joint), for the kernels' dispatch.
     pub hinge_axis: Vec<HingeAxis>,
+    /// For each body, whether its joint placement has no rotation (`x_parent_joint.rot` exactly
+    /// the identity, as on most MJCF bodies and URDF joints without `rpy`): a hinge's pose is then
+    /// its parent's with two columns turned, no 3×3 product (`kinematics::hinge_world_pose`).
+    pub placement_unrotated: Vec<bool>,
     /// Armature per degree of freedom.
     pub dof_armature: Vec<f64>,
     /// Damping per degree of freedom.

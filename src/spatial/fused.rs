@@ -64,7 +64,7 @@ pub fn mat_tr_vec<A: MulAdd>(r: &Mat3, v: &Vec3) -> Vec3 {
 
 /// `r v + c`.
 #[inline(always)]
-fn mat_vec_add<A: MulAdd>(r: &Mat3, v: &Vec3, c: &Vec3) -> Vec3 {
+pub fn mat_vec_add<A: MulAdd>(r: &Mat3, v: &Vec3, c: &Vec3) -> Vec3 {
     let row = |i: usize| A::madd(r[(i, 2)], v.z, A::madd(r[(i, 1)], v.y, A::madd(r[(i, 0)], v.x, c[i])));
     Vec3::new(row(0), row(1), row(2))
 }
