@@ -11,8 +11,13 @@
 //! by the number of calls (`CALLS`) is its cost per call. ROBOT: ur5, panda, solo12,
 //! talos_reduced, go1, g1 (the last three read from the validation venv, as
 //! `validation/bench_native` does).
+//!
+//! `kernel_counts ROBOT --time` times the kernels instead: the best over 200 batches of the 16
+//! states of each kernel's time per call, in µs. Run it pinned (`taskset -c 1 …`) and alternate
+//! the builds being compared several times: on a shared machine a single run moves by a few
+//! percent. The same-run comparison with Pinocchio and MuJoCo is `validation/bench_native/run`.
 
-use lagrange::dynamics::{aba, crba, factorize_mass_matrix, rnea, solve_mass_matrix};
+use lagrange::dynamics::{aba, crba, crba_upper, factorize_mass_matrix, rnea, solve_mass_matrix};
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::forward_kinematics;
 use lagrange::{Data, Model};
@@ -83,6 +88,10 @@ fn main() {
             (q, v, tau)
         })
         .collect();
+    if std::env::args().any(|a| a == "--time") {
+        time_kernels(&name, &model, &mut data, &states);
+        return;
+    }
     let mut sink = 0.0;
     for i in 0..CALLS {
         let (q, _, _) = &states[i % 16];
@@ -113,4 +122,33 @@ fn main() {
         sink += aba(&model, &mut data, black_box(q), v, tau)[0];
     }
     println!("{name}: nv {} sink {sink}", model.nv);
+}
+
+/// (q, v, a or τ).
+type KernelState = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// The best time per call (µs) of each kernel over 200 batches of all states.
+fn time_kernels(name: &str, model: &Model, data: &mut Data, states: &[KernelState]) {
+    let mut best = |kernel: &mut dyn FnMut(&mut Data, &KernelState) -> f64| {
+        let (mut t_min, mut sink) = (f64::INFINITY, 0.0);
+        for _ in 0..200 {
+            let start = std::time::Instant::now();
+            for _ in 0..20 {
+                for s in states {
+                    sink += kernel(data, black_box(s));
+                }
+            }
+            t_min = t_min.min(start.elapsed().as_secs_f64() / (20 * states.len()) as f64);
+        }
+        assert!(sink.is_finite());
+        t_min * 1e6
+    };
+    let fk = best(&mut |d, (q, _, _)| {
+        forward_kinematics(model, d, q);
+        d.x_world_body[model.nbody() - 1].pos.x
+    });
+    let rnea_us = best(&mut |d, (q, v, a)| rnea(model, d, q, v, a)[0]);
+    let crba_us = best(&mut |d, (q, _, _)| crba_upper(model, d, q)[(0, model.nv - 1)]);
+    let aba_us = best(&mut |d, (q, v, tau)| aba(model, d, q, v, tau)[0]);
+    println!("{name}: µs per call (best of 200 batches): FK {fk:.4}  RNEA {rnea_us:.4}  CRBA (upper) {crba_us:.4}  ABA {aba_us:.4}");
 }
