@@ -78,6 +78,11 @@ pub type Controller = Box<dyn FnMut(f64, &[f64], &[f64], &mut [f64]) + Send>;
 
 impl Simulation {
     /// A simulation from the model's `qpos0` at rest, with `options` over the model's own.
+    ///
+    /// A fixed-step integrator's `timestep` other than the model's is written into (a copy of)
+    /// the model: as MuJoCo's `opt.timestep`, the step is also what the soft constraints'
+    /// `refsafe` time constant (at least 2 · timestep) and the actuators' `actearly` look ahead
+    /// by are computed from. The adaptive integrator's steps vary: its model keeps the file's.
     pub fn new(model: Arc<Model>, options: &SimOptions) -> Self {
         let mut notes = Vec::new();
         let integrator = options.integrator.unwrap_or_else(|| {
@@ -85,6 +90,14 @@ impl Simulation {
             notes.extend(note);
             kind
         });
+        let model = match options.timestep {
+            Some(h) if h != model.options.timestep && integrator != IntegratorKind::Adaptive => {
+                let mut stepped = (*model).clone();
+                stepped.options.timestep = h;
+                Arc::new(stepped)
+            }
+            _ => model,
+        };
         let mut plan = Plan::new(&model, options.constraints);
         if integrator == IntegratorKind::Variational
             && plan.mode == ConstraintMode::Soft
