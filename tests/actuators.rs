@@ -563,3 +563,39 @@ fn tendon_actuator_force_range_scales_its_actuators() {
     forward(&model, &plan, &mut data, &[0.0, 0.0], &[0.0, 0.0]);
     assert_eq!(&data.actuator_force.as_slice()[..3], [0.5, -0.2, 0.0]);
 }
+
+/// A step size given to the simulation is the timestep `actearly` looks ahead by, as MuJoCo's
+/// `opt.timestep`: `activation.xml` (timestep 0.002) run at 0.005 s equals the file run with
+/// `<option timestep="0.005">`, bit for bit, and differs from looking ahead by the file's 0.002 s.
+#[test]
+fn a_step_size_override_is_the_timestep_of_actearly() {
+    let file = load(Path::new(ACTIVATION), &LoadOptions::default()).unwrap();
+    assert!(file.actuators.iter().any(|a| a.actearly) && file.options.timestep == 0.002);
+    let run = |model: lagrange::Model, timestep: Option<f64>, by_hand: Option<f64>| {
+        let key = &model.keyframes[0];
+        let (mut q, mut v, mut ctrl, mut act) = (
+            model.qpos0.clone(),
+            vec![0.0; model.nv],
+            vec![0.0; model.actuators.len()],
+            vec![0.0; model.na()],
+        );
+        key.apply(&mut q, &mut v, &mut ctrl, &mut act);
+        let mut sim = Simulation::new(Arc::new(model), &SimOptions { timestep, ..Default::default() });
+        sim.set_state(&q, &v).unwrap();
+        sim.set_act(&act).unwrap();
+        sim.ctrl_mut().copy_from_slice(&ctrl);
+        if let Some(h) = by_hand {
+            sim.timestep = h;
+        }
+        for _ in 0..40 {
+            sim.step().unwrap();
+        }
+        sim.state.v.clone()
+    };
+    let mut at_h = file.clone();
+    at_h.options.timestep = 0.005;
+    let overridden = run(file.clone(), Some(0.005), None);
+    assert_eq!(overridden, run(at_h, None, None), "the override runs the model at its own timestep");
+    let diff = (&overridden - run(file, None, Some(0.005))).amax();
+    assert!(diff > 1e-9, "actearly's look-ahead step matters here: {diff:e}");
+}
