@@ -182,10 +182,13 @@ pub struct Model {
     pub dof_body: Vec<usize>,
     /// For each body, the coordinate axis its hinge turns about ([`JointKind::hinge_axis`];
     /// [`HingeAxis::Other`] for the world and every other joint), for the kernels' dispatch.
+    /// Derived when the model is compiled, as `dof_parent` is: code that edits a joint's axis
+    /// afterwards updates it too.
     pub hinge_axis: Vec<HingeAxis>,
     /// For each body, whether its joint placement has no rotation (`x_parent_joint.rot` exactly
     /// the identity, as on most MJCF bodies and URDF joints without `rpy`): a hinge's pose is then
     /// its parent's with two columns turned, no 3×3 product (`kinematics::hinge_world_pose`).
+    /// Derived when the model is compiled, like [`hinge_axis`](Self::hinge_axis).
     pub placement_unrotated: Vec<bool>,
     /// Armature per degree of freedom.
     pub dof_armature: Vec<f64>,
