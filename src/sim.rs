@@ -58,7 +58,9 @@ pub struct Simulation {
     pub data: Data,
     pub stepper: Box<dyn Stepper>,
     pub state: State,
-    /// The step size used by [`step`](Self::step).
+    /// The step size used by [`step`](Self::step). For a fixed-step integrator it is also the
+    /// model's timestep (soft constraints' `refsafe`, `actearly`): set here after
+    /// [`new`](Self::new), the model follows at the next step.
     pub timestep: f64,
     pub steps: u64,
     /// What was chosen for the caller and why (integrator fallbacks, constraint mode).
@@ -68,6 +70,16 @@ pub struct Simulation {
     /// Called before each step to set the applied joint forces
     /// ([`set_torque_controller`](Self::set_torque_controller)).
     torque_controller: Option<Controller>,
+    /// Whether the integrator steps by `timestep` (all but the adaptive one), which is then the
+    /// model's timestep too ([`new`](Self::new)).
+    fixed_step: bool,
+}
+
+/// A copy of `model` whose `<option timestep>` is `h`.
+fn with_timestep(model: &Model, h: f64) -> Model {
+    let mut stepped = model.clone();
+    stepped.options.timestep = h;
+    stepped
 }
 
 /// A control law `f(time, q, v, out)`: it reads the state at the start of a step and writes the
@@ -90,12 +102,9 @@ impl Simulation {
             notes.extend(note);
             kind
         });
+        let fixed_step = integrator != IntegratorKind::Adaptive;
         let model = match options.timestep {
-            Some(h) if h != model.options.timestep && integrator != IntegratorKind::Adaptive => {
-                let mut stepped = (*model).clone();
-                stepped.options.timestep = h;
-                Arc::new(stepped)
-            }
+            Some(h) if h != model.options.timestep && fixed_step => Arc::new(with_timestep(&model, h)),
             _ => model,
         };
         let mut plan = Plan::new(&model, options.constraints);
@@ -134,6 +143,7 @@ impl Simulation {
             model,
             controller: None,
             torque_controller: None,
+            fixed_step,
         }
     }
 
@@ -210,6 +220,10 @@ impl Simulation {
         }
         if let Some(f) = self.torque_controller.as_mut() {
             f(t, q, v, self.data.qfrc_applied.as_mut_slice());
+        }
+        if self.fixed_step && self.model.options.timestep != self.timestep {
+            // `timestep` set after `new`: the model's timestep follows it, as there.
+            self.model = Arc::new(with_timestep(&self.model, self.timestep));
         }
         let mut report =
             self.stepper.step(&self.model, &self.plan, &mut self.data, &mut self.state, self.timestep);

@@ -272,39 +272,36 @@ fn a_tendon_limit_alone_constrains_the_model() {
 
 /// A step size given to the simulation is the model's timestep for the soft constraints too, as
 /// MuJoCo's `opt.timestep`: `refsafe` raises a limit's time constant (solref 0.02 s) to 2 · 0.02 s
-/// at a 0.02 s step, so the run with `SimOptions::timestep` = 0.02 is the run of the model whose
-/// `<option timestep>` is 0.02, bit for bit (it once kept the file's 0.005 s for `refsafe`, and
-/// the humanoid's work-precision rows left MuJoCo's at that step: 0.147 against 0.129).
+/// at a 0.02 s step, so the run with `SimOptions::timestep` = 0.02 (or `timestep` set after `new`)
+/// is the run of the model whose `<option timestep>` is 0.02, bit for bit. (It once kept the
+/// file's 0.005 s for `refsafe`, and the humanoid's work-precision rows left MuJoCo's at that
+/// step: 0.147 against 0.129.)
 #[test]
 fn a_step_size_override_is_the_timestep_of_the_soft_constraints() {
     let model = load(Path::new("models/mjcf/humanoid/humanoid.xml"), &LoadOptions::default()).unwrap();
     assert!(model.options.timestep < 0.01 && model.options.flags.refsafe);
-    let run = |model: Model, timestep: Option<f64>| {
+    let run = |model: Model, timestep: Option<f64>, set_after: Option<f64>| {
         let mut sim = Simulation::new(Arc::new(model), &SimOptions { timestep, ..Default::default() });
+        if let Some(h) = set_after {
+            sim.timestep = h;
+        }
         for (k, v) in sim.state.v.iter_mut().enumerate().skip(6) {
             *v = if k % 2 == 0 { 1.0 } else { -1.0 };
         }
         for _ in 0..25 {
             sim.step().unwrap();
         }
-        (sim.state.q.clone(), sim.timestep)
+        assert_eq!(sim.model.options.timestep, 0.02);
+        sim.state.q.clone()
     };
     let mut at_h = model.clone();
     at_h.options.timestep = 0.02;
-    let (q_override, h) = run(model.clone(), Some(0.02));
-    let (q_file, _) = run(at_h, None);
-    assert_eq!(h, 0.02);
-    assert_eq!(q_override, q_file, "the override runs the model at its own timestep");
-    // And refsafe matters here: the model at 0.005 s, stepped at 0.02 s by hand, differs.
-    let mut sim = Simulation::new(Arc::new(model), &SimOptions::default());
-    for (k, v) in sim.state.v.iter_mut().enumerate().skip(6) {
-        *v = if k % 2 == 0 { 1.0 } else { -1.0 };
-    }
-    sim.timestep = 0.02;
-    for _ in 0..25 {
-        sim.step().unwrap();
-    }
-    let diff = (&sim.state.q - &q_file).amax();
-    println!("refsafe at 0.005 s instead of 0.02 s moves q by {diff:.3e} after 0.5 s");
+    let q_file = run(at_h.clone(), None, None);
+    assert_eq!(run(model.clone(), Some(0.02), None), q_file, "SimOptions::timestep");
+    assert_eq!(run(model, None, Some(0.02)), q_file, "timestep set after new");
+    // And refsafe matters in this scene: without it the limits are twice as stiff.
+    at_h.options.flags.refsafe = false;
+    let diff = (run(at_h, None, None) - &q_file).amax();
+    println!("refsafe off at 0.02 s moves q by {diff:.3e} after 0.5 s");
     assert!(diff > 1e-6, "the scene exercises refsafe: {diff:e}");
 }
