@@ -122,7 +122,10 @@ pub trait Stepper: Send {
     fn name(&self) -> &'static str;
     /// Order of the global error in the step size for smooth problems.
     fn order(&self) -> u32;
-    /// Advances `state` by `h` with the inputs in `data` (`qfrc_applied`, `ctrl`).
+    /// Advances `state` by `h` with the inputs in `data` (`qfrc_applied`, `ctrl`). The soft
+    /// constraints' `refsafe` and `actearly` read `model.options.timestep`, as MuJoCo's read
+    /// `opt.timestep`: for MuJoCo's behaviour it equals h ([`Simulation`](crate::sim::Simulation)
+    /// keeps the two equal for the fixed-step integrators).
     fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport;
     /// Why the last step was not taken, if it was not (a Newton iteration that failed).
     fn failure(&self) -> Option<StepFailure> {
