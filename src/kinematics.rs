@@ -27,10 +27,7 @@ pub(crate) fn update_joint(model: &Model, data: &mut Data, b: usize, q: &[f64]) 
                 model.placement_unrotated[b],
                 q[qa],
             );
-            // Field by field: a whole-`Motion` store is staged through the stack.
-            let s = &mut data.s_body[da];
-            s.ang = *axis;
-            s.lin = Vec3::zeros();
+            set_hinge_column(data, da, axis);
         }
         JointKind::Prismatic { axis } => {
             let x_pj = &body.x_parent_joint;
@@ -134,9 +131,7 @@ pub(crate) fn hinge_world_pose<A: MulAdd>(model: &Model, data: &mut Data, b: usi
         unreachable!("hinge_world_pose on a body whose joint is not a hinge")
     };
     let principal = model.hinge_axis[b];
-    let s_body = &mut data.s_body[j.dof_adr];
-    s_body.ang = *axis;
-    s_body.lin = Vec3::zeros();
+    set_hinge_column(data, j.dof_adr, axis);
     let x_world_parent = &data.x_world_body[body.parent];
     let x_pj = &body.x_parent_joint;
     if !model.placement_unrotated[b] {
@@ -149,6 +144,34 @@ pub(crate) fn hinge_world_pose<A: MulAdd>(model: &Model, data: &mut Data, b: usi
     let pos = fused::mat_vec_add::<A>(&x_world_parent.rot, &x_pj.pos, &x_world_parent.pos);
     data.x_parent_body[b] = Transform::new(principal_rotation(axis, principal, s, c), x_pj.pos);
     Transform::new(rot, pos)
+}
+
+/// A hinge's motion-subspace column (axis, 0) into `s_body[dof]`, field by field (a whole-`Motion`
+/// store is staged through the stack).
+#[inline(always)]
+fn set_hinge_column(data: &mut Data, dof: usize, axis: &Vec3) {
+    let s = &mut data.s_body[dof];
+    s.ang = *axis;
+    s.lin = Vec3::zeros();
+}
+
+/// Body b's world pose `x_world_parent · x_parent_body` (returned, not stored), after its joint's
+/// update ([`update_joint`]); `HINGE` (the body's hinge turns about a coordinate axis, checked by
+/// the caller against `Model::hinge_axis`) takes [`hinge_world_pose`]. A constant, so that a
+/// caller dispatching once per body gets each arm compiled on its own.
+#[inline(always)]
+pub(crate) fn body_world_pose<A: MulAdd, const HINGE: bool>(
+    model: &Model,
+    data: &mut Data,
+    b: usize,
+    q: &[f64],
+) -> Transform {
+    if HINGE {
+        hinge_world_pose::<A>(model, data, b, q)
+    } else {
+        update_joint(model, data, b, q);
+        fused::compose::<A>(&data.x_world_body[model.bodies[b].parent], &data.x_parent_body[b])
+    }
 }
 
 /// Joint velocity `v_J = S q̇` of body `b`, body coordinates (needs `update_joint` first).
@@ -173,11 +196,9 @@ pub(crate) fn body_poses(model: &Model, data: &mut Data, q: &[f64]) {
 fn body_poses_with<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64]) {
     for b in 1..model.nbody() {
         data.x_world_body[b] = if model.hinge_axis[b] != HingeAxis::Other {
-            hinge_world_pose::<A>(model, data, b, q)
+            body_world_pose::<A, true>(model, data, b, q)
         } else {
-            update_joint(model, data, b, q);
-            let p = model.bodies[b].parent;
-            fused::compose::<A>(&data.x_world_body[p], &data.x_parent_body[b])
+            body_world_pose::<A, false>(model, data, b, q)
         };
     }
 }

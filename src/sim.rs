@@ -75,13 +75,6 @@ pub struct Simulation {
     fixed_step: bool,
 }
 
-/// A copy of `model` whose `<option timestep>` is `h`.
-fn with_timestep(model: &Model, h: f64) -> Model {
-    let mut stepped = model.clone();
-    stepped.options.timestep = h;
-    stepped
-}
-
 /// A control law `f(time, q, v, out)`: it reads the state at the start of a step and writes the
 /// controls (or, for a torque controller, the applied generalized forces), which are then held
 /// for the whole step — every stage of RK4 and of the adaptive method sees the same values (a
@@ -103,10 +96,6 @@ impl Simulation {
             kind
         });
         let fixed_step = integrator != IntegratorKind::Adaptive;
-        let model = match options.timestep {
-            Some(h) if h != model.options.timestep && fixed_step => Arc::new(with_timestep(&model, h)),
-            _ => model,
-        };
         let mut plan = Plan::new(&model, options.constraints);
         if integrator == IntegratorKind::Variational
             && plan.mode == ConstraintMode::Soft
@@ -127,7 +116,7 @@ impl Simulation {
         if plan.has_constraints() {
             notes.push(format!("constraints: {} ({})", plan.mode.name(), plan.mode_reason));
         }
-        Self {
+        let mut sim = Self {
             data: Data::new(&model),
             stepper: match (integrator, options.tolerances) {
                 (IntegratorKind::Adaptive, Some([rtol, atol])) => {
@@ -144,6 +133,18 @@ impl Simulation {
             controller: None,
             torque_controller: None,
             fixed_step,
+        };
+        sim.sync_timestep();
+        sim
+    }
+
+    /// For a fixed-step integrator, makes the model's timestep the step's (a copy of the model
+    /// when they differ): what `refsafe` and `actearly` read.
+    fn sync_timestep(&mut self) {
+        if self.fixed_step && self.model.options.timestep != self.timestep {
+            let mut stepped = (*self.model).clone();
+            stepped.options.timestep = self.timestep;
+            self.model = Arc::new(stepped);
         }
     }
 
@@ -221,10 +222,8 @@ impl Simulation {
         if let Some(f) = self.torque_controller.as_mut() {
             f(t, q, v, self.data.qfrc_applied.as_mut_slice());
         }
-        if self.fixed_step && self.model.options.timestep != self.timestep {
-            // `timestep` set after `new`: the model's timestep follows it, as there.
-            self.model = Arc::new(with_timestep(&self.model, self.timestep));
-        }
+        // `timestep` may have been set after `new`.
+        self.sync_timestep();
         let mut report =
             self.stepper.step(&self.model, &self.plan, &mut self.data, &mut self.state, self.timestep);
         if self.plan.soft.is_some() && self.data.nefc > 0 {

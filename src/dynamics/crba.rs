@@ -1,12 +1,12 @@
 //! Composite-rigid-body algorithm for M(q) (RBDA §6.2, Table 6.2) and the tree-sparse LᵀDL
 //! factorization and solve (RBDA §6.3, Tables 6.3–6.4).
 
-use crate::kinematics::{hinge_world_pose, update_joint};
+use crate::kinematics::body_world_pose;
 use crate::model::{Data, HingeAxis, JointKind, Model, NO_DOF};
 #[cfg(target_arch = "x86_64")]
 use crate::spatial::fused::Fused;
 use crate::spatial::fused::{self, MulAdd, Separate};
-use crate::spatial::{Mat3, Transform};
+use crate::spatial::{Motion, RigidInertia, Transform};
 use nalgebra::{DMatrix, DVector, Vector3};
 
 /// Joint-space inertia matrix M(q), armature included, into `data.mass_matrix` (and returned).
@@ -62,7 +62,7 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
     let floating_base = matches!(model.joints.first(), Some(j) if matches!(j.kind, JointKind::Free)
         && j.dof_adr == 0
         && model.bodies[1].parent == 0
-        && model.bodies[1].x_parent_joint.rot == Mat3::identity());
+        && model.placement_unrotated[1]);
     // Pass 1, root to leaves: body poses, then world-frame motion subspaces and body inertias
     // (the 10 parameters moved by RBDA eq. 2.66; a hinge's column is (R a, p × R a)).
     for b in 1..model.nbody() {
@@ -127,12 +127,7 @@ fn body_pass<A: MulAdd, const HINGE: bool>(
     q: &[f64],
     no_columns: bool,
 ) {
-    let x_world_body = if HINGE {
-        hinge_world_pose::<A>(model, data, b, q)
-    } else {
-        update_joint(model, data, b, q);
-        fused::compose::<A>(&data.x_world_body[model.bodies[b].parent], &data.x_parent_body[b])
-    };
+    let x_world_body = body_world_pose::<A, HINGE>(model, data, b, q);
     data.x_world_body[b] = x_world_body;
     let j = model.joint_of(b);
     if HINGE {
@@ -152,8 +147,8 @@ fn body_pass<A: MulAdd, const HINGE: bool>(
 #[allow(clippy::too_many_arguments)]
 fn column<A: MulAdd, const MIRROR: bool>(
     k: usize,
-    i_c: &crate::spatial::RigidInertia,
-    s_world: &[crate::spatial::Motion],
+    i_c: &RigidInertia,
+    s_world: &[Motion],
     dof_parent: &[usize],
     m: &mut [f64],
     nv: usize,
@@ -201,10 +196,7 @@ fn column<A: MulAdd, const MIRROR: bool>(
 /// uᵢᵀ I_p uⱼ (angular–angular): ~100 multiply–adds instead of forming six world columns, six
 /// products I S and 21 dot products.
 #[inline(always)]
-fn floating_base_block<A: MulAdd>(
-    i_c: &crate::spatial::RigidInertia,
-    x_world_base: &Transform,
-) -> [[f64; 6]; 6] {
+fn floating_base_block<A: MulAdd>(i_c: &RigidInertia, x_world_base: &Transform) -> [[f64; 6]; 6] {
     let (r, p, m, h) = (&x_world_base.rot, &x_world_base.pos, i_c.mass, &i_c.h);
     let h_p = Vector3::new(A::madd(-m, p.x, h.x), A::madd(-m, p.y, h.y), A::madd(-m, p.z, h.z));
     // Rᵀ p, Rᵀ h_p, Rᵀ h: the rank-two shift in base axes.
