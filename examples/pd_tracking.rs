@@ -55,11 +55,11 @@ fn main() {
         }
     });
     let mut worst = 0.0f64;
-    while sim.state.time < 3.0 {
+    while sim.data.time < 3.0 {
         sim.step().expect("the arm simulates");
-        if sim.state.time > 1.0 {
-            let (q_ref, _) = reference(sim.state.time);
-            for (q, r) in sim.state.q.iter().zip(q_ref) {
+        if sim.data.time > 1.0 {
+            let (q_ref, _) = reference(sim.data.time);
+            for (q, r) in sim.data.qpos.iter().zip(q_ref) {
                 worst = worst.max((q - r).abs());
             }
         }
@@ -80,10 +80,10 @@ fn main() {
             tau[k] = 2000.0 * (hold[k] - q[k]) - 80.0 * v[k];
         }
     });
-    while sim.state.time < 2.0 {
+    while sim.data.time < 2.0 {
         sim.step().expect("the ur5 simulates");
     }
-    let error = sim.state.q.iter().zip(hold).map(|(q, h)| (q - h).abs()).fold(0.0, f64::max);
+    let error = sim.data.qpos.iter().zip(hold).map(|(q, h)| (q - h).abs()).fold(0.0, f64::max);
     println!("UR5 holding a pose with PD joint torques, efforts clamped to <limit effort>, 2 s:");
     println!("  largest joint error (the sag PD needs to hold the arm against gravity): {error:.4} rad");
 }

@@ -45,14 +45,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for step in 1..=1500 {
         sim.step()?;
         if step % 125 == 0 {
-            let (q, act) = (&sim.state.q, sim.act());
+            let (q, act) = (&sim.data.qpos, sim.act());
             println!(
                 "{:>6.2} {:>10.5} {:>10.5} {:>10.5} {:>10.5}",
-                sim.state.time, q[0], act[0], q[1], act[1]
+                sim.data.time, q[0], act[0], q[1], act[1]
             );
         }
     }
-    let (q, act) = (&sim.state.q, sim.act());
+    let (q, act) = (&sim.data.qpos, sim.act());
     println!(
         "held after 3 s: shoulder {:.4} rad (setpoint {:.4}), elbow {:.4} rad (target 0.8); the gaps are gravity over kp",
         q[0], act[0], q[1]

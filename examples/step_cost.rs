@@ -12,8 +12,7 @@
 //! not optimized away).
 
 use lagrange::dynamics::aba;
-use lagrange::forward::Plan;
-use lagrange::integrate::{IntegratorKind, State, Variational};
+use lagrange::integrate::{IntegratorKind, Variational};
 use lagrange::io::{load, LoadOptions};
 use lagrange::Data;
 use std::hint::black_box;
@@ -30,16 +29,15 @@ fn main() {
     let model = load(Path::new(&args[1]), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let n: usize = args[3].parse().expect("N is a count");
     let tilt: f64 = args.get(4).map_or(0.3, |t| t.parse().expect("TILT is a number"));
-    let mut state = State::neutral(&model);
+    let mut data = Data::new(&model);
     for j in &model.joints {
         if j.kind.nq() == 1 {
-            state.q[j.qpos_adr] += tilt;
+            data.qpos[j.qpos_adr] += tilt;
         }
     }
     for k in 0..model.nv {
-        state.v[k] = 0.1 * ((k % 5) as f64 - 2.0) * tilt / 0.3;
+        data.qvel[k] = 0.1 * ((k % 5) as f64 - 2.0) * tilt / 0.3;
     }
-    let mut data = Data::new(&model);
     let h = model.options.timestep;
     let kind = match args[2].as_str() {
         "aba" => None,
@@ -58,13 +56,13 @@ fn main() {
         None if variational_tol.is_none() => {
             let tau = vec![0.0; model.nv];
             for _ in 0..n {
-                let qacc = aba(&model, &mut data, black_box(state.q.as_slice()), state.v.as_slice(), &tau);
+                let (q, v) = (data.qpos.clone(), data.qvel.clone());
+                let qacc = aba(&model, &mut data, black_box(q.as_slice()), v.as_slice(), &tau)[0];
                 // A cheap update so that successive calls see different states.
-                state.v[0] += 1e-9 * qacc[0];
+                data.qvel[0] += 1e-9 * qacc;
             }
         }
         _ => {
-            let plan = Plan::new(&model, None);
             let mut stepper: Box<dyn lagrange::integrate::Stepper> = match (kind, variational_tol) {
                 (Some(kind), _) => kind.build(&model),
                 (None, Some(tol)) => Box::new(Variational::with_tolerance(&model, tol)),
@@ -72,10 +70,10 @@ fn main() {
             };
             let mut iterations = 0u64;
             for _ in 0..n {
-                iterations += stepper.step(&model, &plan, &mut data, &mut state, h).solver_iterations as u64;
+                iterations += stepper.step(&model, &mut data, h).solver_iterations as u64;
             }
             eprintln!("mean solver iterations per step: {:.2}", iterations as f64 / n.max(1) as f64);
         }
     }
-    println!("{}", black_box(state.q[0]));
+    println!("{}", black_box(data.qpos[0]));
 }

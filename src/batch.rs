@@ -94,9 +94,9 @@ pub fn rollout_with<T: Sync>(
 /// Steps one simulation, recording as asked.
 fn run_one(mut sim: Simulation, options: &BatchOptions) -> Result<Rollout, SimError> {
     let sample = |sim: &Simulation| Sample {
-        time: sim.state.time,
-        q: sim.state.q.as_slice().to_vec(),
-        v: sim.state.v.as_slice().to_vec(),
+        time: sim.data.time,
+        q: sim.data.qpos.as_slice().to_vec(),
+        v: sim.data.qvel.as_slice().to_vec(),
     };
     let mut trajectory = Vec::new();
     let every = options.record_every.filter(|&n| n > 0);

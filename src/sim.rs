@@ -1,12 +1,12 @@
-//! The simulation (DESIGN.md, layer 10): a model behind `Arc`, its [`Data`], the forward [`Plan`],
-//! a [`Stepper`], the state and the controls. The model's `<option>` timestep and integrator are
+//! The simulation (DESIGN.md, layer 10): a model behind `Arc`, its [`Data`] (the state, the
+//! controls and every buffer), a [`Stepper`] and the controllers. The model's `<option>` timestep and integrator are
 //! honoured unless the caller overrides them ([`SimOptions`]); a non-finite state is reported with
 //! the step, time and joint, never propagated.
 
 use crate::constraint::ConstraintMode;
 use crate::dynamics;
-use crate::forward::{DriftCorrection, Plan};
-use crate::integrate::{DormandPrince54, IntegratorKind, State, StepReport, Stepper};
+use crate::forward::DriftCorrection;
+use crate::integrate::{DormandPrince54, IntegratorKind, StepReport, Stepper};
 use crate::kinematics::forward_kinematics;
 use crate::model::{Data, Model};
 use std::sync::Arc;
@@ -51,13 +51,14 @@ pub struct SimOptions {
     pub tolerances: Option<[f64; 2]>,
 }
 
-/// A model, its workspace and plan, a stepper and the current state.
+/// A model, its data (the state, the inputs and every buffer) and a stepper.
 pub struct Simulation {
+    /// The model, with the plan in use (the options' constraint mode and drift correction).
     pub model: Arc<Model>,
-    pub plan: Plan,
+    /// The state (`time`, `qpos`, `qvel`, `act`), the inputs (`ctrl`, `qfrc_applied`) and the
+    /// outputs of the last `forward`.
     pub data: Data,
     pub stepper: Box<dyn Stepper>,
-    pub state: State,
     /// The step size used by [`step`](Self::step). For a fixed-step integrator it is also the
     /// model's timestep (soft constraints' `refsafe`, `actearly`): set here after
     /// [`new`](Self::new), the model follows at the next step.
@@ -82,7 +83,9 @@ pub struct Simulation {
 pub type Controller = Box<dyn FnMut(f64, &[f64], &[f64], &mut [f64]) + Send>;
 
 impl Simulation {
-    /// A simulation from the model's `qpos0` at rest, with `options` over the model's own.
+    /// A simulation from the model's `qpos0` at rest, with `options` over the model's own. A
+    /// constraint mode or drift correction other than the model's plan is written into (a copy
+    /// of) the model, as the timestep is.
     ///
     /// A fixed-step integrator's `timestep` other than the model's is written into (a copy of)
     /// the model: as MuJoCo's `opt.timestep`, the step is also what the soft constraints'
@@ -96,25 +99,29 @@ impl Simulation {
             kind
         });
         let fixed_step = integrator != IntegratorKind::Adaptive;
-        let mut plan = Plan::new(&model, options.constraints);
+        let mut model = model;
+        if let Some(mode) = options.constraints {
+            Arc::make_mut(&mut model).set_constraint_mode(mode);
+        }
         if integrator == IntegratorKind::Variational
-            && plan.mode == ConstraintMode::Soft
-            && plan.has_constraints()
+            && model.plan.mode == ConstraintMode::Soft
+            && model.plan.has_constraints()
         {
             // The variational integrator holds constraints itself (equality multipliers, limits and
             // contacts by projection): the soft model's forces would be left out of its equations.
             let why = format!(
                 "{}, but the variational integrator holds constraints exactly (multipliers and projection), so exact is used",
-                plan.mode_reason
+                model.plan.mode_reason
             );
-            plan = Plan::new(&model, Some(ConstraintMode::Exact));
-            plan.mode_reason = why;
+            let m = Arc::make_mut(&mut model);
+            m.set_constraint_mode(ConstraintMode::Exact);
+            m.plan.mode_reason = why;
         }
         if let Some(drift) = options.drift {
-            plan.drift = drift;
+            Arc::make_mut(&mut model).plan.drift = drift;
         }
-        if plan.has_constraints() {
-            notes.push(format!("constraints: {} ({})", plan.mode.name(), plan.mode_reason));
+        if model.plan.has_constraints() {
+            notes.push(format!("constraints: {} ({})", model.plan.mode.name(), model.plan.mode_reason));
         }
         let mut sim = Self {
             data: Data::new(&model),
@@ -124,11 +131,9 @@ impl Simulation {
                 }
                 _ => integrator.build(&model),
             },
-            state: State::neutral(&model),
             timestep: options.timestep.unwrap_or(model.options.timestep),
             steps: 0,
             notes,
-            plan,
             model,
             controller: None,
             torque_controller: None,
@@ -142,9 +147,7 @@ impl Simulation {
     /// when they differ): what `refsafe` and `actearly` read.
     fn sync_timestep(&mut self) {
         if self.fixed_step && self.model.options.timestep != self.timestep {
-            let mut stepped = (*self.model).clone();
-            stepped.options.timestep = self.timestep;
-            self.model = Arc::new(stepped);
+            Arc::make_mut(&mut self.model).options.timestep = self.timestep;
         }
     }
 
@@ -176,8 +179,8 @@ impl Simulation {
         if let Some(i) = q.iter().chain(v).position(|x| !x.is_finite()) {
             return Err(SimError::BadState(format!("value {i} of (q, v) is not finite")));
         }
-        self.state.q.copy_from_slice(q);
-        self.state.v.copy_from_slice(v);
+        self.data.qpos.copy_from_slice(q);
+        self.data.qvel.copy_from_slice(v);
         Ok(())
     }
 
@@ -194,13 +197,13 @@ impl Simulation {
         if let Some(i) = act.iter().position(|x| !x.is_finite()) {
             return Err(SimError::BadState(format!("value {i} of act is not finite")));
         }
-        self.state.act.copy_from_slice(act);
+        self.data.act.copy_from_slice(act);
         Ok(())
     }
 
     /// The actuator activations of the current state (MuJoCo's `act`).
     pub fn act(&self) -> &[f64] {
-        self.state.act.as_slice()
+        self.data.act.as_slice()
     }
 
     /// Controls, one per actuator (MuJoCo's `ctrl`).
@@ -215,24 +218,24 @@ impl Simulation {
 
     /// Advances one step of `timestep`; a non-finite result is reported, never propagated.
     pub fn step(&mut self) -> Result<StepReport, SimError> {
-        let (t, q, v) = (self.state.time, self.state.q.as_slice(), self.state.v.as_slice());
+        let d = &mut self.data;
+        let (t, q, v) = (d.time, d.qpos.as_slice(), d.qvel.as_slice());
         if let Some(f) = self.controller.as_mut() {
-            f(t, q, v, self.data.ctrl.as_mut_slice());
+            f(t, q, v, d.ctrl.as_mut_slice());
         }
         if let Some(f) = self.torque_controller.as_mut() {
-            f(t, q, v, self.data.qfrc_applied.as_mut_slice());
+            f(t, q, v, d.qfrc_applied.as_mut_slice());
         }
         // `timestep` may have been set after `new`.
         self.sync_timestep();
-        let mut report =
-            self.stepper.step(&self.model, &self.plan, &mut self.data, &mut self.state, self.timestep);
-        if self.plan.soft.is_some() && self.data.nefc > 0 {
+        let mut report = self.stepper.step(&self.model, &mut self.data, self.timestep);
+        if self.model.plan.soft.is_some() && self.data.nefc > 0 {
             report.solver_improvement = self.data.solver_improvement;
         }
         if let Some(f) = self.stepper.failure() {
             return Err(SimError::NotConverged {
                 integrator: self.stepper.name(),
-                time: self.state.time,
+                time: self.data.time,
                 step: self.steps + 1,
                 dt: self.timestep,
                 iterations: f.iterations,
@@ -266,7 +269,7 @@ impl Simulation {
     }
 
     fn check_finite(&self) -> Result<(), SimError> {
-        if self.state.q.iter().chain(self.state.v.iter()).all(|x| x.is_finite()) {
+        if self.data.qpos.iter().chain(self.data.qvel.iter()).all(|x| x.is_finite()) {
             return Ok(());
         }
         // Non-finite values spread through ABA to every joint; the origin is a joint whose
@@ -277,7 +280,7 @@ impl Simulation {
             let d_inv = self.data.d_inv[b][(0, 0)];
             if !d_inv.is_finite() {
                 return Err(SimError::Diverged {
-                    time: self.state.time,
+                    time: self.data.time,
                     step: self.steps,
                     quantity: "articulated inertia about the axis (D⁻¹)",
                     joint: j.name.clone(),
@@ -287,7 +290,7 @@ impl Simulation {
             }
         }
         for (quantity, values, by_dof) in
-            [("position", self.state.q.as_slice(), false), ("velocity", self.state.v.as_slice(), true)]
+            [("position", self.data.qpos.as_slice(), false), ("velocity", self.data.qvel.as_slice(), true)]
         {
             if let Some(i) = values.iter().position(|x| !x.is_finite()) {
                 let joint = self
@@ -302,7 +305,7 @@ impl Simulation {
                     .map(|j| j.name.clone())
                     .unwrap_or_default();
                 return Err(SimError::Diverged {
-                    time: self.state.time,
+                    time: self.data.time,
                     step: self.steps,
                     quantity,
                     joint,
@@ -317,23 +320,29 @@ impl Simulation {
     /// Kinetic and potential energy (T, V: gravity and joint springs) at the current state
     /// (forward kinematics included).
     pub fn energies(&mut self) -> (f64, f64) {
-        let (q, v) = (self.state.q.as_slice(), self.state.v.as_slice());
-        let kinetic = dynamics::kinetic_energy(&self.model, &mut self.data, q, v);
-        (kinetic, dynamics::potential_energy(&self.model, &self.data) + self.model.spring_energy(q))
+        let (q, v) = (std::mem::take(&mut self.data.qpos), std::mem::take(&mut self.data.qvel));
+        let kinetic = dynamics::kinetic_energy(&self.model, &mut self.data, q.as_slice(), v.as_slice());
+        let potential =
+            dynamics::potential_energy(&self.model, &self.data) + self.model.spring_energy(q.as_slice());
+        (self.data.qpos, self.data.qvel) = (q, v);
+        (kinetic, potential)
     }
 
     /// Forward kinematics at the current state (poses in `data`).
     pub fn kinematics(&mut self) {
-        forward_kinematics(&self.model, &mut self.data, self.state.q.as_slice());
+        let q = std::mem::take(&mut self.data.qpos);
+        forward_kinematics(&self.model, &mut self.data, q.as_slice());
+        self.data.qpos = q;
     }
 
     /// max |φ| and max |J v| of the active constraint rows at the current state (0 without rows).
     pub fn constraint_violation(&mut self) -> [f64; 2] {
-        if !self.plan.has_constraints() {
+        if !self.model.plan.has_constraints() {
             return [0.0, 0.0];
         }
-        let (q, v) = (self.state.q.as_slice(), self.state.v.as_slice());
-        self.plan.constraints.evaluate(&self.model, &mut self.data, q, v);
+        let (q, v) = (std::mem::take(&mut self.data.qpos), std::mem::take(&mut self.data.qvel));
+        self.model.plan.constraints.evaluate(&self.model, &mut self.data, q.as_slice(), v.as_slice());
+        (self.data.qpos, self.data.qvel) = (q, v);
         crate::constraint::row_violation(&self.data)
     }
 

@@ -6,9 +6,9 @@
 
 mod common;
 
-use common::{ALGO_REL, FD_REL, FD_STEP};
+use common::{forward_at, with_mode, ALGO_REL, FD_REL, FD_STEP};
 use lagrange::constraint::ConstraintMode;
-use lagrange::forward::{actuation, forward, unsimulated_reason, Plan, Status};
+use lagrange::forward::{actuation, unsimulated_reason, Plan, Status};
 use lagrange::integrate::IntegratorKind;
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::forward_kinematics;
@@ -20,7 +20,8 @@ use std::sync::Arc;
 #[test]
 fn actuator_forces_follow_mujocos_formulas() {
     let model = load(Path::new("tests/data/mjcf/actuators/basic.xml"), &LoadOptions::default()).unwrap();
-    let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+    let model = with_mode(model, ConstraintMode::Exact);
+    let plan = &model.plan;
     let stage = plan.stages.iter().find(|s| s.name == "actuation").unwrap();
     println!("actuation stage: {:?} — {}", stage.status, stage.reason);
     assert_eq!(stage.status, Status::Runs);
@@ -38,7 +39,7 @@ fn actuator_forces_follow_mujocos_formulas() {
     // filter's activation is 0.2: its force is gain · act, whatever the control.
     data.ctrl.copy_from_slice(&[2.0, 0.9, 3.0, 1.5, -0.6, 5.0]);
     data.act[0] = 0.2;
-    forward(&model, &plan, &mut data, &q, &v);
+    forward_at(&model, &mut data, &q, &v);
     let f = data.actuator_force.as_slice();
     let want = [
         50.0 * (1.0 - 0.3) - 3.0 * 1.0, // kp (ctrl − q) − kv q̇, ctrl clamped to 1
@@ -86,12 +87,12 @@ fn actuation_switched_off_or_absent_costs_nothing() {
     assert_eq!((stage.status, stage.reason.as_str()), (Status::Skipped, "no actuators"));
     let options = LoadOptions { disabled_flags: vec!["actuation".into()], ..Default::default() };
     let model = load(Path::new("tests/data/mjcf/actuators/basic.xml"), &options).unwrap();
-    let plan = Plan::new(&model, None);
+    let plan = &model.plan;
     let stage = plan.stages.iter().find(|s| s.name == "actuation").unwrap();
     assert_eq!(stage.status, Status::Skipped);
     let mut data = Data::new(&model);
     data.ctrl.fill(1.0);
-    forward(&model, &plan, &mut data, &[0.0; 4], &[0.0; 4]);
+    forward_at(&model, &mut data, &[0.0; 4], &[0.0; 4]);
     assert_eq!(data.qfrc_actuator.amax(), 0.0);
 }
 
@@ -109,7 +110,8 @@ fn load_mjcf_str(text: &str) -> Result<lagrange::Model, lagrange::io::LoadError>
 fn activation_dynamics_follow_mujocos_formulas() {
     let model = load(Path::new(ACTIVATION), &LoadOptions::default()).unwrap();
     assert_eq!(model.na(), 9);
-    let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+    let model = with_mode(model, ConstraintMode::Exact);
+    let plan = &model.plan;
     let stage = plan.stages.iter().find(|s| s.name == "actuation").unwrap();
     assert!(stage.status == Status::Runs && !stage.reason.contains("not simulated"), "{}", stage.reason);
     let mut data = Data::new(&model);
@@ -118,7 +120,7 @@ fn activation_dynamics_follow_mujocos_formulas() {
     let act = [0.1, 0.2, -0.3, 0.35, 0.9, 0.1, 0.05, 0.4, 1.95];
     data.ctrl.copy_from_slice(&ctrl);
     data.act.copy_from_slice(&act);
-    forward(&model, &plan, &mut data, &q, &v);
+    forward_at(&model, &mut data, &q, &v);
     let h = model.options.timestep;
     // filterexact's next activation: act + act_dot τ (1 − e^(−h/τ)).
     let exact_next = |a: f64, rate: f64, tau: f64| a + rate * tau * (1.0 - (-h / tau).exp());
@@ -263,7 +265,7 @@ fn intvelocity_servo_holds_a_position() {
         sim.step().unwrap();
     }
     // The setpoint is ∫ ctrl dt = 0.5 rad, held once the command stops.
-    let (q, v, act) = (sim.state.q[0], sim.state.v[0], sim.act()[0]);
+    let (q, v, act) = (sim.data.qpos[0], sim.data.qvel[0], sim.act()[0]);
     println!("after 4 s: q {q}, v {v}, act {act}, qacc {}", sim.data.qacc[0]);
     assert!((act - 0.5).abs() < 1e-12, "{act}");
     assert!(v.abs() < 1e-6 && sim.data.qacc[0].abs() < 1e-6, "at rest: v {v}");
@@ -275,7 +277,7 @@ fn intvelocity_servo_holds_a_position() {
     for _ in 0..2000 {
         sim_free.step().unwrap();
     }
-    assert!((sim_free.state.q[0] - q).abs() > 0.5, "without the servo the pendulum falls");
+    assert!((sim_free.data.qpos[0] - q).abs() > 0.5, "without the servo the pendulum falls");
 }
 
 fn activation_free_pendulum() -> Simulation {
@@ -308,7 +310,7 @@ fn fd(model: &lagrange::Model, q: &[f64], k: usize, mut f: impl FnMut(&[f64]) ->
 #[test]
 fn site_transmission_moments_are_length_gradients() {
     let model = load(Path::new(TRANSMISSIONS), &LoadOptions::default()).unwrap();
-    let plan = Plan::new(&model, None);
+    let plan = &model.plan;
     let mut data = Data::new(&model);
     let mut q = model.qpos0.clone();
     let perturb = [
@@ -531,7 +533,7 @@ fn implicitfast_is_implicit_in_actuator_velocity_derivatives() {
         let mut sim = Simulation::new(model, &SimOptions { integrator: Some(kind), ..Default::default() });
         sim.set_state(&[0.0], &[2.0]).unwrap();
         sim.step().unwrap();
-        sim.state.v[0]
+        sim.data.qvel[0]
     };
     let (h, kv, i) = (0.002, 10.0, 0.4 * 0.01);
     let implicit = step(IntegratorKind::ImplicitFast);
@@ -549,10 +551,9 @@ fn tendon_actuator_force_range_scales_its_actuators() {
     let model =
         load(Path::new("tests/data/mjcf/actuators/tendon_force_range.xml"), &LoadOptions::default()).unwrap();
     assert_eq!(model.tendons[0].actuator_force_range, Some([-1.0, 1.0]));
-    let plan = Plan::new(&model, None);
     let mut data = Data::new(&model);
     data.ctrl.copy_from_slice(&[3.0, 1.0, 0.0, 7.0, 5.0]);
-    forward(&model, &plan, &mut data, &[0.0, 0.0], &[0.0, 0.0]);
+    forward_at(&model, &mut data, &[0.0, 0.0], &[0.0, 0.0]);
     // Total on t: 3 + 1 + 0 = 4 > 1: scaled by 1/4 (clamping m1 to its forcerange 2.5 first would
     // give 2.5/3.5 instead).
     let f = data.actuator_force.as_slice();
@@ -560,7 +561,7 @@ fn tendon_actuator_force_range_scales_its_actuators() {
     assert_eq!(f, [0.75, 0.25, 0.0, 7.0, 5.0]);
     // Within the range: unchanged; a total of 0 is left alone.
     data.ctrl.copy_from_slice(&[0.5, -0.2, 0.0, 0.0, 0.0]);
-    forward(&model, &plan, &mut data, &[0.0, 0.0], &[0.0, 0.0]);
+    forward_at(&model, &mut data, &[0.0, 0.0], &[0.0, 0.0]);
     assert_eq!(&data.actuator_force.as_slice()[..3], [0.5, -0.2, 0.0]);
 }
 
@@ -592,7 +593,7 @@ fn a_step_size_override_is_the_timestep_of_actearly() {
         for _ in 0..40 {
             sim.step().unwrap();
         }
-        sim.state.v.clone()
+        sim.data.qvel.clone()
     };
     let mut at_h = file.clone();
     at_h.options.timestep = 0.005;
@@ -600,17 +601,15 @@ fn a_step_size_override_is_the_timestep_of_actearly() {
     assert_eq!(overridden, run(at_h, None), "the override runs the model at its own timestep");
     // The file's model stepped at 0.005 s by its stepper directly: actearly looks 0.002 s ahead.
     let (q, v, ctrl, act) = start(&file);
-    let plan = Plan::new(&file, None);
     let mut stepper = IntegratorKind::Euler.build(&file);
     let mut data = Data::new(&file);
     data.ctrl.as_mut_slice().copy_from_slice(&ctrl);
-    let mut state = lagrange::integrate::State::neutral(&file);
-    state.q.as_mut_slice().copy_from_slice(&q);
-    state.v.as_mut_slice().copy_from_slice(&v);
-    state.act.as_mut_slice().copy_from_slice(&act);
+    data.qpos.as_mut_slice().copy_from_slice(&q);
+    data.qvel.as_mut_slice().copy_from_slice(&v);
+    data.act.as_mut_slice().copy_from_slice(&act);
     for _ in 0..40 {
-        stepper.step(&file, &plan, &mut data, &mut state, 0.005);
+        stepper.step(&file, &mut data, 0.005);
     }
-    let diff = (&overridden - &state.v).amax();
+    let diff = (&overridden - &data.qvel).amax();
     assert!(diff > 1e-9, "actearly's look-ahead step matters here: {diff:e}");
 }

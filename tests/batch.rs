@@ -36,9 +36,9 @@ fn sequential(model: &Arc<Model>, state: &InitialState, options: &BatchOptions) 
     let mut trajectory = vec![];
     let every = options.record_every.unwrap_or(0);
     let sample = |sim: &Simulation| lagrange::batch::Sample {
-        time: sim.state.time,
-        q: sim.state.q.as_slice().to_vec(),
-        v: sim.state.v.as_slice().to_vec(),
+        time: sim.data.time,
+        q: sim.data.qpos.as_slice().to_vec(),
+        v: sim.data.qvel.as_slice().to_vec(),
     };
     if every > 0 {
         trajectory.push(sample(&sim));
@@ -102,6 +102,7 @@ fn parameter_sets_run_in_order() {
         .map(|s| {
             let mut m = (*base).clone();
             m.bodies[1].inertia = m.bodies[1].inertia.scaled(s as f64);
+            m.rebuild_plan();
             Arc::new(m)
         })
         .collect();
@@ -112,7 +113,7 @@ fn parameter_sets_run_in_order() {
         for _ in 0..50 {
             sim.step().unwrap();
         }
-        assert_eq!(result.as_ref().unwrap().last.q, sim.state.q.as_slice());
-        assert_eq!(result.as_ref().unwrap().last.v, sim.state.v.as_slice());
+        assert_eq!(result.as_ref().unwrap().last.q, sim.data.qpos.as_slice());
+        assert_eq!(result.as_ref().unwrap().last.v, sim.data.qvel.as_slice());
     }
 }

@@ -3,6 +3,8 @@
 //! load, refuse only what they refuse — with file, line, element and fix — and never panic, hang,
 //! or load NaN.
 
+mod common;
+
 use lagrange::io::{load, LoadOptions};
 use lagrange::mass::read_mesh;
 use lagrange::spatial::Vec3;
@@ -299,7 +301,6 @@ fn contact_rows_that_move_nothing_get_no_force() {
     // Found by fuzzing (the unmutated panda at a random state): the fingers, overlapping below
     // their limits, touch along a normal that no dof can move (Delassus diagonal 5e-30 beside
     // 1e2); dividing round-off by round-off gave an infinite force and NaN accelerations.
-    use lagrange::forward::{forward, Plan};
     let model =
         load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("models/panda/panda.urdf"), &LoadOptions::default())
             .unwrap();
@@ -325,9 +326,8 @@ fn contact_rows_that_move_nothing_get_no_force() {
         0.2834793965271598,
         -0.2694435487696456,
     ];
-    let plan = Plan::new(&model, None);
     let mut data = lagrange::Data::new(&model);
-    forward(&model, &plan, &mut data, &q, &v);
+    common::forward_at(&model, &mut data, &q, &v);
     assert!(data.contacts.len() >= 4, "{} contacts", data.contacts.len());
     assert!(data.qacc.iter().all(|x| x.is_finite()), "{:?}", data.qacc.as_slice());
     assert!(data.efc_force.iter().take(data.nefc).all(|x| x.is_finite()));
@@ -338,7 +338,6 @@ fn frictional_solve_never_diverges_to_nan() {
     // Found by fuzzing (the unmodified go1 scene at a random state: the trunk 8.6 cm into the
     // floor, four knees beyond their limits, fast slips): projected Gauss–Seidel with the sliding
     // law grew without bound to ±inf. It now restarts with the symmetric cone projection.
-    use lagrange::forward::{forward, Plan};
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/mjcf/unitree_go1/scene.xml");
     let model = load(&path, &LoadOptions::default()).unwrap();
     let q = [
@@ -382,9 +381,9 @@ fn frictional_solve_never_diverges_to_nan() {
         0.07704165357650794,
         0.8557783079830759,
     ];
-    let plan = Plan::new(&model, Some(lagrange::constraint::ConstraintMode::Exact));
+    let model = common::with_mode(model, lagrange::constraint::ConstraintMode::Exact);
     let mut data = lagrange::Data::new(&model);
-    forward(&model, &plan, &mut data, &q, &v);
+    common::forward_at(&model, &mut data, &q, &v);
     assert_eq!(data.contacts.len(), 4);
     assert!(data.qacc.iter().all(|x| x.is_finite()), "{:?}", data.qacc.as_slice());
     assert!(data.efc_converged && data.efc_safe_friction);
@@ -485,9 +484,8 @@ fn negative_and_negative_zero_sizes() {
     let path = dir.join("zero.urdf");
     std::fs::write(&path, robot("-0")).unwrap();
     let m = load(&path, &LoadOptions::default()).unwrap();
-    let plan = lagrange::forward::Plan::new(&m, None);
     let mut data = lagrange::Data::new(&m);
-    lagrange::forward::forward(&m, &plan, &mut data, &[0.3], &[0.0]);
+    common::forward_at(&m, &mut data, &[0.3], &[0.0]);
     assert!(data.qacc[0].is_finite());
     let path = dir.join("negative.urdf");
     std::fs::write(&path, robot("-0.1")).unwrap();

@@ -6,7 +6,7 @@ mod common;
 use common::{rel_err, rel_err_vec, CONSTRAINT_REL, JDOTV_FD_REL, PROJECTED_DRIFT};
 use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{crba, spatial_momentum};
-use lagrange::forward::{forward, DriftCorrection, Plan};
+use lagrange::forward::DriftCorrection;
 use lagrange::integrate::IntegratorKind;
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::{forward_kinematics, forward_velocities};
@@ -23,6 +23,7 @@ use std::sync::Arc;
 fn model(path: &str) -> Model {
     let mut model = load(Path::new(path), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     model.options.flags.limit = false;
+    model.rebuild_plan();
     model
 }
 
@@ -32,14 +33,14 @@ fn model(path: &str) -> Model {
 #[test]
 fn rod_tension_is_the_lagrange_multiplier_notes_1_6() {
     let model = model("models/textbook/rod_pendulum.xml");
-    let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+    let model = common::with_mode(model, ConstraintMode::Exact);
     let mut data = Data::new(&model);
     let (m, g, l) = (1.5, 9.81, 1.0);
     let mut rng = SmallRng::seed_from_u64(16);
     let mut worst = 0.0f64;
     for _ in 0..20 {
         let (theta, theta_dot): (f64, f64) = (rng.random_range(-3.0..3.0), rng.random_range(-5.0..5.0));
-        forward(&model, &plan, &mut data, &[theta, l], &[theta_dot, 0.0]);
+        common::forward_at(&model, &mut data, &[theta, l], &[theta_dot, 0.0]);
         assert_eq!(data.nefc, 1);
         let lambda = data.efc_force[0];
         let tension = -m * l * theta_dot * theta_dot - m * g * theta.cos();
@@ -72,7 +73,7 @@ fn pendulum_on_movable_support_conserves_horizontal_momentum_notes_1_4() {
     );
     sim.set_state(key.qpos.as_ref().unwrap(), key.qvel.as_ref().unwrap()).unwrap();
     let momentum = |sim: &mut Simulation| {
-        let (q, v) = (sim.state.q.clone(), sim.state.v.clone());
+        let (q, v) = (sim.data.qpos.clone(), sim.data.qvel.clone());
         forward_kinematics(&sim.model, &mut sim.data, q.as_slice());
         forward_velocities(&sim.model, &mut sim.data, v.as_slice());
         spatial_momentum(&sim.model, &sim.data).lin.x
@@ -113,7 +114,8 @@ fn kkt_solution_satisfies_dynamics_and_constraints() {
     for file in files {
         let model = model(file);
         assert!(!model.equalities.is_empty(), "{file}: no equality constraints loaded");
-        let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+        let model = common::with_mode(model, ConstraintMode::Exact);
+        let plan = &model.plan;
         let mut data = Data::new(&model);
         let nv = model.nv;
         let (mut e_dyn, mut e_acc, mut e_fd) = (0.0f64, 0.0f64, 0.0f64);
@@ -129,7 +131,7 @@ fn kkt_solution_satisfies_dynamics_and_constraints() {
             lagrange::dynamics::factorize_mass_matrix(&model, &mut data);
             lagrange::constraint::project_velocities(&model, &mut data, &mut v, 0.0, Default::default());
             data.qfrc_applied.copy_from_slice(&tau);
-            forward(&model, &plan, &mut data, &q, &v);
+            common::forward_at(&model, &mut data, &q, &v);
             let n = data.nefc;
             let m = crba(&model, &mut data, &q).clone();
             let qacc = data.qacc.clone();
@@ -208,7 +210,7 @@ fn mimic_full_coordinates_equal_reduced_dynamics() {
         "tests/data/urdf/constraints/mimic_chain.urdf",
     ] {
         let model = model(file);
-        let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+        let model = common::with_mode(model, ConstraintMode::Exact);
         let mut data = Data::new(&model);
         let nv = model.nv;
         // G: one column per independent dof; a mimic dof is multiplier × its leader's column.
@@ -248,7 +250,7 @@ fn mimic_full_coordinates_equal_reduced_dynamics() {
             }
             let tau: Vec<f64> = (0..nv).map(|_| rng.random_range(-1.0..1.0)).collect();
             data.qfrc_applied.copy_from_slice(&tau);
-            forward(&model, &plan, &mut data, &q, v.as_slice());
+            common::forward_at(&model, &mut data, &q, v.as_slice());
             let full = data.qacc.clone();
             let m = crba(&model, &mut data, &q).clone();
             let f = DVector::from_vec(tau) + &data.qfrc_passive - &data.qfrc_bias;

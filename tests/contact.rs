@@ -6,7 +6,7 @@ mod common;
 
 use common::{rel_err, CONTACT_REL, ENERGY_GAIN_REL, PENETRATION_AT_REST};
 use lagrange::constraint::ConstraintMode;
-use lagrange::forward::{forward, Plan};
+use lagrange::forward::forward;
 use lagrange::io::{load, LoadOptions};
 use lagrange::sim::{SimOptions, Simulation};
 use lagrange::spatial::Vec3;
@@ -30,10 +30,10 @@ fn with_friction(file: &str, mu: f64) -> Model {
 /// `forward` at the model's `qpos0` at rest in exact mode. The Gauss–Seidel solve converges
 /// linearly, slowly right at the stick/slip threshold: the tests allow it 10 000 sweeps.
 fn forward_at_rest(model: &Model) -> Data {
-    let mut plan = Plan::new(model, Some(ConstraintMode::Exact));
-    plan.solver.max_iterations = 10_000;
-    let mut data = Data::new(model);
-    forward(model, &plan, &mut data, &model.qpos0, &vec![0.0; model.nv]);
+    let mut model = common::with_mode(model.clone(), ConstraintMode::Exact);
+    model.plan.solver.max_iterations = 10_000;
+    let mut data = Data::new(&model);
+    forward(&model, &mut data);
     data
 }
 
@@ -158,8 +158,8 @@ fn dropped_bodies_come_to_rest_without_sinking_or_gaining_energy() {
             }
         }
     }
-    let v = sim.state.v.amax();
-    let (ball_z, box_z) = (sim.state.q[2], sim.state.q[9]);
+    let v = sim.data.qvel.amax();
+    let (ball_z, box_z) = (sim.data.qpos[2], sim.data.qpos[9]);
     println!(
         "after 3 s: ball z {ball_z:.9}, box z {box_z:.9}, max |v| {v:e}, penetration after settling {depth_settled:e} m, largest energy rise in a step after the impact {rise:e} J"
     );
@@ -190,7 +190,7 @@ fn go1_settles_on_its_floor() {
     let (mut lowest_base, mut lowest_foot, mut max_contacts) = (f64::MAX, f64::MAX, 0);
     for _ in 0..2000 {
         sim.step().unwrap();
-        lowest_base = lowest_base.min(sim.state.q[2]);
+        lowest_base = lowest_base.min(sim.data.qpos[2]);
         sim.kinematics();
         for &f in &feet {
             let g = &model.geoms[f];
@@ -201,8 +201,8 @@ fn go1_settles_on_its_floor() {
     }
     println!(
         "go1 after 2 s: base z {:.4} (lowest {lowest_base:.4}), lowest foot bottom {lowest_foot:e} m, up to {max_contacts} contacts, max |v| {:e}",
-        sim.state.q[2],
-        sim.state.v.amax()
+        sim.data.qpos[2],
+        sim.data.qvel.amax()
     );
     assert!(lowest_base >= 0.05, "base sank to {lowest_base}");
     assert!(lowest_foot >= -PENETRATION_AT_REST, "a foot sank {lowest_foot} m below the floor");
@@ -235,7 +235,7 @@ fn go1_stands_on_its_actuators() {
     let mut lowest = f64::MAX;
     for _ in 0..steps {
         sim.step().unwrap();
-        lowest = lowest.min(sim.state.q[2]);
+        lowest = lowest.min(sim.data.qpos[2]);
     }
     let contacts = (0..sim.data.nefc).filter(|&i| sim.data.efc_is_normal(i)).count();
     println!(
@@ -243,10 +243,10 @@ fn go1_stands_on_its_actuators() {
         steps,
         sim.timestep,
         sim.integrator(),
-        sim.state.q[2],
-        sim.state.v.amax()
+        sim.data.qpos[2],
+        sim.data.qvel.amax()
     );
-    assert!(sim.state.q[2] > 0.25 && sim.state.q[2] < 0.30, "base z {}", sim.state.q[2]);
+    assert!(sim.data.qpos[2] > 0.25 && sim.data.qpos[2] < 0.30, "base z {}", sim.data.qpos[2]);
     assert!(lowest > 0.2, "it should never fall: lowest base z {lowest}");
     assert_eq!(contacts, 4, "standing on its four feet");
 }

@@ -36,7 +36,7 @@ fn controller_sets_the_controls_once_per_step() {
     assert_eq!(sim.data.qfrc_actuator[0], 2.0);
     // The moment arm (MuJoCo's actuator_moment) is the gear: qfrc_actuator = momentᵀ force.
     assert_eq!(sim.data.actuator_moment[(0, 0)], 2.0);
-    let after_5 = sim.state.v[0];
+    let after_5 = sim.data.qvel[0];
     for _ in 0..5 {
         sim.step().unwrap();
     }
@@ -46,7 +46,7 @@ fn controller_sets_the_controls_once_per_step() {
     // of 0.5 N·m, is (2 + 0.5)·5e-3 / I.
     let i = sim.model.bodies[1].inertia.i_origin[(1, 1)];
     assert!((after_5 - 2.0 * 5e-3 / i).abs() < 1e-12 * after_5.abs(), "{after_5}");
-    assert!((sim.state.v[0] - 2.5 * 5e-3 / i).abs() < 1e-12 * sim.state.v[0].abs());
+    assert!((sim.data.qvel[0] - 2.5 * 5e-3 / i).abs() < 1e-12 * sim.data.qvel[0].abs());
 }
 
 /// A horizontal pendulum (no gravity torque at rest) whose joint allows 1.5 N·m of effort.
@@ -63,7 +63,7 @@ fn torque_driven(clamp_effort: bool) -> f64 {
     let mut sim = Simulation::new(model, &sim_options);
     sim.set_torque_controller(|_, _, _, tau| tau[0] = 10.0);
     sim.step().unwrap();
-    sim.state.v[0]
+    sim.data.qvel[0]
 }
 
 #[test]

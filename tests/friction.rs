@@ -6,7 +6,6 @@ mod common;
 
 use common::{rel_err, CONSTRAINT_REL, ENERGY_GAIN_REL, JDOTV_FD_REL, LIMIT_EXCURSION};
 use lagrange::constraint::{ball_angle_axis, ConstraintMode, LimitRow};
-use lagrange::forward::{forward, Plan};
 use lagrange::io::{load, LoadOptions};
 use lagrange::model::{integrate_configuration, EfcType};
 use lagrange::sim::Simulation;
@@ -23,7 +22,7 @@ fn model(file: &str) -> Model {
 #[test]
 fn friction_loss_sticks_below_its_bound_and_slides_at_it() {
     let model = model("friction_loss.xml");
-    let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+    let model = common::with_mode(model, ConstraintMode::Exact);
     let mut data = Data::new(&model);
     let slide = model.joint_id("slide").unwrap();
     let d = model.joints[slide].dof_adr;
@@ -41,7 +40,7 @@ fn friction_loss_sticks_below_its_bound_and_slides_at_it() {
         data.qfrc_applied[d] = push;
         let mut vel = vec![0.0; model.nv];
         vel[d] = v;
-        forward(&model, &plan, &mut data, &q, &vel);
+        common::forward_at(&model, &mut data, &q, &vel);
         let r = (0..data.nefc)
             .find(|&r| data.efc_type[r] == EfcType::FrictionDof && data.efc_id[r] == d)
             .unwrap();
@@ -64,7 +63,7 @@ fn friction_loss_sticks_below_its_bound_and_slides_at_it() {
 #[test]
 fn friction_loss_holds_a_pendulum_below_the_breakaway_angle() {
     let model = model("friction_loss.xml");
-    let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+    let model = common::with_mode(model, ConstraintMode::Exact);
     let mut data = Data::new(&model);
     let hinge = model.joint_id("hinge").unwrap();
     let (qa, d) = (model.joints[hinge].qpos_adr, model.joints[hinge].dof_adr);
@@ -74,13 +73,13 @@ fn friction_loss_holds_a_pendulum_below_the_breakaway_angle() {
     for theta in [0.5 * breakaway, 0.99 * breakaway, -0.9 * breakaway] {
         let mut q = model.qpos0.clone();
         q[qa] = theta;
-        forward(&model, &plan, &mut data, &q, &v);
+        common::forward_at(&model, &mut data, &q, &v);
         println!("θ = {theta:+.4} rad (breakaway {breakaway:.4}): q̈ = {:e}", data.qacc[d]);
         assert!(data.qacc[d].abs() <= 1e-12, "held at rest: q̈ = {}", data.qacc[d]);
     }
     let mut q = model.qpos0.clone();
     q[qa] = 2.0 * breakaway;
-    forward(&model, &plan, &mut data, &q, &v);
+    common::forward_at(&model, &mut data, &q, &v);
     // Free acceleration reduced by f / I about the hinge.
     let inertia = data.qfrc_constraint[d] / (data.qacc[d] - data.qacc_smooth[d]);
     let want = data.qacc_smooth[d] + f / inertia * -data.qacc_smooth[d].signum();
@@ -113,11 +112,11 @@ fn friction_loss_dissipates_and_brings_a_pendulum_to_rest() {
     let breakaway = (0.5f64 / (9.81 * 0.5)).asin();
     println!(
         "after 20 s: θ = {:.5}, v = {:e}, largest energy rise in one step {rise:e} J",
-        sim.state.q[qa], sim.state.v[d]
+        sim.data.qpos[qa], sim.data.qvel[d]
     );
     assert!(rise <= 1e-9, "energy rose by {rise:e} J in a step");
-    assert!(sim.state.v[d].abs() <= 1e-9, "at rest: v = {}", sim.state.v[d]);
-    assert!(sim.state.q[qa].abs() <= breakaway + 1e-9, "rests inside the band: θ = {}", sim.state.q[qa]);
+    assert!(sim.data.qvel[d].abs() <= 1e-9, "at rest: v = {}", sim.data.qvel[d]);
+    assert!(sim.data.qpos[qa].abs() <= breakaway + 1e-9, "rests inside the band: θ = {}", sim.data.qpos[qa]);
 }
 
 /// Resting on its 30° cone, the inverted rod (m = 1 kg, centre of mass l = 0.5 m from the ball)
@@ -125,12 +124,12 @@ fn friction_loss_dissipates_and_brings_a_pendulum_to_rest() {
 #[test]
 fn ball_cone_limit_carries_the_gravity_torque() {
     let model = model("ball_cone.xml");
-    let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+    let model = common::with_mode(model, ConstraintMode::Exact);
     let mut data = Data::new(&model);
     let max_angle = 30f64.to_radians();
     // Rotation by exactly the cone angle about x.
     let q = [(0.5 * max_angle).cos(), (0.5 * max_angle).sin(), 0.0, 0.0];
-    forward(&model, &plan, &mut data, &q, &[0.0; 3]);
+    common::forward_at(&model, &mut data, &q, &[0.0; 3]);
     assert_eq!((data.nefc, data.efc_type[0]), (1, EfcType::LimitJoint));
     let want = 1.0 * 9.81 * 0.5 * max_angle.sin();
     println!("cone multiplier {} vs m g l sin θ = {want}", data.efc_force[0]);
@@ -138,7 +137,7 @@ fn ball_cone_limit_carries_the_gravity_torque() {
     assert!(data.qacc.amax() <= 1e-12, "q̈ = {}", data.qacc);
     // Inside the cone: no row.
     let inside = [(0.2f64).cos(), (0.2f64).sin(), 0.0, 0.0];
-    forward(&model, &plan, &mut data, &inside, &[0.0; 3]);
+    common::forward_at(&model, &mut data, &inside, &[0.0; 3]);
     assert_eq!(data.nefc, 0);
 }
 
@@ -182,7 +181,7 @@ fn ball_cone_holds_a_spinning_rod_without_energy_gain() {
     let (mut worst, mut rise, mut at_limit) = (0.0f64, f64::MIN, 0);
     for _ in 0..5000 {
         sim.step().unwrap();
-        let angle = ball_angle_axis(sim.state.q.as_slice()).0;
+        let angle = ball_angle_axis(sim.data.qpos.as_slice()).0;
         worst = worst.max(angle - max_angle);
         at_limit += usize::from(angle >= max_angle - 1e-9);
         let (t, v) = sim.energies();

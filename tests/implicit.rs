@@ -41,8 +41,8 @@ fn assert_matches_mujoco(mut sim: Simulation, label: &str) {
     for _ in 0..100 {
         sim.step().unwrap();
     }
-    let eq = rel_err_vec(sim.state.q.as_slice(), &MUJOCO_QPOS);
-    let ev = rel_err_vec(sim.state.v.as_slice(), &MUJOCO_QVEL);
+    let eq = rel_err_vec(sim.data.qpos.as_slice(), &MUJOCO_QPOS);
+    let ev = rel_err_vec(sim.data.qvel.as_slice(), &MUJOCO_QVEL);
     println!("{label} vs MuJoCo after 100 steps: q rel {eq:.2e}, v rel {ev:.2e}");
     assert!(eq <= REF_REL && ev <= REF_REL, "{label}: q {eq}, v {ev}");
 }
@@ -79,9 +79,9 @@ fn explicit_euler_diverges_where_implicitfast_is_stable() {
         stable.step().unwrap_or_else(|e| panic!("implicitfast: {e}"));
     }
     assert!(
-        stable.state.v.amax() < 1e-3,
+        stable.data.qvel.amax() < 1e-3,
         "implicitfast after 100 s (decaying: 1.7e-4 measured): v = {}",
-        stable.state.v
+        stable.data.qvel
     );
 }
 
@@ -151,8 +151,8 @@ fn check_implicit(file: &str, q0: &[f64], v0: &[f64], steps: usize, qpos: &[f64]
     for _ in 0..steps {
         sim.step().unwrap();
     }
-    let eq = rel_err_vec(sim.state.q.as_slice(), qpos);
-    let ev = rel_err_vec(sim.state.v.as_slice(), qvel);
+    let eq = rel_err_vec(sim.data.qpos.as_slice(), qpos);
+    let ev = rel_err_vec(sim.data.qvel.as_slice(), qvel);
     println!("{file}: implicit vs MuJoCo after {steps} steps: q rel {eq:.2e}, v rel {ev:.2e}");
     assert!(eq <= REF_REL && ev <= REF_REL, "{file}: q {eq}, v {ev}");
 }

@@ -5,7 +5,6 @@ mod common;
 
 use common::{rel_err, CONSTRAINT_REL, LIMIT_EXCURSION};
 use lagrange::constraint::ConstraintMode;
-use lagrange::forward::{forward, Plan};
 use lagrange::integrate::IntegratorKind;
 use lagrange::io::{load, load_urdf_str, LoadOptions};
 use lagrange::model::EfcType;
@@ -32,21 +31,21 @@ fn arm() -> Model {
 #[test]
 fn hinge_at_its_limit_carries_the_gravity_torque() {
     let model = arm();
-    let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+    let model = common::with_mode(model, ConstraintMode::Exact);
     let mut data = Data::new(&model);
     let (m, g, l) = (2.0, 9.81, 0.5);
-    forward(&model, &plan, &mut data, &[0.0], &[0.0]);
+    common::forward_at(&model, &mut data, &[0.0], &[0.0]);
     assert_eq!((data.nefc, data.efc_type[0]), (1, EfcType::LimitJoint));
     let err = rel_err(data.efc_force[0], m * g * l);
     println!("limit multiplier {} vs m g l = {}: rel err {err:.1e}", data.efc_force[0], m * g * l);
     assert!(err <= CONSTRAINT_REL, "λ = {}", data.efc_force[0]);
     assert!(data.qacc[0].abs() <= 1e-12, "q̈ = {}", data.qacc[0]);
     // Separating (v < 0 leaves the upper bound): no force, the free acceleration.
-    forward(&model, &plan, &mut data, &[0.0], &[-1.0]);
+    common::forward_at(&model, &mut data, &[0.0], &[-1.0]);
     assert_eq!(data.efc_force[0], 0.0);
     assert!(rel_err(data.qacc[0], data.qacc_smooth[0]) <= CONSTRAINT_REL && data.qacc[0] > 0.0);
     // Inside the range no row exists, and forward is ABA's.
-    forward(&model, &plan, &mut data, &[-0.5], &[0.0]);
+    common::forward_at(&model, &mut data, &[-0.5], &[0.0]);
     assert_eq!(data.nefc, 0);
 }
 
@@ -64,16 +63,16 @@ fn impact_on_a_limit_is_inelastic() {
     let (mut worst, mut e_max, mut hit) = (0.0f64, f64::MIN, false);
     for _ in 0..3000 {
         sim.step().unwrap();
-        worst = worst.max(sim.state.q[0]);
-        hit |= sim.state.q[0] >= -1e-9;
+        worst = worst.max(sim.data.qpos[0]);
+        hit |= sim.data.qpos[0] >= -1e-9;
         let (t, v) = sim.energies();
         e_max = e_max.max(t + v - e0);
     }
-    println!("arm into its limit: max q {worst:e}, max E − E0 {e_max:.2e} J, final v {:e}", sim.state.v[0]);
+    println!("arm into its limit: max q {worst:e}, max E − E0 {e_max:.2e} J, final v {:e}", sim.data.qvel[0]);
     assert!(hit, "the arm should reach its bound");
     assert!(worst <= LIMIT_EXCURSION, "passed the bound by {worst:e}");
     assert!(e_max <= 1e-9, "energy increased by {e_max:e}");
-    assert!(sim.state.v[0].abs() <= 1e-9, "at rest on the bound: v = {}", sim.state.v[0]);
+    assert!(sim.data.qvel[0].abs() <= 1e-9, "at rest on the bound: v = {}", sim.data.qvel[0]);
 }
 
 /// The UR5 released under gravity (notes-free: the scene) stays within its joint limits
@@ -91,7 +90,7 @@ fn ur5_stays_within_its_joint_limits() {
         let mut touching = false;
         for j in &model.joints {
             if let Some([lo, hi]) = j.limits {
-                let q = sim.state.q[j.qpos_adr];
+                let q = sim.data.qpos[j.qpos_adr];
                 excursion = excursion.max(lo - q).max(q - hi);
                 touching |= q <= lo || q >= hi;
             }

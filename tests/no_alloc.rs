@@ -4,8 +4,8 @@
 
 use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{aba, bias_forces, crba, factorize_mass_matrix, rnea, solve_mass_matrix};
-use lagrange::forward::{forward, Plan};
-use lagrange::integrate::{IntegratorKind, State};
+use lagrange::forward::forward;
+use lagrange::integrate::IntegratorKind;
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::{forward_kinematics, forward_velocities, frame_jacobian, ReferenceFrame};
 use lagrange::Data;
@@ -97,11 +97,16 @@ fn kernels_and_integrators_do_not_allocate() {
         });
         assert_eq!(kernels, 0, "{file}: kernels allocated {kernels} times");
         // The staged pipeline with the model's constraint rows (projection included in the steps).
-        let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+        let mut model = model;
+        model.set_constraint_mode(ConstraintMode::Exact);
+        let mut data = Data::new(&model);
         data.qfrc_applied.copy_from_slice(&tau);
         data.ctrl.fill(0.5);
         data.act.fill(0.1);
-        let forwards = allocations(|| forward(&model, &plan, &mut data, &q, &v));
+        data.qpos.copy_from_slice(&q);
+        data.qvel.copy_from_slice(&v);
+        forward(&model, &mut data);
+        let forwards = allocations(|| forward(&model, &mut data));
         assert_eq!(forwards, 0, "{file}: forward allocated {forwards} times");
         for kind in [
             IntegratorKind::Euler,
@@ -112,10 +117,11 @@ fn kernels_and_integrators_do_not_allocate() {
             IntegratorKind::Variational,
         ] {
             let mut integrator = kind.build(&model);
-            let mut state = State::new(&model, q.clone(), v.clone());
+            data.qpos.copy_from_slice(&q);
+            data.qvel.copy_from_slice(&v);
             let steps = allocations(|| {
                 for _ in 0..10 {
-                    integrator.step(&model, &plan, &mut data, &mut state, 1e-3);
+                    integrator.step(&model, &mut data, 1e-3);
                 }
             });
             assert_eq!(steps, 0, "{file}: {kind:?} steps allocated {steps} times");
@@ -134,31 +140,35 @@ fn contact_scenes_do_not_allocate() {
         [("models/textbook/incline_box.xml", None), ("models/mjcf/unitree_go1/scene.xml", Some("home"))]
     {
         let model = load(&root.join(file), &LoadOptions::default()).unwrap();
-        let mut data = Data::new(&model);
+        let _data = Data::new(&model);
         let q = match keyframe {
             Some(k) => model.keyframes[model.keyframe_id(k).unwrap()].qpos.clone().unwrap(),
             None => model.qpos0.clone(),
         };
         let v = vec![0.0; model.nv];
         for mode in [ConstraintMode::Exact, ConstraintMode::Soft] {
-            let plan = Plan::new(&model, Some(mode));
+            let mut model = model.clone();
+            model.set_constraint_mode(mode);
+            let mut data = Data::new(&model);
             // Warm up: the warm-start record of the first solve is the only growth (in soft mode,
             // a few steps first, so that the bodies sink into their contacts and the rows exist).
-            let mut state = State::new(&model, q.clone(), v.clone());
+            data.qpos.copy_from_slice(&q);
+            data.qvel.copy_from_slice(&v);
             let mut warm = IntegratorKind::Euler.build(&model);
             for _ in 0..20 {
-                warm.step(&model, &plan, &mut data, &mut state, 1e-3);
+                warm.step(&model, &mut data, 1e-3);
             }
-            let (qs, vs) = (state.q.as_slice().to_vec(), state.v.as_slice().to_vec());
-            forward(&model, &plan, &mut data, &qs, &vs);
-            let forwards = allocations(|| forward(&model, &plan, &mut data, &qs, &vs));
+            let (qs, vs) = (data.qpos.as_slice().to_vec(), data.qvel.as_slice().to_vec());
+            forward(&model, &mut data);
+            let forwards = allocations(|| forward(&model, &mut data));
             assert_eq!(forwards, 0, "{file} {mode:?}: forward allocated {forwards} times");
             for kind in [IntegratorKind::Euler, IntegratorKind::Rk4] {
                 let mut integrator = kind.build(&model);
-                let mut state = State::new(&model, qs.clone(), vs.clone());
+                data.qpos.copy_from_slice(&qs);
+                data.qvel.copy_from_slice(&vs);
                 let steps = allocations(|| {
                     for _ in 0..50 {
-                        integrator.step(&model, &plan, &mut data, &mut state, 1e-3);
+                        integrator.step(&model, &mut data, 1e-3);
                     }
                 });
                 assert_eq!(steps, 0, "{file} {mode:?}: {kind:?} steps allocated {steps} times");

@@ -83,11 +83,11 @@ fn pendulum_on_movable_support_conserves_x_momentum() {
             &SimOptions { integrator: Some(IntegratorKind::Rk4), timestep: Some(dt), ..Default::default() },
         );
         sim.set_state(&[0.0, 1.2], &[0.3, -0.5]).unwrap();
-        let p0 = p_x(&sim.state);
+        let p0 = p_x(&State::of(&sim.data));
         let mut worst = 0.0f64;
-        while sim.state.time < 5.0 - 1e-12 {
+        while sim.data.time < 5.0 - 1e-12 {
             sim.step().unwrap();
-            worst = worst.max((p_x(&sim.state) - p0).abs());
+            worst = worst.max((p_x(&State::of(&sim.data)) - p0).abs());
         }
         worst
     };
@@ -161,10 +161,10 @@ fn simulated_period(model: &Model, kind: IntegratorKind, theta0: f64, dt: f64, t
         &SimOptions { integrator: Some(kind), timestep: Some(dt), ..Default::default() },
     );
     sim.set_state(&[theta0], &[0.0]).unwrap();
-    let mut prev = (sim.state.time, sim.state.q[0], sim.state.v[0]);
+    let mut prev = (sim.data.time, sim.data.qpos[0], sim.data.qvel[0]);
     loop {
         sim.step().unwrap();
-        let now = (sim.state.time, sim.state.q[0], sim.state.v[0]);
+        let now = (sim.data.time, sim.data.qpos[0], sim.data.qvel[0]);
         if now.0 > 0.75 * t_guess && prev.2 > 0.0 && now.2 <= 0.0 {
             let mut acc = |theta: f64, omega: f64| aba(model, &mut data, &[theta], &[omega], &[0.0])[0];
             let (a0, a1) = (acc(prev.1, prev.2), acc(now.1, now.2));

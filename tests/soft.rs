@@ -10,7 +10,7 @@ mod common;
 use common::{rel_err, SOFT_CG_REL, SOFT_REL};
 use lagrange::constraint::soft::impedance::impedance;
 use lagrange::constraint::ConstraintMode;
-use lagrange::forward::{forward, Plan};
+use lagrange::forward::Plan;
 use lagrange::io::{load, LoadOptions};
 use lagrange::model::options::Solver;
 use lagrange::sim::{SimOptions, Simulation};
@@ -57,12 +57,12 @@ fn against_golden(name: &str, solver: Solver) -> (f64, f64) {
         // (measured: 1e-6 after about 20000 sweeps, 1e-7 after 40000).
         model.options.iterations = 40_000;
     }
-    let plan = Plan::new(&model, Some(ConstraintMode::Soft));
+    let model = common::with_mode(model, ConstraintMode::Soft);
     let mut data = Data::new(&model);
     let (mut e_acc, mut e_frc) = (0.0_f64, 0.0_f64);
     for (i, s) in g["states"].as_array().unwrap().iter().enumerate() {
         let (q, v) = (floats(&s["q"]), floats(&s["v"]));
-        forward(&model, &plan, &mut data, &q, &v);
+        common::forward_at(&model, &mut data, &q, &v);
         assert_eq!(data.nefc as u64, s["nefc"].as_u64().unwrap(), "{name} state {i}: rows");
         // qacc relative to the larger of itself and qacc_smooth: a body held at rest by its
         // contacts has qacc ≈ 0 as the difference of gravity-sized terms.
@@ -107,7 +107,7 @@ fn rolling_cylinder_matches_mujocos_soft_error() {
         ..SimOptions::default()
     };
     let mut sim = Simulation::new(model, &options);
-    let x0: Vec<f64> = sim.state.q.as_slice()[..3].to_vec();
+    let x0: Vec<f64> = sim.data.qpos.as_slice()[..3].to_vec();
     let steps = g["steps"].as_u64().unwrap();
     let mut report = None;
     for _ in 0..steps {
@@ -118,7 +118,7 @@ fn rolling_cylinder_matches_mujocos_soft_error() {
     assert!(report.solver_iterations > 0 && report.solver_improvement.is_finite(), "{report:?}");
     let theta = 30f64.to_radians();
     let downhill = [theta.cos(), 0.0, -theta.sin()];
-    let travelled: f64 = (0..3).map(|k| (sim.state.q[k] - x0[k]) * downhill[k]).sum();
+    let travelled: f64 = (0..3).map(|k| (sim.data.qpos[k] - x0[k]) * downhill[k]).sum();
     let t = steps as f64 * g["timestep"].as_f64().unwrap();
     let ours = 2.0 * travelled / (t * t);
     let mujoco = g["acceleration"].as_f64().unwrap();
@@ -178,19 +178,19 @@ fn go1_stands_on_its_servos_as_in_mujoco() {
         (model.qpos0.clone(), vec![0.0; model.nv], vec![0.0; model.actuators.len()], vec![0.0; model.na()]);
     key.apply(&mut q, &mut v, &mut ctrl, &mut act);
     let mut sim = Simulation::new(model.clone(), &SimOptions::default());
-    assert_eq!(sim.plan.mode, ConstraintMode::Soft, "MJCF defaults to soft");
+    assert_eq!(sim.model.plan.mode, ConstraintMode::Soft, "MJCF defaults to soft");
     sim.set_state(&q, &v).unwrap();
     sim.ctrl_mut().copy_from_slice(&ctrl);
     for _ in 0..2500 {
         sim.step().unwrap();
     }
-    let z = sim.state.q[2];
+    let z = sim.data.qpos[2];
     println!(
         "go1 base after 5 s: {z:.10} m, MuJoCo {MUJOCO_HEIGHT} m, difference {:.2e} m",
         z - MUJOCO_HEIGHT
     );
     assert!((z - MUJOCO_HEIGHT).abs() < 0.01, "issue 13: within 1 cm of MuJoCo's; got {z}");
-    assert!(sim.state.v.amax() < 1e-2, "standing still: |v| = {}", sim.state.v.amax());
+    assert!(sim.data.qvel.amax() < 1e-2, "standing still: |v| = {}", sim.data.qvel.amax());
 }
 
 /// Fluid forces (`<option density viscosity wind>`) are not simulated: the plan says so.
@@ -225,7 +225,7 @@ fn variational_integrator_uses_the_exact_mode() {
         ..Default::default()
     };
     let sim = Simulation::new(model, &options);
-    assert_eq!(sim.plan.mode, ConstraintMode::Exact);
+    assert_eq!(sim.model.plan.mode, ConstraintMode::Exact);
     assert!(
         sim.notes.iter().any(|n| n.contains("variational integrator holds constraints exactly")),
         "{:?}",
@@ -249,13 +249,14 @@ fn a_tendon_limit_alone_constrains_the_model() {
         let mut highest = f64::NEG_INFINITY;
         for _ in 0..2000 {
             sim.step().unwrap();
-            let q = &sim.state.q;
+            let q = &sim.data.qpos;
             highest = highest.max(q[0] + 0.5 * q[1] + 0.3 * q[2]);
         }
         highest
     };
     let mut free = model.clone();
     free.options.flags.limit = false;
+    free.rebuild_plan();
     let (held, unheld) = (highest(&model), highest(&free));
     println!("highest tendon length {held:.4} with the limit, {unheld:.4} without (range −0.25..0.25)");
     assert!(unheld > 0.5, "without the limit the chain swings far past it: {unheld}");
@@ -285,14 +286,14 @@ fn a_step_size_override_is_the_timestep_of_the_soft_constraints() {
         if let Some(h) = set_after {
             sim.timestep = h;
         }
-        for (k, v) in sim.state.v.iter_mut().enumerate().skip(6) {
+        for (k, v) in sim.data.qvel.iter_mut().enumerate().skip(6) {
             *v = if k % 2 == 0 { 1.0 } else { -1.0 };
         }
         for _ in 0..25 {
             sim.step().unwrap();
         }
         assert_eq!(sim.model.options.timestep, 0.02);
-        sim.state.q.clone()
+        sim.data.qpos.clone()
     };
     let mut at_h = model.clone();
     at_h.options.timestep = 0.02;

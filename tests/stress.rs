@@ -30,7 +30,7 @@ fn sim(model: &Model, kind: IntegratorKind, dt: f64, q0: &[f64], v0: &[f64]) -> 
 
 /// World angular momentum about the world origin (the pivot or the body origin at 0).
 fn angular_momentum(s: &mut Simulation) -> Vec3 {
-    let (q, v) = (s.state.q.clone(), s.state.v.clone());
+    let (q, v) = (s.data.qpos.clone(), s.data.qvel.clone());
     forward_kinematics(&s.model, &mut s.data, q.as_slice());
     forward_velocities(&s.model, &mut s.data, v.as_slice());
     let h = spatial_momentum(&s.model, &s.data);
@@ -76,14 +76,14 @@ fn free_symmetric_top_precesses_at_eq_91_rate() {
         let (mut phase, mut last, mut w3_err) = (0.0, 0.0f64, 0.0f64);
         for _ in 0..10_000 {
             s.step().unwrap();
-            let angle = s.state.v[4].atan2(s.state.v[3]);
+            let angle = s.data.qvel[4].atan2(s.data.qvel[3]);
             let mut d = angle - last;
             d -= 2.0 * PI * (d / (2.0 * PI)).round();
             phase += d;
             last = angle;
-            w3_err = w3_err.max((s.state.v[5] - w3).abs() / w3);
+            w3_err = w3_err.max((s.data.qvel[5] - w3).abs() / w3);
         }
-        let rate = phase / s.state.time;
+        let rate = phase / s.data.time;
         let err = (rate - omega).abs() / omega;
         println!("free symmetric top, {} dt 1 ms: precession {rate:.10} rad/s vs eq. 91 Ω = {omega}, rel {err:.2e}; ω₃ rel {w3_err:.1e}", kind.name());
         assert!(err <= tol && w3_err <= 1e-10, "{}: Ω rel {err}, ω₃ {w3_err}", kind.name());
@@ -152,9 +152,9 @@ fn intermediate_axis_flip_period_matches_elliptic_integral() {
         let mut s = sim(&model, kind, 1e-3, &q0, &v0);
         let mut crossings = Vec::new();
         let (mut t_prev, mut w_prev) = (0.0, w[1]);
-        while s.state.time < 30.0 {
+        while s.data.time < 30.0 {
             s.step().unwrap();
-            let (t, w2) = (s.state.time, s.state.v[4]);
+            let (t, w2) = (s.data.time, s.data.qvel[4]);
             if w_prev < 0.0 && w2 >= 0.0 {
                 crossings.push(t_prev + (t - t_prev) * (-w_prev) / (w2 - w_prev));
             }
@@ -203,7 +203,7 @@ fn heavy_top_variational_conserves_discrete_momenta_over_100_s() {
     let mut s = sim(&model, IntegratorKind::Variational, 1e-3, &q0, &v0);
     let lz_and_lzp = |s: &mut Simulation| {
         let l = angular_momentum(s);
-        (l.z, l.dot(&body_z_axis(s.state.q.as_slice())))
+        (l.z, l.dot(&body_z_axis(s.data.qpos.as_slice())))
     };
     let (lz0, lzp0) = lz_and_lzp(&mut s);
     let e0 = total_energy(&mut s);
@@ -245,9 +245,9 @@ fn heavy_top_steady_precession_matches_eq_107() {
     let mut s = sim(&model, IntegratorKind::Variational, 1e-3, &q0, &v0);
     let azimuth = |a: &Vec3| a.x.atan2(-a.y);
     let (mut phase, mut last, mut theta_err) = (0.0, 0.0f64, 0.0f64);
-    while s.state.time < 10.0 - 1e-9 {
+    while s.data.time < 10.0 - 1e-9 {
         s.step().unwrap();
-        let a = body_z_axis(s.state.q.as_slice());
+        let a = body_z_axis(s.data.qpos.as_slice());
         theta_err = theta_err.max((a.z.acos() - theta).abs());
         let phi = azimuth(&a);
         let mut d = phi - last;
@@ -255,7 +255,7 @@ fn heavy_top_steady_precession_matches_eq_107() {
         phase += d;
         last = phi;
     }
-    let rate = phase / s.state.time;
+    let rate = phase / s.data.time;
     let err = (rate - phi_dot).abs() / phi_dot;
     println!("steady precession, variational dt 1 ms, 10 s: φ̇ {rate:.8} vs eq. 107 {phi_dot:.8} rad/s (rel {err:.1e}), max |θ − θ₀| {theta_err:.1e} rad");
     assert!(err <= 1e-4 && theta_err <= 1e-4, "φ̇ rel {err}, θ {theta_err}");
@@ -274,7 +274,7 @@ fn sleeping_top_threshold_eq_109() {
         let mut max_tilt: f64 = 0.0;
         for _ in 0..10_000 {
             s.step().unwrap();
-            max_tilt = max_tilt.max(body_z_axis(s.state.q.as_slice()).z.clamp(-1.0, 1.0).acos());
+            max_tilt = max_tilt.max(body_z_axis(s.data.qpos.as_slice()).z.clamp(-1.0, 1.0).acos());
         }
         println!("sleeping top, variational dt 1 ms: S = {factor} × {critical:.3} rad/s → max tilt {max_tilt:.4} rad over 10 s");
         if stays {
@@ -304,7 +304,7 @@ fn chaotic_double_pendulum_divergence_time_grows_as_step_shrinks() {
         for _ in 0..128 {
             reference.step().unwrap();
         }
-        ref_q.push([reference.state.q[0], reference.state.q[1]]);
+        ref_q.push([reference.data.qpos[0], reference.data.qpos[1]]);
     }
     let dts = [4e-3, 2e-3, 1e-3, 5e-4];
     println!("divergence time (s) of the double pendulum from q = (2.0, 2.5): |Δq| > 0.1 rad against RK4 at {h_ref:.2e} s");
@@ -323,7 +323,7 @@ fn chaotic_double_pendulum_divergence_time_grows_as_step_shrinks() {
                             return i as f64 * sample;
                         }
                     }
-                    let d = (s.state.q[0] - r[0]).abs().max((s.state.q[1] - r[1]).abs());
+                    let d = (s.data.qpos[0] - r[0]).abs().max((s.data.qpos[1] - r[1]).abs());
                     if d > 0.1 {
                         return (i + 1) as f64 * sample;
                     }
@@ -411,7 +411,7 @@ fn stiff_spring_damper_implicit_stable_where_euler_diverges() {
     for _ in 0..1000 {
         implicit.step().unwrap_or_else(|e| panic!("implicit: {e}"));
     }
-    let (q, v) = (implicit.state.q[0], implicit.state.v[0]);
+    let (q, v) = (implicit.data.qpos[0], implicit.data.qvel[0]);
     println!("implicit dt 0.01 s after 10 s: q = {q:.2e}, v = {v:.2e}");
     assert!(q.abs() < 1e-6 && v.abs() < 1e-6);
 }

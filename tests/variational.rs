@@ -90,7 +90,7 @@ fn free_body_conserves_spatial_momentum_and_bounds_energy() {
     let v0 = [0.1, -0.2, 0.3, 3.0, 1.0, 2.0];
     let mut s = sim(model, 1e-3, &q0, &v0);
     let momentum = |s: &mut Simulation| {
-        let (q, v) = (s.state.q.clone(), s.state.v.clone());
+        let (q, v) = (s.data.qpos.clone(), s.data.qvel.clone());
         forward_kinematics(&s.model, &mut s.data, q.as_slice());
         forward_velocities(&s.model, &mut s.data, v.as_slice());
         let h = spatial_momentum(&s.model, &s.data);
@@ -130,7 +130,7 @@ fn constrained_loop_holds_the_constraint_and_conserves_momentum() {
     // The keyframe leaves the pivot at x = 0 with the cart: consistent with the connect.
     let mut s = sim(model, 1e-3, &q0, &v0);
     let momentum = |s: &mut Simulation| {
-        let (q, v) = (s.state.q.clone(), s.state.v.clone());
+        let (q, v) = (s.data.qpos.clone(), s.data.qvel.clone());
         forward_kinematics(&s.model, &mut s.data, q.as_slice());
         forward_velocities(&s.model, &mut s.data, v.as_slice());
         spatial_momentum(&s.model, &s.data).lin.x
@@ -198,7 +198,7 @@ fn newton_failure_is_a_typed_error_naming_step_time_and_residual() {
     ] {
         assert!(msg.contains(needle), "missing '{needle}' in: {msg}");
     }
-    assert_eq!(s.state.q.as_slice(), &q0);
+    assert_eq!(s.data.qpos.as_slice(), &q0);
     assert_eq!(s.steps, 0);
 }
 
@@ -213,7 +213,7 @@ fn states_at_rest_with_round_off_forces_converge() {
         for _ in 0..200 {
             s.step().unwrap_or_else(|e| panic!("from {q0:?}: {e}"));
         }
-        let moved = (s.state.q[0] - q0[0]).abs().max(s.state.q[1].abs());
+        let moved = (s.data.qpos[0] - q0[0]).abs().max(s.data.qpos[1].abs());
         println!("double pendulum at rest at {q0:?}: moved {moved:.1e} rad in 0.2 s");
         assert!(moved <= tol, "from {q0:?}: moved {moved}");
     }
@@ -276,26 +276,22 @@ fn command_line_selects_implicit_and_variational() {
 /// within 1e-6 rad of it over 0.2 s (dt = 1 ms).
 #[test]
 fn looser_newton_tolerance_takes_fewer_iterations() {
-    use lagrange::forward::Plan;
-    use lagrange::integrate::{State, Stepper, Variational};
+    use lagrange::integrate::{Stepper, Variational};
     let model = textbook("chain30.xml");
-    let plan = Plan::new(&model, None);
-    let mut start = State::neutral(&model);
-    start.q.add_scalar_mut(0.3);
     let run = |mut stepper: Variational| {
         let mut data = Data::new(&model);
-        let mut state = start.clone();
+        data.qpos.add_scalar_mut(0.3);
         let mut iterations = 0;
         for _ in 0..200 {
-            let report = stepper.step(&model, &plan, &mut data, &mut state, 1e-3);
+            let report = stepper.step(&model, &mut data, 1e-3);
             assert!(report.accepted);
             iterations += report.solver_iterations;
         }
-        (state, iterations)
+        (data.qpos, iterations)
     };
     let (tight, n_tight) = run(Variational::new(&model));
     let (loose, n_loose) = run(Variational::with_tolerance(&model, 1e-10));
-    let diff = (&tight.q - &loose.q).amax();
+    let diff = (&tight - &loose).amax();
     println!("chain30, 200 steps: {n_tight} iterations at round-off, {n_loose} at 1e-10; |Δq| {diff:.1e}");
     assert!(n_loose < n_tight && diff < 1e-6, "{n_loose} vs {n_tight}, Δq {diff}");
 }

@@ -31,9 +31,10 @@ pub use limits::{ball_angle_axis, LimitKind, LimitRow, LIMIT_ACTIVE_DISTANCE};
 pub use rows::{ConstraintModel, RowGeometry, ScalarCoord};
 
 /// Which constraint model `forward` solves.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ConstraintMode {
     /// Rigid constraints: the KKT solution (Lagrange multipliers).
+    #[default]
     Exact,
     /// MuJoCo's soft convex model (solref/solimp, [`soft`]).
     Soft,

@@ -33,9 +33,24 @@ use crate::constraint::{soft, solve_exact};
 use crate::dynamics::{aba, bias_forces, crba, factorize_mass_matrix, solve_mass_matrix};
 use crate::model::{Data, Model};
 
-/// Forward dynamics at (q, v) with the model's passive forces, `data.qfrc_applied` and
-/// `data.ctrl`: every stage of `plan` that runs, in order. The result is `data.qacc`.
-pub fn forward(model: &Model, plan: &Plan, data: &mut Data, q: &[f64], v: &[f64]) {
+/// Forward dynamics at the state in `data` (`qpos`, `qvel`, `act`, `ctrl`, `qfrc_applied`):
+/// every stage of the model's [`Plan`] that runs, in order (MuJoCo's `mj_forward`). The result
+/// is `data.qacc`; the other stages' outputs are in their named buffers.
+pub fn forward(model: &Model, data: &mut Data) {
+    // The stages read the state beside the buffers they write: moved out for the call (no copy,
+    // no allocation) and back.
+    let q = std::mem::take(&mut data.qpos);
+    let v = std::mem::take(&mut data.qvel);
+    forward_at(model, data, q.as_slice(), v.as_slice());
+    data.qpos = q;
+    data.qvel = v;
+}
+
+/// [`forward`] at a configuration and velocity other than the state's: the steppers' stages
+/// (`q₀ ⊕ θ`, a stage velocity) and the drift correction evaluate here; `data.qpos` and
+/// `data.qvel` are neither read nor written.
+pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+    let plan = &model.plan;
     let cm = &plan.constraints;
     let m_path = match &plan.soft {
         // Soft (the plan has its weights only when the model has constraint rows): collision with

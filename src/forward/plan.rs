@@ -75,8 +75,11 @@ impl Default for DriftCorrection {
     }
 }
 
-/// The per-model plan of [`forward`](super::forward).
-#[derive(Clone, Debug)]
+/// The per-model plan of [`forward`](super::forward): part of the compiled [`Model`]
+/// ([`Model::plan`]), built when the model is compiled and rebuilt by
+/// [`Model::set_constraint_mode`] and [`Model::rebuild_plan`]. The default is the empty plan of a
+/// model without elements (what a model holds while it is being compiled).
+#[derive(Clone, Debug, Default)]
 pub struct Plan {
     pub stages: Vec<Stage>,
     /// The constraint mode used, and why (requested, the format's default, or a fallback).

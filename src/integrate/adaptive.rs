@@ -15,7 +15,7 @@
 
 use super::stage::{evaluate_stage, StageInput};
 use super::{correct_drift, State, StepReport, Stepper};
-use crate::forward::{clamp_activations, Plan};
+use crate::forward::clamp_activations;
 use crate::model::{integrate_configuration, Data, JointKind, Model};
 use nalgebra::DVector;
 
@@ -40,6 +40,8 @@ pub const DEFAULT_ATOL: f64 = 1e-10;
 
 /// Dormand–Prince 5(4) stepper with error control.
 pub struct DormandPrince54 {
+    /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
+    stage_act: DVector<f64>,
     pub rtol: f64,
     pub atol: f64,
     /// The internal step size proposed for the next step (None before the first).
@@ -69,6 +71,7 @@ impl DormandPrince54 {
             }
         }
         Self {
+            stage_act: DVector::zeros(model.na()),
             rtol,
             atol,
             h_proposed: None,
@@ -85,7 +88,7 @@ impl DormandPrince54 {
 
     /// One internal step of size h from `state` (left unchanged); the stages are left in the
     /// buffers. Returns the scaled error norm.
-    fn attempt(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &State, h: f64) -> f64 {
+    fn attempt(&mut self, model: &Model, data: &mut Data, state: &State, h: f64) -> f64 {
         // The first stage picks the limit and contact rows; the later ones keep them.
         data.thaw_rows();
         for i in 0..7 {
@@ -99,7 +102,6 @@ impl DormandPrince54 {
             }
             evaluate_stage(
                 model,
-                plan,
                 data,
                 StageInput { q0: &state.q, theta: &self.theta, v_stage: &self.v_stage },
                 &mut self.q_stage,
@@ -155,7 +157,19 @@ impl Stepper for DormandPrince54 {
     fn order(&self) -> u32 {
         5
     }
-    fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
+    fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
+        let mut stage_act = std::mem::take(&mut self.stage_act);
+        let mut state = State::take(data, &mut stage_act);
+        let report = self.advance(model, data, &mut state, h);
+        state.put(data, &mut stage_act);
+        self.stage_act = stage_act;
+        report
+    }
+}
+
+impl DormandPrince54 {
+    /// One step of the method on the state moved out of `data` ([`State::take`]).
+    fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         let t_end = state.time + h;
         let mut h_try = self.h_proposed.unwrap_or(h).min(h);
         let mut max_err: f64 = 0.0;
@@ -167,7 +181,7 @@ impl Stepper for DormandPrince54 {
             }
             let last = h_try >= remaining;
             let h_step = if last { remaining } else { h_try };
-            let err = self.attempt(model, plan, data, state, h_step);
+            let err = self.attempt(model, data, state, h_step);
             let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
             if err <= 1.0 && err.is_finite() {
                 state.v.copy_from(&self.v_stage);
@@ -194,7 +208,7 @@ impl Stepper for DormandPrince54 {
                         error_estimate: Some(err),
                         substeps: accepted,
                         rejected,
-                        ..StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
+                        ..StepReport::fixed_step(h, correct_drift(model, data, state, h))
                     };
                 }
             }
@@ -205,7 +219,7 @@ impl Stepper for DormandPrince54 {
             error_estimate: Some(max_err),
             substeps: accepted,
             rejected,
-            ..StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
+            ..StepReport::fixed_step(h, correct_drift(model, data, state, h))
         }
     }
 }

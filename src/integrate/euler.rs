@@ -5,18 +5,20 @@
 
 use super::implicit_fast::implicit_acceleration;
 use super::{correct_drift, State, StepReport, Stepper};
-use crate::forward::{advance_activations, forward, Plan};
+use crate::forward::{advance_activations, forward_at};
 use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
 /// Semi-implicit Euler stepper, with its buffer for the implicitly damped acceleration.
 pub struct SemiImplicitEuler {
+    /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
+    stage_act: DVector<f64>,
     damped: DVector<f64>,
 }
 
 impl SemiImplicitEuler {
     pub fn new(model: &Model) -> Self {
-        Self { damped: DVector::zeros(model.nv) }
+        Self { stage_act: DVector::zeros(model.na()), damped: DVector::zeros(model.nv) }
     }
 }
 
@@ -27,9 +29,21 @@ impl Stepper for SemiImplicitEuler {
     fn order(&self) -> u32 {
         1
     }
-    fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
+    fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
+        let mut stage_act = std::mem::take(&mut self.stage_act);
+        let mut state = State::take(data, &mut stage_act);
+        let report = self.advance(model, data, &mut state, h);
+        state.put(data, &mut stage_act);
+        self.stage_act = stage_act;
+        report
+    }
+}
+
+impl SemiImplicitEuler {
+    /// One step of the method on the state moved out of `data` ([`State::take`]).
+    fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         data.act.copy_from(&state.act);
-        forward(model, plan, data, state.q.as_slice(), state.v.as_slice());
+        forward_at(model, data, state.q.as_slice(), state.v.as_slice());
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         let flags = &model.options.flags;
         if flags.eulerdamp
@@ -42,6 +56,6 @@ impl Stepper for SemiImplicitEuler {
         }
         integrate_configuration(model, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
-        StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
+        StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }
 }

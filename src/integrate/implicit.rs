@@ -13,12 +13,14 @@
 use super::bias_derivative::BiasDerivative;
 use super::{add_force_derivative, correct_drift, State, StepReport, Stepper};
 use crate::dynamics::crba;
-use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward, Plan};
+use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
 use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::{DMatrix, DVector};
 
 /// The implicit stepper with its derivative pass, LU matrix and force buffer.
 pub struct Implicit {
+    /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
+    stage_act: DVector<f64>,
     derivative: BiasDerivative,
     lu: DMatrix<f64>,
     force: DVector<f64>,
@@ -27,6 +29,7 @@ pub struct Implicit {
 impl Implicit {
     pub fn new(model: &Model) -> Self {
         Self {
+            stage_act: DVector::zeros(model.na()),
             derivative: BiasDerivative::new(model),
             lu: DMatrix::zeros(model.nv, model.nv),
             force: DVector::zeros(model.nv),
@@ -78,10 +81,22 @@ impl Stepper for Implicit {
     fn order(&self) -> u32 {
         1
     }
-    fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
+    fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
+        let mut stage_act = std::mem::take(&mut self.stage_act);
+        let mut state = State::take(data, &mut stage_act);
+        let report = self.advance(model, data, &mut state, h);
+        state.put(data, &mut stage_act);
+        self.stage_act = stage_act;
+        report
+    }
+}
+
+impl Implicit {
+    /// One step of the method on the state moved out of `data` ([`State::take`]).
+    fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         let nv = model.nv;
         data.act.copy_from(&state.act);
-        forward(model, plan, data, state.q.as_slice(), state.v.as_slice());
+        forward_at(model, data, state.q.as_slice(), state.v.as_slice());
         // Activations as in MuJoCo's `mj_advance` (explicit in act_dot; filterexact exact).
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         crba(model, data, state.q.as_slice());
@@ -98,7 +113,7 @@ impl Stepper for Implicit {
             add_actuator_velocity_derivative(
                 model,
                 data,
-                &plan.actuator_bias_velocity,
+                &model.plan.actuator_bias_velocity,
                 self.lu.as_mut_slice(),
                 h,
             );
@@ -108,6 +123,6 @@ impl Stepper for Implicit {
         state.v.axpy(h, &self.force, 1.0);
         integrate_configuration(model, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
-        StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
+        StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }
 }

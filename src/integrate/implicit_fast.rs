@@ -14,18 +14,20 @@
 
 use super::{correct_drift, State, StepReport, Stepper};
 use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
-use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward, Plan};
+use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
 use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
 /// The implicitfast stepper with its force buffer.
 pub struct ImplicitFast {
+    /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
+    stage_act: DVector<f64>,
     force: DVector<f64>,
 }
 
 impl ImplicitFast {
     pub fn new(model: &Model) -> Self {
-        Self { force: DVector::zeros(model.nv) }
+        Self { stage_act: DVector::zeros(model.na()), force: DVector::zeros(model.nv) }
     }
 }
 
@@ -83,13 +85,25 @@ impl Stepper for ImplicitFast {
     fn order(&self) -> u32 {
         1
     }
-    fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
+    fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
+        let mut stage_act = std::mem::take(&mut self.stage_act);
+        let mut state = State::take(data, &mut stage_act);
+        let report = self.advance(model, data, &mut state, h);
+        state.put(data, &mut stage_act);
+        self.stage_act = stage_act;
+        report
+    }
+}
+
+impl ImplicitFast {
+    /// One step of the method on the state moved out of `data` ([`State::take`]).
+    fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         data.act.copy_from(&state.act);
-        forward(model, plan, data, state.q.as_slice(), state.v.as_slice());
+        forward_at(model, data, state.q.as_slice(), state.v.as_slice());
         // Activations as in MuJoCo's `mj_advance` (explicit in act_dot; filterexact exact).
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         let actuated = !model.actuators.is_empty() && model.options.flags.actuation;
-        let bias_velocity = actuated.then_some(plan.actuator_bias_velocity.as_slice());
+        let bias_velocity = actuated.then_some(model.plan.actuator_bias_velocity.as_slice());
         if implicit_acceleration(model, data, state.q.as_slice(), &mut self.force, h, bias_velocity) {
             state.v.axpy(h, &self.force, 1.0);
         } else {
@@ -97,6 +111,6 @@ impl Stepper for ImplicitFast {
         }
         integrate_configuration(model, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
-        StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
+        StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }
 }

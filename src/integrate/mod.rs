@@ -27,14 +27,17 @@ pub use rk4::RungeKutta4;
 pub use variational::{Variational, CONSTRAINT_TOL, RESIDUAL_TOL};
 
 use crate::constraint::{project_positions, project_velocities, row_violation};
-use crate::forward::{DriftCorrection, Plan};
+use crate::forward::DriftCorrection;
 use crate::model::{options, Data, Model};
 use nalgebra::DVector;
 
-/// The state advanced by a stepper, in MuJoCo's qpos/qvel/act layout: `act` holds the actuator
-/// activations (MuJoCo's `act`, `na` values; empty without activation dynamics), integrated from
-/// the actuation stage's `act_dot` as MuJoCo does (`filterexact` exactly, then clamped to
-/// `actrange`; [`advance_activations`](crate::forward::advance_activations)).
+/// A simulation state by value: a snapshot of [`Data`]'s state ([`State::of`]), and what a
+/// stepper advances while the state is moved out of `Data` for the duration of one step
+/// (`State::take`, `State::put`: the stages evaluate `forward` at other configurations,
+/// velocities and activations than the step's start, which the stepper keeps here). `act` holds
+/// the actuator activations (MuJoCo's `act`, `na` values; empty without activation dynamics),
+/// integrated from the actuation stage's `act_dot` as MuJoCo does (`filterexact` exactly, then
+/// clamped to `actrange`; [`advance_activations`](crate::forward::advance_activations)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct State {
     pub time: f64,
@@ -44,14 +47,25 @@ pub struct State {
 }
 
 impl State {
-    /// The model's reference configuration (`qpos0`) at rest, time 0.
-    pub fn neutral(model: &Model) -> Self {
-        Self::new(model, model.qpos0.clone(), vec![0.0; model.nv])
+    /// A copy of the state in `data` (`time`, `qpos`, `qvel`, `act`).
+    pub fn of(data: &Data) -> Self {
+        Self { time: data.time, q: data.qpos.clone(), v: data.qvel.clone(), act: data.act.clone() }
     }
 
-    /// The state (q, v) at time 0 with zero activations.
-    pub fn new(model: &Model, q: Vec<f64>, v: Vec<f64>) -> Self {
-        Self { time: 0.0, q: DVector::from_vec(q), v: DVector::from_vec(v), act: DVector::zeros(model.na()) }
+    /// Moves the state out of `data` (no copy, no allocation): `data.qpos` and `data.qvel` are
+    /// left empty and `data.act` becomes the stepper's stage buffer `act_stage` (na values),
+    /// which the stages fill before each `forward`.
+    pub(crate) fn take(data: &mut Data, act_stage: &mut DVector<f64>) -> Self {
+        let act = std::mem::replace(&mut data.act, std::mem::take(act_stage));
+        Self { time: data.time, q: std::mem::take(&mut data.qpos), v: std::mem::take(&mut data.qvel), act }
+    }
+
+    /// Moves the state back into `data` and the stage buffer back to the stepper.
+    pub(crate) fn put(self, data: &mut Data, act_stage: &mut DVector<f64>) {
+        *act_stage = std::mem::replace(&mut data.act, self.act);
+        data.time = self.time;
+        data.qpos = self.q;
+        data.qvel = self.v;
     }
 }
 
@@ -122,11 +136,12 @@ pub trait Stepper: Send {
     fn name(&self) -> &'static str;
     /// Order of the global error in the step size for smooth problems.
     fn order(&self) -> u32;
-    /// Advances `state` by `h` with the inputs in `data` (`qfrc_applied`, `ctrl`). The soft
-    /// constraints' `refsafe` and `actearly` read `model.options.timestep`, as MuJoCo's read
-    /// `opt.timestep`: for MuJoCo's behaviour it equals h ([`Simulation`](crate::sim::Simulation)
-    /// keeps the two equal for the fixed-step integrators).
-    fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport;
+    /// Advances the state in `data` (`time`, `qpos`, `qvel`, `act`) by `h` with the inputs in
+    /// `data` (`ctrl`, `qfrc_applied`) held over the step. The soft constraints' `refsafe` and
+    /// `actearly` read `model.options.timestep`, as MuJoCo's read `opt.timestep`: for MuJoCo's
+    /// behaviour it equals h ([`Simulation`](crate::sim::Simulation) keeps the two equal for the
+    /// fixed-step integrators).
+    fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport;
     /// Why the last step was not taken, if it was not (a Newton iteration that failed).
     fn failure(&self) -> Option<StepFailure> {
         None
@@ -138,13 +153,8 @@ pub trait Stepper: Send {
 /// the step), if `drift.projection`. In soft mode nothing is projected (as in MuJoCo); the soft
 /// solve's iterations and its rows' violation at the last stage are returned. Returns (iterations, [max |φ|,
 /// max |J v|]) after the correction; no work without constraint rows.
-pub fn correct_drift(
-    model: &Model,
-    plan: &Plan,
-    data: &mut Data,
-    state: &mut State,
-    h: f64,
-) -> (u32, [f64; 2]) {
+pub(crate) fn correct_drift(model: &Model, data: &mut Data, state: &mut State, h: f64) -> (u32, [f64; 2]) {
+    let plan = &model.plan;
     if !plan.has_constraints() {
         data.thaw_rows();
         return (0, [0.0, 0.0]);

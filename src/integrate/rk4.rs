@@ -12,12 +12,14 @@
 
 use super::stage::{evaluate_stage, StageInput};
 use super::{correct_drift, State, StepReport, Stepper};
-use crate::forward::{advance_activations, Plan};
+use crate::forward::advance_activations;
 use crate::model::{integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
 /// RK4 stepper with its stage buffers.
 pub struct RungeKutta4 {
+    /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
+    stage_act: DVector<f64>,
     q_stage: DVector<f64>,
     v_stage: DVector<f64>,
     theta: DVector<f64>,
@@ -32,6 +34,7 @@ impl RungeKutta4 {
     pub fn new(model: &Model) -> Self {
         let z = || DVector::zeros(model.nv);
         Self {
+            stage_act: DVector::zeros(model.na()),
             q_stage: DVector::zeros(model.nq),
             v_stage: z(),
             theta: z(),
@@ -50,7 +53,19 @@ impl Stepper for RungeKutta4 {
     fn order(&self) -> u32 {
         4
     }
-    fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
+    fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
+        let mut stage_act = std::mem::take(&mut self.stage_act);
+        let mut state = State::take(data, &mut stage_act);
+        let report = self.advance(model, data, &mut state, h);
+        state.put(data, &mut stage_act);
+        self.stage_act = stage_act;
+        report
+    }
+}
+
+impl RungeKutta4 {
+    /// One step of the method on the state moved out of `data` ([`State::take`]).
+    fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         // Stage i evaluates at q₀ ⊕ θᵢ, v₀ + cᵢ h a_{i−1} with θᵢ = cᵢ h θ̇_{i−1}, c = (0, ½, ½, 1).
         const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
         for i in 0..4 {
@@ -66,7 +81,6 @@ impl Stepper for RungeKutta4 {
             }
             evaluate_stage(
                 model,
-                plan,
                 data,
                 StageInput { q0: &state.q, theta: &self.theta, v_stage: &self.v_stage },
                 &mut self.q_stage,
@@ -92,6 +106,6 @@ impl Stepper for RungeKutta4 {
         advance_activations(model, state.act.as_mut_slice(), self.act_mean.as_slice(), h);
         integrate_configuration(model, state.q.as_mut_slice(), self.theta.as_slice(), 1.0);
         state.time += h;
-        StepReport::fixed_step(h, correct_drift(model, plan, data, state, h))
+        StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }
 }

@@ -4,7 +4,7 @@
 //! the acceleration, and the slope of θ is dexp⁻¹(θ) v (Iserles et al., *Lie-group methods*,
 //! Acta Numerica 2000, §3.3).
 
-use crate::forward::{forward, Plan};
+use crate::forward::forward_at;
 use crate::model::{dexp_inv_configuration, integrate_configuration, Data, Model};
 use nalgebra::DVector;
 
@@ -18,7 +18,6 @@ pub(super) struct StageInput<'a> {
 /// Evaluates the stage: `accel` ← qacc(q₀ ⊕ θ, v), `theta_rate` ← dexp⁻¹(θ) v.
 pub(super) fn evaluate_stage(
     model: &Model,
-    plan: &Plan,
     data: &mut Data,
     input: StageInput,
     q_stage: &mut DVector<f64>,
@@ -26,7 +25,7 @@ pub(super) fn evaluate_stage(
 ) {
     q_stage.copy_from(input.q0);
     integrate_configuration(model, q_stage.as_mut_slice(), input.theta.as_slice(), 1.0);
-    forward(model, plan, data, q_stage.as_slice(), input.v_stage.as_slice());
+    forward_at(model, data, q_stage.as_slice(), input.v_stage.as_slice());
     accel.copy_from(&data.qacc);
     dexp_inv_configuration(
         model,

@@ -49,7 +49,7 @@
 use super::lagrangian_terms::LagrangianTerms;
 use super::{correct_drift, State, StepFailure, StepReport, Stepper};
 use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
-use crate::forward::{actuation, advance_activations, passive, Plan};
+use crate::forward::{actuation, advance_activations, passive};
 use crate::kinematics::forward_kinematics;
 use crate::model::{dexp_inv_configuration, integrate_configuration, Data, EfcType, JointKind, Model};
 use nalgebra::{DMatrix, DVector};
@@ -116,6 +116,8 @@ fn guarded_lu_solve(a: &mut [f64], n: usize, ld: usize, x: &mut [f64]) {
 
 /// The variational stepper with its buffers (allocated once per model).
 pub struct Variational {
+    /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
+    stage_act: DVector<f64>,
     terms0: LagrangianTerms,
     terms1: LagrangianTerms,
     xi: DVector<f64>,
@@ -251,6 +253,7 @@ impl Variational {
         let rows = 6 * crate::constraint::ConstraintModel::new(model).equalities.len();
         let z = || DVector::zeros(nv);
         Self {
+            stage_act: DVector::zeros(model.na()),
             terms0: LagrangianTerms::new(model),
             terms1: LagrangianTerms::new(model),
             xi: z(),
@@ -324,7 +327,8 @@ impl Variational {
     }
 
     /// The active equality rows at q into `data.efc_j`, `data.efc_pos` (rows 0..m); returns m.
-    fn equality_rows(&self, model: &Model, plan: &Plan, data: &mut Data, q: &[f64]) -> usize {
+    fn equality_rows(&self, model: &Model, data: &mut Data, q: &[f64]) -> usize {
+        let plan = &model.plan;
         if !self.has_equalities || !plan.has_constraints() {
             return 0;
         }
@@ -344,7 +348,19 @@ impl Stepper for Variational {
     fn failure(&self) -> Option<StepFailure> {
         self.failure
     }
-    fn step(&mut self, model: &Model, plan: &Plan, data: &mut Data, state: &mut State, h: f64) -> StepReport {
+    fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
+        let mut stage_act = std::mem::take(&mut self.stage_act);
+        let mut state = State::take(data, &mut stage_act);
+        let report = self.advance(model, data, &mut state, h);
+        state.put(data, &mut stage_act);
+        self.stage_act = stage_act;
+        report
+    }
+}
+
+impl Variational {
+    /// One step of the method on the state moved out of `data` ([`State::take`]).
+    fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         self.failure = None;
         let nv = model.nv;
         let q0 = state.q.as_slice();
@@ -353,7 +369,7 @@ impl Stepper for Variational {
         // The drive, held over the step (with the activations at the step's start).
         if !model.actuators.is_empty() {
             data.act.copy_from(&state.act);
-            actuation(model, data, q0, state.v.as_slice(), &plan.actuator_bias_velocity);
+            actuation(model, data, q0, state.v.as_slice(), &model.plan.actuator_bias_velocity);
         }
         for k in 0..nv {
             let limit = model.dof_effort_limit[k];
@@ -372,7 +388,7 @@ impl Stepper for Variational {
             self.chord_factor.copy_from(&self.mass_factor);
         }
         // Equality rows at q_k: J_k and Y = C⁻¹ J_kᵀ.
-        let m = self.equality_rows(model, plan, data, q0);
+        let m = self.equality_rows(model, data, q0);
         for i in 0..m {
             for k in 0..nv {
                 self.jac_k[(i, k)] = data.efc_j[(i, k)];
@@ -444,7 +460,7 @@ impl Stepper for Variational {
             self.dxi.copy_from(&self.residual);
             solve_with_factor(model, &self.chord_factor, self.dxi.as_mut_slice());
             if m > 0 {
-                self.equality_rows(model, plan, data, self.q1.as_slice());
+                self.equality_rows(model, data, self.q1.as_slice());
                 phi_max = data.efc_pos.rows(0, m).amax();
                 // S = h J₁ Y, rhs = −φ − h J₁ C⁻¹ R.
                 for i in 0..m {
@@ -588,12 +604,13 @@ impl Stepper for Variational {
         if !model.actuators.is_empty() {
             advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         }
+        let plan = &model.plan;
         let others = plan.has_constraints()
             && (!plan.constraints.limits.is_empty()
                 || !plan.constraints.friction.is_empty()
                 || plan.constraints.has_collision());
         let (extra_iterations, violation) =
-            if others { correct_drift(model, plan, data, state, h) } else { (0, [phi_max, jv_max]) };
+            if others { correct_drift(model, data, state, h) } else { (0, [phi_max, jv_max]) };
         self.last_v1.copy_from(&state.v);
         StepReport::fixed_step(h, (iterations + extra_iterations, violation))
     }

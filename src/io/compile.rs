@@ -279,6 +279,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         body_root,
         elements: spec.elements.clone(),
         warnings,
+        plan: crate::forward::Plan::default(),
     };
     let mut e = crate::io::compile_elements::compile_elements(spec, &model)?;
     model.equalities = e.equalities;
@@ -321,6 +322,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             ),
         });
     }
+    model.plan = crate::forward::Plan::new(&model, None);
     Ok(model)
 }
 

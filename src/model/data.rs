@@ -157,11 +157,25 @@ impl SoftWork {
     }
 }
 
-/// Buffers every algorithm writes into. `Data::new(&model)` allocates them all; afterwards the
-/// algorithms allocate nothing. Per-body arrays are indexed by body (0 = world), per-dof arrays by
-/// degree of freedom.
+/// The simulation state and every buffer the algorithms write into (MuJoCo's `mjData`).
+/// `Data::new(&model)` allocates them all; afterwards the algorithms allocate nothing. Per-body
+/// arrays are indexed by body (0 = world), per-dof arrays by degree of freedom.
+///
+/// The state is `time`, `qpos`, `qvel`, `act`, and the inputs `ctrl` and `qfrc_applied`: a
+/// stepper advances it, [`forward`](crate::forward::forward) reads it. Everything else is an
+/// output of the stages or scratch.
 #[derive(Clone, Debug)]
 pub struct Data {
+    // --- state (MuJoCo's names) ---
+    /// Simulation time (s).
+    pub time: f64,
+    /// Generalized coordinates, nq values in MuJoCo's layout (a free joint's position then its
+    /// unit quaternion w x y z; a ball joint's quaternion; one value per hinge and slide).
+    pub qpos: DVector<f64>,
+    /// Generalized velocities, nv values (a free joint's linear velocity in the world frame, then
+    /// its angular velocity in the body frame; a ball joint's body-frame angular velocity).
+    pub qvel: DVector<f64>,
+
     /// Pose of each body frame in its parent body frame (joint placement · joint transform).
     pub x_parent_body: Vec<Transform>,
     /// Pose of each body frame in the world.
@@ -211,7 +225,7 @@ pub struct Data {
     /// Controls, one per actuator (MuJoCo's `ctrl`).
     pub ctrl: DVector<f64>,
     /// Actuator activations, one per activation state (MuJoCo's `act`, `na` values in actuator
-    /// order): an input of `forward` like `ctrl`, set from the integrator's state.
+    /// order): part of the state, advanced by the steppers from `act_dot`.
     pub act: DVector<f64>,
     /// Time derivative of `act` (MuJoCo's `act_dot`), written by the actuation stage.
     pub act_dot: DVector<f64>,
@@ -368,7 +382,8 @@ pub struct Data {
 }
 
 impl Data {
-    /// Allocates every buffer for `model`.
+    /// Allocates every buffer for `model`; the state is the model's `qpos0` at rest at time 0,
+    /// with zero controls, activations and applied forces (MuJoCo's `mj_makeData`).
     pub fn new(model: &Model) -> Self {
         let nb = model.nbody();
         let nv = model.nv;
@@ -384,6 +399,9 @@ impl Data {
             + model.joints.iter().filter(|j| j.friction > 0.0).map(|j| j.kind.nv()).sum::<usize>()
             + 6 * model.max_contacts().min(INITIAL_CONTACT_ROWS);
         Self {
+            time: 0.0,
+            qpos: DVector::from_column_slice(&model.qpos0),
+            qvel: DVector::zeros(nv),
             x_parent_body: vec![Transform::identity(); nb],
             x_world_body: vec![Transform::identity(); nb],
             x_world_frame: vec![Transform::identity(); model.frames.len()],

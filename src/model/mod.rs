@@ -224,6 +224,12 @@ pub struct Model {
     pub elements: Vec<Element>,
     /// What the loader ignored or could not interpret, each with file:line.
     pub warnings: Vec<String>,
+    /// What is derived from the elements above once, when the model is compiled: the stages
+    /// [`forward`](crate::forward::forward) runs, the constraint mode and its solver, the
+    /// constraint rows' and collision's fixed structure, the soft mode's inverse weights, the
+    /// actuators' resolved bias terms. Code that edits the elements or options afterwards calls
+    /// [`rebuild_plan`](Self::rebuild_plan).
+    pub plan: crate::forward::Plan,
 }
 
 /// A linear spring on a one-dof joint: generalized force `−stiffness·(q[qpos_adr] − rest)` on
@@ -306,6 +312,26 @@ impl Model {
 
     pub fn has_damping(&self) -> bool {
         self.dof_damping.iter().any(|&d| d != 0.0)
+    }
+
+    /// Solves the constraints in `mode` from now on: the plan is rebuilt for it, with the mode's
+    /// own drift correction (projection in exact mode, none in soft mode) and the iterative
+    /// solver's settings kept. MJCF models default to soft, URDF models to exact.
+    pub fn set_constraint_mode(&mut self, mode: crate::constraint::ConstraintMode) {
+        let solver = self.plan.solver;
+        self.plan = crate::forward::Plan::new(self, Some(mode));
+        self.plan.solver = solver;
+    }
+
+    /// Rebuilds [`plan`](Self::plan) after the elements or options were edited (a joint's limit,
+    /// `<flag>`s, equality constraints, …), keeping the constraint mode, its reason, the drift
+    /// correction and the solver settings.
+    pub fn rebuild_plan(&mut self) {
+        let old = std::mem::take(&mut self.plan);
+        self.plan = crate::forward::Plan::new(self, Some(old.mode));
+        self.plan.mode_reason = old.mode_reason;
+        self.plan.drift = old.drift;
+        self.plan.solver = old.solver;
     }
 }
 

@@ -12,7 +12,7 @@ use lagrange::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, ModelS
 use lagrange::model::{JointKind, SourceLoc};
 use lagrange::sim::{SimOptions, Simulation};
 use lagrange::spatial::{quat_to_matrix, Mat3, Transform, Vec3};
-use lagrange::Model;
+use lagrange::{Data, Model};
 use nalgebra::DMatrix;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
@@ -549,6 +549,20 @@ pub fn exact_rk4(dt: f64) -> lagrange::sim::SimOptions {
     }
 }
 
+/// `model` solving its constraints in `mode` ([`Model::set_constraint_mode`]).
+pub fn with_mode(mut model: Model, mode: lagrange::constraint::ConstraintMode) -> Model {
+    model.set_constraint_mode(mode);
+    model
+}
+
+/// Forward dynamics at (q, v): the state is written into `data`, then
+/// [`forward`](lagrange::forward::forward) (the tests evaluate at many states).
+pub fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+    data.qpos.copy_from_slice(q);
+    data.qvel.copy_from_slice(v);
+    lagrange::forward::forward(model, data);
+}
+
 /// Runs `n` steps of `dt` from (q0, v0) with zero torques; returns the final state.
 pub fn run(model: &Model, kind: IntegratorKind, q0: &[f64], v0: &[f64], dt: f64, n: usize) -> State {
     let mut sim = Simulation::new(
@@ -559,7 +573,7 @@ pub fn run(model: &Model, kind: IntegratorKind, q0: &[f64], v0: &[f64], dt: f64,
     for _ in 0..n {
         sim.step().unwrap();
     }
-    sim.state
+    State::of(&sim.data)
 }
 
 /// Runs the `lagrange` binary from the repository root: (success, stdout, stderr).

@@ -5,7 +5,7 @@
 use super::CliError;
 use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{aba, crba, rnea};
-use lagrange::forward::{forward, Plan};
+use lagrange::forward::forward;
 use lagrange::integrate::IntegratorKind;
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::forward_kinematics;
@@ -63,10 +63,15 @@ pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliErro
         std::hint::black_box(aba(&model, &mut data, &q, &v, &tau));
     });
     // The whole staged pipeline at the same state (with the model's constraint rows, if any).
-    let plan = Plan::new(&model, Some(ConstraintMode::Exact));
+    let mut model = model;
+    model.set_constraint_mode(ConstraintMode::Exact);
+    let plan = &model.plan;
+    let mut data = Data::new(&model);
     data.qfrc_applied.copy_from_slice(&tau);
+    data.qpos.copy_from_slice(&q);
+    data.qvel.copy_from_slice(&v);
     let forward_us = median_us(budget, 100, || {
-        forward(&model, &plan, &mut data, &q, &v);
+        forward(&model, &mut data);
         std::hint::black_box(&data.qacc);
     });
     let nefc = data.nefc;

@@ -4,7 +4,7 @@
 use super::CliError;
 use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{aba, bias_forces, center_of_mass, crba, kinetic_energy, potential_energy};
-use lagrange::forward::{forward, Plan};
+use lagrange::forward::forward;
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::{forward_kinematics, frame_jacobian, ReferenceFrame};
 use lagrange::model::EfcType;
@@ -43,7 +43,7 @@ fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
 
 /// Evaluates one state: M, bias, qacc, poses of every frame, energies, com, and the requested
 /// frame Jacobians (world-aligned).
-pub fn evaluate(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, jacobians: &[usize]) -> Value {
+pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]) -> Value {
     let zeros = vec![0.0; model.nv];
     let v = s.v.as_deref().unwrap_or(&zeros);
     let tau = s.tau.as_deref().unwrap_or(&zeros);
@@ -75,13 +75,13 @@ pub fn evaluate(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, jacobi
         }
         out["jacobians"] = Value::Object(jmap);
     }
-    out["forward"] = forward_json(model, plan, data, s, v, tau);
+    out["forward"] = forward_json(model, data, s, v, tau);
     out
 }
 
 /// The staged forward pipeline at the state: `qacc` (constrained), its parts, and one entry per
 /// active constraint with its multipliers and residuals (README, "eval").
-fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f64]) -> Value {
+fn forward_json(model: &Model, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f64]) -> Value {
     data.qfrc_applied.copy_from_slice(tau);
     data.ctrl.fill(0.0);
     if let Some(ctrl) = &s.ctrl {
@@ -91,7 +91,9 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
     if let Some(act) = &s.act {
         data.act.copy_from_slice(act);
     }
-    forward(model, plan, data, &s.q, v);
+    data.qpos.copy_from_slice(&s.q);
+    data.qvel.copy_from_slice(v);
+    forward(model, data);
     let mut constraints = Vec::new();
     let file = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
     let mut r = 0;
@@ -131,7 +133,7 @@ fn forward_json(model: &Model, plan: &Plan, data: &mut Data, s: &StateIn, v: &[f
         r += n;
     }
     let vec = |x: &nalgebra::DVector<f64>| x.as_slice().to_vec();
-    let efc = plan.soft.is_some().then(|| soft_rows_json(model, data));
+    let efc = model.plan.soft.is_some().then(|| soft_rows_json(model, data));
     let mut out = json!({
         "qacc": vec(&data.qacc), "qacc_smooth": vec(&data.qacc_smooth), "qfrc_passive": vec(&data.qfrc_passive),
         "qfrc_actuator": vec(&data.qfrc_actuator), "qfrc_constraint": vec(&data.qfrc_constraint),
@@ -230,8 +232,10 @@ pub fn run(
     jacobians: &[String],
     mode: Option<ConstraintMode>,
 ) -> Result<(), CliError> {
-    let model = load(path, options)?;
-    let plan = Plan::new(&model, mode);
+    let mut model = load(path, options)?;
+    if let Some(mode) = mode {
+        model.set_constraint_mode(mode);
+    }
     let file = states.display().to_string();
     let text =
         std::fs::read_to_string(states).map_err(|source| CliError::Io { file: file.clone(), source })?;
@@ -254,10 +258,9 @@ pub fn run(
     let mut results = Vec::with_capacity(input.states.len());
     for (i, s) in input.states.iter().enumerate() {
         check_state(&model, &file, i, s)?;
-        results.push(evaluate(&model, &plan, &mut data, s, &frame_ids));
+        results.push(evaluate(&model, &mut data, s, &frame_ids));
     }
-    let out =
-        json!({ "results": results, "constraints": {"mode": plan.mode.name(), "reason": plan.mode_reason} });
+    let out = json!({ "results": results, "constraints": {"mode": model.plan.mode.name(), "reason": model.plan.mode_reason} });
     println!("{}", serde_json::to_string(&out).expect("JSON values serialize"));
     Ok(())
 }

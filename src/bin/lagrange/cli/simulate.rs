@@ -236,7 +236,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         let (contacts, penetration) = contact_summary(&sim.data);
         max_contacts = max_contacts.max(contacts);
         max_penetration = max_penetration.max(penetration);
-        let soft = sim.plan.soft.is_some();
+        let soft = sim.model.plan.soft.is_some();
         max_iterations =
             max_iterations.max(if soft { report.solver_iterations } else { sim.data.efc_iterations });
         max_violation = [max_violation[0].max(violation[0]), max_violation[1].max(violation[1])];
@@ -249,7 +249,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         energy = kinetic + potential;
         max_kinetic = max_kinetic.max(kinetic);
         max_dev = max_dev.max((energy - energy_start).abs());
-        track_limit_excursions(model, &sim.state, &mut excursions);
+        track_limit_excursions(model, sim.data.qpos.as_slice(), &mut excursions);
         if k % 4096 == 0 {
             progress.set_position(k);
         }
@@ -268,7 +268,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     Ok(Summary {
         passive,
         contacts_dropped: sim.data.contacts_dropped,
-        constrained: sim.plan.has_constraints(),
+        constrained: sim.model.plan.has_constraints(),
         integrator: sim.integrator(),
         dt,
         notes: sim.notes.clone(),
@@ -276,7 +276,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         max_penetration,
         max_contacts,
         max_solver_iterations: max_iterations,
-        soft: sim.plan.soft.is_some(),
+        soft: sim.model.plan.soft.is_some(),
         unconverged: (sim.data.efc_unconverged, sim.data.efc_unconverged_residual),
         redundant,
         steps,
@@ -285,7 +285,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         energy_end: energy,
         energy_max_dev: max_dev,
         energy_scale: energy_start.abs().max(max_kinetic).max(f64::MIN_POSITIVE),
-        final_state: sim.state.clone(),
+        final_state: State::of(&sim.data),
         limit_excursions: model
             .joints
             .iter()
@@ -310,10 +310,10 @@ fn contact_summary(data: &lagrange::Data) -> (usize, f64) {
 }
 
 /// Records, per joint, how far beyond its limits the state has gone (0 if never).
-fn track_limit_excursions(model: &Model, state: &State, excursions: &mut [f64]) {
+fn track_limit_excursions(model: &Model, qpos: &[f64], excursions: &mut [f64]) {
     for (j, e) in model.joints.iter().zip(excursions.iter_mut()) {
         if let Some([lo, hi]) = j.limits {
-            let q = state.q[j.qpos_adr];
+            let q = qpos[j.qpos_adr];
             *e = e.max(lo - q).max(q - hi);
         }
     }
@@ -343,8 +343,8 @@ fn write_header(w: &mut impl Write, model: &Model) -> std::io::Result<()> {
 }
 
 fn write_row(w: &mut impl Write, sim: &Simulation, energy: f64, violation: f64) -> std::io::Result<()> {
-    write!(w, "{}", display_time(sim.state.time))?;
-    for x in sim.state.q.iter().chain(sim.state.v.iter()).chain(sim.state.act.iter()) {
+    write!(w, "{}", display_time(sim.data.time))?;
+    for x in sim.data.qpos.iter().chain(sim.data.qvel.iter()).chain(sim.data.act.iter()) {
         write!(w, ",{x}")?;
     }
     writeln!(w, ",{energy},{violation}")

@@ -315,8 +315,8 @@ impl Setup {
         };
         let record = |sim: &mut Simulation, out: &mut Samples| {
             let (kinetic, potential) = sim.energies();
-            out.q.push(sim.state.q.clone());
-            out.v.push(sim.state.v.clone());
+            out.q.push(sim.data.qpos.clone());
+            out.v.push(sim.data.qvel.clone());
             out.energy.push(kinetic + potential);
             out.kinetic.push(kinetic);
         };
@@ -327,7 +327,7 @@ impl Setup {
                 if !report.accepted {
                     return Err(format!(
                         "the error control gave up at t = {:.6} s (step size below round-off)",
-                        sim.state.time
+                        sim.data.time
                     ));
                 }
                 out.steps += u64::from(report.substeps);
@@ -336,7 +336,7 @@ impl Setup {
             if out.steps + out.rejected > self.budget {
                 return Err(format!(
                     "gave up at t = {:.6} s after {} internal steps ({} rejected), over the budget of {} ({BUDGET_FACTOR} × the finest fixed-step run): contact events or stiffness?",
-                    sim.state.time, out.steps + out.rejected, out.rejected, self.budget
+                    sim.data.time, out.steps + out.rejected, out.rejected, self.budget
                 ));
             }
             record(&mut sim, &mut out);
@@ -527,10 +527,10 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
         per_sample: 1,
         tolerances: None,
     })?;
-    if probe.plan.has_constraints() && setup.model.collision_pairs.is_empty() {
+    if probe.model.plan.has_constraints() && setup.model.collision_pairs.is_empty() {
         notes.push(format!(
             "the model has constraint rows: measured with the engine's constraint handling as it is ({}; drift projection after each step)",
-            probe.plan.mode.name()
+            probe.model.plan.mode.name()
         ));
     }
     if integrators.contains(&IntegratorKind::ImplicitFast)
