@@ -104,7 +104,7 @@ impl Simulation {
             Arc::make_mut(&mut model).set_constraint_mode(mode);
         }
         if integrator == IntegratorKind::Variational
-            && model.plan.mode == ConstraintMode::Soft
+            && model.plan.mode() == ConstraintMode::Soft
             && model.plan.has_constraints()
         {
             // The variational integrator holds constraints itself (equality multipliers, limits and
@@ -118,10 +118,12 @@ impl Simulation {
             m.plan.mode_reason = why;
         }
         if let Some(drift) = options.drift {
-            Arc::make_mut(&mut model).plan.drift = drift;
+            if let Some(e) = Arc::make_mut(&mut model).plan.solver.exact_mut() {
+                e.drift = drift;
+            }
         }
         if model.plan.has_constraints() {
-            notes.push(format!("constraints: {} ({})", model.plan.mode.name(), model.plan.mode_reason));
+            notes.push(format!("constraints: {} ({})", model.plan.mode().name(), model.plan.mode_reason));
         }
         let mut sim = Self {
             data: Data::new(&model),
@@ -229,7 +231,7 @@ impl Simulation {
         // `timestep` may have been set after `new`.
         self.sync_timestep();
         let mut report = self.stepper.step(&self.model, &mut self.data, self.timestep);
-        if self.model.plan.soft.is_some() && self.data.nefc > 0 {
+        if self.model.plan.solver.soft_weights().is_some() && self.data.nefc > 0 {
             report.solver_improvement = self.data.solver_improvement;
         }
         if let Some(f) = self.stepper.failure() {

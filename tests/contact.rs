@@ -31,7 +31,7 @@ fn with_friction(file: &str, mu: f64) -> Model {
 /// linearly, slowly right at the stick/slip threshold: the tests allow it 10 000 sweeps.
 fn forward_at_rest(model: &Model) -> Data {
     let mut model = common::with_mode(model.clone(), ConstraintMode::Exact);
-    model.plan.solver.max_iterations = 10_000;
+    model.plan.solver.exact_mut().unwrap().settings.max_iterations = 10_000;
     let mut data = Data::new(&model);
     forward(&model, &mut data);
     data

@@ -159,10 +159,10 @@ fn mjcf_defaults_to_soft_and_urdf_to_exact() {
     let mjcf = load(Path::new("models/textbook/incline_box.xml"), &LoadOptions::default()).unwrap();
     let urdf = load(Path::new("models/ur5/ur5.urdf"), &LoadOptions::default()).unwrap();
     let (p, q) = (Plan::new(&mjcf, None), Plan::new(&urdf, None));
-    assert_eq!((p.mode, p.mode_reason.as_str()), (ConstraintMode::Soft, "soft is the default for MJCF"));
-    assert_eq!((q.mode, q.mode_reason.as_str()), (ConstraintMode::Exact, "exact is the default for URDF"));
+    assert_eq!((p.mode(), p.mode_reason.as_str()), (ConstraintMode::Soft, "soft is the default for MJCF"));
+    assert_eq!((q.mode(), q.mode_reason.as_str()), (ConstraintMode::Exact, "exact is the default for URDF"));
     let r = Plan::new(&mjcf, Some(ConstraintMode::Exact));
-    assert_eq!((r.mode, r.mode_reason.as_str()), (ConstraintMode::Exact, "exact requested"));
+    assert_eq!((r.mode(), r.mode_reason.as_str()), (ConstraintMode::Exact, "exact requested"));
 }
 
 /// Issue 13's standing robot in soft mode: go1 from keyframe `home`, holding the keyframe's
@@ -178,7 +178,7 @@ fn go1_stands_on_its_servos_as_in_mujoco() {
         (model.qpos0.clone(), vec![0.0; model.nv], vec![0.0; model.actuators.len()], vec![0.0; model.na()]);
     key.apply(&mut q, &mut v, &mut ctrl, &mut act);
     let mut sim = Simulation::new(model.clone(), &SimOptions::default());
-    assert_eq!(sim.model.plan.mode, ConstraintMode::Soft, "MJCF defaults to soft");
+    assert_eq!(sim.model.plan.mode(), ConstraintMode::Soft, "MJCF defaults to soft");
     sim.set_state(&q, &v).unwrap();
     sim.ctrl_mut().copy_from_slice(&ctrl);
     for _ in 0..2500 {
@@ -225,7 +225,7 @@ fn variational_integrator_uses_the_exact_mode() {
         ..Default::default()
     };
     let sim = Simulation::new(model, &options);
-    assert_eq!(sim.model.plan.mode, ConstraintMode::Exact);
+    assert_eq!(sim.model.plan.mode(), ConstraintMode::Exact);
     assert!(
         sim.notes.iter().any(|n| n.contains("variational integrator holds constraints exactly")),
         "{:?}",

@@ -26,6 +26,7 @@
 //! forces when the rows are the same (warm start).
 
 use super::dense::solve_psd;
+use super::ExactWork;
 use crate::model::{Data, EfcType, Model};
 
 /// Iteration limit and tolerance of the Gauss–Seidel solve.
@@ -86,16 +87,16 @@ pub fn solve_coulomb(
     let ne = (0..n).take_while(|&i| data.efc_type[i] == EfcType::Equality).count();
     // A row whose diagonal is round-off next to the others' moves nothing (a contact normal no
     // dof can move along): it gets no force rather than round-off divided by round-off.
-    data.efc_a_floor = DIAGONAL_ROUNDOFF * (0..n).map(|i| data.efc_delassus[(i, i)]).fold(0.0, f64::max);
+    data.exact.a_floor = DIAGONAL_ROUNDOFF * (0..n).map(|i| data.exact.delassus[(i, i)]).fold(0.0, f64::max);
     // b in efc_force during the iterations, λ in efc_rhs.
     for i in 0..n {
-        data.efc_force[i] = data.efc_rhs[i];
+        data.efc_force[i] = data.exact.rhs[i];
     }
     let warm = level == Level::Acceleration
-        && data.efc_warm_rows.len() == n
-        && (0..n).all(|i| data.efc_warm_rows[i] == (data.efc_type[i], data.efc_id[i]));
+        && data.exact.warm_rows.len() == n
+        && (0..n).all(|i| data.exact.warm_rows[i] == (data.efc_type[i], data.efc_id[i]));
     for i in 0..n {
-        data.efc_rhs[i] = if warm { data.efc_warm[i] } else { 0.0 };
+        data.exact.rhs[i] = if warm { data.exact.warm[i] } else { 0.0 };
     }
     let mut change = 0.0;
     let mut iterations = 0;
@@ -114,7 +115,7 @@ pub fn solve_coulomb(
     while iterations < limit {
         iterations += 1;
         for i in 0..n {
-            data.efc_lambda_prev[i] = data.efc_rhs[i];
+            data.exact.lambda_prev[i] = data.exact.rhs[i];
         }
         if ne > 0 {
             equality_block(data, ne);
@@ -147,9 +148,9 @@ pub fn solve_coulomb(
         for k in 0..model.nv {
             let (mut dk, mut tk) = (0.0, 0.0);
             for i in 0..n {
-                let y = data.efc_minv_jt[(k, i)];
-                dk += y * (data.efc_rhs[i] - data.efc_lambda_prev[i]);
-                tk += y * data.efc_rhs[i];
+                let y = data.exact.minv_jt[(k, i)];
+                dk += y * (data.exact.rhs[i] - data.exact.lambda_prev[i]);
+                tk += y * data.exact.rhs[i];
             }
             moved = moved.max(dk.abs());
             total = total.max(tk.abs());
@@ -158,7 +159,7 @@ pub fn solve_coulomb(
             first_total = total;
         }
         if !(total.is_finite() && total <= DIVERGED * first_total.max(motion_scale)) {
-            data.efc_rhs.as_mut_slice()[..n].fill(0.0);
+            data.exact.rhs.as_mut_slice()[..n].fill(0.0);
             if data.efc_safe_friction {
                 change = f64::INFINITY;
                 break;
@@ -198,28 +199,28 @@ pub fn solve_coulomb(
 /// w_i = (A λ)_i − b_i with the current λ.
 fn row_w(data: &Data, i: usize) -> f64 {
     let n = data.nefc;
-    (0..n).map(|j| data.efc_delassus[(i, j)] * data.efc_rhs[j]).sum::<f64>() - data.efc_force[i]
+    (0..n).map(|j| data.exact.delassus[(i, j)] * data.exact.rhs[j]).sum::<f64>() - data.efc_force[i]
 }
 
 /// Sets λ of rows i..i+len to 0; returns the change (times A_ii).
 fn set_zero(data: &mut Data, i: usize, len: usize) -> f64 {
     let mut change = 0.0f64;
     for k in i..i + len {
-        change = change.max((data.efc_rhs[k] * data.efc_delassus[(k, k)]).abs());
-        data.efc_rhs[k] = 0.0;
+        change = change.max((data.exact.rhs[k] * data.exact.delassus[(k, k)]).abs());
+        data.exact.rhs[k] = 0.0;
     }
     change
 }
 
 /// Whether limit/contact row i moves away from its bound (acceleration level only).
 fn separating(data: &Data, i: usize, level: Level) -> bool {
-    level == Level::Acceleration && !data.efc_frozen && data.efc_vel[i] > SEPARATING_VELOCITY
+    level == Level::Acceleration && !data.rows_frozen() && data.efc_vel[i] > SEPARATING_VELOCITY
 }
 
 /// The lower bound of a limit or contact normal force: 0, or none for a row still pressing at the
 /// velocity projection (`efc_pressing`: its velocity is held at 0, as a bilateral row's).
 fn normal_lower_bound(data: &Data, i: usize) -> f64 {
-    if data.efc_pressing[i] {
+    if data.exact.pressing[i] {
         f64::NEG_INFINITY
     } else {
         0.0
@@ -228,13 +229,13 @@ fn normal_lower_bound(data: &Data, i: usize) -> f64 {
 
 /// λ_i ← clamp(λ_i − w_i / A_ii, lo, hi); returns |Δλ_i| A_ii.
 fn scalar_update(data: &mut Data, i: usize, lo: f64, hi: f64) -> f64 {
-    let a = data.efc_delassus[(i, i)];
-    if a <= data.efc_a_floor {
+    let a = data.exact.delassus[(i, i)];
+    if a <= data.exact.a_floor {
         return set_zero(data, i, 1);
     }
-    let old = data.efc_rhs[i];
+    let old = data.exact.rhs[i];
     let new = (old - row_w(data, i) / a).clamp(lo, hi);
-    data.efc_rhs[i] = new;
+    data.exact.rhs[i] = new;
     ((new - old) * a).abs()
 }
 
@@ -242,7 +243,20 @@ fn scalar_update(data: &mut Data, i: usize, lo: f64, hi: f64) -> f64 {
 /// redundant); returns the largest |Δλ_i| A_ii.
 fn equality_block(data: &mut Data, ne: usize) -> f64 {
     let n = data.nefc;
-    let Data { efc_delassus, efc_sub, efc_sub_rhs, efc_rhs, efc_force, efc_factor, efc_eig, .. } = data;
+    let Data {
+        efc_force,
+        exact:
+            ExactWork {
+                delassus: efc_delassus,
+                sub: efc_sub,
+                sub_rhs: efc_sub_rhs,
+                rhs: efc_rhs,
+                factor: efc_factor,
+                eig: efc_eig,
+                ..
+            },
+        ..
+    } = data;
     for i in 0..ne {
         efc_sub_rhs[i] = efc_force[i] - (ne..n).map(|j| efc_delassus[(i, j)] * efc_rhs[j]).sum::<f64>();
         for j in 0..ne {
@@ -252,8 +266,9 @@ fn equality_block(data: &mut Data, ne: usize) -> f64 {
     data.efc_rank = solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..ne], efc_factor, efc_eig);
     let mut change = 0.0f64;
     for i in 0..ne {
-        change = change.max(((data.efc_sub_rhs[i] - data.efc_rhs[i]) * data.efc_delassus[(i, i)]).abs());
-        data.efc_rhs[i] = data.efc_sub_rhs[i];
+        change =
+            change.max(((data.exact.sub_rhs[i] - data.exact.rhs[i]) * data.exact.delassus[(i, i)]).abs());
+        data.exact.rhs[i] = data.exact.sub_rhs[i];
     }
     change
 }
@@ -268,10 +283,10 @@ fn friction_dof(model: &Model, data: &mut Data, i: usize, level: Level) -> f64 {
     }
     let speed = data.efc_vel[i];
     if speed.abs() > SLIP_VELOCITY && !data.efc_frozen_at_rest(i) {
-        let a = data.efc_delassus[(i, i)];
+        let a = data.exact.delassus[(i, i)];
         let new = -loss * speed.signum();
-        let change = ((new - data.efc_rhs[i]) * a).abs();
-        data.efc_rhs[i] = new;
+        let change = ((new - data.exact.rhs[i]) * a).abs();
+        data.exact.rhs[i] = new;
         change
     } else {
         scalar_update(data, i, -loss, loss)
@@ -306,7 +321,7 @@ const MAX_DIM: usize = 6;
 
 /// A frictional contact's block: rows i (normal) .. i+len (friction).
 fn contact_block(data: &mut Data, i: usize, len: usize, level: Level) -> f64 {
-    if separating(data, i, level) || data.efc_delassus[(i, i)] <= data.efc_a_floor {
+    if separating(data, i, level) || data.exact.delassus[(i, i)] <= data.exact.a_floor {
         return set_zero(data, i, len);
     }
     let mut change = scalar_update(data, i, normal_lower_bound(data, i), f64::INFINITY);
@@ -328,8 +343,8 @@ fn contact_block(data: &mut Data, i: usize, len: usize, level: Level) -> f64 {
     }
     for k in 1..len {
         let r = i + k;
-        change = change.max(((new[k - 1] - data.efc_rhs[r]) * data.efc_delassus[(r, r)]).abs());
-        data.efc_rhs[r] = new[k - 1];
+        change = change.max(((new[k - 1] - data.exact.rhs[r]) * data.exact.delassus[(r, r)]).abs());
+        data.exact.rhs[r] = new[k - 1];
     }
     change
 }
@@ -362,7 +377,7 @@ fn cone_solve(
     let mut idx = [0usize; MAX_DIM];
     let mut m = 0;
     for k in 1..len {
-        if mu(friction, k) > 0.0 && data.efc_delassus[(i + k, i + k)] > data.efc_a_floor {
+        if mu(friction, k) > 0.0 && data.exact.delassus[(i + k, i + k)] > data.exact.a_floor {
             idx[m] = k;
             m += 1;
         }
@@ -376,12 +391,13 @@ fn cone_solve(
     for p in 0..m {
         let rp = i + idx[p];
         let mp = mu(friction, idx[p]);
-        let own: f64 = (1..len).map(|k| data.efc_delassus[(rp, i + k)] * data.efc_rhs[i + k]).sum();
-        let w_other: f64 = (0..n).map(|j| data.efc_delassus[(rp, j)] * data.efc_rhs[j]).sum::<f64>() - own;
-        let shift: f64 = (1..len).map(|k| data.efc_delassus[(rp, i + k)] * spent[k - 1]).sum();
+        let own: f64 = (1..len).map(|k| data.exact.delassus[(rp, i + k)] * data.exact.rhs[i + k]).sum();
+        let w_other: f64 =
+            (0..n).map(|j| data.exact.delassus[(rp, j)] * data.exact.rhs[j]).sum::<f64>() - own;
+        let shift: f64 = (1..len).map(|k| data.exact.delassus[(rp, i + k)] * spent[k - 1]).sum();
         g[p] = mp * (data.efc_force[rp] - w_other + shift);
         for q in 0..m {
-            a[p][q] = mp * mu(friction, idx[q]) * data.efc_delassus[(rp, i + idx[q])];
+            a[p][q] = mp * mu(friction, idx[q]) * data.exact.delassus[(rp, i + idx[q])];
         }
     }
     let mut y = [0.0; MAX_DIM];
@@ -486,34 +502,34 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     const TOL: f64 = 1e-9;
     let mut i = 0;
     let mut any_sliding = false;
-    data.efc_active.clear();
-    data.efc_slipping[..n].fill(false);
+    data.exact.active.clear();
+    data.exact.slipping[..n].fill(false);
     // Classify rows: Free rows go into efc_active; every other row keeps its force.
     while i < n {
         let len = data.efc_block_len(i);
         match data.efc_type[i] {
-            EfcType::Equality => data.efc_active.push(i),
+            EfcType::Equality => data.exact.active.push(i),
             EfcType::LimitJoint
             | EfcType::LimitTendon
             | EfcType::ContactFrictionless
             | EfcType::ContactPyramidal => {
-                if data.efc_rhs[i] > 0.0 || data.efc_pressing[i] {
-                    data.efc_active.push(i);
+                if data.exact.rhs[i] > 0.0 || data.exact.pressing[i] {
+                    data.exact.active.push(i);
                 }
             }
             EfcType::FrictionDof => {
                 let (lo, hi) = friction_dof_bounds(model, data, i, level);
-                let l = data.efc_rhs[i];
+                let l = data.exact.rhs[i];
                 let sliding = level == Level::Acceleration
                     && data.efc_vel[i].abs() > SLIP_VELOCITY
                     && !data.efc_frozen_at_rest(i);
                 if !sliding && l > lo + TOL * (hi - lo).abs() && l < hi - TOL * (hi - lo).abs() {
-                    data.efc_active.push(i);
+                    data.exact.active.push(i);
                 }
             }
             EfcType::ContactElliptic => {
-                if data.efc_rhs[i] > 0.0 || data.efc_pressing[i] {
-                    data.efc_active.push(i);
+                if data.exact.rhs[i] > 0.0 || data.exact.pressing[i] {
+                    data.exact.active.push(i);
                     let friction = data.contacts[data.efc_id[i]].friction;
                     let (radius, spent) = cone_of(data, i, len, level);
                     let sliding = level == Level::Acceleration
@@ -521,11 +537,11 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
                         && !data.efc_frozen_at_rest(i);
                     let y2: f64 = (1..len)
                         .filter(|&k| mu(&friction, k) > 0.0)
-                        .map(|k| ((data.efc_rhs[i + k] + spent[k - 1]) / mu(&friction, k)).powi(2))
+                        .map(|k| ((data.exact.rhs[i + k] + spent[k - 1]) / mu(&friction, k)).powi(2))
                         .sum();
                     if sliding {
                         // Friction fixed by the slip: c · λ_n, updated in the rounds below.
-                        data.efc_slipping[i] = true;
+                        data.exact.slipping[i] = true;
                         any_sliding = true;
                         i += len;
                         continue;
@@ -535,14 +551,14 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
                             return false;
                         }
                         // Starting to slip: friction on the cone, opposing the slip acceleration.
-                        data.efc_slipping[i] = true;
+                        data.exact.slipping[i] = true;
                         any_sliding = true;
                         i += len;
                         continue;
                     }
                     for k in 1..len {
                         if mu(&friction, k) > 0.0 {
-                            data.efc_active.push(i + k);
+                            data.exact.active.push(i + k);
                         }
                     }
                 }
@@ -554,23 +570,27 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     // (efc_lambda_prev; efc_rhs keeps the iterate if the polish fails). A sliding contact's friction
     // is c · λ_n with c = −μ² u / ‖μ ∘ u‖ from its slip u: rounds update it from the new λ_n until
     // it settles (a contraction for μ < 1 coupling).
-    let k = data.efc_active.len();
+    let k = data.exact.active.len();
     if k == 0 {
         return false;
     }
     for j in 0..n {
-        data.efc_lambda_prev[j] = data.efc_rhs[j];
+        data.exact.lambda_prev[j] = data.exact.rhs[j];
     }
     for round in 0..30 {
         let Data {
-            efc_delassus,
-            efc_sub,
-            efc_sub_rhs,
-            efc_active,
             efc_force,
-            efc_lambda_prev,
-            efc_factor,
-            efc_eig,
+            exact:
+                ExactWork {
+                    delassus: efc_delassus,
+                    sub: efc_sub,
+                    sub_rhs: efc_sub_rhs,
+                    active: efc_active,
+                    lambda_prev: efc_lambda_prev,
+                    factor: efc_factor,
+                    eig: efc_eig,
+                    ..
+                },
             ..
         } = &mut *data;
         for (a, &r) in efc_active.iter().enumerate() {
@@ -593,7 +613,7 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
             break;
         }
         let change = update_sliding_friction(data);
-        let scale = 1.0 + (0..n).map(|j| data.efc_lambda_prev[j].abs()).fold(0.0, f64::max);
+        let scale = 1.0 + (0..n).map(|j| data.exact.lambda_prev[j].abs()).fold(0.0, f64::max);
         if change <= 1e-15 * scale {
             break;
         }
@@ -604,13 +624,14 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     // Verify every row's law with w = A λ − b.
     let scale = 1.0 + (0..n).map(|j| data.efc_force[j].abs()).fold(0.0, f64::max);
     let w = |data: &Data, r: usize| -> f64 {
-        (0..n).map(|j| data.efc_delassus[(r, j)] * data.efc_lambda_prev[j]).sum::<f64>() - data.efc_force[r]
+        (0..n).map(|j| data.exact.delassus[(r, j)] * data.exact.lambda_prev[j]).sum::<f64>()
+            - data.efc_force[r]
     };
-    let force_scale = 1.0 + (0..n).map(|j| data.efc_lambda_prev[j].abs()).fold(0.0, f64::max);
+    let force_scale = 1.0 + (0..n).map(|j| data.exact.lambda_prev[j].abs()).fold(0.0, f64::max);
     let mut i = 0;
     while i < n {
         let len = data.efc_block_len(i);
-        let l = data.efc_lambda_prev[i];
+        let l = data.exact.lambda_prev[i];
         let ok = match data.efc_type[i] {
             EfcType::Equality => true,
             EfcType::LimitJoint
@@ -618,8 +639,8 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
             | EfcType::ContactFrictionless
             | EfcType::ContactElliptic
             | EfcType::ContactPyramidal => {
-                let free = data.efc_active.contains(&i);
-                let normal_ok = if data.efc_pressing[i] {
+                let free = data.exact.active.contains(&i);
+                let normal_ok = if data.exact.pressing[i] {
                     true
                 } else if free {
                     l >= -1e-12 * force_scale
@@ -639,7 +660,7 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
                         let y2: f64 = (1..len)
                             .filter(|&k| mu(&friction, k) > 0.0)
                             .map(|k| {
-                                ((data.efc_lambda_prev[i + k] + spent[k - 1]) / mu(&friction, k)).powi(2)
+                                ((data.exact.lambda_prev[i + k] + spent[k - 1]) / mu(&friction, k)).powi(2)
                             })
                             .sum();
                         y2.sqrt() <= radius * (1.0 + 1e-12) + 1e-12 * force_scale
@@ -648,7 +669,7 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
             EfcType::FrictionDof => {
                 let (lo, hi) = friction_dof_bounds(model, data, i, level);
                 let slack = 1e-12 * force_scale;
-                if data.efc_active.contains(&i) {
+                if data.exact.active.contains(&i) {
                     l >= lo - slack && l <= hi + slack
                 } else {
                     let wi = w(data, i);
@@ -665,7 +686,7 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         i += len;
     }
     for j in 0..n {
-        data.efc_rhs[j] = data.efc_lambda_prev[j];
+        data.exact.rhs[j] = data.exact.lambda_prev[j];
     }
     true
 }
@@ -679,9 +700,9 @@ fn update_sliding_friction(data: &mut Data) -> f64 {
     let mut i = 0;
     while i < n {
         let len = data.efc_block_len(i);
-        if data.efc_slipping[i] {
+        if data.exact.slipping[i] {
             let friction = data.contacts[data.efc_id[i]].friction;
-            let lambda_n = data.efc_lambda_prev[i].max(0.0);
+            let lambda_n = data.exact.lambda_prev[i].max(0.0);
             // The slip velocity, or for a contact starting to slip its slip acceleration w_f.
             let moving =
                 (1..len).any(|k| data.efc_vel[i + k].abs() > SLIP_VELOCITY) && !data.efc_frozen_at_rest(i);
@@ -690,15 +711,15 @@ fn update_sliding_friction(data: &mut Data) -> f64 {
                 slip[k - 1] = if moving {
                     data.efc_vel[i + k]
                 } else {
-                    (0..n).map(|j| data.efc_delassus[(i + k, j)] * data.efc_lambda_prev[j]).sum::<f64>()
+                    (0..n).map(|j| data.exact.delassus[(i + k, j)] * data.exact.lambda_prev[j]).sum::<f64>()
                         - data.efc_force[i + k]
                 };
             }
             let mut new = [0.0; MAX_DIM];
             max_dissipation(lambda_n, &friction, &slip[..len - 1], &mut new[..len - 1]);
             for k in 1..len {
-                change = change.max((new[k - 1] - data.efc_lambda_prev[i + k]).abs());
-                data.efc_lambda_prev[i + k] = new[k - 1];
+                change = change.max((new[k - 1] - data.exact.lambda_prev[i + k]).abs());
+                data.exact.lambda_prev[i + k] = new[k - 1];
             }
         }
         i += len;
@@ -725,12 +746,12 @@ fn friction_dof_bounds(model: &Model, data: &Data, i: usize, level: Level) -> (f
 fn cone_of(data: &Data, i: usize, len: usize, level: Level) -> (f64, [f64; MAX_DIM]) {
     let mut spent = [0.0; MAX_DIM];
     let radius = match level {
-        Level::Acceleration => data.efc_rhs[i],
+        Level::Acceleration => data.exact.rhs[i],
         Level::Velocity { dt } => {
             for k in 1..len {
                 spent[k - 1] = dt * data.efc_previous_force(i, k);
             }
-            data.efc_rhs[i].max(0.0) + dt * data.efc_previous_force(i, 0).max(0.0)
+            data.exact.rhs[i].max(0.0) + dt * data.efc_previous_force(i, 0).max(0.0)
         }
     };
     (radius, spent)

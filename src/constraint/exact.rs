@@ -11,6 +11,7 @@
 use super::active_set::{solve_delassus, solve_mixed};
 use super::coulomb::{has_friction, solve_coulomb, Level, SolverSettings, SEPARATING_VELOCITY};
 use super::ConstraintModel;
+use super::ExactWork;
 use crate::collision::{collide, EXACT_REACH};
 use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
 use crate::kinematics::body_poses;
@@ -21,7 +22,12 @@ use crate::model::{integrate_configuration, Data, EfcType, Model};
 fn delassus(model: &Model, data: &mut Data) {
     let n = data.nefc;
     let nv = model.nv;
-    let Data { efc_j, efc_minv_jt, efc_delassus, mass_factor, .. } = data;
+    let Data {
+        efc_j,
+        mass_factor,
+        exact: ExactWork { minv_jt: efc_minv_jt, delassus: efc_delassus, .. },
+        ..
+    } = data;
     for i in 0..n {
         let mut col = efc_minv_jt.column_mut(i);
         for k in 0..nv {
@@ -46,9 +52,9 @@ fn row_dot(data: &Data, nv: usize, i: usize, x: &[f64]) -> f64 {
 /// x += s · M⁻¹Jᵀ μ with μ the first nefc entries of `efc_rhs` (the result of a Delassus solve).
 fn add_minv_jt_mu(data: &Data, nv: usize, s: f64, x: &mut [f64]) {
     for i in 0..data.nefc {
-        let mu = s * data.efc_rhs[i];
+        let mu = s * data.exact.rhs[i];
         for k in 0..nv {
-            x[k] += data.efc_minv_jt[(k, i)] * mu;
+            x[k] += data.exact.minv_jt[(k, i)] * mu;
         }
     }
 }
@@ -64,16 +70,17 @@ pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>, 
     let [alpha, beta] = baumgarte.unwrap_or([0.0, 0.0]);
     for i in 0..n {
         let j_qacc = row_dot(data, nv, i, data.qacc_smooth.as_slice());
-        data.efc_rhs[i] = -(j_qacc + data.efc_jdotv[i]) - alpha * data.efc_vel[i] - beta * data.efc_pos[i];
+        data.exact.rhs[i] = -(j_qacc + data.efc_jdotv[i]) - alpha * data.efc_vel[i] - beta * data.efc_pos[i];
     }
     if has_friction(data) {
         let scale = data.qacc_smooth.amax();
         solve_coulomb(model, data, Level::Acceleration, settings, scale);
         // No rank to report: the iterative solve gives one of the equivalent force distributions.
-        data.efc_active.clear();
+        data.exact.active.clear();
     } else {
         // A limit or contact row moving away from its bound (J v > 0) is separating: no force.
-        data.efc_iterations = solve_mixed(data, |d, i| !d.efc_frozen && d.efc_vel[i] > SEPARATING_VELOCITY);
+        data.efc_iterations =
+            solve_mixed(data, |d, i| !d.rows_frozen() && d.efc_vel[i] > SEPARATING_VELOCITY);
         data.efc_residual = 0.0;
         data.efc_converged = true;
     }
@@ -82,12 +89,12 @@ pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>, 
     add_minv_jt_mu(data, nv, 1.0, qacc.as_mut_slice());
     data.qacc = qacc;
     data.qfrc_constraint.fill(0.0);
-    data.efc_warm_rows.clear();
+    data.exact.warm_rows.clear();
     for i in 0..n {
-        let lambda = data.efc_rhs[i];
+        let lambda = data.exact.rhs[i];
         data.efc_force[i] = lambda;
-        data.efc_warm[i] = lambda;
-        data.efc_warm_rows.push((data.efc_type[i], data.efc_id[i]));
+        data.exact.warm[i] = lambda;
+        data.exact.warm_rows.push((data.efc_type[i], data.efc_id[i]));
         for k in 0..nv {
             data.qfrc_constraint[k] += data.efc_j[(i, k)] * lambda;
         }
@@ -151,7 +158,7 @@ pub fn project_positions(
         }
         delassus(model, data);
         for i in 0..n {
-            data.efc_rhs[i] = data.efc_pos[i];
+            data.exact.rhs[i] = data.efc_pos[i];
         }
         solve_delassus(data);
         let mut dq = std::mem::take(&mut data.scratch_v);
@@ -180,17 +187,17 @@ pub fn project_velocities(
     let nv = model.nv;
     delassus(model, data);
     for i in 0..n {
-        data.efc_rhs[i] = -row_dot(data, nv, i, v);
-        data.efc_pressing[i] = data.efc_is_normal_or_limit(i) && data.efc_previous_force(i, 0) > 0.0;
+        data.exact.rhs[i] = -row_dot(data, nv, i, v);
+        data.exact.pressing[i] = data.efc_is_normal_or_limit(i) && data.efc_previous_force(i, 0) > 0.0;
     }
     if has_friction(data) {
         let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         solve_coulomb(model, data, Level::Velocity { dt }, settings, scale);
-        data.efc_active.clear();
+        data.exact.active.clear();
     } else {
         solve_mixed(data, |_, _| false);
     }
-    data.efc_pressing[..n].fill(false);
+    data.exact.pressing[..n].fill(false);
     add_minv_jt_mu(data, nv, 1.0, v);
     // J v of the projected velocity, measured as every row violation is.
     for i in 0..n {

@@ -100,9 +100,7 @@ impl LimitRow {
     /// The row at configuration `q` as [`Data`]'s rows are chosen: by [`active`](Self::active), or,
     /// while the step's rows are frozen and the joint's row is among them, the nearer side.
     pub fn row(&self, data: &Data, q: &[f64]) -> Option<(Vec3, f64)> {
-        self.active(q).or_else(|| {
-            (data.efc_frozen && data.efc_frozen_limits.contains(&self.joint)).then(|| self.nearest(q))
-        })
+        self.active(q).or_else(|| data.lifecycle.keeps_limit(self.joint).then(|| self.nearest(q)))
     }
 
     /// Number of dofs the row spans.

@@ -17,18 +17,24 @@ mod contact;
 mod coulomb;
 mod dense;
 mod exact;
+mod exact_work;
 mod friction_loss;
 mod limits;
+mod row_lifecycle;
 mod rows;
 pub mod soft;
+mod solver;
 
 pub use contact::CONTACT_ACTIVE_DISTANCE;
 pub use coulomb::{solve_coulomb, Level, SolverSettings, SEPARATING_VELOCITY, SLIP_VELOCITY};
 pub use dense::solve_psd;
 pub use exact::{project_positions, project_velocities, row_violation, solve_exact};
+pub(crate) use exact_work::ExactWork;
 pub use friction_loss::FrictionRow;
 pub use limits::{ball_angle_axis, LimitKind, LimitRow, LIMIT_ACTIVE_DISTANCE};
+pub(crate) use row_lifecycle::RowLifecycle;
 pub use rows::{ConstraintModel, RowGeometry, ScalarCoord};
+pub use solver::{ConstraintSolver, DriftCorrection, ExactSolver, SoftSolver};
 
 /// Which constraint model `forward` solves.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

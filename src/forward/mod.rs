@@ -27,9 +27,9 @@ pub use actuation::{
     actuation, add_actuator_velocity_derivative, resolved_bias_velocity, unsimulated_reason,
 };
 
-pub use plan::{DriftCorrection, Plan, Stage, StageKind, Status};
+pub use crate::constraint::DriftCorrection;
+pub use plan::{Plan, Stage, StageKind, Status};
 
-use crate::constraint::{soft, solve_exact};
 use crate::dynamics::{aba, bias_forces, crba, factorize_mass_matrix, solve_mass_matrix};
 use crate::model::{Data, Model};
 
@@ -51,19 +51,11 @@ pub fn forward(model: &Model, data: &mut Data) {
 /// `data.qvel` are neither read nor written.
 pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     let plan = &model.plan;
-    let cm = &plan.constraints;
-    let m_path = match &plan.soft {
-        // Soft (the plan has its weights only when the model has constraint rows): collision with
-        // MuJoCo's margins, rows by MuJoCo's activation rules.
-        Some(_) => soft::soft_active(cm, model, data, q),
-        // Exact: the M path only while a constraint row is active (an equality, a joint at a
-        // limit, a touching contact): otherwise ABA, as for a model without constraints.
-        None => {
-            let active = plan.has_constraints() && cm.any_active(data, q);
-            // Collision: contacts at q (a touching one needs the M path too).
-            cm.collide(model, data, q) || active
-        }
-    };
+    let (rows, solver) = (&plan.constraints, &plan.solver);
+    // Collision and the rows at q: the M path only while a row exists (an equality, a joint at
+    // a limit, a touching contact, or MuJoCo's activation rules in soft mode); ABA otherwise,
+    // as for a model without constraints.
+    let m_path = plan.has_constraints() && solver.rows_exist(rows, model, data, q);
     for stage in &plan.stages {
         if stage.status != Status::Runs {
             continue;
@@ -72,27 +64,18 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
             StageKind::Position if m_path => {
                 crba(model, data, q);
                 factorize_mass_matrix(model, data);
-                match &plan.soft {
-                    Some(_) => soft::soft_positions(cm, model, data, q, model.options.cone),
-                    None => cm.positions(model, data, q, true),
-                }
+                solver.positions(rows, model, data, q);
             }
             StageKind::Velocity if m_path => {
                 bias_forces(model, data, q, v);
                 data.qfrc_bias.copy_from(&data.tau);
                 // RNEA left the body velocities at v in `v_body`.
-                match &plan.soft {
-                    Some(_) => soft::soft_velocities(cm, model, data, v),
-                    None => cm.velocities(model, data, q, v),
-                }
+                solver.velocities(rows, model, data, q, v);
             }
             StageKind::Passive => passive(model, data, q, v),
             StageKind::Actuation => actuation(model, data, q, v, &plan.actuator_bias_velocity),
             StageKind::Acceleration => acceleration(model, data, q, v, m_path),
-            StageKind::Constraint if m_path => match &plan.soft {
-                Some(weights) => soft::solve_soft(model, weights, data),
-                None => solve_exact(model, data, plan.drift.baumgarte, plan.solver),
-            },
+            StageKind::Constraint if m_path => solver.solve(model, data),
             // Row sources are built by the position stage; the rest are listings.
             _ => {}
         }

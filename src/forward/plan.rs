@@ -4,8 +4,7 @@
 //! contains what it acts on: a scene without constraint rows never builds M (ABA path), a scene
 //! without damping or springs has no passive pass.
 
-use crate::constraint::soft::InverseWeights;
-use crate::constraint::{ConstraintMode, ConstraintModel, LimitKind, SolverSettings};
+use crate::constraint::{ConstraintMode, ConstraintModel, ConstraintSolver, LimitKind};
 use crate::model::Model;
 use serde::Serialize;
 
@@ -56,25 +55,6 @@ pub struct Stage {
     pub reason: String,
 }
 
-/// How the steppers keep a constrained state on its manifold (DESIGN.md: drift correction belongs
-/// to the stepper, not to `forward`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DriftCorrection {
-    /// After each step, project q onto φ(q) = 0 and v onto J v = 0.
-    pub projection: bool,
-    /// Tolerance on max |φ| of the position projection.
-    pub tolerance: f64,
-    /// Baumgarte gains [α, β] of J q̈ + J̇v + α J v + β φ = 0 in the acceleration solve
-    /// (None: the pure KKT system).
-    pub baumgarte: Option<[f64; 2]>,
-}
-
-impl Default for DriftCorrection {
-    fn default() -> Self {
-        Self { projection: true, tolerance: 1e-12, baumgarte: None }
-    }
-}
-
 /// The per-model plan of [`forward`](super::forward): part of the compiled [`Model`]
 /// ([`Model::plan`]), built when the model is compiled and rebuilt by
 /// [`Model::set_constraint_mode`] and [`Model::rebuild_plan`]. The default is the empty plan of a
@@ -82,17 +62,12 @@ impl Default for DriftCorrection {
 #[derive(Clone, Debug, Default)]
 pub struct Plan {
     pub stages: Vec<Stage>,
-    /// The constraint mode used, and why (requested, the format's default, or a fallback).
-    pub mode: ConstraintMode,
+    /// Why the constraint mode is what it is (requested, the format's default, or a fallback).
     pub mode_reason: String,
     /// The constraint rows of the model.
     pub constraints: ConstraintModel,
-    /// In soft mode, the inverse weights at `qpos0` the regularizer is built from (None in exact
-    /// mode, or when the model has no constraint rows).
-    pub soft: Option<InverseWeights>,
-    pub drift: DriftCorrection,
-    /// Iteration limit and tolerance of the iterative solve of rows with dry friction.
-    pub solver: SolverSettings,
+    /// The constraint solver: exact or soft, with its settings ([`Plan::mode`] tells which).
+    pub solver: ConstraintSolver,
     /// Each actuator's velocity bias coefficient with `dampratio` resolved at `qpos0`
     /// ([`super::resolved_bias_velocity`]).
     pub actuator_bias_velocity: Vec<f64>,
@@ -111,24 +86,19 @@ impl Plan {
             0
         };
         let stages = stages(model, &constraints, mode, exact_tendon_limits);
-        let soft =
-            (mode == ConstraintMode::Soft && !constraints.is_empty()).then(|| InverseWeights::new(model));
-        // The soft model allows its own drift (MuJoCo projects nothing after a step).
-        let drift = if mode == ConstraintMode::Soft {
-            DriftCorrection { projection: false, ..DriftCorrection::default() }
-        } else {
-            DriftCorrection::default()
-        };
+        let solver = ConstraintSolver::new(mode, model, &constraints);
         Self {
             stages,
-            mode,
             mode_reason,
             constraints,
-            soft,
-            drift,
-            solver: SolverSettings::default(),
+            solver,
             actuator_bias_velocity: super::resolved_bias_velocity(model),
         }
+    }
+
+    /// The constraint mode of the plan's solver.
+    pub fn mode(&self) -> ConstraintMode {
+        self.solver.mode()
     }
 
     /// Whether the stage of `kind` runs.

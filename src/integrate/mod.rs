@@ -26,8 +26,6 @@ pub use lagrangian_terms::LagrangianTerms;
 pub use rk4::RungeKutta4;
 pub use variational::{Variational, CONSTRAINT_TOL, RESIDUAL_TOL};
 
-use crate::constraint::{project_positions, project_velocities, row_violation};
-use crate::forward::DriftCorrection;
 use crate::model::{options, Data, Model};
 use nalgebra::DVector;
 
@@ -148,41 +146,13 @@ pub trait Stepper: Send {
     }
 }
 
-/// After a step `h` of a constrained model: project q onto φ(q) = 0 (Gauss–Newton on the
-/// manifold) and v onto J v = 0 (M-orthogonally; impacts inelastic, dry friction as impulses over
-/// the step), if `drift.projection`. In soft mode nothing is projected (as in MuJoCo); the soft
-/// solve's iterations and its rows' violation at the last stage are returned. Returns (iterations, [max |φ|,
-/// max |J v|]) after the correction; no work without constraint rows.
+/// After a step `h` of a constrained model, the model's solver corrects the drift
+/// ([`ConstraintSolver::correct_drift`](crate::constraint::ConstraintSolver)): the exact mode
+/// projects q onto φ(q) = 0 and v onto J v = 0, the soft mode projects nothing. Returns
+/// (iterations, [max |φ|, max |J v|]) after the correction.
 pub(crate) fn correct_drift(model: &Model, data: &mut Data, state: &mut State, h: f64) -> (u32, [f64; 2]) {
     let plan = &model.plan;
-    if !plan.has_constraints() {
-        data.thaw_rows();
-        return (0, [0.0, 0.0]);
-    }
-    if plan.soft.is_some() {
-        // The soft model is not projected (MuJoCo's steps are not): the report carries the last
-        // solve's iterations and the violation of its rows.
-        data.thaw_rows();
-        return (data.solver_niter, row_violation(data));
-    }
-    // Rows still pressing after the step's last stage stay closed through the projection (a
-    // sustained contact drifted open by the integrator's error is closed again, not released).
-    data.freeze_rows(true);
-    let DriftCorrection { projection, tolerance, .. } = plan.drift;
-    let out = if projection {
-        let (iterations, phi) =
-            project_positions(model, &plan.constraints, data, state.q.as_mut_slice(), tolerance, 50);
-        // The velocity projection takes every row at the projected q, friction included (impulses
-        // in the Coulomb cone).
-        plan.constraints.positions(model, data, state.q.as_slice(), true);
-        let jv = project_velocities(model, data, state.v.as_mut_slice(), h, plan.solver);
-        (iterations, [phi, jv])
-    } else {
-        plan.constraints.evaluate(model, data, state.q.as_slice(), state.v.as_slice());
-        (0, row_violation(data))
-    };
-    data.thaw_rows();
-    out
+    plan.solver.correct_drift(&plan.constraints, model, data, state, h)
 }
 
 /// The integrators `simulate` offers, by name.

@@ -8,6 +8,8 @@
 //! `efc_*`. Each buffer keeps one meaning.
 
 use super::{Contact, JointKind, Model};
+use crate::constraint::soft::SoftWork;
+use crate::constraint::{ExactWork, RowLifecycle};
 use crate::spatial::{ArticulatedInertia, Force, Motion, RigidInertia, Transform};
 use nalgebra::{DMatrix, DVector, Matrix6};
 
@@ -102,57 +104,6 @@ impl EfcState {
             EfcState::LinearNeg => "linearneg",
             EfcState::LinearPos => "linearpos",
             EfcState::Cone => "cone",
-        }
-    }
-}
-
-/// Scratch of the soft solvers (`crate::constraint::soft`).
-#[derive(Clone, Debug)]
-pub struct SoftWork {
-    /// J a − aref per row, and J d along a search direction d.
-    pub jar: DVector<f64>,
-    pub jv: DVector<f64>,
-    /// J a − aref at a trial point of the line search.
-    pub jar_trial: DVector<f64>,
-    /// The cost's gradient, its preconditioned form, the search direction, M a, M d, and the
-    /// previous gradient and direction (CG) — length nv.
-    pub grad: DVector<f64>,
-    pub mgrad: DVector<f64>,
-    pub dir: DVector<f64>,
-    pub ma: DVector<f64>,
-    pub mdir: DVector<f64>,
-    pub grad_prev: DVector<f64>,
-    pub mgrad_prev: DVector<f64>,
-    /// The cost's Hessian M + Jᵀ D J (+ cone blocks) and its Cholesky factor, nv × nv.
-    pub hessian: DMatrix<f64>,
-    pub factor: DMatrix<f64>,
-    /// The nonzero columns of each row of J: row i's are `nz_index[nz_start[i]..nz_start[i + 1]]`.
-    pub nz_start: Vec<usize>,
-    pub nz_index: Vec<usize>,
-    /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
-    pub ar: DMatrix<f64>,
-    pub minv_jt: DMatrix<f64>,
-}
-
-impl SoftWork {
-    fn new(nv: usize, nefc: usize) -> Self {
-        Self {
-            jar: DVector::zeros(nefc),
-            jv: DVector::zeros(nefc),
-            jar_trial: DVector::zeros(nefc),
-            grad: DVector::zeros(nv),
-            mgrad: DVector::zeros(nv),
-            dir: DVector::zeros(nv),
-            ma: DVector::zeros(nv),
-            mdir: DVector::zeros(nv),
-            grad_prev: DVector::zeros(nv),
-            mgrad_prev: DVector::zeros(nv),
-            hessian: DMatrix::zeros(nv, nv),
-            factor: DMatrix::zeros(nv, nv),
-            nz_start: Vec::with_capacity(nefc + 1),
-            nz_index: Vec::with_capacity(nefc * nv),
-            ar: DMatrix::zeros(0, 0),
-            minv_jt: DMatrix::zeros(0, 0),
         }
     }
 }
@@ -275,26 +226,10 @@ pub struct Data {
     /// For each row, the element it comes from: the equality (index in `Model::equalities`) or
     /// the limited joint (index in `Model::joints`) (MuJoCo's `efc_id`).
     pub efc_id: Vec<usize>,
-    /// M⁻¹Jᵀ, nv × nefc (columns 0..nefc used).
-    pub efc_minv_jt: DMatrix<f64>,
-    /// The Delassus matrix J M⁻¹ Jᵀ, nefc × nefc, and its factor or eigenvectors (scratch).
-    pub efc_delassus: DMatrix<f64>,
-    pub efc_factor: DMatrix<f64>,
-    /// Right-hand side and eigenvalue scratch of the dense solve, length nefc.
-    pub efc_rhs: DVector<f64>,
-    pub efc_eig: DVector<f64>,
-    /// Scratch of the unilateral solve: the active set, its Delassus block, its right-hand side.
-    pub efc_active: Vec<usize>,
-    pub efc_sub: DMatrix<f64>,
-    pub efc_sub_rhs: DVector<f64>,
     /// Active-set changes of the last unilateral solve (0 without unilateral rows).
     pub efc_iterations: u32,
     /// Rank of J M⁻¹ Jᵀ at the last solve (< nefc: redundant rows, minimum-norm multipliers).
     pub efc_rank: usize,
-    /// Rows whose Delassus diagonal A_ii is at most this are round-off (their force would move
-    /// nothing: J_i M⁻¹ J_iᵀ ≈ 0) and get no force: 1e-12 of the largest diagonal, set by the
-    /// frictional solve.
-    pub efc_a_floor: f64,
     /// Set by the frictional solve when it restarted after diverging: sliding contacts were then
     /// solved with the symmetric cone projection instead of the maximal-dissipation law.
     pub efc_safe_friction: bool,
@@ -308,36 +243,10 @@ pub struct Data {
     /// non-finite value) without meeting the tolerance, and the largest residual they left.
     pub efc_unconverged: u64,
     pub efc_unconverged_residual: f64,
-    /// Warm start of the iterative solve: the forces of the previous acceleration-level solve and
-    /// the (type, id) of each of its rows; reused when the rows are the same.
-    pub efc_warm: DVector<f64>,
-    pub efc_warm_rows: Vec<(EfcType, usize)>,
-    /// λ at the start of a Gauss–Seidel sweep (scratch of the iterative solve).
-    pub efc_lambda_prev: DVector<f64>,
-    /// Per row, during the velocity projection: a limit or contact row that carried a compressive
-    /// force in the last acceleration-level solve. Its velocity is held at 0 (the row stays
-    /// closed) rather than allowed to grow: a small separating J v left by the integrator's error
-    /// is drift, not a lift-off.
-    pub efc_pressing: Vec<bool>,
-    /// Per row, scratch of the Coulomb solve's polish: a contact (at its normal row) whose
-    /// friction is on its cone, slipping or starting to.
-    pub efc_slipping: Vec<bool>,
-
-    /// Rows frozen within a step ([`Data::freeze_rows`]): while set, a limit or contact row that
-    /// was frozen exists whatever its distance (rows within the activation distance exist as
-    /// always), and no row counts as separating — the later stages of a step keep the contacts
-    /// the step started with, even where a stage's configuration lifts them off by round-off or
-    /// by the integrator's error.
-    pub efc_frozen: bool,
-    /// The limited joints (index in `Model::joints`) with a row at the step's start.
-    pub efc_frozen_limits: Vec<usize>,
-    /// The contacts (geom pair and feature, see `Contact::feature`) with a row when frozen.
-    pub efc_frozen_contacts: Vec<([usize; 2], u32)>,
-    /// Of the frozen rows, the contacts and friction-loss dofs that were at rest (slip at most
-    /// [`SLIP_VELOCITY`]) when frozen: the later stages of the step keep their sticking law (a
-    /// stage's velocity carries the integrator's O(h²) slip, which is no slip).
-    pub efc_frozen_sticking: Vec<([usize; 2], u32)>,
-    pub efc_frozen_sticking_dofs: Vec<usize>,
+    /// The exact solver's workspace (Delassus matrix, factors, warm start, active set).
+    pub(crate) exact: ExactWork,
+    /// Which limit and contact rows exist within a step ([`RowLifecycle`]).
+    pub(crate) lifecycle: RowLifecycle,
 
     // --- soft (MuJoCo-compatible) constraint model, MuJoCo's buffer names ---
     /// Rows of equality constraints and of friction loss in the soft solve (MuJoCo's `ne`, `nf`;
@@ -368,7 +277,7 @@ pub struct Data {
     pub solver_improvement: f64,
     pub solver_gradient: f64,
     /// Scratch of the soft solvers (sized nv, nefc or nv × nv).
-    pub soft: SoftWork,
+    pub(crate) soft: SoftWork,
 
     // --- collision ---
     /// World pose of each geom that collides, from the last collision pass (MuJoCo's `geom_xpos`,
@@ -446,32 +355,15 @@ impl Data {
             efc_force: DVector::zeros(nefc),
             efc_type: vec![EfcType::Equality; nefc],
             efc_id: vec![0; nefc],
-            efc_active: Vec::with_capacity(nefc),
-            efc_sub: DMatrix::zeros(nefc, nefc),
-            efc_sub_rhs: DVector::zeros(nefc),
-            efc_minv_jt: DMatrix::zeros(nv, nefc),
-            efc_delassus: DMatrix::zeros(nefc, nefc),
-            efc_factor: DMatrix::zeros(nefc, nefc),
-            efc_rhs: DVector::zeros(nefc),
-            efc_eig: DVector::zeros(nefc),
             efc_iterations: 0,
             efc_rank: 0,
-            efc_a_floor: 0.0,
             efc_safe_friction: false,
             efc_residual: 0.0,
             efc_converged: true,
             efc_unconverged: 0,
             efc_unconverged_residual: 0.0,
-            efc_warm: DVector::zeros(nefc),
-            efc_warm_rows: Vec::with_capacity(nefc),
-            efc_lambda_prev: DVector::zeros(nefc),
-            efc_pressing: vec![false; nefc],
-            efc_slipping: vec![false; nefc],
-            efc_frozen: false,
-            efc_frozen_limits: Vec::with_capacity(model.joints.len()),
-            efc_frozen_contacts: Vec::with_capacity(model.max_contacts()),
-            efc_frozen_sticking: Vec::with_capacity(model.max_contacts()),
-            efc_frozen_sticking_dofs: Vec::with_capacity(nv),
+            exact: ExactWork::new(nv, nefc),
+            lifecycle: RowLifecycle::new(model),
             ne: 0,
             nf: 0,
             efc_margin: DVector::zeros(nefc),
@@ -510,96 +402,13 @@ impl Data {
         }
     }
 
-    /// Freezes the current limit and contact rows (with `pressing_only`, those whose force is
-    /// positive): until [`thaw_rows`](Self::thaw_rows) they keep a row whatever their distance
-    /// (see `efc_frozen`). Multi-stage steppers freeze all rows after the first stage's `forward`;
-    /// the drift correction freezes the rows still pressing after the last stage, so that a
-    /// sustained contact stays closed through the projection.
-    pub fn freeze_rows(&mut self, pressing_only: bool) {
-        self.efc_frozen_limits.clear();
-        self.efc_frozen_contacts.clear();
-        self.efc_frozen_sticking.clear();
-        self.efc_frozen_sticking_dofs.clear();
-        self.add_frozen_rows(pressing_only);
-        let mut i = 0;
-        while i < self.nefc {
-            let len = self.efc_block_len(i);
-            let slip = (i + 1..i + len).map(|k| self.efc_vel[k].abs()).fold(0.0, f64::max);
-            match self.efc_type[i] {
-                EfcType::FrictionDof if self.efc_vel[i].abs() <= SLIP_VELOCITY => {
-                    self.efc_frozen_sticking_dofs.push(self.efc_id[i])
-                }
-                EfcType::ContactElliptic if slip <= SLIP_VELOCITY => {
-                    let c = &self.contacts[self.efc_id[i]];
-                    if self.efc_frozen_sticking.len() < self.efc_frozen_sticking.capacity() {
-                        self.efc_frozen_sticking.push((c.geom, c.feature));
-                    }
-                }
-                _ => {}
-            }
-            i += len;
-        }
-    }
-
-    /// Whether the friction of row block `i` (a contact's normal row or a friction-loss row) keeps
-    /// its sticking law because rows are frozen and it was at rest when frozen.
-    pub fn efc_frozen_at_rest(&self, i: usize) -> bool {
-        self.efc_frozen
-            && match self.efc_type[i] {
-                EfcType::FrictionDof => self.efc_frozen_sticking_dofs.contains(&self.efc_id[i]),
-                EfcType::ContactElliptic => {
-                    let c = &self.contacts[self.efc_id[i]];
-                    self.efc_frozen_sticking.contains(&(c.geom, c.feature))
-                }
-                _ => false,
-            }
-    }
-
-    /// Adds the current limit and contact rows (with `pressing_only`, those whose force is
-    /// positive) to the frozen ones and freezes: the position projection keeps every row it
-    /// corrects until it lands on φ = 0 (a corner pushed out of the floor stays a row even where a
-    /// Gauss–Newton step overshoots), so the velocity projection that follows sees it too.
-    pub fn add_frozen_rows(&mut self, pressing_only: bool) {
-        for i in 0..self.nefc {
-            if pressing_only && self.efc_force[i] <= 0.0 {
-                continue;
-            }
-            match self.efc_type[i] {
-                EfcType::LimitJoint if !self.efc_frozen_limits.contains(&self.efc_id[i]) => {
-                    self.efc_frozen_limits.push(self.efc_id[i])
-                }
-                EfcType::ContactFrictionless | EfcType::ContactElliptic if self.efc_is_normal(i) => {
-                    let c = &self.contacts[self.efc_id[i]];
-                    let key = (c.geom, c.feature);
-                    if !self.efc_frozen_contacts.contains(&key)
-                        && self.efc_frozen_contacts.len() < self.efc_frozen_contacts.capacity()
-                    {
-                        self.efc_frozen_contacts.push(key);
-                    }
-                }
-                _ => {}
-            }
-        }
-        self.efc_frozen = true;
-    }
-
-    /// Whether contact `c` keeps a row while rows are frozen.
-    pub fn contact_is_frozen(&self, c: &Contact) -> bool {
-        self.efc_frozen && self.efc_frozen_contacts.contains(&(c.geom, c.feature))
-    }
-
-    /// Ends the frozen stages of a step: rows are again chosen by distance.
-    pub fn thaw_rows(&mut self) {
-        self.efc_frozen = false;
-    }
-
     /// The force of row i + k (the k-th row of the block starting at row i) in the last
     /// acceleration-level solve (`efc_warm`, matched by type and element), 0 if it had no such row.
     pub fn efc_previous_force(&self, i: usize, k: usize) -> f64 {
         let key = (self.efc_type[i], self.efc_id[i]);
-        self.efc_warm_rows.iter().position(|w| *w == key).map_or(0.0, |j| {
-            if j + k < self.efc_warm_rows.len() && self.efc_warm_rows[j + k] == key {
-                self.efc_warm[j + k]
+        self.exact.warm_rows.iter().position(|w| *w == key).map_or(0.0, |j| {
+            if j + k < self.exact.warm_rows.len() && self.exact.warm_rows[j + k] == key {
+                self.exact.warm[j + k]
             } else {
                 0.0
             }
@@ -609,7 +418,13 @@ impl Data {
     /// Whether row `i`'s force has a sign in the current solve: a limit or contact row that is
     /// not held closed by `efc_pressing`.
     pub fn efc_signed(&self, i: usize) -> bool {
-        self.efc_type[i].is_unilateral() && !self.efc_pressing[i]
+        self.efc_type[i].is_unilateral() && !self.exact.pressing[i]
+    }
+
+    /// Rows in the active set of the last exact solve without friction (compare with `efc_rank`:
+    /// fewer independent rows than active ones means redundant constraints).
+    pub fn efc_active_rows(&self) -> usize {
+        self.exact.active.len()
     }
 
     /// The number of rows the buffers hold.
@@ -627,19 +442,12 @@ impl Data {
         let new = n.max(2 * cap);
         let nv = self.efc_j.ncols();
         self.efc_j = DMatrix::zeros(new, nv);
-        self.efc_minv_jt = DMatrix::zeros(nv, new);
-        for m in [&mut self.efc_delassus, &mut self.efc_factor, &mut self.efc_sub] {
-            *m = DMatrix::zeros(new, new);
-        }
+        self.exact.grow(nv, new);
         for v in [
             &mut self.efc_pos,
             &mut self.efc_vel,
             &mut self.efc_jdotv,
             &mut self.efc_force,
-            &mut self.efc_rhs,
-            &mut self.efc_eig,
-            &mut self.efc_sub_rhs,
-            &mut self.efc_lambda_prev,
             &mut self.efc_margin,
             &mut self.efc_frictionloss,
             &mut self.efc_diag_a,
@@ -652,15 +460,10 @@ impl Data {
         ] {
             *v = DVector::zeros(new);
         }
-        self.efc_warm.resize_vertically_mut(new, 0.0);
         self.efc_type.resize(new, EfcType::Equality);
         self.efc_id.resize(new, 0);
-        self.efc_pressing.resize(new, false);
-        self.efc_slipping.resize(new, false);
         self.efc_kbip.resize(new, [0.0; 4]);
         self.efc_state.resize(new, EfcState::Satisfied);
-        self.efc_active.reserve(new.saturating_sub(self.efc_active.len()));
-        self.efc_warm_rows.reserve(new.saturating_sub(self.efc_warm_rows.len()));
     }
 
     /// Whether row `i` is a limit row or a contact's normal row (the rows with a gap φ ≥ 0).

@@ -18,7 +18,7 @@ pub mod tendon;
 pub use actuator::Actuator;
 pub use collision_pairs::CollisionPair;
 pub use contact::{Contact, ContactExclude, ContactPair};
-pub use data::{Data, EfcState, EfcType, SoftWork, SLIP_VELOCITY};
+pub use data::{Data, EfcState, EfcType, SLIP_VELOCITY};
 pub use elements::{Element, Keyframe};
 pub use equality::{Equality, EqualityKind};
 pub use joint::{axis_angle, HingeAxis, JointKind};
@@ -315,12 +315,14 @@ impl Model {
     }
 
     /// Solves the constraints in `mode` from now on: the plan is rebuilt for it, with the mode's
-    /// own drift correction (projection in exact mode, none in soft mode) and the iterative
-    /// solver's settings kept. MJCF models default to soft, URDF models to exact.
+    /// default drift correction (projection in exact mode, none in soft mode) and the exact
+    /// solver's iteration settings kept. MJCF models default to soft, URDF models to exact.
     pub fn set_constraint_mode(&mut self, mode: crate::constraint::ConstraintMode) {
-        let solver = self.plan.solver;
+        let settings = self.plan.solver.exact().map(|e| e.settings);
         self.plan = crate::forward::Plan::new(self, Some(mode));
-        self.plan.solver = solver;
+        if let (Some(settings), Some(e)) = (settings, self.plan.solver.exact_mut()) {
+            e.settings = settings;
+        }
     }
 
     /// Rebuilds [`plan`](Self::plan) after the elements or options were edited (a joint's limit,
@@ -328,10 +330,11 @@ impl Model {
     /// correction and the solver settings.
     pub fn rebuild_plan(&mut self) {
         let old = std::mem::take(&mut self.plan);
-        self.plan = crate::forward::Plan::new(self, Some(old.mode));
+        self.plan = crate::forward::Plan::new(self, Some(old.mode()));
         self.plan.mode_reason = old.mode_reason;
-        self.plan.drift = old.drift;
-        self.plan.solver = old.solver;
+        if let (Some(old), Some(e)) = (old.solver.exact(), self.plan.solver.exact_mut()) {
+            *e = old.clone();
+        }
     }
 }
 

@@ -17,10 +17,12 @@ pub mod pgs;
 pub mod primal;
 pub mod rows;
 pub mod weights;
+mod work;
 
 pub use primal::{solve_primal, Primal, Settings};
 pub use rows::{soft_active, soft_positions, soft_velocities};
 pub use weights::InverseWeights;
+pub(crate) use work::SoftWork;
 
 use crate::model::options::Solver;
 use crate::model::{Data, Model};

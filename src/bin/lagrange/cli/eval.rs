@@ -133,7 +133,7 @@ fn forward_json(model: &Model, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f
         r += n;
     }
     let vec = |x: &nalgebra::DVector<f64>| x.as_slice().to_vec();
-    let efc = model.plan.soft.is_some().then(|| soft_rows_json(model, data));
+    let efc = model.plan.solver.soft_weights().is_some().then(|| soft_rows_json(model, data));
     let mut out = json!({
         "qacc": vec(&data.qacc), "qacc_smooth": vec(&data.qacc_smooth), "qfrc_passive": vec(&data.qfrc_passive),
         "qfrc_actuator": vec(&data.qfrc_actuator), "qfrc_constraint": vec(&data.qfrc_constraint),
@@ -260,7 +260,7 @@ pub fn run(
         check_state(&model, &file, i, s)?;
         results.push(evaluate(&model, &mut data, s, &frame_ids));
     }
-    let out = json!({ "results": results, "constraints": {"mode": model.plan.mode.name(), "reason": model.plan.mode_reason} });
+    let out = json!({ "results": results, "constraints": {"mode": model.plan.mode().name(), "reason": model.plan.mode_reason} });
     println!("{}", serde_json::to_string(&out).expect("JSON values serialize"));
     Ok(())
 }

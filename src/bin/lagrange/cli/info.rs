@@ -223,7 +223,7 @@ pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
         "elements": elements,
         "warnings": model.warnings,
         "stages": stages,
-        "constraints": {"mode": plan.mode.name(), "reason": plan.mode_reason},
+        "constraints": {"mode": plan.mode().name(), "reason": plan.mode_reason},
     })
 }
 
@@ -318,7 +318,7 @@ pub fn to_text(model: &Model, mode: Option<ConstraintMode>) -> String {
             let _ = writeln!(s, "  {n:>4} × {k:<28} {status}");
         }
     }
-    let _ = writeln!(s, "\nforward plan (constraint mode: {}; {}):", plan.mode.name(), plan.mode_reason);
+    let _ = writeln!(s, "\nforward plan (constraint mode: {}; {}):", plan.mode().name(), plan.mode_reason);
     for st in &plan.stages {
         let _ = writeln!(s, "  {:<22} {:<22} {}", st.name, st.status.as_str(), st.reason);
     }

@@ -236,11 +236,11 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         let (contacts, penetration) = contact_summary(&sim.data);
         max_contacts = max_contacts.max(contacts);
         max_penetration = max_penetration.max(penetration);
-        let soft = sim.model.plan.soft.is_some();
+        let soft = sim.model.plan.solver.soft_weights().is_some();
         max_iterations =
             max_iterations.max(if soft { report.solver_iterations } else { sim.data.efc_iterations });
         max_violation = [max_violation[0].max(violation[0]), max_violation[1].max(violation[1])];
-        let active = sim.data.efc_active.len();
+        let active = sim.data.efc_active_rows();
         if !soft && sim.data.nefc > 0 && sim.data.efc_rank < active {
             redundant = Some((sim.data.efc_rank, active));
         }
@@ -276,7 +276,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         max_penetration,
         max_contacts,
         max_solver_iterations: max_iterations,
-        soft: sim.model.plan.soft.is_some(),
+        soft: sim.model.plan.solver.soft_weights().is_some(),
         unconverged: (sim.data.efc_unconverged, sim.data.efc_unconverged_residual),
         redundant,
         steps,

@@ -530,7 +530,7 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
     if probe.model.plan.has_constraints() && setup.model.collision_pairs.is_empty() {
         notes.push(format!(
             "the model has constraint rows: measured with the engine's constraint handling as it is ({}; drift projection after each step)",
-            probe.model.plan.mode.name()
+            probe.model.plan.mode().name()
         ));
     }
     if integrators.contains(&IntegratorKind::ImplicitFast)

@@ -1,0 +1,82 @@
+//! The exact (rigid) solver's workspace: the Delassus matrix J M⁻¹ Jᵀ of the rows, its factor
+//! or eigenvectors, the active set of the unilateral solve, the Gauss–Seidel scratch of the
+//! Coulomb solve and its warm start (`docs/architecture.md`, "Constraint solvers"). It lives in
+//! [`Data`](crate::Data), private to the solver: the outputs users read (`efc_force`, `efc_rank`,
+//! `efc_converged`, …) are `Data`'s own fields.
+
+use crate::model::EfcType;
+use nalgebra::{DMatrix, DVector};
+
+/// Buffers of [`solve_exact`](super::solve_exact), the Coulomb solve and the velocity projection,
+/// sized for the row capacity of [`Data`](crate::Data) (grown with it by `Data::reserve_rows`).
+#[derive(Clone, Debug)]
+pub(crate) struct ExactWork {
+    /// M⁻¹Jᵀ, nv × nefc (columns 0..nefc used).
+    pub minv_jt: DMatrix<f64>,
+    /// The Delassus matrix J M⁻¹ Jᵀ, nefc × nefc, and its factor or eigenvectors.
+    pub delassus: DMatrix<f64>,
+    pub factor: DMatrix<f64>,
+    /// Right-hand side and eigenvalue scratch of the dense solve, length nefc.
+    pub rhs: DVector<f64>,
+    pub eig: DVector<f64>,
+    /// The unilateral solve's active set, its Delassus block and right-hand side.
+    pub active: Vec<usize>,
+    pub sub: DMatrix<f64>,
+    pub sub_rhs: DVector<f64>,
+    /// Rows whose Delassus diagonal A_ii is at most this are round-off (their force would move
+    /// nothing: J_i M⁻¹ J_iᵀ ≈ 0) and get no force: 1e-12 of the largest diagonal, set by the
+    /// frictional solve.
+    pub a_floor: f64,
+    /// Warm start of the iterative solve: the forces of the previous acceleration-level solve and
+    /// the (type, id) of each of its rows; reused when the rows are the same.
+    pub warm: DVector<f64>,
+    pub warm_rows: Vec<(EfcType, usize)>,
+    /// λ at the start of a Gauss–Seidel sweep.
+    pub lambda_prev: DVector<f64>,
+    /// Per row, during the velocity projection: a limit or contact row that carried a compressive
+    /// force in the last acceleration-level solve. Its velocity is held at 0 (the row stays
+    /// closed) rather than allowed to grow: a small separating J v left by the integrator's error
+    /// is drift, not a lift-off.
+    pub pressing: Vec<bool>,
+    /// Per row, the Coulomb solve's polish: a contact (at its normal row) whose friction is on
+    /// its cone, slipping or starting to.
+    pub slipping: Vec<bool>,
+}
+
+impl ExactWork {
+    /// The workspace for `nefc` rows of a model with `nv` dofs.
+    pub fn new(nv: usize, nefc: usize) -> Self {
+        Self {
+            minv_jt: DMatrix::zeros(nv, nefc),
+            delassus: DMatrix::zeros(nefc, nefc),
+            factor: DMatrix::zeros(nefc, nefc),
+            rhs: DVector::zeros(nefc),
+            eig: DVector::zeros(nefc),
+            active: Vec::with_capacity(nefc),
+            sub: DMatrix::zeros(nefc, nefc),
+            sub_rhs: DVector::zeros(nefc),
+            a_floor: 0.0,
+            warm: DVector::zeros(nefc),
+            warm_rows: Vec::with_capacity(nefc),
+            lambda_prev: DVector::zeros(nefc),
+            pressing: vec![false; nefc],
+            slipping: vec![false; nefc],
+        }
+    }
+
+    /// Grows every buffer to `nefc` rows, keeping the warm start.
+    pub fn grow(&mut self, nv: usize, nefc: usize) {
+        self.minv_jt = DMatrix::zeros(nv, nefc);
+        for m in [&mut self.delassus, &mut self.factor, &mut self.sub] {
+            *m = DMatrix::zeros(nefc, nefc);
+        }
+        for v in [&mut self.rhs, &mut self.eig, &mut self.sub_rhs, &mut self.lambda_prev] {
+            *v = DVector::zeros(nefc);
+        }
+        self.warm.resize_vertically_mut(nefc, 0.0);
+        self.pressing.resize(nefc, false);
+        self.slipping.resize(nefc, false);
+        self.active.reserve(nefc.saturating_sub(self.active.len()));
+        self.warm_rows.reserve(nefc.saturating_sub(self.warm_rows.len()));
+    }
+}

@@ -1,0 +1,57 @@
+//! The soft solvers' workspace (Newton, CG and PGS of [`super`]): the cost's per-row and
+//! per-dof scratch, the Hessian and its Cholesky factor, and the dual matrix of PGS. It lives in
+//! [`Data`](crate::Data), private to the solvers; their outputs (`efc_force`, `efc_state`,
+//! `qacc`, `solver_niter`, …) are `Data`'s own fields.
+
+use nalgebra::{DMatrix, DVector};
+
+/// Scratch of the soft solvers (`crate::constraint::soft`).
+#[derive(Clone, Debug)]
+pub(crate) struct SoftWork {
+    /// J a − aref per row, and J d along a search direction d.
+    pub jar: DVector<f64>,
+    pub jv: DVector<f64>,
+    /// J a − aref at a trial point of the line search.
+    pub jar_trial: DVector<f64>,
+    /// The cost's gradient, its preconditioned form, the search direction, M a, M d, and the
+    /// previous gradient and direction (CG) — length nv.
+    pub grad: DVector<f64>,
+    pub mgrad: DVector<f64>,
+    pub dir: DVector<f64>,
+    pub ma: DVector<f64>,
+    pub mdir: DVector<f64>,
+    pub grad_prev: DVector<f64>,
+    pub mgrad_prev: DVector<f64>,
+    /// The cost's Hessian M + Jᵀ D J (+ cone blocks) and its Cholesky factor, nv × nv.
+    pub hessian: DMatrix<f64>,
+    pub factor: DMatrix<f64>,
+    /// The nonzero columns of each row of J: row i's are `nz_index[nz_start[i]..nz_start[i + 1]]`.
+    pub nz_start: Vec<usize>,
+    pub nz_index: Vec<usize>,
+    /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
+    pub ar: DMatrix<f64>,
+    pub minv_jt: DMatrix<f64>,
+}
+
+impl SoftWork {
+    pub fn new(nv: usize, nefc: usize) -> Self {
+        Self {
+            jar: DVector::zeros(nefc),
+            jv: DVector::zeros(nefc),
+            jar_trial: DVector::zeros(nefc),
+            grad: DVector::zeros(nv),
+            mgrad: DVector::zeros(nv),
+            dir: DVector::zeros(nv),
+            ma: DVector::zeros(nv),
+            mdir: DVector::zeros(nv),
+            grad_prev: DVector::zeros(nv),
+            mgrad_prev: DVector::zeros(nv),
+            hessian: DMatrix::zeros(nv, nv),
+            factor: DMatrix::zeros(nv, nv),
+            nz_start: Vec::with_capacity(nefc + 1),
+            nz_index: Vec::with_capacity(nefc * nv),
+            ar: DMatrix::zeros(0, 0),
+            minv_jt: DMatrix::zeros(0, 0),
+        }
+    }
+}
