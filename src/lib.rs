@@ -15,6 +15,7 @@ pub mod batch;
 pub mod collision;
 pub mod constraint;
 pub mod dynamics;
+pub mod error;
 pub mod forward;
 pub mod integrate;
 pub mod io;
@@ -23,6 +24,7 @@ mod kernel_test_states;
 pub mod kinematics;
 pub mod mass;
 pub mod model;
+pub mod prelude;
 pub mod sim;
 pub mod spatial;
 

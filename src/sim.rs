@@ -31,6 +31,9 @@ pub enum SimError {
     },
     #[error("invalid initial state: {0}")]
     BadState(String),
+    /// A call's argument or the data does not fit the model.
+    #[error(transparent)]
+    Input(#[from] crate::error::InputError),
 }
 
 /// A simulation time for display: rounded to 12 significant digits, so that a sum of steps
@@ -271,52 +274,7 @@ impl Simulation {
     }
 
     fn check_finite(&self) -> Result<(), SimError> {
-        if self.data.qpos.iter().chain(self.data.qvel.iter()).all(|x| x.is_finite()) {
-            return Ok(());
-        }
-        // Non-finite values spread through ABA to every joint; the origin is a joint whose
-        // articulated inertia D = Sᵀ Iᴬ S was singular. Leaves first, the first such joint has
-        // only finite descendants.
-        for b in (1..self.model.nbody()).rev() {
-            let j = self.model.joint_of(b);
-            let d_inv = self.data.d_inv[b][(0, 0)];
-            if !d_inv.is_finite() {
-                return Err(SimError::Diverged {
-                    time: self.data.time,
-                    step: self.steps,
-                    quantity: "articulated inertia about the axis (D⁻¹)",
-                    joint: j.name.clone(),
-                    value: d_inv,
-                    hint: "the joint carries no mass or inertia about its axis at this configuration, which no step size fixes: check the inertias of the bodies it moves".into(),
-                });
-            }
-        }
-        for (quantity, values, by_dof) in
-            [("position", self.data.qpos.as_slice(), false), ("velocity", self.data.qvel.as_slice(), true)]
-        {
-            if let Some(i) = values.iter().position(|x| !x.is_finite()) {
-                let joint = self
-                    .model
-                    .joints
-                    .iter()
-                    .find(|j| {
-                        let (adr, n) =
-                            if by_dof { (j.dof_adr, j.kind.nv()) } else { (j.qpos_adr, j.kind.nq()) };
-                        (adr..adr + n).contains(&i)
-                    })
-                    .map(|j| j.name.clone())
-                    .unwrap_or_default();
-                return Err(SimError::Diverged {
-                    time: self.data.time,
-                    step: self.steps,
-                    quantity,
-                    joint,
-                    value: values[i],
-                    hint: self.divergence_hint(),
-                });
-            }
-        }
-        Ok(())
+        check_finite(&self.model, &self.data, self.steps, || self.divergence_hint())
     }
 
     /// Kinetic and potential energy (T, V: gravity and joint springs) at the current state
@@ -352,4 +310,59 @@ impl Simulation {
     pub fn integrator(&self) -> &'static str {
         self.stepper.name()
     }
+}
+
+/// `Ok` while the state in `data` is finite; else [`SimError::Diverged`] naming the joint where
+/// it started (a singular articulated inertia first: that is the origin no step size fixes), the
+/// time and `step`, with `hint` for a state that went non-finite.
+pub(crate) fn check_finite(
+    model: &Model,
+    data: &Data,
+    step: u64,
+    hint: impl FnOnce() -> String,
+) -> Result<(), SimError> {
+    if data.qpos.iter().chain(data.qvel.iter()).all(|x| x.is_finite()) {
+        return Ok(());
+    }
+    // Non-finite values spread through ABA to every joint; the origin is a joint whose
+    // articulated inertia D = Sᵀ Iᴬ S was singular. Leaves first, the first such joint has
+    // only finite descendants.
+    for b in (1..model.nbody()).rev() {
+        let j = model.joint_of(b);
+        let d_inv = data.d_inv[b][(0, 0)];
+        if !d_inv.is_finite() {
+            return Err(SimError::Diverged {
+                time: data.time,
+                step,
+                quantity: "articulated inertia about the axis (D⁻¹)",
+                joint: j.name.clone(),
+                value: d_inv,
+                hint: "the joint carries no mass or inertia about its axis at this configuration, which no step size fixes: check the inertias of the bodies it moves".into(),
+            });
+        }
+    }
+    for (quantity, values, by_dof) in
+        [("position", data.qpos.as_slice(), false), ("velocity", data.qvel.as_slice(), true)]
+    {
+        if let Some(i) = values.iter().position(|x| !x.is_finite()) {
+            let joint = model
+                .joints
+                .iter()
+                .find(|j| {
+                    let (adr, n) = if by_dof { (j.dof_adr, j.kind.nv()) } else { (j.qpos_adr, j.kind.nq()) };
+                    (adr..adr + n).contains(&i)
+                })
+                .map(|j| j.name.clone())
+                .unwrap_or_default();
+            return Err(SimError::Diverged {
+                time: data.time,
+                step,
+                quantity,
+                joint,
+                value: values[i],
+                hint: hint(),
+            });
+        }
+    }
+    Ok(())
 }

@@ -14,6 +14,7 @@
 
 mod active_set;
 mod contact;
+pub mod contact_force;
 mod coulomb;
 mod dense;
 mod exact;

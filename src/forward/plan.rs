@@ -113,7 +113,11 @@ impl Plan {
 }
 
 fn is_mjcf(model: &Model) -> bool {
-    model.source.as_ref().and_then(|p| p.extension()).is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+    model
+        .source
+        .as_ref()
+        .and_then(|p| p.extension())
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml") || e.eq_ignore_ascii_case("mjcf"))
 }
 
 fn resolve_mode(model: &Model, requested: Option<ConstraintMode>) -> (ConstraintMode, String) {

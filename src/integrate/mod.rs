@@ -15,6 +15,7 @@ mod implicit_fast;
 mod lagrangian_terms;
 mod rk4;
 mod stage;
+mod step;
 mod variational;
 
 pub use adaptive::{DormandPrince54, DEFAULT_ATOL, DEFAULT_RTOL};
@@ -24,6 +25,8 @@ pub use implicit::Implicit;
 pub use implicit_fast::{add_force_derivative, ImplicitFast};
 pub use lagrangian_terms::LagrangianTerms;
 pub use rk4::RungeKutta4;
+pub use step::step;
+pub(crate) use step::StepperSlot;
 pub use variational::{Variational, CONSTRAINT_TOL, RESIDUAL_TOL};
 
 use crate::model::{options, Data, Model};

@@ -69,7 +69,7 @@ pub enum LoadError {
     Unsupported { loc: SourceLoc, element: String, what: String, fix: String },
     #[error("{loc}: <{element}>: file '{path}' does not exist; fix the file name or <compiler meshdir/assetdir> (relative paths start at the model file's folder)")]
     AssetNotFound { loc: SourceLoc, element: String, path: String },
-    #[error("{file}: unsupported model format (expected .urdf or .xml)")]
+    #[error("{file}: unsupported model format (expected a URDF file, root element <robot>, named .urdf, or an MJCF file, root element <mujoco>, named .xml)")]
     UnsupportedFormat { file: String },
 }
 

@@ -92,3 +92,78 @@ pub fn load_spec(path: &Path, options: &LoadOptions) -> Result<ModelSpec, LoadEr
 pub fn load_urdf_str(text: &str, path: &Path, options: &LoadOptions) -> Result<Model, LoadError> {
     compile(&urdf::parse(text, path, options)?)
 }
+
+/// The format of a model text, from its root element: `<robot>` is URDF, `<mujoco>` MJCF.
+fn format_of(text: &str) -> Option<&'static str> {
+    let mut rest = text;
+    loop {
+        let start = rest.find('<')?;
+        rest = &rest[start + 1..];
+        if rest.starts_with('?') || rest.starts_with('!') {
+            // An XML declaration, comment or doctype: skip to its end.
+            let end = if rest.starts_with("!--") { rest.find("-->")? + 3 } else { rest.find('>')? + 1 };
+            rest = &rest[end..];
+            continue;
+        }
+        let name: String =
+            rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_' || *c == ':').collect();
+        return match name.as_str() {
+            "robot" => Some("urdf"),
+            "mujoco" => Some("xml"),
+            _ => None,
+        };
+    }
+}
+
+impl Model {
+    /// Loads a URDF or MJCF file, telling the format by its root element (`<robot>` or
+    /// `<mujoco>`), with the default [`LoadOptions`] (use [`load`] for others). Meshes and
+    /// includes are found relative to the file.
+    ///
+    /// # Errors
+    /// [`LoadError`] naming the file, line, element and what is wrong.
+    ///
+    /// # Example
+    /// ```
+    /// let model = lagrange::Model::from_file("models/ur5/ur5.urdf")?;
+    /// assert_eq!(model.nv, 6);
+    /// # Ok::<(), lagrange::io::LoadError>(())
+    /// ```
+    pub fn from_file(path: impl AsRef<Path>) -> Result<Model, LoadError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| LoadError::Io { file: path.display().to_string(), source })?;
+        let options = LoadOptions::default();
+        let spec = match format_of(&text) {
+            Some("urdf") => urdf::parse(&text, path, &options)?,
+            Some(_) => mjcf::parse_str(&text, path, &options)?,
+            None => return Err(LoadError::UnsupportedFormat { file: path.display().to_string() }),
+        };
+        compile(&spec)
+    }
+
+    /// Loads a URDF or MJCF model from text, telling the format by its root element. Relative
+    /// mesh and include paths are taken from the current directory.
+    ///
+    /// # Errors
+    /// [`LoadError`] naming the line, element and what is wrong.
+    ///
+    /// # Example
+    /// ```
+    /// let model = lagrange::Model::from_str(
+    ///     r#"<robot name="r"><link name="a"><inertial><mass value="1"/>
+    ///        <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>"#,
+    /// )?;
+    /// assert_eq!(model.nv, 0);
+    /// # Ok::<(), lagrange::io::LoadError>(())
+    /// ```
+    #[allow(clippy::should_implement_trait)]
+    pub fn from_str(text: &str) -> Result<Model, LoadError> {
+        let options = LoadOptions::default();
+        match format_of(text) {
+            Some("urdf") => compile(&urdf::parse(text, Path::new("<string>.urdf"), &options)?),
+            Some(_) => compile(&mjcf::parse_str(text, Path::new("<string>.xml"), &options)?),
+            None => Err(LoadError::UnsupportedFormat { file: "<string>".into() }),
+        }
+    }
+}

@@ -10,6 +10,7 @@
 use super::{Contact, JointKind, Model};
 use crate::constraint::soft::SoftWork;
 use crate::constraint::{ExactWork, RowLifecycle};
+use crate::integrate::StepperSlot;
 use crate::spatial::{ArticulatedInertia, Force, Motion, RigidInertia, Transform};
 use nalgebra::{DMatrix, DVector, Matrix6};
 
@@ -247,6 +248,8 @@ pub struct Data {
     pub(crate) exact: ExactWork,
     /// Which limit and contact rows exist within a step ([`RowLifecycle`]).
     pub(crate) lifecycle: RowLifecycle,
+    /// The stepper of [`step`](crate::integrate::step) (the model's integrator) and its buffers.
+    pub(crate) stepper: StepperSlot,
 
     // --- soft (MuJoCo-compatible) constraint model, MuJoCo's buffer names ---
     /// Rows of equality constraints and of friction loss in the soft solve (MuJoCo's `ne`, `nf`;
@@ -364,6 +367,7 @@ impl Data {
             efc_unconverged_residual: 0.0,
             exact: ExactWork::new(nv, nefc),
             lifecycle: RowLifecycle::new(model),
+            stepper: StepperSlot::for_model(model),
             ne: 0,
             nf: 0,
             efc_margin: DVector::zeros(nefc),
@@ -388,15 +392,14 @@ impl Data {
 }
 
 impl Data {
-    /// Whether row `i` starts a contact's block (its normal row) — a contact's rows are
-    /// consecutive, with the same `efc_id` and type.
+    /// Whether row `i` starts a contact's block of rows: the normal row of a frictionless or
+    /// elliptic contact, the first edge row of a pyramidal one (a contact's rows are consecutive,
+    /// with the same `efc_id` and type). Counting these rows counts the contacts with rows.
     pub fn efc_is_normal(&self, i: usize) -> bool {
         match self.efc_type[i] {
             EfcType::ContactFrictionless => true,
-            EfcType::ContactElliptic => {
-                i == 0
-                    || self.efc_type[i - 1] != EfcType::ContactElliptic
-                    || self.efc_id[i - 1] != self.efc_id[i]
+            kind @ (EfcType::ContactElliptic | EfcType::ContactPyramidal) => {
+                i == 0 || self.efc_type[i - 1] != kind || self.efc_id[i - 1] != self.efc_id[i]
             }
             _ => false,
         }

@@ -12,6 +12,7 @@ mod elements;
 pub mod equality;
 mod joint;
 pub mod options;
+pub mod reset;
 pub mod spec;
 pub mod tendon;
 

@@ -2,6 +2,7 @@
 //! validation scripts use; schema in the README).
 
 use super::CliError;
+use lagrange::constraint::contact_force::contact_force;
 use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{aba, bias_forces, center_of_mass, crba, kinetic_energy, potential_energy};
 use lagrange::forward::forward;
@@ -123,6 +124,7 @@ fn forward_json(model: &Model, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f
                     "frame": [c.frame.row(0).transpose().as_slice(), c.frame.row(1).transpose().as_slice(),
                               c.frame.row(2).transpose().as_slice()],
                     "dist": c.dist, "condim": c.condim,
+                    "contact_force": contact_force(model, data, id).unwrap_or_default(),
                 })
             }
         };
@@ -180,6 +182,7 @@ fn soft_rows_json(model: &Model, data: &Data) -> Value {
                           c.frame.row(2).transpose().as_slice()],
                 "condim": c.condim, "includemargin": c.includemargin, "mu": data.contact_mu[i],
                 "friction": c.friction,
+                "contact_force": contact_force(model, data, i).unwrap_or_default(),
             })
         })
         .collect();

@@ -1,0 +1,81 @@
+//! The typed error of the library's entry points that take user input after a model is loaded:
+//! a slice of the wrong length, an index or name that is not in the model, a value that is not
+//! finite. Each names the function, the argument, what was expected and what was given, so the
+//! caller can fix the call (loading has [`LoadError`](crate::io::LoadError), a simulation that
+//! fails has [`SimError`](crate::sim::SimError)).
+
+use thiserror::Error;
+
+/// Why a call was refused; nothing was computed or changed.
+#[derive(Clone, Debug, Error, PartialEq)]
+#[non_exhaustive]
+pub enum InputError {
+    /// A slice argument has the wrong length.
+    #[error("{function}: {argument} has {got} values, the model needs {expected} ({size})")]
+    Length {
+        function: &'static str,
+        argument: &'static str,
+        expected: usize,
+        got: usize,
+        /// The model's size the length must equal (`nq`, `nv`, `nu`, `na`, …).
+        size: &'static str,
+    },
+    /// An index is not in the model or data.
+    #[error("{function}: {what} {index} does not exist ({count} {what}s; indices 0..{count})")]
+    Index { function: &'static str, what: &'static str, index: usize, count: usize },
+    /// A name is not in the model.
+    #[error("{function}: the model has no {what} named '{name}'{hint}")]
+    Name { function: &'static str, what: &'static str, name: String, hint: String },
+    /// A value is not finite.
+    #[error("{function}: {argument}[{index}] is {value}, not a finite number")]
+    NonFinite { function: &'static str, argument: &'static str, index: usize, value: f64 },
+}
+
+impl InputError {
+    /// `Ok` when `got` equals `expected`, else [`InputError::Length`].
+    pub fn check_len(
+        function: &'static str,
+        argument: &'static str,
+        got: usize,
+        expected: usize,
+        size: &'static str,
+    ) -> Result<(), InputError> {
+        if got == expected {
+            Ok(())
+        } else {
+            Err(InputError::Length { function, argument, expected, got, size })
+        }
+    }
+
+    /// `Ok` when every value is finite, else [`InputError::NonFinite`] naming the first one.
+    pub fn check_finite(
+        function: &'static str,
+        argument: &'static str,
+        values: &[f64],
+    ) -> Result<(), InputError> {
+        match values.iter().position(|x| !x.is_finite()) {
+            None => Ok(()),
+            Some(index) => Err(InputError::NonFinite { function, argument, index, value: values[index] }),
+        }
+    }
+
+    /// [`InputError::Name`] listing up to 8 of the names the model has.
+    pub fn unknown_name<'a>(
+        function: &'static str,
+        what: &'static str,
+        name: &str,
+        known: impl Iterator<Item = &'a str>,
+    ) -> InputError {
+        let known: Vec<&str> = known.filter(|n| !n.is_empty()).collect();
+        let hint = if known.is_empty() {
+            format!(" (it has no named {what}s)")
+        } else {
+            let more = if known.len() > 8 { ", …" } else { "" };
+            format!(
+                " (it has: {}{more})",
+                known.iter().take(8).map(|n| format!("'{n}'")).collect::<Vec<_>>().join(", ")
+            )
+        };
+        InputError::Name { function, what, name: name.to_string(), hint }
+    }
+}
