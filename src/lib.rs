@@ -17,6 +17,7 @@ pub mod constraint;
 pub mod dynamics;
 pub mod error;
 pub mod forward;
+pub mod frames;
 pub mod integrate;
 pub mod io;
 #[cfg(test)]

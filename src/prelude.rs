@@ -15,6 +15,7 @@ pub use crate::constraint::contact_force::{contact_force, contacts, ContactInfo}
 pub use crate::constraint::ConstraintMode;
 pub use crate::error::InputError;
 pub use crate::forward::forward;
+pub use crate::frames;
 pub use crate::integrate::{step, IntegratorKind, StepReport};
 pub use crate::io::{LoadError, LoadOptions};
 pub use crate::model::reset::{reset, reset_keyframe};

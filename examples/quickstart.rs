@@ -1,0 +1,27 @@
+//! Quick start: load the go1 quadruped on its floor, reset it to its `home` keyframe, hold the
+//! keyframe's servo targets as controls, step half a second, and read each foot's contact force
+//! and the trunk's pose.
+//!
+//!     cargo run --release --example quickstart
+
+use lagrange::prelude::*;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let model = Model::from_file("models/mjcf/unitree_go1/scene.xml")?;
+    let mut data = Data::new(&model);
+    reset_keyframe(&model, &mut data, "home")?; // qpos, and ctrl = the servos' targets
+    for _ in 0..250 {
+        step(&model, &mut data)?; // the model's integrator and timestep (2 ms)
+    }
+    forward(&model, &mut data); // the contact forces at the final state
+    for c in contacts(&model, &data).filter(|c| c.active) {
+        let f = c.force_world();
+        println!(
+            "{:>5} on {:<5}: force [{:7.3} {:7.3} {:7.3}] N",
+            c.geom_names[1], c.geom_names[0], f.x, f.y, f.z
+        );
+    }
+    let trunk = frames::pose(&model, &mut data, "trunk")?;
+    println!("t = {:.3} s, trunk at height {:.4} m", data.time, trunk.pos.z);
+    Ok(())
+}

@@ -1,0 +1,109 @@
+//! The library's surface as a user meets it: `Model::from_file`/`from_str` telling URDF from
+//! MJCF by content, `Data` holding the whole state, `reset`/`reset_keyframe`, `step` with the
+//! model's integrator against `Simulation`, frames by name, and the typed errors of wrong names
+//! and of data made for another model (never a panic).
+
+mod common;
+
+use lagrange::prelude::*;
+use std::sync::Arc;
+
+const GO1: &str = "models/mjcf/unitree_go1/scene.xml";
+
+#[test]
+fn from_file_and_from_str_tell_the_format_by_content() {
+    let urdf = std::fs::read_to_string("models/ur5/ur5.urdf").unwrap();
+    let dir = std::env::temp_dir().join(format!("lagrange-api-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A URDF under a name without the extension still loads as URDF (exact mode, its default).
+    let path = dir.join("robot.description");
+    std::fs::write(&path, &urdf).unwrap();
+    let model = Model::from_file(&path).unwrap();
+    assert_eq!((model.nq, model.plan.mode()), (6, ConstraintMode::Exact));
+    let model = Model::from_str(&urdf).unwrap();
+    assert_eq!(model.nv, 6);
+    let mjcf = Model::from_str(
+        r#"<?xml version="1.0"?><!-- a comment --><mujoco><worldbody>
+        <geom type="plane" size="1 1 .1"/><body><freejoint/><geom size="0.1"/></body></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    assert_eq!((mjcf.nq, mjcf.plan.mode()), (7, ConstraintMode::Soft));
+    let err = Model::from_str("<sdf version='1.6'/>").unwrap_err();
+    assert!(err.to_string().contains("unsupported model format"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `step` runs the model's own integrator and timestep: it equals a `Simulation` with the
+/// model's options, bit for bit (go1 from its keyframe, servo controls held, 100 steps).
+#[test]
+fn step_equals_the_simulation_of_the_models_options() {
+    let model = Model::from_file(GO1).unwrap();
+    let mut data = Data::new(&model);
+    reset_keyframe(&model, &mut data, "home").unwrap();
+    let mut sim = Simulation::new(Arc::new(model.clone()), &SimOptions::default());
+    sim.set_state(data.qpos.as_slice(), data.qvel.as_slice()).unwrap();
+    sim.ctrl_mut().copy_from_slice(data.ctrl.as_slice());
+    for _ in 0..100 {
+        step(&model, &mut data).unwrap();
+        sim.step().unwrap();
+    }
+    assert_eq!(data.qpos, sim.data.qpos);
+    assert_eq!(data.qvel, sim.data.qvel);
+    assert!((data.time - 0.2).abs() < 1e-12, "{}", data.time);
+}
+
+#[test]
+fn reset_and_keyframes_set_the_whole_state() {
+    let model = Model::from_file(GO1).unwrap();
+    let mut data = Data::new(&model);
+    assert_eq!(data.qpos.as_slice(), model.qpos0.as_slice(), "Data::new starts at qpos0");
+    reset_keyframe(&model, &mut data, "home").unwrap();
+    let key = &model.keyframes[model.keyframe_id("home").unwrap()];
+    assert_eq!(data.qpos.as_slice(), key.qpos.as_deref().unwrap());
+    assert_eq!(data.ctrl.as_slice(), key.ctrl.as_deref().unwrap());
+    for _ in 0..10 {
+        step(&model, &mut data).unwrap();
+    }
+    data.qfrc_applied[0] = 1.0;
+    reset(&model, &mut data).unwrap();
+    assert_eq!(data.time, 0.0);
+    assert_eq!(data.qpos.as_slice(), model.qpos0.as_slice());
+    assert!(data.qvel.iter().chain(data.ctrl.iter()).chain(data.qfrc_applied.iter()).all(|&x| x == 0.0));
+    let err = reset_keyframe(&model, &mut data, "sitting").unwrap_err();
+    println!("{err}");
+    assert!(matches!(err, InputError::Name { .. }) && err.to_string().contains("'home'"), "{err}");
+}
+
+/// Data made for another model is refused with the size that differs, by every call that
+/// takes both (never an index out of bounds).
+#[test]
+fn data_of_another_model_is_a_typed_error() {
+    let go1 = Model::from_file(GO1).unwrap();
+    let ur5 = Model::from_file("models/ur5/ur5.urdf").unwrap();
+    let mut data = Data::new(&ur5);
+    let err = step(&go1, &mut data).unwrap_err();
+    println!("{err}");
+    assert!(err.to_string().contains("step: data.qpos has 6 values, the model needs 19 (nq)"), "{err}");
+    assert!(matches!(reset(&go1, &mut data), Err(InputError::Length { .. })));
+    assert!(matches!(frames::pose(&go1, &mut data, "trunk"), Err(InputError::Length { .. })));
+}
+
+#[test]
+fn frames_by_name() {
+    let model = Model::from_file(GO1).unwrap();
+    let mut data = Data::new(&model);
+    reset_keyframe(&model, &mut data, "home").unwrap();
+    let trunk = frames::pose(&model, &mut data, "trunk").unwrap();
+    assert!((trunk.pos.z - data.qpos[2]).abs() < 1e-15, "the free joint's position is the trunk's");
+    // A site (MJCF's foot sites) and a body by name; a linear velocity of the base shows at the foot.
+    data.qvel[0] = 0.5;
+    let (lin, _) = frames::velocity(&model, &mut data, "FR").unwrap();
+    assert!((lin.x - 0.5).abs() < 1e-12, "{lin:?}");
+    let mut jac = nalgebra::DMatrix::zeros(6, model.nv);
+    frames::jacobian(&model, &mut data, "FR", &mut jac).unwrap();
+    assert!(((&jac * &data.qvel).fixed_rows::<3>(0) - lin).amax() < 1e-12);
+    let err = frames::pose(&model, &mut data, "tail").unwrap_err();
+    assert!(err.to_string().contains("no body, link or site named 'tail'"), "{err}");
+    let mut small = nalgebra::DMatrix::zeros(6, 3);
+    assert!(matches!(frames::jacobian(&model, &mut data, "FR", &mut small), Err(InputError::Length { .. })));
+}
