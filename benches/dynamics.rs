@@ -45,26 +45,28 @@ fn robots(c: &mut Criterion) {
         let mut data = Data::new(&model);
         let (q, v, tau) = state(&model);
         let mut group = c.benchmark_group(name);
-        group.bench_function("fk", |b| b.iter(|| forward_kinematics(&model, &mut data, black_box(&q))));
+        group.bench_function("fk", |b| {
+            b.iter(|| forward_kinematics(&model, &mut data, black_box(&q)).unwrap())
+        });
         group.bench_function("rnea", |b| {
             b.iter(|| {
-                rnea(&model, &mut data, black_box(&q), black_box(&v), black_box(&tau));
+                rnea(&model, &mut data, black_box(&q), black_box(&v), black_box(&tau)).unwrap();
             })
         });
         group.bench_function("crba", |b| {
             b.iter(|| {
-                crba(&model, &mut data, black_box(&q));
+                crba(&model, &mut data, black_box(&q)).unwrap();
             })
         });
         group.bench_function("crba+ltdl", |b| {
             b.iter(|| {
-                crba(&model, &mut data, black_box(&q));
+                crba(&model, &mut data, black_box(&q)).unwrap();
                 factorize_mass_matrix(&model, &mut data);
             })
         });
         group.bench_function("aba", |b| {
             b.iter(|| {
-                aba(&model, &mut data, black_box(&q), black_box(&v), black_box(&tau));
+                aba(&model, &mut data, black_box(&q), black_box(&v), black_box(&tau)).unwrap();
             })
         });
         group.finish();

@@ -95,31 +95,31 @@ fn main() {
     let mut sink = 0.0;
     for i in 0..CALLS {
         let (q, _, _) = &states[i % 16];
-        forward_kinematics(&model, &mut data, black_box(q));
+        forward_kinematics(&model, &mut data, black_box(q)).unwrap();
         sink += data.x_world_body[model.nbody() - 1].pos.x;
     }
     for i in 0..CALLS {
         let (q, v, a) = &states[i % 16];
-        sink += rnea(&model, &mut data, black_box(q), v, a)[0];
+        sink += rnea(&model, &mut data, black_box(q), v, a).unwrap()[0];
     }
     for i in 0..CALLS {
         let (q, _, _) = &states[i % 16];
-        sink += crba(&model, &mut data, black_box(q))[0];
+        sink += crba(&model, &mut data, black_box(q)).unwrap()[0];
     }
     let mut x = DVector::zeros(model.nv);
     for i in 0..CALLS {
         let (q, _, tau) = &states[i % 16];
         if i % 16 == 0 {
-            crba(&model, &mut data, q);
+            crba(&model, &mut data, q).unwrap();
         }
         factorize_mass_matrix(&model, &mut data);
         x.copy_from_slice(tau);
-        solve_mass_matrix(&model, &data, &mut x);
+        solve_mass_matrix(&model, &data, &mut x).unwrap();
         sink += x[0];
     }
     for i in 0..CALLS {
         let (q, v, tau) = &states[i % 16];
-        sink += aba(&model, &mut data, black_box(q), v, tau)[0];
+        sink += aba(&model, &mut data, black_box(q), v, tau).unwrap()[0];
     }
     println!("{name}: nv {} sink {sink}", model.nv);
 }
@@ -144,11 +144,11 @@ fn time_kernels(name: &str, model: &Model, data: &mut Data, states: &[KernelStat
         t_min * 1e6
     };
     let fk = best(&mut |d, (q, _, _)| {
-        forward_kinematics(model, d, q);
+        forward_kinematics(model, d, q).unwrap();
         d.x_world_body[model.nbody() - 1].pos.x
     });
-    let rnea_us = best(&mut |d, (q, v, a)| rnea(model, d, q, v, a)[0]);
-    let crba_us = best(&mut |d, (q, _, _)| crba_upper(model, d, q)[(0, model.nv - 1)]);
-    let aba_us = best(&mut |d, (q, v, tau)| aba(model, d, q, v, tau)[0]);
+    let rnea_us = best(&mut |d, (q, v, a)| rnea(model, d, q, v, a).unwrap()[0]);
+    let crba_us = best(&mut |d, (q, _, _)| crba_upper(model, d, q).unwrap()[(0, model.nv - 1)]);
+    let aba_us = best(&mut |d, (q, v, tau)| aba(model, d, q, v, tau).unwrap()[0]);
     println!("{name}: µs per call (best of 200 batches): FK {fk:.4}  RNEA {rnea_us:.4}  CRBA (upper) {crba_us:.4}  ABA {aba_us:.4}");
 }

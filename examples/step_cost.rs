@@ -57,7 +57,7 @@ fn main() {
             let tau = vec![0.0; model.nv];
             for _ in 0..n {
                 let (q, v) = (data.qpos.clone(), data.qvel.clone());
-                let qacc = aba(&model, &mut data, black_box(q.as_slice()), v.as_slice(), &tau)[0];
+                let qacc = aba(&model, &mut data, black_box(q.as_slice()), v.as_slice(), &tau).unwrap()[0];
                 // A cheap update so that successive calls see different states.
                 data.qvel[0] += 1e-9 * qacc;
             }

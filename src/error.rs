@@ -79,3 +79,41 @@ impl InputError {
         InputError::Name { function, what, name: name.to_string(), hint }
     }
 }
+
+/// The checks of a kernel's arguments (crate-internal): `data` made for `model`, and the lengths
+/// of q (nq), v-like vectors (nv).
+pub(crate) mod check {
+    use super::InputError;
+    use crate::model::{Data, Model};
+
+    /// `data`'s kinematic buffers have `model`'s body and dof counts.
+    pub fn data(function: &'static str, model: &Model, data: &Data) -> Result<(), InputError> {
+        InputError::check_len(function, "data (bodies)", data.x_world_body.len(), model.nbody(), "nbody")?;
+        InputError::check_len(function, "data (dofs)", data.tau.len(), model.nv, "nv")
+    }
+
+    /// A configuration: nq values.
+    pub fn q(function: &'static str, model: &Model, q: &[f64]) -> Result<(), InputError> {
+        InputError::check_len(function, "q", q.len(), model.nq, "nq")
+    }
+
+    /// A frame index of the model.
+    pub fn frame(function: &'static str, model: &Model, frame: usize) -> Result<(), InputError> {
+        let count = model.frames.len();
+        if frame < count {
+            Ok(())
+        } else {
+            Err(InputError::Index { function, what: "frame", index: frame, count })
+        }
+    }
+
+    /// A velocity, acceleration or generalized force named `argument`: nv values.
+    pub fn v(
+        function: &'static str,
+        argument: &'static str,
+        model: &Model,
+        v: &[f64],
+    ) -> Result<(), InputError> {
+        InputError::check_len(function, argument, v.len(), model.nv, "nv")
+    }
+}

@@ -9,7 +9,7 @@
 //! angular.
 
 use crate::error::InputError;
-use crate::kinematics::{forward_kinematics, forward_velocities, ReferenceFrame};
+use crate::kinematics::{forward_kinematics_unchecked, forward_velocities_unchecked, ReferenceFrame};
 use crate::model::{Data, Model};
 use crate::spatial::{Transform, Vec3};
 use nalgebra::DMatrix;
@@ -29,11 +29,11 @@ fn frame_index(model: &Model, function: &'static str, name: &str) -> Result<usiz
 /// Forward kinematics at the state's configuration (the state moved out and back, no copy).
 fn kinematics_at_state(model: &Model, data: &mut Data, velocities: bool) {
     let q = std::mem::take(&mut data.qpos);
-    forward_kinematics(model, data, q.as_slice());
+    forward_kinematics_unchecked(model, data, q.as_slice());
     data.qpos = q;
     if velocities {
         let v = std::mem::take(&mut data.qvel);
-        forward_velocities(model, data, v.as_slice());
+        forward_velocities_unchecked(model, data, v.as_slice());
         data.qvel = v;
     }
 }
@@ -80,7 +80,7 @@ pub fn velocity(model: &Model, data: &mut Data, name: &str) -> Result<(Vec3, Vec
     let f = frame_index(model, "frames::velocity", name)?;
     data.check_sizes(model, "frames::velocity")?;
     kinematics_at_state(model, data, true);
-    Ok(crate::kinematics::frame_velocity(model, data, f, ReferenceFrame::LocalWorldAligned))
+    Ok(crate::kinematics::frame_velocity_unchecked(model, data, f, ReferenceFrame::LocalWorldAligned))
 }
 
 /// The Jacobian of frame `name`'s origin at `data.qpos` into `jac` (6 × nv; rows 0–2 linear,
@@ -110,6 +110,6 @@ pub fn jacobian(
     InputError::check_len("frames::jacobian", "jac (rows)", jac.nrows(), 6, "6")?;
     InputError::check_len("frames::jacobian", "jac (columns)", jac.ncols(), model.nv, "nv")?;
     kinematics_at_state(model, data, false);
-    crate::kinematics::frame_jacobian(model, data, f, ReferenceFrame::LocalWorldAligned, jac);
+    crate::kinematics::frame_jacobian_unchecked(model, data, f, ReferenceFrame::LocalWorldAligned, jac);
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! Forward kinematics, body velocities and frame Jacobians (RBDA §4.1, §8.1).
 
+use crate::error::{check, InputError};
 use crate::model::{Data, HingeAxis, JointKind, Model};
 #[cfg(target_arch = "x86_64")]
 use crate::spatial::fused::Fused;
@@ -208,7 +209,18 @@ fn body_poses_with<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64]) {
 ///
 /// On x86-64 CPUs with AVX2 and FMA3 it runs compiled for them, the compositions' products and
 /// sums fused ([`fused`]), as CRBA does.
-pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
+///
+/// # Errors
+/// [`InputError::Length`] when q is not nq long or `data` was made for another model.
+pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) -> Result<(), InputError> {
+    check::data("forward_kinematics", model, data)?;
+    check::q("forward_kinematics", model, q)?;
+    forward_kinematics_unchecked(model, data, q);
+    Ok(())
+}
+
+/// [`forward_kinematics`] without the argument checks.
+pub(crate) fn forward_kinematics_unchecked(model: &Model, data: &mut Data, q: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU has AVX2 and FMA (checked just above), all `forward_kinematics_fma`
@@ -237,7 +249,18 @@ fn forward_kinematics_with<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64])
 
 /// Spatial velocity of every body in body coordinates, `v_body` (RBDA eq. 5.7, first line), for
 /// velocity `v`. Needs [`forward_kinematics`] (or any algorithm's first pass) at the same q.
-pub fn forward_velocities(model: &Model, data: &mut Data, v: &[f64]) {
+///
+/// # Errors
+/// [`InputError::Length`] when v is not nv long or `data` was made for another model.
+pub fn forward_velocities(model: &Model, data: &mut Data, v: &[f64]) -> Result<(), InputError> {
+    check::data("forward_velocities", model, data)?;
+    check::v("forward_velocities", "v", model, v)?;
+    forward_velocities_unchecked(model, data, v);
+    Ok(())
+}
+
+/// [`forward_velocities`] without the argument checks.
+pub(crate) fn forward_velocities_unchecked(model: &Model, data: &mut Data, v: &[f64]) {
     for b in 1..model.nbody() {
         let p = model.bodies[b].parent;
         let v_joint = joint_velocity(model, data, b, v);
@@ -298,7 +321,27 @@ pub fn for_each_ancestor_dof(
 /// Jacobian of frame `frame` into `jac` (6 × nv): rows 0–2 linear, rows 3–5 angular velocity, in
 /// `reference` coordinates (the row order of Pinocchio). Columns of degrees of freedom that do not
 /// move the frame are zero. Needs [`forward_kinematics`] at the same q.
+///
+/// # Errors
+/// [`InputError::Index`] when `frame` is not a frame of the model; [`InputError::Length`] when
+/// `jac` is not 6 × nv or `data` was made for another model.
 pub fn frame_jacobian(
+    model: &Model,
+    data: &Data,
+    frame: usize,
+    reference: ReferenceFrame,
+    jac: &mut DMatrix<f64>,
+) -> Result<(), InputError> {
+    check::data("frame_jacobian", model, data)?;
+    check::frame("frame_jacobian", model, frame)?;
+    InputError::check_len("frame_jacobian", "jac (rows)", jac.nrows(), 6, "6")?;
+    InputError::check_len("frame_jacobian", "jac (columns)", jac.ncols(), model.nv, "nv")?;
+    frame_jacobian_unchecked(model, data, frame, reference, jac);
+    Ok(())
+}
+
+/// [`frame_jacobian`] without the argument checks.
+pub(crate) fn frame_jacobian_unchecked(
     model: &Model,
     data: &Data,
     frame: usize,
@@ -317,7 +360,18 @@ pub fn frame_jacobian(
 /// Spatial acceleration of every body at zero joint acceleration and without gravity, body
 /// coordinates, into `data.a_bias_body`: a = X a_parent + c_J + v × v_J (RBDA eq. 5.7 with q̈ = 0).
 /// It is what J̇v of a body-fixed point or frame is made of. Needs [`forward_velocities`] first.
-pub fn bias_accelerations(model: &Model, data: &mut Data, v: &[f64]) {
+///
+/// # Errors
+/// [`InputError::Length`] when v is not nv long or `data` was made for another model.
+pub fn bias_accelerations(model: &Model, data: &mut Data, v: &[f64]) -> Result<(), InputError> {
+    check::data("bias_accelerations", model, data)?;
+    check::v("bias_accelerations", "v", model, v)?;
+    bias_accelerations_unchecked(model, data, v);
+    Ok(())
+}
+
+/// [`bias_accelerations`] without the argument checks.
+pub(crate) fn bias_accelerations_unchecked(model: &Model, data: &mut Data, v: &[f64]) {
     data.a_bias_body[0] = Motion::zero();
     for b in 1..model.nbody() {
         let p = model.bodies[b].parent;
@@ -344,7 +398,28 @@ pub fn point_bias_acceleration(data: &Data, b: usize, r_body: &Vec3) -> (Vec3, V
 
 /// Velocity (linear, angular) of frame `frame` in `reference` coordinates, from the body
 /// velocities of [`forward_velocities`].
-pub fn frame_velocity(model: &Model, data: &Data, frame: usize, reference: ReferenceFrame) -> (Vec3, Vec3) {
+///
+/// # Errors
+/// [`InputError::Index`] when `frame` is not a frame of the model; [`InputError::Length`] when
+/// `data` was made for another model.
+pub fn frame_velocity(
+    model: &Model,
+    data: &Data,
+    frame: usize,
+    reference: ReferenceFrame,
+) -> Result<(Vec3, Vec3), InputError> {
+    check::data("frame_velocity", model, data)?;
+    check::frame("frame_velocity", model, frame)?;
+    Ok(frame_velocity_unchecked(model, data, frame, reference))
+}
+
+/// [`frame_velocity`] without the argument checks.
+pub(crate) fn frame_velocity_unchecked(
+    model: &Model,
+    data: &Data,
+    frame: usize,
+    reference: ReferenceFrame,
+) -> (Vec3, Vec3) {
     let b = model.frames[frame].body;
     let v_world = data.x_world_body[b].act_motion(&data.v_body[b]);
     express(&v_world, &data.x_world_frame[frame], reference)

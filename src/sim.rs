@@ -7,7 +7,7 @@ use crate::constraint::ConstraintMode;
 use crate::dynamics;
 use crate::forward::DriftCorrection;
 use crate::integrate::{DormandPrince54, IntegratorKind, StepReport, Stepper};
-use crate::kinematics::forward_kinematics;
+use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::{Data, Model};
 use std::sync::Arc;
 use thiserror::Error;
@@ -281,9 +281,10 @@ impl Simulation {
     /// (forward kinematics included).
     pub fn energies(&mut self) -> (f64, f64) {
         let (q, v) = (std::mem::take(&mut self.data.qpos), std::mem::take(&mut self.data.qvel));
-        let kinetic = dynamics::kinetic_energy(&self.model, &mut self.data, q.as_slice(), v.as_slice());
-        let potential =
-            dynamics::potential_energy(&self.model, &self.data) + self.model.spring_energy(q.as_slice());
+        let kinetic =
+            dynamics::kinetic_energy_unchecked(&self.model, &mut self.data, q.as_slice(), v.as_slice());
+        let potential = dynamics::potential_energy(&self.model, &self.data)
+            + self.model.spring_energy_unchecked(q.as_slice());
         (self.data.qpos, self.data.qvel) = (q, v);
         (kinetic, potential)
     }
@@ -291,7 +292,7 @@ impl Simulation {
     /// Forward kinematics at the current state (poses in `data`).
     pub fn kinematics(&mut self) {
         let q = std::mem::take(&mut self.data.qpos);
-        forward_kinematics(&self.model, &mut self.data, q.as_slice());
+        forward_kinematics_unchecked(&self.model, &mut self.data, q.as_slice());
         self.data.qpos = q;
     }
 

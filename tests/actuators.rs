@@ -296,8 +296,8 @@ fn fd(model: &lagrange::Model, q: &[f64], k: usize, mut f: impl FnMut(&[f64]) ->
         let mut e = vec![0.0; model.nv];
         e[k] = 1.0;
         let (mut qp, mut qm) = (q.to_vec(), q.to_vec());
-        lagrange::model::integrate_configuration(model, &mut qp, &e, h);
-        lagrange::model::integrate_configuration(model, &mut qm, &e, -h);
+        lagrange::model::integrate_configuration(model, &mut qp, &e, h).unwrap();
+        lagrange::model::integrate_configuration(model, &mut qm, &e, -h).unwrap();
         (f(&qp) - f(&qm)) / (2.0 * h)
     };
     (4.0 * central(FD_STEP / 2.0) - central(FD_STEP)) / 3.0
@@ -351,12 +351,12 @@ fn site_transmission_moments_are_length_gradients() {
     // Without refsite: the gear [1, 2, −0.5] in the site frame, against the site's position.
     let site = model.site_id("hand").unwrap();
     let site_force = id("site_force");
-    forward_kinematics(&model, &mut data, &q);
+    forward_kinematics(&model, &mut data, &q).unwrap();
     let wrench = data.x_world_frame[site].rot * lagrange::spatial::Vec3::new(1.0, 2.0, -0.5);
     let mut data2 = Data::new(&model);
     for k in 0..model.nv {
         let d = fd(&model, &q, k, |q| {
-            forward_kinematics(&model, &mut data2, q);
+            forward_kinematics(&model, &mut data2, q).unwrap();
             data2.x_world_frame[site].pos.dot(&wrench)
         });
         actuation(&model, &mut data, &q, &v, &bias);

@@ -107,3 +107,86 @@ fn frames_by_name() {
     let mut small = nalgebra::DMatrix::zeros(6, 3);
     assert!(matches!(frames::jacobian(&model, &mut data, "FR", &mut small), Err(InputError::Length { .. })));
 }
+
+/// Every public kernel that takes slices refuses a wrong length with `InputError::Length`
+/// naming the function, the argument and the size it needs (Pinocchio's argument checks),
+/// before touching anything.
+#[test]
+fn every_kernel_refuses_wrong_lengths() {
+    use lagrange::dynamics::*;
+    use lagrange::kinematics::*;
+    use lagrange::model::{dexp_inv_configuration, difference_configuration, integrate_configuration};
+    let model = Model::from_file("models/panda/panda.urdf").unwrap();
+    let mut data = Data::new(&model);
+    let (nq, nv) = (model.nq, model.nv);
+    let (q, v) = (model.qpos0.clone(), vec![0.0; nv]);
+    let (q_short, v_long) = (vec![0.0; nq - 1], vec![0.0; nv + 1]);
+    let length = |r: Result<(), InputError>, function: &str, argument: &str, size: &str| {
+        let err = r.expect_err(function);
+        println!("{err}");
+        match &err {
+            InputError::Length { function: f, argument: a, size: s, .. } => {
+                assert_eq!((*f, *a, *s), (function, argument, size), "{err}")
+            }
+            other => panic!("{function}: {other:?}"),
+        }
+    };
+    length(aba(&model, &mut data, &q_short, &v, &v).map(|_| ()), "aba", "q", "nq");
+    length(aba(&model, &mut data, &q, &v_long, &v).map(|_| ()), "aba", "v", "nv");
+    length(aba(&model, &mut data, &q, &v, &v_long).map(|_| ()), "aba", "tau", "nv");
+    length(rnea(&model, &mut data, &q, &v, &v_long).map(|_| ()), "rnea", "qacc", "nv");
+    length(bias_forces(&model, &mut data, &q_short, &v).map(|_| ()), "bias_forces", "q", "nq");
+    length(gravity_forces(&model, &mut data, &q_short).map(|_| ()), "gravity_forces", "q", "nq");
+    length(crba(&model, &mut data, &q_short).map(|_| ()), "crba", "q", "nq");
+    length(crba_upper(&model, &mut data, &q_short).map(|_| ()), "crba_upper", "q", "nq");
+    length(kinetic_energy(&model, &mut data, &q, &v_long).map(|_| ()), "kinetic_energy", "v", "nv");
+    let mut x = nalgebra::DVector::zeros(nv + 1);
+    length(solve_mass_matrix(&model, &data, &mut x), "solve_mass_matrix", "x", "nv");
+    length(solve_with_factor(&model, &data.mass_factor, &mut v_long.clone()), "solve_with_factor", "x", "nv");
+    length(forward_kinematics(&model, &mut data, &q_short), "forward_kinematics", "q", "nq");
+    length(forward_velocities(&model, &mut data, &v_long), "forward_velocities", "v", "nv");
+    length(bias_accelerations(&model, &mut data, &v_long), "bias_accelerations", "v", "nv");
+    let mut jac = nalgebra::DMatrix::zeros(6, nv - 1);
+    length(
+        frame_jacobian(&model, &data, 0, ReferenceFrame::Local, &mut jac),
+        "frame_jacobian",
+        "jac (columns)",
+        "nv",
+    );
+    assert!(matches!(
+        frame_velocity(&model, &data, model.frames.len(), ReferenceFrame::Local),
+        Err(InputError::Index { what: "frame", .. })
+    ));
+    length(
+        integrate_configuration(&model, &mut q_short.clone(), &v, 1.0),
+        "integrate_configuration",
+        "q",
+        "nq",
+    );
+    length(
+        integrate_configuration(&model, &mut q.clone(), &v_long, 1.0),
+        "integrate_configuration",
+        "v",
+        "nv",
+    );
+    length(
+        difference_configuration(&model, &q, &q_short, &mut v.clone()),
+        "difference_configuration",
+        "q1",
+        "nq",
+    );
+    length(
+        dexp_inv_configuration(&model, &v, &v, &mut v_long.clone()),
+        "dexp_inv_configuration",
+        "out",
+        "nv",
+    );
+    length(model.spring_energy(&q_short).map(|_| ()), "Model::spring_energy", "q", "nq");
+    // Data made for another model.
+    let ur5 = Model::from_file("models/ur5/ur5.urdf").unwrap();
+    let mut other = Data::new(&ur5);
+    length(aba(&model, &mut other, &q, &v, &v).map(|_| ()), "aba", "data (bodies)", "nbody");
+    // The message says what to give.
+    let err = aba(&model, &mut data, &q_short, &v, &v).unwrap_err();
+    assert_eq!(err.to_string(), format!("aba: q has {} values, the model needs {nq} (nq)", nq - 1));
+}

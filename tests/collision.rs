@@ -28,7 +28,7 @@ fn mjcf(name: &str, body: &str) -> Result<Model, String> {
 /// The contacts of a scene at its `qpos0` (MuJoCo's inclusion: dist below the margin).
 fn contacts(model: &Model) -> Vec<Contact> {
     let mut data = Data::new(model);
-    forward_kinematics(model, &mut data, &model.qpos0);
+    forward_kinematics(model, &mut data, &model.qpos0).unwrap();
     collide(model, &CollisionModel::new(model), &mut data, 0.0);
     data.contacts.clone()
 }
@@ -357,7 +357,7 @@ fn exact_mode_detects_a_little_beyond_the_margin() {
     .unwrap();
     assert!(contacts(&m).is_empty());
     let mut data = Data::new(&m);
-    forward_kinematics(&m, &mut data, &m.qpos0);
+    forward_kinematics(&m, &mut data, &m.qpos0).unwrap();
     collide(&m, &CollisionModel::new(&m), &mut data, EXACT_REACH);
     assert_eq!(data.contacts.len(), 1);
     assert!((data.contacts[0].dist - 1e-4).abs() <= COLLISION_ABS);

@@ -74,8 +74,8 @@ fn pendulum_on_movable_support_conserves_horizontal_momentum_notes_1_4() {
     sim.set_state(key.qpos.as_ref().unwrap(), key.qvel.as_ref().unwrap()).unwrap();
     let momentum = |sim: &mut Simulation| {
         let (q, v) = (sim.data.qpos.clone(), sim.data.qvel.clone());
-        forward_kinematics(&sim.model, &mut sim.data, q.as_slice());
-        forward_velocities(&sim.model, &mut sim.data, v.as_slice());
+        forward_kinematics(&sim.model, &mut sim.data, q.as_slice()).unwrap();
+        forward_velocities(&sim.model, &mut sim.data, v.as_slice()).unwrap();
         spatial_momentum(&sim.model, &sim.data).lin.x
     };
     let p0 = momentum(&mut sim);
@@ -122,18 +122,18 @@ fn kkt_solution_satisfies_dynamics_and_constraints() {
         for _ in 0..5 {
             let mut q = model.qpos0.clone();
             let dq: Vec<f64> = (0..nv).map(|_| rng.random_range(-0.5..0.5)).collect();
-            integrate_configuration(&model, &mut q, &dq, 1.0);
+            integrate_configuration(&model, &mut q, &dq, 1.0).unwrap();
             let mut v: Vec<f64> = (0..nv).map(|_| rng.random_range(-1.0..1.0)).collect();
             let tau: Vec<f64> = (0..nv).map(|_| rng.random_range(-1.0..1.0)).collect();
             // v onto J v = 0 (the projection of the steppers).
             plan.constraints.evaluate(&model, &mut data, &q, &v);
-            crba(&model, &mut data, &q);
+            crba(&model, &mut data, &q).unwrap();
             lagrange::dynamics::factorize_mass_matrix(&model, &mut data);
             lagrange::constraint::project_velocities(&model, &mut data, &mut v, 0.0, Default::default());
             data.qfrc_applied.copy_from_slice(&tau);
             common::forward_at(&model, &mut data, &q, &v);
             let n = data.nefc;
-            let m = crba(&model, &mut data, &q).clone();
+            let m = crba(&model, &mut data, &q).unwrap().clone();
             let qacc = data.qacc.clone();
             let lhs = &m * &qacc - (DVector::from_vec(tau.clone()) + &data.qfrc_passive - &data.qfrc_bias);
             let j = data.efc_j.rows(0, n).into_owned();
@@ -146,8 +146,8 @@ fn kkt_solution_satisfies_dynamics_and_constraints() {
             let eps = 1e-6;
             let mut jv = |sign: f64| {
                 let mut qe = q.clone();
-                integrate_configuration(&model, &mut qe, &v, sign * eps);
-                forward_kinematics(&model, &mut data, &qe);
+                integrate_configuration(&model, &mut qe, &v, sign * eps).unwrap();
+                forward_kinematics(&model, &mut data, &qe).unwrap();
                 plan.constraints.positions(&model, &mut data, &qe, true);
                 data.efc_j.rows(0, n).into_owned() * DVector::from_vec(v.clone())
             };
@@ -252,7 +252,7 @@ fn mimic_full_coordinates_equal_reduced_dynamics() {
             data.qfrc_applied.copy_from_slice(&tau);
             common::forward_at(&model, &mut data, &q, v.as_slice());
             let full = data.qacc.clone();
-            let m = crba(&model, &mut data, &q).clone();
+            let m = crba(&model, &mut data, &q).unwrap().clone();
             let f = DVector::from_vec(tau) + &data.qfrc_passive - &data.qfrc_bias;
             let mr = g.transpose() * &m * &g;
             let reduced = &g * mr.cholesky().unwrap().solve(&(g.transpose() * f));

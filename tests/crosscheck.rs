@@ -136,13 +136,13 @@ fn check_aba_against_mass_matrix(models: &[(String, Model)], seed: u64) {
         let mut r = rng(seed);
         for s in 0..STATES {
             let (q, v, tau) = (random_q(model, &mut r), random_v(model, &mut r), random_tau(model, &mut r));
-            let qacc = aba(model, &mut data, &q, &v, &tau).clone();
-            let c = bias_forces(model, &mut data, &q, &v).clone();
+            let qacc = aba(model, &mut data, &q, &v, &tau).unwrap().clone();
+            let c = bias_forces(model, &mut data, &q, &v).unwrap().clone();
             let rhs = dvec(&tau) - c;
-            crba(model, &mut data, &q);
+            crba(model, &mut data, &q).unwrap();
             factorize_mass_matrix(model, &mut data);
             let mut x_sparse = rhs.clone();
-            solve_mass_matrix(model, &data, &mut x_sparse);
+            solve_mass_matrix(model, &data, &mut x_sparse).unwrap();
             let m = data.mass_matrix.clone();
             let eig = m.clone().symmetric_eigenvalues();
             max_cond = max_cond.max(eig.max() / eig.min());
@@ -179,8 +179,8 @@ fn check_rnea_inverts_aba(models: &[(String, Model)], seed: u64) {
         let mut r = rng(seed);
         for s in 0..STATES {
             let (q, v, tau) = (random_q(model, &mut r), random_v(model, &mut r), random_tau(model, &mut r));
-            let qacc = aba(model, &mut data, &q, &v, &tau).clone();
-            let tau2 = rnea(model, &mut data, &q, &v, qacc.as_slice());
+            let qacc = aba(model, &mut data, &q, &v, &tau).unwrap().clone();
+            let tau2 = rnea(model, &mut data, &q, &v, qacc.as_slice()).unwrap();
             e.add(rel_err_vec(tau2.as_slice(), &tau), || format!("{name}, state {s}"));
         }
     }
@@ -211,17 +211,17 @@ fn check_mass_matrix(models: &[(String, Model)], seed: u64) {
         let nv = model.nv;
         for s in 0..STATES {
             let q = random_q(model, &mut r);
-            let m = crba(model, &mut data, &q).clone();
+            let m = crba(model, &mut data, &q).unwrap().clone();
             let at = || format!("{name}, state {s}");
             e_sym.add(rel_err_mat(&m, &m.transpose()), at);
             e_pd.add(if m.clone().cholesky().is_some() { 0.0 } else { 1.0 }, at);
             let zero = vec![0.0; nv];
-            let g = rnea(model, &mut data, &q, &zero, &zero).clone();
+            let g = rnea(model, &mut data, &q, &zero, &zero).unwrap().clone();
             let mut m_cols = DMatrix::zeros(nv, nv);
             let mut e_k = vec![0.0; nv];
             for k in 0..nv {
                 e_k[k] = 1.0;
-                let col = rnea(model, &mut data, &q, &zero, &e_k) - &g;
+                let col = rnea(model, &mut data, &q, &zero, &e_k).unwrap() - &g;
                 m_cols.set_column(k, &col);
                 e_k[k] = 0.0;
             }
@@ -256,14 +256,14 @@ fn check_jacobian_times_v(models: &[(String, Model)], seed: u64) {
         let mut r = rng(seed);
         for s in 0..STATES {
             let (q, v) = (random_q(model, &mut r), random_v(model, &mut r));
-            forward_kinematics(model, &mut data, &q);
-            forward_velocities(model, &mut data, &v);
+            forward_kinematics(model, &mut data, &q).unwrap();
+            forward_velocities(model, &mut data, &v).unwrap();
             let v_vec = dvec(&v);
             for (f, frame) in model.frames.iter().enumerate() {
                 for (rf, e) in REFERENCE_FRAMES.iter().zip(errs.iter_mut()) {
-                    frame_jacobian(model, &data, f, *rf, &mut jac);
+                    frame_jacobian(model, &data, f, *rf, &mut jac).unwrap();
                     let jv = &jac * &v_vec;
-                    let (lin, ang) = frame_velocity(model, &data, f, *rf);
+                    let (lin, ang) = frame_velocity(model, &data, f, *rf).unwrap();
                     e.add(rel_err_vec(jv.as_slice(), &stack(&lin, &ang)), || {
                         format!("{name}, state {s}, frame {}", frame.name)
                     });
@@ -297,13 +297,13 @@ fn central_differences(model: &Model, data: &mut Data, q: &[f64], h: f64) -> Vec
     for k in 0..model.nv {
         e_k[k] = 1.0;
         let mut q_plus = q.to_vec();
-        integrate_configuration(model, &mut q_plus, &e_k, h);
+        integrate_configuration(model, &mut q_plus, &e_k, h).unwrap();
         let mut q_minus = q.to_vec();
-        integrate_configuration(model, &mut q_minus, &e_k, -h);
+        integrate_configuration(model, &mut q_minus, &e_k, -h).unwrap();
         e_k[k] = 0.0;
-        forward_kinematics(model, data, &q_plus);
+        forward_kinematics(model, data, &q_plus).unwrap();
         let plus = data.x_world_frame.clone();
-        forward_kinematics(model, data, &q_minus);
+        forward_kinematics(model, data, &q_minus).unwrap();
         for f in 0..nf {
             let (xp, xm) = (&plus[f], &data.x_world_frame[f]);
             let p_dot = (xp.pos - xm.pos) / (2.0 * h);
@@ -328,7 +328,7 @@ fn check_jacobian_finite_differences(models: &[(String, Model)], seed: u64) {
             let q = random_q(model, &mut r);
             let d_h = central_differences(model, &mut data, &q, FD_STEP);
             let d_h2 = central_differences(model, &mut data, &q, FD_STEP / 2.0);
-            forward_kinematics(model, &mut data, &q);
+            forward_kinematics(model, &mut data, &q).unwrap();
             for (f, frame) in model.frames.iter().enumerate() {
                 let x = data.x_world_frame[f];
                 // Richardson: (4 D(h/2) − D(h)) / 3, per column.
@@ -347,7 +347,7 @@ fn check_jacobian_finite_differences(models: &[(String, Model)], seed: u64) {
                     }
                 }
                 for ((rf, e), fd_m) in REFERENCE_FRAMES.iter().zip(errs.iter_mut()).zip(&fd) {
-                    frame_jacobian(model, &data, f, *rf, &mut jac);
+                    frame_jacobian(model, &data, f, *rf, &mut jac).unwrap();
                     let (err, (row, col)) = rel_err_mat_at(&jac, fd_m);
                     e.add(err, || format!("{name}, state {s}, frame {}, ({row}, {col})", frame.name));
                 }
@@ -384,10 +384,10 @@ fn check_energy(models: &[(String, Model)], seed: u64) {
         for s in 0..STATES {
             let (q, v, tau) = (random_q(model, &mut r), random_v(model, &mut r), random_tau(model, &mut r));
             let at = || format!("{name}, state {s}");
-            let qacc = aba(model, &mut data, &q, &v, &tau).clone();
+            let qacc = aba(model, &mut data, &q, &v, &tau).unwrap().clone();
             // True (gravity-free) body accelerations at q̈.
-            rnea(&model0, &mut data0, &q, &v, qacc.as_slice());
-            forward_kinematics(&model0, &mut data0, &q);
+            rnea(&model0, &mut data0, &q, &v, qacc.as_slice()).unwrap();
+            forward_kinematics(&model0, &mut data0, &q).unwrap();
             let mut terms = Vec::new();
             for b in 1..model.nbody() {
                 let inertia = &model.bodies[b].inertia;
@@ -407,13 +407,13 @@ fn check_energy(models: &[(String, Model)], seed: u64) {
             let diff = terms.iter().sum::<f64>() - power.iter().sum::<f64>();
             e_rate.add(diff.abs() / scale.max(REL_FLOOR), at);
 
-            let t = kinetic_energy(model, &mut data, &q, &v);
-            let m = crba(model, &mut data, &q);
+            let t = kinetic_energy(model, &mut data, &q, &v).unwrap();
+            let m = crba(model, &mut data, &q).unwrap();
             let v_vec = dvec(&v);
             let t_m = 0.5 * v_vec.dot(&(m * &v_vec));
             e_kin.add(rel_err(t, t_m), at);
 
-            forward_kinematics(model, &mut data, &q);
+            forward_kinematics(model, &mut data, &q).unwrap();
             let pot = potential_energy(model, &data);
             let com = center_of_mass(model, &data);
             e_pot.add(rel_err(pot, -moving_mass * model.gravity.dot(&com)), at);
@@ -459,8 +459,8 @@ fn check_momentum(models: &[(String, Model)], seed: u64) {
             let (q, v, mut tau) =
                 (random_q(model, &mut r), random_v(model, &mut r), random_tau(model, &mut r));
             let at = || format!("{name}, state {s}");
-            forward_kinematics(model, &mut data, &q);
-            forward_velocities(model, &mut data, &v);
+            forward_kinematics(model, &mut data, &q).unwrap();
+            forward_velocities(model, &mut data, &v).unwrap();
             let h = spatial_momentum(model, &data);
             // Independent construction: point velocities of the centres of mass from the
             // world-aligned Jacobians, angular momentum about the world origin.
@@ -469,7 +469,7 @@ fn check_momentum(models: &[(String, Model)], seed: u64) {
             for b in 1..model.nbody() {
                 let body = &model.bodies[b];
                 let f = frame_of_body(model, b);
-                frame_jacobian(model, &data, f, ReferenceFrame::LocalWorldAligned, &mut jac);
+                frame_jacobian(model, &data, f, ReferenceFrame::LocalWorldAligned, &mut jac).unwrap();
                 let jv = &jac * &v_vec;
                 let (p_dot, w) = (Vec3::new(jv[0], jv[1], jv[2]), Vec3::new(jv[3], jv[4], jv[5]));
                 let x = &data.x_world_body[b];
@@ -485,8 +485,8 @@ fn check_momentum(models: &[(String, Model)], seed: u64) {
             if moving_mass > 0.0 {
                 let com_at = |data: &mut Data, t: f64| {
                     let mut qt = q.clone();
-                    integrate_configuration(model, &mut qt, &v, t);
-                    forward_kinematics(model, data, &qt);
+                    integrate_configuration(model, &mut qt, &v, t).unwrap();
+                    forward_kinematics(model, data, &qt).unwrap();
                     center_of_mass(model, data)
                 };
                 let mut central = |hh: f64| (com_at(&mut data, hh) - com_at(&mut data, -hh)) / (2.0 * hh);
@@ -507,9 +507,9 @@ fn check_momentum(models: &[(String, Model)], seed: u64) {
                 model_r.dof_armature[..6].fill(0.0);
                 model_r.joints[0].armature = 0.0;
                 let model_r0 = without_gravity(&model_r);
-                let qacc = aba(&model_r, &mut data, &q, &v, &tau).clone();
-                rnea(&model_r0, &mut data0, &q, &v, qacc.as_slice());
-                forward_kinematics(&model_r0, &mut data0, &q);
+                let qacc = aba(&model_r, &mut data, &q, &v, &tau).unwrap().clone();
+                rnea(&model_r0, &mut data0, &q, &v, qacc.as_slice()).unwrap();
+                forward_kinematics(&model_r0, &mut data0, &q).unwrap();
                 let mut rate = Force::zero();
                 let mut wrench = Force::zero();
                 for b in 1..model.nbody() {
@@ -602,7 +602,7 @@ fn free_body_follows_euler_equations() {
         for s in 0..4 {
             let q = random_q(&model, &mut r);
             let v = random_v(&model, &mut r);
-            let qacc = aba(&model, &mut data, &q, &v, &[0.0; 6]).clone();
+            let qacc = aba(&model, &mut data, &q, &v, &[0.0; 6]).unwrap().clone();
             // Expected, by hand. Inertia about the centre of mass in body axes:
             let i_c = r_principal * Mat3::from_diagonal(&principal) * r_principal.transpose();
             let w = Vec3::new(v[3], v[4], v[5]);
@@ -619,7 +619,7 @@ fn free_body_follows_euler_equations() {
                 e_lin.add(rel_err_vec(&qacc.as_slice()[0..3], p_ddot.as_slice()), at);
             }
             e_all.add(rel_err_vec(qacc.as_slice(), &expected), at);
-            let tau = rnea(&model, &mut data, &q, &v, &expected);
+            let tau = rnea(&model, &mut data, &q, &v, &expected).unwrap();
             // Scale: the inertial forces m p̈ and I ω̇ the RNEA balances.
             let scale = (p_ddot.amax() * 2.5).max((i_c * w_dot).amax()).max(REL_FLOOR);
             e_rnea.add(tau.amax() / scale, at);
@@ -640,9 +640,9 @@ fn free_joint_velocity_convention() {
     for s in 0..4 {
         let q = random_q(&model, &mut r);
         let v = random_v(&model, &mut r);
-        forward_kinematics(&model, &mut data, &q);
-        forward_velocities(&model, &mut data, &v);
-        let (lin, ang) = frame_velocity(&model, &data, 0, ReferenceFrame::LocalWorldAligned);
+        forward_kinematics(&model, &mut data, &q).unwrap();
+        forward_velocities(&model, &mut data, &v).unwrap();
+        let (lin, ang) = frame_velocity(&model, &data, 0, ReferenceFrame::LocalWorldAligned).unwrap();
         let rot = quat_to_matrix(q[3], q[4], q[5], q[6]);
         let w_world = rot * Vec3::new(v[3], v[4], v[5]);
         e.add(rel_err_vec(&stack(&lin, &ang), &stack(&Vec3::new(v[0], v[1], v[2]), &w_world)), || {
@@ -673,9 +673,9 @@ fn check_integrate_difference(models: &[(String, Model)], seed: u64) {
             let (q0, v) = (random_q(model, &mut r), random_v(model, &mut r));
             for dt in [0.5, 1e-2] {
                 let mut q1 = q0.clone();
-                integrate_configuration(model, &mut q1, &v, dt);
+                integrate_configuration(model, &mut q1, &v, dt).unwrap();
                 let mut d = vec![0.0; model.nv];
-                difference_configuration(model, &q0, &q1, &mut d);
+                difference_configuration(model, &q0, &q1, &mut d).unwrap();
                 let v_dt: Vec<f64> = v.iter().map(|x| x * dt).collect();
                 e.add(rel_err_vec(&d, &v_dt), || format!("{name}, state {s}, dt {dt}"));
             }

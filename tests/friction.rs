@@ -157,8 +157,8 @@ fn ball_cone_jdotv_matches_finite_differences() {
     };
     let eps = 1e-6;
     let (mut qp, mut qm) = (q.to_vec(), q.to_vec());
-    integrate_configuration(&model, &mut qp, &v, eps);
-    integrate_configuration(&model, &mut qm, &v, -eps);
+    integrate_configuration(&model, &mut qp, &v, eps).unwrap();
+    integrate_configuration(&model, &mut qm, &v, -eps).unwrap();
     let fd = (jv(&qp) - jv(&qm)) / (2.0 * eps);
     let exact = row.jdotv(&q, &v);
     println!("cone J̇v {exact} vs central difference {fd}; angle check {}", ball_angle_axis(&q).0);

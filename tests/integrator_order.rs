@@ -25,7 +25,7 @@ fn textbook(name: &str) -> Model {
 /// max |q ⊖ q_ref| and |v − v_ref|.
 fn state_error(model: &Model, s: &State, reference: &State) -> f64 {
     let mut dq = vec![0.0; model.nv];
-    difference_configuration(model, reference.q.as_slice(), s.q.as_slice(), &mut dq);
+    difference_configuration(model, reference.q.as_slice(), s.q.as_slice(), &mut dq).unwrap();
     let dv = (&s.v - &reference.v).amax();
     dq.iter().fold(dv, |m, x| m.max(x.abs()))
 }

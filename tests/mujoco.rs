@@ -292,19 +292,19 @@ fn check_model(name: &str) {
                 "{name} state {s}"
             );
 
-            let m = crba(&model, &mut data, &st.q).clone();
+            let m = crba(&model, &mut data, &st.q).unwrap().clone();
             let (err, (r, c)) = rel_err_mat_at(&m, &matrix(&st.m, model.nv));
             e_m.add(err, || format!("state {s}, ({r}, {c}): {} vs {}", m[(r, c)], st.m[r][c]));
 
-            let bias = bias_forces(&model, &mut data, &st.q, &st.v).clone();
+            let bias = bias_forces(&model, &mut data, &st.q, &st.v).unwrap().clone();
             let (err, i) = rel_err_vec_at(bias.as_slice(), &st.bias);
             e_bias.add(err, || format!("state {s}, [{i}]: {} vs {}", bias[i], st.bias[i]));
 
-            let qacc = aba(&model, &mut data, &st.q, &st.v, &st.tau).clone();
+            let qacc = aba(&model, &mut data, &st.q, &st.v, &st.tau).unwrap().clone();
             let (err, i) = rel_err_vec_at(qacc.as_slice(), &st.qacc);
             e_qacc.add(err, || format!("state {s}, [{i}]: {} vs {}", qacc[i], st.qacc[i]));
 
-            forward_kinematics(&model, &mut data, &st.q);
+            forward_kinematics(&model, &mut data, &st.q).unwrap();
             let (mut pos, mut pos_ref, mut rot, mut rot_ref, mut quat, mut quat_ref) =
                 (vec![], vec![], vec![], vec![], vec![], vec![]);
             let mut which = vec![];

@@ -111,19 +111,19 @@ fn check_robot(robot: &str) {
         );
         let at = || format!("state {s}");
 
-        let m = crba(&model, &mut data, &st.q).clone();
+        let m = crba(&model, &mut data, &st.q).unwrap().clone();
         let (err, (r, c)) = rel_err_mat_at(&m, &matrix(&st.m, model.nv));
         e_m.add(err, || format!("state {s}, ({r}, {c})"));
 
-        let bias = bias_forces(&model, &mut data, &st.q, &st.v).clone();
+        let bias = bias_forces(&model, &mut data, &st.q, &st.v).unwrap().clone();
         let (err, i) = rel_err_vec_at(bias.as_slice(), &st.bias);
         e_bias.add(err, || format!("state {s}, [{i}]"));
 
-        let qacc = aba(&model, &mut data, &st.q, &st.v, &st.tau).clone();
+        let qacc = aba(&model, &mut data, &st.q, &st.v, &st.tau).unwrap().clone();
         let (err, i) = rel_err_vec_at(qacc.as_slice(), &st.qacc);
         e_qacc.add(err, || format!("state {s}, [{i}]"));
 
-        forward_kinematics(&model, &mut data, &st.q);
+        forward_kinematics(&model, &mut data, &st.q).unwrap();
         let (mut pos, mut pos_ref, mut rot, mut rot_ref) = (vec![], vec![], vec![], vec![]);
         let (mut quat, mut quat_ref) = (vec![], vec![]);
         let link_names: Vec<&String> = st.poses.keys().collect();
@@ -165,7 +165,7 @@ fn check_robot(robot: &str) {
             / all_ref;
         e_com_all.add(rel_err_vec(com_all.as_slice(), com_all_ref.as_slice()), at);
 
-        let kin = kinetic_energy(&model, &mut data, &st.q, &st.v);
+        let kin = kinetic_energy(&model, &mut data, &st.q, &st.v).unwrap();
         e_kin.add(rel_err(kin, st.kinetic), at);
     }
     println!(

@@ -31,8 +31,8 @@ fn sim(model: &Model, kind: IntegratorKind, dt: f64, q0: &[f64], v0: &[f64]) -> 
 /// World angular momentum about the world origin (the pivot or the body origin at 0).
 fn angular_momentum(s: &mut Simulation) -> Vec3 {
     let (q, v) = (s.data.qpos.clone(), s.data.qvel.clone());
-    forward_kinematics(&s.model, &mut s.data, q.as_slice());
-    forward_velocities(&s.model, &mut s.data, v.as_slice());
+    forward_kinematics(&s.model, &mut s.data, q.as_slice()).unwrap();
+    forward_velocities(&s.model, &mut s.data, v.as_slice()).unwrap();
     let h = spatial_momentum(&s.model, &s.data);
     // About the centre of mass for a free body: L_com = L_o − c × p (c = body origin + offset).
     h.ang

@@ -13,9 +13,9 @@ use super::coulomb::{has_friction, solve_coulomb, Level, SolverSettings, SEPARAT
 use super::ConstraintModel;
 use super::ExactWork;
 use crate::collision::{collide, EXACT_REACH};
-use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
+use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
 use crate::kinematics::body_poses;
-use crate::model::{integrate_configuration, Data, EfcType, Model};
+use crate::model::{integrate_configuration_unchecked, Data, EfcType, Model};
 
 /// Y = M⁻¹Jᵀ into `efc_minv_jt` and A = J M⁻¹ Jᵀ into `efc_delassus` for the current rows (needs
 /// the factor of M in `mass_factor`).
@@ -33,7 +33,7 @@ fn delassus(model: &Model, data: &mut Data) {
         for k in 0..nv {
             col[k] = efc_j[(i, k)];
         }
-        solve_with_factor(model, mass_factor, col.as_mut_slice());
+        solve_with_factor_unchecked(model, mass_factor, col.as_mut_slice());
     }
     for i in 0..n {
         for j in i..n {
@@ -136,7 +136,7 @@ pub fn project_positions(
     tolerance: f64,
     max_iterations: u32,
 ) -> (u32, f64) {
-    crba(model, data, q);
+    crba_unchecked(model, data, q);
     factorize_mass_matrix(model, data);
     let mut iterations = 0;
     loop {
@@ -164,7 +164,7 @@ pub fn project_positions(
         let mut dq = std::mem::take(&mut data.scratch_v);
         dq.fill(0.0);
         add_minv_jt_mu(data, model.nv, -1.0, dq.as_mut_slice());
-        integrate_configuration(model, q, dq.as_slice(), 1.0);
+        integrate_configuration_unchecked(model, q, dq.as_slice(), 1.0);
         data.scratch_v = dq;
         iterations += 1;
     }

@@ -19,8 +19,8 @@ use super::limits::LimitRow;
 use crate::collision::{collide, CollisionModel, EXACT_REACH};
 use crate::kinematics::body_poses;
 use crate::kinematics::{
-    bias_accelerations, for_each_ancestor_dof, forward_kinematics, forward_velocities,
-    point_bias_acceleration,
+    bias_accelerations_unchecked, for_each_ancestor_dof, forward_kinematics_unchecked,
+    forward_velocities_unchecked, point_bias_acceleration,
 };
 use crate::model::{Data, EfcType, EqualityKind, Model, TendonKind};
 use crate::spatial::{Mat3, Transform, Vec3};
@@ -167,7 +167,7 @@ impl ConstraintModel {
             return Self { collision, equalities: Vec::new(), friction, limits, tendon_limits };
         }
         let mut data = Data::new(model);
-        forward_kinematics(model, &mut data, &model.qpos0);
+        forward_kinematics_unchecked(model, &mut data, &model.qpos0);
         let frame = |f: usize| {
             let fr = &model.frames[f];
             (fr.body, fr.x_body_frame, data.x_world_frame[f])
@@ -376,7 +376,7 @@ impl ConstraintModel {
     /// same q. Needs the body velocities (`v_body`, e.g. from RNEA or `forward_velocities`);
     /// computes the bias accelerations itself.
     pub fn velocities(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
-        bias_accelerations(model, data, v);
+        bias_accelerations_unchecked(model, data, v);
         let mut r = 0;
         for e in &self.equalities {
             if !data.eq_active[e.id] {
@@ -448,8 +448,8 @@ impl ConstraintModel {
     /// [`positions`](Self::positions) and [`velocities`](Self::velocities).
     pub fn evaluate(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         self.collide(model, data, q);
-        forward_kinematics(model, data, q);
-        forward_velocities(model, data, v);
+        forward_kinematics_unchecked(model, data, q);
+        forward_velocities_unchecked(model, data, v);
         self.positions(model, data, q, true);
         self.velocities(model, data, q, v);
     }

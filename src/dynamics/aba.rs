@@ -1,5 +1,6 @@
 //! Articulated-body algorithm for forward dynamics (RBDA §7.3, Table 7.1).
 
+use crate::error::{check, InputError};
 use crate::kinematics::{joint_velocity, update_joint};
 use crate::model::{Data, Model};
 use crate::spatial::{ArticulatedInertia, Force, Motion, Vec3};
@@ -12,7 +13,32 @@ use nalgebra::{DVector, Matrix6};
 /// On x86-64 CPUs with AVX2 the kernel runs compiled for AVX2 (chosen at run time): the same
 /// operations in the same order, so the same bits (`avx2_kernel_is_bit_for_bit`), in fewer,
 /// 3-operand instructions.
-pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d DVector<f64> {
+///
+/// # Errors
+/// [`InputError::Length`] when q is not nq long, v or tau not nv long, or `data` was made for
+/// another model; nothing is computed then.
+pub fn aba<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+) -> Result<&'d DVector<f64>, InputError> {
+    check::data("aba", model, data)?;
+    check::q("aba", model, q)?;
+    check::v("aba", "v", model, v)?;
+    check::v("aba", "tau", model, tau)?;
+    Ok(aba_unchecked(model, data, q, v, tau))
+}
+
+/// [`aba`] without the argument checks (the crate's own callers, whose sizes are right).
+pub(crate) fn aba_unchecked<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+) -> &'d DVector<f64> {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (checked just above), all `aba_avx2` requires.

@@ -1,6 +1,7 @@
 //! Composite-rigid-body algorithm for M(q) (RBDA §6.2, Table 6.2) and the tree-sparse LᵀDL
 //! factorization and solve (RBDA §6.3, Tables 6.3–6.4).
 
+use crate::error::{check, InputError};
 use crate::kinematics::body_world_pose;
 use crate::model::{Data, HingeAxis, JointKind, Model, NO_DOF};
 #[cfg(target_arch = "x86_64")]
@@ -21,7 +22,17 @@ use nalgebra::{DMatrix, DVector, Vector3};
 /// shorter dependent instructions on this flop-dense pass. Elsewhere the same formulas run with
 /// separate multiplies and adds; the two agree to round-off
 /// (`fma_kernel_matches_separate_multiply_adds`).
-pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64> {
+///
+/// # Errors
+/// [`InputError::Length`] when q is not nq long or `data` was made for another model.
+pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>, InputError> {
+    check::data("crba", model, data)?;
+    check::q("crba", model, q)?;
+    Ok(crba_unchecked(model, data, q))
+}
+
+/// [`crba`] without the argument checks.
+pub(crate) fn crba_unchecked<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64> {
     crba_dispatch::<true>(model, data, q);
     &data.mass_matrix
 }
@@ -29,9 +40,14 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64
 /// [`crba`] writing only the upper triangle of `data.mass_matrix` (the entries M[l][k], l ≤ k, on
 /// the tree's ancestor chains), as Pinocchio's `crba` does: what [`factorize_mass_matrix`] reads.
 /// The strictly lower triangle keeps whatever it held (after [`crba`], an older M's mirror).
-pub fn crba_upper<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64> {
+///
+/// # Errors
+/// As [`crba`].
+pub fn crba_upper<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>, InputError> {
+    check::data("crba_upper", model, data)?;
+    check::q("crba_upper", model, q)?;
     crba_dispatch::<false>(model, data, q);
-    &data.mass_matrix
+    Ok(&data.mass_matrix)
 }
 
 #[inline(always)]
@@ -275,13 +291,31 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
 
 /// Solves M x = b in place (`x` holds b on entry) with the factor of [`factorize_mass_matrix`]
 /// (RBDA §6.3, Table 6.4): x ← L⁻¹ D⁻¹ L⁻ᵀ b.
-pub fn solve_mass_matrix(model: &Model, data: &Data, x: &mut DVector<f64>) {
-    solve_with_factor(model, &data.mass_factor, x.as_mut_slice());
+///
+/// # Errors
+/// [`InputError::Length`] when x is not nv long or `data` was made for another model.
+pub fn solve_mass_matrix(model: &Model, data: &Data, x: &mut DVector<f64>) -> Result<(), InputError> {
+    check::data("solve_mass_matrix", model, data)?;
+    check::v("solve_mass_matrix", "x", model, x.as_slice())?;
+    solve_with_factor_unchecked(model, &data.mass_factor, x.as_mut_slice());
+    Ok(())
 }
 
 /// [`solve_mass_matrix`] on a slice, with the factor passed explicitly (so that the right-hand
 /// side may be another buffer of the same `Data`).
-pub fn solve_with_factor(model: &Model, factor: &DMatrix<f64>, x: &mut [f64]) {
+///
+/// # Errors
+/// [`InputError::Length`] when x is not nv long or the factor not nv × nv.
+pub fn solve_with_factor(model: &Model, factor: &DMatrix<f64>, x: &mut [f64]) -> Result<(), InputError> {
+    check::v("solve_with_factor", "x", model, x)?;
+    InputError::check_len("solve_with_factor", "factor (rows)", factor.nrows(), model.nv, "nv")?;
+    InputError::check_len("solve_with_factor", "factor (columns)", factor.ncols(), model.nv, "nv")?;
+    solve_with_factor_unchecked(model, factor, x);
+    Ok(())
+}
+
+/// [`solve_with_factor`] without the argument checks.
+pub(crate) fn solve_with_factor_unchecked(model: &Model, factor: &DMatrix<f64>, x: &mut [f64]) {
     let lambda = &model.dof_parent[..model.nv];
     let nv = model.nv;
     let h = factor.as_slice();
@@ -323,9 +357,9 @@ mod tests {
     fn upper_triangle_is_crbas() {
         for (file, model, q) in crate::kernel_test_states::robots() {
             let mut data = Data::new(&model);
-            let full = crba(&model, &mut data, &q).clone();
+            let full = crba(&model, &mut data, &q).unwrap().clone();
             data.mass_matrix.fill(7.0);
-            let upper = crba_upper(&model, &mut data, &q);
+            let upper = crba_upper(&model, &mut data, &q).unwrap();
             for k in 0..model.nv {
                 let mut chain = vec![k];
                 while let Some(&l) = chain.last().filter(|&&l| model.dof_parent[l] != NO_DOF) {

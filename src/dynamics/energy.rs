@@ -1,15 +1,30 @@
 //! Energy, centre of mass and momentum of the moving bodies (notes §2.1–2.2, §1.5). Bodies welded
 //! to the world (body 0) are excluded, as in MuJoCo and Pinocchio.
 
+use crate::error::{check, InputError};
+use crate::kinematics::{forward_kinematics_unchecked, forward_velocities_unchecked};
+#[cfg(doc)]
 use crate::kinematics::{forward_kinematics, forward_velocities};
 use crate::model::{Data, Model};
 use crate::spatial::{Force, Vec3};
 
 /// Kinetic energy T = Σ ½ vᵢ·Iᵢvᵢ + ½ Σ armature·v² (= ½ vᵀ M v, MuJoCo's definition). Runs forward
 /// kinematics and velocities at (q, v).
-pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> f64 {
-    forward_kinematics(model, data, q);
-    forward_velocities(model, data, v);
+///
+/// # Errors
+/// [`InputError::Length`] when q is not nq long, v not nv long, or `data` was made for another
+/// model.
+pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> Result<f64, InputError> {
+    check::data("kinetic_energy", model, data)?;
+    check::q("kinetic_energy", model, q)?;
+    check::v("kinetic_energy", "v", model, v)?;
+    Ok(kinetic_energy_unchecked(model, data, q, v))
+}
+
+/// [`kinetic_energy`] without the argument checks.
+pub(crate) fn kinetic_energy_unchecked(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> f64 {
+    forward_kinematics_unchecked(model, data, q);
+    forward_velocities_unchecked(model, data, v);
     let bodies: f64 =
         (1..model.nbody()).map(|b| model.bodies[b].inertia.kinetic_energy(&data.v_body[b])).sum();
     let armature: f64 = model.dof_armature.iter().zip(v).map(|(a, vi)| 0.5 * a * vi * vi).sum();

@@ -8,6 +8,10 @@ mod energy;
 mod rnea;
 
 pub use aba::aba;
+pub(crate) use aba::aba_unchecked;
 pub use crba::{crba, crba_upper, factorize_mass_matrix, solve_mass_matrix, solve_with_factor};
+pub(crate) use crba::{crba_unchecked, solve_with_factor_unchecked};
+pub(crate) use energy::kinetic_energy_unchecked;
 pub use energy::{center_of_mass, kinetic_energy, potential_energy, spatial_momentum};
+pub(crate) use rnea::bias_forces_unchecked;
 pub use rnea::{bias_forces, gravity_forces, rnea};

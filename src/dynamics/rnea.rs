@@ -1,5 +1,6 @@
 //! Recursive Newton–Euler inverse dynamics (RBDA §5.3, Table 5.1).
 
+use crate::error::{check, InputError};
 use crate::kinematics::{joint_velocity, update_joint};
 use crate::model::{Data, Model};
 use crate::spatial::{Motion, Vec3};
@@ -7,7 +8,32 @@ use nalgebra::DVector;
 
 /// Inverse dynamics τ = M(q) q̈ + c(q, v) into `data.tau` (and returned). Gravity enters as a
 /// fictitious upward acceleration of the world (RBDA §5.3); armature adds `armature · q̈`.
-pub fn rnea<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], qacc: &[f64]) -> &'d DVector<f64> {
+///
+/// # Errors
+/// [`InputError::Length`] when q is not nq long, v or qacc not nv long, or `data` was made for
+/// another model.
+pub fn rnea<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+    qacc: &[f64],
+) -> Result<&'d DVector<f64>, InputError> {
+    check::data("rnea", model, data)?;
+    check::q("rnea", model, q)?;
+    check::v("rnea", "v", model, v)?;
+    check::v("rnea", "qacc", model, qacc)?;
+    Ok(rnea_unchecked(model, data, q, v, qacc))
+}
+
+/// [`rnea`] without the argument checks.
+pub(crate) fn rnea_unchecked<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+    qacc: &[f64],
+) -> &'d DVector<f64> {
     data.v_body[0] = Motion::zero();
     data.a_body[0] = Motion::new(Vec3::zeros(), -model.gravity);
     // Pass 1, root to leaves: body velocities, accelerations and the net force each needs.
@@ -46,19 +72,49 @@ pub fn rnea<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], qacc: &
 
 /// Bias forces c(q, v) = RNEA(q, v, 0): Coriolis, centrifugal and gravity (MuJoCo's
 /// `qfrc_bias`), into `data.tau`.
-pub fn bias_forces<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64]) -> &'d DVector<f64> {
+///
+/// # Errors
+/// As [`rnea`].
+pub fn bias_forces<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+) -> Result<&'d DVector<f64>, InputError> {
+    check::data("bias_forces", model, data)?;
+    check::q("bias_forces", model, q)?;
+    check::v("bias_forces", "v", model, v)?;
+    Ok(bias_forces_unchecked(model, data, q, v))
+}
+
+/// [`bias_forces`] without the argument checks.
+pub(crate) fn bias_forces_unchecked<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+) -> &'d DVector<f64> {
     data.scratch_v.fill(0.0);
     let zeros = std::mem::take(&mut data.scratch_v);
-    rnea(model, data, q, v, zeros.as_slice());
+    rnea_unchecked(model, data, q, v, zeros.as_slice());
     data.scratch_v = zeros;
     &data.tau
 }
 
 /// Generalized gravity g(q) = RNEA(q, 0, 0), into `data.tau`.
-pub fn gravity_forces<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DVector<f64> {
+///
+/// # Errors
+/// As [`rnea`].
+pub fn gravity_forces<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+) -> Result<&'d DVector<f64>, InputError> {
+    check::data("gravity_forces", model, data)?;
+    check::q("gravity_forces", model, q)?;
     data.scratch_v.fill(0.0);
     let zeros = std::mem::take(&mut data.scratch_v);
-    rnea(model, data, q, zeros.as_slice(), zeros.as_slice());
+    rnea_unchecked(model, data, q, zeros.as_slice(), zeros.as_slice());
     data.scratch_v = zeros;
-    &data.tau
+    Ok(&data.tau)
 }

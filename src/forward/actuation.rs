@@ -22,7 +22,7 @@
 
 use super::activation::{activation_rate, next_activation};
 use super::transmission::{needs_poses, transmission, Poses};
-use crate::kinematics::forward_kinematics;
+use crate::kinematics::forward_kinematics_unchecked;
 pub use crate::model::actuator::unsimulated_reason;
 use crate::model::actuator::{BiasType, GainType, Transmission};
 use crate::model::{Data, Model};
@@ -44,9 +44,9 @@ pub fn resolved_bias_velocity(model: &Model) -> Vec<f64> {
             }
             let data = data.get_or_insert_with(|| {
                 let mut data = Data::new(model);
-                crate::dynamics::crba(model, &mut data, q0);
+                crate::dynamics::crba_unchecked(model, &mut data, q0);
                 crate::dynamics::factorize_mass_matrix(model, &mut data);
-                forward_kinematics(model, &mut data, q0);
+                forward_kinematics_unchecked(model, &mut data, q0);
                 data
             });
             let Data { actuator_moment, x_world_body, s_body, x_world_frame, .. } = data;
@@ -55,7 +55,7 @@ pub fn resolved_bias_velocity(model: &Model) -> Vec<f64> {
             transmission(model, a, q0, poses, actuator_moment, i);
             let moment = actuator_moment.row(i).transpose();
             let mut x = moment.clone();
-            crate::dynamics::solve_mass_matrix(model, data, &mut x);
+            crate::dynamics::solve_with_factor_unchecked(model, &data.mass_factor, x.as_mut_slice());
             let inverse_mass = moment.dot(&x);
             if inverse_mass <= 0.0 {
                 return b2;
@@ -73,7 +73,7 @@ pub fn actuation(model: &Model, data: &mut Data, q: &[f64], v: &[f64], bias_velo
     data.qfrc_actuator.fill(0.0);
     let clamp = model.options.flags.clampctrl;
     if model.actuators.iter().any(|a| needs_poses(a) && unsimulated_reason(model, a).is_none()) {
-        forward_kinematics(model, data, q);
+        forward_kinematics_unchecked(model, data, q);
     }
     let mut act_adr = 0;
     for (i, a) in model.actuators.iter().enumerate() {

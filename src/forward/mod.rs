@@ -30,7 +30,9 @@ pub use actuation::{
 pub use crate::constraint::DriftCorrection;
 pub use plan::{Plan, Stage, StageKind, Status};
 
-use crate::dynamics::{aba, bias_forces, crba, factorize_mass_matrix, solve_mass_matrix};
+use crate::dynamics::{
+    aba_unchecked, bias_forces_unchecked, crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked,
+};
 use crate::model::{Data, Model};
 
 /// Forward dynamics at the state in `data` (`qpos`, `qvel`, `act`, `ctrl`, `qfrc_applied`):
@@ -62,12 +64,12 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         }
         match stage.kind {
             StageKind::Position if m_path => {
-                crba(model, data, q);
+                crba_unchecked(model, data, q);
                 factorize_mass_matrix(model, data);
                 solver.positions(rows, model, data, q);
             }
             StageKind::Velocity if m_path => {
-                bias_forces(model, data, q, v);
+                bias_forces_unchecked(model, data, q, v);
                 data.qfrc_bias.copy_from(&data.tau);
                 // RNEA left the body velocities at v in `v_body`.
                 solver.velocities(rows, model, data, q, v);
@@ -117,14 +119,14 @@ fn acceleration(model: &Model, data: &mut Data, q: &[f64], v: &[f64], m_path: bo
         }
         data.qacc_smooth.copy_from(&data.qfrc_smooth);
         let mut x = std::mem::take(&mut data.qacc_smooth);
-        solve_mass_matrix(model, data, &mut x);
+        solve_with_factor_unchecked(model, &data.mass_factor, x.as_mut_slice());
         data.qacc_smooth = x;
     } else {
         let mut tau = std::mem::take(&mut data.scratch_v);
         for k in 0..model.nv {
             tau[k] = data.qfrc_passive[k] + drive(model, data, k);
         }
-        aba(model, data, q, v, tau.as_slice());
+        aba_unchecked(model, data, q, v, tau.as_slice());
         data.scratch_v = tau;
         data.qacc_smooth.copy_from(&data.aba_qacc);
     }

@@ -152,8 +152,8 @@ mod tests {
                 let (mut vp, mut vm) = (v.clone(), v.clone());
                 vp[k] += eps;
                 vm[k] -= eps;
-                let cp = rnea(&model, &mut data, &q, &vp, &zero).clone();
-                let cm = rnea(&model, &mut data, &q, &vm, &zero).clone();
+                let cp = rnea(&model, &mut data, &q, &vp, &zero).unwrap().clone();
+                let cm = rnea(&model, &mut data, &q, &vm, &zero).unwrap().clone();
                 for i in 0..model.nv {
                     let fd = (cp[i] - cm[i]) / (2.0 * eps);
                     worst = worst.max((fd - d.dbias_dv[(i, k)]).abs() / scale);

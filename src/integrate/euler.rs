@@ -6,7 +6,7 @@
 use super::implicit_fast::implicit_acceleration;
 use super::{correct_drift, State, StepReport, Stepper};
 use crate::forward::{advance_activations, forward_at};
-use crate::model::{integrate_configuration, Data, Model};
+use crate::model::{integrate_configuration_unchecked, Data, Model};
 use nalgebra::DVector;
 
 /// Semi-implicit Euler stepper, with its buffer for the implicitly damped acceleration.
@@ -54,7 +54,7 @@ impl SemiImplicitEuler {
         } else {
             state.v.axpy(h, &data.qacc, 1.0);
         }
-        integrate_configuration(model, state.q.as_mut_slice(), state.v.as_slice(), h);
+        integrate_configuration_unchecked(model, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }

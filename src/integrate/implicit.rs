@@ -12,9 +12,9 @@
 
 use super::bias_derivative::BiasDerivative;
 use super::{add_force_derivative, correct_drift, State, StepReport, Stepper};
-use crate::dynamics::crba;
+use crate::dynamics::crba_unchecked;
 use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
-use crate::model::{integrate_configuration, Data, Model};
+use crate::model::{integrate_configuration_unchecked, Data, Model};
 use nalgebra::{DMatrix, DVector};
 
 /// The implicit stepper with its derivative pass, LU matrix and force buffer.
@@ -99,7 +99,7 @@ impl Implicit {
         forward_at(model, data, state.q.as_slice(), state.v.as_slice());
         // Activations as in MuJoCo's `mj_advance` (explicit in act_dot; filterexact exact).
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
-        crba(model, data, state.q.as_slice());
+        crba_unchecked(model, data, state.q.as_slice());
         self.force.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
         self.derivative.compute(model, data, state.q.as_slice(), state.v.as_slice());
         // M − h D = M + h ∂c/∂v − h ∂(passive + actuator)/∂v.
@@ -121,7 +121,7 @@ impl Implicit {
         lu_factor_in_place(self.lu.as_mut_slice(), nv, nv);
         lu_solve_in_place(self.lu.as_slice(), nv, nv, self.force.as_mut_slice());
         state.v.axpy(h, &self.force, 1.0);
-        integrate_configuration(model, state.q.as_mut_slice(), state.v.as_slice(), h);
+        integrate_configuration_unchecked(model, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }

@@ -13,9 +13,9 @@
 //! [`Implicit`](super::Implicit) adds the Coriolis derivatives −∂c/∂v to D.
 
 use super::{correct_drift, State, StepReport, Stepper};
-use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
+use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
 use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
-use crate::model::{integrate_configuration, Data, Model};
+use crate::model::{integrate_configuration_unchecked, Data, Model};
 use nalgebra::DVector;
 
 /// The implicitfast stepper with its force buffer.
@@ -57,7 +57,7 @@ pub(super) fn implicit_acceleration(
     if !damped && actuator_bias_velocity.is_none() {
         return false;
     }
-    crba(model, data, q);
+    crba_unchecked(model, data, q);
     out.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
     add_force_derivative(model, data.mass_matrix.as_mut_slice(), h);
     let mut m = std::mem::take(&mut data.mass_matrix);
@@ -67,7 +67,7 @@ pub(super) fn implicit_acceleration(
     if implicit {
         data.mass_matrix = m;
         factorize_mass_matrix(model, data);
-        solve_with_factor(model, &data.mass_factor, out.as_mut_slice());
+        solve_with_factor_unchecked(model, &data.mass_factor, out.as_mut_slice());
         m = std::mem::take(&mut data.mass_matrix);
     }
     if let Some(b) = actuator_bias_velocity {
@@ -109,7 +109,7 @@ impl ImplicitFast {
         } else {
             state.v.axpy(h, &data.qacc, 1.0);
         }
-        integrate_configuration(model, state.q.as_mut_slice(), state.v.as_slice(), h);
+        integrate_configuration_unchecked(model, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }

@@ -5,7 +5,7 @@
 //! Acta Numerica 2000, §3.3).
 
 use crate::forward::forward_at;
-use crate::model::{dexp_inv_configuration, integrate_configuration, Data, Model};
+use crate::model::{dexp_inv_configuration_unchecked, integrate_configuration_unchecked, Data, Model};
 use nalgebra::DVector;
 
 /// Stage inputs: base configuration, increment θ, stage velocity; `q_stage` is scratch.
@@ -24,10 +24,10 @@ pub(super) fn evaluate_stage(
     (accel, theta_rate): (&mut DVector<f64>, &mut DVector<f64>),
 ) {
     q_stage.copy_from(input.q0);
-    integrate_configuration(model, q_stage.as_mut_slice(), input.theta.as_slice(), 1.0);
+    integrate_configuration_unchecked(model, q_stage.as_mut_slice(), input.theta.as_slice(), 1.0);
     forward_at(model, data, q_stage.as_slice(), input.v_stage.as_slice());
     accel.copy_from(&data.qacc);
-    dexp_inv_configuration(
+    dexp_inv_configuration_unchecked(
         model,
         input.theta.as_slice(),
         input.v_stage.as_slice(),

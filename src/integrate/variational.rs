@@ -48,10 +48,12 @@
 
 use super::lagrangian_terms::LagrangianTerms;
 use super::{correct_drift, State, StepFailure, StepReport, Stepper};
-use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
+use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
 use crate::forward::{actuation, advance_activations, passive};
-use crate::kinematics::forward_kinematics;
-use crate::model::{dexp_inv_configuration, integrate_configuration, Data, EfcType, JointKind, Model};
+use crate::kinematics::forward_kinematics_unchecked;
+use crate::model::{
+    dexp_inv_configuration_unchecked, integrate_configuration_unchecked, Data, EfcType, JointKind, Model,
+};
 use nalgebra::{DMatrix, DVector};
 
 /// Newton stops when the residual of the DEL equations is below this relative to the momentum
@@ -302,7 +304,7 @@ impl Variational {
     /// `tmp` = J_r⁻¹(θ) μ̄ (`theta`, `mu_bar`): the identity on models without ball or free joints.
     fn dexp_inv_mu_bar(&mut self, model: &Model) {
         if self.has_rotations {
-            dexp_inv_configuration(
+            dexp_inv_configuration_unchecked(
                 model,
                 self.theta.as_slice(),
                 self.mu_bar.as_slice(),
@@ -318,7 +320,7 @@ impl Variational {
         if self.mass_valid && self.mass_q == *q {
             return;
         }
-        crba(model, data, q.as_slice());
+        crba_unchecked(model, data, q.as_slice());
         factorize_mass_matrix(model, data);
         self.mass.copy_from(&data.mass_matrix);
         self.mass_factor.copy_from(&data.mass_factor);
@@ -332,7 +334,7 @@ impl Variational {
         if !self.has_equalities || !plan.has_constraints() {
             return 0;
         }
-        forward_kinematics(model, data, q);
+        forward_kinematics_unchecked(model, data, q);
         plan.constraints.positions(model, data, q, false);
         (0..data.nefc).take_while(|&i| data.efc_type[i] == EfcType::Equality).count()
     }
@@ -394,7 +396,11 @@ impl Variational {
                 self.jac_k[(i, k)] = data.efc_j[(i, k)];
                 self.y[(k, i)] = data.efc_j[(i, k)];
             }
-            solve_with_factor(model, &self.chord_factor, &mut self.y.as_mut_slice()[i * nv..(i + 1) * nv]);
+            solve_with_factor_unchecked(
+                model,
+                &self.chord_factor,
+                &mut self.y.as_mut_slice()[i * nv..(i + 1) * nv],
+            );
         }
         self.lambda.fill(0.0);
 
@@ -432,7 +438,7 @@ impl Variational {
         loop {
             iterations += 1;
             self.q1.copy_from(&state.q);
-            integrate_configuration(model, self.q1.as_mut_slice(), self.xi.as_slice(), h);
+            integrate_configuration_unchecked(model, self.q1.as_mut_slice(), self.xi.as_slice(), h);
             if iterations == 1 {
                 self.terms0.compute(model, data, q0, self.xi.as_slice());
             } else {
@@ -458,7 +464,7 @@ impl Variational {
                 self.residual[k] = r;
             }
             self.dxi.copy_from(&self.residual);
-            solve_with_factor(model, &self.chord_factor, self.dxi.as_mut_slice());
+            solve_with_factor_unchecked(model, &self.chord_factor, self.dxi.as_mut_slice());
             if m > 0 {
                 self.equality_rows(model, data, self.q1.as_slice());
                 phi_max = data.efc_pos.rows(0, m).amax();
@@ -560,7 +566,7 @@ impl Variational {
         state.q.copy_from(&self.q1);
         self.ensure_mass(model, data, &state.q);
         state.v.copy_from(&self.residual);
-        solve_with_factor(model, &self.mass_factor, state.v.as_mut_slice());
+        solve_with_factor_unchecked(model, &self.mass_factor, state.v.as_mut_slice());
         let mut jv_max = 0.0;
         if m > 0 {
             // v ← v − Z (J Z)⁻¹ J v with Z = M⁻¹ Jᵀ (RATTLE's velocity multiplier).
@@ -568,7 +574,11 @@ impl Variational {
                 for k in 0..nv {
                     self.y[(k, i)] = data.efc_j[(i, k)];
                 }
-                solve_with_factor(model, &self.mass_factor, &mut self.y.as_mut_slice()[i * nv..(i + 1) * nv]);
+                solve_with_factor_unchecked(
+                    model,
+                    &self.mass_factor,
+                    &mut self.y.as_mut_slice()[i * nv..(i + 1) * nv],
+                );
             }
             for i in 0..m {
                 let mut jv = 0.0;

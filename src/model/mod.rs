@@ -291,7 +291,16 @@ impl Model {
         !self.springs.is_empty()
     }
     /// Potential energy stored in the joint springs, Σ ½ k (q − rest)².
-    pub fn spring_energy(&self, q: &[f64]) -> f64 {
+    ///
+    /// # Errors
+    /// [`InputError::Length`](crate::error::InputError) when q is not nq long.
+    pub fn spring_energy(&self, q: &[f64]) -> Result<f64, crate::error::InputError> {
+        crate::error::check::q("Model::spring_energy", self, q)?;
+        Ok(self.spring_energy_unchecked(q))
+    }
+
+    /// [`spring_energy`](Self::spring_energy) without the length check.
+    pub(crate) fn spring_energy_unchecked(&self, q: &[f64]) -> f64 {
         self.springs.iter().map(|s| 0.5 * s.stiffness * (q[s.qpos_adr] - s.rest).powi(2)).sum()
     }
     /// Neutral configuration (zeros, identity quaternions).
@@ -354,7 +363,23 @@ pub fn dof_run_starts(dof_parent: &[usize]) -> Vec<usize> {
 pub const MAX_CONTACTS: usize = 500;
 
 /// `q ← q ⊕ v·dt` for the whole configuration (MuJoCo's `mj_integratePos`).
-pub fn integrate_configuration(model: &Model, q: &mut [f64], v: &[f64], dt: f64) {
+///
+/// # Errors
+/// [`InputError::Length`](crate::error::InputError) when q is not nq long or v not nv long.
+pub fn integrate_configuration(
+    model: &Model,
+    q: &mut [f64],
+    v: &[f64],
+    dt: f64,
+) -> Result<(), crate::error::InputError> {
+    crate::error::check::q("integrate_configuration", model, q)?;
+    crate::error::check::v("integrate_configuration", "v", model, v)?;
+    integrate_configuration_unchecked(model, q, v, dt);
+    Ok(())
+}
+
+/// [`integrate_configuration`] without the length checks.
+pub(crate) fn integrate_configuration_unchecked(model: &Model, q: &mut [f64], v: &[f64], dt: f64) {
     for j in &model.joints {
         let (qa, va) = (j.qpos_adr, j.dof_adr);
         j.kind.integrate(&mut q[qa..qa + j.kind.nq()], &v[va..va + j.kind.nv()], dt);
@@ -365,7 +390,24 @@ pub fn integrate_configuration(model: &Model, q: &mut [f64], v: &[f64], dt: f64)
 /// increment θ of `q0 ⊕ θ` when the joint velocity at that configuration is `v`
 /// ([`JointKind::dexp_inv`]); the Runge–Kutta–Munthe-Kaas stages of
 /// the integrators use it.
-pub fn dexp_inv_configuration(model: &Model, theta: &[f64], v: &[f64], out: &mut [f64]) {
+///
+/// # Errors
+/// [`InputError::Length`](crate::error::InputError) when theta, v or out is not nv long.
+pub fn dexp_inv_configuration(
+    model: &Model,
+    theta: &[f64],
+    v: &[f64],
+    out: &mut [f64],
+) -> Result<(), crate::error::InputError> {
+    crate::error::check::v("dexp_inv_configuration", "theta", model, theta)?;
+    crate::error::check::v("dexp_inv_configuration", "v", model, v)?;
+    crate::error::check::v("dexp_inv_configuration", "out", model, out)?;
+    dexp_inv_configuration_unchecked(model, theta, v, out);
+    Ok(())
+}
+
+/// [`dexp_inv_configuration`] without the length checks.
+pub(crate) fn dexp_inv_configuration_unchecked(model: &Model, theta: &[f64], v: &[f64], out: &mut [f64]) {
     for j in &model.joints {
         let (va, nv) = (j.dof_adr, j.kind.nv());
         j.kind.dexp_inv(&theta[va..va + nv], &v[va..va + nv], &mut out[va..va + nv]);
@@ -373,7 +415,25 @@ pub fn dexp_inv_configuration(model: &Model, theta: &[f64], v: &[f64], out: &mut
 }
 
 /// The tangent `v` (length nv) with `q0 ⊕ v = q1`.
-pub fn difference_configuration(model: &Model, q0: &[f64], q1: &[f64], v: &mut [f64]) {
+///
+/// # Errors
+/// [`InputError::Length`](crate::error::InputError) when q0 or q1 is not nq long or v not nv
+/// long.
+pub fn difference_configuration(
+    model: &Model,
+    q0: &[f64],
+    q1: &[f64],
+    v: &mut [f64],
+) -> Result<(), crate::error::InputError> {
+    crate::error::InputError::check_len("difference_configuration", "q0", q0.len(), model.nq, "nq")?;
+    crate::error::InputError::check_len("difference_configuration", "q1", q1.len(), model.nq, "nq")?;
+    crate::error::check::v("difference_configuration", "v", model, v)?;
+    difference_configuration_unchecked(model, q0, q1, v);
+    Ok(())
+}
+
+/// [`difference_configuration`] without the length checks.
+pub(crate) fn difference_configuration_unchecked(model: &Model, q0: &[f64], q1: &[f64], v: &mut [f64]) {
     for j in &model.joints {
         let (qa, va) = (j.qpos_adr, j.dof_adr);
         let (nq, nv) = (j.kind.nq(), j.kind.nv());

@@ -11,7 +11,7 @@
 //! second-order cone and its projection has a closed form.
 
 use super::primal::Settings;
-use crate::dynamics::solve_with_factor;
+use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, EfcType, Model};
 use nalgebra::DMatrix;
 
@@ -186,7 +186,7 @@ pub fn solve_pgs(model: &Model, data: &mut Data, s: Settings) {
         for k in 0..nv {
             col[k] = data.efc_j[(i, k)];
         }
-        solve_with_factor(model, &data.mass_factor, data.soft.minv_jt.column_mut(i).as_mut_slice());
+        solve_with_factor_unchecked(model, &data.mass_factor, data.soft.minv_jt.column_mut(i).as_mut_slice());
     }
     for i in 0..n {
         for j in 0..=i {

@@ -15,7 +15,7 @@
 
 use super::cost::Rows;
 use crate::constraint::dense::{cholesky, cholesky_solve};
-use crate::dynamics::solve_with_factor;
+use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, Model};
 use nalgebra::{DMatrix, DVector};
 
@@ -187,13 +187,13 @@ pub fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings)
                 if cholesky(&soft.hessian, nv, &mut soft.factor, 0.0) {
                     cholesky_solve(&soft.factor, nv, soft.dir.as_mut_slice());
                 } else {
-                    solve_with_factor(model, mass_factor, soft.dir.as_mut_slice());
+                    solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
                 }
                 soft.dir.neg_mut();
             }
             Primal::Cg => {
                 soft.mgrad.copy_from(&soft.grad);
-                solve_with_factor(model, mass_factor, soft.mgrad.as_mut_slice());
+                solve_with_factor_unchecked(model, mass_factor, soft.mgrad.as_mut_slice());
                 let beta = if have_dir {
                     let den = soft.grad_prev.dot(&soft.mgrad_prev);
                     let num: f64 = (0..nv).map(|k| soft.grad[k] * (soft.mgrad[k] - soft.mgrad_prev[k])).sum();

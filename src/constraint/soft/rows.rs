@@ -21,7 +21,7 @@ use crate::constraint::contact::add_contact_jacobian;
 use crate::constraint::limits::{ball_angle_axis, LimitKind, LimitRow};
 use crate::constraint::rows::{point_motion, RowGeometry};
 use crate::constraint::ConstraintModel;
-use crate::kinematics::bias_accelerations;
+use crate::kinematics::bias_accelerations_unchecked;
 use crate::model::{options::Cone, Data, EfcType, Model, TendonKind};
 use crate::spatial::{Mat3, Transform, Vec3};
 
@@ -256,7 +256,7 @@ pub fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Data, v: 
     if data.ne == 0 {
         return;
     }
-    bias_accelerations(model, data, v);
+    bias_accelerations_unchecked(model, data, v);
     let mut r = 0;
     for e in &cm.equalities {
         if !data.eq_active[e.id] {

@@ -11,8 +11,8 @@
 //! - `tendon_invweight0`: J_t M⁻¹ J_tᵀ of a fixed tendon;
 //! - `meaninertia`: the mean of M's diagonal at `qpos0`, which scales the solvers' tolerance.
 
-use crate::dynamics::{crba, factorize_mass_matrix, solve_with_factor};
-use crate::kinematics::{for_each_ancestor_dof, forward_kinematics};
+use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
+use crate::kinematics::{for_each_ancestor_dof, forward_kinematics_unchecked};
 use crate::model::{Data, FrameKind, JointKind, Model, TendonKind};
 use crate::spatial::Vec3;
 
@@ -34,13 +34,13 @@ impl InverseWeights {
     pub fn new(model: &Model) -> Self {
         let nv = model.nv;
         let mut data = Data::new(model);
-        forward_kinematics(model, &mut data, &model.qpos0);
-        crba(model, &mut data, &model.qpos0);
+        forward_kinematics_unchecked(model, &mut data, &model.qpos0);
+        crba_unchecked(model, &mut data, &model.qpos0);
         factorize_mass_matrix(model, &mut data);
         let meaninertia =
             if nv > 0 { (0..nv).map(|k| data.mass_matrix[(k, k)]).sum::<f64>() / nv as f64 } else { 1.0 };
         // x ↦ M⁻¹ x with the factor at qpos0.
-        let solve = |x: &mut [f64]| solve_with_factor(model, &data.mass_factor, x);
+        let solve = |x: &mut [f64]| solve_with_factor_unchecked(model, &data.mass_factor, x);
         let quadratic = |rows: &[Vec<f64>]| -> Vec<f64> {
             rows.iter()
                 .map(|r| {

@@ -123,13 +123,13 @@ pub fn run(path: &Path, options: &LoadOptions, states_file: &Path, robot: &str) 
     );
     let mut x = DVector::zeros(nv);
     for (s, st) in states.iter().enumerate().take(4) {
-        emit_check(robot, "rnea", s, rnea(&model, &mut data, &st.q, &st.v, &st.a).as_slice());
-        emit_check(robot, "crba", s, crba(&model, &mut data, &st.q).as_slice());
+        emit_check(robot, "rnea", s, rnea(&model, &mut data, &st.q, &st.v, &st.a)?.as_slice());
+        emit_check(robot, "crba", s, crba(&model, &mut data, &st.q)?.as_slice());
         factorize_mass_matrix(&model, &mut data);
         x.copy_from_slice(&st.tau);
-        solve_mass_matrix(&model, &data, &mut x);
+        solve_mass_matrix(&model, &data, &mut x)?;
         emit_check(robot, "solve", s, x.as_slice());
-        emit_check(robot, "aba", s, aba(&model, &mut data, &st.q, &st.v, &st.tau).as_slice());
+        emit_check(robot, "aba", s, aba(&model, &mut data, &st.q, &st.v, &st.tau)?.as_slice());
     }
     let none = |_: &mut Data, _: usize| {};
     let last_frame = model.frames.len().checked_sub(1);
@@ -147,17 +147,22 @@ pub fn run(path: &Path, options: &LoadOptions, states_file: &Path, robot: &str) 
             .map_err(|_| CliError::Usage(format!("bench-native: not a budget in ms: {budget}")))?;
         let us = match op {
             "fk" => time_op(&mut data, n, budget_ms, none, |d, s| {
-                forward_kinematics(m, d, &st[s].q);
-                last_frame.map_or(0.0, |f| d.x_world_frame[f].pos[0])
+                // The states' sizes were checked by the calls above: a NaN result would show an error.
+                match forward_kinematics(m, d, &st[s].q) {
+                    Ok(()) => last_frame.map_or(0.0, |f| d.x_world_frame[f].pos[0]),
+                    Err(_) => f64::NAN,
+                }
             }),
-            "rnea" => {
-                time_op(&mut data, n, budget_ms, none, |d, s| rnea(m, d, &st[s].q, &st[s].v, &st[s].a)[0])
-            }
+            "rnea" => time_op(&mut data, n, budget_ms, none, |d, s| {
+                rnea(m, d, &st[s].q, &st[s].v, &st[s].a).map_or(f64::NAN, |t| t[0])
+            }),
             // The upper triangle, as Pinocchio's `crba` computes it (the check above compares the full M).
-            "crba" => time_op(&mut data, n, budget_ms, none, |d, s| crba_upper(m, d, &st[s].q)[(0, nv - 1)]),
-            "aba" => {
-                time_op(&mut data, n, budget_ms, none, |d, s| aba(m, d, &st[s].q, &st[s].v, &st[s].tau)[0])
-            }
+            "crba" => time_op(&mut data, n, budget_ms, none, |d, s| {
+                crba_upper(m, d, &st[s].q).map_or(f64::NAN, |mm| mm[(0, nv - 1)])
+            }),
+            "aba" => time_op(&mut data, n, budget_ms, none, |d, s| {
+                aba(m, d, &st[s].q, &st[s].v, &st[s].tau).map_or(f64::NAN, |a| a[0])
+            }),
             // Factor + solve of the M of one state per batch (CRBA untimed), one right-hand side
             // per call.
             "factor_solve" => time_op(
@@ -165,13 +170,12 @@ pub fn run(path: &Path, options: &LoadOptions, states_file: &Path, robot: &str) 
                 n,
                 budget_ms,
                 |(d, _), s| {
-                    crba(m, d, &st[s].q);
+                    let _ = crba(m, d, &st[s].q);
                 },
                 |(d, x), s| {
                     x.copy_from_slice(&st[s].tau);
                     factorize_mass_matrix(m, d);
-                    solve_mass_matrix(m, d, x);
-                    x[0]
+                    solve_mass_matrix(m, d, x).map_or(f64::NAN, |()| x[0])
                 },
             ),
             _ => return Err(CliError::Usage(format!("bench-native: unknown operation {op}"))),

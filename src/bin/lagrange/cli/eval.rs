@@ -44,15 +44,15 @@ fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
 
 /// Evaluates one state: M, bias, qacc, poses of every frame, energies, com, and the requested
 /// frame Jacobians (world-aligned).
-pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]) -> Value {
+pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]) -> Result<Value, CliError> {
     let zeros = vec![0.0; model.nv];
     let v = s.v.as_deref().unwrap_or(&zeros);
     let tau = s.tau.as_deref().unwrap_or(&zeros);
-    let m = rows(crba(model, data, &s.q));
-    let bias: Vec<f64> = bias_forces(model, data, &s.q, v).iter().copied().collect();
-    let qacc: Vec<f64> = aba(model, data, &s.q, v, tau).iter().copied().collect();
-    let kinetic = kinetic_energy(model, data, &s.q, v);
-    forward_kinematics(model, data, &s.q);
+    let m = rows(crba(model, data, &s.q)?);
+    let bias: Vec<f64> = bias_forces(model, data, &s.q, v)?.iter().copied().collect();
+    let qacc: Vec<f64> = aba(model, data, &s.q, v, tau)?.iter().copied().collect();
+    let kinetic = kinetic_energy(model, data, &s.q, v)?;
+    forward_kinematics(model, data, &s.q)?;
     let potential = potential_energy(model, data);
     let com = center_of_mass(model, data);
     // Links/bodies (and joint-anchor frames) in "poses", MJCF sites in "sites": MuJoCo keeps
@@ -71,13 +71,13 @@ pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]
         let mut jac = DMatrix::zeros(6, model.nv);
         let mut jmap = Map::new();
         for &f in jacobians {
-            frame_jacobian(model, data, f, ReferenceFrame::LocalWorldAligned, &mut jac);
+            frame_jacobian(model, data, f, ReferenceFrame::LocalWorldAligned, &mut jac)?;
             jmap.insert(model.frames[f].name.clone(), json!(rows(&jac)));
         }
         out["jacobians"] = Value::Object(jmap);
     }
     out["forward"] = forward_json(model, data, s, v, tau);
-    out
+    Ok(out)
 }
 
 /// The staged forward pipeline at the state: `qacc` (constrained), its parts, and one entry per
@@ -261,7 +261,7 @@ pub fn run(
     let mut results = Vec::with_capacity(input.states.len());
     for (i, s) in input.states.iter().enumerate() {
         check_state(&model, &file, i, s)?;
-        results.push(evaluate(&model, &mut data, s, &frame_ids));
+        results.push(evaluate(&model, &mut data, s, &frame_ids)?);
     }
     let out = json!({ "results": results, "constraints": {"mode": model.plan.mode().name(), "reason": model.plan.mode_reason} });
     println!("{}", serde_json::to_string(&out).expect("JSON values serialize"));

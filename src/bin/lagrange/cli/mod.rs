@@ -19,6 +19,8 @@ pub enum CliError {
     Load(#[from] lagrange::io::LoadError),
     #[error(transparent)]
     Sim(#[from] lagrange::sim::SimError),
+    #[error(transparent)]
+    Api(#[from] lagrange::error::InputError),
     #[error("{file}: {detail}")]
     Input { file: String, detail: String },
     #[error("{0}")]

@@ -366,7 +366,10 @@ fn state_error(
     v: &DVector<f64>,
     dq: &mut [f64],
 ) -> (f64, f64) {
-    difference_configuration(model, q_ref.as_slice(), q.as_slice(), dq);
+    // The reference and the run are states of the same model: the lengths agree.
+    if difference_configuration(model, q_ref.as_slice(), q.as_slice(), dq).is_err() {
+        return (f64::NAN, f64::NAN);
+    }
     let mut max: f64 = 0.0;
     for j in &model.joints {
         let d = &dq[j.dof_adr..j.dof_adr + j.kind.nv()];
