@@ -1,4 +1,4 @@
-//! PD tracking through the controller callback of [`Simulation`] (issue 13).
+//! PD tracking through the controller callback of [`Simulation`].
 //!
 //! 1. An MJCF two-link arm with motor actuators: `set_controller` writes the controls (motor
 //!    torques, clamped by MuJoCo's `ctrlrange`) from a PD law tracking a sinusoid on each joint.

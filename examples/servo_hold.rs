@@ -1,4 +1,4 @@
-//! Actuators with activation state (issue 13): an `intvelocity` servo — MuJoCo's integrated-
+//! Actuators with activation state: an `intvelocity` servo — MuJoCo's integrated-
 //! velocity position servo, whose setpoint is the activation `act` — and a `position` servo with
 //! a `timeconst` (a filterexact low-pass on its target) on a two-link arm under gravity.
 //!

@@ -1,5 +1,5 @@
 //! Runs N steps of one integrator (or N ABA calls) on a model, for counting instructions per step
-//! with callgrind (issue 15 item 4; `validation/step_cost.sh` runs it at two N and takes the
+//! with callgrind (`validation/step_cost.sh` runs it at two N and takes the
 //! difference, so loading and warm-up cancel):
 //!
 //!     cargo run --release --example step_cost -- MODEL {aba|euler|rk4|implicit|implicitfast|variational|variational:TOL|adaptive} N [TILT]

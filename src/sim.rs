@@ -1,4 +1,4 @@
-//! The simulation (DESIGN.md, layer 10): a model behind `Arc`, its [`Data`] (the state, the
+//! The simulation (docs/architecture.md, "Layers"): a model behind `Arc`, its [`Data`] (the state, the
 //! controls and every buffer), a [`Stepper`] and the controllers. The model's `<option>` timestep and integrator are
 //! honoured unless the caller overrides them ([`SimOptions`]); a non-finite state is reported with
 //! the step, time and joint, never propagated.

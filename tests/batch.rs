@@ -1,4 +1,4 @@
-//! Batch rollouts (issue 14, item 4): a batch over several threads equals the same rollouts run
+//! Batch rollouts: a batch over several threads equals the same rollouts run
 //! one after the other, bit for bit, in input order; a bad item reports its error in its place.
 
 use lagrange::batch::{rollout, rollout_models, BatchOptions, InitialState, Rollout};

@@ -1,4 +1,4 @@
-//! Regression tests for issue 16's compatibility bug classes and fuzzing findings, each built from
+//! Regression tests for compatibility bug classes and fuzzing findings, each built from
 //! a small hand-made file (tests/data/compat/ or generated here): load what MuJoCo and Pinocchio
 //! load, refuse only what they refuse — with file, line, element and fix — and never panic, hang,
 //! or load NaN.

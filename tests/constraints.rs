@@ -27,9 +27,9 @@ fn model(path: &str) -> Model {
     model
 }
 
-/// Notes §1.6: the point mass in polar coordinates (θ hinge, r slide) held at r = l by the
-/// equality r − l = 0. Its multiplier is the rod tension λ = −m r θ̇² − m g cos θ (the notes'
-/// sign: negative = the rod pulls the mass inwards), at 20 states.
+/// docs/physics.md §1.6: the point mass in polar coordinates (θ hinge, r slide) held at r = l by the
+/// equality r − l = 0. Its multiplier is the rod tension λ = −m r θ̇² − m g cos θ (the sign of
+/// docs/physics.md: negative = the rod pulls the mass inwards), at 20 states.
 #[test]
 fn rod_tension_is_the_lagrange_multiplier_notes_1_6() {
     let model = model("models/textbook/rod_pendulum.xml");
@@ -53,7 +53,7 @@ fn rod_tension_is_the_lagrange_multiplier_notes_1_6() {
         assert!(data.qacc[1].abs() <= CONSTRAINT_REL * (tension.abs() / m), "r̈ = {}", data.qacc[1]);
         worst = worst.max(err);
     }
-    println!("rod tension vs notes §1.6 at 20 states: max rel err {worst:.2e}");
+    println!("rod tension vs docs/physics.md §1.6 at 20 states: max rel err {worst:.2e}");
 }
 
 /// Notes §1.4: the pendulum on a movable support, built as cart and pendulum on their own slides

@@ -1,4 +1,4 @@
-//! Frictional contact in exact mode against the closed forms of notes §2.5 (a cylinder rolling or
+//! Frictional contact in exact mode against the closed forms of docs/physics.md §2.5 (a cylinder rolling or
 //! sliding down an incline, the critical friction coefficient), statics of a box on an incline,
 //! inelastic impacts of dropped bodies, and the go1 quadruped settling on its floor.
 

@@ -1,4 +1,4 @@
-//! Controls in the API (issue 13, items 3 and 4): the controller callbacks of `Simulation` (a
+//! Controls in the API: the controller callbacks of `Simulation` (a
 //! zero-order hold, called once per step) and the URDF effort limits of `--clamp-effort`.
 
 use lagrange::integrate::IntegratorKind;

@@ -1,4 +1,4 @@
-//! Algorithms checked against each other (DESIGN.md, "Truth"): ABA against the mass matrix, RNEA
+//! Algorithms checked against each other (docs/architecture.md, "Truth"): ABA against the mass matrix, RNEA
 //! against ABA, CRBA against RNEA columns, Jacobians against propagated velocities and against
 //! finite differences of forward kinematics, the energy balance dE/dt = τ·v, momentum, and a free
 //! rigid body against Euler's equations. On random trees covering every joint type and on the four

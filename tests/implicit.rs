@@ -1,4 +1,4 @@
-//! MuJoCo's `implicit` and `implicitfast` integrators (issue 15) on damped passive scenes. First
+//! MuJoCo's `implicit` and `implicitfast` integrators on damped passive scenes. First
 //! implicitfast on
 //! `models/textbook/damped_double_pendulum.xml` (its `<option integrator="implicitfast">`
 //! selects it): 100 steps of 0.01 s from q = (1, −0.5) at rest against MuJoCo 4.0.0's `mj_step`,

@@ -1,4 +1,4 @@
-//! Convergence order of every integrator on quaternion joints (issue 15): a heavy symmetric top on
+//! Convergence order of every integrator on quaternion joints: a heavy symmetric top on
 //! a ball joint and a free tumbling asymmetric body (`models/textbook/`). Each integrator runs to
 //! the same final time at three step sizes h, h/2, h/4; the error against a fine RK4 reference
 //! (h_ref = 0.004 s / 32, whose own error is ≥ 32⁴ ≈ 1e6 times below RK4's smallest) is the max-norm

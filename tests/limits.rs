@@ -75,7 +75,7 @@ fn impact_on_a_limit_is_inelastic() {
     assert!(sim.data.qvel[0].abs() <= 1e-9, "at rest on the bound: v = {}", sim.data.qvel[0]);
 }
 
-/// The UR5 released under gravity (notes-free: the scene) stays within its joint limits
+/// The UR5 released under gravity stays within its joint limits
 /// for 10 s, with the limits reached.
 #[test]
 fn ur5_stays_within_its_joint_limits() {

@@ -449,7 +449,7 @@ fn chain(joints: &[(&str, &str, &str)]) -> String {
 
 #[test]
 fn mimic_of_an_undefined_joint_is_an_error() {
-    // urdfdom and Pinocchio ignore such a mimic; issue 10 makes it an error (an intended coupling
+    // urdfdom and Pinocchio ignore such a mimic; lagrange makes it an error (an intended coupling
     // silently lost is a different robot).
     let text = chain(&[("a", "revolute", ""), ("j", "revolute", "    <mimic joint=\"nope\"/>")]);
     let (e, file) = load_err("mimic_undefined", &text);

@@ -267,7 +267,7 @@ const NS: [usize; 5] = [8, 16, 32, 64, 128];
 
 #[test]
 fn solid_hemisphere_centre_of_mass_eq37() {
-    // z_CM = 3a/8 (notes eq. 37).
+    // z_CM = 3a/8 (docs/physics.md (37)).
     let a = 0.7;
     let e = assert_second_order("solid hemisphere z_CM = 3a/8 (eq. 37)", &NS, 3.0 * a / 8.0, |n| {
         props(&solid_hemisphere(a, n), MeshInertia::Exact, "hemisphere").1.com().z
@@ -397,7 +397,7 @@ fn rod_disk_and_perpendicular_axis_eq51_eq52_eq54() {
 
 #[test]
 fn square_plate_about_centre_and_corner_section_3_1() {
-    // A uniform l × l plate (notes §3.1): about its centre (ml²/12) diag(1, 1, 2); about a corner
+    // A uniform l × l plate (docs/physics.md §3.1): about its centre (ml²/12) diag(1, 1, 2); about a corner
     // with x, y along the edges (ml²/12) [[4, −3, 0], [−3, 4, 0], [0, 0, 8]].
     let l = 0.8;
     let plate =
@@ -575,8 +575,8 @@ fn exact_legacy_and_convex_differ_as_documented() {
 #[test]
 fn moved_mesh_gives_transformed_properties() {
     // A real, asymmetric mesh (Barkour's upper leg, 2.7k triangles) in every mode, moved by random
-    // rigid transformations: the properties of the moved mesh are the moved properties (notes eq.
-    // 56 for the shift, eq. 81 for the rotation, through RigidInertia::transformed).
+    // rigid transformations: the properties of the moved mesh are the moved properties (docs/physics.md
+    // (56) for the shift, §3.2 for the rotation, through RigidInertia::transformed).
     let mesh = read_mesh(&mesh_file("mujoco/google_barkour_vb/upper_leg.stl"), &Vec3::repeat(1.0)).unwrap();
     let size = mesh.diameter();
     let mut rng = common::rng(4242);

@@ -1,4 +1,4 @@
-//! Memory discipline (DESIGN.md, "Style"): once `Data` exists, the kinematics and dynamics
+//! Memory discipline (docs/architecture.md, "Errors"): once `Data` exists, the kinematics and dynamics
 //! kernels and the integrators perform zero heap allocations. A counting global allocator counts
 //! the allocations this thread makes while the kernels run.
 

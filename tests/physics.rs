@@ -225,7 +225,7 @@ fn large_amplitude_pendulum_period_converges_at_integrator_order() {
 }
 
 /// Double pendulum: M(q) and g(q) against the closed-form Lagrangian of two point masses
-/// (notes §1.3: T and V in generalized coordinates), q = [θ1, φ2] with φ2 relative.
+/// (docs/physics.md §1.3: T and V in generalized coordinates), q = [θ1, φ2] with φ2 relative.
 #[test]
 fn double_pendulum_mass_matrix_and_gravity_closed_form() {
     let (m1, m2, l1, l2) = (1.0, 0.5, 1.0, 0.7);

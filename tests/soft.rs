@@ -1,6 +1,6 @@
 //! The soft (MuJoCo-compatible) constraint mode against MuJoCo 4.0 (golden data of
 //! `validation/mujoco_soft_golden.py`: `mj_forward` at keyframes, snapshots of MuJoCo's own
-//! simulation and perturbations of them; the rolling cylinder of notes §2.5 stepped by MuJoCo's
+//! simulation and perturbations of them; the rolling cylinder of docs/physics.md §2.5 stepped by MuJoCo's
 //! Euler), the impedance function of MuJoCo's documentation ("Computation → Soft constraints"),
 //! and the three solvers against each other. The live, row-by-row comparison is
 //! `validation/crossval_soft.py` (in `.ci/run`).
@@ -165,7 +165,7 @@ fn mjcf_defaults_to_soft_and_urdf_to_exact() {
     assert_eq!((r.mode(), r.mode_reason.as_str()), (ConstraintMode::Exact, "exact requested"));
 }
 
-/// Issue 13's standing robot in soft mode: go1 from keyframe `home`, holding the keyframe's
+/// The standing robot in soft mode: go1 from keyframe `home`, holding the keyframe's
 /// position-servo controls, 5 s with the scene's own options (Euler, 2 ms, Newton). MuJoCo 4.0.0
 /// (`mj_resetDataKeyframe`, 2500 × `mj_step`) ends with the base at 0.2648645591 m.
 #[test]
@@ -189,7 +189,7 @@ fn go1_stands_on_its_servos_as_in_mujoco() {
         "go1 base after 5 s: {z:.10} m, MuJoCo {MUJOCO_HEIGHT} m, difference {:.2e} m",
         z - MUJOCO_HEIGHT
     );
-    assert!((z - MUJOCO_HEIGHT).abs() < 0.01, "issue 13: within 1 cm of MuJoCo's; got {z}");
+    assert!((z - MUJOCO_HEIGHT).abs() < 0.01, "within 1 cm of MuJoCo's; got {z}");
     assert!(sim.data.qvel.amax() < 1e-2, "standing still: |v| = {}", sim.data.qvel.amax());
 }
 

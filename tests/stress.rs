@@ -1,5 +1,4 @@
-//! The stress suite of issue 15, from the lecture notes (`../shared/reference/
-//! classical-mechanics-notes.md`, §3.3–3.7) and the integrators' stability: long runs, chaos and
+//! The stress suite: the rigid bodies of `docs/physics.md` §3.3–3.7 and the integrators' stability: long runs, chaos and
 //! stiffness on the scenes of `models/textbook/`. Each test names its integrator, step and
 //! tolerance; each prints what it measured (run with `--nocapture` for the tables).
 
@@ -178,13 +177,13 @@ impl Top {
     const IS: f64 = 0.008;
 
     /// The state tilted by θ about x (Euler angles φ = ψ = 0) with θ̇ = 0, precession rate φ̇ and
-    /// spin S = φ̇ cos θ + ψ̇ (notes eq. 94: body ω = (θ̇, φ̇ sin θ, S)).
+    /// spin S = φ̇ cos θ + ψ̇ (docs/physics.md (94): body ω = (θ̇, φ̇ sin θ, S)).
     fn state(theta: f64, phi_dot: f64, spin: f64) -> ([f64; 4], [f64; 3]) {
         let h = 0.5 * theta;
         ([h.cos(), h.sin(), 0.0, 0.0], [0.0, phi_dot * theta.sin(), spin])
     }
 
-    /// The critical spin of the sleeping top, notes eq. 109: S = 2 √(m g l I) / I_s.
+    /// The critical spin of the sleeping top, docs/physics.md (109): S = 2 √(m g l I) / I_s.
     fn sleeping_threshold() -> f64 {
         2.0 * (Self::MGL * Self::I).sqrt() / Self::IS
     }

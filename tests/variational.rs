@@ -1,4 +1,4 @@
-//! The variational integrator (issue 15; `src/integrate/variational.rs`): its Lagrangian terms
+//! The variational integrator (`src/integrate/variational.rs`): its Lagrangian terms
 //! against CRBA, RNEA and finite differences; momentum conservation (Noether) on a free body and
 //! on a constrained loop; the equality constraints held to the solver tolerance; the error of a
 //! Newton iteration that does not converge. Its order on ball and free joints is in

@@ -2,7 +2,7 @@
 ("slots"), random states, relative errors and the tolerances.
 
 Every engine (lagrange, MuJoCo, Pinocchio) is driven in ONE set of coordinates, the *canonical*
-layout: lagrange's, which is MuJoCo's qpos/qvel layout (DESIGN.md, "Conventions"):
+layout: lagrange's, which is MuJoCo's qpos/qvel layout (docs/architecture.md, "Conventions"):
 
 - free joint  q = [x y z qw qx qy qz], v = [world-frame linear velocity of the body origin,
   body-frame angular velocity];
@@ -25,7 +25,7 @@ import numpy as np
 # Tolerances and the relative error (the same definition as tests/common/mod.rs)
 # ---------------------------------------------------------------------------------------------
 
-#: Agreement required against a reference (DESIGN.md "Truth"; tests/common/mod.rs REF_REL).
+#: Agreement required against a reference (docs/architecture.md "Truth"; tests/common/mod.rs REF_REL).
 REF_REL = 1e-9
 
 #: Floor of the relative error's denominator: only turns 0/0 into 0 (tests/common REL_FLOOR).

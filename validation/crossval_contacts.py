@@ -5,7 +5,7 @@ constrained dynamics and a rigid KKT solve on MuJoCo's own quantities.
 Scenes (MJCF, floors and inclines): the Menagerie go1 on its floor (a copy with the feet at
 condim 3, point contacts with sliding friction, since Pinocchio's point contacts have no
 torsional or rolling friction), the textbook box resting on a 20° incline (four corners), and the
-textbook cylinder on a 30° incline (notes §2.5). Each is evaluated at rest (v = 0) at states where
+textbook cylinder on a 30° incline (docs/physics.md §2.5). Each is evaluated at rest (v = 0) at states where
 its contacts touch exactly: the go1 at its home keyframe with random joint perturbations, the base
 height and tilt and one knee solved so that all four feet touch the floor.
 

@@ -8,7 +8,7 @@ element (contacts by geom pair and position):
 
 - the rows themselves: efc_pos, efc_margin, efc_diagA, efc_R, efc_aref (relative, 1e-9);
 - the solution: qacc and efc_force (relative to their largest entry, 1e-6: the solver's
-  tolerance, DESIGN.md "Truth" and issue 12);
+  tolerance, docs/architecture.md "Truth" and issue 12);
 - contact geometry for primitive pairs: position, normal and distance (absolute, 1e-9 m); scenes
   with mesh contacts 1e-7 m, and 1e-4 on the rows (MuJoCo keeps mesh vertices in single precision).
 
@@ -67,7 +67,7 @@ def scenes(mj_corpus: Path | None) -> list[tuple[str, Path]]:
     out = [
         ("go1 (scene.xml: elliptic, impratio 100, limits, friction loss)", m / "mjcf/unitree_go1/scene.xml"),
         ("humanoid (dm_control: pyramidal, limits)", m / "mjcf/humanoid/humanoid.xml"),
-        ("incline_cylinder (notes §2.5)", m / "textbook/incline_cylinder.xml"),
+        ("incline_cylinder (docs/physics.md §2.5)", m / "textbook/incline_cylinder.xml"),
         ("incline_box", m / "textbook/incline_box.xml"),
         ("drop", m / "textbook/drop.xml"),
         ("rod_pendulum (connect)", m / "textbook/rod_pendulum.xml"),

@@ -3,7 +3,7 @@
 For each scene, MuJoCo 4.0's mj_forward (Newton, tolerance 1e-15, 1000 iterations, ls_tolerance
 1e-12, dense Jacobians: the tight copy of validation/crossval_soft.py) at the states of
 crossval_soft.random_states: qacc, qacc_smooth, qfrc_constraint and nefc. Plus the rolling
-cylinder of notes §2.5 (models/textbook/incline_cylinder.xml) stepped by MuJoCo's Euler for
+cylinder of docs/physics.md §2.5 (models/textbook/incline_cylinder.xml) stepped by MuJoCo's Euler for
 500 steps from rest: the distance travelled along the incline. Regenerate with
   validation/.venv/bin/python validation/mujoco_soft_golden.py
 (the files say they are generated).
@@ -54,7 +54,7 @@ def main():
                "states": states}
         (OUT / f"{name}.json").write_text(json.dumps(doc) + "\n")
         print(name, len(states), "states, nefc", [s["nefc"] for s in states])
-    # Rolling cylinder (notes §2.5): 500 Euler steps from rest.
+    # Rolling cylinder (docs/physics.md §2.5): 500 Euler steps from rest.
     copy = cs.tight_copy(ROOT / "models/textbook/incline_cylinder.xml")
     try:
         m = mj.MjModel.from_xml_path(str(copy))

@@ -1,4 +1,4 @@
-//! `lagrange-fuzz`: a stable-Rust mutation fuzzer for the loaders (issue 16, item 3).
+//! `lagrange-fuzz`: a stable-Rust mutation fuzzer for the loaders.
 //!
 //! One target per input format (URDF, MJCF with includes, STL, OBJ, MSH); each execution mutates a
 //! seed from `models/` and `tests/data/` (see `mutate.rs`) and drives load → compile → one

@@ -1,4 +1,4 @@
-//! The collision layer (DESIGN.md, layer 6): for the candidate pairs fixed at compile time
+//! The collision layer (docs/architecture.md, "Layers"): for the candidate pairs fixed at compile time
 //! (`Model::collision_pairs`, see [`crate::model::collision_pairs`]) the contacts at the current
 //! body poses, written into `Data::contacts` in MuJoCo's form (`mjContact`: position midway
 //! between the surfaces, frame with the normal first pointing from geom 1 to geom 2, signed

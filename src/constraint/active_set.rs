@@ -20,7 +20,7 @@ pub(crate) fn solve_delassus(data: &mut Data) -> usize {
 /// The mixed complementarity problem of bilateral and unilateral rows on A = J M⁻¹ Jᵀ (in
 /// `efc_delassus`) with b in `efc_rhs`: find μ with w = A μ − b and, per row, w = 0 (bilateral),
 /// or μ ≥ 0, w ≥ 0, μ w = 0 (unilateral: joint limits) — the KKT conditions of Signorini's law
-/// (notes §1.6 with inequality constraints; Cottle, Pang & Stone, *The Linear Complementarity
+/// (docs/physics.md §1.6 with inequality constraints; Cottle, Pang & Stone, *The Linear Complementarity
 /// Problem*, §4.1, the principal pivoting / active-set method). Unilateral rows whose `skip` is
 /// true (separating at the acceleration level) carry no force. Solves each active set exactly
 /// (minimum-norm for redundant rows), dropping the most negative force or adding the most violated

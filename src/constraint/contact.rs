@@ -13,7 +13,7 @@
 //!
 //! with v_b(p) the velocity of the material point of body b at p. The friction rows' forces lie in
 //! the elliptic Coulomb cone Σ (λ_i / μ_i)² ≤ λ_n² with μ = `friction` (sliding, sliding,
-//! torsional, rolling, rolling) — Coulomb's law of notes §2.5 ("the surface can only provide a
+//! torsional, rolling, rolling) — Coulomb's law of docs/physics.md §2.5 ("the surface can only provide a
 //! force not larger than μ F_N"), extended to torsion and rolling as MuJoCo does.
 //!
 //! J̇v: the gap and slip of two smooth surfaces change with the motion of the contact point over

@@ -18,7 +18,7 @@
 //!   w_f ∝ −λ_i/μ_i²), by the stick solve or, when that leaves the cone, Newton on the secular
 //!   equation ‖(Ã + νI)⁻¹ g̃‖ = λ_n of the scaled problem (Moré & Sorensen 1983).
 //!
-//! A fixed point satisfies Signorini's and Coulomb's laws exactly (notes §2.5: F_P ≤ μ F_N, and
+//! A fixed point satisfies Signorini's and Coulomb's laws exactly (docs/physics.md §2.5: F_P ≤ μ F_N, and
 //! F_P = μ F_N while slipping). The iteration stops when a sweep changes the motion, M⁻¹Jᵀ Δλ
 //! (an acceleration, or a velocity at the velocity level), by less than the tolerance relative to
 //! the constraints' whole correction M⁻¹Jᵀ λ — redundant rows that still trade force among

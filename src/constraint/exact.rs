@@ -1,5 +1,5 @@
 //! The exact (rigid) constraint solver: the KKT system of Lagrangian mechanics with multipliers
-//! (notes §1.6, eq. 20: M q̈ + c − τ = Jᵀλ together with the acceleration form of the constraints,
+//! (docs/physics.md §1.6, eq. 20: M q̈ + c − τ = Jᵀλ together with the acceleration form of the constraints,
 //! J q̈ + J̇v = 0), solved by the range-space method with the tree-sparse LᵀDL factor of M
 //! (RBDA §6.3): Y = M⁻¹Jᵀ, the Delassus matrix A = J Y, then A λ = −(J q̈_smooth + J̇v) and
 //! q̈ = q̈_smooth + Y λ. Redundant rows give the minimum-norm multipliers ([`solve_psd`]).

@@ -1,6 +1,6 @@
-//! The constraint layer (DESIGN.md, layer 7): which rows a model has ([`ConstraintModel`]), their
+//! The constraint layer (docs/architecture.md, "Layers"): which rows a model has ([`ConstraintModel`]), their
 //! Jacobian `J`, residual `φ`, `J v` and `J̇ v` in [`Data`](crate::Data) (`efc_*` buffers), and the
-//! exact (rigid) solver: the KKT system `M q̈ + c − τ = Jᵀλ`, `J q̈ + J̇v = 0` (notes §1.6,
+//! exact (rigid) solver: the KKT system `M q̈ + c − τ = Jᵀλ`, `J q̈ + J̇v = 0` (docs/physics.md §1.6,
 //! eq. 19–22: λ are Lagrange multipliers, `Jᵀλ` the generalized forces of constraint), plus the
 //! drift correction of the steppers (projection onto φ = 0 and J v = 0).
 //!

@@ -1,10 +1,10 @@
-//! Energy, centre of mass and momentum of the moving bodies (notes §2.1–2.2, §1.5). Bodies welded
+//! Energy, centre of mass and momentum of the moving bodies (docs/physics.md §2.1–2.2, §1.5). Bodies welded
 //! to the world (body 0) are excluded, as in MuJoCo and Pinocchio.
 
 use crate::error::{check, InputError};
-use crate::kinematics::{forward_kinematics_unchecked, forward_velocities_unchecked};
 #[cfg(doc)]
 use crate::kinematics::{forward_kinematics, forward_velocities};
+use crate::kinematics::{forward_kinematics_unchecked, forward_velocities_unchecked};
 use crate::model::{Data, Model};
 use crate::spatial::{Force, Vec3};
 
@@ -41,7 +41,7 @@ pub fn potential_energy(model: &Model, data: &Data) -> f64 {
         .sum()
 }
 
-/// Centre of mass of the moving bodies in the world frame (notes eq. 31). Needs
+/// Centre of mass of the moving bodies in the world frame (docs/physics.md §2.1). Needs
 /// [`forward_kinematics`]. The origin if they are massless.
 pub fn center_of_mass(model: &Model, data: &Data) -> Vec3 {
     let mut first_moment = Vec3::zeros();

@@ -1,4 +1,4 @@
-//! Rigid-body dynamics (DESIGN.md, layer 5): inverse dynamics (RNEA), the joint-space inertia
+//! Rigid-body dynamics (docs/architecture.md, "Layers"): inverse dynamics (RNEA), the joint-space inertia
 //! matrix (CRBA) and its tree-sparse factorization, forward dynamics (ABA), energy, centre of mass
 //! and momentum. Every function writes into [`Data`](crate::Data) and allocates nothing.
 

@@ -1,4 +1,4 @@
-//! The staged forward pipeline (DESIGN.md, layer 8), with MuJoCo's stage names (MuJoCo
+//! The staged forward pipeline (docs/architecture.md, "Layers"), with MuJoCo's stage names (MuJoCo
 //! documentation, "Computation → Forward dynamics"): position → velocity → passive → actuation →
 //! acceleration → constraint, each writing named buffers of [`Data`]:
 //!

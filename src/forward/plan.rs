@@ -1,4 +1,4 @@
-//! The plan of the forward pipeline: which stages run for a model and why (DESIGN.md, layer 8).
+//! The plan of the forward pipeline: which stages run for a model and why (docs/architecture.md, "Layers").
 //! It is built once from the model; [`forward`](super::forward) walks its stages, and `lagrange
 //! info` prints the same list, so what is reported is what runs. A stage runs only when the model
 //! contains what it acts on: a scene without constraint rows never builds M (ABA path), a scene
@@ -75,7 +75,7 @@ pub struct Plan {
 
 impl Plan {
     /// The plan for `model`, with the constraint mode `requested` (None: MJCF models soft, URDF
-    /// models exact, as DESIGN.md fixes).
+    /// models exact, docs/architecture.md, "Conventions").
     pub fn new(model: &Model, requested: Option<ConstraintMode>) -> Self {
         let (mode, mode_reason) = resolve_mode(model, requested);
         let mut constraints = ConstraintModel::new(model);

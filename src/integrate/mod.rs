@@ -1,4 +1,4 @@
-//! Time steppers (DESIGN.md, layer 9). Every integrator implements [`Stepper`] over the staged
+//! Time steppers (docs/architecture.md, "Layers"). Every integrator implements [`Stepper`] over the staged
 //! [`forward`](crate::forward::forward) pipeline and returns a [`StepReport`]; each owns the stage
 //! buffers it needs, allocated once, so a step allocates nothing.
 //!

@@ -6,7 +6,7 @@
 //! acts on a vector space and keeps its order 4 on ball and free joints too. For flat joints
 //! (hinge, slide, planar) dexp⁻¹ is the identity and the method is MuJoCo's `mj_RungeKutta`.
 //! (Averaging the body-frame stage velocities without dexp⁻¹, as before, is second order on
-//! quaternion joints: issue 15.) Activations are stages of the same tableau, and the step applies
+//! quaternion joints.) Activations are stages of the same tableau, and the step applies
 //! their weighted mean rate as MuJoCo's `mj_RungeKutta` does (through `mj_advance`: `filterexact`
 //! with its exponential factor, then clamped to `actrange`).
 

@@ -41,7 +41,7 @@
 //!
 //! Properties (tested in `tests/variational.rs` and `tests/stress.rs`): second order; symplectic;
 //! the discrete momentum maps of symmetries of L_d are conserved to round-off (discrete Noether
-//! theorem): for the heavy symmetric top L_z and L_z′ (notes eq. 104–106); the energy error
+//! theorem): for the heavy symmetric top L_z and L_z′ (docs/physics.md (104)–(106)); the energy error
 //! stays bounded, without secular drift. Limits, friction rows and contacts, if the model has
 //! them, are left to the drift projection after the step ([`correct_drift`]), outside the
 //! variational structure.

@@ -1,6 +1,6 @@
 //! The compile step: [`ModelSpec`] → [`Model`]. Checks physical validity, normalizes axes, fuses
 //! fixed joints into their parent body (inertia composed, every link kept as a [`Frame`]), and lays
-//! out q and v in depth-first file order (DESIGN.md, layer 3); then resolves the equality
+//! out q and v in depth-first file order (docs/architecture.md, "Layers"); then resolves the equality
 //! constraints, mimics, tendons, actuators and contact pairs against the tree
 //! ([`compile_elements`](crate::io::compile_elements)).
 

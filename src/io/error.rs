@@ -1,5 +1,5 @@
 //! Typed loader errors. Every message names the file (and line where known), the element, what is
-//! wrong and how to fix it (DESIGN.md, "Style").
+//! wrong and how to fix it (docs/architecture.md, "Errors").
 
 use crate::model::SourceLoc;
 use thiserror::Error;

@@ -1,4 +1,4 @@
-//! Loaders: model files → [`ModelSpec`] → (compile) → [`Model`] (DESIGN.md, layer 3).
+//! Loaders: model files → [`ModelSpec`] → (compile) → [`Model`] (docs/architecture.md, "Layers").
 //! Loaders never touch dynamics code.
 
 pub mod compile;

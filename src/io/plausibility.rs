@@ -1,5 +1,5 @@
 //! Resource limits and plausibility of a parsed model, checked before anything is computed from it
-//! (issue 16, items 2 and 4): counts of links, joints and geoms bounded so that a hostile file
+//! (hostile inputs, docs/architecture.md "Errors"): counts of links, joints and geoms bounded so that a hostile file
 //! cannot exhaust memory; lengths, sizes, mesh scales, masses, densities and inertias that are not
 //! finite or are absurd (lengths beyond [`ABSURD_LENGTH`], other quantities beyond [`ABSURD`], in
 //! SI units) refused with file and line; and the derived

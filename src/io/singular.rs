@@ -1,5 +1,5 @@
 //! The compile step's last check: whether the joint-space mass matrix M(qpos0) is positive
-//! definite, so that forward dynamics is defined (issue 16: massless moving links, duplicated
+//! definite, so that forward dynamics is defined (massless moving links, duplicated
 //! joints). A singular M is a warning naming the joints, not an error: Pinocchio loads massless
 //! leaf links and MuJoCo loads duplicated joints, and a model either reference loads must load
 //! (kinematics, inverse dynamics and M itself are fine); forward dynamics at such a state is not

@@ -1,4 +1,4 @@
-//! URDF loader: text → [`ModelSpec`] (DESIGN.md, layer 3).
+//! URDF loader: text → [`ModelSpec`] (docs/architecture.md, "Layers").
 //!
 //! Two passes over the text. `roxmltree` first checks the XML (its errors carry line and column)
 //! and indexes every `<link>` and `<joint>` (with their `<inertial>`, `<visual>`, `<collision>`,
@@ -7,7 +7,7 @@
 //! reads the data; its i-th link/joint is the i-th `<link>`/`<joint>` element of the file. Finally
 //! the tree is checked (one root, no cycles, every link has at most one parent joint) and the links
 //! are laid out in depth-first pre-order from the root, children in file order of their joints —
-//! MuJoCo's order, which the rest of the engine relies on (DESIGN.md, "Conventions").
+//! MuJoCo's order, which the rest of the engine relies on (docs/architecture.md, "Conventions").
 //!
 //! Semantics follow the URDF specification (<http://wiki.ros.org/urdf/XML>): `<origin rpy>` is a
 //! fixed-axis roll–pitch–yaw, `<axis>` defaults to x, `<limit>` is kept for revolute and prismatic

@@ -9,7 +9,7 @@
 //! with signed volume `V = (a − p)·((b − p) × (c − p)) / 6`, centroid `(a + b + c + p)/4`, and
 //! second moment about its apex `∫ x xᵀ dV = V/20 (Σ a aᵀ + s sᵀ)` with `s = a + b + c` (apex at
 //! the origin). For shells each triangle of area `A` contributes `∫ x xᵀ dA = A/12 (Σ a aᵀ + s sᵀ)`.
-//! The inertia tensor follows from the second moments `S` as `I = tr(S) 1 − S` (notes eq. 68–69).
+//! The inertia tensor follows from the second moments `S` as `I = tr(S) 1 − S` (docs/physics.md (68)–(69)).
 
 use super::error::MeshError;
 use super::fast_hash::{point_key, FastMap};
@@ -231,7 +231,7 @@ fn measure(
             (measure, com, s)
         }
     };
-    // I = tr(S) 1 − S (notes eq. 68–69), about the centre of mass.
+    // I = tr(S) 1 − S (docs/physics.md (68)–(69)), about the centre of mass.
     let i_com = Mat3::identity() * second_moment.trace() - second_moment;
     check_physical(&i_com)?;
     Ok(((measure, RigidInertia::from_com(measure, com, i_com)), open))

@@ -1,8 +1,8 @@
-//! Mass properties of primitives and triangle meshes (DESIGN.md, layer 4).
+//! Mass properties of primitives and triangle meshes (docs/architecture.md, "Layers").
 //!
 //! Every function returns a [`RigidInertia`] expressed in the shape's own frame (mass, first
 //! moment, rotational inertia about the frame origin), so placing a shape in a body is
-//! [`RigidInertia::transformed`] and composing shapes is `+=` or [`compose`] (notes §3, eq. 56
+//! [`RigidInertia::transformed`] and composing shapes is `+=` or [`compose`] (docs/physics.md §3, eq. 56
 //! and 81–83).
 //!
 //! - `primitive`: MuJoCo's closed forms for spheres, capsules, cylinders, boxes and ellipsoids,

@@ -65,7 +65,7 @@ pub fn primitive_inertia(p: &Primitive, d: Distribution, mass: f64) -> RigidIner
     RigidInertia::from_com(mass, Vec3::zeros(), Mat3::from_diagonal(&diag))
 }
 
-/// Principal moments about the centre (notes eq. 51–53 for rods, disks and spheres; the capsule is
+/// Principal moments about the centre (docs/physics.md (51)–(53) for rods, disks and spheres; the capsule is
 /// a cylinder plus two hemispheres shifted by the parallel-axis theorem, eq. 56).
 fn principal_moments(p: &Primitive, d: Distribution, m: f64) -> Vec3 {
     use Distribution::*;
@@ -118,7 +118,7 @@ fn principal_moments(p: &Primitive, d: Distribution, m: f64) -> Vec3 {
             let (lx, ly, lz) = (2.0 * s.x, 2.0 * s.y, 2.0 * s.z);
             let (a0, a1, a2) = (lx * ly, ly * lz, lz * lx);
             let total = 2.0 * (a0 + a1 + a2);
-            // Two faces of each orientation: 0 ⊥ z, 1 ⊥ x, 2 ⊥ y (thin plates, notes §3.1).
+            // Two faces of each orientation: 0 ⊥ z, 1 ⊥ x, 2 ⊥ y (thin plates, docs/physics.md §3.1).
             let (m0, m1, m2) = (m * a0 / total, m * a1 / total, m * a2 / total);
             let ix = m0 * ly * ly / 12.0 + m1 * (ly * ly + lz * lz) / 12.0 + m2 * lz * lz / 12.0;
             let iy = m0 * lx * lx / 12.0 + m1 * lz * lz / 12.0 + m2 * (lx * lx + lz * lz) / 12.0;

@@ -1,4 +1,4 @@
-//! Inertia-tensor algebra of the notes' §2.3 and §3.1–3.2: the parallel-axis shift (eq. 56, in
+//! Inertia-tensor algebra of docs/physics.md §2.3 and §3.1–3.2: the parallel-axis shift (eq. 56, in
 //! its tensor form), rotation of a tensor into other axes (eq. 81), the principal moments and
 //! axes (§3.2, eq. 74) and the principal-axis angle of a planar tensor (eq. 83), and composition
 //! of several parts into one body (the sum rule under eq. 50).
@@ -7,7 +7,7 @@
 
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
 
-/// Principal moments and axes of an inertia tensor (notes §3.2).
+/// Principal moments and axes of an inertia tensor (docs/physics.md §3.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Principal {
     /// Principal moments `I₁ ≤ I₂ ≤ I₃` (ascending).
@@ -18,7 +18,7 @@ pub struct Principal {
 }
 
 /// Principal moments and axes of the symmetric tensor `i` by symmetric eigen-decomposition,
-/// `I = E diag(I₁, I₂, I₃) Eᵀ` (notes eq. 74).
+/// `I = E diag(I₁, I₂, I₃) Eᵀ` (docs/physics.md (74)).
 ///
 /// Deterministic order and sign, so that equal inputs give equal outputs and the axes form a
 /// right-handed frame:
@@ -71,21 +71,21 @@ pub fn principal(i: &Mat3) -> Principal {
 
 /// The inertia tensor about a point displaced by `r` from the centre of mass, from the tensor
 /// `i_com` about the centre of mass (same axes): `I_O = I_C + m (|r|² 1 − r rᵀ)`. Component-wise
-/// this is notes eq. 56 (`I_z = m l²_CM + I_CM,z`) for each axis, with the products of inertia
+/// this is docs/physics.md (56) (`I_z = m l²_CM + I_CM,z`) for each axis, with the products of inertia
 /// shifted by `−m r_a r_b` (eq. 69).
 pub fn parallel_axis(i_com: &Mat3, mass: f64, r: &Vec3) -> Mat3 {
     i_com + (Mat3::identity() * r.norm_squared() - r * r.transpose()) * mass
 }
 
 /// The tensor in frame a of a body whose tensor in frame b is `i_b`, with `r_a_b` the orientation
-/// of b's axes in a: `I_a = R I_b Rᵀ`. The notes' eq. 81 is the inverse direction,
+/// of b's axes in a: `I_a = R I_b Rᵀ`. The rotation (81) of docs/physics.md §3.2 is the inverse direction,
 /// `I' = P⁻¹ I P` for new axes given by the columns of `P`.
 pub fn rotate_tensor(r_a_b: &Mat3, i_b: &Mat3) -> Mat3 {
     r_a_b * i_b * r_a_b.transpose()
 }
 
 /// The angle θ about z that diagonalizes the xy block of a tensor with a principal axis along z
-/// (notes eq. 80–83): `tan 2θ = 2 I_xy / (I_xx − I_yy)`, taken as `θ = ½ atan2(2 I_xy, I_xx − I_yy)`,
+/// (docs/physics.md (80)–(83)): `tan 2θ = 2 I_xy / (I_xx − I_yy)`, taken as `θ = ½ atan2(2 I_xy, I_xx − I_yy)`,
 /// so θ ∈ (−π/2, π/2]. The columns of `P` of eq. 81 with this θ are principal axes, and this
 /// choice of branch puts the larger in-plane moment, `(I_xx + I_yy)/2 + √(((I_xx − I_yy)/2)² + I_xy²)`,
 /// on `(cos θ, sin θ, 0)` (θ = 0 when the block is already isotropic).
@@ -95,7 +95,7 @@ pub fn principal_angle_xy(i_xx: f64, i_yy: f64, i_xy: f64) -> f64 {
 
 /// The mass properties of several parts as one body, in the body frame: each part is given in its
 /// own frame with the part's pose `x_body_part` in the body; the sum of the transformed inertias
-/// (the sum rule for composite bodies, notes under eq. 50, with eq. 56 and 81 for the shift and
+/// (the sum rule for composite bodies, docs/physics.md §2.3, with eq. 56 and 81 for the shift and
 /// rotation).
 pub fn compose<'a>(parts: impl IntoIterator<Item = (&'a Transform, &'a RigidInertia)>) -> RigidInertia {
     let mut sum = RigidInertia::zero();

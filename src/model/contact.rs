@@ -1,5 +1,5 @@
 //! Explicit contact pairs and exclusions (MJCF `<contact>`), with resolved geom and body indices.
-//! Used by the collision layer when it arrives; listed by `info` until then.
+//! The collision layer's candidate pairs (`model::collision_pairs`) are built from them.
 
 use super::SourceLoc;
 

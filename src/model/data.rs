@@ -202,7 +202,7 @@ pub struct Data {
     pub qfrc_smooth: DVector<f64>,
     /// Unconstrained acceleration M⁻¹(qfrc_passive + qfrc_actuator + qfrc_applied − qfrc_bias).
     pub qacc_smooth: DVector<f64>,
-    /// Constraint forces Jᵀλ (notes §1.6, eq. 22).
+    /// Constraint forces Jᵀλ (docs/physics.md §1.6, eq. 22).
     pub qfrc_constraint: DVector<f64>,
     /// The acceleration: qacc_smooth + M⁻¹ qfrc_constraint.
     pub qacc: DVector<f64>,

@@ -1,5 +1,5 @@
 //! Joint models: configuration → transform, motion subspace and velocity-product term
-//! (RBDA §4.4, Table 4.1), in MuJoCo's qpos/qvel layout (DESIGN.md, "Conventions").
+//! (RBDA §4.4, Table 4.1), in MuJoCo's qpos/qvel layout (docs/architecture.md, "Conventions").
 
 use crate::spatial::{quat_to_matrix, Mat3, Motion, Transform, Vec3};
 

@@ -1,4 +1,4 @@
-//! The immutable [`Model`] and the mutable [`Data`] workspace (DESIGN.md, layer 2).
+//! The immutable [`Model`] and the mutable [`Data`] workspace (docs/architecture.md, "Layers").
 //!
 //! A model is a kinematic tree of *bodies* in parent-before-child order; body 0 is the world and
 //! every other body `b` hangs from its parent through exactly one movable joint (`joints[b - 1]`).
@@ -59,7 +59,9 @@ pub struct Joint {
     pub qpos_adr: usize,
     /// First index of this joint's degrees of freedom in v.
     pub dof_adr: usize,
-    /// Position limits `[lower, upper]` of a one-dof joint, if limited. Not enforced yet.
+    /// Position limits `[lower, upper]` of a hinge or slide (of a ball joint: the larger entry is
+    /// the half-angle of its cone), if limited; enforced by the constraint rows of both modes
+    /// (unless `<flag limit>` is off).
     pub limits: Option<[f64; 2]>,
     /// The range `qfrc_actuator` is clamped to on this joint's dofs (MJCF `actuatorfrcrange`).
     pub actuator_force_range: Option<[f64; 2]>,
@@ -67,7 +69,8 @@ pub struct Joint {
     pub effort_limit: Option<f64>,
     /// Viscous damping coefficient (N·m·s/rad or N·s/m) applied by `simulate` as `−damping·v`.
     pub damping: f64,
-    /// Coulomb friction (stored; enforced by the constraints work, not yet).
+    /// Dry friction of each of the joint's dofs (MJCF `frictionloss`): a friction-loss
+    /// constraint row per dof bounds its force by this value.
     pub friction: f64,
     /// Rotor armature added to the diagonal of M (MuJoCo's `dof_armature`).
     pub armature: f64,
@@ -131,7 +134,7 @@ pub struct Frame {
     pub inertia: RigidInertia,
 }
 
-/// A geometry kept from the model file (not yet used by dynamics).
+/// A geometry of the model file: collision shape (when `collision`) and mass contribution.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Geom {
     /// The geom's own name (MJCF), empty if unnamed.

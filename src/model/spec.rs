@@ -1,4 +1,4 @@
-//! The model *spec*: what a loader parsed, before the compile step (DESIGN.md, layer 3) resolves
+//! The model *spec*: what a loader parsed, before the compile step (docs/architecture.md, "Layers") resolves
 //! it into a [`Model`](super::Model). Links are a tree in depth-first file order; fixed joints are
 //! still present here. Equality constraints, tendons, actuators and contact pairs name the objects
 //! they act on; the compile step resolves the names to indices ([`EqualitySpec`] and the types

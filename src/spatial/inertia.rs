@@ -6,7 +6,7 @@ use std::ops::AddAssign;
 
 /// Spatial inertia of a rigid body about the origin of the frame it is expressed in, stored
 /// compactly as mass `m`, first moment `h = m c` (c the centre of mass) and the rotational inertia
-/// about the origin `i_origin = I_c − m [c]×²` (parallel-axis theorem, notes eq. 56).
+/// about the origin `i_origin = I_c − m [c]×²` (parallel-axis theorem, docs/physics.md (56)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RigidInertia {
     pub mass: f64,

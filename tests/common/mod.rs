@@ -70,7 +70,7 @@ pub const WORKPREC_SLOPE_TOL: f64 = 0.25;
 /// bound the global error; it accumulates over the steps and through the dynamics' sensitivity).
 pub const ADAPTIVE_TOL_FACTOR: f64 = 100.0;
 
-/// Relative error of the small-amplitude period of the physical pendulum (notes eq. 59) measured
+/// Relative error of the small-amplitude period of the physical pendulum (docs/physics.md (59)) measured
 /// from an RK4 run of 4000 steps per period (`tests/physics.rs`). Model errors: the amplitude
 /// correction θ₀²/16 = 6.25e-12 at θ₀ = 1e-5 (eq. 59 is its limit θ₀ → 0); RK4's phase error
 /// ≈ (ω dt)⁴/120 ≈ 5e-14 for ω dt = 2π/4000. Measured 6.3e-12 (the amplitude term); 1e-10 leaves a
@@ -83,7 +83,7 @@ pub const PERIOD_SMALL_AMPLITUDE_REL: f64 = 1e-10;
 /// margin of 25 over the estimate, while a first-order error (≈ ω² dt ≈ 1e-2) would fail by far.
 pub const RK4_CONSERVATION_REL: f64 = 1e-9;
 
-/// Soft (MuJoCo-compatible) constraints against MuJoCo's `mj_forward` (`tests/soft.rs`, issue 12's
+/// Soft (MuJoCo-compatible) constraints against MuJoCo's `mj_forward` (`tests/soft.rs`,
 /// 1e-6): both sides minimize the same strictly convex cost, MuJoCo's Newton stopping at its
 /// tolerance (set to 1e-15 in the golden data's copy of the model). Measured on the go1, humanoid,
 /// box and weld scenes: qacc ≤ 1e-9 and forces ≤ 1e-8 of their scale (the elliptic cones with
@@ -98,8 +98,8 @@ pub const SOFT_REL: f64 = 1e-6;
 /// to 10000: CG stops on stagnation, not on the iteration limit).
 pub const SOFT_CG_REL: f64 = 5e-6;
 
-/// Relative tolerance of mesh mass properties against MuJoCo (`tests/mujoco_meshes.rs`; the
-/// issue's 1e-6). Both sides integrate the same polyhedron in f64 by the same decomposition
+/// Relative tolerance of mesh mass properties against MuJoCo (`tests/mujoco_meshes.rs`,
+/// 1e-6). Both sides integrate the same polyhedron in f64 by the same decomposition
 /// (`mjCMesh::ComputeVolume`/`ComputeInertia`), so binary STL meshes agree to the round-off of sums
 /// over up to 2e5 triangles (~1e-12); MuJoCo reads OBJ coordinates as f32 where we keep f64, a
 /// relative perturbation of ≤ 6e-8 per coordinate that moves masses and tensors by up to a few
@@ -515,7 +515,7 @@ pub fn robots() -> Vec<(String, Model)> {
     ROBOTS.iter().map(|&(name, floating)| (name.to_string(), load_robot(name, floating))).collect()
 }
 
-/// Exact-mode constraint checks: rod tension against notes §1.6, KKT residuals, J q̈ + J̇v = 0 and
+/// Exact-mode constraint checks: rod tension against docs/physics.md §1.6, KKT residuals, J q̈ + J̇v = 0 and
 /// the mimic full/reduced equality are algebraic identities, checked at this relative tolerance.
 pub const CONSTRAINT_REL: f64 = 1e-10;
 /// A loop closed by projection stays closed to this (max |φ| in m over a long run).
@@ -529,8 +529,8 @@ pub const LIMIT_EXCURSION: f64 = 1e-6;
 /// on a ball joint gains ≈ 7e-10 of the energy in 0.2 s of free flight). A constraint force or an
 /// impulse that added energy would show at the scale of the motion's kinetic energy, orders above.
 pub const ENERGY_GAIN_REL: f64 = 1e-9;
-/// Contact accelerations and forces in exact mode against the closed forms of notes §2.5 (issue
-/// 11 asks 1e-8): the solve is exact for sticking contacts (the Coulomb problem's fixed point) and
+/// Contact accelerations and forces in exact mode against the closed forms of docs/physics.md §2.5
+/// (1e-8): the solve is exact for sticking contacts (the Coulomb problem's fixed point) and
 /// iterated to 1e-13 of the right-hand side's scale otherwise.
 pub const CONTACT_REL: f64 = 1e-8;
 /// Penetration (m) of a body at rest on a floor, and of a foot below it, in exact mode.

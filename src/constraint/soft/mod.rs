@@ -1,4 +1,4 @@
-//! The soft, MuJoCo-compatible constraint mode (DESIGN.md, layer 7; MuJoCo documentation,
+//! The soft, MuJoCo-compatible constraint mode (docs/architecture.md, "Layers"; MuJoCo documentation,
 //! "Computation → Constraint model", "Soft constraints" and "Solver", for MuJoCo 4.0): every row
 //! is a spring–damper-like soft constraint whose reference acceleration aref and regularizer R
 //! come from the element's `solref` and `solimp` ([`impedance`]), and the constrained

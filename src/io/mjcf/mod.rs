@@ -1,4 +1,4 @@
-//! MJCF loader (MuJoCo's XML format): file → [`ModelSpec`] (DESIGN.md, layer 3), with MuJoCo's
+//! MJCF loader (MuJoCo's XML format): file → [`ModelSpec`] (docs/architecture.md, "Layers"), with MuJoCo's
 //! semantics.
 //!
 //! Passes: read the file into one element tree with `<include>`s spliced ([`xml`]); check every

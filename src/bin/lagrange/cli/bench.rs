@@ -1,6 +1,6 @@
 //! `lagrange bench MODEL [--json]`: median wall time of loading the model (parse + compile) and of
 //! the dynamics kernels and the staged `forward` on it, for side-by-side comparisons with MuJoCo and Pinocchio run by
-//! `validation/bench_load.py` in the same session (DESIGN.md, "Truth": speed is quoted as ratios).
+//! `validation/bench_load.py` in the same session (docs/architecture.md, "Truth": speed is quoted as ratios).
 
 use super::CliError;
 use lagrange::constraint::ConstraintMode;

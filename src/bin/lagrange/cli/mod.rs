@@ -1,4 +1,4 @@
-//! The command implementations of the `lagrange` binary (DESIGN.md, layer 11). They live with the
+//! The command implementations of the `lagrange` binary (docs/architecture.md, "Layers"). They live with the
 //! binary, not in the library: argument types are not part of the library API.
 
 pub mod bench;

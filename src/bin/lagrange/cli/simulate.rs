@@ -83,7 +83,8 @@ pub struct Summary {
     pub energy_scale: f64,
     /// The state at the end of the run.
     pub final_state: State,
-    /// Joints that went outside their (not yet enforced) limits, with the farthest excursion.
+    /// Joints that went outside their limits (a soft limit gives way, a rigid one by drift), with
+    /// the farthest excursion.
     pub limit_excursions: Vec<(String, f64)>,
 }
 

@@ -1,4 +1,4 @@
-//! `lagrange workprec`: work-precision of the integrators on one model (issue 15). Every
+//! `lagrange workprec`: work-precision of the integrators on one model. Every
 //! integrator runs the model from the same initial state for the same duration at several step
 //! sizes (fixed-step methods) or tolerances (the adaptive method); each run is compared with a
 //! reference solution — the adaptive Dormand–Prince 5(4) method at rtol = atol = 1e-13 — by
