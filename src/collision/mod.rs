@@ -16,6 +16,7 @@
 //! off by round-off or within a step is still known (its rows exist only while touching, or while
 //! the step's rows are frozen).
 
+pub mod box_box;
 pub mod box_primitive;
 pub mod convex;
 mod frame;
