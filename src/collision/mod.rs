@@ -6,9 +6,10 @@
 //! "Computation → Collision detection").
 //!
 //! A bounding-sphere test rejects far pairs first (MuJoCo's `mj_filterSphere`); the narrow phase
-//! is closed form for planes ([`plane`]), spheres and capsules, and GJK/EPA on support maps for
-//! the other convex pairs ([`convex`]). Meshes collide by their convex hulls; height fields are not
-//! collided yet (`info` lists them).
+//! is closed form for planes ([`plane`]), spheres and capsules, and boxes against spheres,
+//! capsules ([`box_primitive`]) and boxes ([`box_box`]) with MuJoCo's multi-point manifolds, and
+//! GJK/EPA on support maps for the other convex pairs ([`convex`]). Meshes collide by their
+//! convex hulls; height fields are not collided yet (`info` lists them).
 //!
 //! `collide` reports the contacts closer than the pair's margin + gap plus `reach`: MuJoCo's rule
 //! with `reach` = 0 (contacts in the gap are reported without rows: rows exist below the margin,
@@ -16,6 +17,8 @@
 //! off by round-off or within a step is still known (its rows exist only while touching, or while
 //! the step's rows are frozen).
 
+pub mod box_box;
+pub mod box_primitive;
 pub mod convex;
 mod frame;
 pub mod plane;
@@ -26,6 +29,7 @@ pub use frame::contact_frame;
 use crate::model::spec::Shape;
 use crate::model::{Contact, Data, Model};
 use crate::spatial::{Transform, Vec3};
+use convex::PairPoint;
 use parry3d_f64::math::Vector;
 use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder};
 use plane::PlanePoint;
@@ -180,6 +184,38 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
                 }
                 Shape::Plane { .. } | Shape::Hfield { .. } => {}
             }
+            continue;
+        }
+        // Boxes against spheres, capsules and boxes: MuJoCo's closed forms (geom 1 the lower
+        // type; a pair given the other way round is swapped and its normal turned back).
+        let mut emit = |p: PairPoint, feature: u32, swap: bool| match swap {
+            false => push(p.p1, p.p2, p.normal, p.dist, None, feature),
+            true => push(p.p2, p.p1, -p.normal, p.dist, None, feature),
+        };
+        let boxed = match (&geom1.shape, &geom2.shape) {
+            (Shape::Sphere { radius }, Shape::Box { size })
+            | (Shape::Box { size }, Shape::Sphere { radius }) => {
+                let (xs, xb, swap) =
+                    if let Shape::Box { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
+                let mut out = |p, f| emit(p, f, swap);
+                box_primitive::sphere_box(&xs.pos, *radius, &xb, &(size / 2.0), within, 0, &mut out);
+                true
+            }
+            (Shape::Capsule { radius, length }, Shape::Box { size })
+            | (Shape::Box { size }, Shape::Capsule { radius, length }) => {
+                let (xc, xb, swap) =
+                    if let Shape::Box { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
+                let mut out = |p, f| emit(p, f, swap);
+                box_primitive::capsule_box(&xc, *radius, 0.5 * length, &xb, &(size / 2.0), within, &mut out);
+                true
+            }
+            (Shape::Box { size: s1 }, Shape::Box { size: s2 }) => {
+                box_box::box_box(&x1, &(s1 / 2.0), &x2, &(s2 / 2.0), within, &mut |p, f| emit(p, f, false));
+                true
+            }
+            _ => false,
+        };
+        if boxed {
             continue;
         }
         let segment = |x: &Transform, shape: &Shape| match shape {

@@ -1,0 +1,559 @@
+#!/usr/bin/env python3
+"""MuJoCo's contacts for pairs of primitive geoms, for lagrange's collision tests.
+
+Run from the repository root with the validation venv (see validation/README.md):
+
+    python validation/mujoco_collision_golden.py            # (re)write tests/data/mujoco/collision/*.json
+    python validation/mujoco_collision_golden.py --check    # recompute in memory, exit 1 if a file differs beyond round-off
+
+One file per pair type: the closed forms lagrange follows point for point (sphere-box,
+capsule-box, box-box: MuJoCo's mjc_SphereBox, mjc_CapsuleBox, mjc_BoxBox) and, as regression,
+sphere-sphere, sphere-capsule, capsule-capsule and plane against sphere, capsule, box and
+cylinder. Each file holds a few scenes (an MJCF text: two free bodies with one geom each, or a
+world plane and one free body; margins and gaps nonzero in some) and, per scene, cases: the
+bodies' poses (qpos), MuJoCo's world poses of the two geoms and every contact of mj_forward
+(geom ids, pos, frame, dist, includemargin) in MuJoCo's order.
+
+The cases cover, per scene:
+- random relative poses (seeded), placed by bisection along a random direction so that the
+  smallest contact distance is a chosen value: penetrating (-0.03 to -0.002), separated within
+  the margin (margin scenes), and separated beyond the margin (no contact expected);
+- hand-made poses touching at exactly zero distance (sizes and positions are dyadic fractions and
+  rotations exact, so every engine computes 0 exactly; MuJoCo reports contacts at dist <= margin);
+- degenerate poses: parallel faces, box resting flat on a box (aligned, turned, and both turned
+  alike), edge on face, corner on face, crossed edges, coincident centres, a segment end inside a
+  box, a capsule along a box edge or lying on a face.
+
+Deterministic: a fixed seed per scene, floats written with repr, keys sorted. --check compares
+numbers relative to the largest magnitude of their quantity (MuJoCo's last bits may differ between
+machines; 1e-12 passes) and structure (counts, ids) exactly.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import pathlib
+import sys
+import zlib
+
+import mujoco
+import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from mujoco_golden import dump, roundoff_difference  # noqa: E402
+
+REPO = pathlib.Path(__file__).resolve().parent.parent
+OUT_DIR = REPO / "tests" / "data" / "mujoco" / "collision"
+SCRIPT = "validation/mujoco_collision_golden.py"
+SEED = 20270405
+CHECK_REL = 1e-12
+
+# Geoms (MJCF half-sizes); dyadic so that hand-made touching poses are exact in floating point.
+SPHERE = 'type="sphere" size="0.125"'
+SPHERE_SMALL = 'type="sphere" size="0.0625"'
+CAPSULE = 'type="capsule" size="0.0625 0.25"'
+CAPSULE_LONG = 'type="capsule" size="0.046875 0.375"'
+BOX_A = 'type="box" size="0.25 0.1875 0.125"'
+BOX_B = 'type="box" size="0.125 0.125 0.0625"'
+CUBE = 'type="box" size="0.125 0.125 0.125"'
+CYLINDER = 'type="cylinder" size="0.125 0.25"'
+PLANE = 'type="plane" size="2 2 0.1"'
+
+# Margins and gaps per geom (a pair's are the sums): 1/32 m margin, 1/64 m gap.
+NO_MARGIN = (0.0, 0.0)
+MARGIN = (0.015625, 0.0)
+MARGIN_GAP = (0.0078125, 0.00390625)
+
+# Exact rotations (w, x, y, z): every matrix entry MuJoCo computes from them is exact.
+Q_I = (1.0, 0.0, 0.0, 0.0)
+Q_X180 = (0.0, 1.0, 0.0, 0.0)
+Q_Z180 = (0.0, 0.0, 0.0, 1.0)
+Q_ZX = (0.5, 0.5, 0.5, 0.5)  # 120 degrees about (1,1,1): z -> x, x -> y, y -> z
+Q_ZY = (0.5, -0.5, -0.5, -0.5)  # its inverse: z -> y, x -> z, y -> x
+
+
+def axis_angle(axis, angle) -> tuple:
+    a = np.asarray(axis, float)
+    a = a / np.linalg.norm(a)
+    s = math.sin(angle / 2)
+    return (math.cos(angle / 2), *(float(x) for x in a * s))
+
+
+def qmul(p, q) -> tuple:
+    w1, x1, y1, z1 = p
+    w2, x2, y2, z2 = q
+    return (w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2)
+
+
+def qmat(q) -> np.ndarray:
+    m = np.zeros(9)
+    mujoco.mju_quat2Mat(m, np.asarray(q, float))
+    return m.reshape(3, 3)
+
+
+def random_quat(rng) -> tuple:
+    q = rng.normal(size=4)
+    q /= np.linalg.norm(q)
+    return tuple(float(x) for x in q)
+
+
+def unit(rng) -> np.ndarray:
+    v = rng.normal(size=3)
+    return v / np.linalg.norm(v)
+
+
+def mjcf(name: str, geom1: str | None, geom2: str, margins: tuple, offset: str = "") -> str:
+    """Two free bodies with one geom each (geom1 None: a world plane and one free body)."""
+    margin, gap = margins
+    extra = f' margin="{margin!r}" gap="{gap!r}"' if margin or gap else ""
+    parts = [f'<mujoco model="{name}">', '<compiler angle="radian"/>',
+             '<option><flag contact="enable"/></option>', "<worldbody>"]
+    if geom1 is None:
+        parts.append(f'<geom name="plane" {PLANE}{extra}/>')
+    else:
+        parts.append(f'<body name="b1"><freejoint/><geom name="g1" {geom1}{extra}{offset}/></body>')
+    parts.append(f'<body name="b2"><freejoint/><geom name="g2" {geom2}{extra}{offset}/></body>')
+    parts += ["</worldbody>", "</mujoco>"]
+    return "\n".join(parts) + "\n"
+
+
+class Scene:
+    def __init__(self, name: str, geom1: str | None, geom2: str, margins: tuple, offset: str = ""):
+        self.name = name
+        self.plane = geom1 is None
+        self.xml = mjcf(name, geom1, geom2, margins, offset)
+        self.m = mujoco.MjModel.from_xml_string(self.xml)
+        self.d = mujoco.MjData(self.m)
+        self.margin = 2 * margins[0]
+        self.reach = 2 * (margins[0] + margins[1])
+        # The same scene with a large margin: its smallest contact distance places random poses.
+        self.oracle = mujoco.MjModel.from_xml_string(self.xml)
+        self.oracle.geom_margin[:] = 2.0
+        self.od = mujoco.MjData(self.oracle)
+
+    def qpos(self, q1, q2) -> list:
+        """q1, q2: (pos, quat) of body 1 and body 2 (q1 ignored for plane scenes)."""
+        out = [] if self.plane else [*q1[0], *q1[1]]
+        return [float(x) for x in out + [*q2[0], *q2[1]]]
+
+    def min_dist(self, qpos) -> float:
+        self.od.qpos[:] = qpos
+        mujoco.mj_forward(self.oracle, self.od)
+        return min((self.od.contact[i].dist for i in range(self.od.ncon)), default=math.inf)
+
+    def place(self, q1, quat2, direction, target, start=None) -> tuple:
+        """Body 2's pose at `start` (default: body 1's position) + s * direction with the smallest
+        contact distance `target` (bisection on s)."""
+        p1 = np.asarray(q1[0] if start is None else start, float)
+        lo, hi = 0.0, 3.0
+        at = lambda s: self.qpos(q1, (p1 + s * direction, quat2))  # noqa: E731
+        assert self.min_dist(at(hi)) > target, "upper bracket too close"
+        if self.min_dist(at(lo)) > target:
+            return None  # cannot penetrate that deep along this direction
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            if self.min_dist(at(mid)) > target:
+                hi = mid
+            else:
+                lo = mid
+        return (tuple(float(x) for x in p1 + lo * direction), quat2)
+
+    def record(self, name: str, kind: str, q1, q2) -> dict:
+        qpos = self.qpos(q1, q2)
+        m, d = self.m, self.d
+        mujoco.mj_resetData(m, d)
+        d.qpos[:] = qpos
+        mujoco.mj_forward(m, d)
+        contacts = []
+        for i in range(d.ncon):
+            c = d.contact[i]
+            contacts.append({"geom": [int(c.geom[0]), int(c.geom[1])], "pos": [float(x) for x in c.pos],
+                             "frame": [float(x) for x in c.frame], "dist": float(c.dist),
+                             "includemargin": float(c.includemargin)})
+        if kind == "touching":
+            assert contacts and min(c["dist"] for c in contacts) == 0.0, f"{self.name}/{name}: not touching exactly"
+        if kind == "outside":
+            assert not contacts, f"{self.name}/{name}: contacts beyond the margin"
+        if kind in ("penetrating", "within_margin", "touching"):
+            assert contacts, f"{self.name}/{name}: no contact"
+        return {"name": name, "kind": kind, "qpos": qpos,
+                "geom_xpos": [[float(x) for x in p] for p in d.geom_xpos],
+                "geom_xmat": [[float(x) for x in r] for r in d.geom_xmat],
+                "contacts": contacts}
+
+
+def random_cases(scene: Scene, rng, count: int) -> list:
+    """Random relative poses at chosen smallest contact distances."""
+    cases = []
+    kinds = ["penetrating", "outside"] + (["within_margin"] if scene.reach > 0 else [])
+    k = 0
+    while len(cases) < count:
+        kind = kinds[k % len(kinds)]
+        k += 1
+        q1 = (tuple(float(x) for x in rng.uniform(-0.5, 0.5, 3)), random_quat(rng))
+        quat2 = random_quat(rng)
+        if scene.plane:
+            q1 = ((0.0, 0.0, 0.0), Q_I)
+            direction = np.array([0.0, 0.0, 1.0])
+        else:
+            direction = unit(rng)
+        target = {"penetrating": -rng.uniform(0.002, 0.03),
+                  "within_margin": rng.uniform(0.1, 0.9) * scene.reach,
+                  "outside": scene.reach + rng.uniform(0.002, 0.01)}[kind]
+        q2 = scene.place(q1, quat2, direction, target)
+        if q2 is None:
+            continue
+        cases.append(scene.record(f"random{len(cases)}", kind, q1, q2))
+    return cases
+
+
+def resting_cases(scene: Scene, rng, count: int, body1_quat, body2_quat, spread, name="resting") -> list:
+    """Random poses of body 2 resting on (or hanging under) body 1 with small tilts, near the
+    edges and corners of the contact patch: body 1 at an offset (x, y, 0) from a vertical line
+    along which body 2 is placed at a random depth. body1_quat(rng), body2_quat(rng) give the
+    orientations; spread the (x, y) half-ranges."""
+    cases = []
+    while len(cases) < count:
+        q1 = ((0.0, 0.0, 0.0), body1_quat(rng))
+        start = (float(rng.uniform(-spread[0], spread[0])), float(rng.uniform(-spread[1], spread[1])), 0.0)
+        up = 1.0 if len(cases) % 4 else -1.0  # one in four from below
+        q2 = scene.place(q1, body2_quat(rng), np.array([0.0, 0.0, up]), -rng.uniform(0.0005, 0.02), start=start)
+        if q2 is None:
+            continue
+        cases.append(scene.record(f"{name}{len(cases)}", "penetrating", q1, q2))
+    return cases
+
+
+def z_to(direction) -> tuple:
+    """The rotation taking z to `direction` (about z x direction)."""
+    d = np.asarray(direction, float)
+    d = d / np.linalg.norm(d)
+    return axis_angle(np.cross([0.0, 0.0, 1.0], d), math.acos(d[2]))
+
+
+def over_corner(scene: Scene, name: str, yaw: float, drop: float, along: float, depth: float, kind="degenerate"):
+    """A capsule nearly level, its segment passing over the box's (+x, +y, +z) corner at yaw `yaw`,
+    going down by `drop` per unit length, the corner under the segment's point `along` (from the
+    centre); the box placed below at contact distance `depth`."""
+    d = np.array([math.cos(yaw), math.sin(yaw), -drop])
+    d /= np.linalg.norm(d)
+    centre = np.array([0.25, 0.1875, 0.0]) - along * d * np.array([1.0, 1.0, 0.0])
+    q1 = ((float(centre[0]), float(centre[1]), 0.0), z_to(d))
+    q2 = scene.place(q1, Q_I, np.array([0.0, 0.0, -1.0]), depth, start=(0.0, 0.0, 0.0))
+    assert q2 is not None, f"{scene.name}/{name}: cannot place"
+    return scene.record(name, kind, q1, q2)
+
+
+def yaw_tilt(rng, tilt, base=(1.0, 0.0, 0.0, 0.0)) -> tuple:
+    """A random turn about z, then a random tilt of at most `tilt` rad, applied to `base`."""
+    q = qmul(axis_angle((0, 0, 1), rng.uniform(0, 2 * math.pi)),
+             qmul(axis_angle((*unit(rng)[:2], 0.0), rng.uniform(0, tilt)), base))
+    return q
+
+
+ORIGIN = ((0.0, 0.0, 0.0), Q_I)
+
+
+def at(*pos, q=Q_I) -> tuple:
+    return (tuple(float(x) for x in pos), q)
+
+
+def rotated(q1, local_pos, q2_rel) -> tuple:
+    """Body 2 at body 1's frame point `local_pos`, orientation q1 * q2_rel."""
+    p = np.asarray(q1[0]) + qmat(q1[1]) @ np.asarray(local_pos, float)
+    return (tuple(float(x) for x in p), qmul(q1[1], q2_rel))
+
+
+def placed(scene: Scene, name: str, q1, quat2, direction, target, kind="degenerate") -> dict:
+    q2 = scene.place(q1, quat2, np.asarray(direction, float) / np.linalg.norm(direction), target)
+    assert q2 is not None, f"{scene.name}/{name}: cannot place"
+    return scene.record(name, kind, q1, q2)
+
+
+# ------------------------------------------------------------------------------------------------
+# Pair types: scenes and their hand-made cases
+# ------------------------------------------------------------------------------------------------
+
+def sphere_box() -> list:
+    out = []
+    s = Scene("sphere_box", SPHERE, BOX_A, NO_MARGIN)
+    # Body 1: the sphere; body 2: the box at the origin.
+    cases = [
+        s.record("touch_face_x", "touching", at(0.375, 0.0, 0.0), ORIGIN),
+        s.record("touch_face_z_box_turned", "touching", at(0.0, 0.0, -0.25), at(0, 0, 0, q=Q_Z180)),
+        s.record("face", "penetrating", at(0.3125, 0.0625, 0.03125), ORIGIN),
+        s.record("edge", "penetrating", at(0.3125, 0.25, 0.0), ORIGIN),
+        s.record("corner", "penetrating", at(0.3125, 0.25, 0.1875), ORIGIN),
+        s.record("centre_inside_near_face", "degenerate", at(0.0, 0.0625, 0.0625), ORIGIN),
+        s.record("centre_on_face", "degenerate", at(0.25, 0.0, 0.0), ORIGIN),
+        s.record("coincident_centres", "degenerate", ORIGIN, ORIGIN),
+        s.record("coincident_centres_turned", "degenerate", at(0.1, 0.2, 0.3, q=axis_angle((1, 2, 3), 0.7)),
+                 at(0.1, 0.2, 0.3, q=axis_angle((-1, 0.5, 2), 1.1))),
+    ]
+    out.append((s, cases, 12))
+    s = Scene("sphere_box_margin", SPHERE, BOX_A, MARGIN)
+    out.append((s, [s.record("touch_face_y", "touching", at(0.0, 0.3125, 0.0), ORIGIN),
+                    s.record("face_within_margin", "within_margin", at(0.0, 0.0, 0.265625), ORIGIN)], 12))
+    # The box on body 1: MuJoCo's geom 1 is still the sphere (lower type), geom id 1.
+    s = Scene("box_sphere_order", BOX_A, SPHERE, MARGIN_GAP)
+    out.append((s, [s.record("touch_face_x", "touching", ORIGIN, at(-0.375, 0.0, 0.0))], 8))
+    s = Scene("sphere_cube", SPHERE, CUBE, NO_MARGIN)
+    out.append((s, [s.record("coincident_centres_tie", "degenerate", ORIGIN, ORIGIN),
+                    s.record("inside_on_diagonal_tie", "degenerate", at(0.0625, 0.0625, 0.0625), ORIGIN)], 4))
+    return out
+
+
+def capsule_box() -> list:
+    out = []
+    s = Scene("capsule_box", CAPSULE, BOX_A, NO_MARGIN)
+    slant = axis_angle((0.3, 1.0, 0.0), 1.2)
+    cases = [
+        s.record("lying_on_face_touch", "touching", at(0.0, 0.0, 0.1875, q=Q_ZX), ORIGIN),
+        s.record("lying_on_face", "penetrating", at(0.0, 0.03125, 0.171875, q=Q_ZX), ORIGIN),
+        s.record("lying_on_face_overhanging", "penetrating", at(0.1875, 0.0, 0.171875, q=Q_ZX), ORIGIN),
+        s.record("lying_across_face", "penetrating", at(0.0625, 0.0, 0.171875, q=Q_ZY), ORIGIN),
+        s.record("segment_on_face", "degenerate", at(0.0, 0.0, 0.125, q=Q_ZY), ORIGIN),
+        s.record("pointing_at_face", "penetrating", at(0.0625, 0.03125, 0.421875), ORIGIN),
+        s.record("pointing_at_face_touch", "touching", at(0.0625, 0.03125, 0.4375), ORIGIN),
+        s.record("end_inside", "degenerate", at(0.0625, 0.0, 0.25), ORIGIN),
+        s.record("along_edge", "degenerate", at(0.28125, 0.0, 0.15625, q=Q_ZY), ORIGIN),
+        s.record("along_edge_x", "degenerate", at(0.0, 0.21875, 0.15625, q=Q_ZX), ORIGIN),
+        s.record("coincident_centres", "degenerate", ORIGIN, ORIGIN),
+        s.record("coincident_centres_along_x", "degenerate", at(0, 0, 0, q=Q_ZX), ORIGIN),
+        s.record("coincident_centres_turned", "degenerate", at(0, 0, 0, q=axis_angle((1, 1, 0.2), 0.9)), ORIGIN),
+        # placed() moves body 2 (the box) from the capsule's centre along -(the capsule's side).
+        placed(s, "crossing_edge", at(0.25, 0.0, 0.125, q=axis_angle((0.0, 1.0, 0.2), 0.8)), Q_I, (-1, -0.1, -1), -0.01),
+        placed(s, "crossing_edge_square", at(0.25, 0.0, 0.125, q=axis_angle((0.0, 1.0, 0.0), 0.8)), Q_I, (-1, 0, -1), -0.005),
+        placed(s, "near_corner", at(0.25, 0.1875, 0.125, q=slant), Q_I, (-1, -1, -1), -0.01),
+        placed(s, "near_corner_tilted", at(0.25, 0.1875, 0.125, q=axis_angle((1, -1, 0.3), 1.0)), Q_I, (-1, -1, -1), -0.005),
+        placed(s, "over_face_tilted", at(0.0, 0.0, 0.125, q=axis_angle((0.2, 1.0, 0.0), 1.4)), Q_I, (0, 0, -1), -0.01),
+    ]
+    rng = np.random.default_rng([SEED, zlib.crc32(b"capsule_box resting")])
+    cases += resting_cases(s, rng, 24, lambda r: yaw_tilt(r, 0.15, Q_ZX),
+                           lambda r: axis_angle((0, 0, 1), r.uniform(0, 2 * math.pi)), (0.4, 0.35))
+    # Over the corner, nearly level: the closest box point is the corner, the second point lies
+    # back over the top face (or along an edge when the segment runs nearly along one).
+    for k, (yaw, drop, along, depth) in enumerate([(0.8, 0.02, 0.1, -0.01), (0.6, 0.05, -0.05, -0.005),
+                                                   (1.2, 0.01, 0.15, -0.015), (0.3, 0.03, 0.0, -0.01),
+                                                   (0.1, 0.02, 0.05, -0.01), (1.5, 0.02, 0.1, -0.01)]):
+        cases.append(over_corner(s, f"over_corner{k}", yaw, drop, along, depth))
+    rng = np.random.default_rng([SEED, zlib.crc32(b"capsule_box corners")])
+    cases += resting_cases(s, rng, 24, lambda r: yaw_tilt(r, 0.8, Q_ZX),
+                           lambda r: Q_I, (0.45, 0.4), name="by_corner")
+    out.append((s, cases, 16))
+    s = Scene("capsule_box_margin", CAPSULE, BOX_A, MARGIN)
+    cases = [s.record("lying_on_face_within_margin", "within_margin", at(0.0, 0.0, 0.203125, q=Q_ZX), ORIGIN),
+             s.record("lying_on_face_touch", "touching", at(0.0, 0.0, 0.1875, q=Q_ZX), ORIGIN)]
+    for k, (yaw, drop, along, depth) in enumerate([(0.8, 0.02, 0.1, 0.01), (0.5, 0.04, 0.0, -0.005)]):
+        cases.append(over_corner(s, f"over_corner{k}", yaw, drop, along, depth,
+                                 kind="within_margin" if depth > 0 else "degenerate"))
+    rng = np.random.default_rng([SEED, zlib.crc32(b"capsule_box_margin corners")])
+    cases += resting_cases(s, rng, 24, lambda r: yaw_tilt(r, 0.3, Q_ZX), lambda r: Q_I, (0.45, 0.4), name="by_corner")
+    out.append((s, cases, 12))
+    s = Scene("box_capsule_order", BOX_A, CAPSULE_LONG, MARGIN_GAP)
+    out.append((s, [s.record("lying_on_face", "penetrating", ORIGIN, at(0.0, 0.0, 0.1640625, q=Q_ZX)),
+                    s.record("lying_on_face_overhanging", "penetrating", ORIGIN, at(0.125, 0.0625, 0.1640625, q=Q_ZX))], 8))
+    return out
+
+
+def box_box() -> list:
+    out = []
+    s = Scene("box_box", BOX_A, BOX_B, NO_MARGIN)
+    turned = axis_angle((0.3, -0.5, 0.8), 2.1)
+    corner_down = qmul(axis_angle((1, 0, 0), math.atan(math.sqrt(2))), axis_angle((0, 0, 1), math.pi / 4))
+    cases = [
+        s.record("flat_touch", "touching", ORIGIN, at(0.0, 0.0, 0.1875)),
+        s.record("flat_touch_turned_180", "touching", ORIGIN, at(0.0625, 0.0, 0.1875, q=Q_Z180)),
+        s.record("flat_touch_side_x", "touching", ORIGIN, at(0.375, 0.0625, 0.0, q=Q_X180)),
+        s.record("flat", "penetrating", ORIGIN, at(0.03125, -0.0625, 0.171875)),
+        s.record("flat_overhanging_corner", "penetrating", ORIGIN, at(0.1875, 0.125, 0.171875)),
+        s.record("flat_turned_45", "penetrating", ORIGIN, at(0.0, 0.0, 0.18, q=axis_angle((0, 0, 1), math.pi / 4))),
+        s.record("flat_turned_30_overhanging", "penetrating", ORIGIN,
+                 at(0.2, 0.1, 0.18, q=axis_angle((0, 0, 1), math.pi / 6))),
+        s.record("flat_both_turned_alike", "degenerate", at(0.1, -0.2, 0.3, q=turned),
+                 rotated(at(0.1, -0.2, 0.3, q=turned), (0.05, 0.03, 0.1825), Q_I)),
+        s.record("flat_both_turned_alike_overhanging", "degenerate", at(0.1, -0.2, 0.3, q=turned),
+                 rotated(at(0.1, -0.2, 0.3, q=turned), (0.2, 0.15, 0.18), axis_angle((0, 0, 1), 0.3))),
+        placed(s, "edge_on_face", ORIGIN, axis_angle((1, 0, 0), math.pi / 4), (0, 0, 1), -0.01),
+        placed(s, "edge_on_face_turned", ORIGIN, qmul(axis_angle((0, 0, 1), 0.4), axis_angle((1, 0, 0), 0.6)),
+               (0.1, 0.05, 1), -0.008),
+        placed(s, "corner_on_face", ORIGIN, corner_down, (0.05, -0.02, 1), -0.01),
+        placed(s, "tilted_slightly", ORIGIN, axis_angle((1, 0.2, 0), 0.01), (0, 0, 1), -0.01),
+        placed(s, "tilted_slightly_small_depth", ORIGIN, axis_angle((0.3, 1, 0), 0.002), (0.01, 0, 1), -0.0005),
+        placed(s, "edge_edge_crossed", at(0, 0, 0, q=axis_angle((1, 0, 0), math.pi / 4)),
+               qmul(axis_angle((0, 0, 1), math.pi / 2), axis_angle((1, 0, 0), math.pi / 4)), (0, 0, 1), -0.01),
+        placed(s, "edge_edge_skew", at(0, 0, 0, q=axis_angle((1, 0.1, 0), 0.7)),
+               qmul(axis_angle((0, 0.2, 1), 1.2), axis_angle((1, 0, 0), 0.9)), (0.1, 0.2, 1), -0.006),
+        s.record("coincident_centres", "degenerate", ORIGIN, ORIGIN),
+        s.record("coincident_centres_turned", "degenerate", ORIGIN, at(0, 0, 0, q=turned)),
+        s.record("inside", "degenerate", ORIGIN, at(0.0625, 0.03125, 0.0)),
+    ]
+    # An incident edge through a corner of the reference face: clipping makes near-duplicates.
+    for k, angle in enumerate(np.linspace(0.1, 3.0, 40)):
+        corner = np.array([0.25, 0.1875, 0.0])
+        turn = axis_angle((0, 0, 1), angle)
+        start = corner - qmat(turn) @ np.array([0.125, 0.0, 0.0])
+        q2 = s.place(ORIGIN, turn, np.array([0.0, 0.0, 1.0]), -0.01, start=start)
+        cases.append(s.record(f"edge_through_corner{k}", "degenerate", ORIGIN, q2))
+    rng = np.random.default_rng([SEED, zlib.crc32(b"box_box resting")])
+    cases += resting_cases(s, rng, 24, lambda r: Q_I, lambda r: yaw_tilt(r, 0.06), (0.4, 0.35))
+    out.append((s, cases, 16))
+    s = Scene("box_box_same", BOX_A, BOX_A, NO_MARGIN)
+    out.append((s, [
+        s.record("flat_touch", "touching", ORIGIN, at(0.0, 0.0, 0.25)),
+        s.record("flat_touch_shifted", "touching", ORIGIN, at(0.125, -0.0625, 0.25)),
+        s.record("flat", "penetrating", ORIGIN, at(0.0, 0.0, 0.234375)),
+        s.record("flat_turned_90", "penetrating", ORIGIN, at(0.0, 0.0, 0.234375, q=axis_angle((0, 0, 1), math.pi / 2))),
+        s.record("coincident", "degenerate", ORIGIN, ORIGIN),
+        s.record("coincident_turned_180", "degenerate", ORIGIN, at(0, 0, 0, q=Q_Z180)),
+        s.record("side_by_side", "penetrating", ORIGIN, at(0.46875, 0.0625, 0.03125)),
+    ], 8))
+    s = Scene("box_box_margin", BOX_A, CUBE, MARGIN)
+    out.append((s, [
+        s.record("flat_touch", "touching", ORIGIN, at(0.0, 0.0625, 0.25)),
+        s.record("flat_within_margin", "within_margin", ORIGIN, at(0.0, 0.0625, 0.265625)),
+        s.record("flat_turned_within_margin", "within_margin", ORIGIN,
+                 at(0.1, 0.0, 0.26, q=axis_angle((0, 0, 1), 0.5))),
+        placed(s, "edge_edge_within_margin", at(0, 0, 0, q=axis_angle((1, 0, 0), math.pi / 4)),
+               qmul(axis_angle((0, 0, 1), math.pi / 2), axis_angle((1, 0, 0), math.pi / 4)), (0, 0, 1), 0.02,
+               kind="within_margin"),
+    ], 16))
+    # Geoms away from their body origins, turned: exercises the geom frames.
+    s = Scene("box_box_offset", BOX_B, BOX_A, MARGIN_GAP, offset=' pos="0.1 -0.05 0.02" euler="0.3 -0.2 0.5"')
+    out.append((s, [], 10))
+    return out
+
+
+def sphere_sphere() -> list:
+    s = Scene("sphere_sphere", SPHERE, SPHERE_SMALL, MARGIN)
+    return [(s, [s.record("touch", "touching", ORIGIN, at(0.1875, 0.0, 0.0)),
+                 s.record("coincident_centres", "degenerate", ORIGIN, at(0, 0, 0, q=axis_angle((1, 3, 0), 0.6)))], 8)]
+
+
+def sphere_capsule() -> list:
+    s = Scene("sphere_capsule", SPHERE, CAPSULE, MARGIN)
+    return [(s, [s.record("touch_side", "touching", ORIGIN, at(0.1875, 0.0, 0.125))], 8)]
+
+
+def capsule_capsule() -> list:
+    s = Scene("capsule_capsule", CAPSULE, CAPSULE_LONG, MARGIN)
+    return [(s, [s.record("crossed", "penetrating", at(0, 0, 0, q=Q_ZX), at(0.0625, 0.0, 0.1, q=Q_ZY)),
+                 s.record("parallel_overlapping", "degenerate", at(0, 0, 0, q=Q_ZX), at(0.1, 0.0, 0.1, q=Q_ZX)),
+                 s.record("coincident_centres", "degenerate", ORIGIN, at(0, 0, 0, q=Q_ZX))], 10)]
+
+
+def plane_sphere() -> list:
+    s = Scene("plane_sphere", None, SPHERE, MARGIN)
+    return [(s, [s.record("touch", "touching", None, at(0.25, -0.5, 0.125))], 6)]
+
+
+def plane_capsule() -> list:
+    s = Scene("plane_capsule", None, CAPSULE, MARGIN)
+    return [(s, [s.record("lying_touch", "touching", None, at(0.25, -0.5, 0.0625, q=Q_ZX)),
+                 s.record("lying", "penetrating", None, at(0.25, -0.5, 0.046875, q=Q_ZY))], 8)]
+
+
+def plane_box() -> list:
+    s = Scene("plane_box", None, BOX_A, MARGIN)
+    return [(s, [s.record("flat_touch", "touching", None, at(0.25, -0.5, 0.125)),
+                 s.record("flat", "penetrating", None, at(0.0, 0.0, 0.109375, q=Q_Z180)),
+                 s.record("on_edge", "penetrating", None,
+                          at(0.0, 0.0, 0.1875 * math.sqrt(0.5) + 0.125 * math.sqrt(0.5) - 0.01,
+                             q=axis_angle((1, 0, 0), math.pi / 4)))], 8)]
+
+
+def plane_cylinder() -> list:
+    s = Scene("plane_cylinder", None, CYLINDER, MARGIN)
+    return [(s, [s.record("on_cap", "penetrating", None, at(0.0, 0.0, 0.234375)),
+                 s.record("on_side", "penetrating", None, at(0.0, 0.0, 0.109375, q=Q_ZX))], 8)]
+
+
+PAIRS = {
+    "sphere_box": sphere_box,
+    "capsule_box": capsule_box,
+    "box_box": box_box,
+    "sphere_sphere": sphere_sphere,
+    "sphere_capsule": sphere_capsule,
+    "capsule_capsule": capsule_capsule,
+    "plane_sphere": plane_sphere,
+    "plane_capsule": plane_capsule,
+    "plane_box": plane_box,
+    "plane_cylinder": plane_cylinder,
+}
+
+
+def golden(pair: str) -> str:
+    scenes = []
+    for scene, cases, n_random in PAIRS[pair]():
+        rng = np.random.default_rng([SEED, zlib.crc32(scene.name.encode())])
+        cases = cases + random_cases(scene, rng, n_random)
+        scenes.append({"name": scene.name, "mjcf": scene.xml, "margin": scene.margin, "reach": scene.reach,
+                       "cases": cases})
+    doc = {
+        "generated": f"by {SCRIPT} with mujoco {mujoco.__version__}; do not edit (rerun the script)",
+        "generator": f"mujoco {mujoco.__version__}",
+        "script": SCRIPT,
+        "pair": pair,
+        "layout": "qpos: both free joints (pos, quat wxyz), or one above a world plane; geom_xpos, geom_xmat "
+                  "(row-major): MuJoCo's world poses of every geom; contacts in MuJoCo's order, frame row-major "
+                  "(normal, tangent1, tangent2), normal from geom[0] to geom[1]",
+        "scenes": scenes,
+    }
+    text = dump(doc) + "\n"
+    assert json.loads(text) == json.loads(json.dumps(doc)), "dump() lost information"
+    return text
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--check", action="store_true", help="recompute in memory; exit 1 if a file differs")
+    ap.add_argument("--only", action="append", default=[], help="only this pair type (repeatable)")
+    args = ap.parse_args()
+    unknown = set(args.only) - set(PAIRS)
+    if unknown:
+        print("unknown pair type(s): %s" % ", ".join(sorted(unknown)), file=sys.stderr)
+        return 2
+    OUT_DIR.mkdir(parents=True, exist_ok=True)
+    stale = []
+    for pair in PAIRS:
+        if args.only and pair not in args.only:
+            continue
+        text = golden(pair)
+        out = OUT_DIR / (pair + ".json")
+        old = out.read_text() if out.exists() else None
+        doc = json.loads(text)
+        n_cases = sum(len(s["cases"]) for s in doc["scenes"])
+        n_contacts = sum(len(c["contacts"]) for s in doc["scenes"] for c in s["cases"])
+        if args.check:
+            if old == text:
+                status = "ok"
+            elif old is None:
+                status = "MISSING"
+            else:
+                worst = roundoff_difference(json.loads(old), doc)
+                status = "DIFFERS" if worst is None or worst > CHECK_REL else "ok (round-off %.1e)" % worst
+            if not status.startswith("ok"):
+                stale.append(out.relative_to(REPO).as_posix())
+        else:
+            status = "unchanged" if old == text else "written"
+            if old != text:
+                out.write_text(text)
+        print("%-16s %3d cases %4d contacts  %-9s %s" % (pair, n_cases, n_contacts, status,
+                                                         out.relative_to(REPO).as_posix()))
+    if not args.only:
+        extra = sorted(p.name for p in OUT_DIR.glob("*.json") if p.stem not in PAIRS)
+        for e in extra:
+            print("%-16s EXTRA: no pair type produces it" % e)
+        if args.check:
+            stale += extra
+    if args.check and stale:
+        print("collision golden data out of date: %s" % ", ".join(stale), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
