@@ -213,7 +213,7 @@ fn ellipsoid_against_plane_and_sphere_uses_its_exact_surface() {
 }
 
 #[test]
-fn sphere_and_box_pairs_by_gjk() {
+fn sphere_and_box_pairs_in_closed_form() {
     // Sphere (geom 1, lower type) beside a box face: normal from the sphere to the box, −x.
     let m = mjcf(
         "sb",
@@ -236,9 +236,21 @@ fn sphere_and_box_pairs_by_gjk() {
         ),
     )
     .unwrap();
+    // MuJoCo's box–box manifold: the small box's four bottom corners, midway between the faces.
     let c = contacts(&m);
-    assert_eq!(c.len(), 1);
-    assert!((c[0].dist + 0.01).abs() <= COLLISION_ABS && close(&c[0].frame.row(0).transpose(), &Vec3::z()));
+    assert_eq!(c.len(), 4);
+    for contact in &c {
+        assert!(
+            (contact.dist + 0.01).abs() <= COLLISION_ABS
+                && close(&contact.frame.row(0).transpose(), &Vec3::z())
+        );
+        let p = contact.pos;
+        assert!(
+            (p.x.abs() - 0.1).abs() <= COLLISION_ABS && (p.y.abs() - 0.1).abs() <= COLLISION_ABS,
+            "{p:?}"
+        );
+        assert!((p.z - 1.095).abs() <= COLLISION_ABS, "{p:?}");
+    }
 }
 
 #[test]

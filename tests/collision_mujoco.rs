@@ -8,8 +8,7 @@
 //! sphere–box, capsule–box and box–box follow MuJoCo's closed forms point for point; the other
 //! pairs are regression checks of the existing plane and sphere/capsule code, where the few
 //! degenerate cases lagrange handles differently are listed in [`KNOWN_DIFFERENCES`] (and asserted
-//! to differ). The compiled model still caps box–box and capsule–box pairs at one contact; the
-//! test lifts the cap to MuJoCo's counts ([`raise_box_limits`]).
+//! to differ). The compiled model allows the box pairs MuJoCo's counts ([`assert_box_limits`]).
 
 mod common;
 
@@ -81,25 +80,23 @@ fn load_scene(scene: &Scene) -> Model {
     model
 }
 
-/// MuJoCo's largest contact count of the box pairs' collision functions (`mjc_BoxBox`: 8,
-/// `mjc_CapsuleBox`: 2). The compiled model still limits these pairs to one contact
-/// (`collision_pairs::max_contacts` in src/model, outside the collision layer), so the test raises
-/// the limit to exercise the whole point sets; every other pair keeps the model's limit.
-fn raise_box_limits(model: &mut Model) {
-    for p in &mut model.collision_pairs {
+/// The compiled model allows each box pair MuJoCo's largest contact count of its collision
+/// function (`mjc_BoxBox`: 8, `mjc_CapsuleBox`: 2), so the whole point sets reach `Data`.
+fn assert_box_limits(model: &Model) {
+    for p in &model.collision_pairs {
         let (a, b) = (&model.geoms[p.geom[0]].shape, &model.geoms[p.geom[1]].shape);
         let limit = match (a, b) {
             (Shape::Box { .. }, Shape::Box { .. }) => 8,
             (Shape::Capsule { .. }, Shape::Box { .. }) | (Shape::Box { .. }, Shape::Capsule { .. }) => 2,
             _ => continue,
         };
-        p.max_contacts = p.max_contacts.max(limit);
+        assert_eq!(p.max_contacts, limit, "the model's contact limit of a {a:?}–{b:?} pair");
     }
 }
 
 /// The contacts of `model` at `qpos` (MuJoCo's rule: closer than the margin + gap).
 fn contacts_at(model: &Model, data: &mut Data, qpos: &[f64]) -> Vec<Contact> {
-    forward_kinematics(model, data, qpos);
+    forward_kinematics(model, data, qpos).unwrap();
     collide(model, &CollisionModel::new(model), data, 0.0);
     data.contacts.clone()
 }
@@ -219,8 +216,8 @@ fn check(pair: &str) -> Worst {
     let mut failures = Vec::new();
     let mut kinds = std::collections::BTreeMap::new();
     for scene in &golden.scenes {
-        let mut model = load_scene(scene);
-        raise_box_limits(&mut model);
+        let model = load_scene(scene);
+        assert_box_limits(&model);
         let mut data = Data::new(&model);
         for case in &scene.cases {
             let known = KNOWN_DIFFERENCES.iter().find(|(s, c, _)| *s == scene.name && *c == case.name);
@@ -308,8 +305,8 @@ fn box_pairs_stored_the_other_way_round_give_the_same_contacts_reversed() {
     for pair in ["sphere_box", "capsule_box"] {
         let golden = golden(pair);
         let scene = &golden.scenes[0];
-        let mut model = load_scene(scene);
-        raise_box_limits(&mut model);
+        let model = load_scene(scene);
+        assert_box_limits(&model);
         let mut swapped = model.clone();
         for p in &mut swapped.collision_pairs {
             p.geom.swap(0, 1);

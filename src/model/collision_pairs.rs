@@ -53,12 +53,16 @@ pub fn type_rank(shape: &Shape) -> u8 {
     }
 }
 
-/// The most contacts a pair of these shapes yields (plane against box, cylinder or mesh hull: 4;
-/// against a capsule: 2; every other pair: 1).
+/// The most contacts a pair of these shapes yields (MuJoCo's closed forms): box against box 8,
+/// plane against box, cylinder or mesh hull 4, plane or box against a capsule 2, every other
+/// pair 1.
 fn max_contacts(a: &Shape, b: &Shape) -> usize {
     match (a, b) {
+        (Shape::Box { .. }, Shape::Box { .. }) => 8,
         (Shape::Plane { .. }, Shape::Box { .. } | Shape::Cylinder { .. } | Shape::Mesh { .. }) => 4,
-        (Shape::Plane { .. }, Shape::Capsule { .. }) => 2,
+        (Shape::Plane { .. }, Shape::Capsule { .. })
+        | (Shape::Capsule { .. }, Shape::Box { .. })
+        | (Shape::Box { .. }, Shape::Capsule { .. }) => 2,
         _ => 1,
     }
 }
