@@ -21,6 +21,7 @@ mod activation;
 mod actuation;
 mod plan;
 mod transmission;
+mod xfrc;
 
 pub use activation::{activation_rate, advance_activations, clamp_activations, next_activation};
 pub use actuation::{
@@ -29,6 +30,7 @@ pub use actuation::{
 
 pub use crate::constraint::DriftCorrection;
 pub use plan::{Plan, Stage, StageKind, Status};
+pub(crate) use xfrc::accumulate_xfrc;
 
 use crate::dynamics::{
     aba_unchecked, bias_forces_unchecked, crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked,
@@ -109,13 +111,16 @@ fn drive(model: &Model, data: &Data, k: usize) -> f64 {
     (data.qfrc_actuator[k] + data.qfrc_applied[k]).clamp(-limit, limit)
 }
 
-/// The unconstrained acceleration. ABA path: `qacc_smooth` = ABA(q, v, passive + drive). M path:
-/// `qfrc_smooth` = passive + drive − bias, `qacc_smooth` = M⁻¹ `qfrc_smooth` with the factor of
-/// the position stage. The drive is actuator + applied, clamped to the effort limits ([`drive`]).
+/// The unconstrained acceleration. ABA path: `qacc_smooth` = ABA(q, v, passive + drive + xfrc).
+/// M path: `qfrc_smooth` = passive + drive + xfrc − bias, `qacc_smooth` = M⁻¹ `qfrc_smooth` with
+/// the factor of the position stage. The drive is actuator + applied, clamped to the effort limits
+/// ([`drive`]); xfrc the bodies' applied wrenches as generalized forces (`qfrc_xfrc`).
 fn acceleration(model: &Model, data: &mut Data, q: &[f64], v: &[f64], m_path: bool) {
+    accumulate_xfrc(model, data, q);
     if m_path {
         for k in 0..model.nv {
-            data.qfrc_smooth[k] = data.qfrc_passive[k] + drive(model, data, k) - data.qfrc_bias[k];
+            data.qfrc_smooth[k] =
+                data.qfrc_passive[k] + drive(model, data, k) + data.qfrc_xfrc[k] - data.qfrc_bias[k];
         }
         data.qacc_smooth.copy_from(&data.qfrc_smooth);
         let mut x = std::mem::take(&mut data.qacc_smooth);
@@ -124,7 +129,7 @@ fn acceleration(model: &Model, data: &mut Data, q: &[f64], v: &[f64], m_path: bo
     } else {
         let mut tau = std::mem::take(&mut data.scratch_v);
         for k in 0..model.nv {
-            tau[k] = data.qfrc_passive[k] + drive(model, data, k);
+            tau[k] = data.qfrc_passive[k] + drive(model, data, k) + data.qfrc_xfrc[k];
         }
         aba_unchecked(model, data, q, v, tau.as_slice());
         data.scratch_v = tau;

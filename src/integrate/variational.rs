@@ -49,7 +49,7 @@
 use super::lagrangian_terms::LagrangianTerms;
 use super::{correct_drift, State, StepFailure, StepReport, Stepper};
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
-use crate::forward::{actuation, advance_activations, passive};
+use crate::forward::{accumulate_xfrc, actuation, advance_activations, passive};
 use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::{
     dexp_inv_configuration_unchecked, integrate_configuration_unchecked, Data, EfcType, JointKind, Model,
@@ -366,6 +366,8 @@ impl Variational {
         self.failure = None;
         let nv = model.nv;
         let q0 = state.q.as_slice();
+        // The bodies' applied wrenches at q_k, held over the step with the drive.
+        accumulate_xfrc(model, data, q0);
         self.ensure_mass(model, data, &state.q);
         self.p_k.gemv(1.0, &self.mass, &state.v, 0.0);
         // The drive, held over the step (with the activations at the step's start).
@@ -376,7 +378,7 @@ impl Variational {
         for k in 0..nv {
             let limit = model.dof_effort_limit[k];
             let f = if model.actuators.is_empty() { 0.0 } else { data.qfrc_actuator[k] };
-            self.drive[k] = (f + data.qfrc_applied[k]).clamp(-limit, limit);
+            self.drive[k] = (f + data.qfrc_applied[k]).clamp(-limit, limit) + data.qfrc_xfrc[k];
         }
         // The chord matrix C = M(q_k) + h/2 diag(damping).
         if model.has_damping() {

@@ -7,7 +7,7 @@
 //! `qfrc_applied`, `qfrc_smooth`, `qacc_smooth`, `qfrc_constraint`, `qacc`, and the constraint rows
 //! `efc_*`. Each buffer keeps one meaning.
 
-use super::{Contact, JointKind, Model};
+use super::{Contact, FrameKind, JointKind, Model};
 use crate::constraint::soft::SoftWork;
 use crate::constraint::{ExactWork, RowLifecycle};
 use crate::integrate::StepperSlot;
@@ -113,7 +113,8 @@ impl EfcState {
 /// `Data::new(&model)` allocates them all; afterwards the algorithms allocate nothing. Per-body
 /// arrays are indexed by body (0 = world), per-dof arrays by degree of freedom.
 ///
-/// The state is `time`, `qpos`, `qvel`, `act`, and the inputs `ctrl` and `qfrc_applied`: a
+/// The state is `time`, `qpos`, `qvel`, `act`, and the inputs `ctrl`, `qfrc_applied` and
+/// `xfrc_applied`: a
 /// stepper advances it, [`forward`](crate::forward::forward) reads it. Everything else is an
 /// output of the stages or scratch.
 #[derive(Clone, Debug)]
@@ -183,6 +184,14 @@ pub struct Data {
     pub act_dot: DVector<f64>,
     /// Generalized forces applied by the user (MuJoCo's `qfrc_applied`).
     pub qfrc_applied: DVector<f64>,
+    /// Cartesian wrenches applied by the user to bodies (MuJoCo's `xfrc_applied`): one per
+    /// MuJoCo body (the model's frames of kind `Link`, world first, in file order), force then
+    /// torque in world axes, the force acting at the body's own centre of mass. Honoured by
+    /// `forward` and every integrator.
+    pub xfrc_applied: Vec<[f64; 6]>,
+    /// `xfrc_applied` as generalized forces (Jᵀ of the wrenches), formed by the acceleration
+    /// stage when a wrench is nonzero.
+    pub qfrc_xfrc: DVector<f64>,
     /// Bias forces c(q, v) = RNEA(q, v, 0) (Coriolis, centrifugal, gravity). Filled by the velocity
     /// stage when the plan solves with M (constraint rows present); the ABA path does not need it.
     pub qfrc_bias: DVector<f64>,
@@ -338,6 +347,8 @@ impl Data {
             act: DVector::zeros(model.na()),
             act_dot: DVector::zeros(model.na()),
             qfrc_applied: DVector::zeros(nv),
+            xfrc_applied: vec![[0.0; 6]; model.frames.iter().filter(|f| f.kind == FrameKind::Link).count()],
+            qfrc_xfrc: DVector::zeros(nv),
             qfrc_bias: DVector::zeros(nv),
             qfrc_passive: DVector::zeros(nv),
             qfrc_actuator: DVector::zeros(nv),

@@ -6,7 +6,7 @@ use super::{Data, Model};
 use crate::error::InputError;
 
 /// Resets `data` to `model`'s reference state: time 0, `qpos` = `qpos0`, and zero velocities,
-/// activations, controls and applied forces; the solvers' warm starts are cleared, so the next
+/// activations, controls and applied forces (`qfrc_applied`, `xfrc_applied`); the solvers' warm starts are cleared, so the next
 /// step is the first of a new run (MuJoCo's `mj_resetData`). Allocates nothing. The output
 /// buffers keep their values until the next `forward`.
 ///
@@ -34,6 +34,7 @@ pub fn reset(model: &Model, data: &mut Data) -> Result<(), InputError> {
     {
         buffer.fill(0.0);
     }
+    data.xfrc_applied.fill([0.0; 6]);
     data.exact.warm_rows.clear();
     data.contacts.clear();
     data.nefc = 0;
