@@ -30,8 +30,8 @@ fn a_force_at_the_centre_of_mass_accelerates_by_f_over_m() {
     // Free joint: qacc[0..3] is the acceleration of the body origin, which moves with the centre
     // of mass while the body does not turn (a force through the centre of mass turns nothing).
     let want = [1.0, -2.0, 0.5];
-    for k in 0..3 {
-        assert!((data.qacc[k] - want[k]).abs() < 1e-14, "{:?}", data.qacc.as_slice());
+    for (a, w) in data.qacc.iter().zip(want) {
+        assert!((a - w).abs() < 1e-14, "{:?}", data.qacc.as_slice());
     }
     assert!(data.qacc.as_slice()[3..].iter().all(|a| a.abs() < 1e-14), "{:?}", data.qacc.as_slice());
     reset(&model, &mut data).unwrap();
