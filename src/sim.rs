@@ -18,7 +18,7 @@ use thiserror::Error;
 pub enum SimError {
     #[error("the simulation diverged at t = {} s (step {step}): {quantity} of joint '{joint}' is {value}; {hint}", display_time(*.time))]
     Diverged { time: f64, step: u64, quantity: &'static str, joint: String, value: f64, hint: String },
-    #[error("the {integrator} integrator's Newton iteration did not converge in step {step} (t = {} s → {} s, dt = {dt} s): residual {residual:.3e} after {iterations} iterations (last update {update:.3e}, constraint violation {constraint:.3e}); the state is left at the start of the step; reduce --dt", display_time(*.time), display_time(*.time + *.dt))]
+    #[error("the {integrator} integrator's Newton iteration did not converge in step {step} (t = {} s → {} s, dt = {dt} s): residual {residual:.3e} after {iterations} iterations (last update {update:.3e}, constraint violation {constraint:.3e}); the state is left at the start of the step; reduce SimOptions::timestep", display_time(*.time), display_time(*.time + *.dt))]
     NotConverged {
         integrator: &'static str,
         time: f64,
@@ -263,11 +263,11 @@ impl Simulation {
                 self.timestep
             );
         }
-        let mut hint = format!("reduce --dt (now {} s)", self.timestep);
+        let mut hint = format!("reduce SimOptions::timestep (now {} s)", self.timestep);
         match self.integrator() {
             "rk4" | "adaptive" => {}
-            "euler" => hint.push_str(", or use --integrator rk4 (or implicit for stiff damping)"),
-            _ => hint.push_str(", or use --integrator rk4"),
+            "euler" => hint.push_str(", or use SimOptions::integrator = rk4 (or implicit for stiff damping)"),
+            _ => hint.push_str(", or use SimOptions::integrator = rk4"),
         }
         hint.push_str("; if it persists, check the model's stiffnesses and inertias");
         hint

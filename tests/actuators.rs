@@ -380,30 +380,6 @@ fn site_transmission_moments_are_length_gradients() {
     assert_eq!(data.actuator_length[id("free")], 0.0);
 }
 
-/// The kind not simulated (body: adhesion) is warned about at load, listed by `info` as not
-/// simulated, and exerts no force.
-#[test]
-fn unsimulated_transmissions_are_warned_and_listed() {
-    let model = load(Path::new(TRANSMISSIONS), &LoadOptions::default()).unwrap();
-    println!("{:#?}", model.warnings);
-    let why = "'suction': a body (adhesion) transmission is not simulated";
-    assert!(
-        model.warnings.iter().any(|w| w.contains(why) && w.contains("transmissions.xml:")),
-        "{:?}",
-        model.warnings
-    );
-    let (ok, out, err) = common::lagrange(&["info", TRANSMISSIONS, "--json"]);
-    assert!(ok, "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let status = |name: &str| {
-        v["elements"].as_array().unwrap().iter().find(|e| e["name"] == name).unwrap()["status"].clone()
-    };
-    assert_eq!(status("suction"), "parsed, not simulated");
-    assert_eq!(status("crank"), "simulated");
-    assert_eq!(status("ref_base"), "simulated");
-    assert_eq!(status("free_parent"), "simulated");
-}
-
 #[test]
 fn activation_input_errors_name_the_fix() {
     let base = |act: &str| {
@@ -443,53 +419,6 @@ fn activation_input_errors_name_the_fix() {
     let mut sim = Simulation::new(Arc::new(model), &SimOptions::default());
     let err = sim.set_act(&[0.0; 3]).unwrap_err().to_string();
     assert!(err.contains("act has 3 values, the model has na = 9"), "{err}");
-}
-
-/// `eval` takes `"act"` per state and reports `act_dot`; `simulate` writes act columns and the
-/// final act from the keyframe's.
-#[test]
-fn eval_and_simulate_carry_act() {
-    let states = std::env::temp_dir().join(format!("lagrange-act-{}.json", std::process::id()));
-    std::fs::write(
-        &states,
-        r#"{"states": [{"q": [0.1, -0.2, 0.05, 0.3], "ctrl": [1.5, 1, -1, 2, 0.5, 0.3, 0.2, 1, 30],
-                         "act": [0.1, 0.2, -0.3, 0.35, -0.5, 0.1, 0.05, 0.4, 1.95]}]}"#,
-    )
-    .unwrap();
-    let (ok, out, err) = common::lagrange(&["eval", ACTIVATION, "--states", states.to_str().unwrap()]);
-    assert!(ok, "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let act_dot = &v["results"][0]["forward"]["act_dot"];
-    assert_eq!(act_dot.as_array().unwrap().len(), 9);
-    assert!((act_dot[1].as_f64().unwrap() - 16.0).abs() < 1e-12, "{act_dot}");
-    assert!((v["results"][0]["forward"]["actuator_force"][0].as_f64().unwrap() - 0.2).abs() < 1e-15);
-    std::fs::write(&states, r#"{"states": [{"q": [0, 0, 0, 0], "act": [1, 2]}]}"#).unwrap();
-    let (ok, _, err) = common::lagrange(&["eval", ACTIVATION, "--states", states.to_str().unwrap()]);
-    assert!(!ok && err.contains("states[0]: 'act' has 2 values, the model needs 9"), "{err}");
-    let _ = std::fs::remove_file(&states);
-
-    let csv = std::env::temp_dir().join(format!("lagrange-act-{}.csv", std::process::id()));
-    let (ok, out, err) = common::lagrange(&[
-        "simulate",
-        ACTIVATION,
-        "--keyframe",
-        "loaded",
-        "--duration",
-        "0.05",
-        "--json",
-        "--out",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
-    let text = std::fs::read_to_string(&csv).unwrap();
-    let _ = std::fs::remove_file(&csv);
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let first: Vec<f64> = text.lines().nth(1).unwrap().split(',').map(|x| x.parse().unwrap()).collect();
-    let col = header.iter().position(|h| *h == "act:clamped").expect("an act column per activation");
-    assert_eq!(header.iter().filter(|h| h.starts_with("act:")).count(), 9);
-    assert_eq!(first[col], 0.35, "the keyframe's act");
-    let summary: serde_json::Value = serde_json::from_str(&out).unwrap();
-    assert_eq!(summary["act"][3], 0.4, "integrated and clamped to actrange: {}", summary["act"]);
 }
 
 /// Actuator `damping` and `armature` on a hinge transmission are the joint's gear² · damping and

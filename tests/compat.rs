@@ -86,7 +86,8 @@ fn shared_load_options_act_on_mjcf_or_say_they_do_not_apply() {
     assert!(m.warnings.iter().any(|w| w.contains("kept as written")), "{:?}", m.warnings);
     let float = LoadOptions { floating: true, package_dirs: vec!["/tmp".into()], ..Default::default() };
     let m = load(&path, &LoadOptions { accept_nonphysical_inertia: true, ..float }).unwrap();
-    for needle in ["--floating applies to URDF only", "--package-dir applies to URDF"] {
+    for needle in ["LoadOptions::floating applies to URDF only", "LoadOptions::package_dirs applies to URDF"]
+    {
         assert!(m.warnings.iter().any(|w| w.contains(needle)), "no '{needle}' in {:?}", m.warnings);
     }
 }

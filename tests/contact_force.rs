@@ -1,11 +1,10 @@
 //! Reading contacts: `contact_force` (MuJoCo's `mj_contactForce`) for frictionless, elliptic and
 //! pyramidal contacts, the `contacts` iterator, the count of contacts with rows on both cone
-//! types (`efc_is_normal`, `simulate`'s summary), and the typed error of a contact index out of
+//! types (`efc_is_normal`), and the typed error of a contact index out of
 //! range. The comparison with MuJoCo itself is `validation/crossval_contact_force.py`.
 
 mod common;
 
-use common::lagrange;
 use lagrange::prelude::*;
 
 /// A 1 kg box resting on a plane (4 corner contacts), settled for 1 s, with `cone` and `condim`.
@@ -86,18 +85,4 @@ fn a_contact_index_out_of_range_is_a_typed_error() {
     let err = contact_force(&model, &data, 99).unwrap_err();
     assert_eq!(err, InputError::Index { function: "contact_force", what: "contact", index: 99, count: 4 });
     assert!(err.to_string().contains("contact 99 does not exist (4 contacts"), "{err}");
-}
-
-/// `simulate`'s summary counts pyramidal contacts (MJCF's default cone), so the drop scene is
-/// not a passive scene without contacts.
-#[test]
-fn simulate_counts_pyramidal_contacts() {
-    let (ok, out, err) = lagrange(&["simulate", "models/textbook/drop.xml", "--duration", "3", "--json"]);
-    assert!(ok, "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    println!("max_contacts {} max_penetration {}", v["max_contacts"], v["max_penetration"]);
-    assert!(v["max_contacts"].as_u64().unwrap() >= 5, "ball + 4 box corners: {}", v["max_contacts"]);
-    assert!(v["max_penetration"].as_f64().unwrap() > 0.0);
-    let (ok, text, _) = lagrange(&["simulate", "models/textbook/drop.xml", "--duration", "3"]);
-    assert!(ok && !text.contains("passive scene"), "{text}");
 }

@@ -75,5 +75,9 @@ fn clamp_effort_bounds_applied_joint_torques() {
     // MJCF: the option does not apply, and says so.
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/textbook/heavy_top.xml");
     let m = load(&path, &LoadOptions { clamp_effort: true, ..Default::default() }).unwrap();
-    assert!(m.warnings.iter().any(|w| w.contains("--clamp-effort applies to URDF")), "{:?}", m.warnings);
+    assert!(
+        m.warnings.iter().any(|w| w.contains("LoadOptions::clamp_effort applies to URDF")),
+        "{:?}",
+        m.warnings
+    );
 }

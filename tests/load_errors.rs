@@ -314,7 +314,7 @@ fn unresolvable_package_uri() {
             "link 'b'",
             "package 'lagrange_no_such_pkg' not found",
             "/nonexistent/lagrange/pkgs",
-            "--package-dir",
+            "LoadOptions::package_dirs",
             "ROS_PACKAGE_PATH",
         ],
     );
@@ -573,7 +573,7 @@ fn floating_root_joint_name_clash() {
     let (e, file) = load_err_with("root_clash", text, &options);
     assert_mentions(
         &e.to_string(),
-        &[&format!("{file}:4:"), "joint 'root_joint'", "--floating", "rename it"],
+        &[&format!("{file}:4:"), "joint 'root_joint'", "LoadOptions::floating", "rename it"],
     );
 }
 
@@ -638,7 +638,7 @@ fn nonphysical_inertia_is_refused_unless_accepted() {
     let inertial = r#"    <inertial><mass value="1"/><inertia ixx="0.001" iyy="0.001" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>"#;
     let text = two_links("continuous", "", inertial);
     let (e, _) = load_err("triangle", &text);
-    assert_mentions(&e.to_string(), &["triangle inequality", "--accept-nonphysical-inertia"]);
+    assert_mentions(&e.to_string(), &["triangle inequality", "LoadOptions::accept_nonphysical_inertia"]);
     let path = write_urdf("triangle_accepted", &text);
     let options = LoadOptions { accept_nonphysical_inertia: true, ..Default::default() };
     let model = load(&path, &options).expect("accepted as written");

@@ -66,7 +66,12 @@ fn diverging_simulation_names_time_joint_and_fix() {
     let mut sim = stiff_spring(IntegratorKind::Euler);
     sim.set_state(&[0.1], &[0.0]).unwrap();
     let msg = diverge(&mut sim);
-    for needle in ["diverged at t = ", "joint 'spring'", "reduce --dt (now 0.01 s)", "use --integrator rk4"] {
+    for needle in [
+        "diverged at t = ",
+        "joint 'spring'",
+        "reduce SimOptions::timestep (now 0.01 s)",
+        "use SimOptions::integrator = rk4",
+    ] {
         assert!(msg.contains(needle), "missing '{needle}' in: {msg}");
     }
     // The time is printed rounded (a sum of steps, not 6.800000000000003).
@@ -76,7 +81,10 @@ fn diverging_simulation_names_time_joint_and_fix() {
     let mut sim = stiff_spring(IntegratorKind::Rk4);
     sim.set_state(&[0.1], &[0.0]).unwrap();
     let msg = diverge(&mut sim);
-    assert!(msg.contains("reduce --dt") && !msg.contains("use --integrator rk4"), "{msg}");
+    assert!(
+        msg.contains("reduce SimOptions::timestep") && !msg.contains("use SimOptions::integrator = rk4"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -87,7 +95,7 @@ fn divergence_in_the_first_step_points_at_the_initial_state() {
     for needle in ["(step 1)", "first step", "initial state", "huge initial velocity"] {
         assert!(msg.contains(needle), "missing '{needle}' in: {msg}");
     }
-    assert!(!msg.contains("use --integrator"), "{msg}");
+    assert!(!msg.contains("use SimOptions::integrator"), "{msg}");
 }
 
 #[test]

@@ -401,7 +401,8 @@ fn stiff_spring_damper_implicit_stable_where_euler_diverges() {
     let err = (0..1000).find_map(|_| euler.step().err()).expect("semi-implicit Euler should diverge");
     let msg = err.to_string();
     println!("euler: {msg}");
-    for needle in ["diverged at t = ", "(step ", "joint 'stiff'", "reduce --dt (now 0.01 s)"] {
+    for needle in ["diverged at t = ", "(step ", "joint 'stiff'", "reduce SimOptions::timestep (now 0.01 s)"]
+    {
         assert!(msg.contains(needle), "missing '{needle}' in: {msg}");
     }
     let mut implicit = Simulation::new(Arc::new(model), &SimOptions::default());

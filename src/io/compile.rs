@@ -317,7 +317,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             loc: SourceLoc { file: spec.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default(), line: 0 },
             element: "geom".into(),
             detail: format!(
-                "more than {} candidate collision pairs (a resource limit); give geoms that need not touch contype=\"0\" conaffinity=\"0\", use <contact><exclude>, or disable contacts (--disable contact)",
+                "more than {} candidate collision pairs (a resource limit); give geoms that need not touch contype=\"0\" conaffinity=\"0\", use <contact><exclude>, or disable contacts (LoadOptions::disabled_flags += contact)",
                 crate::model::collision_pairs::MAX_COLLISION_PAIRS
             ),
         });
@@ -506,7 +506,7 @@ fn link_mass(
                 if !rules.accept_nonphysical {
                     return Err(e);
                 }
-                warnings.push(format!("{e} [kept as written: --accept-nonphysical-inertia]"));
+                warnings.push(format!("{e} [kept as written: LoadOptions::accept_nonphysical_inertia]"));
                 Ok(None)
             }
         };

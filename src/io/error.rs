@@ -36,9 +36,9 @@ pub enum LoadError {
     ZeroAxis { loc: SourceLoc, joint: String },
     #[error("{loc}: {what} '{link}': negative mass {mass}; mass must be ≥ 0 kg: fix {}", mass_attribute(.what))]
     NegativeMass { loc: SourceLoc, what: LinkWord, link: String, mass: f64 },
-    #[error("{loc}: {what} '{link}': non-physical inertia: {detail}; an inertia tensor must be symmetric positive semi-definite with principal moments satisfying the triangle inequality (I1 + I2 ≥ I3): fix {}, or pass --accept-nonphysical-inertia to use them as written (as Pinocchio does)", inertia_attribute(.what))]
+    #[error("{loc}: {what} '{link}': non-physical inertia: {detail}; an inertia tensor must be symmetric positive semi-definite with principal moments satisfying the triangle inequality (I1 + I2 ≥ I3): fix {}, or set LoadOptions::accept_nonphysical_inertia to use them as written (as Pinocchio does)", inertia_attribute(.what))]
     NonPhysicalInertia { loc: SourceLoc, what: LinkWord, link: String, detail: String },
-    #[error("{loc}: link '{link}': cannot resolve '{uri}': package '{package}' not found (searched: {}); pass --package-dir DIR (the folder holding '{package}/') or add it to ROS_PACKAGE_PATH", searched_list(.searched))]
+    #[error("{loc}: link '{link}': cannot resolve '{uri}': package '{package}' not found (searched: {}); add the folder holding '{package}/' to LoadOptions::package_dirs or to ROS_PACKAGE_PATH", searched_list(.searched))]
     PackageNotFound {
         loc: SourceLoc,
         link: String,
@@ -47,7 +47,7 @@ pub enum LoadError {
         /// The folders searched, in order (boxed to keep `LoadError` small).
         searched: Box<[String]>,
     },
-    #[error("{loc}: link '{link}': mesh file '{path}' does not exist; fix the filename, or point --package-dir / ROS_PACKAGE_PATH at the right package for a package:// path")]
+    #[error("{loc}: link '{link}': mesh file '{path}' does not exist; fix the filename, or point LoadOptions::package_dirs or ROS_PACKAGE_PATH at the right package for a package:// path")]
     MeshNotFound { loc: SourceLoc, link: String, path: String },
     #[error("{loc}: {what} '{link}': the mass properties of mesh '{path}' are needed (the {what}'s inertia comes from its geoms) but {reason}")]
     MeshMass { loc: SourceLoc, what: LinkWord, link: String, path: String, reason: String },
@@ -125,7 +125,7 @@ fn list(names: &[String]) -> String {
 /// The searched folders of a `package://` lookup, or a note that there were none.
 fn searched_list(dirs: &[String]) -> String {
     if dirs.is_empty() {
-        "no folders: no --package-dir given and ROS_PACKAGE_PATH is unset".to_string()
+        "no folders: LoadOptions::package_dirs is empty and ROS_PACKAGE_PATH is unset".to_string()
     } else {
         list(dirs)
     }

@@ -62,7 +62,7 @@ fn disable_flags(spec: &mut ModelSpec, names: &[String]) -> Result<(), LoadError
                     },
                     element: "option".into(),
                     detail: format!(
-                        "--disable {name}: not a MuJoCo <flag>; use one of constraint, equality, limit, frictionloss, contact, spring, damper, gravity, actuation, …"
+                        "LoadOptions::disabled_flags += {name}: not a MuJoCo <flag>; use one of constraint, equality, limit, frictionloss, contact, spring, damper, gravity, actuation, …"
                     ),
                 });
             }

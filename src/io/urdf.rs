@@ -535,9 +535,9 @@ fn root_joint(root: &LinkIndex, index: &Index, options: &LoadOptions) -> Result<
                 loc: j.loc.clone(),
                 element: "joint".into(),
                 detail: format!(
-                    "joint '{ROOT_FREE_JOINT}': loading with --floating adds a free joint named \
+                    "joint '{ROOT_FREE_JOINT}': loading with LoadOptions::floating adds a free joint named \
                      '{ROOT_FREE_JOINT}' for the root link '{}', and this joint has the same name; rename it \
-                     or load without --floating",
+                     or load without LoadOptions::floating",
                     root.name
                 ),
             });

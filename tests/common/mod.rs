@@ -575,17 +575,3 @@ pub fn run(model: &Model, kind: IntegratorKind, q0: &[f64], v0: &[f64], dt: f64,
     }
     State::of(&sim.data)
 }
-
-/// Runs the `lagrange` binary from the repository root: (success, stdout, stderr).
-pub fn lagrange(args: &[&str]) -> (bool, String, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lagrange"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the binary runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}

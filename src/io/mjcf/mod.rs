@@ -96,19 +96,19 @@ fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<Mo
     // The shared load options: each acts on MJCF too, or says that it does not apply.
     if load.floating {
         warnings.push(format!(
-            "{}: --floating applies to URDF only: an MJCF model says which bodies float with <freejoint> (ignored)",
+            "{}: LoadOptions::floating applies to URDF only: an MJCF model says which bodies float with <freejoint> (ignored)",
             path.display()
         ));
     }
     if load.clamp_effort {
         warnings.push(format!(
-            "{}: --clamp-effort applies to URDF <limit effort> only: MJCF joints bound actuator forces with actuatorfrcrange (ignored)",
+            "{}: LoadOptions::clamp_effort applies to URDF <limit effort> only: MJCF joints bound actuator forces with actuatorfrcrange (ignored)",
             path.display()
         ));
     }
     if !load.package_dirs.is_empty() {
         warnings.push(format!(
-            "{}: --package-dir applies to URDF package:// paths only: MJCF paths are relative to the model file or <compiler meshdir/assetdir> (ignored)",
+            "{}: LoadOptions::package_dirs applies to URDF package:// paths only: MJCF paths are relative to the model file or <compiler meshdir/assetdir> (ignored)",
             path.display()
         ));
     }

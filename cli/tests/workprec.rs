@@ -4,9 +4,12 @@
 //! are written, saved and extra rows are merged, the reference dump holds the trajectory, and bad
 //! input is refused naming the flag. No timing is asserted.
 
+#[path = "../../tests/common/mod.rs"]
 mod common;
+mod run;
 
-use common::{lagrange, INTEGRATOR_ORDER_BAND, WORKPREC_SLOPE_TOL};
+use common::{INTEGRATOR_ORDER_BAND, WORKPREC_SLOPE_TOL};
+use run::lagrange;
 use serde_json::Value;
 use std::path::PathBuf;
 

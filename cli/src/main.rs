@@ -328,7 +328,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", cli::in_cli_terms(&e.to_string()));
             ExitCode::FAILURE
         }
     }

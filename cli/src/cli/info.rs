@@ -221,7 +221,7 @@ pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
                     "flags": model.options.flags.changed().into_iter().map(|(n, on)| (n.to_string(), json!(if on { "enable" } else { "disable" }))).collect::<Map<String, Value>>()},
         "keyframes": keyframes,
         "elements": elements,
-        "warnings": model.warnings,
+        "warnings": model.warnings.iter().map(|w| super::in_cli_terms(w)).collect::<Vec<_>>(),
         "stages": stages,
         "constraints": {"mode": plan.mode().name(), "reason": plan.mode_reason},
     })
@@ -325,7 +325,7 @@ pub fn to_text(model: &Model, mode: Option<ConstraintMode>) -> String {
     if !model.warnings.is_empty() {
         let _ = writeln!(s, "\nwarnings ({}):", model.warnings.len());
         for w in &model.warnings {
-            let _ = writeln!(s, "  {w}");
+            let _ = writeln!(s, "  {}", super::in_cli_terms(w));
         }
     }
     s

@@ -16,8 +16,8 @@ use std::time::{Duration, Instant};
 
 /// The scene `lagrange` simulates when run without arguments: the Unitree Go1 of
 /// `models/mjcf/unitree_go1` on its floor (`scene.xml` includes `go1.xml`).
-pub const DEFAULT_SCENE_XML: &str = include_str!("../../../../models/mjcf/unitree_go1/scene.xml");
-pub const DEFAULT_ROBOT_XML: &str = include_str!("../../../../models/mjcf/unitree_go1/go1.xml");
+pub const DEFAULT_SCENE_XML: &str = include_str!("../../../models/mjcf/unitree_go1/scene.xml");
+pub const DEFAULT_ROBOT_XML: &str = include_str!("../../../models/mjcf/unitree_go1/go1.xml");
 /// go1's base height after 5 s from keyframe `home` in MuJoCo 4.0.0 (`mj_resetDataKeyframe`, then
 /// 2500 × `mj_step` with the scene's own options), measured for comparison in the default run.
 pub const DEFAULT_MUJOCO_HEIGHT: f64 = 0.2648645591;

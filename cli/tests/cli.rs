@@ -1,12 +1,15 @@
 //! End-to-end tests of the `lagrange` binary: `info --json` keys, `eval` against the Pinocchio
 //! reference data, `simulate` output and CSV, the default run, and input errors.
 
+#[path = "../../tests/common/mod.rs"]
 mod common;
+mod run;
 
-use common::{lagrange, rel_err_mat, rel_err_vec, REF_REL};
+use common::{rel_err_mat, rel_err_vec, REF_REL};
 use nalgebra::DMatrix;
+use run::lagrange;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn temp_file(name: &str, text: &str) -> PathBuf {
     let path = std::env::temp_dir().join(format!("lagrange-cli-{}-{name}", std::process::id()));
@@ -70,7 +73,7 @@ fn info_text_lists_the_plan_and_mimic() {
 /// `eval` on the Pinocchio reference states reproduces M, bias, qacc and poses at REF_REL.
 #[test]
 fn eval_matches_pinocchio_reference_data() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = run::root();
     let golden: Value = serde_json::from_str(
         &std::fs::read_to_string(root.join("tests/data/pinocchio/solo12.json")).unwrap(),
     )
