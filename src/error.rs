@@ -13,22 +13,53 @@ pub enum InputError {
     /// A slice argument has the wrong length.
     #[error("{function}: {argument} has {got} values, the model needs {expected} ({size})")]
     Length {
+        /// The function called (`aba`, `Model::spring_energy`, …).
         function: &'static str,
+        /// The argument or buffer whose length is wrong (`q`, `tau`, `data.qpos`, …).
         argument: &'static str,
+        /// The length the model needs.
         expected: usize,
+        /// The length given.
         got: usize,
         /// The model's size the length must equal (`nq`, `nv`, `nu`, `na`, …).
         size: &'static str,
     },
     /// An index is not in the model or data.
     #[error("{function}: {what} {index} does not exist ({count} {what}s; indices 0..{count})")]
-    Index { function: &'static str, what: &'static str, index: usize, count: usize },
+    Index {
+        /// The function called.
+        function: &'static str,
+        /// What the index counts (`contact`, `frame`, …).
+        what: &'static str,
+        /// The index given.
+        index: usize,
+        /// How many there are.
+        count: usize,
+    },
     /// A name is not in the model.
     #[error("{function}: the model has no {what} named '{name}'{hint}")]
-    Name { function: &'static str, what: &'static str, name: String, hint: String },
+    Name {
+        /// The function called.
+        function: &'static str,
+        /// What was looked up (`keyframe`, `body, link or site`, …).
+        what: &'static str,
+        /// The name given.
+        name: String,
+        /// Some of the names the model has, to pick from.
+        hint: String,
+    },
     /// A value is not finite.
     #[error("{function}: {argument}[{index}] is {value}, not a finite number")]
-    NonFinite { function: &'static str, argument: &'static str, index: usize, value: f64 },
+    NonFinite {
+        /// The function called.
+        function: &'static str,
+        /// The argument holding the value.
+        argument: &'static str,
+        /// The value's index in the argument.
+        index: usize,
+        /// The value (NaN or ±∞).
+        value: f64,
+    },
 }
 
 impl InputError {

@@ -16,19 +16,43 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum SimError {
+    /// The state became non-finite.
     #[error("the simulation diverged at t = {} s (step {step}): {quantity} of joint '{joint}' is {value}; {hint}", display_time(*.time))]
-    Diverged { time: f64, step: u64, quantity: &'static str, joint: String, value: f64, hint: String },
+    Diverged {
+        /// Simulation time at the end of the step that went non-finite (s).
+        time: f64,
+        /// The step's number (1 = the first).
+        step: u64,
+        /// What went non-finite: position, velocity, or the articulated inertia about an axis.
+        quantity: &'static str,
+        /// The joint where it started.
+        joint: String,
+        /// The non-finite value.
+        value: f64,
+        /// What to try.
+        hint: String,
+    },
+    /// An implicit step's Newton iteration did not converge; the state is left at the step's start.
     #[error("the {integrator} integrator's Newton iteration did not converge in step {step} (t = {} s → {} s, dt = {dt} s): residual {residual:.3e} after {iterations} iterations (last update {update:.3e}, constraint violation {constraint:.3e}); the state is left at the start of the step; reduce SimOptions::timestep", display_time(*.time), display_time(*.time + *.dt))]
     NotConverged {
+        /// The integrator's name.
         integrator: &'static str,
+        /// Simulation time at the start of the step (s).
         time: f64,
+        /// The step's number.
         step: u64,
+        /// The step size (s).
         dt: f64,
+        /// Newton iterations done.
         iterations: u32,
+        /// Max-norm of the residual at the last iterate.
         residual: f64,
+        /// Max-norm of the last Newton update.
         update: f64,
+        /// max |φ| of the equality constraints at the last iterate.
         constraint: f64,
     },
+    /// A state given to the simulation has the wrong length or a non-finite value.
     #[error("invalid initial state: {0}")]
     BadState(String),
     /// A call's argument or the data does not fit the model.
@@ -46,9 +70,13 @@ pub fn display_time(t: f64) -> f64 {
 /// constraint mode).
 #[derive(Clone, Debug, Default)]
 pub struct SimOptions {
+    /// The integrator (the model's `<option integrator>` by default).
     pub integrator: Option<IntegratorKind>,
+    /// The step size in seconds (the model's `<option timestep>` by default).
     pub timestep: Option<f64>,
+    /// The constraint mode (MJCF soft, URDF exact by default).
     pub constraints: Option<ConstraintMode>,
+    /// The exact mode's drift correction (projection after each step by default).
     pub drift: Option<DriftCorrection>,
     /// (rtol, atol) of the adaptive integrator (default: `DEFAULT_RTOL`, `DEFAULT_ATOL`).
     pub tolerances: Option<[f64; 2]>,
@@ -61,11 +89,13 @@ pub struct Simulation {
     /// The state (`time`, `qpos`, `qvel`, `act`), the inputs (`ctrl`, `qfrc_applied`) and the
     /// outputs of the last `forward`.
     pub data: Data,
+    /// The integrator that advances `data`.
     pub stepper: Box<dyn Stepper>,
     /// The step size used by [`step`](Self::step). For a fixed-step integrator it is also the
     /// model's timestep (soft constraints' `refsafe`, `actearly`): set here after
     /// [`new`](Self::new), the model follows at the next step.
     pub timestep: f64,
+    /// Steps taken since [`new`](Self::new).
     pub steps: u64,
     /// What was chosen for the caller and why (integrator fallbacks, constraint mode).
     pub notes: Vec<String>,

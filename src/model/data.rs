@@ -201,7 +201,9 @@ pub struct Data {
     pub qfrc_actuator: DVector<f64>,
     /// Per actuator: transmission length, velocity, and scalar force (MuJoCo's names).
     pub actuator_length: DVector<f64>,
+    /// Per actuator: the transmission's velocity (MuJoCo's `actuator_velocity`).
     pub actuator_velocity: DVector<f64>,
+    /// Per actuator: the scalar force (MuJoCo's `actuator_force`).
     pub actuator_force: DVector<f64>,
     /// Per actuator (rows) and dof (columns): the moment arm ∂actuator_length/∂q̇ (MuJoCo's
     /// `actuator_moment`, stored dense here), so that qfrc_actuator = momentᵀ · actuator_force
@@ -252,6 +254,7 @@ pub struct Data {
     /// Iterative solves since `Data::new` that stopped at their iteration limit (or on a
     /// non-finite value) without meeting the tolerance, and the largest residual they left.
     pub efc_unconverged: u64,
+    /// The largest residual an unconverged iterative solve left.
     pub efc_unconverged_residual: f64,
     /// The exact solver's workspace (Delassus matrix, factors, warm start, active set).
     pub(crate) exact: ExactWork,
@@ -264,6 +267,7 @@ pub struct Data {
     /// Rows of equality constraints and of friction loss in the soft solve (MuJoCo's `ne`, `nf`;
     /// the rows come in MuJoCo's order: equality, friction, limits, contacts).
     pub ne: usize,
+    /// Rows of dof friction loss (MuJoCo's `nf`).
     pub nf: usize,
     /// Per row: the margin within which it is active (MuJoCo's `efc_margin`), its friction loss
     /// (`efc_frictionloss`), the approximate diagonal of J M⁻¹ Jᵀ (`efc_diagA`), the regularizer
@@ -271,12 +275,19 @@ pub struct Data {
     /// (`efc_KBIP`), the reference acceleration (`efc_aref`) and the row's state in the cost
     /// (`efc_state`).
     pub efc_margin: DVector<f64>,
+    /// Per row: its friction loss (MuJoCo's `efc_frictionloss`).
     pub efc_frictionloss: DVector<f64>,
+    /// Per row: the approximate diagonal of J M⁻¹ Jᵀ (MuJoCo's `efc_diagA`).
     pub efc_diag_a: DVector<f64>,
+    /// Per row: the regularizer R (MuJoCo's `efc_R`).
     pub efc_r: DVector<f64>,
+    /// Per row: D = 1/R (MuJoCo's `efc_D`).
     pub efc_d: DVector<f64>,
+    /// Per row: stiffness, damping, impedance and its derivative (MuJoCo's `efc_KBIP`).
     pub efc_kbip: Vec<[f64; 4]>,
+    /// Per row: the reference acceleration (MuJoCo's `efc_aref`).
     pub efc_aref: DVector<f64>,
+    /// Per row: its state in the soft cost (MuJoCo's `efc_state`).
     pub efc_state: Vec<EfcState>,
     /// Per contact (index in `contacts`): the friction coefficient of the regularized cone
     /// (MuJoCo's `mjContact.mu`), set by the soft mode.
@@ -286,7 +297,9 @@ pub struct Data {
     /// Iterations of the last soft solve and its final scaled improvement and gradient
     /// (MuJoCo's `solver_niter` and `solver` statistics).
     pub solver_niter: u32,
+    /// The last soft solve's final scaled improvement of the cost (MuJoCo's `solver.improvement`).
     pub solver_improvement: f64,
+    /// The last soft solve's final scaled gradient norm (MuJoCo's `solver.gradient`).
     pub solver_gradient: f64,
     /// Scratch of the soft solvers (sized nv, nefc or nv × nv).
     pub(crate) soft: SoftWork,

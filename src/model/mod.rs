@@ -32,7 +32,9 @@ use std::path::PathBuf;
 /// Where an element came from, for error messages: file and 1-based line.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct SourceLoc {
+    /// The model file (or `<string>` for a model loaded from text).
     pub file: String,
+    /// The 1-based line in it (0 when unknown).
     pub line: u32,
 }
 
@@ -49,7 +51,9 @@ impl std::fmt::Display for SourceLoc {
 /// A movable joint of the compiled tree.
 #[derive(Clone, Debug)]
 pub struct Joint {
+    /// The joint's name in the file (a fixed URDF joint fused away has none here).
     pub name: String,
+    /// Hinge, slide, ball, free or planar, with its axis.
     pub kind: JointKind,
     /// Index of the body this joint moves (its child).
     pub body: usize,
@@ -77,6 +81,7 @@ pub struct Joint {
     /// Spring stiffness and rest position (MuJoCo `stiffness`, `springref`), applied by
     /// `simulate` as `−stiffness·(q − spring_ref)` for hinge and slide joints.
     pub stiffness: f64,
+    /// The spring's rest position (MuJoCo's `springref`), radians or metres.
     pub spring_ref: f64,
     /// Soft-constraint parameters of the limit and friction-loss rows (soft mode only).
     pub soft: spec::SoftParams,
@@ -85,6 +90,7 @@ pub struct Joint {
 /// A rigid body of the compiled tree (the fused links included).
 #[derive(Clone, Debug)]
 pub struct Body {
+    /// The body's name (the URDF link's or MJCF body's).
     pub name: String,
     /// Parent body (0 = world; the world's own parent is 0).
     pub parent: usize,
@@ -124,8 +130,11 @@ pub enum FrameKind {
 /// A named frame rigidly attached to a body: every URDF link and MJCF body is one (fused or not).
 #[derive(Clone, Debug)]
 pub struct Frame {
+    /// The name of the link, body or site.
     pub name: String,
+    /// Whether it is a link/body, a site or a joint-anchor frame.
     pub kind: FrameKind,
+    /// The compiled body it is attached to (index in `Model::bodies`).
     pub body: usize,
     /// Pose of the frame in its body's frame.
     pub x_body_frame: Transform,
@@ -141,8 +150,11 @@ pub struct Geom {
     pub name: String,
     /// Name of the link or body it belongs to.
     pub link: String,
+    /// The compiled body it is attached to (index in `Model::bodies`).
     pub body: usize,
+    /// Pose of the geom frame in its body's frame.
     pub x_body_geom: Transform,
+    /// The shape and its sizes (metres).
     pub shape: spec::Shape,
     /// Whether it takes part in collisions (URDF `<collision>`; MJCF contype/conaffinity ≠ 0).
     pub collision: bool,
@@ -159,7 +171,9 @@ pub struct Geom {
 /// compiling a [`spec::ModelSpec`].
 #[derive(Clone, Debug)]
 pub struct Model {
+    /// The model's name (MJCF `<mujoco model>`, URDF `<robot name>`).
     pub name: String,
+    /// The file it was loaded from (None for a model compiled from a spec or text).
     pub source: Option<PathBuf>,
     /// Gravity acceleration in the world frame (m/s²).
     pub gravity: Vec3,
@@ -171,9 +185,13 @@ pub struct Model {
     pub body_root: Vec<usize>,
     /// Movable joints: `joints[b - 1]` moves body `b`.
     pub joints: Vec<Joint>,
+    /// Named frames: every link or body (fused or not), site and joint anchor.
     pub frames: Vec<Frame>,
+    /// Geometries, in file order (collision shapes and mass contributions).
     pub geoms: Vec<Geom>,
+    /// Number of generalized coordinates (length of `qpos`).
     pub nq: usize,
+    /// Number of degrees of freedom (length of `qvel`).
     pub nv: usize,
     /// For each degree of freedom, the previous degree of freedom on the path to the root
     /// (Featherstone's λ for the tree-sparse factorization, RBDA §6.3), or `usize::MAX`.
@@ -240,9 +258,13 @@ pub struct Model {
 /// degree of freedom `dof_adr`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spring {
+    /// Index of the joint's coordinate in q.
     pub qpos_adr: usize,
+    /// Index of the joint's degree of freedom in v.
     pub dof_adr: usize,
+    /// Stiffness k (N·m/rad or N/m).
     pub stiffness: f64,
+    /// Rest position (rad or m).
     pub rest: f64,
 }
 
@@ -314,7 +336,6 @@ impl Model {
         }
         q
     }
-    /// Whether any joint has viscous damping (the passive pass of `simulate`).
     /// Upper bound on the number of contacts one collision pass can report (sizes
     /// `Data::contacts` and the contact rows): the sum of each candidate pair's bound, capped at
     /// [`MAX_CONTACTS`] (a resource limit, like MuJoCo's contact arena: contacts beyond it are
@@ -323,6 +344,7 @@ impl Model {
         self.collision_pairs.iter().map(|p| p.max_contacts).sum::<usize>().min(MAX_CONTACTS)
     }
 
+    /// Whether any degree of freedom has viscous damping (the passive stage's damping term).
     pub fn has_damping(&self) -> bool {
         self.dof_damping.iter().any(|&d| d != 0.0)
     }
