@@ -13,7 +13,7 @@ use nalgebra::{DMatrix, DVector, Vector3};
 /// Joint-space inertia matrix M(q), armature included, into `data.mass_matrix` (and returned).
 ///
 /// The composite-rigid-body algorithm (RBDA §6.2, Table 6.2) evaluated in world coordinates: composite
-/// inertias then add without change of frame, and the entry M[i][j] for j an ancestor degree of
+/// inertias then add without change of frame, and the entry `M[i][j]` for j an ancestor degree of
 /// freedom is the plain product S_jᵀ (Iᶜ_i S_i) of world-frame vectors, so the walk up the tree
 /// transforms nothing.
 ///
@@ -37,7 +37,7 @@ pub(crate) fn crba_unchecked<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -
     &data.mass_matrix
 }
 
-/// [`crba`] writing only the upper triangle of `data.mass_matrix` (the entries M[l][k], l ≤ k, on
+/// [`crba`] writing only the upper triangle of `data.mass_matrix` (the entries `M[l][k]`, l ≤ k, on
 /// the tree's ancestor chains), as Pinocchio's `crba` does: what [`factorize_mass_matrix`] reads.
 /// The strictly lower triangle keeps whatever it held (after [`crba`], an older M's mirror).
 ///

@@ -4,8 +4,9 @@
 //!
 //! The continuous dynamics are q̇ = v (on the configuration manifold, see
 //! [`integrate_configuration`](crate::model::integrate_configuration)) and v̇ = `qacc` of
-//! `forward`. With constraint rows, drift is corrected after each step ([`correct_drift`]): q is
-//! projected onto φ(q) = 0 and v onto J v = 0, as the plan's [`DriftCorrection`] says.
+//! `forward`. With constraint rows, drift is corrected after each step by the model's constraint solver
+//! ([`ConstraintSolver`](crate::constraint::ConstraintSolver)): in exact mode q is projected onto
+//! φ(q) = 0 and v onto J v = 0, as its [`DriftCorrection`](crate::constraint::DriftCorrection) says.
 
 mod adaptive;
 mod bias_derivative;
@@ -99,8 +100,8 @@ pub struct StepReport {
 }
 
 impl StepReport {
-    /// The report of an accepted fixed step `h`, with the (iterations, violation) of
-    /// [`correct_drift`].
+    /// The report of an accepted fixed step `h`, with the (iterations, violation) of the drift
+    /// correction.
     pub fn fixed_step(h: f64, (iterations, violation): (u32, [f64; 2])) -> Self {
         Self {
             accepted: true,
