@@ -14,7 +14,7 @@
 //! norm with s = max(|w₀|, |w₁|)), clamped to `actrange` after each accepted internal step.
 
 use super::stage::{evaluate_stage, StageInput};
-use super::{correct_drift, State, StepReport, Stepper};
+use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::forward::clamp_activations;
 use crate::model::{integrate_configuration_unchecked, Data, JointKind, Model};
 use nalgebra::DVector;
@@ -158,17 +158,15 @@ impl Stepper for DormandPrince54 {
         5
     }
     fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
-        let mut stage_act = std::mem::take(&mut self.stage_act);
-        let mut state = State::take(data, &mut stage_act);
-        let report = self.advance(model, data, &mut state, h);
-        state.put(data, &mut stage_act);
-        self.stage_act = stage_act;
-        report
+        self.step_moved(model, data, h)
     }
 }
 
-impl DormandPrince54 {
-    /// One step of the method on the state moved out of `data` ([`State::take`]).
+impl Advance for DormandPrince54 {
+    fn stage_act(&mut self) -> &mut DVector<f64> {
+        &mut self.stage_act
+    }
+
     fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         let t_end = state.time + h;
         let mut h_try = self.h_proposed.unwrap_or(h).min(h);

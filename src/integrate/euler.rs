@@ -4,7 +4,7 @@
 //! v ← v + h (M + h·diag(damping))⁻¹ M v̇, which keeps strongly damped joints stable.
 
 use super::implicit_fast::implicit_acceleration;
-use super::{correct_drift, State, StepReport, Stepper};
+use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::forward::{advance_activations, forward_at};
 use crate::model::{integrate_configuration_unchecked, Data, Model};
 use nalgebra::DVector;
@@ -30,17 +30,15 @@ impl Stepper for SemiImplicitEuler {
         1
     }
     fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
-        let mut stage_act = std::mem::take(&mut self.stage_act);
-        let mut state = State::take(data, &mut stage_act);
-        let report = self.advance(model, data, &mut state, h);
-        state.put(data, &mut stage_act);
-        self.stage_act = stage_act;
-        report
+        self.step_moved(model, data, h)
     }
 }
 
-impl SemiImplicitEuler {
-    /// One step of the method on the state moved out of `data` ([`State::take`]).
+impl Advance for SemiImplicitEuler {
+    fn stage_act(&mut self) -> &mut DVector<f64> {
+        &mut self.stage_act
+    }
+
     fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         data.act.copy_from(&state.act);
         forward_at(model, data, state.q.as_slice(), state.v.as_slice());

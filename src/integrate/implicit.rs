@@ -11,7 +11,7 @@
 //! actuator part of D is [`add_force_derivative`]'s, shared with implicitfast, which drops ∂c/∂v.
 
 use super::bias_derivative::BiasDerivative;
-use super::{add_force_derivative, correct_drift, State, StepReport, Stepper};
+use super::{add_force_derivative, correct_drift, Advance, State, StepReport, Stepper};
 use crate::dynamics::crba_unchecked;
 use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
 use crate::model::{integrate_configuration_unchecked, Data, Model};
@@ -82,17 +82,15 @@ impl Stepper for Implicit {
         1
     }
     fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
-        let mut stage_act = std::mem::take(&mut self.stage_act);
-        let mut state = State::take(data, &mut stage_act);
-        let report = self.advance(model, data, &mut state, h);
-        state.put(data, &mut stage_act);
-        self.stage_act = stage_act;
-        report
+        self.step_moved(model, data, h)
     }
 }
 
-impl Implicit {
-    /// One step of the method on the state moved out of `data` ([`State::take`]).
+impl Advance for Implicit {
+    fn stage_act(&mut self) -> &mut DVector<f64> {
+        &mut self.stage_act
+    }
+
     fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         let nv = model.nv;
         data.act.copy_from(&state.act);

@@ -12,7 +12,7 @@
 //! (implicit damping), so its `mj_step` is the reference on damped passive scenes.
 //! [`Implicit`](super::Implicit) adds the Coriolis derivatives −∂c/∂v to D.
 
-use super::{correct_drift, State, StepReport, Stepper};
+use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
 use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
 use crate::model::{integrate_configuration_unchecked, Data, Model};
@@ -86,17 +86,15 @@ impl Stepper for ImplicitFast {
         1
     }
     fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
-        let mut stage_act = std::mem::take(&mut self.stage_act);
-        let mut state = State::take(data, &mut stage_act);
-        let report = self.advance(model, data, &mut state, h);
-        state.put(data, &mut stage_act);
-        self.stage_act = stage_act;
-        report
+        self.step_moved(model, data, h)
     }
 }
 
-impl ImplicitFast {
-    /// One step of the method on the state moved out of `data` ([`State::take`]).
+impl Advance for ImplicitFast {
+    fn stage_act(&mut self) -> &mut DVector<f64> {
+        &mut self.stage_act
+    }
+
     fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         data.act.copy_from(&state.act);
         forward_at(model, data, state.q.as_slice(), state.v.as_slice());

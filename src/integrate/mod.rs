@@ -71,6 +71,26 @@ impl State {
     }
 }
 
+/// A method's step on the state moved out of `Data` for the duration of the step
+/// ([`State::take`], [`State::put`]); every stepper's [`Stepper::step`] is [`step_moved`](Self::step_moved).
+pub(crate) trait Advance {
+    /// The stepper's buffer for the activations its stages evaluate at (na values).
+    fn stage_act(&mut self) -> &mut DVector<f64>;
+
+    /// One step of the method on `state`, with the inputs in `data`.
+    fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport;
+
+    /// Moves the state out of `data`, advances it, and moves it back.
+    fn step_moved(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
+        let mut stage_act = std::mem::take(self.stage_act());
+        let mut state = State::take(data, &mut stage_act);
+        let report = self.advance(model, data, &mut state, h);
+        state.put(data, &mut stage_act);
+        *self.stage_act() = stage_act;
+        report
+    }
+}
+
 /// What one step did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepReport {

@@ -11,7 +11,7 @@
 //! with its exponential factor, then clamped to `actrange`).
 
 use super::stage::{evaluate_stage, StageInput};
-use super::{correct_drift, State, StepReport, Stepper};
+use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::forward::advance_activations;
 use crate::model::{integrate_configuration_unchecked, Data, Model};
 use nalgebra::DVector;
@@ -54,17 +54,15 @@ impl Stepper for RungeKutta4 {
         4
     }
     fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
-        let mut stage_act = std::mem::take(&mut self.stage_act);
-        let mut state = State::take(data, &mut stage_act);
-        let report = self.advance(model, data, &mut state, h);
-        state.put(data, &mut stage_act);
-        self.stage_act = stage_act;
-        report
+        self.step_moved(model, data, h)
     }
 }
 
-impl RungeKutta4 {
-    /// One step of the method on the state moved out of `data` ([`State::take`]).
+impl Advance for RungeKutta4 {
+    fn stage_act(&mut self) -> &mut DVector<f64> {
+        &mut self.stage_act
+    }
+
     fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         // Stage i evaluates at q₀ ⊕ θᵢ, v₀ + cᵢ h a_{i−1} with θᵢ = cᵢ h θ̇_{i−1}, c = (0, ½, ½, 1).
         const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];

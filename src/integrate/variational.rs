@@ -47,7 +47,7 @@
 //! variational structure.
 
 use super::lagrangian_terms::LagrangianTerms;
-use super::{correct_drift, State, StepFailure, StepReport, Stepper};
+use super::{correct_drift, Advance, State, StepFailure, StepReport, Stepper};
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
 use crate::forward::{accumulate_xfrc, actuation, advance_activations, passive};
 use crate::kinematics::forward_kinematics_unchecked;
@@ -351,17 +351,15 @@ impl Stepper for Variational {
         self.failure
     }
     fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
-        let mut stage_act = std::mem::take(&mut self.stage_act);
-        let mut state = State::take(data, &mut stage_act);
-        let report = self.advance(model, data, &mut state, h);
-        state.put(data, &mut stage_act);
-        self.stage_act = stage_act;
-        report
+        self.step_moved(model, data, h)
     }
 }
 
-impl Variational {
-    /// One step of the method on the state moved out of `data` ([`State::take`]).
+impl Advance for Variational {
+    fn stage_act(&mut self) -> &mut DVector<f64> {
+        &mut self.stage_act
+    }
+
     fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         self.failure = None;
         let nv = model.nv;
