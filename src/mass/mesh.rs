@@ -88,7 +88,7 @@ impl TriangleMesh {
             .sum()
     }
 
-    /// The edge topology (closedness and orientation), see [`topology::analyze`]. Indices must be
+    /// The edge topology (closedness and orientation), see [`Topology`](crate::mass::Topology). Indices must be
     /// in range.
     pub fn topology(&self) -> topology::Topology {
         topology::analyze(self)
