@@ -4,8 +4,9 @@
 //!
 //! The continuous dynamics are q̇ = v (on the configuration manifold, see
 //! [`integrate_configuration`](crate::model::integrate_configuration)) and v̇ = `qacc` of
-//! `forward`. With constraint rows, drift is corrected after each step ([`correct_drift`]): q is
-//! projected onto φ(q) = 0 and v onto J v = 0, as the plan's [`DriftCorrection`] says.
+//! `forward`. With constraint rows, drift is corrected after each step (`correct_drift`): q is
+//! projected onto φ(q) = 0 and v onto J v = 0, as the plan's
+//! [`DriftCorrection`](crate::constraint::DriftCorrection) says.
 
 mod adaptive;
 mod bias_derivative;
@@ -41,9 +42,13 @@ use nalgebra::DVector;
 /// clamped to `actrange`; [`advance_activations`](crate::forward::advance_activations)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct State {
+    /// Simulation time (s).
     pub time: f64,
+    /// Configuration (`qpos`, nq values).
     pub q: DVector<f64>,
+    /// Velocity (`qvel`, nv values).
     pub v: DVector<f64>,
+    /// Actuator activations (`act`, na values).
     pub act: DVector<f64>,
 }
 
@@ -99,8 +104,8 @@ pub struct StepReport {
 }
 
 impl StepReport {
-    /// The report of an accepted fixed step `h`, with the (iterations, violation) of
-    /// [`correct_drift`].
+    /// The report of an accepted fixed step `h`, with the (iterations, violation) of the drift
+    /// correction (`correct_drift`).
     pub fn fixed_step(h: f64, (iterations, violation): (u32, [f64; 2])) -> Self {
         Self {
             accepted: true,
@@ -161,7 +166,9 @@ pub(crate) fn correct_drift(model: &Model, data: &mut Data, state: &mut State, h
 /// The integrators `simulate` offers, by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum IntegratorKind {
+    /// MuJoCo's semi-implicit Euler ([`SemiImplicitEuler`]).
     Euler,
+    /// Classical fourth-order Runge–Kutta on the configuration manifold ([`RungeKutta4`]).
     Rk4,
     /// Dormand–Prince 5(4) with error control at [`DEFAULT_RTOL`]/[`DEFAULT_ATOL`]
     /// ([`DormandPrince54::new`] takes others).
@@ -199,6 +206,7 @@ impl IntegratorKind {
         }
     }
 
+    /// Short name (`euler`, `rk4`, …), as reports print it.
     pub fn name(self) -> &'static str {
         match self {
             IntegratorKind::Euler => "euler",
