@@ -130,7 +130,8 @@ pub enum LoadError {
     },
     /// A link's or body's mass properties are not physical (non-finite, non-symmetric, a negative
     /// principal moment, or moments violating the triangle inequality), unless accepted by
-    /// `--accept-nonphysical-inertia` ([`MassRules::accept_nonphysical`](crate::model::MassRules)).
+    /// `--accept-nonphysical-inertia`
+    /// ([`MassRules::accept_nonphysical`](crate::model::spec::MassRules::accept_nonphysical)).
     #[error("{loc}: {what} '{link}': non-physical inertia: {detail}; an inertia tensor must be symmetric positive semi-definite with principal moments satisfying the triangle inequality (I1 + I2 ≥ I3): fix {}, or pass --accept-nonphysical-inertia to use them as written (as Pinocchio does)", inertia_attribute(.what))]
     NonPhysicalInertia {
         /// File and line of the `<inertial>` (or of the link when the mass comes from geoms).
