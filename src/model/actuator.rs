@@ -12,7 +12,7 @@ use super::{JointKind, Model, SourceLoc, TendonKind};
 pub enum ActuatorShortcut {
     /// `<general>`: the parameters as written.
     General,
-    /// `<motor>`: force = gear · control.
+    /// `<motor>`: force = control (gain 1, no bias).
     Motor,
     /// `<position>`: a position servo (gain `kp`, bias −`kp` · length − `kv` · velocity).
     Position,
