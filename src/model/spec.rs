@@ -47,18 +47,19 @@ pub struct ModelSpec {
 /// MuJoCo's `<compiler>` rules for mass properties, applied per link in this order: inertia from
 /// geoms (decided per link, [`LinkSpec::inertia_from_geoms`]), `boundmass` and `boundinertia` (lower
 /// bounds on the mass and the principal moments), `balanceinertia` (replace moments that violate
-/// the triangle inequality by their mean), then `settotalmass` (scale all moving masses).
+/// the triangle inequality by their mean), then `settotalmass` (scale the masses of all links but
+/// the world).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MassRules {
-    /// Lower bound on every moving link's mass (kg; MJCF `boundmass`, 0 = none).
+    /// Lower bound on the mass of every link but the world (kg; MJCF `boundmass`, 0 = none).
     pub bound_mass: f64,
-    /// Lower bound on every moving link's principal moments of inertia (kg·m²; MJCF
+    /// Lower bound on the principal moments of inertia of every link but the world (kg·m²; MJCF
     /// `boundinertia`, 0 = none).
     pub bound_inertia: f64,
     /// Replace principal moments that violate the triangle inequality by their mean (MJCF
     /// `balanceinertia`); otherwise such moments are an error.
     pub balance_inertia: bool,
-    /// Scale the masses and inertias of the moving links so that they total this (kg).
+    /// Scale the masses and inertias of all links but the world so that they total this (kg).
     pub total_mass: Option<f64>,
     /// Every moving body (its welded links included) must have mass and principal moments of at
     /// least MuJoCo's `mjMINVAL` (MJCF; URDF allows massless moving links with massive children).
