@@ -16,7 +16,9 @@ use std::sync::Arc;
 /// An initial state: configuration `q` (nq values) and velocity `v` (nv values), at time 0.
 #[derive(Clone, Debug, PartialEq)]
 pub struct InitialState {
+    /// Configuration, `nq` values in MuJoCo's qpos layout.
     pub q: Vec<f64>,
+    /// Velocity, `nv` values in MuJoCo's qvel layout.
     pub v: Vec<f64>,
 }
 
@@ -37,8 +39,11 @@ pub struct BatchOptions {
 /// One recorded state of a rollout.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sample {
+    /// Simulation time (s).
     pub time: f64,
+    /// Configuration (`qpos`).
     pub q: Vec<f64>,
+    /// Velocity (`qvel`).
     pub v: Vec<f64>,
 }
 

@@ -28,6 +28,7 @@
 //! State vectors use MuJoCo's qpos/qvel layout; `docs/architecture.md` describes the layers, the
 //! pipeline and the solvers, `docs/physics.md` the closed forms the tests check.
 
+#![warn(missing_docs)]
 // The kernels index several parallel per-dof arrays (S, v, q̈, τ) with one dof index; iterator
 // zips over four slices would hide the RBDA table they transcribe.
 #![allow(clippy::needless_range_loop)]

@@ -12,6 +12,7 @@ use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, Supp
 /// An ellipsoid with semi-axes `radii` about its frame's axes.
 #[derive(Clone, Debug)]
 pub struct Ellipsoid {
+    /// Semi-axes along the frame's x, y, z (m).
     pub radii: Vector,
 }
 
@@ -31,11 +32,17 @@ impl SupportMap for Ellipsoid {
 /// a cylinder carries the rotation from lagrange's z axis).
 #[derive(Clone, Debug)]
 pub enum ConvexShape {
+    /// A sphere.
     Ball(Ball),
+    /// A capsule along the geom's z axis.
     Capsule(Capsule),
+    /// A box (half-extents).
     Cuboid(Cuboid),
+    /// A cylinder, parry's y axis standing for the geom's z axis.
     Cylinder(Cylinder),
+    /// An ellipsoid.
     Ellipsoid(Ellipsoid),
+    /// A mesh's convex hull.
     Hull(ConvexPolyhedron),
 }
 
@@ -60,9 +67,13 @@ impl SupportMap for ConvexShape {
 /// towards geom 2, the signed distance.
 #[derive(Clone, Copy, Debug)]
 pub struct PairPoint {
+    /// Witness point on geom 1's surface (world).
     pub p1: Vec3,
+    /// Witness point on geom 2's surface (world).
     pub p2: Vec3,
+    /// Unit normal from geom 1 towards geom 2 (world).
     pub normal: Vec3,
+    /// Signed distance (m), negative = penetration.
     pub dist: f64,
 }
 

@@ -41,7 +41,10 @@ pub const EXACT_REACH: f64 = 1e-3;
 /// bounding-sphere radius. Built once per model.
 #[derive(Clone, Debug, Default)]
 pub struct CollisionModel {
+    /// Per geom, its support-map shape (`None` for planes, height fields and non-colliding meshes).
     pub shapes: Vec<Option<ConvexShape>>,
+    /// Per geom, its bounding-sphere radius about the geom origin (m; infinite for planes and
+    /// height fields).
     pub rbound: Vec<f64>,
     /// Per candidate pair (`Model::collision_pairs` order), what the bounding-sphere test needs,
     /// packed: the two geoms, the pair's margin + gap plus both bounding radii (geom 2's alone
@@ -52,12 +55,18 @@ pub struct CollisionModel {
 /// The bounding-sphere test of one candidate pair (see [`CollisionModel::broad`]).
 #[derive(Clone, Copy, Debug)]
 pub struct BroadPair {
+    /// The pair's geoms (indices in `Model::geoms`).
     pub geom: [u32; 2],
+    /// Margin + gap plus both bounding radii (geom 2's alone against a plane) (m): the distance
+    /// between the geom origins (against a plane, geom 2's height above it) beyond which the pair
+    /// cannot touch.
     pub reach: f64,
+    /// Whether geom 1 is a plane.
     pub plane: bool,
 }
 
 impl CollisionModel {
+    /// The shapes, bounding radii and broad-phase data of `model`'s geoms and candidate pairs.
     pub fn new(model: &Model) -> Self {
         let mut shapes = Vec::with_capacity(model.geoms.len());
         let mut rbound = Vec::with_capacity(model.geoms.len());

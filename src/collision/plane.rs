@@ -20,8 +20,11 @@ use crate::spatial::{Transform, Vec3};
 /// tangent hint.
 #[derive(Clone, Copy, Debug)]
 pub struct PlanePoint {
+    /// The point on the geom's surface (world).
     pub surface: Vec3,
+    /// Its signed distance above the plane (m), negative = penetration.
     pub dist: f64,
+    /// Direction for the contact frame's first tangent (a capsule's axis), if any.
     pub hint: Option<Vec3>,
     /// Which feature of the geom: corner, end, rim point or hull vertex index.
     pub feature: u32,

@@ -77,9 +77,11 @@ pub struct ContactInfo<'a> {
     pub index: usize,
     /// The collision data (MuJoCo's `mjContact`).
     pub contact: &'a Contact,
-    /// The geoms' names (empty for unnamed geoms) and their bodies (indices in `Model::bodies`).
+    /// The geoms' names (empty for unnamed geoms).
     pub geom_names: [&'a str; 2],
+    /// The geoms' bodies (indices in `Model::bodies`).
     pub body: [usize; 2],
+    /// The bodies' names.
     pub body_names: [&'a str; 2],
     /// Whether the contact has constraint rows (closer than its margin): only then a force.
     pub active: bool,

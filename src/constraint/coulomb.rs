@@ -32,6 +32,7 @@ use crate::model::{Data, EfcType, Model};
 /// Iteration limit and tolerance of the Gauss–Seidel solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverSettings {
+    /// The most Gauss–Seidel sweeps per solve.
     pub max_iterations: u32,
     /// Relative tolerance on the change one sweep makes to the motion, max |M⁻¹Jᵀ Δλ|, against the
     /// constraint forces' whole correction max |M⁻¹Jᵀ λ|.
@@ -67,7 +68,10 @@ pub enum Level {
     /// |dt λ̄ + p| ≤ f dt; for a contact, dt λ̄_f + p_f lies in the cone of dt λ̄_n + p_n. A slip that
     /// the step's friction could have stopped thus ends at rest instead of reversing, and a slip
     /// that friction could not stop keeps the velocity the step gave it.
-    Velocity { dt: f64 },
+    Velocity {
+        /// The step (s).
+        dt: f64,
+    },
 }
 
 /// Solves the rows' conditions on A (`efc_delassus`) and b (`efc_rhs`, first nefc entries); λ is

@@ -12,6 +12,7 @@ use crate::model::{Data, EfcType, Model};
 pub struct FrictionRow {
     /// Index in `Model::joints`.
     pub joint: usize,
+    /// Index of the dof in `qvel`.
     pub dof: usize,
     /// The bound f on |λ| (N or N·m).
     pub loss: f64,

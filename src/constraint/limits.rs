@@ -26,9 +26,15 @@ const BALL_AXIS_EPS: f64 = 1e-12;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LimitKind {
     /// A hinge or slide joint with `[lower, upper]`.
-    Scalar { range: [f64; 2] },
+    Scalar {
+        /// `[lower, upper]` (rad or m).
+        range: [f64; 2],
+    },
     /// A ball joint whose rotation angle may not exceed `max_angle` (rad).
-    Cone { max_angle: f64 },
+    Cone {
+        /// The cone's half-angle (rad).
+        max_angle: f64,
+    },
 }
 
 /// A limited joint: a unilateral row when it reaches a bound.
@@ -36,8 +42,11 @@ pub enum LimitKind {
 pub struct LimitRow {
     /// Index in `Model::joints`.
     pub joint: usize,
+    /// The joint's first index in `qpos`.
     pub qpos_adr: usize,
+    /// The joint's first index in `qvel`.
     pub dof_adr: usize,
+    /// Its bounds.
     pub kind: LimitKind,
 }
 

@@ -48,6 +48,7 @@ pub enum ConstraintMode {
 }
 
 impl ConstraintMode {
+    /// `exact` or `soft`, as `info` and `eval` print it.
     pub fn name(self) -> &'static str {
         match self {
             ConstraintMode::Exact => "exact",

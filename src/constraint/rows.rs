@@ -29,12 +29,16 @@ use crate::spatial::{Mat3, Transform, Vec3};
 /// length Σ coef · q.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ScalarCoord {
+    /// A hinge or slide joint's value.
     Joint {
+        /// Its index in `qpos`.
         qpos_adr: usize,
+        /// Its index in `qvel`.
         dof_adr: usize,
     },
-    /// (qpos address, dof address, coefficient) of each joint of a fixed tendon.
+    /// A fixed tendon's length.
     Tendon {
+        /// (qpos address, dof address, coefficient) of each joint of a fixed tendon.
         terms: Vec<(usize, usize, f64)>,
     },
 }
@@ -66,12 +70,43 @@ impl ScalarCoord {
 #[derive(Clone, Debug, PartialEq)]
 pub enum RowGeometry {
     /// Point `r_a` of body `a` coincides with point `r_b` of body `b` (3 rows).
-    Points { a: usize, r_a: Vec3, b: usize, r_b: Vec3 },
+    Points {
+        /// Body A (index in `Model::bodies`).
+        a: usize,
+        /// The point in body A's coordinates (m).
+        r_a: Vec3,
+        /// Body B (index in `Model::bodies`).
+        b: usize,
+        /// The point in body B's coordinates (m).
+        r_b: Vec3,
+    },
     /// Frame `x_a` of body `a` coincides with frame `x_b` of body `b` (3 + 3 rows; rotation rows
     /// scaled by `torquescale`, absent when it is 0).
-    Frames { a: usize, x_a: Transform, b: usize, x_b: Transform, torquescale: f64 },
+    Frames {
+        /// Body A (index in `Model::bodies`).
+        a: usize,
+        /// The frame's pose in body A.
+        x_a: Transform,
+        /// Body B (index in `Model::bodies`).
+        b: usize,
+        /// The frame's pose in body B.
+        x_b: Transform,
+        /// Scale of the rotation rows (MJCF `torquescale`).
+        torquescale: f64,
+    },
     /// x₁ − ref₁ = P(x₂ − ref₂) (1 row).
-    Scalar { first: ScalarCoord, second: Option<ScalarCoord>, polycoef: [f64; 5], ref1: f64, ref2: f64 },
+    Scalar {
+        /// x₁: the constrained coordinate.
+        first: ScalarCoord,
+        /// x₂: the coordinate it follows (`None`: x₁ − ref₁ = a₀).
+        second: Option<ScalarCoord>,
+        /// The polynomial's coefficients a₀…a₄ (a URDF mimic: offset, multiplier, 0, 0, 0).
+        polycoef: [f64; 5],
+        /// x₁'s reference (its value at `qpos0`; 0 for a URDF mimic).
+        ref1: f64,
+        /// x₂'s reference (its value at `qpos0`; 0 for a URDF mimic or without `second`).
+        ref2: f64,
+    },
 }
 
 impl RowGeometry {
@@ -95,6 +130,7 @@ impl RowGeometry {
 pub struct EqualityRows {
     /// Index in `Model::equalities`.
     pub id: usize,
+    /// What its rows constrain.
     pub geometry: RowGeometry,
 }
 
@@ -103,9 +139,12 @@ pub struct EqualityRows {
 pub struct ConstraintModel {
     /// The geoms' collision shapes (contacts come from `Model::collision_pairs`).
     pub collision: CollisionModel,
+    /// Equality constraints and URDF mimics with rows (all of them unless `<flag equality>` or
+    /// `constraint` is off).
     pub equalities: Vec<EqualityRows>,
     /// Degrees of freedom with dry friction (`frictionloss`), one row each, always active.
     pub friction: Vec<FrictionRow>,
+    /// Limited joints, one entry each (rows when a bound is within the margin).
     pub limits: Vec<LimitRow>,
     /// Fixed tendons with a length range: a row per bound within the tendon's margin, soft mode
     /// only (the exact mode has no tendon rows: `Plan::new` empties this list there and lists the

@@ -49,13 +49,16 @@ pub struct ExactSolver {
 /// (`solver`, `iterations`, `tolerance`, …).
 #[derive(Clone, Debug, Default)]
 pub struct SoftSolver {
+    /// The inverse weights at `qpos0` (`None` without constraint rows).
     pub weights: Option<InverseWeights>,
 }
 
 /// The model's constraint solver (part of [`Plan`](crate::forward::Plan)).
 #[derive(Clone, Debug)]
 pub enum ConstraintSolver {
+    /// Rigid constraints ([`ConstraintMode::Exact`](super::ConstraintMode::Exact)).
     Exact(ExactSolver),
+    /// MuJoCo's soft model ([`ConstraintMode::Soft`](super::ConstraintMode::Soft)).
     Soft(SoftSolver),
 }
 

@@ -12,31 +12,48 @@ use serde::Serialize;
 /// and what the model holds that is not simulated yet).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum StageKind {
+    /// Body poses, M and its factor, constraint rows (MuJoCo's `mj_fwdPosition`).
     Position,
+    /// Bias forces and the rows' velocity terms (`mj_fwdVelocity`).
     Velocity,
+    /// Joint damping and springs (`mj_passive`).
     Passive,
+    /// Actuator forces and activation derivatives (`mj_fwdActuation`).
     Actuation,
+    /// Unconstrained acceleration `qacc_smooth` (`mj_fwdAcceleration`), or ABA without rows.
     Acceleration,
+    /// The constraint solve (`mj_fwdConstraint`).
     Constraint,
+    /// Rows of equality constraints and URDF mimics.
     Equality,
+    /// Rows of joint limits (and fixed-tendon limits).
     JointLimits,
+    /// Rows of joint friction loss.
     FrictionLoss,
+    /// Collision detection and contact rows.
     Collision,
+    /// Spatial tendons (kept, not simulated).
     Tendons,
+    /// Sensors (kept, not evaluated).
     Sensors,
+    /// Other passive forces MuJoCo computes (fluid forces, gravity compensation, spring-dampers, …;
+    /// not simulated).
     PassiveOther,
 }
 
 /// Whether a stage runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum Status {
+    /// The stage runs in `forward`.
     Runs,
+    /// The model has nothing for it (or a `<flag>` switches it off).
     Skipped,
     /// The model has such elements; they are kept and listed, not simulated yet.
     NotSimulated,
 }
 
 impl Status {
+    /// The status as `info` prints it.
     pub fn as_str(self) -> &'static str {
         match self {
             Status::Runs => "runs",
@@ -49,9 +66,13 @@ impl Status {
 /// One stage with its status and the reason.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Stage {
+    /// Which stage.
     pub kind: StageKind,
+    /// Its name as `info` prints it (`position`, `joint limits`, …).
     pub name: &'static str,
+    /// Whether it runs.
     pub status: Status,
+    /// What it does for this model, or why it does not run.
     pub reason: String,
 }
 
@@ -61,6 +82,7 @@ pub struct Stage {
 /// model without elements (what a model holds while it is being compiled).
 #[derive(Clone, Debug, Default)]
 pub struct Plan {
+    /// Every stage in pipeline order, then the row sources and the elements not simulated.
     pub stages: Vec<Stage>,
     /// Why the constraint mode is what it is (requested, the format's default, or a fallback).
     pub mode_reason: String,
@@ -351,7 +373,7 @@ fn stages(
             "collision",
             Runs,
             format!(
-                "{npairs} candidate geom pairs ({} explicit <pair>) among {colliding} collision geoms, up to {bound} contacts: bounding spheres, then closed forms (planes, spheres, capsules) or GJK/EPA; {}{hfield_note}",
+                "{npairs} candidate geom pairs ({} explicit <pair>) among {colliding} collision geoms, up to {bound} contacts: bounding spheres, then closed forms (planes, spheres, capsules, boxes) or GJK/EPA; {}{hfield_note}",
                 model.collision_pairs.iter().filter(|p| p.pair.is_some()).count(),
                 if mode == ConstraintMode::Soft {
                     "soft mode: rows for contacts closer than their margin (detected to margin + gap)"

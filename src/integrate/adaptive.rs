@@ -36,13 +36,16 @@ const B4: [f64; 7] =
 
 /// Default tolerances of `--integrator adaptive`.
 pub const DEFAULT_RTOL: f64 = 1e-8;
+/// Default absolute tolerance of `--integrator adaptive`.
 pub const DEFAULT_ATOL: f64 = 1e-10;
 
 /// Dormand–Prince 5(4) stepper with error control.
 pub struct DormandPrince54 {
     /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
     stage_act: DVector<f64>,
+    /// Relative tolerance of the error control.
     pub rtol: f64,
+    /// Absolute tolerance of the error control (m, rad, m/s, rad/s as the component is).
     pub atol: f64,
     /// The internal step size proposed for the next step (None before the first).
     h_proposed: Option<f64>,
@@ -60,6 +63,7 @@ pub struct DormandPrince54 {
 }
 
 impl DormandPrince54 {
+    /// The stepper for `model` with tolerances `rtol` and `atol`.
     pub fn new(model: &Model, rtol: f64, atol: f64) -> Self {
         let z = || DVector::zeros(model.nv);
         let mut flat_qpos = vec![None; model.nv];

@@ -34,6 +34,7 @@ pub struct BiasDerivative {
 }
 
 impl BiasDerivative {
+    /// Buffers sized for `model`, the derivative zero.
     pub fn new(model: &Model) -> Self {
         let nb = model.nbody();
         Self {

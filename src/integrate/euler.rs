@@ -17,6 +17,7 @@ pub struct SemiImplicitEuler {
 }
 
 impl SemiImplicitEuler {
+    /// The stepper with its buffers sized for `model`.
     pub fn new(model: &Model) -> Self {
         Self { stage_act: DVector::zeros(model.na()), damped: DVector::zeros(model.nv) }
     }

@@ -27,6 +27,7 @@ pub struct Implicit {
 }
 
 impl Implicit {
+    /// The stepper with its buffers sized for `model`.
     pub fn new(model: &Model) -> Self {
         Self {
             stage_act: DVector::zeros(model.na()),

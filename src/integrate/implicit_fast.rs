@@ -26,6 +26,7 @@ pub struct ImplicitFast {
 }
 
 impl ImplicitFast {
+    /// The stepper with its buffers sized for `model`.
     pub fn new(model: &Model) -> Self {
         Self { stage_act: DVector::zeros(model.na()), force: DVector::zeros(model.nv) }
     }

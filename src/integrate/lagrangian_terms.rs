@@ -48,6 +48,7 @@ pub struct LagrangianTerms {
 }
 
 impl LagrangianTerms {
+    /// Buffers sized for `model`, the terms zero.
     pub fn new(model: &Model) -> Self {
         let nb = model.nbody();
         Self {

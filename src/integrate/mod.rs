@@ -42,9 +42,13 @@ use nalgebra::DVector;
 /// clamped to `actrange`; [`advance_activations`](crate::forward::advance_activations)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct State {
+    /// Simulation time (s).
     pub time: f64,
+    /// Configuration (`qpos`, nq values).
     pub q: DVector<f64>,
+    /// Velocity (`qvel`, nv values).
     pub v: DVector<f64>,
+    /// Actuator activations (`act`, na values).
     pub act: DVector<f64>,
 }
 
@@ -182,7 +186,9 @@ pub(crate) fn correct_drift(model: &Model, data: &mut Data, state: &mut State, h
 /// The integrators `simulate` offers, by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum IntegratorKind {
+    /// MuJoCo's semi-implicit Euler ([`SemiImplicitEuler`]).
     Euler,
+    /// Classical fourth-order Runge–Kutta on the configuration manifold ([`RungeKutta4`]).
     Rk4,
     /// Dormand–Prince 5(4) with error control at [`DEFAULT_RTOL`]/[`DEFAULT_ATOL`]
     /// ([`DormandPrince54::new`] takes others).
@@ -220,6 +226,7 @@ impl IntegratorKind {
         }
     }
 
+    /// Short name (`euler`, `rk4`, …), as reports print it.
     pub fn name(self) -> &'static str {
         match self {
             IntegratorKind::Euler => "euler",

@@ -31,6 +31,7 @@ pub struct RungeKutta4 {
 }
 
 impl RungeKutta4 {
+    /// The stepper with its buffers sized for `model`.
     pub fn new(model: &Model) -> Self {
         let z = || DVector::zeros(model.nv);
         Self {

@@ -249,6 +249,7 @@ impl Anderson {
 }
 
 impl Variational {
+    /// The stepper with its buffers sized for `model`.
     pub fn new(model: &Model) -> Self {
         let (nq, nv) = (model.nq, model.nv);
         // At most 6 rows per equality (a weld).

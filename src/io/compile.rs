@@ -2,7 +2,7 @@
 //! fixed joints into their parent body (inertia composed, every link kept as a [`Frame`]), and lays
 //! out q and v in depth-first file order (docs/architecture.md, "Layers"); then resolves the equality
 //! constraints, mimics, tendons, actuators and contact pairs against the tree
-//! ([`compile_elements`](crate::io::compile_elements)).
+//! (`io::compile_elements`).
 
 use crate::io::{LinkWord, LoadError};
 use crate::model::spec::{InertialSpec, JointSpec, JointType, LinkSpec, MassRules, ModelSpec, Shape};

@@ -23,6 +23,7 @@ pub const ABSURD_LENGTH: f64 = 1e6;
 /// Resource limits: the most links (URDF links, MJCF bodies and joint anchors), and geoms a model
 /// may have.
 pub const MAX_LINKS: usize = 10_000;
+/// Resource limit on the number of geoms a model may have.
 pub const MAX_GEOMS: usize = 100_000;
 /// Resource limit on degrees of freedom: the mass matrix and its factor are dense nv × nv
 /// buffers (72 MB each at this limit).

@@ -17,7 +17,9 @@ pub enum MeshError {
     /// The file could not be opened or read.
     #[error("the file cannot be read: {source}")]
     Io {
+        /// The mesh file.
         path: PathBuf,
+        /// The operating system's error.
         #[source]
         source: std::io::Error,
     },
@@ -27,35 +29,75 @@ pub enum MeshError {
          (binary or ASCII), OBJ and MuJoCo MSH files; convert the mesh (e.g. with MeshLab or \
          Blender) or {SOLID_FIX}"
     )]
-    UnsupportedFormat { path: PathBuf, extension: String },
+    UnsupportedFormat {
+        /// The mesh file.
+        path: PathBuf,
+        /// Its extension with the dot (`.dae`), or `no extension`.
+        extension: String,
+    },
     /// The file is not a well-formed file of its format.
     #[error("it is not a valid {format} file: {}{detail}", match line { Some(l) => format!("line {l}: "), None => String::new() })]
-    Parse { path: PathBuf, format: &'static str, line: Option<usize>, detail: String },
+    Parse {
+        /// The mesh file.
+        path: PathBuf,
+        /// The format it was read as (`ASCII STL`, `binary STL`, `OBJ`, …).
+        format: &'static str,
+        /// The line of the defect (1-based) in text formats, where known.
+        line: Option<usize>,
+        /// What is wrong.
+        detail: String,
+    },
     /// The scale has a non-finite component.
     #[error("its scale ({x}, {y}, {z}) is not finite; give finite scale factors")]
-    BadScale { x: f64, y: f64, z: f64 },
+    BadScale {
+        /// Scale factor along x.
+        x: f64,
+        /// Scale factor along y.
+        y: f64,
+        /// Scale factor along z.
+        z: f64,
+    },
     /// A vertex coordinate is NaN or infinite.
     #[error("vertex {index} has a non-finite coordinate; fix the file or {SOLID_FIX}")]
-    NonFiniteVertex { index: usize },
+    NonFiniteVertex {
+        /// The vertex (0-based index in [`TriangleMesh::vertices`](crate::mass::TriangleMesh)).
+        index: usize,
+    },
     /// A triangle refers to a vertex that does not exist.
     #[error(
         "triangle {triangle} refers to vertex {vertex}, but the mesh has {count} vertices; fix the file"
     )]
-    VertexIndexOutOfRange { triangle: usize, vertex: u32, count: usize },
+    VertexIndexOutOfRange {
+        /// The triangle (0-based).
+        triangle: usize,
+        /// The vertex index it names (0-based).
+        vertex: u32,
+        /// The number of vertices.
+        count: usize,
+    },
     /// Fewer than 4 vertices: no solid (MuJoCo: "at least 4 vertices required").
     #[error("it has {count} vertices, and a mesh needs at least 4 to enclose a volume; {SOLID_FIX}")]
-    TooFewVertices { count: usize },
+    TooFewVertices {
+        /// The number of vertices.
+        count: usize,
+    },
     /// The surface area is zero: every triangle is degenerate (MuJoCo: "mesh surface area is too
     /// small").
     #[error(
         "its surface area ({area:.3e} m²) is zero: every triangle is degenerate (repeated or \
          collinear vertices); fix the mesh or {SOLID_FIX}"
     )]
-    ZeroArea { area: f64 },
+    ZeroArea {
+        /// The total surface area (m², scale applied).
+        area: f64,
+    },
     /// The convex hull cannot be built (all vertices coplanar or collinear, or the hull
     /// algorithm failed).
     #[error("its convex hull cannot be computed ({detail}); use <mesh inertia=\"shell\"> or {SOLID_FIX}")]
-    Hull { detail: String },
+    Hull {
+        /// Why the hull failed.
+        detail: String,
+    },
     /// The surface has holes large enough to leave its volume undetermined.
     #[error(
         "it is not closed: {edges} boundary edge(s) (edges used by an odd number of triangles) \
@@ -65,7 +107,18 @@ pub enum MeshError {
          inertia=\"convex\" (the solid hull), or {SOLID_FIX}",
         fmt_point(.example.0), fmt_point(.example.1), .relative
     )]
-    Open { edges: usize, holes: usize, hole_area: f64, relative: f64, example: ([f64; 3], [f64; 3]) },
+    Open {
+        /// Number of boundary edges (used by an odd number of triangles).
+        edges: usize,
+        /// Number of holes (closed loops of boundary edges).
+        holes: usize,
+        /// Total area of the holes (m²).
+        hole_area: f64,
+        /// Bound on the volume's uncertainty relative to the volume (diameter · hole area / 3 / |V|).
+        relative: f64,
+        /// One boundary edge, as its two end points (m, mesh frame).
+        example: ([f64; 3], [f64; 3]),
+    },
     /// Neighbouring triangles are wound in opposite senses (MuJoCo: "faces of mesh have
     /// inconsistent orientation").
     #[error(
@@ -75,21 +128,32 @@ pub enum MeshError {
          default, which tolerates it) or inertia=\"shell\", or {SOLID_FIX}",
         fmt_point(.example.0), fmt_point(.example.1)
     )]
-    Misoriented { edges: usize, example: ([f64; 3], [f64; 3]) },
+    Misoriented {
+        /// Number of edges traversed twice in the same direction.
+        edges: usize,
+        /// One such edge, as its two end points (m, mesh frame).
+        example: ([f64; 3], [f64; 3]),
+    },
     /// The enclosed volume is negative: the mesh is inside out. Never flipped silently.
     #[error(
         "its signed volume is negative ({volume:.6e} m³): the triangles are wound clockwise seen \
          from outside (an inside-out mesh); reverse the winding of every triangle (e.g. MeshLab \
          'Invert Faces Orientation'), or {SOLID_FIX}"
     )]
-    NegativeVolume { volume: f64 },
+    NegativeVolume {
+        /// The signed volume (m³).
+        volume: f64,
+    },
     /// The volume is too small to carry mass: a flat or degenerate solid (MuJoCo: "mesh volume is
     /// too small ... Try setting inertia to shell").
     #[error(
         "its volume ({volume:.3e} m³) is too small to carry mass (a flat or degenerate mesh); use \
          <mesh inertia=\"shell\"> (mass on the surface) or {SOLID_FIX}"
     )]
-    VolumeTooSmall { volume: f64 },
+    VolumeTooSmall {
+        /// The volume (m³).
+        volume: f64,
+    },
     /// The computed inertia is not that of a physical body (MuJoCo: "eigenvalue of mesh inertia
     /// must be positive" / "eigenvalues of mesh inertia violate A + B >= C"); happens for
     /// self-intersecting meshes.
@@ -98,7 +162,12 @@ pub enum MeshError {
          which happens for self-intersecting meshes; repair the mesh, use <mesh inertia=\"convex\">, \
          or {SOLID_FIX}"
     )]
-    NonPhysicalInertia { moments: [f64; 3], why: &'static str },
+    NonPhysicalInertia {
+        /// The principal moments per unit density (m⁵ for solids, m⁴ for shells).
+        moments: [f64; 3],
+        /// Which check failed (`are not all positive`, `violate I₁ + I₂ ≥ I₃`).
+        why: &'static str,
+    },
 }
 
 fn fmt_point(p: [f64; 3]) -> String {

@@ -41,7 +41,9 @@ const TRIANGLE_ATOL: f64 = 1e-9;
 /// A triangle mesh in its file's coordinates, scale applied.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriangleMesh {
+    /// Vertex positions (m).
     pub vertices: Vec<Vec3>,
+    /// Triangles as indices into `vertices`, counter-clockwise seen from outside.
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -88,7 +90,7 @@ impl TriangleMesh {
             .sum()
     }
 
-    /// The edge topology (closedness and orientation), see [`topology::analyze`]. Indices must be
+    /// The edge topology (closedness and orientation), see [`Topology`](crate::mass::Topology). Indices must be
     /// in range.
     pub fn topology(&self) -> topology::Topology {
         topology::analyze(self)

@@ -34,6 +34,7 @@ pub enum ObjObjects {
 /// Options of [`read_mesh_with`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ReadOptions {
+    /// Which objects of a multi-object OBJ file become the mesh.
     pub obj_objects: ObjObjects,
 }
 

@@ -42,8 +42,10 @@ use crate::spatial::RigidInertia;
 /// shell, MJCF `shellinertia="true"` / mesh `inertia="shell"`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Distribution {
+    /// A solid: mass through the volume.
     #[default]
     Volume,
+    /// A thin shell: mass on the surface.
     Shell,
 }
 

@@ -10,23 +10,33 @@ use std::f64::consts::PI;
 /// A primitive shape in MuJoCo's size convention (half-lengths).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Primitive {
+    /// A sphere.
     Sphere {
+        /// Radius (m).
         radius: f64,
     },
     /// A cylinder of half-length `half_length` along z capped by two hemispheres.
     Capsule {
+        /// Radius of the cylinder and the caps (m).
         radius: f64,
+        /// Half-length of the cylindrical part (m).
         half_length: f64,
     },
+    /// A cylinder along z.
     Cylinder {
+        /// Radius (m).
         radius: f64,
+        /// Half-length (m).
         half_length: f64,
     },
     /// A box with half-extents along x, y, z.
     Box {
+        /// Half-extents along x, y, z (m).
         half_extents: Vec3,
     },
+    /// An ellipsoid.
     Ellipsoid {
+        /// Semi-axes along x, y, z (m).
         radii: Vec3,
     },
 }

@@ -39,7 +39,9 @@ pub struct Topology {
     pub misoriented_area: f64,
     /// Triangles with two corners at the same position (left out of the edge count).
     pub collapsed_triangles: usize,
+    /// One boundary edge as (from, to) vertex indices, if any.
     pub boundary_example: Option<(u32, u32)>,
+    /// One misoriented edge as (from, to) vertex indices, if any.
     pub misoriented_example: Option<(u32, u32)>,
     /// Number of closed polygons the boundary edges form.
     pub boundary_loops: usize,

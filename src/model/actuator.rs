@@ -10,15 +10,26 @@ use super::{JointKind, Model, SourceLoc, TendonKind};
 /// The MJCF element the actuator was written as.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ActuatorShortcut {
+    /// `<general>`: the parameters as written.
     General,
+    /// `<motor>`: force = control (gain 1, no bias).
     Motor,
+    /// `<position>`: a position servo (gain `kp`, bias −`kp` · length − `kv` · velocity).
     Position,
+    /// `<velocity>`: a velocity servo (gain `kv`, bias −`kv` · velocity).
     Velocity,
+    /// `<intvelocity>`: a position servo on an integrated velocity control.
     IntVelocity,
+    /// `<damper>`: force −`kv` · control · velocity.
     Damper,
+    /// `<cylinder>`: a pneumatic or hydraulic cylinder (first-order filter on the pressure).
     Cylinder,
+    /// `<muscle>`: MuJoCo's muscle model (not simulated).
     Muscle,
+    /// `<adhesion>`: an adhesive body force (not simulated).
     Adhesion,
+    /// `<plugin>`: an engine plugin (the MJCF loader keeps plugin actuators as untyped elements,
+    /// so none has this shortcut).
     Plugin,
 }
 
@@ -50,58 +61,94 @@ pub enum Transmission {
     /// A tendon (index in `Model::tendons`).
     Tendon(usize),
     /// A site (index in `Model::frames`), with an optional reference site.
-    Site { site: usize, refsite: Option<usize> },
+    Site {
+        /// The site the force acts at (index in `Model::frames`).
+        site: usize,
+        /// The reference site (`refsite`; index in `Model::frames`), if any.
+        refsite: Option<usize>,
+    },
     /// A body (adhesion; index in `Model::bodies`).
     Body(usize),
     /// A slider-crank between two sites (frame indices).
-    SliderCrank { cranksite: usize, slidersite: usize, cranklength: f64 },
+    SliderCrank {
+        /// The crank's site (index in `Model::frames`).
+        cranksite: usize,
+        /// The slider's site (index in `Model::frames`).
+        slidersite: usize,
+        /// Length of the connecting rod (m).
+        cranklength: f64,
+    },
 }
 
 /// Activation dynamics (`dyntype`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum DynType {
+    /// No activation state: the force acts on the control (`none`, `mjDYN_NONE`).
     #[default]
     None,
+    /// ẇ = u (`integrator`).
     Integrator,
+    /// ẇ = (u − w) / τ, τ = `dynprm[0]` (`filter`), integrated by the stepper.
     Filter,
+    /// The same filter integrated exactly over a step (`filterexact`).
     FilterExact,
+    /// MuJoCo's muscle activation (`muscle`; not simulated).
     Muscle,
+    /// A user callback (`user`; not simulated).
     User,
 }
 
 /// Gain (`gaintype`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GainType {
+    /// gain = `gainprm[0]` (`fixed`).
     #[default]
     Fixed,
+    /// gain = `gainprm[0]` + `gainprm[1]` · length + `gainprm[2]` · velocity (`affine`).
     Affine,
+    /// MuJoCo's muscle gain (`muscle`; not simulated).
     Muscle,
+    /// A user callback (`user`; not simulated).
     User,
 }
 
 /// Bias (`biastype`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BiasType {
+    /// No bias (`none`).
     #[default]
     None,
+    /// bias = `biasprm[0]` + `biasprm[1]` · length + `biasprm[2]` · velocity (`affine`; a
+    /// positive `biasprm[2]` of a position servo is a damping ratio, resolved in the model's plan).
     Affine,
+    /// MuJoCo's muscle bias (`muscle`; not simulated).
     Muscle,
+    /// A user callback (`user`; not simulated).
     User,
 }
 
 /// One actuator with MuJoCo's parameter vectors (lengths as `mjNDYN`, `mjNGAIN`, `mjNBIAS`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Actuator {
+    /// Its `name` (may be empty).
     pub name: String,
+    /// The MJCF element it was written as.
     pub shortcut: ActuatorShortcut,
+    /// What it acts on.
     pub transmission: Transmission,
     /// Gear (moment arm scaling; 6 values for site and joint-in-parent transmissions).
     pub gear: [f64; 6],
+    /// Activation dynamics (`dyntype`, `actuator_dyntype`).
     pub dyntype: DynType,
+    /// Gain (`gaintype`, `actuator_gaintype`).
     pub gaintype: GainType,
+    /// Bias (`biastype`, `actuator_biastype`).
     pub biastype: BiasType,
+    /// Activation dynamics parameters (`dynprm`, `actuator_dynprm`).
     pub dynprm: [f64; 10],
+    /// Gain parameters (`gainprm`, `actuator_gainprm`).
     pub gainprm: [f64; 10],
+    /// Bias parameters (`biasprm`, `actuator_biasprm`).
     pub biasprm: [f64; 10],
     /// Control range if limited (`ctrllimited`, resolved with `autolimits`).
     pub ctrlrange: Option<[f64; 2]>,
@@ -111,6 +158,7 @@ pub struct Actuator {
     pub actrange: Option<[f64; 2]>,
     /// `actearly`: use the next activation in the force (MuJoCo ≥ 3).
     pub actearly: bool,
+    /// Where it is written.
     pub loc: SourceLoc,
 }
 

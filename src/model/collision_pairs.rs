@@ -25,13 +25,19 @@ use super::Model;
 pub struct CollisionPair {
     /// Indices in `Model::geoms`, in MuJoCo's order (lower geom type first).
     pub geom: [usize; 2],
+    /// 1 (frictionless), 3 (sliding), 4 (+ torsional), 6 (+ rolling).
     pub condim: u32,
     /// MuJoCo's 5-vector: sliding, sliding, torsional, rolling, rolling.
     pub friction: [f64; 5],
+    /// `solref` of the normal rows (time constant, damping ratio).
     pub solref: [f64; 2],
+    /// `solref` of the friction rows of elliptic cones (`[0, 0]`: use `solref`).
     pub solreffriction: [f64; 2],
+    /// `solimp` of the rows (dmin, dmax, width, midpoint, power).
     pub solimp: [f64; 5],
+    /// Distance below which a contact has constraint rows (m).
     pub margin: f64,
+    /// Distance beyond `margin` within which contacts are reported without rows (m).
     pub gap: f64,
     /// Index in `Model::contact_pairs` for an explicit `<pair>`.
     pub pair: Option<usize>,

@@ -6,18 +6,27 @@ use super::SourceLoc;
 /// `<pair>`: a candidate contact between two geoms with its own parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactPair {
+    /// Its `name` (may be empty).
     pub name: String,
     /// Indices in [`Model::geoms`](super::Model).
     pub geom1: usize,
+    /// The second geom (index in `Model::geoms`).
     pub geom2: usize,
+    /// 1 (frictionless), 3 (sliding), 4 (+ torsional), 6 (+ rolling).
     pub condim: u32,
     /// Sliding (2), torsional and rolling (2) friction.
     pub friction: [f64; 5],
+    /// `solref` of the normal rows.
     pub solref: [f64; 2],
+    /// `solref` of the friction rows of elliptic cones (`[0, 0]`: use `solref`).
     pub solreffriction: [f64; 2],
+    /// `solimp` of the rows.
     pub solimp: [f64; 5],
+    /// Distance below which a contact has constraint rows (m).
     pub margin: f64,
+    /// Distance beyond `margin` within which contacts are reported without rows (m).
     pub gap: f64,
+    /// Where it is written.
     pub loc: SourceLoc,
 }
 
@@ -25,9 +34,13 @@ pub struct ContactPair {
 /// [`Model::bodies`](super::Model)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactExclude {
+    /// Its `name` (may be empty).
     pub name: String,
+    /// The first body (index in `Model::bodies`).
     pub body1: usize,
+    /// The second body (index in `Model::bodies`).
     pub body2: usize,
+    /// Where it is written.
     pub loc: SourceLoc,
 }
 
@@ -47,11 +60,15 @@ pub struct Contact {
     /// the geoms' margins add up, and contacts are detected up to margin + gap, the gap's
     /// contacts being kept without rows).
     pub includemargin: f64,
+    /// 1 (frictionless), 3 (sliding), 4 (+ torsional), 6 (+ rolling).
     pub condim: u32,
     /// tangent1, tangent2, torsional, rolling1, rolling2.
     pub friction: [f64; 5],
+    /// `solref` of the normal rows (time constant, damping ratio).
     pub solref: [f64; 2],
+    /// `solref` of the friction rows of elliptic cones (`[0, 0]`: use `solref`).
     pub solreffriction: [f64; 2],
+    /// `solimp` of the rows (dmin, dmax, width, midpoint, power).
     pub solimp: [f64; 5],
     /// Index in `Model::contact_pairs` for explicit pairs.
     pub pair: Option<usize>,

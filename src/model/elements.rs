@@ -6,11 +6,17 @@ use super::SourceLoc;
 /// A named state (MJCF `<key>`): absent vectors mean the model's `qpos0` / zeros.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Keyframe {
+    /// Its `name` (may be empty).
     pub name: String,
+    /// Where it is written.
     pub loc: SourceLoc,
+    /// Simulation time (s).
     pub time: f64,
+    /// Joint positions, `nq` values in MuJoCo's qpos layout.
     pub qpos: Option<Vec<f64>>,
+    /// Joint velocities, `nv` values in MuJoCo's qvel layout.
     pub qvel: Option<Vec<f64>>,
+    /// Controls, one per actuator (MuJoCo's `ctrl`).
     pub ctrl: Option<Vec<f64>>,
     /// Actuator activations (MuJoCo's `act`, one per activation state, `na`).
     pub act: Option<Vec<f64>>,
@@ -50,5 +56,6 @@ pub struct Element {
     pub targets: Vec<String>,
     /// All its attributes after default classes were applied, in file order.
     pub attributes: Vec<(String, String)>,
+    /// Where it is written.
     pub loc: SourceLoc,
 }

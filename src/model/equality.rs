@@ -15,12 +15,16 @@ pub const DEFAULT_SOLIMP: [f64; 5] = [0.9, 0.95, 0.001, 0.5, 2.0];
 pub struct Equality {
     /// Its `name` (MJCF), or a generated one (`mimic:<joint>` for URDF mimics); may be empty.
     pub name: String,
+    /// What it ties together.
     pub kind: EqualityKind,
     /// Whether it is active at the start (`active`, MuJoCo's `eq_active0`).
     pub active: bool,
-    /// Soft-constraint parameters (used by the soft mode only).
+    /// Soft-constraint parameters (used by the soft mode only): `solref` (time constant, damping
+    /// ratio).
     pub solref: [f64; 2],
+    /// `solimp` (dmin, dmax, width, midpoint, power; soft mode only).
     pub solimp: [f64; 5],
+    /// Where it is written (the `<mimic>` element for URDF mimics).
     pub loc: SourceLoc,
 }
 
@@ -33,27 +37,63 @@ pub enum EqualityKind {
     /// Two points coincide (3 rows; MuJoCo `connect`). Body semantic: `anchor` is the point in
     /// `frame1` coordinates, and its position in `frame2` is taken at `qpos0`. Site semantic
     /// (`anchor` = None): the origins of the two site frames coincide.
-    Connect { frame1: usize, frame2: usize, anchor: Option<[f64; 3]> },
+    Connect {
+        /// The first body or site (index in `Model::frames`).
+        frame1: usize,
+        /// The second body or site (index in `Model::frames`).
+        frame2: usize,
+        /// The point in `frame1` coordinates (m); `None` for sites.
+        anchor: Option<[f64; 3]>,
+    },
     /// Two frames are welded (6 rows, 3 without rotation when `torquescale` is 0; MuJoCo `weld`).
     /// Body semantic: `anchor` is a point in `frame2` coordinates; `relpose` the pose of frame2's
     /// anchor frame in frame1 (None: taken at `qpos0`, MuJoCo's all-zero quaternion default).
     /// Site semantic (`sites`): the two site frames coincide.
     Weld {
+        /// The first body or site (index in `Model::frames`).
         frame1: usize,
+        /// The second body or site (index in `Model::frames`).
         frame2: usize,
+        /// The anchor point in `frame2` coordinates (m).
         anchor: [f64; 3],
+        /// Pose of frame2's anchor frame in frame1 (`None`: taken at `qpos0`).
         relpose: Option<Transform>,
+        /// Weight of the rotational rows relative to the translational ones (0: position only).
         torquescale: f64,
+        /// Site semantic: the two site frames coincide.
         sites: bool,
     },
     /// `q1 − q1₀ = a₀ + a₁ x + a₂ x² + a₃ x³ + a₄ x⁴` with `x = q2 − q2₀` (MuJoCo `joint`; hinge and
     /// slide joints only; without `joint2`, `q1 − q1₀ = a₀`). `₀` is `qpos0`.
-    Joint { joint1: usize, joint2: Option<usize>, polycoef: [f64; 5] },
+    Joint {
+        /// The constrained joint (index in `Model::joints`).
+        joint1: usize,
+        /// The joint it follows (index in `Model::joints`), if any.
+        joint2: Option<usize>,
+        /// The polynomial's coefficients a₀…a₄.
+        polycoef: [f64; 5],
+    },
     /// The same polynomial between fixed-tendon lengths, relative to their lengths at `qpos0`
     /// (MuJoCo `tendon`).
-    Tendon { tendon1: usize, tendon2: Option<usize>, polycoef: [f64; 5] },
+    Tendon {
+        /// The constrained tendon (index in `Model::tendons`).
+        tendon1: usize,
+        /// The tendon it follows (index in `Model::tendons`), if any.
+        tendon2: Option<usize>,
+        /// The polynomial's coefficients a₀…a₄.
+        polycoef: [f64; 5],
+    },
     /// URDF `<mimic>`: `q[joint] = multiplier · q[leader] + offset` (absolute joint values).
-    Mimic { joint: usize, leader: usize, multiplier: f64, offset: f64 },
+    Mimic {
+        /// The following joint (index in `Model::joints`).
+        joint: usize,
+        /// The joint it follows (index in `Model::joints`).
+        leader: usize,
+        /// URDF `multiplier`.
+        multiplier: f64,
+        /// URDF `offset` (rad or m).
+        offset: f64,
+    },
 }
 
 impl EqualityKind {

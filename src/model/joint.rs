@@ -8,9 +8,17 @@ use crate::spatial::{quat_to_matrix, Mat3, Motion, Transform, Vec3};
 #[derive(Clone, Debug, PartialEq)]
 pub enum JointKind {
     /// Rotation by q about the unit `axis` (URDF `revolute` and `continuous`, MJCF `hinge`).
-    Revolute { axis: Vec3, continuous: bool },
+    Revolute {
+        /// The unit rotation axis in the joint frame.
+        axis: Vec3,
+        /// URDF `continuous`: a revolute joint without limits, named `continuous` by `info`.
+        continuous: bool,
+    },
     /// Translation by q along the unit `axis` (URDF `prismatic`, MJCF `slide`).
-    Prismatic { axis: Vec3 },
+    Prismatic {
+        /// The unit translation axis in the joint frame.
+        axis: Vec3,
+    },
     /// Six degrees of freedom. q = [x y z qw qx qy qz] (position of the body origin in the parent,
     /// orientation w-first); v = [linear velocity of the body origin in the *parent* frame,
     /// angular velocity in the *body* frame] — MuJoCo's free joint.
@@ -20,7 +28,14 @@ pub enum JointKind {
     /// Motion in the plane normal to `normal`: q = [x y θ], the translation `x·axis1 + y·axis2` in
     /// the joint frame followed by a rotation θ about `normal`; v = q̇ (the layout MuJoCo gives a
     /// slide–slide–hinge chain).
-    Planar { axis1: Vec3, axis2: Vec3, normal: Vec3 },
+    Planar {
+        /// The unit direction of the first translation, in the plane.
+        axis1: Vec3,
+        /// The unit direction of the second translation: `normal × axis1`.
+        axis2: Vec3,
+        /// The unit plane normal (the rotation axis), in the joint frame.
+        normal: Vec3,
+    },
 }
 
 /// Which coordinate axis a hinge turns about, decided once when the model is compiled so that the

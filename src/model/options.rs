@@ -30,24 +30,32 @@ impl Integrator {
 /// Friction cone of the soft contact model (`<option cone>`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Cone {
+    /// Each friction direction as a pair of rows on the edges of a pyramid (MuJoCo's default).
     #[default]
     Pyramidal,
+    /// One row per friction direction, within an elliptic cone.
     Elliptic,
 }
 
 /// Constraint solver of the soft mode (`<option solver>`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Solver {
+    /// Projected Gauss–Seidel on the dual (`PGS`).
     Pgs,
+    /// Nonlinear conjugate gradient on the primal (`CG`).
     Cg,
+    /// Newton's method on the primal (`Newton`, MuJoCo's default).
     #[default]
     Newton,
 }
 
-/// Constraint Jacobian storage (`<option jacobian>`).
+/// Constraint Jacobian storage (`<option jacobian>`); kept as written, lagrange does not read
+/// it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum JacobianStorage {
+    /// Dense (`dense`).
     Dense,
+    /// Sparse (`sparse`).
     Sparse,
     /// Dense up to 60 degrees of freedom, sparse above (MuJoCo's rule).
     #[default]
@@ -58,29 +66,55 @@ pub enum JacobianStorage {
 /// (MuJoCo's "disable" flags default to on, its "enable" flags to off).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Flags {
+    /// All constraints (`mjDSBL_CONSTRAINT`).
     pub constraint: bool,
+    /// Equality constraints (`mjDSBL_EQUALITY`).
     pub equality: bool,
+    /// Joint and tendon friction-loss rows (`mjDSBL_FRICTIONLOSS`).
     pub frictionloss: bool,
+    /// Joint and tendon limit rows (`mjDSBL_LIMIT`).
     pub limit: bool,
+    /// Contacts: collision detection and contact rows (`mjDSBL_CONTACT`).
     pub contact: bool,
+    /// Passive joint springs (`mjDSBL_SPRING`; applied when the model is compiled).
     pub spring: bool,
+    /// Passive damping of joints and actuators (`mjDSBL_DAMPER`).
     pub damper: bool,
+    /// Gravity (`mjDSBL_GRAVITY`).
     pub gravity: bool,
+    /// Clamping controls to `ctrlrange` (`mjDSBL_CLAMPCTRL`).
     pub clampctrl: bool,
+    /// Warm start of the soft constraint solver (`mjDSBL_WARMSTART`).
     pub warmstart: bool,
+    /// Filtering out contacts between a body and its parent (`mjDSBL_FILTERPARENT`).
     pub filterparent: bool,
+    /// Actuator forces (`mjDSBL_ACTUATION`).
     pub actuation: bool,
+    /// Raising `solref`'s time constant to at least twice the time step (`mjDSBL_REFSAFE`).
     pub refsafe: bool,
+    /// Sensors (`mjDSBL_SENSOR`); lagrange does not read it.
     pub sensor: bool,
+    /// Mid-phase collision filtering (`mjDSBL_MIDPHASE`); lagrange does not read it.
     pub midphase: bool,
+    /// MuJoCo's native convex collision detection (`mjDSBL_NATIVECCD`); lagrange does not read it.
     pub nativeccd: bool,
+    /// Implicit joint damping in the Euler integrator (`mjDSBL_EULERDAMP`).
     pub eulerdamp: bool,
+    /// Automatic reset on numerical instability (`mjDSBL_AUTORESET`); lagrange does not read it.
     pub autoreset: bool,
+    /// Overriding contact parameters with `o_margin`, `o_solref`, … (`mjENBL_OVERRIDE`, MJCF
+    /// `override`); not simulated, listed by `info`.
     pub override_contacts: bool,
+    /// Energy computation (`mjENBL_ENERGY`); lagrange does not read it.
     pub energy: bool,
+    /// Comparing forward and inverse dynamics (`mjENBL_FWDINV`); lagrange does not read it.
     pub fwdinv: bool,
+    /// Discrete-time inverse dynamics (`mjENBL_INVDISCRETE`); lagrange does not read it.
     pub invdiscrete: bool,
+    /// Multi-point convex collision detection (`mjENBL_MULTICCD`); lagrange does not read it.
     pub multiccd: bool,
+    /// Constraint island discovery (`mjENBL_ISLAND`); islands are solved as one problem, listed by
+    /// `info`.
     pub island: bool,
 }
 
@@ -191,9 +225,13 @@ impl Flags {
 pub struct Options {
     /// Time step (s); MuJoCo's default 0.002.
     pub timestep: f64,
+    /// Numerical integrator (`integrator`).
     pub integrator: Integrator,
+    /// Friction cone of the soft mode (`cone`).
     pub cone: Cone,
+    /// Constraint solver of the soft mode (`solver`).
     pub solver: Solver,
+    /// Constraint Jacobian storage (`jacobian`; not read).
     pub jacobian: JacobianStorage,
     /// Maximum iterations of the constraint solver (100).
     pub iterations: u32,
@@ -207,11 +245,14 @@ pub struct Options {
     pub noslip_iterations: u32,
     /// Ratio of frictional to normal constraint impedance (1).
     pub impratio: f64,
-    /// The medium's density, viscosity and wind (MuJoCo's fluid forces act when density or
-    /// viscosity is positive; not simulated, listed by `info`).
+    /// The medium's density (kg/m³; MuJoCo's fluid forces act when density or viscosity is
+    /// positive; not simulated, listed by `info`).
     pub density: f64,
+    /// The medium's viscosity (Pa·s; not simulated, listed by `info`).
     pub viscosity: f64,
+    /// The medium's velocity in the world frame (m/s; not simulated, listed by `info`).
     pub wind: [f64; 3],
+    /// The `<flag>` switches.
     pub flags: Flags,
 }
 

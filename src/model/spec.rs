@@ -13,6 +13,7 @@ use std::path::PathBuf;
 /// A parsed model, ready to compile.
 #[derive(Clone, Debug, Default)]
 pub struct ModelSpec {
+    /// The model's name (URDF `<robot name>`, MJCF `<mujoco model>`).
     pub name: String,
     /// The file the model came from.
     pub source: Option<PathBuf>,
@@ -46,13 +47,19 @@ pub struct ModelSpec {
 /// MuJoCo's `<compiler>` rules for mass properties, applied per link in this order: inertia from
 /// geoms (decided per link, [`LinkSpec::inertia_from_geoms`]), `boundmass` and `boundinertia` (lower
 /// bounds on the mass and the principal moments), `balanceinertia` (replace moments that violate
-/// the triangle inequality by their mean), then `settotalmass` (scale all moving masses).
+/// the triangle inequality by their mean), then `settotalmass` (scale the masses of all links but
+/// the world).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MassRules {
+    /// Lower bound on the mass of every link but the world (kg; MJCF `boundmass`, 0 = none).
     pub bound_mass: f64,
+    /// Lower bound on the principal moments of inertia of every link but the world (kg·m²; MJCF
+    /// `boundinertia`, 0 = none).
     pub bound_inertia: f64,
+    /// Replace principal moments that violate the triangle inequality by their mean (MJCF
+    /// `balanceinertia`); otherwise such moments are an error.
     pub balance_inertia: bool,
-    /// Scale the masses and inertias of the moving links so that they total this (kg).
+    /// Scale the masses and inertias of all links but the world so that they total this (kg).
     pub total_mass: Option<f64>,
     /// Every moving body (its welded links included) must have mass and principal moments of at
     /// least MuJoCo's `mjMINVAL` (MJCF; URDF allows massless moving links with massive children).
@@ -65,17 +72,23 @@ pub struct MassRules {
 /// One link (URDF) or body (MJCF) with the joint that attaches it to its parent.
 #[derive(Clone, Debug)]
 pub struct LinkSpec {
+    /// The link's (body's) name.
     pub name: String,
+    /// Where the link is written.
     pub loc: SourceLoc,
     /// Index of the parent link in [`ModelSpec::links`]; `None` for the root (parent = world).
     pub parent: Option<usize>,
+    /// The joint attaching the link to its parent (fixed when the link is welded to it).
     pub joint: JointSpec,
+    /// Mass properties as written (`<inertial>`); `None` if the file gives none.
     pub inertial: Option<InertialSpec>,
     /// Compute the mass properties from the geoms' (replacing `inertial`): MJCF
     /// `inertiafromgeom`, decided by the loader.
     pub inertia_from_geoms: bool,
+    /// The link's geometries, visual and collision, in file order.
     pub geoms: Vec<GeomSpec>,
-    /// What the link's own frame stands for (MJCF joint anchors get [`FrameKind::Joint`]).
+    /// What the link's own frame stands for (MJCF joint anchors get
+    /// [`FrameKind::Joint`](super::FrameKind::Joint)).
     pub kind: super::FrameKind,
     /// Further named frames rigidly attached to the link (MJCF sites; the MJCF body frame when a
     /// joint anchor or several joints put the link frame elsewhere).
@@ -85,21 +98,32 @@ pub struct LinkSpec {
 /// A named frame attached to a link.
 #[derive(Clone, Debug)]
 pub struct FrameSpec {
+    /// The frame's name.
     pub name: String,
+    /// Where the frame is written (the MJCF `<site>` or `<body>`).
     pub loc: SourceLoc,
+    /// What the frame stands for (site, body, joint anchor).
     pub kind: super::FrameKind,
+    /// Pose of the frame in the link frame.
     pub x_link_frame: Transform,
 }
 
 /// Joint types as model files name them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum JointType {
+    /// No motion: the link is welded to its parent (URDF `fixed`, an MJCF body without joints).
     Fixed,
+    /// Rotation about `axis` (URDF `revolute`, MJCF `hinge`).
     Revolute,
+    /// Rotation about `axis`, unbounded (URDF `continuous`).
     Continuous,
+    /// Translation along `axis` (URDF `prismatic`, MJCF `slide`).
     Prismatic,
+    /// Six degrees of freedom (URDF `floating`, MJCF `free`).
     Floating,
+    /// Translation in the plane normal to `axis` and rotation about it (URDF `planar`).
     Planar,
+    /// Three rotational degrees of freedom (MJCF `ball`, URDF `spherical`).
     Ball,
 }
 
@@ -118,13 +142,17 @@ impl JointType {
 /// The joint between a link and its parent.
 #[derive(Clone, Debug)]
 pub struct JointSpec {
+    /// The joint's name (may be empty in MJCF).
     pub name: String,
+    /// Where the joint is written.
     pub loc: SourceLoc,
+    /// The joint's type.
     pub jtype: JointType,
     /// Pose of the joint frame in the parent link frame (URDF `<origin>`).
     pub x_parent_joint: Transform,
     /// Axis in the joint frame as written (the compile step normalizes it; zero is an error).
     pub axis: Vec3,
+    /// Position limits `[lower, upper]` (rad or m) if limited; for a ball joint `[0, max angle]`.
     pub limits: Option<[f64; 2]>,
     /// MJCF `actuatorfrcrange` (with `actuatorfrclimited`): the range `qfrc_actuator` is clamped
     /// to on this joint's dofs.
@@ -132,11 +160,15 @@ pub struct JointSpec {
     /// URDF `<limit effort>` when the loader was asked to clamp to it (`--clamp-effort`): the
     /// largest |actuator + applied| generalized force on the joint's dofs.
     pub effort_limit: Option<f64>,
+    /// Viscous damping (N·m·s/rad or N·s/m; URDF `<dynamics damping>`, MJCF `damping`).
     pub damping: f64,
+    /// Dry friction loss (N·m or N; URDF `<dynamics friction>`, MJCF `frictionloss`).
     pub friction: f64,
+    /// Rotor inertia added to the diagonal of the mass matrix (kg·m² or kg; MJCF `armature`).
     pub armature: f64,
-    /// Joint spring: stiffness and its rest position (in q), MuJoCo `stiffness` / `springref`.
+    /// Joint spring stiffness (N·m/rad or N/m; MuJoCo `stiffness`).
     pub stiffness: f64,
+    /// The spring's rest position, in q (MuJoCo `springref`).
     pub spring_ref: f64,
     /// The joint's reference configuration (MuJoCo `qpos0`); empty means neutral.
     pub qpos0: Vec<f64>,
@@ -152,9 +184,13 @@ pub struct JointSpec {
 /// tendon's `tendon_solref_lim`, …; MuJoCo documentation, "XML Reference → joint / tendon").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SoftParams {
+    /// `solref` of the limit rows (MJCF `solreflimit`).
     pub solref_limit: [f64; 2],
+    /// `solimp` of the limit rows (MJCF `solimplimit`).
     pub solimp_limit: [f64; 5],
+    /// `solref` of the friction-loss rows (MJCF `solreffriction`).
     pub solref_friction: [f64; 2],
+    /// `solimp` of the friction-loss rows (MJCF `solimpfriction`).
     pub solimp_friction: [f64; 5],
     /// Distance from a bound within which the limit row is active (MuJoCo's `jnt_margin`).
     pub margin: f64,
@@ -178,7 +214,9 @@ impl Default for SoftParams {
 pub struct MimicSpec {
     /// The joint followed (`joint` attribute).
     pub leader: String,
+    /// `multiplier` (default 1).
     pub multiplier: f64,
+    /// `offset` (rad or m, default 0).
     pub offset: f64,
     /// The `<mimic>` element.
     pub loc: SourceLoc,
@@ -212,44 +250,64 @@ impl JointSpec {
 /// is the centre of mass), and the inertia tensor about the centre of mass in inertial-frame axes.
 #[derive(Clone, Debug)]
 pub struct InertialSpec {
+    /// Mass (kg).
     pub mass: f64,
+    /// Pose of the inertial frame in the link frame; its origin is the centre of mass.
     pub x_link_inertial: Transform,
+    /// Inertia tensor about the centre of mass in inertial-frame axes (kg·m²).
     pub inertia: Mat3,
+    /// Where the `<inertial>` is written.
     pub loc: SourceLoc,
 }
 
 /// Geometric shapes kept from model files.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
+    /// A box centred on the geom frame, axes along its axes.
     Box {
+        /// Full edge lengths (m; MJCF `size` holds half of them).
         size: Vec3,
     },
+    /// A cylinder centred on the geom frame, along its z axis.
     Cylinder {
+        /// Radius (m).
         radius: f64,
+        /// Full length (m; MJCF `size` holds the half-length).
         length: f64,
     },
+    /// A capsule (a cylinder with hemispherical caps) centred on the geom frame, along its z axis.
     Capsule {
+        /// Radius of the cylinder and the caps (m).
         radius: f64,
+        /// Full length of the cylindrical part, caps excluded (m; MJCF `size` holds the
+        /// half-length).
         length: f64,
     },
+    /// A sphere centred on the geom frame.
     Sphere {
+        /// Radius (m).
         radius: f64,
     },
     /// An ellipsoid with the given semi-axes (MJCF).
     Ellipsoid {
+        /// Semi-axes along the geom frame's x, y, z (m).
         radii: Vec3,
     },
     /// An infinite plane z = 0 of the geom frame (MJCF; `size` is for drawing only).
     Plane {
+        /// MJCF `size` as written.
         size: Vec3,
     },
     /// A height field asset (MJCF), by name.
     Hfield {
+        /// The `<hfield>` asset's name.
         name: String,
     },
     /// A mesh file, resolved to a path on disk, with its scale.
     Mesh {
+        /// The mesh file.
         path: PathBuf,
+        /// Scale factors along the mesh's x, y, z, applied to its vertices.
         scale: Vec3,
     },
 }
@@ -257,14 +315,19 @@ pub enum Shape {
 /// A visual or collision geometry of a link.
 #[derive(Clone, Debug)]
 pub struct GeomSpec {
+    /// The geom's name (may be empty).
     pub name: String,
+    /// Where the geom is written.
     pub loc: SourceLoc,
+    /// Pose of the geom frame in the link frame.
     pub x_link_geom: Transform,
+    /// The geometry.
     pub shape: Shape,
     /// Whether it takes part in collisions (URDF `<collision>`; MJCF contype or conaffinity ≠ 0).
     pub collision: bool,
     /// The mass it contributes when the link's inertia comes from its geoms.
     pub mass: GeomMass,
+    /// Whether the mass fills the volume or lies on the surface (MJCF `shellinertia`).
     pub distribution: Distribution,
     /// For meshes: how MuJoCo computes its inertia (`<mesh inertia>`).
     pub mesh_inertia: crate::mass::MeshInertia,
@@ -279,17 +342,26 @@ pub struct GeomSpec {
 /// Collision detection → Contact parameters").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GeomContact {
+    /// Contact type bit mask (`contype`): two geoms may touch when either's `contype` shares a bit
+    /// with the other's `conaffinity`.
     pub contype: u32,
+    /// Contact affinity bit mask (`conaffinity`).
     pub conaffinity: u32,
     /// 1 (frictionless), 3 (sliding), 4 (+ torsional), 6 (+ rolling).
     pub condim: u32,
+    /// `priority`: of two geoms in contact, the higher one's parameters are used.
     pub priority: i32,
     /// Sliding, torsional, rolling.
     pub friction: [f64; 3],
+    /// `solmix`: weight of this geom's `solref`/`solimp` when mixed with the other geom's.
     pub solmix: f64,
+    /// `solref` of the contact rows (time constant, damping ratio).
     pub solref: [f64; 2],
+    /// `solimp` of the contact rows (dmin, dmax, width, midpoint, power).
     pub solimp: [f64; 5],
+    /// Distance below which a contact has constraint rows (m; a dynamic pair adds its geoms').
     pub margin: f64,
+    /// Distance beyond `margin` within which contacts are reported without rows (m).
     pub gap: f64,
 }
 
@@ -333,11 +405,17 @@ impl GeomSpec {
 /// compiled into [`Equality`](super::Equality).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EqualitySpec {
+    /// Its `name` (may be empty).
     pub name: String,
+    /// What it ties together.
     pub kind: EqualitySpecKind,
+    /// Whether it is active at the start (`active`).
     pub active: bool,
+    /// `solref` of its rows (time constant, damping ratio).
     pub solref: [f64; 2],
+    /// `solimp` of its rows (dmin, dmax, width, midpoint, power).
     pub solimp: [f64; 5],
+    /// Where it is written.
     pub loc: SourceLoc,
 }
 
@@ -345,31 +423,72 @@ pub struct EqualitySpec {
 #[derive(Clone, Debug, PartialEq)]
 pub enum EqualitySpecKind {
     /// `<connect body1 body2 anchor>`: `anchor` in body1 coordinates.
-    ConnectBodies { body1: String, body2: Option<String>, anchor: [f64; 3] },
+    ConnectBodies {
+        /// The first body.
+        body1: String,
+        /// The second body (`None`: the world).
+        body2: Option<String>,
+        /// The point that must coincide, in body1 coordinates (m).
+        anchor: [f64; 3],
+    },
     /// `<connect site1 site2>`.
-    ConnectSites { site1: String, site2: String },
+    ConnectSites {
+        /// The first site.
+        site1: String,
+        /// The second site.
+        site2: String,
+    },
     /// `<weld body1 body2 anchor relpose torquescale>`: `anchor` in body2 coordinates, `relpose`
     /// the pose of body2's anchor frame in body1 (`None`: taken at `qpos0`).
     WeldBodies {
+        /// The first body.
         body1: String,
+        /// The second body (`None`: the world).
         body2: Option<String>,
+        /// The anchor point in body2 coordinates (m).
         anchor: [f64; 3],
+        /// Pose of body2's anchor frame in body1 (`None`: taken at `qpos0`).
         relpose: Option<Transform>,
+        /// Weight of the rotational rows relative to the translational ones (0: position only).
         torquescale: f64,
     },
     /// `<weld site1 site2 torquescale>`.
-    WeldSites { site1: String, site2: String, torquescale: f64 },
+    WeldSites {
+        /// The first site.
+        site1: String,
+        /// The second site.
+        site2: String,
+        /// Weight of the rotational rows relative to the translational ones (0: position only).
+        torquescale: f64,
+    },
     /// `<joint joint1 joint2 polycoef>`.
-    Joint { joint1: String, joint2: Option<String>, polycoef: [f64; 5] },
+    Joint {
+        /// The constrained joint.
+        joint1: String,
+        /// The joint it follows (`None`: joint1 is held at `qpos0 + polycoef[0]`).
+        joint2: Option<String>,
+        /// Coefficients a₀…a₄ of the polynomial in joint2's displacement from `qpos0`.
+        polycoef: [f64; 5],
+    },
     /// `<tendon tendon1 tendon2 polycoef>`.
-    Tendon { tendon1: String, tendon2: Option<String>, polycoef: [f64; 5] },
+    Tendon {
+        /// The constrained tendon.
+        tendon1: String,
+        /// The tendon it follows (`None`: tendon1's length is held at its `qpos0` value +
+        /// `polycoef[0]`).
+        tendon2: Option<String>,
+        /// Coefficients a₀…a₄ of the polynomial in tendon2's length change from `qpos0`.
+        polycoef: [f64; 5],
+    },
 }
 
 /// A tendon as written (MJCF `<fixed>` or `<spatial>`); compiled into
 /// [`Tendon`](super::Tendon).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TendonSpec {
+    /// Its `name` (may be empty).
     pub name: String,
+    /// Fixed or spatial, with its joints or path.
     pub kind: TendonSpecKind,
     /// Length limits if limited (`limited`/`range`, resolved with `autolimits`).
     pub range: Option<[f64; 2]>,
@@ -377,80 +496,138 @@ pub struct TendonSpec {
     pub soft: SoftParams,
     /// Total actuator force range if limited (`actuatorfrclimited`/`actuatorfrcrange`).
     pub actuator_force_range: Option<[f64; 2]>,
+    /// Where it is written.
     pub loc: SourceLoc,
 }
 
+/// What a [`TendonSpec`] is made of, by name.
 #[derive(Clone, Debug, PartialEq)]
 pub enum TendonSpecKind {
     /// `<fixed>`: its `<joint joint coef>` children (joint name, coefficient, element).
-    Fixed { joints: Vec<(String, f64, SourceLoc)> },
+    Fixed {
+        /// (joint name, coefficient, element) per `<joint>` child.
+        joints: Vec<(String, f64, SourceLoc)>,
+    },
     /// `<spatial>`: its path as (element, name): `site` and `geom` with the object's name,
     /// `pulley` with its divisor.
-    Spatial { path: Vec<(String, String)> },
+    Spatial {
+        /// (element tag, name or divisor) per path element, in file order.
+        path: Vec<(String, String)>,
+    },
 }
 
 /// What an actuator acts on, by name (MJCF `joint`, `jointinparent`, `tendon`, `site` with
 /// `refsite`, `body`, `cranksite` with `slidersite`).
 #[derive(Clone, Debug, PartialEq)]
 pub enum TransmissionSpec {
+    /// A joint (`joint`).
     Joint(String),
+    /// A joint, the force applied in the parent frame (`jointinparent`; ball and free joints).
     JointInParent(String),
+    /// A tendon (`tendon`).
     Tendon(String),
-    Site { site: String, refsite: Option<String> },
+    /// A site (`site`), with an optional reference site (`refsite`).
+    Site {
+        /// The site the force acts at.
+        site: String,
+        /// The reference site (`refsite`), if any.
+        refsite: Option<String>,
+    },
+    /// A body (`body`; adhesion actuators).
     Body(String),
-    SliderCrank { cranksite: String, slidersite: String, cranklength: f64 },
+    /// A slider-crank (`cranksite`, `slidersite`, `cranklength`).
+    SliderCrank {
+        /// The crank's site.
+        cranksite: String,
+        /// The slider's site.
+        slidersite: String,
+        /// Length of the connecting rod (m).
+        cranklength: f64,
+    },
 }
 
 /// An actuator as written, with its shortcut already expanded into MuJoCo's general form;
 /// compiled into [`Actuator`](super::Actuator).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ActuatorSpec {
+    /// Its `name` (may be empty).
     pub name: String,
+    /// The MJCF element it was written as.
     pub shortcut: ActuatorShortcut,
+    /// What it acts on.
     pub transmission: TransmissionSpec,
+    /// `gear` (moment arm scaling; 6 values for site and joint-in-parent transmissions).
     pub gear: [f64; 6],
+    /// Activation dynamics (`dyntype`).
     pub dyntype: DynType,
+    /// Gain (`gaintype`).
     pub gaintype: GainType,
+    /// Bias (`biastype`).
     pub biastype: BiasType,
+    /// Activation dynamics parameters (`dynprm`).
     pub dynprm: [f64; 10],
+    /// Gain parameters (`gainprm`).
     pub gainprm: [f64; 10],
+    /// Bias parameters (`biasprm`).
     pub biasprm: [f64; 10],
+    /// Control range if limited (`ctrllimited`/`ctrlrange`, resolved with `autolimits`).
     pub ctrlrange: Option<[f64; 2]>,
+    /// Force range if limited (`forcelimited`/`forcerange`).
     pub forcerange: Option<[f64; 2]>,
+    /// Activation range if limited (`actlimited`/`actrange`).
     pub actrange: Option<[f64; 2]>,
+    /// `actearly`: use the next activation in the force.
     pub actearly: bool,
     /// `inheritrange` (position and intvelocity servos): the control range (activation range for
     /// `intvelocity`) is this fraction of the target joint's or tendon's range, about its middle;
     /// set by the compile step, which knows the target.
     pub inheritrange: Option<f64>,
-    /// Actuator-level passive damping and armature (MuJoCo's `actuator_damping`,
-    /// `actuator_armature`): reflected through the transmission onto its dofs.
+    /// Actuator-level passive damping (MuJoCo's `actuator_damping`): reflected through the
+    /// transmission onto its dofs.
     pub damping: f64,
+    /// Actuator-level armature (MuJoCo's `actuator_armature`): reflected through the transmission
+    /// onto its dofs.
     pub armature: f64,
+    /// Where it is written.
     pub loc: SourceLoc,
 }
 
 /// `<contact><pair>` as written; compiled into [`ContactPair`](super::ContactPair).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactPairSpec {
+    /// Its `name` (may be empty).
     pub name: String,
+    /// The first geom (`geom1`).
     pub geom1: String,
+    /// The second geom (`geom2`).
     pub geom2: String,
+    /// 1 (frictionless), 3 (sliding), 4 (+ torsional), 6 (+ rolling).
     pub condim: u32,
+    /// Sliding (2), torsional and rolling (2) friction coefficients.
     pub friction: [f64; 5],
+    /// `solref` of the normal rows.
     pub solref: [f64; 2],
+    /// `solref` of the friction rows of elliptic cones (`[0, 0]`: use `solref`, as MuJoCo does).
     pub solreffriction: [f64; 2],
+    /// `solimp` of the rows.
     pub solimp: [f64; 5],
+    /// Distance below which a contact has constraint rows (m).
     pub margin: f64,
+    /// Distance beyond `margin` within which contacts are reported without rows (m).
     pub gap: f64,
+    /// Where it is written.
     pub loc: SourceLoc,
 }
 
 /// `<contact><exclude>` as written; compiled into [`ContactExclude`](super::ContactExclude).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactExcludeSpec {
+    /// Its `name` (may be empty).
     pub name: String,
+    /// The first body.
     pub body1: String,
+    /// The second body.
     pub body2: String,
+    /// Where it is written.
     pub loc: SourceLoc,
 }

@@ -2,7 +2,7 @@
 //! dispatched at run time to a build with fused multiply–add (FMA3) instructions.
 //!
 //! Rust never contracts `a * b + c` into one instruction by itself, so the operations of
-//! [`Transform`](super::Transform), [`RigidInertia`] and [`Motion`] compile to separate multiplies
+//! [`Transform`], [`RigidInertia`] and [`Motion`] compile to separate multiplies
 //! and adds even where the CPU has FMA. These functions take the policy as a type parameter:
 //! [`Fused`] rounds a·b + c once (`f64::mul_add`, one instruction inside a function compiled with
 //! `#[target_feature(enable = "fma")]`, a slow library call anywhere else — so use it only there),
@@ -14,6 +14,7 @@ use super::{Force, Mat3, Motion, RigidInertia, Transform, Vec3};
 
 /// How `a·b + c` is evaluated.
 pub trait MulAdd {
+    /// `a·b + c` under this policy.
     fn madd(a: f64, b: f64, c: f64) -> f64;
 }
 

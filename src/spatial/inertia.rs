@@ -9,8 +9,11 @@ use std::ops::AddAssign;
 /// about the origin `i_origin = I_c − m [c]×²` (parallel-axis theorem, docs/physics.md (56)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RigidInertia {
+    /// Mass (kg).
     pub mass: f64,
+    /// First moment `m c` (kg·m).
     pub h: Vec3,
+    /// Rotational inertia about the frame origin (kg·m²).
     pub i_origin: Mat3,
 }
 
@@ -21,6 +24,7 @@ impl Default for RigidInertia {
 }
 
 impl RigidInertia {
+    /// The inertia of nothing (zero mass).
     pub fn zero() -> Self {
         Self { mass: 0.0, h: Vec3::zeros(), i_origin: Mat3::zeros() }
     }
@@ -53,9 +57,9 @@ impl RigidInertia {
     }
     /// The same inertia expressed in frame a, given the pose `x_a_b` of its current frame b.
     ///
-    /// I_a = R I_b Rᵀ − ([h']×[p]× + [p]×[h']×) − m [p]×² with h' = R h (RBDA eq. 2.66 on the
-    /// 10 parameters); with [a]×[b]× = b aᵀ − (a·b) 1 the shift is
-    /// −p h'ᵀ − h' pᵀ − m p pᵀ + (2 h'·p + m p·p) 1, and only the 6 entries of the symmetric
+    /// `I_a = R I_b Rᵀ − ([h']×[p]× + [p]×[h']×) − m [p]×²` with `h' = R h` (RBDA eq. 2.66 on the
+    /// 10 parameters); with `[a]×[b]× = b aᵀ − (a·b) 1` the shift is
+    /// `−p h'ᵀ − h' pᵀ − m p pᵀ + (2 h'·p + m p·p) 1`, and only the 6 entries of the symmetric
     /// result are computed.
     /// One formula with the kernels' ([`super::fused::transformed`], separate multiply–adds).
     #[inline]
@@ -86,8 +90,11 @@ impl AddAssign<&RigidInertia> for RigidInertia {
 /// bodies have (RBDA §7.2): `a` angular–angular, `b` angular–linear, `c` linear–linear.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ArticulatedInertia {
+    /// Angular–angular block (kg·m²).
     pub a: Mat3,
+    /// Angular–linear block (kg·m).
     pub b: Mat3,
+    /// Linear–linear block (kg).
     pub c: Mat3,
 }
 
@@ -125,7 +132,7 @@ impl ArticulatedInertia {
     ///
     /// A rotation about one coordinate axis (a hinge about a principal axis with an unrotated
     /// placement, the common case) is applied as a plane rotation of two rows and two columns
-    /// ([`coordinate_rotation`]), 24 products per 3×3 block instead of 54.
+    /// (`coordinate_rotation`), 24 products per 3×3 block instead of 54.
     #[inline]
     pub fn add_transformed_to(&self, x_a_b: &Transform, target: &mut ArticulatedInertia) {
         let r = &x_a_b.rot;

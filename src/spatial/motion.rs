@@ -7,21 +7,27 @@ use std::ops::{Add, AddAssign, Mul, Neg, Sub};
 /// (velocity of the body-fixed point at the frame origin), in the coordinates of one frame.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Motion {
+    /// Angular part (rad/s, or rad/s² for an acceleration).
     pub ang: Vec3,
+    /// Linear part: of the body-fixed point at the frame origin (m/s, or m/s²).
     pub lin: Vec3,
 }
 
 /// Spatial force vector: moment `ang` about the frame origin and force `lin`.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Force {
+    /// Moment about the frame origin (N·m).
     pub ang: Vec3,
+    /// Force (N).
     pub lin: Vec3,
 }
 
 impl Motion {
+    /// The motion with angular part `ang` and linear part `lin`.
     pub const fn new(ang: Vec3, lin: Vec3) -> Self {
         Self { ang, lin }
     }
+    /// The zero motion.
     pub fn zero() -> Self {
         Self::default()
     }
@@ -44,9 +50,11 @@ impl Motion {
 }
 
 impl Force {
+    /// The force with moment `ang` and force `lin`.
     pub const fn new(ang: Vec3, lin: Vec3) -> Self {
         Self { ang, lin }
     }
+    /// The zero force.
     pub fn zero() -> Self {
         Self::default()
     }

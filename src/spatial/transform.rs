@@ -9,7 +9,9 @@ use std::ops::Mul;
 /// b's origin in a.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {
+    /// Orientation of b's axes in a (columns: b's axes in a's coordinates).
     pub rot: Mat3,
+    /// Position of b's origin in a (m).
     pub pos: Vec3,
 }
 
@@ -31,12 +33,15 @@ pub fn quat_to_matrix(w: f64, x: f64, y: f64, z: f64) -> Mat3 {
 }
 
 impl Transform {
+    /// The identity: b coincides with a.
     pub fn identity() -> Self {
         Self { rot: Mat3::identity(), pos: Vec3::zeros() }
     }
+    /// The pose with orientation `rot` and position `pos`.
     pub fn new(rot: Mat3, pos: Vec3) -> Self {
         Self { rot, pos }
     }
+    /// A pure translation by `pos`.
     pub fn from_translation(pos: Vec3) -> Self {
         Self { rot: Mat3::identity(), pos }
     }

@@ -19,15 +19,25 @@ use nalgebra::DVector;
 
 /// The rows of the soft problem, read-only.
 pub struct Rows<'a> {
+    /// Number of equality rows (first in the row order).
     pub ne: usize,
+    /// Number of friction-loss rows (after the equality rows).
     pub nf: usize,
+    /// Number of rows.
     pub nefc: usize,
+    /// Each row's kind (`efc_type`).
     pub kind: &'a [EfcType],
+    /// Each row's element (`efc_id`; for contact rows the index in `contacts`).
     pub id: &'a [usize],
+    /// Each row's D = 1/R (`efc_D`).
     pub d: &'a DVector<f64>,
+    /// Each row's regularizer R (`efc_R`).
     pub r: &'a DVector<f64>,
+    /// Each friction-loss row's bound f (`efc_frictionloss`).
     pub floss: &'a DVector<f64>,
+    /// The contacts of the contact rows.
     pub contacts: &'a [Contact],
+    /// Per contact, the regularized cone's friction coefficient (`mjContact.mu`).
     pub mu: &'a [f64],
 }
 

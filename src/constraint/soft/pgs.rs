@@ -7,7 +7,7 @@
 //! acceleration a = a₀ + M⁻¹ Jᵀ f as the primal solvers.
 //!
 //! Scalar rows are updated in closed form; an elliptic contact's block is minimized over its cone
-//! ([`elliptic_block`]) in the coordinates x = (f_n, f_i / μ_i), where the cone is the standard
+//! (`elliptic_block`) in the coordinates x = (f_n, f_i / μ_i), where the cone is the standard
 //! second-order cone and its projection has a closed form.
 
 use super::primal::Settings;

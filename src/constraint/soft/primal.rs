@@ -22,17 +22,25 @@ use nalgebra::{DMatrix, DVector};
 /// Which primal method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Primal {
+    /// Newton's method with the cost's Hessian (MuJoCo's `mjSOL_NEWTON`).
     Newton,
+    /// Polak–Ribière conjugate gradient, M⁻¹-preconditioned (MuJoCo's `mjSOL_CG`).
     Cg,
 }
 
 /// Iteration limits and tolerances (MJCF `<option>`).
 #[derive(Clone, Copy, Debug)]
 pub struct Settings {
+    /// The most iterations (`iterations`).
     pub iterations: u32,
+    /// Scaled improvement or gradient norm below which the solve stops (`tolerance`).
     pub tolerance: f64,
+    /// The most line-search iterations per iteration (`ls_iterations`).
     pub ls_iterations: u32,
+    /// Line-search tolerance (`ls_tolerance`).
     pub ls_tolerance: f64,
+    /// Start from the previous step's accelerations when they cost less than the unconstrained
+    /// ones (`<flag warmstart>`).
     pub warmstart: bool,
     /// 1 / (meaninertia · max(1, nv)).
     pub scale: f64,

@@ -24,8 +24,11 @@ pub struct InverseWeights {
     pub frame_invweight0: Vec<[f64; 2]>,
     /// Per geom: the index of the frame of its MuJoCo body.
     pub geom_frame: Vec<usize>,
+    /// Per dof: its inverse weight at `qpos0` (MuJoCo's `dof_invweight0`).
     pub dof_invweight0: Vec<f64>,
+    /// Per tendon: J_t M⁻¹ J_tᵀ at `qpos0` for a fixed tendon (MuJoCo's `tendon_invweight0`).
     pub tendon_invweight0: Vec<f64>,
+    /// The mean of M's diagonal at `qpos0` (MuJoCo's `meaninertia`).
     pub meaninertia: f64,
 }
 

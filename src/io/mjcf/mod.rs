@@ -1,13 +1,13 @@
 //! MJCF loader (MuJoCo's XML format): file → [`ModelSpec`] (docs/architecture.md, "Layers"), with MuJoCo's
 //! semantics.
 //!
-//! Passes: read the file into one element tree with `<include>`s spliced ([`xml`]); check every
-//! element and attribute against MuJoCo's schema ([`check`]: unknown ones are warnings, elements
+//! Passes: read the file into one element tree with `<include>`s spliced (`xml`); check every
+//! element and attribute against MuJoCo's schema (`check`: unknown ones are warnings, elements
 //! that would change the dynamics and are not supported are errors); read `<compiler>` and
-//! `<option>`; build the default classes ([`defaults`]); read the mesh assets ([`assets`]); walk
-//! `<worldbody>` depth-first in file order into links ([`body`], [`geom`]); read keyframes and
-//! sensors ([`sections`]), equality constraints ([`equality`]), tendons ([`tendon`]), actuators
-//! ([`actuator`]) and contact pairs and exclusions ([`contact`]), whose names the compile step
+//! `<option>`; build the default classes (`defaults`); read the mesh assets (`assets`); walk
+//! `<worldbody>` depth-first in file order into links (`body`, `geom`); read keyframes and
+//! sensors (`sections`), equality constraints (`equality`), tendons (`tendon`), actuators
+//! (`actuator`) and contact pairs and exclusions (`contact`), whose names the compile step
 //! resolves.
 
 mod actuator;
