@@ -317,7 +317,7 @@ impl ConstraintModel {
     /// Whether any row other than a contact's is active at configuration `q`: an active equality,
     /// a friction-loss row, or a joint at or beyond a limit. Cheap (no kinematics): `forward`
     /// takes the ABA path when none is (and no contact touches).
-    pub fn any_active(&self, data: &Data, q: &[f64]) -> bool {
+    pub(crate) fn any_active(&self, data: &Data, q: &[f64]) -> bool {
         !self.friction.is_empty()
             || self.equalities.iter().any(|e| data.eq_active[e.id])
             || self.limits.iter().any(|l| l.row(data, q).is_some())
@@ -414,7 +414,7 @@ impl ConstraintModel {
     /// `efc_vel` = J v and `efc_jdotv` = J̇ v of the rows of [`positions`](Self::positions) at the
     /// same q. Needs the body velocities (`v_body`, e.g. from RNEA or `forward_velocities`);
     /// computes the bias accelerations itself.
-    pub fn velocities(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+    pub(crate) fn velocities(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         bias_accelerations_unchecked(model, data, v);
         let mut r = 0;
         for e in &self.equalities {
@@ -484,7 +484,7 @@ impl ConstraintModel {
     }
 
     /// Rows, `J v` and `J̇ v` at (q, v) from scratch: forward kinematics, body velocities, then
-    /// [`positions`](Self::positions) and [`velocities`](Self::velocities).
+    /// [`positions`](Self::positions) and `velocities`.
     pub fn evaluate(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         self.collide(model, data, q);
         forward_kinematics_unchecked(model, data, q);

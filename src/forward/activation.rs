@@ -55,7 +55,7 @@ pub fn next_activation(a: &Actuator, act: f64, act_dot: f64, h: f64) -> f64 {
 
 /// Clamps every activation to its `actrange` (the adaptive integrator's step: activations are
 /// integrated as ODE components there, then clamped as MuJoCo clamps after a step).
-pub fn clamp_activations(model: &Model, act: &mut [f64]) {
+pub(crate) fn clamp_activations(model: &Model, act: &mut [f64]) {
     let mut adr = 0;
     for a in &model.actuators {
         if a.actnum() == 1 {
@@ -70,7 +70,7 @@ pub fn clamp_activations(model: &Model, act: &mut [f64]) {
 /// Advances every activation by a step `h` at the rates `act_dot` ([`next_activation`]; MuJoCo's
 /// `mj_advance` for `act`). Nothing moves while actuation is switched off
 /// (`<flag actuation="disable">`), as in MuJoCo.
-pub fn advance_activations(model: &Model, act: &mut [f64], act_dot: &[f64], h: f64) {
+pub(crate) fn advance_activations(model: &Model, act: &mut [f64], act_dot: &[f64], h: f64) {
     if !model.options.flags.actuation {
         return;
     }

@@ -23,7 +23,8 @@ mod plan;
 mod transmission;
 mod xfrc;
 
-pub use activation::{activation_rate, advance_activations, clamp_activations, next_activation};
+pub use activation::{activation_rate, next_activation};
+pub(crate) use activation::{advance_activations, clamp_activations};
 pub use actuation::{
     actuation, add_actuator_velocity_derivative, resolved_bias_velocity, unsimulated_reason,
 };
@@ -95,7 +96,7 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
 
 /// Passive forces: joint damping −d ⊙ v and the springs of hinge and slide joints
 /// −k (q − q_spring) (MuJoCo's `mj_passive` for these elements).
-pub fn passive(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+pub(crate) fn passive(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     for k in 0..model.nv {
         data.qfrc_passive[k] = -model.dof_damping[k] * v[k];
     }

@@ -35,7 +35,7 @@ impl ImplicitFast {
 /// Adds −h·D (D = ∂qfrc/∂v, without Coriolis terms) to `matrix` (column-major nv×nv): the joint
 /// damping part (the actuators' part is
 /// [`add_actuator_velocity_derivative`](crate::forward::add_actuator_velocity_derivative)).
-pub fn add_force_derivative(model: &Model, matrix: &mut [f64], h: f64) {
+pub(crate) fn add_force_derivative(model: &Model, matrix: &mut [f64], h: f64) {
     let nv = model.nv;
     for k in 0..nv {
         matrix[k + k * nv] += h * model.dof_damping[k];

@@ -23,7 +23,8 @@ pub use adaptive::{DormandPrince54, DEFAULT_ATOL, DEFAULT_RTOL};
 pub use bias_derivative::BiasDerivative;
 pub use euler::SemiImplicitEuler;
 pub use implicit::Implicit;
-pub use implicit_fast::{add_force_derivative, ImplicitFast};
+pub(crate) use implicit_fast::add_force_derivative;
+pub use implicit_fast::ImplicitFast;
 pub use lagrangian_terms::LagrangianTerms;
 pub use rk4::RungeKutta4;
 pub use step::step;
@@ -39,7 +40,7 @@ use nalgebra::DVector;
 /// velocities and activations than the step's start, which the stepper keeps here). `act` holds
 /// the actuator activations (MuJoCo's `act`, `na` values; empty without activation dynamics),
 /// integrated from the actuation stage's `act_dot` as MuJoCo does (`filterexact` exactly, then
-/// clamped to `actrange`; [`advance_activations`](crate::forward::advance_activations)).
+/// clamped to `actrange`; `forward::advance_activations`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct State {
     /// Simulation time (s).

@@ -20,7 +20,7 @@ pub mod weights;
 mod work;
 
 pub use primal::{solve_primal, Primal, Settings};
-pub use rows::{soft_active, soft_positions, soft_velocities};
+pub(crate) use rows::{soft_active, soft_positions, soft_velocities};
 pub use weights::InverseWeights;
 pub(crate) use work::SoftWork;
 
@@ -40,7 +40,7 @@ pub fn settings(model: &Model, weights: &InverseWeights) -> Settings {
     }
 }
 
-/// The soft solve of the rows in `data` (from [`soft_positions`] and [`soft_velocities`]):
+/// The soft solve of the rows in `data` (from `soft_positions` and `soft_velocities`):
 /// impedance, regularizer and reference acceleration, then the model's solver. Writes `qacc`,
 /// `efc_force`, `qfrc_constraint` and the solver statistics; keeps `qacc` as the next warm start.
 pub fn solve_soft(model: &Model, weights: &InverseWeights, data: &mut Data) {

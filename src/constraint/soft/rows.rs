@@ -81,7 +81,7 @@ fn row_bound(cm: &ConstraintModel, model: &Model, data: &Data) -> usize {
 /// Writes the soft rows at configuration `q` (body poses and motion subspaces at q, and
 /// `Data::contacts` from a collision pass at q): `nefc`, `ne`, `nf`, `efc_type`, `efc_id`,
 /// `efc_j`, `efc_pos`, `efc_margin`, `efc_frictionloss`.
-pub fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f64], cone: Cone) {
+pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f64], cone: Cone) {
     data.reserve_rows(row_bound(cm, model, data));
     let ne = cm.equality_rows(model, data, q);
     data.efc_margin.rows_mut(0, ne).fill(0.0);
@@ -247,7 +247,7 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
 
 /// `efc_vel` = J v of every row and `efc_jdotv` of connect and weld rows (0 elsewhere), at the
 /// state of [`soft_positions`]. Needs the body velocities (`v_body`).
-pub fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Data, v: &[f64]) {
+pub(crate) fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Data, v: &[f64]) {
     for r in 0..data.nefc {
         let row = data.efc_j.row(r);
         data.efc_vel[r] = (0..model.nv).filter(|&k| row[k] != 0.0).map(|k| row[k] * v[k]).sum();
@@ -306,7 +306,7 @@ pub fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Data, v: 
 /// row exists there: an active equality, a friction-loss dof, a joint within its margin of a
 /// bound, or a contact closer than its `includemargin`. `forward` takes the ABA path when none
 /// does.
-pub fn soft_active(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f64]) -> bool {
+pub(crate) fn soft_active(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f64]) -> bool {
     let mut active = !cm.friction.is_empty() || cm.equalities.iter().any(|e| data.eq_active[e.id]);
     if cm.has_collision() {
         crate::kinematics::body_poses(model, data, q);
