@@ -243,7 +243,10 @@ fn forward_kinematics_with<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64])
     body_poses_with::<A>(model, data, q);
     // Frames rigidly attached to bodies.
     for (f, frame) in model.frames.iter().enumerate() {
-        data.x_world_frame[f] = fused::compose::<A>(&data.x_world_body[frame.body], &frame.x_body_frame);
+        data.x_world_frame[f] = match frame.mocap {
+            Some(m) => data.mocap_pose(m) * frame.x_body_frame,
+            None => fused::compose::<A>(&data.x_world_body[frame.body], &frame.x_body_frame),
+        };
     }
 }
 

@@ -566,6 +566,7 @@ fn free_body(com: Vec3, i_com_principal: Vec3, r_principal: Mat3, gravity: Vec3)
         geoms: Vec::new(),
         kind: lagrange::model::FrameKind::Link,
         frames: Vec::new(),
+        mocap: false,
     };
     compile(&ModelSpec {
         name: "free_body".into(),

@@ -129,7 +129,7 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
     // World poses of the colliding geoms, once per pass (MuJoCo's geom_xpos, geom_xmat).
     for (g, geom) in model.geoms.iter().enumerate() {
         if cm.shapes[g].is_some() || geom.collision {
-            data.x_world_geom[g] = data.x_world_body[geom.body] * geom.x_body_geom;
+            data.x_world_geom[g] = data.attached_pose(geom.body, geom.mocap, &geom.x_body_geom);
         }
     }
     for (pair, b) in model.collision_pairs.iter().zip(&cm.broad) {

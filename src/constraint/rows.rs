@@ -132,6 +132,19 @@ pub struct EqualityRows {
     pub id: usize,
     /// What its rows constrain.
     pub geometry: RowGeometry,
+    /// For the two sides (a, b) of a connect or weld, the mocap body they are anchored on (their
+    /// body is then the world and their anchor in the mocap body's frame), if any.
+    pub mocap: [Option<usize>; 2],
+}
+
+impl EqualityRows {
+    /// The world pose of side `side`'s (0: a, 1: b) body frame: its body's, or its mocap body's.
+    pub(crate) fn side_pose(&self, data: &Data, side: usize, body: usize) -> Transform {
+        match self.mocap[side] {
+            Some(m) => data.mocap_pose(m),
+            None => data.x_world_body[body],
+        }
+    }
 }
 
 /// Which constraint rows a model has and their fixed geometry (built once per model).
@@ -211,6 +224,7 @@ impl ConstraintModel {
             let fr = &model.frames[f];
             (fr.body, fr.x_body_frame, data.x_world_frame[f])
         };
+        let frame_mocap = |f: usize| model.frames[f].mocap;
         let scalar_joint = |j: usize| {
             let jt = &model.joints[j];
             ScalarCoord::Joint { qpos_adr: jt.qpos_adr, dof_adr: jt.dof_adr }
@@ -235,7 +249,11 @@ impl ConstraintModel {
                         Some(p) => {
                             let p1 = Vec3::from(*p);
                             let p_world = x_w1.act_point(&p1);
-                            let r_b = data.x_world_body[b].inverse().act_point(&p_world);
+                            let x_world_b = match frame_mocap(*frame2) {
+                                Some(m) => data.mocap_pose(m),
+                                None => data.x_world_body[b],
+                            };
+                            let r_b = x_world_b.inverse().act_point(&p_world);
                             RowGeometry::Points { a, r_a: x_a1.act_point(&p1), b, r_b }
                         }
                         None => RowGeometry::Points { a, r_a: x_a1.pos, b, r_b: x_b2.pos },
@@ -283,7 +301,13 @@ impl ConstraintModel {
                     ref2: 0.0,
                 },
             };
-            equalities.push(EqualityRows { id, geometry });
+            let mocap = match &eq.kind {
+                EqualityKind::Connect { frame1, frame2, .. } | EqualityKind::Weld { frame1, frame2, .. } => {
+                    [frame_mocap(*frame1), frame_mocap(*frame2)]
+                }
+                _ => [None, None],
+            };
+            equalities.push(EqualityRows { id, geometry, mocap });
         }
         Self { collision, equalities, friction, limits, tendon_limits }
     }
@@ -363,8 +387,8 @@ impl ConstraintModel {
             }
             match &e.geometry {
                 RowGeometry::Points { a, r_a, b, r_b } => {
-                    let p_a = data.x_world_body[*a].act_point(r_a);
-                    let p_b = data.x_world_body[*b].act_point(r_b);
+                    let p_a = e.side_pose(data, 0, *a).act_point(r_a);
+                    let p_b = e.side_pose(data, 1, *b).act_point(r_b);
                     let phi = p_a - p_b;
                     for k in 0..3 {
                         data.efc_pos[r + k] = phi[k];
@@ -373,8 +397,8 @@ impl ConstraintModel {
                     point_rows(model, data, r, *b, &p_b, -1.0, 1.0, false);
                 }
                 RowGeometry::Frames { a, x_a, b, x_b, torquescale } => {
-                    let x_wa = data.x_world_body[*a] * *x_a;
-                    let x_wb = data.x_world_body[*b] * *x_b;
+                    let x_wa = e.side_pose(data, 0, *a) * *x_a;
+                    let x_wb = e.side_pose(data, 1, *b) * *x_b;
                     let phi = x_wa.pos - x_wb.pos;
                     for k in 0..3 {
                         data.efc_pos[r + k] = phi[k];

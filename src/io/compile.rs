@@ -72,6 +72,9 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let mut geoms: Vec<Geom> = Vec::new();
     // For each link: the body it belongs to and its pose in that body's frame.
     let mut link_body: Vec<(usize, Transform)> = Vec::with_capacity(spec.links.len());
+    // Per link, the mocap body it is fused into (welded to the world, posed from `Data`).
+    let mut link_mocap: Vec<Option<usize>> = Vec::with_capacity(spec.links.len());
+    let mut mocap_pose0: Vec<Transform> = Vec::new();
     // Per compiled body: the link (file body) it belongs to, and the first compiled body of it.
     let (mut body_owner, mut body_root) = (vec![usize::MAX], vec![0usize]);
     let (mut nq, mut nv) = (0, 0);
@@ -139,15 +142,37 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             }
         }
         let (body, x_body_link) = link_body[li];
+        // A mocap body starts a mocap subtree; its welded descendants belong to it. Its frames and
+        // geoms are posed relative to the mocap frame.
+        let mocap = if link.mocap {
+            mocap_pose0.push(x_body_link);
+            Some(mocap_pose0.len() - 1)
+        } else {
+            link.parent.and_then(|p| link_mocap[p])
+        };
+        if mocap.is_some() && body != 0 {
+            return Err(LoadError::Unsupported {
+                loc: link.loc.clone(),
+                element: "body".into(),
+                what: format!("body '{}' moves on a joint below a mocap body", link.name),
+                fix: "attach it to the world or to a body with a free joint (moving bodies under mocap bodies are not simulated yet)".into(),
+            });
+        }
+        link_mocap.push(mocap);
         // Mass properties of the link, moved into its body's frame.
         let i_link = link_inertias[li];
         bodies[body].inertia += &i_link.transformed(&x_body_link);
+        let x_body_link = match mocap {
+            Some(m) => mocap_pose0[m].inverse() * x_body_link,
+            None => x_body_link,
+        };
         frames.push(Frame {
             name: link.name.clone(),
             kind: link.kind,
             body,
             x_body_frame: x_body_link,
             inertia: i_link,
+            mocap,
         });
         for f in &link.frames {
             frames.push(Frame {
@@ -156,6 +181,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 body,
                 x_body_frame: x_body_link * f.x_link_frame,
                 inertia: RigidInertia::zero(),
+                mocap,
             });
         }
         for (g, &mass) in link.geoms.iter().zip(&geom_masses[li]) {
@@ -166,6 +192,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 link: link.name.clone(),
                 body,
                 x_body_geom: x_body_link * g.x_link_geom,
+                mocap,
                 shape: g.shape.clone(),
                 collision: g.collision && !unreadable,
                 mass,
@@ -244,6 +271,23 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     }
 
     let keyframes = complete_keyframes(spec, &joints, &qpos0, nv)?;
+    for k in &keyframes {
+        for (what, v, per) in [("mpos", &k.mpos, 3), ("mquat", &k.mquat, 4)] {
+            if let Some(v) = v.as_ref().filter(|v| v.len() != per * mocap_pose0.len()) {
+                return Err(LoadError::Invalid {
+                    loc: k.loc.clone(),
+                    element: "key".into(),
+                    detail: format!(
+                        "keyframe '{}': {what} has {} values, the model needs {} ({per} per mocap body, {} mocap bodies)",
+                        k.name,
+                        v.len(),
+                        per * mocap_pose0.len(),
+                        mocap_pose0.len()
+                    ),
+                });
+            }
+        }
+    }
 
     let hinge_axis =
         std::iter::once(HingeAxis::Other).chain(joints.iter().map(|j| j.kind.hinge_axis())).collect();
@@ -269,6 +313,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         springs,
         qpos0,
         options: spec.options.clone(),
+        mocap_pose0,
         keyframes,
         equalities: Vec::new(),
         tendons: Vec::new(),

@@ -510,6 +510,7 @@ fn build_spec(
             geoms,
             kind: FrameKind::Link,
             frames: Vec::new(),
+            mocap: false,
         });
     }
     Ok(ModelSpec {

@@ -11,7 +11,7 @@ use super::{Contact, FrameKind, JointKind, Model};
 use crate::constraint::soft::SoftWork;
 use crate::constraint::{ExactWork, RowLifecycle};
 use crate::integrate::StepperSlot;
-use crate::spatial::{ArticulatedInertia, Force, Motion, RigidInertia, Transform};
+use crate::spatial::{quat_to_matrix, ArticulatedInertia, Force, Motion, RigidInertia, Transform, Vec3};
 use nalgebra::{DMatrix, DVector, Matrix6};
 
 /// Contacts whose rows `Data::new` makes room for; a scene with more touching contacts grows the
@@ -189,6 +189,13 @@ pub struct Data {
     /// torque in world axes, the force acting at the body's own centre of mass. Honoured by
     /// `forward` and every integrator.
     pub xfrc_applied: Vec<[f64; 6]>,
+    /// World position of each mocap body (MuJoCo's `mocap_pos`, one per `mocap="true"` body in
+    /// file order): an input, like `ctrl`, that poses the body, its geoms and sites, and the
+    /// equality constraints anchored on it. Starts at the body's pose in the file.
+    pub mocap_pos: Vec<Vec3>,
+    /// World orientation of each mocap body as a quaternion w x y z (MuJoCo's `mocap_quat`),
+    /// normalized where it is read (a zero quaternion is the identity).
+    pub mocap_quat: Vec<[f64; 4]>,
     /// `xfrc_applied` as generalized forces (Jᵀ of the wrenches), formed by the acceleration
     /// stage when a wrench is nonzero.
     pub qfrc_xfrc: DVector<f64>,
@@ -362,6 +369,8 @@ impl Data {
             qfrc_applied: DVector::zeros(nv),
             xfrc_applied: vec![[0.0; 6]; model.frames.iter().filter(|f| f.kind == FrameKind::Link).count()],
             qfrc_xfrc: DVector::zeros(nv),
+            mocap_pos: model.mocap_pose0.iter().map(|x| x.pos).collect(),
+            mocap_quat: model.mocap_pose0.iter().map(|x| x.quat_wxyz()).collect(),
             qfrc_bias: DVector::zeros(nv),
             qfrc_passive: DVector::zeros(nv),
             qfrc_actuator: DVector::zeros(nv),
@@ -416,6 +425,28 @@ impl Data {
 }
 
 impl Data {
+    /// The world pose of mocap body `m` from `mocap_pos` and `mocap_quat` (normalized; a zero or
+    /// non-finite quaternion reads as the identity, as MuJoCo normalizes it).
+    pub fn mocap_pose(&self, m: usize) -> Transform {
+        let [w, x, y, z] = self.mocap_quat[m];
+        let norm = (w * w + x * x + y * y + z * z).sqrt();
+        let rot = if norm > 0.0 && norm.is_finite() {
+            quat_to_matrix(w / norm, x / norm, y / norm, z / norm)
+        } else {
+            crate::spatial::Mat3::identity()
+        };
+        Transform::new(rot, self.mocap_pos[m])
+    }
+
+    /// The world pose of a frame or geom at `x_body` on `body`, or on mocap body `mocap`.
+    #[inline]
+    pub(crate) fn attached_pose(&self, body: usize, mocap: Option<usize>, x_body: &Transform) -> Transform {
+        match mocap {
+            Some(m) => self.mocap_pose(m) * *x_body,
+            None => self.x_world_body[body] * *x_body,
+        }
+    }
+
     /// Whether row `i` starts a contact's block of rows: the normal row of a frictionless or
     /// elliptic contact, the first edge row of a pyramidal one (a contact's rows are consecutive,
     /// with the same `efc_id` and type). Counting these rows counts the contacts with rows.

@@ -20,6 +20,10 @@ pub struct Keyframe {
     pub ctrl: Option<Vec<f64>>,
     /// Actuator activations (MuJoCo's `act`, one per activation state, `na`).
     pub act: Option<Vec<f64>>,
+    /// Mocap body positions, 3 per mocap body (MJCF `mpos`; MuJoCo's `key_mpos`).
+    pub mpos: Option<Vec<f64>>,
+    /// Mocap body orientations, quaternions w x y z, 4 per mocap body (MJCF `mquat`).
+    pub mquat: Option<Vec<f64>>,
 }
 
 impl Keyframe {

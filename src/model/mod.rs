@@ -136,11 +136,14 @@ pub struct Frame {
     pub kind: FrameKind,
     /// The compiled body it is attached to (index in `Model::bodies`).
     pub body: usize,
-    /// Pose of the frame in its body's frame.
+    /// Pose of the frame in its body's frame (in its mocap body's frame when `mocap` is set).
     pub x_body_frame: Transform,
     /// The link's own mass properties in this frame's coordinates (before fusion; zero for
     /// sites and massless links).
     pub inertia: RigidInertia,
+    /// The mocap body carrying the frame (index in `Data::mocap_pos`), if any: its world pose is
+    /// then the mocap pose composed with `x_body_frame`.
+    pub mocap: Option<usize>,
 }
 
 /// A geometry of the model file: collision shape (when `collision`) and mass contribution.
@@ -152,8 +155,10 @@ pub struct Geom {
     pub link: String,
     /// The compiled body it is attached to (index in `Model::bodies`).
     pub body: usize,
-    /// Pose of the geom frame in its body's frame.
+    /// Pose of the geom frame in its body's frame (in its mocap body's frame when `mocap` is set).
     pub x_body_geom: Transform,
+    /// The mocap body carrying the geom (index in `Data::mocap_pos`), if any.
+    pub mocap: Option<usize>,
     /// The shape and its sizes (metres).
     pub shape: spec::Shape,
     /// Whether it takes part in collisions (URDF `<collision>`; MJCF contype/conaffinity ≠ 0).
@@ -227,6 +232,9 @@ pub struct Model {
     pub qpos0: Vec<f64>,
     /// Simulation options from the file.
     pub options: Options,
+    /// The initial world pose of each mocap body (MJCF `mocap="true"`, in file order, MuJoCo's
+    /// `body_mocapid` order): what `Data::new` and `reset` set `mocap_pos` and `mocap_quat` to.
+    pub mocap_pose0: Vec<Transform>,
     /// Named initial states (MJCF `<keyframe>`).
     pub keyframes: Vec<Keyframe>,
     /// Equality constraints and URDF mimic couplings (simulated by the constraint layer).

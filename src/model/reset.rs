@@ -35,6 +35,10 @@ pub fn reset(model: &Model, data: &mut Data) -> Result<(), InputError> {
         buffer.fill(0.0);
     }
     data.xfrc_applied.fill([0.0; 6]);
+    for (m, x) in model.mocap_pose0.iter().enumerate() {
+        data.mocap_pos[m] = x.pos;
+        data.mocap_quat[m] = x.quat_wxyz();
+    }
     data.exact.warm_rows.clear();
     data.contacts.clear();
     data.nefc = 0;
@@ -44,8 +48,8 @@ pub fn reset(model: &Model, data: &mut Data) -> Result<(), InputError> {
 }
 
 /// Resets `data` (as [`reset`]) and then sets what keyframe `name` of `model` gives: its time,
-/// `qpos`, `qvel`, `ctrl` and `act` (each only when the keyframe has it, as MuJoCo's
-/// `mj_resetDataKeyframe`).
+/// `qpos`, `qvel`, `ctrl`, `act` and the mocap poses `mpos`, `mquat` (each only when the
+/// keyframe has it, as MuJoCo's `mj_resetDataKeyframe`).
 ///
 /// # Errors
 /// [`InputError::Name`] when the model has no keyframe `name` (the message lists those it has);
@@ -85,6 +89,17 @@ pub fn reset_keyframe(model: &Model, data: &mut Data, name: &str) -> Result<(), 
     for (values, buffer) in parts {
         if let Some(values) = values.filter(|v| v.len() == buffer.len()) {
             buffer.copy_from_slice(values);
+        }
+    }
+    // Mocap poses (the compiler checked 3 and 4 values per mocap body).
+    if let Some(p) = key.mpos.as_deref().filter(|p| p.len() == 3 * data.mocap_pos.len()) {
+        for (pos, xyz) in data.mocap_pos.iter_mut().zip(p.chunks_exact(3)) {
+            *pos = crate::spatial::Vec3::new(xyz[0], xyz[1], xyz[2]);
+        }
+    }
+    if let Some(q) = key.mquat.as_deref().filter(|q| q.len() == 4 * data.mocap_quat.len()) {
+        for (quat, wxyz) in data.mocap_quat.iter_mut().zip(q.chunks_exact(4)) {
+            quat.copy_from_slice(wxyz);
         }
     }
     Ok(())

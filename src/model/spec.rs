@@ -93,6 +93,9 @@ pub struct LinkSpec {
     /// Further named frames rigidly attached to the link (MJCF sites; the MJCF body frame when a
     /// joint anchor or several joints put the link frame elsewhere).
     pub frames: Vec<FrameSpec>,
+    /// An MJCF mocap body (`mocap="true"`, a top-level body without joints): its pose is an input
+    /// of the simulation (`Data::mocap_pos`, `Data::mocap_quat`), not a state.
+    pub mocap: bool,
 }
 
 /// A named frame attached to a link.

@@ -407,6 +407,7 @@ pub fn random_tree_spec(seed: u64, n_links: usize) -> ModelSpec {
             geoms: Vec::new(),
             kind: lagrange::model::FrameKind::Link,
             frames: Vec::new(),
+            mocap: false,
         });
     }
     let gravity = random_unit(&mut rng) * 9.81;

@@ -19,6 +19,7 @@
 
 use crate::constraint::contact::add_contact_jacobian;
 use crate::constraint::limits::{ball_angle_axis, LimitKind, LimitRow};
+use crate::constraint::rows::EqualityRows;
 use crate::constraint::rows::{point_motion, RowGeometry};
 use crate::constraint::ConstraintModel;
 use crate::kinematics::bias_accelerations_unchecked;
@@ -46,9 +47,16 @@ fn pure(v: &Vec3) -> Quat {
 }
 
 /// The world orientations (quaternions) of a weld's frames A (where frame B must be) and B.
-fn weld_quats(data: &Data, a: usize, x_a: &Transform, b: usize, x_b: &Transform) -> (Quat, Quat) {
-    let qa = (data.x_world_body[a] * *x_a).quat_wxyz();
-    let qb = (data.x_world_body[b] * *x_b).quat_wxyz();
+fn weld_quats(
+    data: &Data,
+    e: &EqualityRows,
+    a: usize,
+    x_a: &Transform,
+    b: usize,
+    x_b: &Transform,
+) -> (Quat, Quat) {
+    let qa = (e.side_pose(data, 0, a) * *x_a).quat_wxyz();
+    let qb = (e.side_pose(data, 1, b) * *x_b).quat_wxyz();
     (qa, qb)
 }
 
@@ -95,7 +103,7 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
         let n = model.equalities[e.id].kind.nrow();
         if let RowGeometry::Frames { a, x_a, b, x_b, torquescale } = &e.geometry {
             if n == 6 {
-                let (qa, qb) = weld_quats(data, *a, x_a, *b, x_b);
+                let (qa, qb) = weld_quats(data, e, *a, x_a, *b, x_b);
                 let qb_inv = conj(&qb);
                 let err = qmul(&qb_inv, &qa);
                 for k in 0..3 {
@@ -281,7 +289,7 @@ pub(crate) fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Da
                     // d/dt of ½ imag(q_B⁻¹ (ω_A − ω_B) q_A), the quaternion rates of world
                     // angular velocities being q̇ = ½ (0, ω) q (MuJoCo 4.0's J̇v is this exact
                     // derivative: it matches central differences of its Jacobian).
-                    let (qa, qb) = weld_quats(data, *a, x_a, *b, x_b);
+                    let (qa, qb) = weld_quats(data, e, *a, x_a, *b, x_b);
                     let qb_inv = conj(&qb);
                     let dw = pure(&(wa - wb));
                     let dalpha = pure(&(alpha_a - alpha_b));

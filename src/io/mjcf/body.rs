@@ -78,6 +78,7 @@ impl<'a> TreeBuilder<'a> {
             geoms: Vec::new(),
             kind: FrameKind::Link,
             frames: Vec::new(),
+            mocap: false,
         });
         for wb in root.children_named("worldbody") {
             let content = self.flatten(wb, Transform::identity(), MAIN)?;
@@ -234,6 +235,7 @@ impl<'a> TreeBuilder<'a> {
                     geoms: Vec::new(),
                     kind: FrameKind::Joint,
                     frames: Vec::new(),
+                    mocap: false,
                 });
                 chain_parent = self.links.len() - 1;
                 x_origin = Transform::identity();
@@ -276,6 +278,7 @@ impl<'a> TreeBuilder<'a> {
             geoms: Vec::new(),
             kind: FrameKind::Link,
             frames: Vec::new(),
+            mocap,
         });
         let link = self.links.len() - 1;
         self.attach_geoms_and_sites(link, &content, Transform::identity(), from_geoms)?;

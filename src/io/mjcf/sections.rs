@@ -188,6 +188,8 @@ pub(crate) fn keyframes(root: &Element) -> Result<Vec<Keyframe>, LoadError> {
                 qvel: a.numbers("qvel")?,
                 ctrl: a.numbers("ctrl")?,
                 act: a.numbers("act")?,
+                mpos: a.numbers("mpos")?,
+                mquat: a.numbers("mquat")?,
             });
         }
     }
