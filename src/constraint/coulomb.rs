@@ -80,7 +80,7 @@ pub enum Level {
 /// relative to it or to the constraints' correction has converged. Sets `efc_iterations`, `efc_residual`, `efc_converged`. At the acceleration
 /// level it starts from `efc_warm` when the rows are those of the last solve (the constraint stage
 /// stores it). No allocation.
-pub fn solve_coulomb(
+pub(crate) fn solve_coulomb(
     model: &Model,
     data: &mut Data,
     level: Level,

@@ -11,7 +11,7 @@ use nalgebra::{DMatrix, DVector};
 /// `b` holds x on return. `work` (at least n × n) and `vec` (at least n) are scratch; `a` is
 /// overwritten when the fallback runs. Returns the numerical rank of A: n for a regular system,
 /// less when the minimum-norm solution (zero multipliers along the null space of A) was taken.
-pub fn solve_psd(
+pub(crate) fn solve_psd(
     a: &mut DMatrix<f64>,
     b: &mut [f64],
     work: &mut DMatrix<f64>,

@@ -63,7 +63,12 @@ fn add_minv_jt_mu(data: &Data, nv: usize, s: f64, x: &mut [f64]) {
 /// (`mass_factor`), the rows with `efc_pos`, `efc_vel`, `efc_jdotv`, and `qacc_smooth`. Writes
 /// `efc_force` (λ), `qfrc_constraint` (Jᵀλ), `qacc` and `efc_rank`. `baumgarte = [α, β]` adds the
 /// stabilization J q̈ + J̇v + α J v + β φ = 0 (Baumgarte 1972); `None` solves the pure KKT system.
-pub fn solve_exact(model: &Model, data: &mut Data, baumgarte: Option<[f64; 2]>, settings: SolverSettings) {
+pub(crate) fn solve_exact(
+    model: &Model,
+    data: &mut Data,
+    baumgarte: Option<[f64; 2]>,
+    settings: SolverSettings,
+) {
     let n = data.nefc;
     let nv = model.nv;
     delassus(model, data);
@@ -128,7 +133,7 @@ pub fn row_violation(data: &Data) -> [f64; 2] {
 /// starting q. Stops when max |φ| ≤ `tolerance` or after `max_iterations`; returns (iterations,
 /// final max |φ|). Leaves the factor of M at the starting q in `data`, and the rows it corrected
 /// frozen ([`Data::add_frozen_rows`]) for the velocity projection; [`Data::thaw_rows`] ends that.
-pub fn project_positions(
+pub(crate) fn project_positions(
     model: &Model,
     constraints: &ConstraintModel,
     data: &mut Data,
@@ -174,7 +179,7 @@ pub fn project_positions(
 /// unilateral rows} at configuration `q`: v ← v + M⁻¹Jᵀ μ with the impulses μ of the mixed
 /// complementarity problem (an inelastic impact on a joint limit: restitution 0). With dry friction
 /// the impulses follow Coulomb's law at the velocity level over a step `dt` ([`Level::Velocity`]).
-/// Needs the factor of M (e.g. from [`project_positions`]) and the rows at q (`positions`); returns the largest
+/// Needs the factor of M (e.g. from `project_positions`) and the rows at q (`positions`); returns the largest
 /// remaining violation (|J v| bilateral, max(0, −J v) unilateral) and leaves J v in `efc_vel`.
 pub fn project_velocities(
     model: &Model,

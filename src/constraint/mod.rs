@@ -8,7 +8,7 @@
 //! coupling) and URDF mimic couplings; dof friction loss (bounded rows); limits of hinge, slide
 //! and ball joints; contacts from the collision layer (normal + elliptic Coulomb cone). Unilateral
 //! rows obey Signorini's complementarity at the acceleration level and inelastic impacts at the
-//! velocity level; rows with dry friction are solved by [`solve_coulomb`], the others exactly by an
+//! velocity level; rows with dry friction are solved by `solve_coulomb`, the others exactly by an
 //! active-set method. The soft (MuJoCo-compatible) mode ([`soft`]) writes the same buffers with
 //! MuJoCo's rows, regularization and solvers.
 
@@ -27,9 +27,9 @@ pub mod soft;
 mod solver;
 
 pub use contact::CONTACT_ACTIVE_DISTANCE;
-pub use coulomb::{solve_coulomb, Level, SolverSettings, SEPARATING_VELOCITY, SLIP_VELOCITY};
-pub use dense::solve_psd;
-pub use exact::{project_positions, project_velocities, row_violation, solve_exact};
+pub use coulomb::{Level, SolverSettings, SEPARATING_VELOCITY, SLIP_VELOCITY};
+pub(crate) use exact::{project_positions, solve_exact};
+pub use exact::{project_velocities, row_violation};
 pub(crate) use exact_work::ExactWork;
 pub use friction_loss::FrictionRow;
 pub use limits::{ball_angle_axis, LimitKind, LimitRow, LIMIT_ACTIVE_DISTANCE};

@@ -19,7 +19,7 @@ use crate::Data;
 use nalgebra::DMatrix;
 
 /// Buffers of the derivative pass, allocated once per model.
-pub struct BiasDerivative {
+pub(crate) struct BiasDerivative {
     v_body: Vec<Motion>,
     v_joint: Vec<Motion>,
     /// I V of each body (its momentum), the same for every direction.

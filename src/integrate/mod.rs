@@ -20,7 +20,6 @@ mod step;
 mod variational;
 
 pub use adaptive::{DormandPrince54, DEFAULT_ATOL, DEFAULT_RTOL};
-pub use bias_derivative::BiasDerivative;
 pub use euler::SemiImplicitEuler;
 pub use implicit::Implicit;
 pub(crate) use implicit_fast::add_force_derivative;

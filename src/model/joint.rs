@@ -110,7 +110,7 @@ impl JointKind {
 
     /// Joint transform `X_J(q)`: pose of the child body frame in the joint frame.
     #[inline]
-    pub fn transform(&self, q: &[f64]) -> Transform {
+    pub(crate) fn transform(&self, q: &[f64]) -> Transform {
         match self {
             JointKind::Revolute { axis, .. } => Transform::new(axis_angle(axis, q[0]), Vec3::zeros()),
             JointKind::Prismatic { axis } => Transform::from_translation(axis * q[0]),
@@ -125,7 +125,7 @@ impl JointKind {
     }
 
     /// Motion subspace columns `S` in child-body coordinates (one per degree of freedom), given the
-    /// joint transform `x_j` from [`transform`](Self::transform). For free and planar joints the
+    /// joint transform `x_j` from `transform`. For free and planar joints the
     /// translational columns are the parent-frame directions seen from the body: `Rᵀ eₖ`.
     #[inline]
     pub fn motion_subspace(&self, x_j: &Transform, s: &mut [Motion]) {
@@ -169,7 +169,7 @@ impl JointKind {
     /// `mj_integratePos`: quaternions right-multiplied by the exponential of the body-frame
     /// rotation vector, then normalized).
     #[inline]
-    pub fn integrate(&self, q: &mut [f64], v: &[f64], dt: f64) {
+    pub(crate) fn integrate(&self, q: &mut [f64], v: &[f64], dt: f64) {
         match self {
             JointKind::Revolute { .. } | JointKind::Prismatic { .. } | JointKind::Planar { .. } => {
                 for (qi, vi) in q.iter_mut().zip(v) {
@@ -191,7 +191,7 @@ impl JointKind {
     /// trivialization): θ̇ = J_r⁻¹(θ) ω = ω + ½ θ×ω + (1/|θ|² − (1 + cos|θ|)/(2|θ| sin|θ|)) θ×(θ×ω)
     /// (the inverse right Jacobian of SO(3); Iserles, Munthe-Kaas, Nørsett & Zanna, *Lie-group
     /// methods*, Acta Numerica 2000, §2.3 and eq. 3.14 for the RKMK stages that need it).
-    pub fn dexp_inv(&self, theta: &[f64], v: &[f64], out: &mut [f64]) {
+    pub(crate) fn dexp_inv(&self, theta: &[f64], v: &[f64], out: &mut [f64]) {
         out.copy_from_slice(v);
         match self {
             JointKind::Free => so3_dexp_inv(&theta[3..6], &v[3..6], &mut out[3..6]),
@@ -201,7 +201,7 @@ impl JointKind {
     }
 
     /// The tangent `v` with `q0 ⊕ v = q1` (unit time): the inverse of [`integrate`](Self::integrate).
-    pub fn difference(&self, q0: &[f64], q1: &[f64], v: &mut [f64]) {
+    pub(crate) fn difference(&self, q0: &[f64], q1: &[f64], v: &mut [f64]) {
         match self {
             JointKind::Revolute { .. } | JointKind::Prismatic { .. } | JointKind::Planar { .. } => {
                 for k in 0..v.len() {

@@ -421,7 +421,7 @@ pub(crate) fn integrate_configuration_unchecked(model: &Model, q: &mut [f64], v:
 
 /// θ̇ = dexp⁻¹(θ) v for the whole configuration (length nv): the rate of the tangent
 /// increment θ of `q0 ⊕ θ` when the joint velocity at that configuration is `v`
-/// ([`JointKind::dexp_inv`]); the Runge–Kutta–Munthe-Kaas stages of
+/// (`JointKind::dexp_inv`); the Runge–Kutta–Munthe-Kaas stages of
 /// the integrators use it.
 ///
 /// # Errors

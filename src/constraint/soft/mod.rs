@@ -19,7 +19,8 @@ pub mod rows;
 pub mod weights;
 mod work;
 
-pub use primal::{solve_primal, Primal, Settings};
+pub(crate) use primal::solve_primal;
+pub use primal::{Primal, Settings};
 pub(crate) use rows::{soft_active, soft_positions, soft_velocities};
 pub use weights::InverseWeights;
 pub(crate) use work::SoftWork;
@@ -43,7 +44,7 @@ pub fn settings(model: &Model, weights: &InverseWeights) -> Settings {
 /// The soft solve of the rows in `data` (from `soft_positions` and `soft_velocities`):
 /// impedance, regularizer and reference acceleration, then the model's solver. Writes `qacc`,
 /// `efc_force`, `qfrc_constraint` and the solver statistics; keeps `qacc` as the next warm start.
-pub fn solve_soft(model: &Model, weights: &InverseWeights, data: &mut Data) {
+pub(crate) fn solve_soft(model: &Model, weights: &InverseWeights, data: &mut Data) {
     impedance::make_impedance(model, weights, data);
     let s = settings(model, weights);
     match model.options.solver {

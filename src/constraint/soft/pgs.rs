@@ -172,7 +172,7 @@ fn surface_fista(b: &[[f64; 6]; 6], g: &[f64; 6], dim: usize, start: [f64; 6]) -
 }
 
 /// Solves the soft problem by PGS; writes the same outputs as
-/// [`solve_primal`](super::solve_primal).
+/// `solve_primal`.
 pub fn solve_pgs(model: &Model, data: &mut Data, s: Settings) {
     let nv = model.nv;
     let n = data.nefc;

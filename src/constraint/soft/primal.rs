@@ -86,7 +86,7 @@ fn mul_m(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
 /// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
 /// `qfrc_smooth`, `qacc_smooth`, the mass matrix and its factor: writes `qacc`, `efc_force`,
 /// `efc_state`, `qfrc_constraint`, `solver_niter`, `solver_improvement`, `solver_gradient`.
-pub fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings) {
+pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings) {
     let nv = model.nv;
     let nefc = data.nefc;
     {
