@@ -69,8 +69,11 @@ struct Worst {
 }
 
 fn load_scene(scene: &Scene) -> Model {
+    // One file per call: tests running in parallel load the same scene.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let path: PathBuf = std::env::temp_dir().join(format!(
-        "lagrange-collision-mujoco-{}-{}.xml",
+        "lagrange-collision-mujoco-{}-{call}-{}.xml",
         std::process::id(),
         scene.name
     ));
