@@ -330,7 +330,7 @@ fn site_transmission_moments_are_length_gradients() {
     let id = |name: &str| model.actuators.iter().position(|a| a.name == name).unwrap();
     let mut data_fd = Data::new(&model);
     let mut length = |i: usize, q: &[f64]| {
-        actuation(&model, &mut data_fd, q, &v, &bias);
+        actuation(&model, &mut data_fd, q, &v, &bias).unwrap();
         data_fd.actuator_length[i]
     };
     let mut worst: f64 = 0.0;
@@ -340,13 +340,13 @@ fn site_transmission_moments_are_length_gradients() {
         let a = id(name);
         for k in 0..model.nv {
             let d = fd(&model, &q, k, |q| length(a, q));
-            actuation(&model, &mut data, &q, &v, &bias);
+            actuation(&model, &mut data, &q, &v, &bias).unwrap();
             let m = data.actuator_moment[(a, k)];
             worst = worst.max((m - d).abs());
             assert!((m - d).abs() <= FD_REL * (1.0 + d.abs()), "{name} dof {k}: moment {m}, d length/dq {d}");
         }
     }
-    actuation(&model, &mut data, &q, &v, &bias);
+    actuation(&model, &mut data, &q, &v, &bias).unwrap();
     assert!(data.actuator_moment.row(id("crank2")).amax() > 0.1, "the rod reaches the pin here");
     // Without refsite: the gear [1, 2, −0.5] in the site frame, against the site's position.
     let site = model.site_id("hand").unwrap();
@@ -359,14 +359,14 @@ fn site_transmission_moments_are_length_gradients() {
             forward_kinematics(&model, &mut data2, q).unwrap();
             data2.x_world_frame[site].pos.dot(&wrench)
         });
-        actuation(&model, &mut data, &q, &v, &bias);
+        actuation(&model, &mut data, &q, &v, &bias).unwrap();
         let m = data.actuator_moment[(site_force, k)];
         worst = worst.max((m - d).abs());
         assert!((m - d).abs() <= FD_REL * (1.0 + d.abs()), "site_force dof {k}: moment {m}, fd {d}");
     }
     println!("site transmissions: worst |moment − finite difference| {worst:.1e}");
     // Ball: the gear on the 3 dofs; jointinparent: Rᵀ gear. Free: (gear₀₋₂, gear₃₋₅).
-    actuation(&model, &mut data, &q, &v, &bias);
+    actuation(&model, &mut data, &q, &v, &bias).unwrap();
     let ball = model.joints.iter().find(|j| j.name == "shoulder").unwrap();
     let row =
         |i: usize, a: usize, n: usize| (a..a + n).map(|k| data.actuator_moment[(i, k)]).collect::<Vec<_>>();

@@ -114,6 +114,7 @@ fn frames_by_name() {
 #[test]
 fn every_kernel_refuses_wrong_lengths() {
     use lagrange::dynamics::*;
+    use lagrange::forward::actuation;
     use lagrange::kinematics::*;
     use lagrange::model::{dexp_inv_configuration, difference_configuration, integrate_configuration};
     let model = Model::from_file("models/panda/panda.urdf").unwrap();
@@ -182,6 +183,44 @@ fn every_kernel_refuses_wrong_lengths() {
         "nv",
     );
     length(model.spring_energy(&q_short).map(|_| ()), "Model::spring_energy", "q", "nq");
+    // The constraint rows, the actuation stage and the variational integrator's terms.
+    let rows = &model.plan.constraints;
+    length(rows.positions(&model, &mut data, &q_short, true), "ConstraintModel::positions", "q", "nq");
+    length(rows.evaluate(&model, &mut data, &q, &v_long), "ConstraintModel::evaluate", "v", "nv");
+    length(rows.collide(&model, &mut data, &q_short).map(|_| ()), "ConstraintModel::collide", "q", "nq");
+    length(actuation(&model, &mut data, &q_short, &v, &[]), "actuation", "q", "nq");
+    length(
+        lagrange::constraint::project_velocities(
+            &model,
+            &mut data,
+            &mut v_long.clone(),
+            1e-3,
+            Default::default(),
+        )
+        .map(|_| ()),
+        "project_velocities",
+        "v",
+        "nv",
+    );
+    let mut terms = lagrange::integrate::LagrangianTerms::new(&model);
+    length(terms.compute(&model, &mut data, &q, &v_long), "LagrangianTerms::compute", "xi", "nv");
+    length(
+        terms.recompute_velocity_terms(&model, &v_long),
+        "LagrangianTerms::recompute_velocity_terms",
+        "xi",
+        "nv",
+    );
+    length(
+        lagrange::constraint::ball_angle_axis(&[1.0, 0.0, 0.0]).map(|_| ()),
+        "ball_angle_axis",
+        "quat",
+        "4",
+    );
+    let limit =
+        (0..model.joints.len()).find_map(|j| lagrange::constraint::LimitRow::of_joint(&model, j)).unwrap();
+    length(limit.active(&q_short).map(|_| ()), "LimitRow::active", "q", "nq");
+    length(limit.jdotv(&q, &v_long).map(|_| ()), "LimitRow::jdotv", "v", "nv");
+    assert!(lagrange::constraint::LimitRow::of_joint(&model, 99).is_none(), "no joint 99: no row, no panic");
     // Data made for another model.
     let ur5 = Model::from_file("models/ur5/ur5.urdf").unwrap();
     let mut other = Data::new(&ur5);

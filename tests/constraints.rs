@@ -126,10 +126,11 @@ fn kkt_solution_satisfies_dynamics_and_constraints() {
             let mut v: Vec<f64> = (0..nv).map(|_| rng.random_range(-1.0..1.0)).collect();
             let tau: Vec<f64> = (0..nv).map(|_| rng.random_range(-1.0..1.0)).collect();
             // v onto J v = 0 (the projection of the steppers).
-            plan.constraints.evaluate(&model, &mut data, &q, &v);
+            plan.constraints.evaluate(&model, &mut data, &q, &v).unwrap();
             crba(&model, &mut data, &q).unwrap();
             lagrange::dynamics::factorize_mass_matrix(&model, &mut data);
-            lagrange::constraint::project_velocities(&model, &mut data, &mut v, 0.0, Default::default());
+            lagrange::constraint::project_velocities(&model, &mut data, &mut v, 0.0, Default::default())
+                .unwrap();
             data.qfrc_applied.copy_from_slice(&tau);
             common::forward_at(&model, &mut data, &q, &v);
             let n = data.nefc;
@@ -148,7 +149,7 @@ fn kkt_solution_satisfies_dynamics_and_constraints() {
                 let mut qe = q.clone();
                 integrate_configuration(&model, &mut qe, &v, sign * eps).unwrap();
                 forward_kinematics(&model, &mut data, &qe).unwrap();
-                plan.constraints.positions(&model, &mut data, &qe, true);
+                plan.constraints.positions(&model, &mut data, &qe, true).unwrap();
                 data.efc_j.rows(0, n).into_owned() * DVector::from_vec(v.clone())
             };
             let fd: DVector<f64> = (jv(1.0) - jv(-1.0)) / (2.0 * eps);

@@ -50,7 +50,7 @@ fn lagrangian_terms_match_crba_rnea_and_finite_differences() {
         for _ in 0..3 {
             let q = random_q(model, &mut r);
             let xi = random_v(model, &mut r);
-            terms.compute(model, &mut data, &q, &xi);
+            terms.compute(model, &mut data, &q, &xi).unwrap();
             let m = crba(model, &mut data, &q).unwrap().clone();
             let m_xi = &m * nalgebra::DVector::from_vec(xi.clone());
             let scale = m_xi.amax().max(1.0);

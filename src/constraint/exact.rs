@@ -14,6 +14,7 @@ use super::ConstraintModel;
 use super::ExactWork;
 use crate::collision::{collide, EXACT_REACH};
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
+use crate::error::{check, InputError};
 use crate::kinematics::body_poses;
 use crate::model::{integrate_configuration_unchecked, Data, EfcType, Model};
 
@@ -151,7 +152,7 @@ pub(crate) fn project_positions(
         if constraints.has_collision() {
             collide(model, &constraints.collision, data, EXACT_REACH);
         }
-        constraints.positions(model, data, q, false);
+        constraints.positions_unchecked(model, data, q, false);
         if iterations == 0 {
             // The rows corrected stay rows until they land on φ = 0.
             data.add_frozen_rows(false);
@@ -181,7 +182,23 @@ pub(crate) fn project_positions(
 /// the impulses follow Coulomb's law at the velocity level over a step `dt` ([`Level::Velocity`]).
 /// Needs the factor of M (e.g. from `project_positions`) and the rows at q (`positions`); returns the largest
 /// remaining violation (|J v| bilateral, max(0, −J v) unilateral) and leaves J v in `efc_vel`.
+///
+/// # Errors
+/// [`InputError::Length`] when v is not nv long or `data` was made for another model.
 pub fn project_velocities(
+    model: &Model,
+    data: &mut Data,
+    v: &mut [f64],
+    dt: f64,
+    settings: SolverSettings,
+) -> Result<f64, InputError> {
+    check::data("project_velocities", model, data)?;
+    check::v("project_velocities", "v", model, v)?;
+    Ok(project_velocities_unchecked(model, data, v, dt, settings))
+}
+
+/// [`project_velocities`] without the argument checks.
+pub(crate) fn project_velocities_unchecked(
     model: &Model,
     data: &mut Data,
     v: &mut [f64],

@@ -11,6 +11,7 @@
 //!
 //! Negative distance is penetration; the row's force is λ ≥ 0 (complementarity in the solver).
 
+use crate::error::InputError;
 use crate::model::{Data, JointKind, Model};
 use crate::spatial::Vec3;
 
@@ -48,25 +49,44 @@ pub struct LimitRow {
     pub dof_adr: usize,
     /// Its bounds.
     pub kind: LimitKind,
+    /// The model's nq and nv (the lengths of the configurations and velocities it reads).
+    nq: usize,
+    nv: usize,
 }
 
 impl LimitRow {
     /// The limit row of joint `j` of `model`, if it is limited (hinge, slide or ball).
     pub fn of_joint(model: &Model, j: usize) -> Option<Self> {
-        let joint = &model.joints[j];
+        let joint = model.joints.get(j)?;
         let range = joint.limits?;
         let kind = match joint.kind {
             JointKind::Ball => LimitKind::Cone { max_angle: range[0].max(range[1]) },
             _ if joint.kind.nv() == 1 => LimitKind::Scalar { range },
             _ => return None,
         };
-        Some(Self { joint: j, qpos_adr: joint.qpos_adr, dof_adr: joint.dof_adr, kind })
+        Some(Self {
+            joint: j,
+            qpos_adr: joint.qpos_adr,
+            dof_adr: joint.dof_adr,
+            kind,
+            nq: model.nq,
+            nv: model.nv,
+        })
     }
 
     /// The active side at configuration `q`: (row direction, distance), the direction being the
     /// J row over the joint's dofs (one entry for hinge/slide, the three of the ball), or None
     /// while the joint is inside its range (distance > [`LIMIT_ACTIVE_DISTANCE`]).
-    pub fn active(&self, q: &[f64]) -> Option<(Vec3, f64)> {
+    ///
+    /// # Errors
+    /// [`InputError::Length`] when q is not nq long.
+    pub fn active(&self, q: &[f64]) -> Result<Option<(Vec3, f64)>, InputError> {
+        InputError::check_len("LimitRow::active", "q", q.len(), self.nq, "nq")?;
+        Ok(self.active_unchecked(q))
+    }
+
+    /// [`active`](Self::active) without the length check.
+    pub(crate) fn active_unchecked(&self, q: &[f64]) -> Option<(Vec3, f64)> {
         match self.kind {
             LimitKind::Scalar { range } => {
                 let x = q[self.qpos_adr];
@@ -80,7 +100,7 @@ impl LimitRow {
                 }
             }
             LimitKind::Cone { max_angle } => {
-                let (angle, axis) = ball_angle_axis(&q[self.qpos_adr..self.qpos_adr + 4]);
+                let (angle, axis) = quat_angle_axis(&q[self.qpos_adr..self.qpos_adr + 4]);
                 let dist = max_angle - angle;
                 (dist <= LIMIT_ACTIVE_DISTANCE && angle > BALL_AXIS_EPS).then_some((-axis, dist))
             }
@@ -88,7 +108,7 @@ impl LimitRow {
     }
 
     /// The row of the nearer side at configuration `q`, active or not: (direction, distance).
-    pub fn nearest(&self, q: &[f64]) -> (Vec3, f64) {
+    pub(crate) fn nearest(&self, q: &[f64]) -> (Vec3, f64) {
         match self.kind {
             LimitKind::Scalar { range } => {
                 let x = q[self.qpos_adr];
@@ -100,7 +120,7 @@ impl LimitRow {
                 }
             }
             LimitKind::Cone { max_angle } => {
-                let (angle, axis) = ball_angle_axis(&q[self.qpos_adr..self.qpos_adr + 4]);
+                let (angle, axis) = quat_angle_axis(&q[self.qpos_adr..self.qpos_adr + 4]);
                 (-axis, max_angle - angle)
             }
         }
@@ -108,8 +128,8 @@ impl LimitRow {
 
     /// The row at configuration `q` as [`Data`]'s rows are chosen: by [`active`](Self::active), or,
     /// while the step's rows are frozen and the joint's row is among them, the nearer side.
-    pub fn row(&self, data: &Data, q: &[f64]) -> Option<(Vec3, f64)> {
-        self.active(q).or_else(|| data.lifecycle.keeps_limit(self.joint).then(|| self.nearest(q)))
+    pub(crate) fn row(&self, data: &Data, q: &[f64]) -> Option<(Vec3, f64)> {
+        self.active_unchecked(q).or_else(|| data.lifecycle.keeps_limit(self.joint).then(|| self.nearest(q)))
     }
 
     /// Number of dofs the row spans.
@@ -121,11 +141,21 @@ impl LimitRow {
     }
 
     /// J̇ v of the active row with direction `dir` at (q, v) (0 for hinge and slide).
-    pub fn jdotv(&self, q: &[f64], v: &[f64]) -> f64 {
+    ///
+    /// # Errors
+    /// [`InputError::Length`] when q is not nq long or v not nv long.
+    pub fn jdotv(&self, q: &[f64], v: &[f64]) -> Result<f64, InputError> {
+        InputError::check_len("LimitRow::jdotv", "q", q.len(), self.nq, "nq")?;
+        InputError::check_len("LimitRow::jdotv", "v", v.len(), self.nv, "nv")?;
+        Ok(self.jdotv_unchecked(q, v))
+    }
+
+    /// [`jdotv`](Self::jdotv) without the length checks.
+    pub(crate) fn jdotv_unchecked(&self, q: &[f64], v: &[f64]) -> f64 {
         match self.kind {
             LimitKind::Scalar { .. } => 0.0,
             LimitKind::Cone { .. } => {
-                let (angle, axis) = ball_angle_axis(&q[self.qpos_adr..self.qpos_adr + 4]);
+                let (angle, axis) = quat_angle_axis(&q[self.qpos_adr..self.qpos_adr + 4]);
                 let d = self.dof_adr;
                 let omega = Vec3::new(v[d], v[d + 1], v[d + 2]);
                 // d/dt(−nᵀω) at ω̇ = 0.
@@ -149,7 +179,16 @@ impl LimitRow {
 /// Rotation angle θ ∈ [0, π] and unit axis of a unit quaternion [w, x, y, z] (the axis is
 /// arbitrary at θ = 0): θ = 2 atan2(|v|, |w|), the axis flipped with w's sign so that q and −q
 /// give the same rotation.
-pub fn ball_angle_axis(quat: &[f64]) -> (f64, Vec3) {
+///
+/// # Errors
+/// [`InputError::Length`] when `quat` does not hold 4 values.
+pub fn ball_angle_axis(quat: &[f64]) -> Result<(f64, Vec3), InputError> {
+    InputError::check_len("ball_angle_axis", "quat", quat.len(), 4, "4")?;
+    Ok(quat_angle_axis(quat))
+}
+
+/// [`ball_angle_axis`] of the first 4 values of `quat`.
+pub(crate) fn quat_angle_axis(quat: &[f64]) -> (f64, Vec3) {
     let sign = if quat[0] < 0.0 { -1.0 } else { 1.0 };
     let v = Vec3::new(quat[1], quat[2], quat[3]) * sign;
     let s = v.norm();

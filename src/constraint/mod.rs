@@ -28,7 +28,7 @@ mod solver;
 
 pub use contact::CONTACT_ACTIVE_DISTANCE;
 pub use coulomb::{Level, SolverSettings, SEPARATING_VELOCITY, SLIP_VELOCITY};
-pub(crate) use exact::{project_positions, solve_exact};
+pub(crate) use exact::{project_positions, project_velocities_unchecked, solve_exact};
 pub use exact::{project_velocities, row_violation};
 pub(crate) use exact_work::ExactWork;
 pub use friction_loss::FrictionRow;

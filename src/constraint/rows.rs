@@ -17,6 +17,7 @@ use super::contact::{contact_jdotv, contact_rows, CONTACT_ACTIVE_DISTANCE};
 use super::friction_loss::FrictionRow;
 use super::limits::LimitRow;
 use crate::collision::{collide, CollisionModel, EXACT_REACH};
+use crate::error::{check, InputError};
 use crate::kinematics::body_poses;
 use crate::kinematics::{
     bias_accelerations_unchecked, for_each_ancestor_dof, forward_kinematics_unchecked,
@@ -329,7 +330,17 @@ impl ConstraintModel {
 
     /// The contacts at configuration `q` into `Data::contacts` (body poses first), if the model
     /// has candidate pairs; returns whether any touches (a row in exact mode).
-    pub fn collide(&self, model: &Model, data: &mut Data, q: &[f64]) -> bool {
+    ///
+    /// # Errors
+    /// [`InputError::Length`] when q is not nq long or `data` was made for another model.
+    pub fn collide(&self, model: &Model, data: &mut Data, q: &[f64]) -> Result<bool, InputError> {
+        check::data("ConstraintModel::collide", model, data)?;
+        check::q("ConstraintModel::collide", model, q)?;
+        Ok(self.collide_unchecked(model, data, q))
+    }
+
+    /// [`collide`](Self::collide) without the argument checks.
+    pub(crate) fn collide_unchecked(&self, model: &Model, data: &mut Data, q: &[f64]) -> bool {
         if !self.has_collision() {
             return false;
         }
@@ -353,7 +364,18 @@ impl ConstraintModel {
     /// on it). With `full` false only the rows with a position meaning are written (equalities,
     /// limits, contact normals: the position projection). Needs body poses and motion subspaces at
     /// q (forward kinematics, or CRBA's first pass).
-    pub fn positions(&self, model: &Model, data: &mut Data, q: &[f64], full: bool) {
+    ///
+    /// # Errors
+    /// [`InputError::Length`] when q is not nq long or `data` was made for another model.
+    pub fn positions(&self, model: &Model, data: &mut Data, q: &[f64], full: bool) -> Result<(), InputError> {
+        check::data("ConstraintModel::positions", model, data)?;
+        check::q("ConstraintModel::positions", model, q)?;
+        self.positions_unchecked(model, data, q, full);
+        Ok(())
+    }
+
+    /// [`positions`](Self::positions) without the argument checks.
+    pub(crate) fn positions_unchecked(&self, model: &Model, data: &mut Data, q: &[f64], full: bool) {
         let mut r = self.equality_rows(model, data, q);
         if full {
             for f in &self.friction {
@@ -491,7 +513,7 @@ impl ConstraintModel {
                 EfcType::LimitJoint => {
                     let joint = data.efc_id[r];
                     let l = self.limits.iter().find(|l| l.joint == joint);
-                    data.efc_jdotv[r] = l.map_or(0.0, |l| l.jdotv(q, v));
+                    data.efc_jdotv[r] = l.map_or(0.0, |l| l.jdotv_unchecked(q, v));
                 }
                 EfcType::ContactFrictionless | EfcType::ContactElliptic | EfcType::ContactPyramidal => {
                     let dim = data.efc_block_len(r);
@@ -509,11 +531,24 @@ impl ConstraintModel {
 
     /// Rows, `J v` and `J̇ v` at (q, v) from scratch: forward kinematics, body velocities, then
     /// [`positions`](Self::positions) and `velocities`.
-    pub fn evaluate(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
-        self.collide(model, data, q);
+    ///
+    /// # Errors
+    /// [`InputError::Length`] when q is not nq long, v not nv long, or `data` was made for
+    /// another model.
+    pub fn evaluate(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> Result<(), InputError> {
+        check::data("ConstraintModel::evaluate", model, data)?;
+        check::q("ConstraintModel::evaluate", model, q)?;
+        check::v("ConstraintModel::evaluate", "v", model, v)?;
+        self.evaluate_unchecked(model, data, q, v);
+        Ok(())
+    }
+
+    /// [`evaluate`](Self::evaluate) without the argument checks.
+    pub(crate) fn evaluate_unchecked(&self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+        self.collide_unchecked(model, data, q);
         forward_kinematics_unchecked(model, data, q);
         forward_velocities_unchecked(model, data, v);
-        self.positions(model, data, q, true);
+        self.positions_unchecked(model, data, q, true);
         self.velocities(model, data, q, v);
     }
 }

@@ -10,8 +10,8 @@
 
 use super::soft::{self, InverseWeights};
 use super::{
-    project_positions, project_velocities, row_violation, solve_exact, ConstraintMode, ConstraintModel,
-    SolverSettings,
+    project_positions, project_velocities_unchecked, row_violation, solve_exact, ConstraintMode,
+    ConstraintModel, SolverSettings,
 };
 use crate::integrate::State;
 use crate::model::{Data, Model};
@@ -128,7 +128,7 @@ impl ConstraintSolver {
             }
             _ => {
                 let active = !rows.is_empty() && rows.any_active(data, q);
-                rows.collide(model, data, q) || active
+                rows.collide_unchecked(model, data, q) || active
             }
         }
     }
@@ -139,7 +139,7 @@ impl ConstraintSolver {
             ConstraintSolver::Soft(SoftSolver { weights: Some(_) }) => {
                 soft::soft_positions(rows, model, data, q, model.options.cone)
             }
-            _ => rows.positions(model, data, q, true),
+            _ => rows.positions_unchecked(model, data, q, true),
         }
     }
 
@@ -203,11 +203,11 @@ impl ConstraintSolver {
                 project_positions(model, rows, data, state.q.as_mut_slice(), tolerance, 50);
             // The velocity projection takes every row at the projected q, friction included
             // (impulses in the Coulomb cone).
-            rows.positions(model, data, state.q.as_slice(), true);
-            let jv = project_velocities(model, data, state.v.as_mut_slice(), h, e.settings);
+            rows.positions_unchecked(model, data, state.q.as_slice(), true);
+            let jv = project_velocities_unchecked(model, data, state.v.as_mut_slice(), h, e.settings);
             (iterations, [phi, jv])
         } else {
-            rows.evaluate(model, data, state.q.as_slice(), state.v.as_slice());
+            rows.evaluate_unchecked(model, data, state.q.as_slice(), state.v.as_slice());
             (0, row_violation(data))
         };
         data.thaw_rows();

@@ -22,6 +22,7 @@
 
 use super::activation::{activation_rate, next_activation};
 use super::transmission::{needs_poses, transmission, Poses};
+use crate::error::{check, InputError};
 use crate::kinematics::forward_kinematics_unchecked;
 pub use crate::model::actuator::unsimulated_reason;
 use crate::model::actuator::{BiasType, GainType, Transmission};
@@ -69,7 +70,34 @@ pub fn resolved_bias_velocity(model: &Model) -> Vec<f64> {
 /// `actuator_velocity`, `actuator_moment`, `act_dot`, `actuator_force` and `qfrc_actuator` (zero
 /// for actuators not simulated); `bias_velocity` is [`resolved_bias_velocity`] (the plan holds
 /// it). `actearly` looks one step of the model's `<option timestep>` ahead, as MuJoCo does.
-pub fn actuation(model: &Model, data: &mut Data, q: &[f64], v: &[f64], bias_velocity: &[f64]) {
+///
+/// # Errors
+/// [`InputError::Length`] when q is not nq long, v not nv long, `bias_velocity` not one value per
+/// actuator, or `data` was made for another model.
+pub fn actuation(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    bias_velocity: &[f64],
+) -> Result<(), InputError> {
+    check::data("actuation", model, data)?;
+    data.check_sizes(model, "actuation")?;
+    check::q("actuation", model, q)?;
+    check::v("actuation", "v", model, v)?;
+    InputError::check_len("actuation", "bias_velocity", bias_velocity.len(), model.actuators.len(), "nu")?;
+    actuation_unchecked(model, data, q, v, bias_velocity);
+    Ok(())
+}
+
+/// [`actuation`] without the argument checks.
+pub(crate) fn actuation_unchecked(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    bias_velocity: &[f64],
+) {
     data.qfrc_actuator.fill(0.0);
     let clamp = model.options.flags.clampctrl;
     if model.actuators.iter().any(|a| needs_poses(a) && unsimulated_reason(model, a).is_none()) {

@@ -25,6 +25,7 @@ mod xfrc;
 
 pub use activation::{activation_rate, next_activation};
 pub(crate) use activation::{advance_activations, clamp_activations};
+pub(crate) use actuation::actuation_unchecked;
 pub use actuation::{
     actuation, add_actuator_velocity_derivative, resolved_bias_velocity, unsimulated_reason,
 };
@@ -78,7 +79,7 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
                 solver.velocities(rows, model, data, q, v);
             }
             StageKind::Passive => passive(model, data, q, v),
-            StageKind::Actuation => actuation(model, data, q, v, &plan.actuator_bias_velocity),
+            StageKind::Actuation => actuation_unchecked(model, data, q, v, &plan.actuator_bias_velocity),
             StageKind::Acceleration => acceleration(model, data, q, v, m_path),
             StageKind::Constraint if m_path => solver.solve(model, data),
             // Row sources are built by the position stage; the rest are listings.

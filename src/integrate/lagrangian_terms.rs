@@ -21,6 +21,7 @@
 //! ξ is a velocity in the model's v layout (body-frame angular velocity for ball and free joints,
 //! parent-frame linear velocity for free joints).
 
+use crate::error::{check, InputError};
 use crate::kinematics::update_joint;
 use crate::model::{Data, JointKind, Model};
 use crate::spatial::{Force, Motion, Transform, Vec3};
@@ -68,7 +69,26 @@ impl LagrangianTerms {
 
     /// Evaluates the three terms at (q, ξ); updates the joint transforms and subspaces of `data`
     /// and keeps a copy for [`recompute_velocity_terms`](Self::recompute_velocity_terms).
-    pub fn compute(&mut self, model: &Model, data: &mut Data, q: &[f64], xi: &[f64]) {
+    ///
+    /// # Errors
+    /// [`InputError::Length`] when q is not nq long, ξ not nv long, or `data` was made for another
+    /// model.
+    pub fn compute(
+        &mut self,
+        model: &Model,
+        data: &mut Data,
+        q: &[f64],
+        xi: &[f64],
+    ) -> Result<(), InputError> {
+        check::data("LagrangianTerms::compute", model, data)?;
+        check::q("LagrangianTerms::compute", model, q)?;
+        check::v("LagrangianTerms::compute", "xi", model, xi)?;
+        self.compute_unchecked(model, data, q, xi);
+        Ok(())
+    }
+
+    /// [`compute`](Self::compute) without the argument checks.
+    pub(crate) fn compute_unchecked(&mut self, model: &Model, data: &mut Data, q: &[f64], xi: &[f64]) {
         for b in 1..model.nbody() {
             update_joint(model, data, b, q);
             self.x_parent_body[b] = data.x_parent_body[b];
@@ -82,11 +102,16 @@ impl LagrangianTerms {
 
     /// M(q) ξ and ∂T/∂q for a new ξ at the q of the last [`compute`](Self::compute) (its joint
     /// transforms reused; g(q) unchanged).
-    pub fn recompute_velocity_terms(&mut self, model: &Model, xi: &[f64]) {
+    ///
+    /// # Errors
+    /// [`InputError::Length`] when ξ is not nv long.
+    pub fn recompute_velocity_terms(&mut self, model: &Model, xi: &[f64]) -> Result<(), InputError> {
+        check::v("LagrangianTerms::recompute_velocity_terms", "xi", model, xi)?;
         self.pass(model, xi, false);
+        Ok(())
     }
 
-    fn pass(&mut self, model: &Model, xi: &[f64], with_gravity: bool) {
+    pub(crate) fn pass(&mut self, model: &Model, xi: &[f64], with_gravity: bool) {
         let nb = model.nbody();
         self.v_body[0] = Motion::zero();
         self.a_gravity[0] = -model.gravity;

@@ -49,7 +49,7 @@
 use super::lagrangian_terms::LagrangianTerms;
 use super::{correct_drift, Advance, State, StepFailure, StepReport, Stepper};
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
-use crate::forward::{accumulate_xfrc, actuation, advance_activations, passive};
+use crate::forward::{accumulate_xfrc, actuation_unchecked, advance_activations, passive};
 use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::{
     dexp_inv_configuration_unchecked, integrate_configuration_unchecked, Data, EfcType, JointKind, Model,
@@ -336,7 +336,7 @@ impl Variational {
             return 0;
         }
         forward_kinematics_unchecked(model, data, q);
-        plan.constraints.positions(model, data, q, false);
+        plan.constraints.positions_unchecked(model, data, q, false);
         (0..data.nefc).take_while(|&i| data.efc_type[i] == EfcType::Equality).count()
     }
 }
@@ -372,7 +372,7 @@ impl Advance for Variational {
         // The drive, held over the step (with the activations at the step's start).
         if !model.actuators.is_empty() {
             data.act.copy_from(&state.act);
-            actuation(model, data, q0, state.v.as_slice(), &model.plan.actuator_bias_velocity);
+            actuation_unchecked(model, data, q0, state.v.as_slice(), &model.plan.actuator_bias_velocity);
         }
         for k in 0..nv {
             let limit = model.dof_effort_limit[k];
@@ -441,11 +441,11 @@ impl Advance for Variational {
             self.q1.copy_from(&state.q);
             integrate_configuration_unchecked(model, self.q1.as_mut_slice(), self.xi.as_slice(), h);
             if iterations == 1 {
-                self.terms0.compute(model, data, q0, self.xi.as_slice());
+                self.terms0.compute_unchecked(model, data, q0, self.xi.as_slice());
             } else {
-                self.terms0.recompute_velocity_terms(model, self.xi.as_slice());
+                self.terms0.pass(model, self.xi.as_slice(), false);
             }
-            self.terms1.compute(model, data, self.q1.as_slice(), self.xi.as_slice());
+            self.terms1.compute_unchecked(model, data, self.q1.as_slice(), self.xi.as_slice());
             passive(model, data, q0, self.xi.as_slice());
             for k in 0..nv {
                 self.mu_bar[k] = 0.5 * (self.terms0.momentum_gen[k] + self.terms1.momentum_gen[k]);

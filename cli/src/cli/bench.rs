@@ -79,7 +79,7 @@ pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliErro
     let nefc = data.nefc;
     // The collision pass alone (no candidate pairs: no work), at the same state.
     let collide_us = median_us(budget, 100, || {
-        std::hint::black_box(plan.constraints.collide(&model, &mut data, &q));
+        std::hint::black_box(plan.constraints.collide(&model, &mut data, &q)).ok();
     });
     // Whole steps (RK4, exact mode, drift projection included) from the first keyframe, or qpos0,
     // at rest: a scene on its floor settles into contact.

@@ -18,7 +18,7 @@
 //! subtracts it from their reference acceleration), 0 elsewhere.
 
 use crate::constraint::contact::add_contact_jacobian;
-use crate::constraint::limits::{ball_angle_axis, LimitKind, LimitRow};
+use crate::constraint::limits::{quat_angle_axis, LimitKind, LimitRow};
 use crate::constraint::rows::EqualityRows;
 use crate::constraint::rows::{point_motion, RowGeometry};
 use crate::constraint::ConstraintModel;
@@ -190,7 +190,7 @@ fn joint_limit_sides(l: &LimitRow, q: &[f64], margin: f64) -> [Option<(f64, Vec3
         LimitKind::Cone { max_angle } => {
             let qq = &q[l.qpos_adr..l.qpos_adr + 4];
             let norm = qq.iter().map(|x| x * x).sum::<f64>().sqrt();
-            let (angle, axis) = ball_angle_axis(&[qq[0] / norm, qq[1] / norm, qq[2] / norm, qq[3] / norm]);
+            let (angle, axis) = quat_angle_axis(&[qq[0] / norm, qq[1] / norm, qq[2] / norm, qq[3] / norm]);
             [within(max_angle - angle, -axis), None]
         }
     }
