@@ -64,6 +64,7 @@ pub enum InputError {
 
 impl InputError {
     /// `Ok` when `got` equals `expected`, else [`InputError::Length`].
+    #[inline]
     pub fn check_len(
         function: &'static str,
         argument: &'static str,
@@ -74,7 +75,7 @@ impl InputError {
         if got == expected {
             Ok(())
         } else {
-            Err(InputError::Length { function, argument, expected, got, size })
+            Err(length_error(function, argument, expected, got, size))
         }
     }
 
@@ -111,6 +112,19 @@ impl InputError {
     }
 }
 
+/// [`InputError::Length`], built out of the kernels' hot path.
+#[cold]
+#[inline(never)]
+fn length_error(
+    function: &'static str,
+    argument: &'static str,
+    expected: usize,
+    got: usize,
+    size: &'static str,
+) -> InputError {
+    InputError::Length { function, argument, expected, got, size }
+}
+
 /// The checks of a kernel's arguments (crate-internal): `data` made for `model`, and the lengths
 /// of q (nq), v-like vectors (nv).
 pub(crate) mod check {
@@ -118,12 +132,14 @@ pub(crate) mod check {
     use crate::model::{Data, Model};
 
     /// `data`'s kinematic buffers have `model`'s body and dof counts.
+    #[inline]
     pub fn data(function: &'static str, model: &Model, data: &Data) -> Result<(), InputError> {
         InputError::check_len(function, "data (bodies)", data.x_world_body.len(), model.nbody(), "nbody")?;
         InputError::check_len(function, "data (dofs)", data.tau.len(), model.nv, "nv")
     }
 
     /// A configuration: nq values.
+    #[inline]
     pub fn q(function: &'static str, model: &Model, q: &[f64]) -> Result<(), InputError> {
         InputError::check_len(function, "q", q.len(), model.nq, "nq")
     }
@@ -139,6 +155,7 @@ pub(crate) mod check {
     }
 
     /// A velocity, acceleration or generalized force named `argument`: nv values.
+    #[inline]
     pub fn v(
         function: &'static str,
         argument: &'static str,
