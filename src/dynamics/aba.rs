@@ -175,6 +175,7 @@ mod tests {
     /// The AVX2 build of the kernel gives q̈ bit for bit (no fused multiply–add, no reordering).
     #[test]
     #[cfg(target_arch = "x86_64")]
+    #[ignore = "compares the CPU-specific (AVX2/FMA) build of the kernel with the portable one; needs such a CPU: cargo test --release -p lagrange --lib -- --ignored (as .ci/run does)"]
     fn avx2_kernel_is_bit_for_bit() {
         if !std::arch::is_x86_feature_detected!("avx2") {
             eprintln!("skipped: this CPU has no AVX2, the AVX2 kernel is never used here");
