@@ -71,12 +71,16 @@ pub struct Joint {
     pub actuator_force_range: Option<[f64; 2]>,
     /// URDF `<limit effort>` loaded with `--clamp-effort` (see [`Model::dof_effort_limit`]).
     pub effort_limit: Option<f64>,
-    /// Viscous damping coefficient (N·m·s/rad or N·s/m) applied by `simulate` as `−damping·v`.
+    /// The joint's viscous damping coefficient as the file gives it (N·m·s/rad or N·s/m). What
+    /// the passive stage applies, `−dof_damping ⊙ v`, is [`Model::dof_damping`]: this value plus
+    /// the damping of the actuators on the joint (and zero with `<flag damper="disable">`).
     pub damping: f64,
     /// Dry friction of each of the joint's dofs (MJCF `frictionloss`): a friction-loss
     /// constraint row per dof bounds its force by this value.
     pub friction: f64,
-    /// Rotor armature added to the diagonal of M (MuJoCo's `dof_armature`).
+    /// The joint's rotor armature as the file gives it. What M's diagonal gets is
+    /// [`Model::dof_armature`] (MuJoCo's): this value plus the armature of the actuators on the
+    /// joint.
     pub armature: f64,
     /// Spring stiffness and rest position (MuJoCo `stiffness`, `springref`), applied by
     /// `simulate` as `−stiffness·(q − spring_ref)` for hinge and slide joints.
@@ -217,9 +221,11 @@ pub struct Model {
     /// its parent's with two columns turned, no 3×3 product (`kinematics::hinge_world_pose`).
     /// Derived when the model is compiled, like [`hinge_axis`](Self::hinge_axis).
     pub placement_unrotated: Vec<bool>,
-    /// Armature per degree of freedom.
+    /// Armature per degree of freedom, the one M uses (the joint's plus its actuators'; MuJoCo's
+    /// `dof_armature`).
     pub dof_armature: Vec<f64>,
-    /// Damping per degree of freedom.
+    /// Viscous damping per degree of freedom, the one the passive stage and the implicit
+    /// integrators use (the joint's plus its actuators'; MuJoCo's `dof_damping`).
     pub dof_damping: Vec<f64>,
     /// The bound on |actuator + applied| generalized force per degree of freedom: a URDF
     /// `<limit effort>` loaded with `--clamp-effort`, else +∞.
