@@ -128,6 +128,13 @@ fn eval_rejects_a_state_of_the_wrong_size() {
     let (ok, _, err) = lagrange(&["eval", "models/ur5/ur5.urdf", "--states", input.to_str().unwrap()]);
     assert!(!ok);
     assert!(err.contains("line 2") && err.contains("expected {\"states\""), "{err}");
+    // A misspelled field is an error naming it, never silently ignored.
+    let input = temp_file(
+        "misspelled_states.json",
+        r#"{"states": [{"q": [0, 0, 0, 0, 0, 0], "vel": [1, 0, 0, 0, 0, 0]}]}"#,
+    );
+    let (ok, _, err) = lagrange(&["eval", "models/ur5/ur5.urdf", "--states", input.to_str().unwrap()]);
+    assert!(!ok && err.contains("unknown field `vel`"), "{err}");
 }
 
 #[test]

@@ -18,6 +18,7 @@ use std::path::Path;
 
 /// One input state: q (nq), v (nv, default zero), tau (nv, default zero).
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StateIn {
     pub q: Vec<f64>,
     #[serde(default)]
@@ -34,6 +35,7 @@ pub struct StateIn {
 }
 
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct StatesFile {
     states: Vec<StateIn>,
 }
