@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::SOFT_REL;
+use common::{state_rel_err, SOFT_REL};
 use lagrange::prelude::*;
 use lagrange::spatial::Vec3;
 use serde_json::Value;
@@ -55,13 +55,7 @@ fn mocap_bodies_push_and_hold_as_in_mujoco() {
             step(&model, &mut data).unwrap();
             k += 1;
         }
-        for (key, ours) in [("qpos", &data.qpos), ("qvel", &data.qvel)] {
-            let theirs: Vec<f64> =
-                sample[key].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
-            let scale = theirs.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-            let err = ours.iter().zip(&theirs).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / scale;
-            worst = worst.max(err);
-        }
+        worst = worst.max(state_rel_err(sample, &data));
         println!("step {k}: worst rel err so far {worst:.1e}, ball x {:.4}", data.qpos[0]);
     }
     // The pusher has pushed the ball (MuJoCo's ball is at x = 0.31 after 300 steps).

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::REF_REL;
+use common::{state_rel_err, REF_REL};
 use lagrange::model::FrameKind;
 use lagrange::prelude::*;
 use serde_json::Value;
@@ -59,13 +59,7 @@ fn wrenches_on_bodies_follow_mujoco() {
                 step(&model, &mut data).unwrap();
                 k += 1;
             }
-            for (key, ours) in [("qpos", &data.qpos), ("qvel", &data.qvel)] {
-                let theirs: Vec<f64> =
-                    sample[key].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
-                let scale = theirs.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-                let err = ours.iter().zip(&theirs).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / scale;
-                worst = worst.max(err);
-            }
+            worst = worst.max(state_rel_err(sample, &data));
         }
         println!(
             "{name}: 200 steps with wrenches on box, forearm and welded hand, worst rel err {worst:.1e}"

@@ -550,6 +550,20 @@ pub fn exact_rk4(dt: f64) -> lagrange::sim::SimOptions {
     }
 }
 
+/// The largest difference of `data`'s `qpos` and `qvel` from a reference sample
+/// (`{"qpos": [...], "qvel": [...]}` of a golden file), each relative to the sample's largest entry
+/// (at least 1).
+pub fn state_rel_err(sample: &serde_json::Value, data: &Data) -> f64 {
+    let mut worst = 0.0f64;
+    for (key, ours) in [("qpos", &data.qpos), ("qvel", &data.qvel)] {
+        let theirs: Vec<f64> = sample[key].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        let scale = theirs.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        let err = ours.iter().zip(&theirs).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / scale;
+        worst = worst.max(err);
+    }
+    worst
+}
+
 /// `model` solving its constraints in `mode` ([`Model::set_constraint_mode`]).
 pub fn with_mode(mut model: Model, mode: lagrange::constraint::ConstraintMode) -> Model {
     model.set_constraint_mode(mode);
