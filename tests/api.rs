@@ -229,3 +229,28 @@ fn every_kernel_refuses_wrong_lengths() {
     let err = aba(&model, &mut data, &q_short, &v, &v).unwrap_err();
     assert_eq!(err.to_string(), format!("aba: q has {} values, the model needs {nq} (nq)", nq - 1));
 }
+
+/// A zero or vanishing quaternion in the state reads as the identity, as MuJoCo normalizes it
+/// (free and ball joints): finite accelerations equal to those at the identity, and a step that
+/// stays finite — never NaN in an output.
+#[test]
+fn a_zero_quaternion_is_the_identity() {
+    let model = Model::from_str(
+        r#"<mujoco><worldbody><body pos="0 0 1"><freejoint/><geom type="box" size="0.1 0.2 0.3"/>
+           <body pos="0.2 0 0"><joint type="ball"/><geom size="0.05" pos="0.1 0 0"/></body></body>
+           </worldbody></mujoco>"#,
+    )
+    .unwrap();
+    let mut data = Data::new(&model);
+    data.qvel.copy_from_slice(&[0.1, 0.2, 0.3, 0.5, -0.4, 0.3, 1.0, 0.0, -1.0]);
+    forward(&model, &mut data);
+    let at_identity = data.qacc.clone();
+    for tiny in [0.0, 1e-300] {
+        data.qpos.as_mut_slice()[3..7].copy_from_slice(&[tiny, 0.0, 0.0, 0.0]);
+        data.qpos.as_mut_slice()[7..11].copy_from_slice(&[0.0, tiny, 0.0, tiny]);
+        forward(&model, &mut data);
+        assert_eq!(data.qacc, at_identity, "quaternions of norm {tiny}");
+    }
+    step(&model, &mut data).unwrap();
+    assert!(data.qpos.iter().chain(data.qvel.iter()).all(|x| x.is_finite()), "{:?}", data.qpos);
+}

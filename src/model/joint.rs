@@ -1,7 +1,7 @@
 //! Joint models: configuration → transform, motion subspace and velocity-product term
 //! (RBDA §4.4, Table 4.1), in MuJoCo's qpos/qvel layout (docs/architecture.md, "Conventions").
 
-use crate::spatial::{quat_to_matrix, Mat3, Motion, Transform, Vec3};
+use crate::spatial::{Mat3, Motion, Transform, Vec3};
 
 /// The kind of a movable joint, with its axis data in the joint frame. Fixed joints never reach a
 /// [`Model`](crate::Model): the compile step fuses them.
@@ -114,10 +114,13 @@ impl JointKind {
         match self {
             JointKind::Revolute { axis, .. } => Transform::new(axis_angle(axis, q[0]), Vec3::zeros()),
             JointKind::Prismatic { axis } => Transform::from_translation(axis * q[0]),
-            JointKind::Free => {
-                Transform::new(quat_to_matrix(q[3], q[4], q[5], q[6]), Vec3::new(q[0], q[1], q[2]))
+            JointKind::Free => Transform::new(
+                to_unit_quat(&q[3..7]).to_rotation_matrix().into_inner(),
+                Vec3::new(q[0], q[1], q[2]),
+            ),
+            JointKind::Ball => {
+                Transform::new(to_unit_quat(&q[0..4]).to_rotation_matrix().into_inner(), Vec3::zeros())
             }
-            JointKind::Ball => Transform::new(quat_to_matrix(q[0], q[1], q[2], q[3]), Vec3::zeros()),
             JointKind::Planar { axis1, axis2, normal } => {
                 Transform::new(axis_angle(normal, q[2]), axis1 * q[0] + axis2 * q[1])
             }
@@ -241,8 +244,17 @@ pub fn axis_angle(axis: &Vec3, angle: f64) -> Mat3 {
     Mat3::identity() + k * s + k * k * (1.0 - c)
 }
 
+/// The unit quaternion of a joint's coordinates q = [w x y z], normalized as MuJoCo does
+/// (`mju_normalize4`): one shorter than 1e-15 (zero, or so small that its norm underflows) is the
+/// identity; a non-finite one stays non-finite, for the divergence check to report.
 fn to_unit_quat(q: &[f64]) -> nalgebra::UnitQuaternion<f64> {
-    nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]))
+    let quat = nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]);
+    let norm = quat.norm();
+    if norm < 1e-15 {
+        nalgebra::UnitQuaternion::identity()
+    } else {
+        nalgebra::UnitQuaternion::new_unchecked(quat / norm)
+    }
 }
 
 /// q ← normalize(q ⊗ exp(ω dt / 2)), quaternion stored [w x y z].
