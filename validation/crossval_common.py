@@ -220,3 +220,13 @@ class EngineRun:
     # Pinocchio on a URDF with <mimic>: why its mimic support (mimic=True) refuses the file, if it
     # does. lagrange enforces mimics, so its refusal of such a file matches the reference's.
     mimic_refusal: str = ""
+
+
+def max_sample_difference(new: list[dict], old: list[dict], keys: tuple[str, ...] = ("qpos", "qvel")) -> float:
+    """The largest absolute difference between two runs' samples (lists of dicts holding the
+    vectors `keys`), for the reference-data scripts' --check: how far the live reference moved."""
+    worst = 0.0
+    for a, b in zip(new, old):
+        for key in keys:
+            worst = max(worst, float(np.max(np.abs(np.array(a[key]) - np.array(b[key])))))
+    return worst

@@ -15,7 +15,9 @@ import sys
 from pathlib import Path
 
 import mujoco
-import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from crossval_common import max_sample_difference  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "tests/data/mjcf/applied/xfrc.xml"
@@ -55,11 +57,7 @@ def main() -> int:
     }
     if args.check:
         old = json.loads(OUT.read_text())
-        worst = 0.0
-        for name, samples in doc["runs"].items():
-            for a, b in zip(samples, old["runs"][name]):
-                for key in ("qpos", "qvel"):
-                    worst = max(worst, float(np.max(np.abs(np.array(a[key]) - np.array(b[key])))))
+        worst = max(max_sample_difference(samples, old["runs"][name]) for name, samples in doc["runs"].items())
         ok = worst <= 1e-12 and old["wrenches"] == WRENCHES
         print(f"xfrc reference data: live MuJoCo {mujoco.__version__} differs by {worst:.1e} ({'ok' if ok else 'CHANGED'})")
         return 0 if ok else 1
