@@ -168,8 +168,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             Some(m) => mocap_pose0[m].inverse() * x_body_link,
             None => x_body_link,
         };
-        frame_spec_link.extend(std::iter::repeat(li).take(1 + link.frames.len()));
-        geom_spec_link.extend(std::iter::repeat(li).take(link.geoms.len()));
+        frame_spec_link.extend(std::iter::repeat_n(li, 1 + link.frames.len()));
+        geom_spec_link.extend(std::iter::repeat_n(li, link.geoms.len()));
         frames.push(Frame {
             name: link.name.clone(),
             kind: link.kind,
@@ -325,6 +325,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         equalities: Vec::new(),
         tendons: Vec::new(),
         actuators: Vec::new(),
+        sensors: Vec::new(),
+        nsensordata: 0,
         contact_pairs: Vec::new(),
         contact_excludes: Vec::new(),
         collision_pairs: Vec::new(),
@@ -353,6 +355,20 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 a.shortcut.name()
             ));
         }
+    }
+    let names = crate::io::compile_elements::Names::new(spec, &model);
+    let (sensors, nsensordata) = crate::io::compile_sensors::compile_sensors(&spec.elements, &names, &model)?;
+    model.sensors = sensors;
+    model.nsensordata = nsensordata;
+    model.elements.retain(|e| e.category != "sensor");
+    for s in model.sensors.iter().filter(|s| !s.is_computed()) {
+        model.warnings.push(format!(
+            "{}: <{}> '{}': not computed: {}",
+            s.loc,
+            s.kind.tag(),
+            s.label(),
+            s.not_computed.as_deref().unwrap_or("")
+        ));
     }
     let joint_locs: Vec<SourceLoc> = spec
         .links

@@ -254,6 +254,11 @@ pub struct Model {
     pub tendons: Vec<Tendon>,
     /// Actuators in MuJoCo's order (`ctrl` layout).
     pub actuators: Vec<Actuator>,
+    /// Sensors in MuJoCo's order (MJCF `<sensor>`), each with its slice of `Data::sensordata`
+    /// ([`crate::sensor`]).
+    pub sensors: Vec<crate::sensor::Sensor>,
+    /// The length of `Data::sensordata` (MuJoCo's `nsensordata`).
+    pub nsensordata: usize,
     /// Explicit contact pairs (`<contact><pair>`).
     pub contact_pairs: Vec<ContactPair>,
     /// Body pairs excluded from contact (`<contact><exclude>`).
