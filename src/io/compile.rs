@@ -17,6 +17,29 @@ const INERTIA_TOL: f64 = 1e-9;
 /// Inertia (kg·m²) below which a principal moment is round-off: MuJoCo's `mjMINVAL`.
 const ROUNDOFF_MINVAL: f64 = 1e-15;
 
+/// MuJoCo's body id of each spec link (`geom_bodyid`, `site_bodyid`): its rank among the links of
+/// kind `Link` (the frames of kind `Link` of the compiled model, in the same order); a joint link
+/// of a multi-joint MJCF body takes the id of the body it belongs to (the next `Link` after it).
+fn mj_body_ids(spec: &ModelSpec) -> Vec<usize> {
+    let mut ids = vec![0; spec.links.len()];
+    let mut next: usize = 0;
+    for (id, link) in ids.iter_mut().zip(&spec.links) {
+        if link.kind != FrameKind::Joint {
+            *id = next;
+            next += 1;
+        }
+    }
+    let mut owner = next.saturating_sub(1);
+    for (id, link) in ids.iter_mut().zip(&spec.links).rev() {
+        if link.kind == FrameKind::Joint {
+            *id = owner;
+        } else {
+            owner = *id;
+        }
+    }
+    ids
+}
+
 /// Compiles a spec into a model.
 pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let file = spec.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
@@ -29,6 +52,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let welded = welded_to_world(spec);
     let mut meshes = crate::io::geom_mass::MeshCache::default();
     let mut hulls = crate::io::geom_hull::HullCache::default();
+    let link_mj_body = mj_body_ids(spec);
     let mut warnings = spec.warnings.clone();
     // Pass 0: every link's own mass properties (explicit or from its geoms), with the compiler's
     // bounds; then `settotalmass` scales the moving links.
@@ -166,6 +190,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             Some(m) => mocap_pose0[m].inverse() * x_body_link,
             None => x_body_link,
         };
+        let mj_body = link_mj_body[li];
         frames.push(Frame {
             name: link.name.clone(),
             kind: link.kind,
@@ -173,6 +198,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             x_body_frame: x_body_link,
             inertia: i_link,
             mocap,
+            mj_body,
+            site: None,
         });
         for f in &link.frames {
             frames.push(Frame {
@@ -182,6 +209,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 x_body_frame: x_body_link * f.x_link_frame,
                 inertia: RigidInertia::zero(),
                 mocap,
+                mj_body,
+                site: f.site,
             });
         }
         for (g, &mass) in link.geoms.iter().zip(&geom_masses[li]) {
@@ -198,6 +227,10 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 mass,
                 contact: g.contact,
                 hull,
+                mj_body,
+                group: g.group,
+                rgba: g.rgba,
+                material_rgba: g.material_rgba,
             });
         }
     }

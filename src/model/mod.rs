@@ -148,6 +148,15 @@ pub struct Frame {
     /// The mocap body carrying the frame (index in `Data::mocap_pos`), if any: its world pose is
     /// then the mocap pose composed with `x_body_frame`.
     pub mocap: Option<usize>,
+    /// MuJoCo's body id of the frame (`site_bodyid` for a site): the index, among the model's
+    /// frames of kind [`FrameKind::Link`] (the world first, file order; the indexing of
+    /// `Data::xfrc_applied`), of the MJCF body or URDF link the frame is written in — its own for
+    /// a body frame.
+    pub mj_body: usize,
+    /// An MJCF site's shape and size (MuJoCo's `site_type` and `site_size`: a sphere of radius
+    /// 0.005 unless the file says otherwise), which the touch sensor's zone, `insidesite` and
+    /// contact-sensor site filters use; None for frames that are not sites.
+    pub site: Option<crate::mass::Primitive>,
 }
 
 /// A geometry of the model file: collision shape (when `collision`) and mass contribution.
@@ -174,6 +183,18 @@ pub struct Geom {
     /// For a colliding mesh: the vertices of its convex hull in the geom frame (MuJoCo collides
     /// meshes by their hulls).
     pub hull: Option<std::sync::Arc<Vec<Vec3>>>,
+    /// MuJoCo's body id of the geom (`geom_bodyid`): the index, among the model's frames of kind
+    /// [`FrameKind::Link`] (the world first, file order; the indexing of `Data::xfrc_applied`), of
+    /// the MJCF body or URDF link the geom is written in.
+    pub mj_body: usize,
+    /// MJCF `group` (MuJoCo's `geom_group`; 0 by default): ray casting can select groups.
+    pub group: i32,
+    /// MJCF `rgba` (MuJoCo's `geom_rgba`; 0.5 0.5 0.5 1 by default): ray casting skips a geom
+    /// whose alpha is 0 when it has no material.
+    pub rgba: [f32; 4],
+    /// The `rgba` of the geom's material, if it has one (MuJoCo's `mat_rgba`): ray casting then
+    /// skips the geom when that alpha is 0, whatever its own.
+    pub material_rgba: Option<[f32; 4]>,
 }
 
 /// The compiled, immutable model. Build it with a loader (e.g. [`crate::io::load`]) or by
