@@ -52,6 +52,9 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let welded = welded_to_world(spec);
     let mut meshes = crate::io::geom_mass::MeshCache::default();
     let mut hulls = crate::io::geom_hull::HullCache::default();
+    // The lazily read triangles and hulls of mesh geoms, one per file and scale.
+    let mut geom_meshes: HashMap<(std::path::PathBuf, [u64; 3]), std::sync::Arc<crate::collision::GeomMesh>> =
+        HashMap::new();
     let link_mj_body = mj_body_ids(spec);
     let mut warnings = spec.warnings.clone();
     // Pass 0: every link's own mass properties (explicit or from its geoms), with the compiler's
@@ -231,6 +234,17 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 group: g.group,
                 rgba: g.rgba,
                 material_rgba: g.material_rgba,
+                mesh: match &g.shape {
+                    Shape::Mesh { path, scale } => Some(
+                        geom_meshes
+                            .entry((path.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()]))
+                            .or_insert_with(|| {
+                                std::sync::Arc::new(crate::collision::GeomMesh::new(path.clone(), *scale))
+                            })
+                            .clone(),
+                    ),
+                    _ => None,
+                },
             });
         }
     }

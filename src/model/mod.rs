@@ -195,6 +195,10 @@ pub struct Geom {
     /// The `rgba` of the geom's material, if it has one (MuJoCo's `mat_rgba`): ray casting then
     /// skips the geom when that alpha is 0, whatever its own.
     pub material_rgba: Option<[f32; 4]>,
+    /// For any mesh geom (visual ones too): its file's triangles and convex hull, read on first
+    /// use by ray casting and geom distances ([`crate::collision::GeomMesh`]); geoms using the
+    /// same file and scale share one.
+    pub mesh: Option<std::sync::Arc<crate::collision::GeomMesh>>,
 }
 
 /// The compiled, immutable model. Build it with a loader (e.g. [`crate::io::load`]) or by
