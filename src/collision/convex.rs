@@ -135,7 +135,7 @@ impl ConvexShape {
 
 /// GJK/EPA between two support-map shapes at world poses `x1`, `x2`, if closer than `reach`
 /// (parry3d-f64's GJK and EPA). EPA's normal is exact on faces but only first-order accurate
-/// between two smooth surfaces; there the penetration direction is refined ([`polish`]).
+/// between two smooth surfaces; there the penetration direction is refined by Newton steps (`polish`).
 pub fn support_pair(
     x1: &Transform,
     s1: &ConvexShape,

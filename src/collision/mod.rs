@@ -18,9 +18,9 @@
 //! the step's rows are frozen).
 //!
 //! The geometric queries of the sensors live here too: ray casting against geoms and sites
-//! ([`ray`], MuJoCo's `mj_ray`), the distance between two geoms ([`geom_distance`], MuJoCo's
+//! ([`ray()`], MuJoCo's `mj_ray`), the distance between two geoms ([`geom_distance()`], MuJoCo's
 //! `mj_geomDistance`, through the same narrow phase) and whether a point is inside a site
-//! ([`inside_site`], MuJoCo's `mju_insideGeom`). They consider every geom, visual ones included,
+//! ([`inside_site()`], MuJoCo's `mju_insideGeom`). They consider every geom, visual ones included,
 //! reading the triangles and hulls of mesh geoms on first use ([`GeomMesh`]).
 
 pub mod box_box;
