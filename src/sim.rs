@@ -264,6 +264,9 @@ impl Simulation {
         // `timestep` may have been set after `new`.
         self.sync_timestep();
         let mut report = self.stepper.step(&self.model, &mut self.data, self.timestep);
+        // The next soft solve's warm start: this step's acceleration, rows or not (MuJoCo's
+        // mj_advance), so that a solve with no iterations starts where the motion is.
+        self.data.qacc_warmstart.copy_from(&self.data.qacc);
         if self.model.plan.solver.soft_weights().is_some() && self.data.nefc > 0 {
             report.solver_improvement = self.data.solver_improvement;
         }

@@ -80,6 +80,9 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepReport, SimError> {
     let h = model.options.timestep;
     let mut slot = std::mem::take(&mut data.stepper);
     let report = slot.ensure(model).step(model, data, h);
+    // The next soft solve's warm start: this step's acceleration, rows or not (MuJoCo's
+    // mj_advance), so that a solve with no iterations starts where the motion is.
+    data.qacc_warmstart.copy_from(&data.qacc);
     slot.steps += 1;
     let steps = slot.steps;
     data.stepper = slot;
