@@ -48,6 +48,18 @@ pub enum InputError {
         /// Some of the names the model has, to pick from.
         hint: String,
     },
+    /// A scalar argument is out of its range (a step size of 0, negative or NaN).
+    #[error("{function}: {argument} is {value}, it must be {expected}")]
+    Value {
+        /// The function called.
+        function: &'static str,
+        /// The argument or setting.
+        argument: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must be.
+        expected: &'static str,
+    },
     /// A value is not finite.
     #[error("{function}: {argument}[{index}] is {value}, not a finite number")]
     NonFinite {
