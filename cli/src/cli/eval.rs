@@ -53,7 +53,9 @@ fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
 ///
 /// With `kernels_only`, the smooth kernels alone: no `forward` pipeline and no sensors (what the
 /// corpus cross-validation compares; a model loaded with `--accept-nonphysical-inertia` may have a
-/// pipeline that is not finite where the kernels are).
+/// pipeline that is not finite where the kernels are), and an ABA `qacc` that is not finite — M
+/// singular at the state — is left out with the reason in `qacc_error` (M, bias and poses are
+/// still compared).
 pub fn evaluate(
     model: &Model,
     data: &mut Data,
@@ -92,7 +94,16 @@ pub fn evaluate(
         }
         out["jacobians"] = Value::Object(jmap);
     }
-    if !kernels_only {
+    if kernels_only {
+        if out["qacc"].as_array().is_some_and(|a| a.iter().any(|x| !x.as_f64().is_some_and(f64::is_finite))) {
+            let map = out.as_object_mut().expect("an object");
+            map.remove("qacc");
+            map.insert(
+                "qacc_error".into(),
+                json!("ABA's qacc is not finite: the mass matrix is singular at this state (a massless floating or moving body)"),
+            );
+        }
+    } else {
         out["forward"] = forward_json(model, data, s, v, tau);
         out["sensors"] = sensors_json(model, data);
     }
