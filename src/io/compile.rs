@@ -328,12 +328,21 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             let li = frame_spec_link[f];
             let link = &spec.links[li];
             let i_com = frames[f].inertia.i_com();
+            let quat_of = |r: &Mat3| crate::spatial::Transform::new(*r, Vec3::zeros()).quat_wxyz();
             match &link.inertial {
-                Some(i)
-                    if !link.inertia_from_geoms
-                        && (0..3).all(|r| (0..3).all(|c| r == c || i.inertia[(r, c)] == 0.0)) =>
-                {
-                    crate::spatial::Transform::new(i.x_link_inertial.rot, Vec3::zeros()).quat_wxyz()
+                // `diaginertia`: the file's frame as it is; `fullinertia`: its principal axes
+                // found in the file's frame, as MuJoCo's compiler does.
+                Some(i) if !link.inertia_from_geoms => {
+                    let diagonal = (0..3).all(|r| (0..3).all(|c| r == c || i.inertia[(r, c)] == 0.0));
+                    let q = quat_of(&i.x_link_inertial.rot);
+                    if diagonal {
+                        q
+                    } else {
+                        crate::sensor::objects::mul_quat(
+                            &q,
+                            &crate::sensor::objects::principal_quat(&i.inertia),
+                        )
+                    }
                 }
                 _ if frames[f].inertia.mass > 0.0 => crate::sensor::objects::principal_quat(&i_com),
                 _ => [1.0, 0.0, 0.0, 0.0],

@@ -86,12 +86,15 @@ fn frame_quat(model: &Model, data: &Data, quats: &[Quat], f: usize) -> Quat {
     mul_quat(&base, &rot_quat(&frame.x_body_frame.rot))
 }
 
-/// The principal axes of a symmetric inertia tensor as MuJoCo's compiler finds them
-/// (`mjuu_eig3`, user_util.cc): cyclic Jacobi rotations accumulated as quaternions from the
-/// identity, then the moments sorted in decreasing order by quarter turns — so that the body's
-/// inertial frame (`body_iquat`) and the sensors reading it have MuJoCo's axes and signs.
+/// The principal axes of a symmetric inertia tensor as MuJoCo's compiler orients them
+/// (`mjuu_eig3`, user_util.cc): cyclic Jacobi rotations, each about the axis of the largest
+/// off-diagonal entry, accumulated as quaternions from the identity, then the moments sorted in
+/// decreasing order by quarter turns — so that a body's inertial frame (`body_iquat`) and the
+/// sensors reading it have MuJoCo's axes and signs. The half-angle of each rotation is taken from
+/// its tangent (not from √((1 − cos)/2), which cancels to zero below 1e-8 rad), and the sweeps run
+/// until the off-diagonal entries are round-off: equal to MuJoCo 4.0's `body_iquat` to 2e-16
+/// (tests/data/mjcf/sensors/frames.xml).
 pub(crate) fn principal_quat(inertia: &Mat3) -> Quat {
-    const EPS: f64 = 1e-12;
     let normalize = |q: Quat| normalize_quat(&q);
     let mut quat: Quat = [1.0, 0.0, 0.0, 0.0];
     let mut eig = [0.0; 3];
@@ -106,28 +109,22 @@ pub(crate) fn principal_quat(inertia: &Mat3) -> Quat {
         } else {
             (1, 2, 0)
         };
-        if d[(rk, ck)].abs() < EPS {
+        let off = d[(rk, ck)];
+        if off.abs() <= 1e-16 * d[(rk, rk)].abs().max(d[(ck, ck)].abs()) || off == 0.0 {
             break;
         }
-        let tau = (d[(ck, ck)] - d[(rk, rk)]) / (2.0 * d[(rk, ck)]);
+        let tau = (d[(ck, ck)] - d[(rk, rk)]) / (2.0 * off);
         let t = if tau >= 0.0 {
             1.0 / (tau + (1.0 + tau * tau).sqrt())
         } else {
             -1.0 / (-tau + (1.0 + tau * tau).sqrt())
         };
-        let c = 1.0 / (1.0 + t * t).sqrt();
-        if c > 1.0 - EPS {
-            break;
-        }
-        let mut r = [0.0; 4];
-        let s = (0.5 - 0.5 * c).sqrt();
-        r[rotk + 1] = if tau >= 0.0 { -s } else { s };
-        if rotk == 1 {
-            r[rotk + 1] = -r[rotk + 1];
-        }
-        r[0] = (1.0 - r[rotk + 1] * r[rotk + 1]).sqrt();
-        quat = normalize(mul_quat(&quat, &normalize(r)));
+        let (s, c) = (0.5 * t.atan()).sin_cos();
+        let mut r = [c, 0.0, 0.0, 0.0];
+        r[rotk + 1] = if rotk == 1 { s } else { -s };
+        quat = normalize(mul_quat(&quat, &r));
     }
+    const EPS: f64 = 1e-12;
     for j in 0..3 {
         let j1 = j % 2;
         if eig[j1] + EPS < eig[j1 + 1] {
