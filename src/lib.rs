@@ -48,6 +48,7 @@ pub mod kinematics;
 pub mod mass;
 pub mod model;
 pub mod prelude;
+pub mod sensor;
 pub mod sim;
 pub mod spatial;
 

@@ -48,6 +48,7 @@ pub fn forward(model: &Model, data: &mut Data) {
     let q = std::mem::take(&mut data.qpos);
     let v = std::mem::take(&mut data.qvel);
     forward_at(model, data, q.as_slice(), v.as_slice());
+    crate::sensor::compute_at(model, data, q.as_slice(), v.as_slice(), data.time);
     data.qpos = q;
     data.qvel = v;
 }

@@ -34,7 +34,7 @@ pub enum StageKind {
     Collision,
     /// Spatial tendons (kept, not simulated).
     Tendons,
-    /// Sensors (kept, not evaluated).
+    /// The sensor stage (`sensordata`), after the constraint stage.
     Sensors,
     /// Other passive forces MuJoCo computes (fluid forces, gravity compensation, spring-dampers, …;
     /// not simulated).
@@ -93,6 +93,8 @@ pub struct Plan {
     /// Each actuator's velocity bias coefficient with `dampratio` resolved at `qpos0`
     /// ([`super::resolved_bias_velocity`]).
     pub actuator_bias_velocity: Vec<f64>,
+    /// What the sensor stage computes beside the sensors (body velocities, subtree momenta, …).
+    pub sensor_needs: crate::sensor::SensorNeeds,
 }
 
 impl Plan {
@@ -115,6 +117,7 @@ impl Plan {
             constraints,
             solver,
             actuator_bias_velocity: super::resolved_bias_velocity(model),
+            sensor_needs: crate::sensor::SensorNeeds::of(model),
         }
     }
 
@@ -397,8 +400,7 @@ fn stages(
     let spatial =
         model.tendons.iter().filter(|t| matches!(t.kind, crate::model::TendonKind::Spatial { .. })).count();
     out.push(kept(Tendons, "spatial tendons", spatial, "spatial tendons", "kept, not simulated"));
-    let sensors = model.elements.iter().filter(|e| e.category == "sensor").count();
-    out.push(kept(Sensors, "sensors", sensors, "sensors", "kept, not evaluated"));
+    out.push(sensor_stage(model));
     let multi_dof_springs = model.joints.iter().filter(|j| j.stiffness != 0.0 && j.kind.nq() > 1).count();
     let other = model.elements.iter().filter(|e| matches!(e.category.as_str(), "body" | "joint")).count()
         + multi_dof_springs;
@@ -423,6 +425,51 @@ fn stages(
         ));
     }
     out
+}
+
+/// The sensor stage: how many sensors of each stage are computed, what they add to a `forward`,
+/// and which are not computed (with `info` listing each with its reason).
+fn sensor_stage(model: &Model) -> Stage {
+    use crate::sensor::SensorStage;
+    let n = model.sensors.len();
+    if n == 0 {
+        return stage(StageKind::Sensors, "sensors", Status::Skipped, "no sensors");
+    }
+    if !model.options.flags.sensor {
+        return stage(
+            StageKind::Sensors,
+            "sensors",
+            Status::Skipped,
+            format!("{n} sensors, disabled by <flag sensor=\"disable\">"),
+        );
+    }
+    let computed =
+        |st: SensorStage| model.sensors.iter().filter(|s| s.is_computed() && s.stage == st).count();
+    let not = model.sensors.iter().filter(|s| !s.is_computed()).count();
+    let needs = crate::sensor::SensorNeeds::of(model);
+    let mut extra = vec!["world poses"];
+    if needs.velocities {
+        extra.push("body velocities");
+    }
+    if needs.subtree_com {
+        extra.push("subtree centres of mass");
+    }
+    if needs.subtree_velocities {
+        extra.push("subtree momenta");
+    }
+    let mut reason = format!(
+        "{} position, {} velocity, {} acceleration-stage sensors into sensordata ({} values); adds {}",
+        computed(SensorStage::Position),
+        computed(SensorStage::Velocity),
+        computed(SensorStage::Acceleration),
+        model.nsensordata,
+        extra.join(", ")
+    );
+    if not > 0 {
+        reason.push_str(&format!("; {not} not computed (listed with the reason under sensors)"));
+    }
+    let status = if needs.any { Status::Runs } else { Status::NotSimulated };
+    stage(StageKind::Sensors, "sensors", status, reason)
 }
 
 /// A stage for `n` kept elements: not simulated with `why`, or skipped if there are none.

@@ -43,6 +43,8 @@ impl Advance for SemiImplicitEuler {
     fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         data.act.copy_from(&state.act);
         forward_at(model, data, state.q.as_slice(), state.v.as_slice());
+        // MuJoCo's mj_step: the sensors of the state the step starts from.
+        crate::sensor::compute_at(model, data, state.q.as_slice(), state.v.as_slice(), state.time);
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         let flags = &model.options.flags;
         if flags.eulerdamp

@@ -96,6 +96,8 @@ impl Advance for Implicit {
         let nv = model.nv;
         data.act.copy_from(&state.act);
         forward_at(model, data, state.q.as_slice(), state.v.as_slice());
+        // MuJoCo's mj_step: the sensors of the state the step starts from.
+        crate::sensor::compute_at(model, data, state.q.as_slice(), state.v.as_slice(), state.time);
         // Activations as in MuJoCo's `mj_advance` (explicit in act_dot; filterexact exact).
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         crba_unchecked(model, data, state.q.as_slice());

@@ -87,6 +87,8 @@ impl Advance for RungeKutta4 {
             );
             self.act_rate[i].copy_from(&data.act_dot);
             if i == 0 {
+                // MuJoCo's mj_step: the sensors of the state the step starts from.
+                crate::sensor::compute_at(model, data, state.q.as_slice(), state.v.as_slice(), state.time);
                 // The later stages keep the limit and contact rows the step starts with.
                 data.freeze_rows(false);
             }

@@ -78,6 +78,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     // Per compiled body: the link (file body) it belongs to, and the first compiled body of it.
     let (mut body_owner, mut body_root) = (vec![usize::MAX], vec![0usize]);
     let (mut nq, mut nv) = (0, 0);
+    // The spec link each frame and geom is made from (MuJoCo's body table, `Links`).
+    let (mut frame_spec_link, mut geom_spec_link) = (Vec::new(), Vec::new());
 
     // Pass 1, links in depth-first order: create a body per movable joint, fuse fixed ones.
     for (li, link) in spec.links.iter().enumerate() {
@@ -166,6 +168,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             Some(m) => mocap_pose0[m].inverse() * x_body_link,
             None => x_body_link,
         };
+        frame_spec_link.extend(std::iter::repeat_n(li, 1 + link.frames.len()));
+        geom_spec_link.extend(std::iter::repeat_n(li, link.geoms.len()));
         frames.push(Frame {
             name: link.name.clone(),
             kind: link.kind,
@@ -292,6 +296,9 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let hinge_axis =
         std::iter::once(HingeAxis::Other).chain(joints.iter().map(|j| j.kind.hinge_axis())).collect();
     let placement_unrotated = bodies.iter().map(|b| b.x_parent_joint.rot == Mat3::identity()).collect();
+    let kind_is_link: Vec<bool> = spec.links.iter().map(|l| l.kind == FrameKind::Link).collect();
+    let spec_parent: Vec<Option<usize>> = spec.links.iter().map(|l| l.parent).collect();
+    let links = crate::model::Links::build(&kind_is_link, &spec_parent, &frame_spec_link, &geom_spec_link);
     let mut model = Model {
         name: spec.name.clone(),
         source: spec.source.clone(),
@@ -318,10 +325,13 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         equalities: Vec::new(),
         tendons: Vec::new(),
         actuators: Vec::new(),
+        sensors: Vec::new(),
+        nsensordata: 0,
         contact_pairs: Vec::new(),
         contact_excludes: Vec::new(),
         collision_pairs: Vec::new(),
         body_root,
+        links,
         elements: spec.elements.clone(),
         warnings,
         plan: crate::forward::Plan::default(),
@@ -345,6 +355,20 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 a.shortcut.name()
             ));
         }
+    }
+    let names = crate::io::compile_elements::Names::new(spec, &model);
+    let (sensors, nsensordata) = crate::io::compile_sensors::compile_sensors(&spec.elements, &names, &model)?;
+    model.sensors = sensors;
+    model.nsensordata = nsensordata;
+    model.elements.retain(|e| e.category != "sensor");
+    for s in model.sensors.iter().filter(|s| !s.is_computed()) {
+        model.warnings.push(format!(
+            "{}: <{}> '{}': not computed: {}",
+            s.loc,
+            s.kind.tag(),
+            s.label(),
+            s.not_computed.as_deref().unwrap_or("")
+        ));
     }
     let joint_locs: Vec<SourceLoc> = spec
         .links

@@ -130,7 +130,7 @@ fn quoted(name: &str) -> String {
 }
 
 /// Name → index tables of the compiled model, and the spec joints that were fused away.
-struct Names<'m> {
+pub(crate) struct Names<'m> {
     model: &'m Model,
     links: HashMap<&'m str, usize>,
     sites: HashMap<&'m str, usize>,
@@ -146,7 +146,32 @@ struct Names<'m> {
 }
 
 impl<'m> Names<'m> {
-    fn new(spec: &'m ModelSpec, model: &'m Model) -> Self {
+    /// MuJoCo's id of an MJCF body (its rank among the link frames, `Model::links`).
+    pub(crate) fn body_id_of(&self, name: &str, loc: &SourceLoc, element: &str) -> Result<usize, LoadError> {
+        Ok(self.body_id[&self.body_frame(name, loc, element)?])
+    }
+
+    /// A site's frame.
+    pub(crate) fn site_of(&self, name: &str, loc: &SourceLoc, element: &str) -> Result<usize, LoadError> {
+        self.site(name, loc, element)
+    }
+
+    /// A geom's index.
+    pub(crate) fn geom_of(&self, name: &str, loc: &SourceLoc, element: &str) -> Result<usize, LoadError> {
+        self.geom(name, loc, element)
+    }
+
+    /// A movable joint's index.
+    pub(crate) fn joint_of(&self, name: &str, loc: &SourceLoc, element: &str) -> Result<usize, LoadError> {
+        self.joint(name, loc, element)
+    }
+
+    /// A tendon's index.
+    pub(crate) fn tendon_of(&self, name: &str, loc: &SourceLoc, element: &str) -> Result<usize, LoadError> {
+        self.tendon(name, loc, element)
+    }
+
+    pub(crate) fn new(spec: &'m ModelSpec, model: &'m Model) -> Self {
         let mut links = HashMap::new();
         let mut sites = HashMap::new();
         for (i, f) in model.frames.iter().enumerate() {

@@ -3,6 +3,7 @@
 
 pub mod compile;
 mod compile_elements;
+mod compile_sensors;
 mod error;
 mod geom_hull;
 pub mod geom_mass;

@@ -320,6 +320,13 @@ pub struct Data {
     /// Contacts dropped because a collision pass found more than [`Model::max_contacts`]
     /// (cumulative; MuJoCo's `mjWARN_CONTACTFULL`).
     pub contacts_dropped: u64,
+
+    // --- sensors ---
+    /// The sensors' values from the last `forward` (MuJoCo's `sensordata`; each sensor's slice at
+    /// its `Sensor::adr`, `Sensor::dim`).
+    pub sensordata: DVector<f64>,
+    /// The sensor stage's scratch.
+    pub(crate) sensor_work: crate::sensor::SensorWork,
 }
 
 impl Data {
@@ -419,6 +426,8 @@ impl Data {
             soft: SoftWork::new(nv, nefc),
             x_world_geom: vec![Transform::identity(); model.geoms.len()],
             contacts: Vec::with_capacity(model.max_contacts()),
+            sensordata: DVector::zeros(model.nsensordata),
+            sensor_work: crate::sensor::SensorWork::new(model),
             contacts_dropped: 0,
         }
     }

@@ -11,6 +11,7 @@ mod data;
 mod elements;
 pub mod equality;
 mod joint;
+mod links;
 pub mod options;
 pub mod reset;
 pub mod spec;
@@ -23,6 +24,7 @@ pub use data::{Data, EfcState, EfcType, SLIP_VELOCITY};
 pub use elements::{Element, Keyframe};
 pub use equality::{Equality, EqualityKind};
 pub use joint::{axis_angle, HingeAxis, JointKind};
+pub use links::Links;
 pub use options::{Flags, Options};
 pub use tendon::{Tendon, TendonKind};
 
@@ -192,6 +194,9 @@ pub struct Model {
     /// joints compiles to a chain of bodies, one per joint, which MuJoCo treats as one body
     /// (collision filtering); every other body is its own root.
     pub body_root: Vec<usize>,
+    /// MuJoCo's bodies (the file's bodies, world first) over the compiled ones: their frames,
+    /// parents, and the body of every frame and geom ([`Links`]).
+    pub links: Links,
     /// Movable joints: `joints[b - 1]` moves body `b`.
     pub joints: Vec<Joint>,
     /// Named frames: every link or body (fused or not), site and joint anchor.
@@ -249,6 +254,11 @@ pub struct Model {
     pub tendons: Vec<Tendon>,
     /// Actuators in MuJoCo's order (`ctrl` layout).
     pub actuators: Vec<Actuator>,
+    /// Sensors in MuJoCo's order (MJCF `<sensor>`), each with its slice of `Data::sensordata`
+    /// ([`crate::sensor`]).
+    pub sensors: Vec<crate::sensor::Sensor>,
+    /// The length of `Data::sensordata` (MuJoCo's `nsensordata`).
+    pub nsensordata: usize,
     /// Explicit contact pairs (`<contact><pair>`).
     pub contact_pairs: Vec<ContactPair>,
     /// Body pairs excluded from contact (`<contact><exclude>`).

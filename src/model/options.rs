@@ -252,6 +252,9 @@ pub struct Options {
     pub viscosity: f64,
     /// The medium's velocity in the world frame (m/s; not simulated, listed by `info`).
     pub wind: [f64; 3],
+    /// The global magnetic flux in the world frame, read by magnetometer sensors (MuJoCo's
+    /// `magnetic`, default (0, −0.5, 0)).
+    pub magnetic: [f64; 3],
     /// The `<flag>` switches.
     pub flags: Flags,
 }
@@ -273,6 +276,7 @@ impl Default for Options {
             density: 0.0,
             viscosity: 0.0,
             wind: [0.0; 3],
+            magnetic: [0.0, -0.5, 0.0],
             flags: Flags::default(),
         }
     }

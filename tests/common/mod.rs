@@ -130,6 +130,11 @@ pub const MESH_TRANSFORM_REL: f64 = 1e-10;
 /// physical magnitude, so it never hides a real discrepancy.
 pub const REL_FLOOR: f64 = 1e-300;
 
+/// The absolute floor under a sensor's scale (tests/sensors.rs): sensors read quantities of order
+/// one (m, rad, N, m/s); values below 1e-12 are the round-off of such quantities (a joint
+/// velocity of 1e-17 where the reference has 0), not a difference.
+pub const SENSOR_ABS_FLOOR: f64 = 1e-12;
+
 // ------------------------------------------------------------------------------------------------
 // Relative errors
 // ------------------------------------------------------------------------------------------------

@@ -32,6 +32,9 @@ pub struct StateIn {
     /// values; default zero).
     #[serde(default)]
     pub act: Option<Vec<f64>>,
+    /// The simulation time (s) the clock sensor reads (default zero).
+    #[serde(default)]
+    pub time: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -79,7 +82,34 @@ pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]
         out["jacobians"] = Value::Object(jmap);
     }
     out["forward"] = forward_json(model, data, s, v, tau);
+    out["sensors"] = sensors_json(model, data);
     Ok(out)
+}
+
+/// Every computed sensor's values after `forward` at the state, by [`Sensor::label`]
+/// (`lagrange::sensor::Sensor::label`: its name, or `TYPE#ID` when unnamed).
+pub fn sensors_json(model: &Model, data: &Data) -> Value {
+    let mut map = Map::new();
+    for s in model.sensors.iter().filter(|s| s.is_computed() && model.options.flags.sensor) {
+        map.insert(s.label(), json!(data.sensordata.as_slice()[s.adr..s.adr + s.dim]));
+    }
+    Value::Object(map)
+}
+
+/// The sensors not computed, by label, with the reason.
+pub fn sensors_not_computed_json(model: &Model) -> Value {
+    let mut map = Map::new();
+    for s in &model.sensors {
+        let why = match &s.not_computed {
+            Some(why) => why.clone(),
+            None if !model.options.flags.sensor => {
+                "sensors are disabled (<flag sensor=\"disable\">)".to_string()
+            }
+            None => continue,
+        };
+        map.insert(s.label(), json!(why));
+    }
+    Value::Object(map)
 }
 
 /// The staged forward pipeline at the state: `qacc` (constrained), its parts, and one entry per
@@ -96,6 +126,7 @@ fn forward_json(model: &Model, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f
     }
     data.qpos.copy_from_slice(&s.q);
     data.qvel.copy_from_slice(v);
+    data.time = s.time.unwrap_or(0.0);
     forward(model, data);
     let mut constraints = Vec::new();
     let file = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
@@ -226,7 +257,11 @@ fn check_state(model: &Model, file: &str, i: usize, s: &StateIn) -> Result<(), C
     check("v", &s.v, model.nv)?;
     check("tau", &s.tau, model.nv)?;
     check("ctrl", &s.ctrl, model.actuators.len())?;
-    check("act", &s.act, model.na())
+    check("act", &s.act, model.na())?;
+    match s.time {
+        Some(t) if !t.is_finite() => Err(err("'time' is not finite".to_string())),
+        _ => Ok(()),
+    }
 }
 
 /// Runs `eval`, printing `{"results": [...]}`.
@@ -265,7 +300,11 @@ pub fn run(
         check_state(&model, &file, i, s)?;
         results.push(evaluate(&model, &mut data, s, &frame_ids)?);
     }
-    let out = json!({ "results": results, "constraints": {"mode": model.plan.mode().name(), "reason": model.plan.mode_reason} });
+    let out = json!({
+        "results": results,
+        "constraints": {"mode": model.plan.mode().name(), "reason": model.plan.mode_reason},
+        "sensors_not_computed": sensors_not_computed_json(&model),
+    });
     println!("{}", serde_json::to_string(&out).expect("JSON values serialize"));
     Ok(())
 }

@@ -6,6 +6,7 @@ use lagrange::forward::Plan;
 use lagrange::io::{load, LoadOptions};
 use lagrange::model::actuator::Transmission;
 use lagrange::model::{EqualityKind, TendonKind};
+use lagrange::sensor::SensorObject;
 use lagrange::Model;
 use serde_json::{json, Map, Value};
 use std::path::Path;
@@ -18,7 +19,7 @@ struct Listed {
     /// The names of the objects it acts on.
     targets: Vec<String>,
     source: String,
-    status: &'static str,
+    status: String,
 }
 
 /// Status of elements the engine keeps without simulating them.
@@ -52,7 +53,7 @@ fn listing(model: &Model) -> Vec<Listed> {
             name: e.name.clone(),
             targets,
             source: e.loc.to_string(),
-            status: "simulated (exact mode)",
+            status: "simulated (exact mode)".into(),
         });
     }
     for (i, t) in model.tendons.iter().enumerate() {
@@ -73,7 +74,7 @@ fn listing(model: &Model) -> Vec<Listed> {
             name: t.name.clone(),
             targets,
             source: t.loc.to_string(),
-            status,
+            status: status.into(),
         });
     }
     for a in &model.actuators {
@@ -99,7 +100,7 @@ fn listing(model: &Model) -> Vec<Listed> {
             name: a.name.clone(),
             targets,
             source: a.loc.to_string(),
-            status,
+            status: status.into(),
         });
     }
     for p in &model.contact_pairs {
@@ -109,7 +110,7 @@ fn listing(model: &Model) -> Vec<Listed> {
             name: p.name.clone(),
             targets: vec![model.geoms[p.geom1].name.clone(), model.geoms[p.geom2].name.clone()],
             source: p.loc.to_string(),
-            status: "simulated (exact mode)",
+            status: "simulated (exact mode)".into(),
         });
     }
     for x in &model.contact_excludes {
@@ -119,7 +120,7 @@ fn listing(model: &Model) -> Vec<Listed> {
             name: x.name.clone(),
             targets: vec![model.bodies[x.body1].name.clone(), model.bodies[x.body2].name.clone()],
             source: x.loc.to_string(),
-            status: "simulated (exact mode)",
+            status: "simulated (exact mode)".into(),
         });
     }
     for e in &model.elements {
@@ -129,7 +130,33 @@ fn listing(model: &Model) -> Vec<Listed> {
             name: e.name.clone(),
             targets: e.targets.clone(),
             source: e.loc.to_string(),
-            status: if e.category == "transmission" { TRANSMISSION } else { NOT_SIMULATED },
+            status: if e.category == "transmission" { TRANSMISSION } else { NOT_SIMULATED }.into(),
+        });
+    }
+    for sensor in &model.sensors {
+        let object = |o: SensorObject| -> Option<String> {
+            match o {
+                SensorObject::None => None,
+                SensorObject::Body(b) | SensorObject::XBody(b) => Some(frame(model.links.frame[b])),
+                SensorObject::Site(f) => Some(frame(f)),
+                SensorObject::Geom(g) => Some(model.geoms[g].name.clone()),
+                SensorObject::Joint(j) => Some(joint(j)),
+                SensorObject::Tendon(t) => Some(tendon(t)),
+                SensorObject::Actuator(a) => Some(model.actuators[a].name.clone()),
+            }
+        };
+        let status = match &sensor.not_computed {
+            None if model.options.flags.sensor => "computed".to_string(),
+            None => "not computed: <flag sensor=\"disable\">".to_string(),
+            Some(why) => format!("not computed: {why}"),
+        };
+        out.push(Listed {
+            category: "sensor".into(),
+            kind: sensor.kind.tag().to_string(),
+            name: sensor.label(),
+            targets: object(sensor.object).into_iter().chain(object(sensor.reference)).collect(),
+            source: sensor.loc.to_string(),
+            status,
         });
     }
     out
@@ -311,7 +338,7 @@ pub fn to_text(model: &Model, mode: Option<ConstraintMode>) -> String {
             let key = format!("{} <{}>", e.category, e.kind);
             match by_kind.iter_mut().find(|(k, st, _)| *k == key && *st == e.status) {
                 Some(entry) => entry.2 += 1,
-                None => by_kind.push((key, e.status, 1)),
+                None => by_kind.push((key, &e.status, 1)),
             }
         }
         for (k, status, n) in by_kind {

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod bench_native;
 pub mod eval;
 pub mod info;
+pub mod sensor_columns;
 pub mod simulate;
 pub mod workprec;
 pub mod workprec_plot;

@@ -1,5 +1,6 @@
 //! `lagrange simulate` and the default run of `lagrange` with no arguments.
 
+use super::sensor_columns::{self, SensorProbe};
 use super::CliError;
 use indicatif::{ProgressBar, ProgressStyle};
 use lagrange::constraint::ConstraintMode;
@@ -49,6 +50,8 @@ pub struct Request {
 /// What a run measured.
 pub struct Summary {
     pub integrator: &'static str,
+    /// The computed sensors at the final state (`{"NAME": [values]}`).
+    pub sensors: serde_json::Value,
     /// Nothing adds or removes energy (no damping, friction loss, actuators, joint limits or
     /// contacts): the energy drift measures the integration error alone.
     pub passive: bool,
@@ -189,6 +192,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     sim.ctrl_mut().copy_from_slice(&ctrl);
     sim.set_act(&act)?;
     let steps = (request.duration / dt).round() as u64;
+    let mut probe = SensorProbe::new(model);
     let mut csv = match &request.out {
         Some(path) => {
             let file = std::fs::File::create(path)
@@ -224,7 +228,8 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     let (mut max_penetration, mut max_contacts, mut max_iterations) = (0.0f64, 0usize, 0u32);
     for k in 0..=steps {
         if let Some((w, file)) = csv.as_mut() {
-            write_row(w, &sim, energy, violation[0])
+            let sensordata = probe.as_mut().map(|p| p.read(model, &sim.data));
+            write_row(w, model, &sim, sensordata, energy, violation[0])
                 .map_err(|source| CliError::Io { file: file.clone(), source })?;
         }
         if k == steps {
@@ -266,7 +271,12 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         && model.joints.iter().all(|j| j.friction == 0.0)
         && !limited
         && max_contacts == 0;
+    let sensors = match probe.as_mut() {
+        Some(p) => sensor_columns::to_json(model, p.read(model, &sim.data)),
+        None => serde_json::json!({}),
+    };
     Ok(Summary {
+        sensors,
         passive,
         contacts_dropped: sim.data.contacts_dropped,
         constrained: sim.model.plan.has_constraints(),
@@ -340,15 +350,28 @@ fn write_header(w: &mut impl Write, model: &Model) -> std::io::Result<()> {
             write!(w, ",act:{}", a.name)?;
         }
     }
-    writeln!(w, ",energy,constraint_violation")
+    write!(w, ",energy,constraint_violation")?;
+    sensor_columns::write_header(w, model)?;
+    writeln!(w)
 }
 
-fn write_row(w: &mut impl Write, sim: &Simulation, energy: f64, violation: f64) -> std::io::Result<()> {
+fn write_row(
+    w: &mut impl Write,
+    model: &Model,
+    sim: &Simulation,
+    sensordata: Option<&[f64]>,
+    energy: f64,
+    violation: f64,
+) -> std::io::Result<()> {
     write!(w, "{}", display_time(sim.data.time))?;
     for x in sim.data.qpos.iter().chain(sim.data.qvel.iter()).chain(sim.data.act.iter()) {
         write!(w, ",{x}")?;
     }
-    writeln!(w, ",{energy},{violation}")
+    write!(w, ",{energy},{violation}")?;
+    if let Some(sensordata) = sensordata {
+        sensor_columns::write_values(w, model, sensordata)?;
+    }
+    writeln!(w)
 }
 
 /// The `simulate --json` summary: one object (README, "simulate").
@@ -373,6 +396,7 @@ pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
         "q": s.final_state.q.as_slice(),
         "v": s.final_state.v.as_slice(),
         "act": s.final_state.act.as_slice(),
+        "sensors": s.sensors,
     })
 }
 

@@ -93,6 +93,9 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
         if let Some(v) = a.vec3("wind")? {
             o.wind = [v.x, v.y, v.z];
         }
+        if let Some(v) = a.vec3("magnetic")? {
+            o.magnetic = [v.x, v.y, v.z];
+        }
         if let Some(v) = a.keyword("integrator", &["Euler", "RK4", "implicit", "implicitfast"])? {
             o.integrator = match v.as_str() {
                 "Euler" => Integrator::Euler,
