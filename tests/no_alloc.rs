@@ -3,7 +3,10 @@
 //! the allocations this thread makes while the kernels run.
 
 use lagrange::constraint::ConstraintMode;
-use lagrange::dynamics::{aba, bias_forces, crba, factorize_mass_matrix, rnea, solve_mass_matrix};
+use lagrange::dynamics::{
+    aba, bias_forces, crba, factorize_mass_matrix, interaction_wrench, object_acceleration,
+    rne_post_constraint, rnea, solve_mass_matrix,
+};
 use lagrange::forward::forward;
 use lagrange::integrate::IntegratorKind;
 use lagrange::io::{load, LoadOptions};
@@ -162,6 +165,14 @@ fn contact_scenes_do_not_allocate() {
             forward(&model, &mut data);
             let forwards = allocations(|| forward(&model, &mut data));
             assert_eq!(forwards, 0, "{file} {mode:?}: forward allocated {forwards} times");
+            // MuJoCo's rnePostConstraint (contact forces in cfrc_ext) and the sensors' accessors.
+            let post = allocations(|| {
+                rne_post_constraint(&model, &mut data).unwrap();
+                let p = data.x_world_body[1].pos;
+                std::hint::black_box(object_acceleration(&model, &data, 1, &p).unwrap());
+                std::hint::black_box(interaction_wrench(&model, &data, 1, &p).unwrap());
+            });
+            assert_eq!(post, 0, "{file} {mode:?}: rne_post_constraint allocated {post} times");
             for kind in [IntegratorKind::Euler, IntegratorKind::Rk4] {
                 let mut integrator = kind.build(&model);
                 data.qpos.copy_from_slice(&qs);
@@ -175,7 +186,7 @@ fn contact_scenes_do_not_allocate() {
             }
             let touching = data.contacts.iter().filter(|c| c.dist <= 1e-9).count();
             println!(
-                "{file} {mode:?}: 0 allocations in forward, Euler and RK4 with {touching} touching contacts, {} rows",
+                "{file} {mode:?}: 0 allocations in forward, rne_post_constraint, Euler and RK4 with {touching} touching contacts, {} rows",
                 data.nefc
             );
             assert!(touching > 0 && data.nefc > 0, "{file} {mode:?}: the scene should be in contact");

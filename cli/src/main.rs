@@ -1,5 +1,7 @@
 //! The `lagrange` command line: `info`, `eval`, `simulate`, `bench`, `workprec`; with no arguments it simulates the
 //! embedded default scene (the Go1 quadruped standing on its servos, soft contacts) and prints the summary.
+//! Exit status (README, "Exit status"): 0 success, 1 error, 2 command-line usage (clap), 3 `eval` with
+//! failed states, 130 interrupted by a signal, 141 stdout closed by its reader.
 
 use clap::{Parser, Subcommand, ValueEnum};
 mod cli;
@@ -8,6 +10,7 @@ use lagrange::constraint::ConstraintMode;
 use lagrange::forward::DriftCorrection;
 use lagrange::integrate::IntegratorKind;
 use lagrange::io::LoadOptions;
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -147,8 +150,14 @@ enum Command {
         #[arg(long, allow_hyphen_values = true)]
         ctrl: Option<String>,
         /// Write the trajectory (time, q, v, energy, constraint violation per step) to this CSV file.
+        /// The file is replaced only when the run completes; a run that stops early keeps its
+        /// rows in NAME.partial.csv.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Most bytes the --out CSV may take: a run whose estimate exceeds it is refused before it
+        /// starts, one that reaches it stops (rows kept in NAME.partial.csv); 0: no bound.
+        #[arg(long, value_name = "BYTES", default_value_t = simulate::DEFAULT_MAX_OUTPUT_BYTES)]
+        max_output_bytes: u64,
     },
     /// Work-precision: each integrator's error against a reference solution (adaptive, rtol
     /// 1e-13) and its CPU time, over step sizes and tolerances; table, JSON, log-log plot.
@@ -303,6 +312,7 @@ fn main() -> ExitCode {
             v0,
             ctrl,
             out,
+            max_output_bytes,
         }) => simulate::parse_baumgarte(baumgarte.as_deref()).and_then(|baumgarte| {
             let integrator = integrator.map(IntegratorKind::from);
             let tolerances = simulate::parse_tolerances(integrator, rtol, atol)?;
@@ -321,6 +331,7 @@ fn main() -> ExitCode {
                 v0,
                 ctrl,
                 out,
+                max_output_bytes,
             };
             simulate::run_file(&model, &options, &request)
         }),
@@ -328,8 +339,15 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", cli::in_cli_terms(&e.to_string()));
-            ExitCode::FAILURE
+            // stderr's own failures are ignored (no panic): there is nowhere left to report them.
+            let message = cli::in_cli_terms(&e.to_string());
+            let _ = match &e {
+                // A closed stdout ends the run quietly, as for a Unix tool in a pipe.
+                cli::CliError::StdoutClosed => Ok(()),
+                cli::CliError::Interrupted(_) => writeln!(std::io::stderr(), "lagrange: {message}"),
+                _ => writeln!(std::io::stderr(), "error: {message}"),
+            };
+            ExitCode::from(e.exit_code())
         }
     }
 }

@@ -53,13 +53,22 @@ pub fn contact_force(model: &Model, data: &Data, i: usize) -> Result<[f64; 6], I
         return Err(InputError::Index { function: "contact_force", what: "contact", index: i, count });
     }
     let mut out = [0.0; 6];
-    let Some((r, len, kind)) = contact_rows(data, i) else {
+    let Some((r, len, _)) = contact_rows(data, i) else {
         return Ok(out);
     };
+    out = block_force(data, r, len);
+    Ok(out)
+}
+
+/// The contact-frame force of the contact whose `len` rows start at row `r` (a contact's block:
+/// [`Data::efc_is_normal`] at `r`, `len` = [`Data::efc_block_len`]): the decoding of
+/// [`contact_force`], without the search for the rows.
+pub(crate) fn block_force(data: &Data, r: usize, len: usize) -> [f64; 6] {
+    let mut out = [0.0; 6];
     let forces = &data.efc_force.as_slice()[r..r + len];
-    match kind {
+    match data.efc_type[r] {
         EfcType::ContactPyramidal => {
-            let friction = &data.contacts[i].friction;
+            let friction = &data.contacts[data.efc_id[r]].friction;
             out[0] = forces.iter().sum();
             for k in 0..len / 2 {
                 out[k + 1] = friction[k] * (forces[2 * k] - forces[2 * k + 1]);
@@ -67,7 +76,7 @@ pub fn contact_force(model: &Model, data: &Data, i: usize) -> Result<[f64; 6], I
         }
         _ => out[..len].copy_from_slice(forces),
     }
-    Ok(out)
+    out
 }
 
 /// One contact of the last `forward`, as [`contacts`] gives it.

@@ -1,10 +1,12 @@
 //! Rigid-body dynamics (docs/architecture.md, "Layers"): inverse dynamics (RNEA), the joint-space inertia
 //! matrix (CRBA) and its tree-sparse factorization, forward dynamics (ABA), energy, centre of mass
-//! and momentum. Every function writes into [`Data`](crate::Data) and allocates nothing.
+//! and momentum, and MuJoCo's per-body accelerations and wrenches after a solve (`rne_post`).
+//! Every function writes into [`Data`](crate::Data) and allocates nothing.
 
 mod aba;
 mod crba;
 mod energy;
+pub(crate) mod rne_post;
 mod rnea;
 
 pub use aba::aba;
@@ -13,5 +15,9 @@ pub use crba::{crba, crba_upper, factorize_mass_matrix, solve_mass_matrix, solve
 pub(crate) use crba::{crba_unchecked, solve_with_factor_unchecked};
 pub(crate) use energy::kinetic_energy_unchecked;
 pub use energy::{center_of_mass, kinetic_energy, potential_energy, spatial_momentum};
+pub(crate) use rne_post::RnePost;
+pub use rne_post::{
+    body_acceleration, external_wrench, interaction_wrench, object_acceleration, rne_post_constraint,
+};
 pub(crate) use rnea::bias_forces_unchecked;
 pub use rnea::{bias_forces, gravity_forces, rnea};

@@ -10,6 +10,7 @@
 use super::{Contact, FrameKind, JointKind, Model};
 use crate::constraint::soft::SoftWork;
 use crate::constraint::{ExactWork, RowLifecycle};
+use crate::dynamics::RnePost;
 use crate::integrate::StepperSlot;
 use crate::spatial::{quat_to_matrix, ArticulatedInertia, Force, Motion, RigidInertia, Transform, Vec3};
 use nalgebra::{DMatrix, DVector, Matrix6};
@@ -269,6 +270,9 @@ pub struct Data {
     pub(crate) lifecycle: RowLifecycle,
     /// The stepper of [`step`](crate::integrate::step) (the model's integrator) and its buffers.
     pub(crate) stepper: StepperSlot,
+    /// MuJoCo's `cacc`, `cfrc_ext`, `cfrc_int` per MuJoCo body and their work buffers, filled by
+    /// [`rne_post_constraint`](crate::dynamics::rne_post_constraint).
+    pub(crate) rne_post: RnePost,
 
     // --- soft (MuJoCo-compatible) constraint model, MuJoCo's buffer names ---
     /// Rows of equality constraints and of friction loss in the soft solve (MuJoCo's `ne`, `nf`;
@@ -408,6 +412,7 @@ impl Data {
             exact: ExactWork::new(nv, nefc),
             lifecycle: RowLifecycle::new(model),
             stepper: StepperSlot::for_model(model),
+            rne_post: RnePost::new(model),
             ne: 0,
             nf: 0,
             efc_margin: DVector::zeros(nefc),

@@ -112,27 +112,32 @@ pub fn run(path: &Path, options: &LoadOptions, json: bool) -> Result<(), CliErro
             "step_us": step_us, "step_contacts": contacts, "step_dt": sim.timestep,
             "soft_step_us": soft_step_us, "soft_step_rows": soft_rows,
             "soft_steps": SOFT_STEPS, "soft_integrator": model.options.integrator.mjcf_name()});
-        println!("{out}");
+        super::stdout::print(&format!("{out}\n"))?;
     } else {
-        println!("{} (nq {}, nv {}), median µs per call:", path.display(), model.nq, model.nv);
-        println!("  load (parse + compile) {load_us:>12.1}");
-        println!("  forward kinematics     {fk_us:>12.3}");
-        println!("  RNEA                   {rnea_us:>12.3}");
-        println!("  CRBA                   {crba_us:>12.3}");
-        println!("  ABA                    {aba_us:>12.3}");
-        println!("  forward ({nefc:>2} rows)      {forward_us:>12.3}");
-        println!("  collision ({pairs} pairs)  {collide_us:>12.3}");
-        println!(
+        use std::fmt::Write as _;
+        let mut text = String::new();
+        let _ = writeln!(text, "{} (nq {}, nv {}), median µs per call:", path.display(), model.nq, model.nv);
+        let _ = writeln!(text, "  load (parse + compile) {load_us:>12.1}");
+        let _ = writeln!(text, "  forward kinematics     {fk_us:>12.3}");
+        let _ = writeln!(text, "  RNEA                   {rnea_us:>12.3}");
+        let _ = writeln!(text, "  CRBA                   {crba_us:>12.3}");
+        let _ = writeln!(text, "  ABA                    {aba_us:>12.3}");
+        let _ = writeln!(text, "  forward ({nefc:>2} rows)      {forward_us:>12.3}");
+        let _ = writeln!(text, "  collision ({pairs} pairs)  {collide_us:>12.3}");
+        let _ = writeln!(
+            text,
             "  RK4 step, exact, at rest from {} (dt {}, {contacts} contacts at the end) {step_us:>9.3} (mean of 500)",
             model.keyframes.first().map_or("qpos0", |k| k.name.as_str()),
             sim.timestep
         );
-        println!(
+        let _ = writeln!(
+            text,
             "  step, soft mode, the model's <option> ({}, dt {}), from {} with its ctrl, {soft_rows} rows at the end {soft_step_us:>9.3} (mean of {SOFT_STEPS})",
             model.options.integrator.mjcf_name(),
             model.options.timestep,
             model.keyframes.first().map_or("qpos0", |k| k.name.as_str()),
         );
+        super::stdout::print(&text)?;
     }
     Ok(())
 }

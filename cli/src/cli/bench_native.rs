@@ -99,8 +99,13 @@ fn time_op<C>(
     us
 }
 
-fn emit_check(robot: &str, what: &str, state: usize, x: &[f64]) {
-    println!("{}", json!({"engine": "lagrange", "robot": robot, "check": what, "state": state, "x": x}));
+fn emit_check(robot: &str, what: &str, state: usize, x: &[f64]) -> Result<(), CliError> {
+    emit(&json!({"engine": "lagrange", "robot": robot, "check": what, "state": state, "x": x}))
+}
+
+/// One JSON line to stdout, flushed (the driver waits for it).
+fn emit(value: &serde_json::Value) -> Result<(), CliError> {
+    super::stdout::print(&format!("{value}\n"))
 }
 
 /// Runs `bench-native`.
@@ -115,27 +120,24 @@ pub fn run(path: &Path, options: &LoadOptions, states_file: &Path, robot: &str) 
     }
     let mut data = Data::new(&model);
     let (n, nv) = (states.len(), model.nv);
-    println!(
-        "{}",
-        json!({"engine": "lagrange", "robot": robot, "info": {"nq": model.nq, "nv": nv,
-            "nbody": model.nbody(), "nframes": model.frames.len(),
-            "version": concat!(env!("CARGO_PKG_NAME"), " ", env!("CARGO_PKG_VERSION"))}})
-    );
+    emit(&json!({"engine": "lagrange", "robot": robot, "info": {"nq": model.nq, "nv": nv,
+        "nbody": model.nbody(), "nframes": model.frames.len(),
+        "version": concat!(env!("CARGO_PKG_NAME"), " ", env!("CARGO_PKG_VERSION"))}}))?;
     let mut x = DVector::zeros(nv);
     for (s, st) in states.iter().enumerate().take(4) {
-        emit_check(robot, "rnea", s, rnea(&model, &mut data, &st.q, &st.v, &st.a)?.as_slice());
-        emit_check(robot, "crba", s, crba(&model, &mut data, &st.q)?.as_slice());
+        emit_check(robot, "rnea", s, rnea(&model, &mut data, &st.q, &st.v, &st.a)?.as_slice())?;
+        emit_check(robot, "crba", s, crba(&model, &mut data, &st.q)?.as_slice())?;
         factorize_mass_matrix(&model, &mut data);
         x.copy_from_slice(&st.tau);
         solve_mass_matrix(&model, &data, &mut x)?;
-        emit_check(robot, "solve", s, x.as_slice());
-        emit_check(robot, "aba", s, aba(&model, &mut data, &st.q, &st.v, &st.tau)?.as_slice());
+        emit_check(robot, "solve", s, x.as_slice())?;
+        emit_check(robot, "aba", s, aba(&model, &mut data, &st.q, &st.v, &st.tau)?.as_slice())?;
     }
     let none = |_: &mut Data, _: usize| {};
     let last_frame = model.frames.len().checked_sub(1);
     let st = &states;
     let m = &model;
-    println!("{}", json!({"ready": ["fk", "rnea", "crba", "aba", "factor_solve"]}));
+    emit(&json!({"ready": ["fk", "rnea", "crba", "aba", "factor_solve"]}))?;
     for line in std::io::stdin().lock().lines() {
         let line = line.map_err(|source| CliError::Io { file: "stdin".into(), source })?;
         let mut words = line.split_ascii_whitespace();
@@ -180,7 +182,7 @@ pub fn run(path: &Path, options: &LoadOptions, states_file: &Path, robot: &str) 
             ),
             _ => return Err(CliError::Usage(format!("bench-native: unknown operation {op}"))),
         };
-        println!("{}", json!({"engine": "lagrange", "robot": robot, "op": op, "us": us}));
+        emit(&json!({"engine": "lagrange", "robot": robot, "op": op, "us": us}))?;
     }
     Ok(())
 }

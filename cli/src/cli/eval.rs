@@ -1,6 +1,13 @@
 //! `lagrange eval MODEL --states FILE`: one process evaluates a batch of states (the interface the
-//! validation scripts use; schema in the README).
+//! validation scripts use; schema in the README). The states are read one at a time
+//! ([`super::eval_stream`]) and each result is written as soon as it is computed, so memory does not
+//! grow with the number of states. A state whose result has a non-finite number gets an
+//! `{"error": "..."}` entry in its place (naming the quantity) and the run ends with
+//! [`super::EXIT_STATES_FAILED`]; no `null` is ever printed.
 
+use super::eval_stream::for_each_state;
+use super::finite_json::{describe, first_null};
+use super::stdout::Stdout;
 use super::CliError;
 use lagrange::constraint::contact_force::contact_force;
 use lagrange::constraint::ConstraintMode;
@@ -35,12 +42,6 @@ pub struct StateIn {
     /// The simulation time (s) the clock sensor reads (default zero).
     #[serde(default)]
     pub time: Option<f64>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct StatesFile {
-    states: Vec<StateIn>,
 }
 
 fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
@@ -277,15 +278,6 @@ pub fn run(
         model.set_constraint_mode(mode);
     }
     let file = states.display().to_string();
-    let text =
-        std::fs::read_to_string(states).map_err(|source| CliError::Io { file: file.clone(), source })?;
-    let input: StatesFile = serde_json::from_str(&text).map_err(|e| CliError::Input {
-        file: file.clone(),
-        detail: format!(
-            "line {}: {e}; expected {{\"states\": [{{\"q\": [...], \"v\": [...], \"tau\": [...], \"ctrl\": [...], \"act\": [...]}}]}}",
-            e.line()
-        ),
-    })?;
     let frame_ids = jacobians
         .iter()
         .map(|name| {
@@ -294,17 +286,47 @@ pub fn run(
                 .ok_or_else(|| CliError::Usage(format!("--jacobian {name}: the model has no frame '{name}'")))
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let reader = std::fs::File::open(states)
+        .map(|f| std::io::BufReader::with_capacity(1 << 16, f))
+        .map_err(|source| CliError::Io { file: file.clone(), source })?;
     let mut data = Data::new(&model);
-    let mut results = Vec::with_capacity(input.states.len());
-    for (i, s) in input.states.iter().enumerate() {
-        check_state(&model, &file, i, s)?;
-        results.push(evaluate(&model, &mut data, s, &frame_ids)?);
+    let mut out = Stdout::lock();
+    // The output is `{"constraints": {...}, "results": [...]}`, keys in serde_json's (sorted)
+    // order: byte for byte what serializing the whole object at once gives.
+    let constraints = json!({"mode": model.plan.mode().name(), "reason": model.plan.mode_reason});
+    out.print("{\"constraints\":")?;
+    out.json(&constraints)?;
+    out.print(",\"results\":[")?;
+    let (mut failed, mut first) = (0usize, Vec::new());
+    let expected =
+        "{\"states\": [{\"q\": [...], \"v\": [...], \"tau\": [...], \"ctrl\": [...], \"act\": [...]}]}";
+    let total = for_each_state(reader, &file, expected, &mut |i, s: StateIn| {
+        check_state(&model, &file, i, &s)?;
+        let mut result = evaluate(&model, &mut data, &s, &frame_ids)?;
+        if let Some(path) = first_null(&result) {
+            let reason = format!("states[{i}]: {} is not finite (NaN or infinite)", describe(&path));
+            failed += 1;
+            if first.len() < 3 {
+                first.push(reason.clone());
+            }
+            result = json!({ "error": reason });
+        }
+        if i > 0 {
+            out.print(",")?;
+        }
+        out.json(&result)
+    })?;
+    // `sensors_not_computed` sorts after `results`: the key order stays serde_json's.
+    out.print("],\"sensors_not_computed\":")?;
+    out.json(&sensors_not_computed_json(&model))?;
+    out.print("}\n")?;
+    out.finish()?;
+    if failed > 0 {
+        return Err(CliError::StatesFailed {
+            failed,
+            total,
+            first: first.join("; ") + if failed > first.len() { "; …" } else { "" },
+        });
     }
-    let out = json!({
-        "results": results,
-        "constraints": {"mode": model.plan.mode().name(), "reason": model.plan.mode_reason},
-        "sensors_not_computed": sensors_not_computed_json(&model),
-    });
-    println!("{}", serde_json::to_string(&out).expect("JSON values serialize"));
     Ok(())
 }

@@ -367,9 +367,9 @@ pub fn run(
 ) -> Result<(), CliError> {
     let model = load(path, options)?;
     if json {
-        println!("{}", serde_json::to_string_pretty(&to_json(&model, mode)).expect("JSON values serialize"));
+        let text = serde_json::to_string_pretty(&to_json(&model, mode)).expect("JSON values serialize");
+        super::stdout::print(&(text + "\n"))
     } else {
-        print!("{}", to_text(&model, mode));
+        super::stdout::print(&to_text(&model, mode))
     }
-    Ok(())
 }

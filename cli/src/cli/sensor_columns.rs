@@ -41,6 +41,11 @@ impl SensorProbe {
     }
 }
 
+/// The number of sensor columns of the CSV.
+pub fn count(model: &Model) -> usize {
+    computed(model).map(|s| s.dim).sum()
+}
+
 /// The CSV header's sensor columns (`,sensor:NAME[i]` for each component).
 pub fn write_header(w: &mut impl Write, model: &Model) -> std::io::Result<()> {
     for s in computed(model) {

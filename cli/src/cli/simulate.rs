@@ -1,6 +1,15 @@
 //! `lagrange simulate` and the default run of `lagrange` with no arguments.
+//!
+//! The trajectory CSV (`--out`) is written as [`super::output_file`] guarantees: the previous
+//! file is replaced only when the run completes; a run that diverges, hits the size bound
+//! (`--max-output-bytes`), fails to write or is interrupted (SIGINT/SIGTERM, [`super::interrupt`])
+//! keeps its whole rows — every number finite — in `NAME.partial.csv`.
 
+use super::finite_json::{describe, first_null};
+use super::interrupt;
+use super::output_file::{RowError, RowFile};
 use super::sensor_columns::{self, SensorProbe};
+use super::stdout;
 use super::CliError;
 use indicatif::{ProgressBar, ProgressStyle};
 use lagrange::constraint::ConstraintMode;
@@ -45,6 +54,24 @@ pub struct Request {
     /// Constant controls (comma-separated, one per actuator).
     pub ctrl: Option<String>,
     pub out: Option<PathBuf>,
+    /// Most bytes the CSV may take (`--max-output-bytes`; 0: no bound).
+    pub max_output_bytes: u64,
+}
+
+/// The default of `--max-output-bytes`: 2 GB.
+pub const DEFAULT_MAX_OUTPUT_BYTES: u64 = 2_000_000_000;
+/// Bytes per CSV value assumed by the size estimate made before a run (a double's shortest
+/// round-trip form, sign and comma).
+pub const CSV_BYTES_PER_VALUE: u64 = 20;
+
+/// Where an interrupted run stopped.
+pub struct Interruption {
+    /// Steps the run was asked for.
+    pub planned_steps: u64,
+    /// The partial trajectory kept (`--out`), if any.
+    pub partial: Option<PathBuf>,
+    /// The note on the `--out` file (kept as partial, previous one untouched).
+    pub note: String,
 }
 
 /// What a run measured.
@@ -89,6 +116,8 @@ pub struct Summary {
     /// Joints that went outside their limits (a soft limit gives way, a rigid one by drift), with
     /// the farthest excursion.
     pub limit_excursions: Vec<(String, f64)>,
+    /// Set when a signal stopped the run before its end (`steps` then counts the steps taken).
+    pub interrupted: Option<Interruption>,
 }
 
 /// `--baumgarte α,β` → gains (both finite and ≥ 0).
@@ -193,14 +222,17 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     sim.set_act(&act)?;
     let steps = (request.duration / dt).round() as u64;
     let mut probe = SensorProbe::new(model);
+    let limit = if request.max_output_bytes == 0 { u64::MAX } else { request.max_output_bytes };
+    if let Some(path) = &request.out {
+        check_output_size(model, path, steps, limit)?;
+    }
+    interrupt::watch();
     let mut csv = match &request.out {
         Some(path) => {
-            let file = std::fs::File::create(path)
-                .map_err(|source| CliError::Io { file: path.display().to_string(), source })?;
-            let mut w = std::io::BufWriter::new(file);
-            write_header(&mut w, model)
-                .map_err(|source| CliError::Io { file: path.display().to_string(), source })?;
-            Some((w, path.display().to_string()))
+            let mut w = RowFile::create(path, limit)?;
+            write_header(w.row(), model).map_err(|source| CliError::Io { file: w.label(), source })?;
+            end_row(&mut w, limit, 0.0, 0)?;
+            Some(w)
         }
         None => None,
     };
@@ -226,18 +258,41 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     let mut max_violation = violation;
     let mut redundant = None;
     let (mut max_penetration, mut max_contacts, mut max_iterations) = (0.0f64, 0usize, 0u32);
+    // Why the run ended before its last step, if it did.
+    let mut stopped: Option<CliError> = None;
+    let mut interrupted = false;
+    let mut taken = 0;
     for k in 0..=steps {
-        if let Some((w, file)) = csv.as_mut() {
+        // Every number of a row and of the summary is finite: the run stops before the first
+        // state that is not.
+        if let Some(what) = non_finite(&sim, energy, violation) {
+            stopped = Some(diverged(&sim, k, &what));
+            break;
+        }
+        if let Some(w) = csv.as_mut() {
             let sensordata = probe.as_mut().map(|p| p.read(model, &sim.data));
-            write_row(w, model, &sim, sensordata, energy, violation[0])
-                .map_err(|source| CliError::Io { file: file.clone(), source })?;
+            if let Err(e) = csv_row(w, model, &sim, sensordata, (energy, violation[0]), limit, k) {
+                stopped = Some(e);
+                break;
+            }
         }
         if k == steps {
             break;
         }
+        if interrupt::requested() {
+            interrupted = true;
+            break;
+        }
         let t0 = Instant::now();
-        let report = sim.step()?;
+        let report = match sim.step() {
+            Ok(report) => report,
+            Err(e) => {
+                stopped = Some(e.into());
+                break;
+            }
+        };
         wall += t0.elapsed();
+        taken = k + 1;
         violation = report.constraint_violation;
         let (contacts, penetration) = contact_summary(&sim.data);
         max_contacts = max_contacts.max(contacts);
@@ -253,17 +308,42 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         // Energy monitoring is outside the timed step.
         let (kinetic, potential) = sim.energies();
         energy = kinetic + potential;
-        max_kinetic = max_kinetic.max(kinetic);
-        max_dev = max_dev.max((energy - energy_start).abs());
+        if energy.is_finite() {
+            max_kinetic = max_kinetic.max(kinetic);
+            max_dev = max_dev.max((energy - energy_start).abs());
+        }
         track_limit_excursions(model, sim.data.qpos.as_slice(), &mut excursions);
         if k % 4096 == 0 {
             progress.set_position(k);
         }
     }
     progress.finish_and_clear();
-    if let Some((mut w, file)) = csv {
-        w.flush().map_err(|source| CliError::Io { file, source })?;
+    if let Some(e) = stopped {
+        let note = match csv {
+            // The run's own error comes first; a failure to keep its rows is added to it.
+            Some(w) => partial_note(w).unwrap_or_else(|e| format!("its rows could not be kept: {e}")),
+            None => String::new(),
+        };
+        return Err(e.with_note(&note));
     }
+    let interrupted = if interrupted {
+        let (partial, note) = match csv {
+            Some(w) => {
+                let label = w.label();
+                let replaces = w.replaces_a_file();
+                let partial = w.keep_partial()?;
+                let note = partial_text(&label, replaces, partial.as_deref());
+                (partial, note)
+            }
+            None => (None, String::new()),
+        };
+        Some(Interruption { planned_steps: steps, partial, note })
+    } else {
+        if let Some(w) = csv {
+            w.commit()?;
+        }
+        None
+    };
     // Joint limits and contacts end impacts inelastically: their energy loss is physics.
     let limited = model.options.flags.limit && model.joints.iter().any(|j| j.limits.is_some());
     let passive = !model.has_damping()
@@ -290,7 +370,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         soft: sim.model.plan.solver.soft_weights().is_some(),
         unconverged: (sim.data.efc_unconverged, sim.data.efc_unconverged_residual),
         redundant,
-        steps,
+        steps: taken,
         wall,
         energy_start,
         energy_end: energy,
@@ -304,7 +384,118 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
             .filter(|(_, &e)| e > 0.0)
             .map(|(j, &e)| (j.name.clone(), e))
             .collect(),
+        interrupted,
     })
+}
+
+/// Refuses, before the run, a CSV whose estimated size exceeds `limit`.
+fn check_output_size(model: &Model, path: &Path, steps: u64, limit: u64) -> Result<(), CliError> {
+    let columns = 1 + model.nq + model.nv + model.na() + 2 + sensor_columns::count(model);
+    let rows = steps.saturating_add(1);
+    let estimate = rows.saturating_mul(columns as u64).saturating_mul(CSV_BYTES_PER_VALUE);
+    if estimate > limit {
+        return Err(CliError::Usage(format!(
+            "--out {}: the trajectory would take about {} ({rows} rows × {columns} columns × ~{CSV_BYTES_PER_VALUE} bytes), over --max-output-bytes {limit} ({}): shorten --duration, or raise the bound (--max-output-bytes 0 for none)",
+            path.display(),
+            human_bytes(estimate),
+            human_bytes(limit)
+        )));
+    }
+    Ok(())
+}
+
+/// `13.5 GB`, `812 kB`, `120 bytes`.
+pub fn human_bytes(n: u64) -> String {
+    let x = n as f64;
+    match n {
+        0..1_000 => format!("{n} bytes"),
+        1_000..1_000_000 => format!("{:.0} kB", x / 1e3),
+        1_000_000..1_000_000_000 => format!("{:.1} MB", x / 1e6),
+        1_000_000_000..1_000_000_000_000 => format!("{:.1} GB", x / 1e9),
+        _ => format!("{:.1} TB", x / 1e12),
+    }
+}
+
+/// Writes the CSV row of the current state (`step`), or the error that stops the run.
+fn csv_row(
+    w: &mut RowFile,
+    model: &Model,
+    sim: &Simulation,
+    sensordata: Option<&[f64]>,
+    (energy, violation): (f64, f64),
+    limit: u64,
+    step: u64,
+) -> Result<(), CliError> {
+    // Formatting into the row buffer (a Vec) does not fail.
+    write_row(w.row(), model, sim, sensordata, energy, violation)
+        .map_err(|source| CliError::Io { file: w.label(), source })?;
+    end_row(w, limit, sim.data.time, step)
+}
+
+/// Completes a CSV row, or the error that stops the run: the size bound or a failed write.
+fn end_row(w: &mut RowFile, limit: u64, time: f64, step: u64) -> Result<(), CliError> {
+    match w.end_row() {
+        Ok(()) => Ok(()),
+        Err(RowError::Limit) => Err(CliError::Stopped(format!(
+            "--out {}: the trajectory reached --max-output-bytes {limit} ({}) at t = {} s (step {step}): its values are longer than the ~{CSV_BYTES_PER_VALUE} bytes estimated before the run; raise the bound (--max-output-bytes 0 for none) or shorten --duration",
+            w.label(),
+            human_bytes(limit),
+            display_time(time)
+        ))),
+        Err(RowError::Io(source)) => Err(CliError::Io { file: w.label(), source }),
+    }
+}
+
+/// The first non-finite quantity of the row at the current state, named.
+fn non_finite(sim: &Simulation, energy: f64, violation: [f64; 2]) -> Option<String> {
+    let d = &sim.data;
+    if let Some(i) = d.qpos.iter().position(|x| !x.is_finite()) {
+        return Some(format!("qpos[{i}] is {}", d.qpos[i]));
+    }
+    if let Some(i) = d.qvel.iter().position(|x| !x.is_finite()) {
+        return Some(format!("qvel[{i}] is {}", d.qvel[i]));
+    }
+    if let Some(i) = d.act.iter().position(|x| !x.is_finite()) {
+        return Some(format!("act[{i}] is {}", d.act[i]));
+    }
+    if !energy.is_finite() {
+        return Some(format!("the energy is {energy} (the state's magnitude overflows)"));
+    }
+    if let Some(v) = violation.iter().find(|x| !x.is_finite()) {
+        return Some(format!("the constraint violation is {v}"));
+    }
+    None
+}
+
+/// The error of a run whose state at `step` is not finite.
+fn diverged(sim: &Simulation, step: u64, what: &str) -> CliError {
+    CliError::Stopped(format!(
+        "the simulation diverged at t = {} s (step {step}): {what}; reduce --dt (now {} s), or use --integrator rk4 (or implicit for stiff damping); if it persists, check the initial state, the model's stiffnesses and inertias",
+        display_time(sim.data.time),
+        sim.timestep
+    ))
+}
+
+/// Keeps the rows of a stopped run as the partial file; the note saying so.
+fn partial_note(w: RowFile) -> Result<String, CliError> {
+    let (label, replaces) = (w.label(), w.replaces_a_file());
+    let partial = w.keep_partial()?;
+    Ok(partial_text(&label, replaces, partial.as_deref()))
+}
+
+/// "the trajectory so far is in traj.partial.csv (complete rows); traj.csv is untouched".
+/// (Empty for a target written in place.)
+fn partial_text(label: &str, replaces: bool, partial: Option<&Path>) -> String {
+    let Some(partial) = partial else {
+        // Written in place (a device, a FIFO): nothing to keep apart.
+        return String::new();
+    };
+    let target = if replaces {
+        format!("the previous {label} is untouched")
+    } else {
+        format!("{label} was not written")
+    };
+    format!("the trajectory so far (whole rows, every value finite) is in {}; {target}", partial.display())
 }
 
 /// The number of touching contacts (contact normal rows) and the deepest penetration among them
@@ -376,16 +567,15 @@ fn write_row(
 
 /// The `simulate --json` summary: one object (README, "simulate").
 pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
-    let wall = s.wall.as_secs_f64();
     let simulated = s.steps as f64 * s.dt;
-    json!({
+    let mut out = json!({
         "model": model.source.as_ref().map_or_else(|| model.name.clone(), |p| p.display().to_string()),
         "integrator": s.integrator,
         "dt": s.dt,
         "steps": s.steps,
         "time": display_time(s.final_state.time),
-        "wall_s": wall,
-        "realtime_factor": if wall > 0.0 { simulated / wall } else { f64::INFINITY },
+        "wall_s": s.wall.as_secs_f64(),
+        "realtime_factor": simulated / wall_floor(s.wall),
         "energy": {"initial": s.energy_start, "final": s.energy_end, "max_abs_drift": s.energy_max_dev},
         "max_constraint_violation": {"position": s.max_violation[0], "velocity": s.max_violation[1]},
         "max_penetration": s.max_penetration,
@@ -397,7 +587,20 @@ pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
         "v": s.final_state.v.as_slice(),
         "act": s.final_state.act.as_slice(),
         "sensors": s.sensors,
-    })
+    });
+    if let Some(i) = &s.interrupted {
+        out["interrupted"] = json!({
+            "planned_steps": i.planned_steps,
+            "partial": i.partial.as_ref().map_or_else(String::new, |p| p.display().to_string()),
+        });
+    }
+    out
+}
+
+/// The wall time in seconds, at least 1 ns (the real-time factor of a run too short to time
+/// stays finite).
+fn wall_floor(wall: Duration) -> f64 {
+    wall.as_secs_f64().max(1e-9)
 }
 
 /// Relative energy drift of a passive scene beyond which `simulate` warns.
@@ -417,6 +620,15 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
         "simulated {simulated:.6} s in {} steps of {} s (from {dt_from}) with {} (from {from})",
         s.steps, s.dt, s.integrator
     );
+    if let Some(i) = &s.interrupted {
+        let _ = writeln!(
+            out,
+            "interrupted by a signal at t = {} s after {} of {} steps",
+            display_time(state.time),
+            s.steps,
+            i.planned_steps
+        );
+    }
     for note in &s.notes {
         let _ = writeln!(out, "note: {note}");
     }
@@ -425,7 +637,7 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
         "wall time {:.3} ms ({:.3} µs/step), real-time factor {:.0}×",
         wall * 1e3,
         wall * 1e6 / s.steps.max(1) as f64,
-        if wall > 0.0 { simulated / wall } else { f64::INFINITY }
+        simulated / wall_floor(s.wall)
     );
     let damping = if model.has_damping() { " (joint damping dissipates energy)" } else { "" };
     let _ = writeln!(
@@ -519,14 +731,42 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
 fn run_model(model: &Model, request: &Request) -> Result<(), CliError> {
     let summary = simulate(model, request)?;
     if request.json {
-        println!("{}", summary_json(model, &summary));
-        return Ok(());
+        let value = summary_json(model, &summary);
+        if let Some(path) = first_null(&value) {
+            return Err(CliError::Stopped(format!(
+                "the summary's {} is not finite (NaN or infinite): not printed",
+                describe(&path)
+            )));
+        }
+        stdout::print(&format!("{value}\n"))?;
+    } else {
+        let mut text = summary_text(model, request, &summary);
+        if let (Some(out), None) = (&request.out, &summary.interrupted) {
+            text += &format!("trajectory written to {}\n", out.display());
+        }
+        stdout::print(&text)?;
     }
-    print!("{}", summary_text(model, request, &summary));
-    if let Some(out) = &request.out {
-        println!("trajectory written to {}", out.display());
+    interrupted_error(&summary)
+}
+
+/// Err(Interrupted) with where the run stopped and what became of its file, if a signal stopped
+/// it.
+fn interrupted_error(summary: &Summary) -> Result<(), CliError> {
+    match &summary.interrupted {
+        None => Ok(()),
+        Some(i) => {
+            let mut message = format!(
+                "interrupted at t = {} s after {} of {} steps",
+                display_time(summary.final_state.time),
+                summary.steps,
+                i.planned_steps
+            );
+            if !i.note.is_empty() {
+                message += &format!("; {}", i.note);
+            }
+            Err(CliError::Interrupted(message))
+        }
     }
-    Ok(())
 }
 
 /// Runs `simulate` on a model file.
@@ -548,16 +788,15 @@ pub fn default_run() -> Result<(), CliError> {
     let loaded = load(&dir.join("scene.xml"), &LoadOptions::default());
     let _ = std::fs::remove_dir_all(&dir);
     let model = loaded?;
-    println!(
-        "lagrange {}: no arguments given, so simulating the embedded default scene: the Unitree Go1",
-        env!("CARGO_PKG_VERSION")
-    );
-    println!("quadruped (MuJoCo Menagerie, models/mjcf/unitree_go1) standing on its floor on its own");
-    println!("position servos, from keyframe 'home' holding its controls, with soft (MuJoCo-compatible)");
-    println!("contacts, joint limits and friction loss.");
-    println!("(Run `lagrange --help` for info/eval/simulate on your own URDF or MJCF.)\n");
-    print!("{}", super::info::to_text(&model, None));
-    println!();
+    stdout::print(&format!(
+        "lagrange {}: no arguments given, so simulating the embedded default scene: the Unitree Go1
+quadruped (MuJoCo Menagerie, models/mjcf/unitree_go1) standing on its floor on its own
+position servos, from keyframe 'home' holding its controls, with soft (MuJoCo-compatible)
+contacts, joint limits and friction loss.
+(Run `lagrange --help` for info/eval/simulate on your own URDF or MJCF.)\n\n{}\n",
+        env!("CARGO_PKG_VERSION"),
+        super::info::to_text(&model, None)
+    ))?;
     let request = Request {
         duration: 5.0,
         dt: None,
@@ -571,17 +810,19 @@ pub fn default_run() -> Result<(), CliError> {
         q0: None,
         v0: None,
         out: None,
+        max_output_bytes: DEFAULT_MAX_OUTPUT_BYTES,
     };
     let summary = simulate(&model, &request)?;
-    print!("{}", summary_text(&model, &request, &summary));
     let z0 =
         model.keyframes.iter().find(|k| k.name == "home").and_then(|k| k.qpos.as_ref()).map_or(0.0, |q| q[2]);
-    println!(
-        "base height: {z0:.4} m at the start, {:.6} m after {} s (MuJoCo 4.0's mj_step from the same keyframe: {DEFAULT_MUJOCO_HEIGHT} m); at most {} contacts, deepest penetration {:.2} mm",
+    let text = format!(
+        "{}base height: {z0:.4} m at the start, {:.6} m after {} s (MuJoCo 4.0's mj_step from the same keyframe: {DEFAULT_MUJOCO_HEIGHT} m); at most {} contacts, deepest penetration {:.2} mm\n",
+        summary_text(&model, &request, &summary),
         summary.final_state.q[2],
         display_time(summary.final_state.time),
         summary.max_contacts,
         summary.max_penetration * 1e3
     );
-    Ok(())
+    stdout::print(&text)?;
+    interrupted_error(&summary)
 }

@@ -16,6 +16,9 @@
 //! the README, a log-log plot ([`super::workprec_plot`]); `--dump-reference` writes the reference
 //! trajectory and the run's settings for `validation/workprec_mujoco.py`.
 
+use super::interrupt;
+use super::output_file::OutputFile;
+use super::stdout;
 use super::workprec_plot;
 use super::CliError;
 use lagrange::constraint::ConstraintMode;
@@ -28,6 +31,7 @@ use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -304,12 +308,12 @@ impl Setup {
     /// gives up.
     fn sample_run(&self, spec: RunSpec, samples: usize) -> Result<Samples, String> {
         let mut sim = self.simulation(spec).map_err(|e| e.to_string())?;
-        let n = samples + 1;
+        let n = samples.saturating_add(1);
         let mut out = Samples {
-            q: Vec::with_capacity(n),
-            v: Vec::with_capacity(n),
-            energy: Vec::with_capacity(n),
-            kinetic: Vec::with_capacity(n),
+            q: reserve(n)?,
+            v: reserve(n)?,
+            energy: reserve(n)?,
+            kinetic: reserve(n)?,
             steps: 0,
             rejected: 0,
         };
@@ -322,6 +326,9 @@ impl Setup {
         };
         record(&mut sim, &mut out);
         for _ in 0..samples {
+            if interrupt::requested() {
+                return Err(INTERRUPTED.into());
+            }
             for _ in 0..spec.per_sample {
                 let report = sim.step().map_err(|e| e.to_string())?;
                 if !report.accepted {
@@ -352,9 +359,69 @@ impl Setup {
         let t0 = cpu_time();
         for _ in 0..total {
             sim.step().map_err(|e| e.to_string())?;
+            if interrupt::requested() {
+                return Err(INTERRUPTED.into());
+            }
         }
         Ok(cpu_time() - t0)
     }
+}
+
+/// Err(Interrupted) if a signal asked the run to stop during `what`: nothing is written.
+fn stop_if_interrupted(what: &str) -> Result<(), CliError> {
+    if interrupt::requested() {
+        return Err(CliError::Interrupted(format!(
+            "interrupted during {what}: nothing was written (any earlier output files are untouched)"
+        )));
+    }
+    Ok(())
+}
+
+/// The reason of a run a signal stopped.
+const INTERRUPTED: &str = "interrupted";
+
+/// An empty vector with room for `n` values, or the reason it cannot have it.
+fn reserve<T>(n: usize) -> Result<Vec<T>, String> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| format!("no memory for {n} samples ({} bytes each)", std::mem::size_of::<T>()))?;
+    Ok(v)
+}
+
+/// Bytes of memory a measurement over `samples` sample times needs at most: the states (q, v)
+/// and energies at every sample of the reference, its check and the run being measured, and
+/// with `--dump-reference` the JSON written.
+fn memory_needed(nq: usize, nv: usize, samples: usize, dump: bool) -> f64 {
+    // Two DVectors (32-byte headers, heap blocks with ~16 bytes of allocator overhead), two f64.
+    let per_sample = ((nq + nv) * 8 + 2 * (32 + 16) + 16) as f64;
+    // JSON values (32 bytes each) and their text (~25 bytes) per number, plus row overheads.
+    let per_dump = if dump { ((nq + nv + 2) * (32 + 25) + 3 * 48) as f64 } else { 0.0 };
+    (samples as f64 + 1.0) * (3.0 * per_sample + per_dump)
+}
+
+/// Bytes of memory the system has available (Linux's MemAvailable), if it says.
+fn memory_available() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024.0)
+}
+
+/// Refuses a measurement whose samples cannot fit in the memory available.
+fn check_memory(model: &Model, samples: usize, sample_dt: f64, dump: bool) -> Result<(), CliError> {
+    let needed = memory_needed(model.nq, model.nv, samples, dump);
+    let available = memory_available();
+    let limit = available.unwrap_or(f64::INFINITY).min(usize::MAX as f64 / 2.0);
+    if needed > limit {
+        let bytes = |x: f64| super::simulate::human_bytes(x.min(u64::MAX as f64) as u64);
+        return Err(usage(format!(
+            "{samples} sample times (every {sample_dt} s, the coarsest --dts step, over the duration) need about {} of memory (q, v and energy at each, for the reference, its check and each run{}), more than the {} available: shorten --duration or use a coarser largest --dts step",
+            bytes(needed),
+            if dump { ", and the --dump-reference JSON" } else { "" },
+            available.map_or_else(|| "addressable".to_string(), bytes)
+        )));
+    }
+    Ok(())
 }
 
 /// (max-norm, squared 2-norm) of the state error at one sample (see the module doc).
@@ -501,6 +568,8 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
             k
         }
     };
+    check_memory(&model, samples, sample_dt, request.dump_reference.is_some())?;
+    interrupt::watch();
     let Start { q0, v0, ctrl, act, description: start } = initial_state(&model, request)?;
     let model_label = path.display().to_string();
     if !model.collision_pairs.is_empty() {
@@ -521,7 +590,9 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
         sample_dt,
         samples,
         budget: BUDGET_FACTOR
-            .saturating_mul(samples as u64 * whole_multiple(sample_dt, finest).expect("checked") as u64)
+            .saturating_mul(
+                (samples as u64).saturating_mul(whole_multiple(sample_dt, finest).expect("checked") as u64),
+            )
             .max(MIN_BUDGET),
     };
     let probe = setup.simulation(RunSpec {
@@ -557,10 +628,13 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
     } else {
         setup.sample_run(adaptive(REFERENCE_RTOL, REFERENCE_ATOL), samples)
     };
+    stop_if_interrupted("the reference solution")?;
     let (reference, check, reference_spec, reference_text, reference_per_sample) = match adaptive_reference {
         Ok(reference) => {
             let check = setup.sample_run(adaptive(CHECK_RTOL, CHECK_RTOL), samples).map_err(|e| {
-                usage(format!("the reference check (adaptive, rtol {CHECK_RTOL:e}) failed: {e}"))
+                stop_if_interrupted("the reference check").err().unwrap_or_else(|| {
+                    usage(format!("the reference check (adaptive, rtol {CHECK_RTOL:e}) failed: {e}"))
+                })
             })?;
             let text = format!(
                 "adaptive Dormand–Prince 5(4) at rtol {REFERENCE_RTOL:e}, atol {REFERENCE_ATOL:e} ({} steps); the rtol {CHECK_RTOL:e} solution ends {{check:.1e}} from it (the reference's own error is below that)",
@@ -585,13 +659,20 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
             };
             let budget_free = Setup { budget: u64::MAX, ..setup.clone() };
             let reference = budget_free.sample_run(rk4(n), samples).map_err(|e| {
-                usage(format!(
-                    "the reference solution failed: adaptive: {why}; RK4 at dt {:e}: {e}",
-                    sample_dt / n as f64
-                ))
+                stop_if_interrupted("the reference solution").err().unwrap_or_else(|| {
+                    usage(format!(
+                        "the reference solution failed: adaptive: {why}; RK4 at dt {:e}: {e}",
+                        sample_dt / n as f64
+                    ))
+                })
             })?;
             let check = budget_free.sample_run(rk4(n / 2), samples).map_err(|e| {
-                usage(format!("the reference check (RK4 at dt {:e}) failed: {e}", 2.0 * sample_dt / n as f64))
+                stop_if_interrupted("the reference check").err().unwrap_or_else(|| {
+                    usage(format!(
+                        "the reference check (RK4 at dt {:e}) failed: {e}",
+                        2.0 * sample_dt / n as f64
+                    ))
+                })
             })?;
             notes.push(if contacts {
                 "contacts: the reference is fine-step RK4, not the adaptive method (its error control does not step through contact events); through impacts every method converges at first order at best".to_string()
@@ -659,6 +740,7 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
             }
             Ok((run, end, cpu))
         });
+        stop_if_interrupted(&format!("{} at {setting}", spec.kind.name()))?;
         match measured {
             Ok((run, end, cpu_s)) => {
                 let (mut error, error_l2, energy_error) = errors(&setup, &run, &reference, energy_scale);
@@ -666,6 +748,16 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
                 if let Some(end) = &end {
                     error = final_error(&setup, end, &reference);
                     steps = end.steps;
+                }
+                // Every number printed is finite: a run whose measures are not failed.
+                if let Some((name, x)) =
+                    [("error", error), ("error_l2", error_l2), ("energy_error", energy_error)]
+                        .into_iter()
+                        .find(|(_, x)| !x.is_finite())
+                {
+                    let reason = format!("its {name} is {x} (the run left the reference's scale)");
+                    failures.push(Failure { integrator: spec.kind.name(), setting, reason });
+                    continue;
                 }
                 rows.push(Row {
                     integrator: spec.kind.name().to_string(),
@@ -754,8 +846,9 @@ fn write_reference(
         "samples": {"time": time, "q": rows(&reference.q), "v": rows(&reference.v), "energy": reference.energy},
     });
     let text = serde_json::to_string(&value).expect("serializable");
-    std::fs::write(path, text + "\n")
-        .map_err(|source| CliError::Io { file: path.display().to_string(), source })
+    let mut file = OutputFile::create(path)?;
+    file.write_all((text + "\n").as_bytes())?;
+    file.commit()
 }
 
 /// Reads a `workprec --json` file (the rows of another run or another engine).
@@ -895,9 +988,13 @@ pub fn run(options: &LoadOptions, request: &Request) -> Result<(), CliError> {
         };
         let (setup, m) = measure(model_path, options, request)?;
         for f in &m.failures {
-            eprintln!(
+            // (A failing stderr has nowhere to report to: ignored.)
+            let _ = writeln!(
+                std::io::stderr(),
                 "warning: {} at {} failed and is left out of the rows: {}",
-                f.integrator, f.setting, f.reason
+                f.integrator,
+                f.setting,
+                f.reason
             );
         }
         let report = Report {
@@ -911,13 +1008,15 @@ pub fn run(options: &LoadOptions, request: &Request) -> Result<(), CliError> {
         (report, Some(measurement_text(&setup, &m, &all, extra)))
     };
     report.rows.extend(extra_rows);
+    let mut out = String::new();
     if request.json {
-        println!("{}", serde_json::to_string(&report).expect("serializable"));
+        out = serde_json::to_string(&report).expect("serializable") + "\n";
     } else {
         match text {
-            Some(t) => print!("{t}"),
+            Some(t) => out = t,
             None => {
-                println!(
+                let _ = writeln!(
+                    out,
                     "work-precision of {} ({} s; reference: {}), rows from {}{}",
                     report.model,
                     report.duration,
@@ -925,16 +1024,17 @@ pub fn run(options: &LoadOptions, request: &Request) -> Result<(), CliError> {
                     request.from_json.as_ref().map_or_else(String::new, |p| p.display().to_string()),
                     if extra > 0 { format!(" and --extra-rows ({extra} rows)") } else { String::new() }
                 );
-                print!("{}", definitions(None, None, &report.rows));
-                print!("{}", table(&report.rows));
+                out += &definitions(None, None, &report.rows);
+                out += &table(&report.rows);
             }
         }
     }
     if let Some(plot) = &request.plot {
         workprec_plot::plot(plot, &plot_title(&report), &report.rows)?;
         if !request.json {
-            println!("plot written to {}", plot.display());
+            let _ = writeln!(out, "plot written to {}", plot.display());
         }
     }
+    stdout::print(&out)?;
     Ok(())
 }

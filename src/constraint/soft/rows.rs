@@ -27,7 +27,7 @@ use crate::model::{options::Cone, Data, EfcType, Model, TendonKind};
 use crate::spatial::{Mat3, Transform, Vec3};
 
 /// A quaternion [w, x, y, z] and the Hamilton product.
-type Quat = [f64; 4];
+pub(crate) type Quat = [f64; 4];
 
 fn qmul(a: &Quat, b: &Quat) -> Quat {
     [
@@ -38,7 +38,7 @@ fn qmul(a: &Quat, b: &Quat) -> Quat {
     ]
 }
 
-fn conj(q: &Quat) -> Quat {
+pub(crate) fn conj(q: &Quat) -> Quat {
     [q[0], -q[1], -q[2], -q[3]]
 }
 
@@ -47,7 +47,7 @@ fn pure(v: &Vec3) -> Quat {
 }
 
 /// The world orientations (quaternions) of a weld's frames A (where frame B must be) and B.
-fn weld_quats(
+pub(crate) fn weld_quats(
     data: &Data,
     e: &EqualityRows,
     a: usize,
@@ -61,7 +61,7 @@ fn weld_quats(
 }
 
 /// The 3 × 3 map ω ↦ ½ imag(q_B⁻¹ (0, ω) q_A) of a weld's rotation Jacobian.
-fn weld_rotation_map(qa: &Quat, qb_inv: &Quat) -> Mat3 {
+pub(crate) fn weld_rotation_map(qa: &Quat, qb_inv: &Quat) -> Mat3 {
     let mut t = Mat3::zeros();
     for k in 0..3 {
         let mut e = Vec3::zeros();
