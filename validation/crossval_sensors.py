@@ -388,8 +388,10 @@ def compare(mj, m, ref: list[np.ndarray], out: dict, constrained: bool,
             continue
         if not results or not all(in_results):
             row.status = "FAIL"
+            errors = [f"state {k}: {r['error']}" for k, r in enumerate(results) if "error" in r]
             row.detail = "missing from both 'sensors' and 'sensors_not_computed'" if not any(in_results) \
                 else f"missing in {in_results.count(False)} of {len(results)} states"
+            row.detail += f" ({errors[0][:160]})" if errors else ""
             continue
         a = np.array([r["sensors"][key] for r in results], dtype=float) if all(
             len(r["sensors"][key]) == dim for r in results) else None
@@ -464,7 +466,8 @@ def run_model(mj, args, name: str, path: Path, disable: tuple[str, ...], corpus_
             out = fake_eval(mj, m, states, args.perturb, args.perturb_by)
         else:
             try:
-                out = lagrange_eval_json(Path(args.lagrange), copy, eval_states(states), ["--constraints", "soft"])
+                out = lagrange_eval_json(Path(args.lagrange), copy, eval_states(states), ["--constraints", "soft"],
+                                         state_errors=True)
             except (RuntimeError, json.JSONDecodeError, subprocess.TimeoutExpired) as e:
                 res.error = str(e).strip().splitlines()[0][:300]
                 out = {}
