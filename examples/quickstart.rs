@@ -1,6 +1,6 @@
 //! Quick start: load the go1 quadruped on its floor, reset it to its `home` keyframe, hold the
 //! keyframe's servo targets as controls, step half a second, and read each foot's contact force
-//! and the trunk's pose.
+//! and the trunk's pose; then read the dm_control humanoid's torso IMU (MuJoCo's `sensordata`).
 //!
 //!     cargo run --release --example quickstart
 
@@ -23,5 +23,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let trunk = frames::pose(&model, &mut data, "trunk")?;
     println!("t = {:.3} s, trunk at height {:.4} m", data.time, trunk.pos.z);
+
+    // Sensors: computed by `forward` (and by each step, for the state it starts from).
+    let humanoid = Model::from_file("models/mjcf/humanoid/humanoid.xml")?;
+    let mut hdata = Data::new(&humanoid);
+    while hdata.time < 1.5 {
+        step(&humanoid, &mut hdata)?; // it falls (the accelerometer reads 0) and lands
+    }
+    let imu = hdata.sensor(&humanoid, "torso_accel")?;
+    println!("humanoid torso accelerometer: [{:.3} {:.3} {:.3}] m/s²", imu[0], imu[1], imu[2]);
     Ok(())
 }

@@ -14,23 +14,13 @@ use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{
     body_acceleration, external_wrench, interaction_wrench, object_acceleration, rne_post_constraint,
 };
-use lagrange::io::{load, LoadOptions};
-use lagrange::model::options::Solver;
 use lagrange::prelude::*;
 use lagrange::spatial::{Mat3, Vec3};
 use serde_json::Value;
-use std::path::Path;
 
 /// The model with the golden data's tight solver options (Newton, tolerance 1e-15), in `mode`.
 fn tight(path: &str, mode: ConstraintMode) -> Model {
-    let mut model = load(Path::new(path), &LoadOptions::default()).unwrap();
-    let o = &mut model.options;
-    o.solver = Solver::Newton;
-    o.tolerance = 1e-15;
-    o.iterations = 1000;
-    o.ls_iterations = 100;
-    o.ls_tolerance = 1e-12;
-    common::with_mode(model, mode)
+    common::with_mode(common::tight_model(path), mode)
 }
 
 fn golden(name: &str) -> Value {

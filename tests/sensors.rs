@@ -1,8 +1,9 @@
 //! Sensors (`Data::sensordata`) against MuJoCo 4.0's `sensordata`: on the scenes of
 //! tests/data/mjcf/sensors/ at the states of validation/mujoco_sensor_golden.py (random states,
 //! the puck pressed into the floor), after `forward` — every sensor MuJoCo has is either computed
-//! and compared (relative to the sensor's largest value, over an absolute floor of
-//! `SENSOR_ABS_FLOOR`) or listed as not computed with a reason; and after `step`, which leaves
+//! and compared (relative to the largest value of the sensors of its type at that state, over an
+//! absolute floor of `SENSOR_ABS_FLOOR`: a force sensor reading zero as the difference of two 30 N
+//! wrenches compares at the scale of the scene's forces) or listed as not computed with a reason; and after `step`, which leaves
 //! the sensors of the state the step started from, as `mj_step` does. The reference data is
 //! checked against the live MuJoCo in `.ci/run`; `validation/crossval_sensors` compares more
 //! scenes and corpus models live.
@@ -13,12 +14,11 @@ use common::{MaxErr, REF_REL, SENSOR_ABS_FLOOR};
 use lagrange::prelude::*;
 use serde_json::Value;
 
-/// max |a − b| / max(|a|, |b|, floor) over a sensor's values.
-fn sensor_err(a: &[f64], b: &[f64]) -> f64 {
+/// max |a − b| / scale over a sensor's values.
+fn sensor_err(a: &[f64], b: &[f64], scale: f64) -> f64 {
     if a.len() != b.len() {
         return f64::INFINITY;
     }
-    let scale = a.iter().chain(b).fold(SENSOR_ABS_FLOOR, |m, x| m.max(x.abs()));
     a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale
 }
 
@@ -29,6 +29,15 @@ fn vec(v: &Value) -> Vec<f64> {
 /// Compares every sensor of `expected` with `data`; returns the labels of those not computed.
 fn compare(model: &Model, data: &Data, expected: &Value, check: &mut MaxErr, at: &str) -> Vec<String> {
     let mut skipped = Vec::new();
+    // The scale of each sensor type at this state: its largest reference value.
+    let mut scale = std::collections::HashMap::new();
+    for (label, values) in expected.as_object().unwrap() {
+        if let Some(s) = model.sensor(label) {
+            let m = vec(values).iter().fold(SENSOR_ABS_FLOOR, |m, x| m.max(x.abs()));
+            let e = scale.entry(s.kind).or_insert(SENSOR_ABS_FLOOR);
+            *e = f64::max(*e, m);
+        }
+    }
     for (label, values) in expected.as_object().unwrap() {
         let sensor = model.sensor(label).unwrap_or_else(|| panic!("{at}: lagrange has no sensor '{label}'"));
         if let Some(why) = &sensor.not_computed {
@@ -36,7 +45,9 @@ fn compare(model: &Model, data: &Data, expected: &Value, check: &mut MaxErr, at:
             continue;
         }
         let got = data.sensor(model, label).unwrap();
-        check.add(sensor_err(got, &vec(values)), || format!("{at}, sensor {label}: {got:?} vs {values}"));
+        check.add(sensor_err(got, &vec(values), scale[&sensor.kind]), || {
+            format!("{at}, sensor {label}: {got:?} vs {values}")
+        });
     }
     skipped
 }

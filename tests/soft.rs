@@ -19,16 +19,9 @@ use serde_json::Value;
 use std::path::Path;
 use std::sync::Arc;
 
-/// The model with the golden data's tight solver options (Newton, tolerance 1e-15).
+/// The model with the golden data's tight solver options.
 fn tight(path: &str) -> Model {
-    let mut model = load(Path::new(path), &LoadOptions::default()).unwrap();
-    let o = &mut model.options;
-    o.solver = Solver::Newton;
-    o.tolerance = 1e-15;
-    o.iterations = 1000;
-    o.ls_iterations = 100;
-    o.ls_tolerance = 1e-12;
-    model
+    common::tight_model(path)
 }
 
 fn golden(name: &str) -> Value {

@@ -19,7 +19,7 @@ import mujoco
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-SCENES = [ROOT / "tests/data/mjcf/sensors/kinematic.xml"]
+SCENES = [ROOT / "tests/data/mjcf/sensors/kinematic.xml", ROOT / "tests/data/mjcf/sensors/imu_force.xml"]
 OUT = ROOT / "tests/data/mujoco_sensors"
 # MuJoCo's enum names that differ from the MJCF tags lagrange labels unnamed sensors with.
 TAG = {"jointactfrc": "jointactuatorfrc", "tendonactfrc": "tendonactuatorfrc", "geomdist": "distance",

@@ -298,7 +298,29 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let placement_unrotated = bodies.iter().map(|b| b.x_parent_joint.rot == Mat3::identity()).collect();
     let kind_is_link: Vec<bool> = spec.links.iter().map(|l| l.kind == FrameKind::Link).collect();
     let spec_parent: Vec<Option<usize>> = spec.links.iter().map(|l| l.parent).collect();
-    let links = crate::model::Links::build(&kind_is_link, &spec_parent, &frame_spec_link, &geom_spec_link);
+    let mut links =
+        crate::model::Links::build(&kind_is_link, &spec_parent, &frame_spec_link, &geom_spec_link);
+    // MuJoCo's body_iquat: an explicit diagonal <inertial> keeps its frame; otherwise the
+    // principal axes of the body's inertia as MuJoCo's compiler finds them.
+    links.iquat = links
+        .frame
+        .iter()
+        .map(|&f| {
+            let li = frame_spec_link[f];
+            let link = &spec.links[li];
+            let i_com = frames[f].inertia.i_com();
+            match &link.inertial {
+                Some(i)
+                    if !link.inertia_from_geoms
+                        && (0..3).all(|r| (0..3).all(|c| r == c || i.inertia[(r, c)] == 0.0)) =>
+                {
+                    crate::spatial::Transform::new(i.x_link_inertial.rot, Vec3::zeros()).quat_wxyz()
+                }
+                _ if frames[f].inertia.mass > 0.0 => crate::sensor::objects::principal_quat(&i_com),
+                _ => [1.0, 0.0, 0.0, 0.0],
+            }
+        })
+        .collect();
     let mut model = Model {
         name: spec.name.clone(),
         source: spec.source.clone(),

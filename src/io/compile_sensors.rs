@@ -106,16 +106,13 @@ pub(crate) fn compile_sensors(
     Ok((out, adr))
 }
 
-/// The types whose inputs are still being built (geometric queries; the post-constraint
-/// Newton–Euler pass), with what they wait for.
+/// The types whose inputs are still being built (geometric queries), with what they wait for.
 fn pending(kind: SensorType, object: SensorObject) -> Option<String> {
     use SensorType::*;
     let why = match (kind, object) {
-        (Touch | Rangefinder | InsideSite | GeomDist | GeomNormal | GeomFromTo, _) | (Contact, SensorObject::Site(_)) => {
+        (Touch | Rangefinder | InsideSite | GeomDist | GeomNormal | GeomFromTo, _)
+        | (Contact, SensorObject::Site(_)) => {
             "its geometric query (ray casting, site zones, geom distances) is not implemented yet"
-        }
-        (Accelerometer | Force | Torque | FrameLinAcc | FrameAngAcc, _) => {
-            "body accelerations and interaction forces (MuJoCo's mj_rnePostConstraint) are not implemented yet"
         }
         _ => return None,
     };

@@ -9,7 +9,7 @@
 //! maps them to frames and to each other.
 
 /// MuJoCo's body table: id `b` ↔ link frame, parent, and which body every frame and geom is on.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Links {
     /// The frame of each MuJoCo body (index in `Model::frames`, a frame of kind `Link`).
     pub frame: Vec<usize>,
@@ -20,6 +20,10 @@ pub struct Links {
     pub of_frame: Vec<usize>,
     /// For each geom of `Model::geoms`: MuJoCo's `geom_bodyid`.
     pub of_geom: Vec<usize>,
+    /// The orientation of each body's inertial (principal) frame in the body frame, `[w, x, y, z]`
+    /// (MuJoCo's `body_iquat`: an `<inertial>`'s own `quat` with `diaginertia`, else the principal
+    /// axes MuJoCo's compiler finds, moments in decreasing order).
+    pub iquat: Vec<[f64; 4]>,
 }
 
 impl Links {
@@ -88,6 +92,7 @@ impl Links {
             parent,
             of_frame: frame_spec_link.iter().map(|&l| id[l]).collect(),
             of_geom: geom_spec_link.iter().map(|&l| id[l]).collect(),
+            iquat: Vec::new(),
         }
     }
 }

@@ -121,7 +121,10 @@ pub(crate) fn compute(
         .sum();
     let nmatch = matches.len();
     if spec.reduce == 3 {
-        netforce(model, data, spec, matches, &mut out[..size]);
+        // No match: the slot stays zero (MuJoCo 4.0; the frame fields too).
+        if nmatch > 0 {
+            netforce(model, data, spec, matches, &mut out[..size]);
+        }
         return;
     }
     if spec.reduce == 1 || spec.reduce == 2 {

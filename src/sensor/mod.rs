@@ -49,6 +49,8 @@ pub struct SensorNeeds {
     pub subtree_velocities: bool,
     /// Kinetic energy.
     pub kinetic: bool,
+    /// Body accelerations and interaction forces (MuJoCo's `mj_rnePostConstraint`).
+    pub rne_post: bool,
 }
 
 impl SensorNeeds {
@@ -69,6 +71,7 @@ impl SensorNeeds {
             subtree_com: has(&|k| matches!(k, SubtreeCom | SubtreeLinVel | SubtreeAngMom)),
             subtree_velocities: has(&|k| matches!(k, SubtreeLinVel | SubtreeAngMom)),
             kinetic: has(&|k| k == EKinetic),
+            rne_post: has(&|k| matches!(k, Accelerometer | Force | Torque | FrameLinAcc | FrameAngAcc)),
         }
     }
 }
@@ -139,6 +142,9 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
     }
     if needs.subtree_velocities {
         subtree::subtree_velocities(model, data, &mut work.subtree);
+    }
+    if needs.rne_post {
+        crate::dynamics::rne_post::rne_post_constraint_at(model, data, q, v);
     }
     if needs.kinetic {
         let bodies: f64 =

@@ -8,7 +8,7 @@
 
 use super::types::SensorObject;
 use crate::model::{Data, JointKind, Model};
-use crate::spatial::{Mat3, Transform, Vec3};
+use crate::spatial::{quat_to_matrix, Mat3, Transform, Vec3};
 
 /// A quaternion `[w, x, y, z]`.
 pub(crate) type Quat = [f64; 4];
@@ -86,32 +86,69 @@ fn frame_quat(model: &Model, data: &Data, quats: &[Quat], f: usize) -> Quat {
     mul_quat(&base, &rot_quat(&frame.x_body_frame.rot))
 }
 
+/// The principal axes of a symmetric inertia tensor as MuJoCo's compiler finds them
+/// (`mjuu_eig3`, user_util.cc): cyclic Jacobi rotations accumulated as quaternions from the
+/// identity, then the moments sorted in decreasing order by quarter turns — so that the body's
+/// inertial frame (`body_iquat`) and the sensors reading it have MuJoCo's axes and signs.
+pub(crate) fn principal_quat(inertia: &Mat3) -> Quat {
+    const EPS: f64 = 1e-12;
+    let normalize = |q: Quat| normalize_quat(&q);
+    let mut quat: Quat = [1.0, 0.0, 0.0, 0.0];
+    let mut eig = [0.0; 3];
+    for _ in 0..500 {
+        let e = quat_to_matrix(quat[0], quat[1], quat[2], quat[3]);
+        let d = e.transpose() * inertia * e;
+        eig = [d[(0, 0)], d[(1, 1)], d[(2, 2)]];
+        let (rk, ck, rotk) = if d[(0, 1)].abs() > d[(0, 2)].abs() && d[(0, 1)].abs() > d[(1, 2)].abs() {
+            (0, 1, 2)
+        } else if d[(0, 2)].abs() > d[(1, 2)].abs() {
+            (0, 2, 1)
+        } else {
+            (1, 2, 0)
+        };
+        if d[(rk, ck)].abs() < EPS {
+            break;
+        }
+        let tau = (d[(ck, ck)] - d[(rk, rk)]) / (2.0 * d[(rk, ck)]);
+        let t = if tau >= 0.0 {
+            1.0 / (tau + (1.0 + tau * tau).sqrt())
+        } else {
+            -1.0 / (-tau + (1.0 + tau * tau).sqrt())
+        };
+        let c = 1.0 / (1.0 + t * t).sqrt();
+        if c > 1.0 - EPS {
+            break;
+        }
+        let mut r = [0.0; 4];
+        let s = (0.5 - 0.5 * c).sqrt();
+        r[rotk + 1] = if tau >= 0.0 { -s } else { s };
+        if rotk == 1 {
+            r[rotk + 1] = -r[rotk + 1];
+        }
+        r[0] = (1.0 - r[rotk + 1] * r[rotk + 1]).sqrt();
+        quat = normalize(mul_quat(&quat, &normalize(r)));
+    }
+    for j in 0..3 {
+        let j1 = j % 2;
+        if eig[j1] + EPS < eig[j1 + 1] {
+            eig.swap(j1, j1 + 1);
+            let mut r = [std::f64::consts::FRAC_1_SQRT_2, 0.0, 0.0, 0.0];
+            r[(j1 + 2) % 3 + 1] = std::f64::consts::FRAC_1_SQRT_2;
+            quat = normalize(mul_quat(&quat, &r));
+        }
+    }
+    quat
+}
+
 /// The inertial frame of MuJoCo body `b` in its own frame: centre of mass and principal axes
-/// (MuJoCo's `body_ipos`, `body_iquat`; the axes in decreasing order of the principal moments).
+/// (MuJoCo's `body_ipos`, `body_iquat`, [`Links::iquat`](crate::model::Links::iquat)).
 pub(crate) fn inertial_frame(model: &Model, b: usize) -> Transform {
     let inertia = &model.frames[model.links.frame[b]].inertia;
-    if inertia.mass <= 0.0 {
-        return Transform::identity();
-    }
-    let i_com = inertia.i_com();
-    let is_diagonal = (0..3).all(|r| (0..3).all(|c| r == c || i_com[(r, c)] == 0.0));
-    let rot = if is_diagonal {
-        Mat3::identity()
-    } else {
-        let eig = nalgebra::SymmetricEigen::new(i_com);
-        let mut order = [0usize, 1, 2];
-        order.sort_by(|&x, &y| eig.eigenvalues[y].total_cmp(&eig.eigenvalues[x]));
-        let mut r = Mat3::zeros();
-        for (k, &o) in order.iter().enumerate() {
-            r.set_column(k, &eig.eigenvectors.column(o));
-        }
-        if r.determinant() < 0.0 {
-            let c = -r.column(2);
-            r.set_column(2, &c);
-        }
-        r
-    };
-    Transform::new(rot, inertia.com())
+    let q = model.links.iquat[b];
+    Transform::new(
+        quat_to_matrix(q[0], q[1], q[2], q[3]),
+        if inertia.mass > 0.0 { inertia.com() } else { Vec3::zeros() },
+    )
 }
 
 /// The world pose of a sensed object (MuJoCo's `get_xpos_xmat`); the identity for
@@ -135,7 +172,7 @@ pub(crate) fn object_quat(model: &Model, data: &Data, quats: &[Quat], obj: Senso
         SensorObject::XBody(b) => frame_quat(model, data, quats, model.links.frame[b]),
         SensorObject::Body(b) => {
             let x = frame_quat(model, data, quats, model.links.frame[b]);
-            mul_quat(&x, &rot_quat(&inertial_frame(model, b).rot))
+            mul_quat(&x, &model.links.iquat[b])
         }
         SensorObject::Site(f) => frame_quat(model, data, quats, f),
         SensorObject::Geom(g) => {

@@ -569,6 +569,21 @@ pub fn state_rel_err(sample: &serde_json::Value, data: &Data) -> f64 {
     worst
 }
 
+/// The model at `path` with the golden data's tight solver options (Newton, tolerance 1e-15,
+/// 1000 iterations; line search 100 iterations to 1e-12), as validation/crossval_soft.py's
+/// tight copies.
+#[allow(dead_code)]
+pub fn tight_model(path: &str) -> Model {
+    let mut model = load(std::path::Path::new(path), &LoadOptions::default()).unwrap();
+    let o = &mut model.options;
+    o.solver = lagrange::model::options::Solver::Newton;
+    o.tolerance = 1e-15;
+    o.iterations = 1000;
+    o.ls_iterations = 100;
+    o.ls_tolerance = 1e-12;
+    model
+}
+
 /// `model` solving its constraints in `mode` ([`Model::set_constraint_mode`]).
 pub fn with_mode(mut model: Model, mode: lagrange::constraint::ConstraintMode) -> Model {
     model.set_constraint_mode(mode);
