@@ -60,6 +60,28 @@ pub enum InputError {
         /// The value (NaN or ±∞).
         value: f64,
     },
+    /// A value is outside what the function accepts (a zero ray direction, a frame that is not a
+    /// site, …).
+    #[error("{function}: {argument} {detail}")]
+    Value {
+        /// The function called.
+        function: &'static str,
+        /// The argument holding the value.
+        argument: &'static str,
+        /// What is wrong with it and what is accepted.
+        detail: String,
+    },
+    /// The call asks for something lagrange does not compute yet (e.g. a distance to a height
+    /// field).
+    #[error("{function}: {what} is not supported{reason}")]
+    Unsupported {
+        /// The function called.
+        function: &'static str,
+        /// What is not supported.
+        what: String,
+        /// Why, with a leading separator (may be empty).
+        reason: String,
+    },
 }
 
 impl InputError {

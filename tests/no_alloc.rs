@@ -193,3 +193,51 @@ fn contact_scenes_do_not_allocate() {
         }
     }
 }
+
+#[test]
+fn geometric_queries_do_not_allocate() {
+    // Rays against every geom type (meshes read on the first ray), site rays and point tests, and
+    // geom distances of every pair, closed forms, GJK and EPA: no allocation once the meshes are
+    // read.
+    use lagrange::collision::{geom_distance, inside_site, ray, ray_site, RayFilter};
+    use lagrange::spatial::Vec3;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = std::fs::read_to_string(root.join("tests/data/mujoco_geomq/distance.json")).unwrap();
+    let doc: serde_json::Value = serde_json::from_str(&scene).unwrap();
+    let meshdir = root.join("tests/data/mujoco_geomq/meshes");
+    let mjcf = doc["mjcf"].as_str().unwrap().replace("@MESHDIR@", meshdir.to_str().unwrap());
+    let path = std::env::temp_dir().join(format!("lagrange-no-alloc-geomq-{}.xml", std::process::id()));
+    std::fs::write(
+        &path,
+        mjcf.replace("</worldbody>", r#"<site name="zone" type="box" size="0.1 0.2 0.3"/></worldbody>"#),
+    )
+    .unwrap();
+    let model = load(&path, &LoadOptions::default()).unwrap();
+    let _ = std::fs::remove_file(&path);
+    let mut data = Data::new(&model);
+    let qpos: Vec<f64> =
+        doc["states"][40]["qpos"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    forward_kinematics(&model, &mut data, &qpos).unwrap();
+    let site = model.site_id("zone").unwrap();
+    let queries = |data: &Data| {
+        let mut sum = 0.0;
+        for k in 0..20 {
+            let p = Vec3::new(0.3 * (k as f64).sin(), 0.2 * (k as f64).cos(), 1.0);
+            let v = Vec3::new(-0.1 * p.x, -0.1 * p.y, -1.0);
+            sum += ray(&model, data, p, v, &RayFilter::default()).unwrap().map_or(0.0, |h| h.dist);
+            sum += ray_site(&model, data, site, p, v).unwrap().map_or(0.0, |h| h.0);
+            sum += inside_site(&model, data, site, p * 0.1).unwrap() as u8 as f64;
+        }
+        for g1 in 0..model.geoms.len() {
+            for g2 in 0..model.geoms.len() {
+                sum += geom_distance(&model, data, g1, g2, 1.0).unwrap().dist;
+            }
+        }
+        sum
+    };
+    std::hint::black_box(queries(&data));
+    let n = allocations(|| {
+        std::hint::black_box(queries(&data));
+    });
+    assert_eq!(n, 0, "geometric queries allocated {n} times");
+}

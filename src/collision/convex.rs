@@ -4,9 +4,17 @@
 //! written here (a support-map shape, not a polyhedral approximation), and meshes by their hulls.
 //! One contact per pair, at the midpoint of the two witness points.
 
+use crate::model::spec::Shape;
 use crate::spatial::{Transform, Vec3};
 use parry3d_f64::math::{Pose, Rotation, Vector};
-use parry3d_f64::query::details::contact_support_map_support_map;
+use parry3d_f64::query::epa::EPA;
+use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
+use std::cell::RefCell;
+
+thread_local! {
+    /// The EPA workspace of this thread, reused so that overlapping pairs do not allocate.
+    static EPA_WORK: RefCell<EPA> = RefCell::new(EPA::new());
+}
 use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, SupportMap};
 
 /// An ellipsoid with semi-axes `radii` about its frame's axes.
@@ -87,23 +95,47 @@ fn from_parry(v: Vector) -> Vec3 {
 }
 
 impl ConvexShape {
+    /// The support-map shape of a primitive geom and its bounding-sphere radius about the geom
+    /// origin (None for planes, height fields and meshes).
+    pub(crate) fn of_primitive(shape: &Shape) -> Option<(ConvexShape, f64)> {
+        // (`+ 0.0` turns a size written as −0 into +0: parry asserts a positive sign.)
+        Some(match shape {
+            Shape::Sphere { radius } => (ConvexShape::Ball(Ball::new(radius + 0.0)), *radius),
+            Shape::Capsule { radius, length } => (
+                ConvexShape::Capsule(Capsule::new_z(0.5 * length + 0.0, radius + 0.0)),
+                radius + 0.5 * length,
+            ),
+            Shape::Cylinder { radius, length } => (
+                ConvexShape::Cylinder(Cylinder::new(0.5 * length + 0.0, radius + 0.0)),
+                radius.hypot(0.5 * length),
+            ),
+            Shape::Box { size } => {
+                let h = size / 2.0;
+                (ConvexShape::Cuboid(Cuboid::new(Vector::new(h.x + 0.0, h.y + 0.0, h.z + 0.0))), h.norm())
+            }
+            Shape::Ellipsoid { radii } => (
+                ConvexShape::Ellipsoid(Ellipsoid { radii: Vector::new(radii.x, radii.y, radii.z) }),
+                radii.max(),
+            ),
+            Shape::Plane { .. } | Shape::Hfield { .. } | Shape::Mesh { .. } => return None,
+        })
+    }
+
     /// Whether the surface is smooth (no vertices, edges or faces): spheres, capsules, ellipsoids.
-    fn smooth(&self) -> bool {
+    pub(crate) fn smooth(&self) -> bool {
         matches!(self, ConvexShape::Ball(_) | ConvexShape::Capsule(_) | ConvexShape::Ellipsoid(_))
     }
 
     /// The support point in world coordinates of the shape at pose `x` along world direction `d`.
-    fn world_support(&self, x: &Transform, d: &Vec3) -> Vec3 {
+    pub(crate) fn world_support(&self, x: &Transform, d: &Vec3) -> Vec3 {
         let local = x.rot.transpose() * d;
         x.act_point(&from_parry(self.local_support_point(Vector::new(local.x, local.y, local.z))))
     }
 }
 
-/// GJK/EPA between two support-map shapes at world poses `x1`, `x2`, if closer than `reach`.
-/// EPA's normal is exact on faces but only first-order accurate between two smooth surfaces; there
-/// the penetration direction is refined to the minimiser of the depth h₁(n) + h₂(−n) over unit n
-/// (support functions h; its gradient is p₁ − p₂, the difference of the support points) by Newton
-/// steps on the tangent plane.
+/// GJK/EPA between two support-map shapes at world poses `x1`, `x2`, if closer than `reach`
+/// (parry3d-f64's GJK and EPA). EPA's normal is exact on faces but only first-order accurate
+/// between two smooth surfaces; there the penetration direction is refined by Newton steps (`polish`).
 pub fn support_pair(
     x1: &Transform,
     s1: &ConvexShape,
@@ -112,55 +144,105 @@ pub fn support_pair(
     reach: f64,
 ) -> Option<PairPoint> {
     let pos12 = to_parry(&(x1.inverse() * *x2));
-    let c = contact_support_map_support_map(&pos12, s1, s2, reach)?;
-    // point1 and normal1 in frame 1, point2 in frame 2 (parry's convention).
-    let mut p1 = x1.act_point(&from_parry(c.point1));
-    let mut p2 = x2.act_point(&from_parry(c.point2));
-    let mut normal = x1.rot * from_parry(c.normal1);
-    let mut dist = c.dist;
-    if dist < 0.0 && s1.smooth() && s2.smooth() {
-        // Newton on the tangent plane: gradient g = Pₜ(q₁ − q₂), Hessian by central differences
-        // of g (the sum of the two surfaces' curvature radii), never accepting a deeper depth.
-        let depth_at = |n: &Vec3| {
-            let (q1, q2) = (s1.world_support(x1, n), s2.world_support(x2, &-n));
-            (n.dot(&(q1 - q2)), q1, q2)
-        };
-        let (mut depth, _, _) = depth_at(&normal);
-        for _ in 0..8 {
-            let t1 = crate::collision::contact_frame(&normal, None).row(1).transpose();
-            let t2 = normal.cross(&t1);
-            let grad = |n: &Vec3| {
-                let (_, q1, q2) = depth_at(n);
-                let d = q1 - q2;
-                [t1.dot(&d), t2.dot(&d)]
-            };
-            let g = grad(&normal);
-            if g[0].hypot(g[1]) <= 1e-15 * depth.abs().max(1e-300) {
-                break;
-            }
-            const EPS: f64 = 1e-6;
-            let mut h = [[0.0; 2]; 2];
-            for (j, t) in [t1, t2].iter().enumerate() {
-                let (gp, gm) = (grad(&(normal + t * EPS).normalize()), grad(&(normal - t * EPS).normalize()));
-                for i in 0..2 {
-                    h[i][j] = (gp[i] - gm[i]) / (2.0 * EPS);
-                }
-            }
-            let det = h[0][0] * h[1][1] - h[0][1] * h[1][0];
-            if det.is_nan() || det <= 0.0 || h[0][0] <= 0.0 {
-                break;
-            }
-            let step = [(-g[0] * h[1][1] + g[1] * h[0][1]) / det, (g[0] * h[1][0] - g[1] * h[0][0]) / det];
-            let candidate = (normal + t1 * step[0] + t2 * step[1]).normalize();
-            let (d_new, q1, q2) = depth_at(&candidate);
-            // Never deeper than before (NaN stops too).
-            if d_new.is_nan() || d_new > depth + 1e-15 * depth.abs() {
-                break;
-            }
-            (normal, depth, p1, p2, dist) = (candidate, d_new, q1, q2, -d_new);
+    // parry's `contact_support_map_support_map`, with this thread's EPA workspace reused (a fresh
+    // EPA allocates on every overlapping pair).
+    let mut simplex = VoronoiSimplex::new();
+    let dir = pos12.translation.try_normalize().unwrap_or(Vector::X);
+    simplex.reset(CsoPoint::from_shapes(&pos12, s1, s2, dir));
+    let found = match gjk::closest_points(&pos12, s1, s2, reach, true, &mut simplex) {
+        GJKResult::ClosestPoints(p1, p2, n) => Some((p1, p2, n)),
+        GJKResult::Intersection => {
+            EPA_WORK.with(|epa| epa.borrow_mut().closest_points(&pos12, s1, s2, &simplex))
         }
+        GJKResult::NoIntersection(_) | GJKResult::Proximity(_) => None,
+    };
+    // point1 and normal1 in frame 1, point2_1 (point 2) in frame 1 too.
+    let (point1, point2_1, normal1) = found?;
+    let mut point = PairPoint {
+        p1: x1.act_point(&from_parry(point1)),
+        p2: x1.act_point(&from_parry(point2_1)),
+        normal: x1.rot * from_parry(normal1),
+        dist: (point2_1 - point1).dot(normal1),
+    };
+    if point.dist < 0.0 && s1.smooth() && s2.smooth() {
+        point = polish(x1, s1, x2, s2, point);
     }
-    (dist <= reach).then_some(PairPoint { p1, p2, normal, dist })
+    (point.dist <= reach).then_some(point)
+}
+
+/// The signed distance of two support-map shapes to f64 round-off, if closer than `reach`: when
+/// they are apart, the distance and witness points of [`super::gjk::separation`] (parry's GJK
+/// stops at a relative gap of ~5e-8, see there), polished on smooth shapes; when they overlap,
+/// [`support_pair`]'s EPA. What [`geom_distance`](super::geom_distance) measures with.
+pub(crate) fn support_distance(
+    x1: &Transform,
+    s1: &ConvexShape,
+    x2: &Transform,
+    s2: &ConvexShape,
+    reach: f64,
+) -> Option<PairPoint> {
+    let Some((p1, p2, dist)) = super::gjk::separation(x1, s1, x2, s2) else {
+        return support_pair(x1, s1, x2, s2, reach);
+    };
+    if dist > reach {
+        return None;
+    }
+    let mut point = PairPoint { p1, p2, normal: (p2 - p1) / dist, dist };
+    if s1.smooth() && s2.smooth() {
+        point = polish(x1, s1, x2, s2, point);
+    }
+    (point.dist <= reach).then_some(point)
+}
+
+/// Refines the direction of a pair point between two smooth shapes to the minimiser of
+/// h₁(n) + h₂(−n) over unit n (support functions h; the minimum is minus the signed distance; its
+/// gradient is the tangential part of p₁ − p₂, the difference of the support points) by Newton
+/// steps on the tangent plane, the Hessian by central differences of the gradient (the sum of the
+/// two surfaces' curvature radii), never accepting a step that does not lower it. GJK and EPA
+/// determine the distance to round-off but the witness points on curved surfaces only to the
+/// square root of that (the distance is stationary in them); the Newton steps solve the
+/// first-order condition instead, which fixes them to round-off.
+fn polish(x1: &Transform, s1: &ConvexShape, x2: &Transform, s2: &ConvexShape, start: PairPoint) -> PairPoint {
+    let PairPoint { mut p1, mut p2, mut normal, mut dist } = start;
+    let depth_at = |n: &Vec3| {
+        let (q1, q2) = (s1.world_support(x1, n), s2.world_support(x2, &-n));
+        (n.dot(&(q1 - q2)), q1, q2)
+    };
+    let (mut depth, _, _) = depth_at(&normal);
+    for _ in 0..8 {
+        let t1 = crate::collision::contact_frame(&normal, None).row(1).transpose();
+        let t2 = normal.cross(&t1);
+        let grad = |n: &Vec3| {
+            let (_, q1, q2) = depth_at(n);
+            let d = q1 - q2;
+            [t1.dot(&d), t2.dot(&d)]
+        };
+        let g = grad(&normal);
+        if g[0].hypot(g[1]) <= 1e-15 * depth.abs().max(1e-300) {
+            break;
+        }
+        const EPS: f64 = 1e-6;
+        let mut h = [[0.0; 2]; 2];
+        for (j, t) in [t1, t2].iter().enumerate() {
+            let (gp, gm) = (grad(&(normal + t * EPS).normalize()), grad(&(normal - t * EPS).normalize()));
+            for i in 0..2 {
+                h[i][j] = (gp[i] - gm[i]) / (2.0 * EPS);
+            }
+        }
+        let det = h[0][0] * h[1][1] - h[0][1] * h[1][0];
+        if det.is_nan() || det <= 0.0 || h[0][0] <= 0.0 {
+            break;
+        }
+        let step = [(-g[0] * h[1][1] + g[1] * h[0][1]) / det, (g[0] * h[1][0] - g[1] * h[0][0]) / det];
+        let candidate = (normal + t1 * step[0] + t2 * step[1]).normalize();
+        let (d_new, q1, q2) = depth_at(&candidate);
+        // Never higher than before (NaN stops too).
+        if d_new.is_nan() || d_new > depth + 1e-15 * depth.abs() {
+            break;
+        }
+        (normal, depth, p1, p2, dist) = (candidate, d_new, q1, q2, -d_new);
+    }
+    PairPoint { p1, p2, normal, dist }
 }
 
 /// Closest points of segments [a0, a1] and [b0, b1] (Ericson, *Real-Time Collision Detection*,

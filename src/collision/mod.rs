@@ -16,22 +16,37 @@
 //! the contact's `includemargin`); the exact mode asks a little further ([`EXACT_REACH`]) so that a contact lifted
 //! off by round-off or within a step is still known (its rows exist only while touching, or while
 //! the step's rows are frozen).
+//!
+//! The geometric queries of the sensors live here too: ray casting against geoms and sites
+//! ([`ray()`], MuJoCo's `mj_ray`), the distance between two geoms ([`geom_distance()`], MuJoCo's
+//! `mj_geomDistance`, through the same narrow phase) and whether a point is inside a site
+//! ([`inside_site()`], MuJoCo's `mju_insideGeom`). They consider every geom, visual ones included,
+//! reading the triangles and hulls of mesh geoms on first use ([`GeomMesh`]).
 
 pub mod box_box;
 pub mod box_primitive;
 pub mod convex;
 mod frame;
+pub mod geom_distance;
+mod gjk;
+pub mod inside;
+pub mod mesh;
 pub mod plane;
+pub mod ray;
 
 pub use convex::{ConvexShape, Ellipsoid};
 pub use frame::contact_frame;
+pub use geom_distance::{geom_distance, GeomDistance};
+pub use inside::inside_site;
+pub use mesh::GeomMesh;
+pub use ray::{ray, ray_site, RayFilter, RayHit};
 
 use crate::model::spec::Shape;
 use crate::model::{Contact, Data, Model};
 use crate::spatial::{Transform, Vec3};
 use convex::PairPoint;
 use parry3d_f64::math::Vector;
-use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder};
+use parry3d_f64::shape::ConvexPolyhedron;
 use plane::PlanePoint;
 
 /// How much farther than MuJoCo's margin the exact mode detects contacts (m).
@@ -72,27 +87,6 @@ impl CollisionModel {
         let mut rbound = Vec::with_capacity(model.geoms.len());
         for g in &model.geoms {
             let (shape, r) = match &g.shape {
-                // (`+ 0.0` turns a size written as −0 into +0: parry asserts a positive sign.)
-                Shape::Sphere { radius } => (Some(ConvexShape::Ball(Ball::new(radius + 0.0))), *radius),
-                Shape::Capsule { radius, length } => (
-                    Some(ConvexShape::Capsule(Capsule::new_z(0.5 * length + 0.0, radius + 0.0))),
-                    radius + 0.5 * length,
-                ),
-                Shape::Cylinder { radius, length } => (
-                    Some(ConvexShape::Cylinder(Cylinder::new(0.5 * length + 0.0, radius + 0.0))),
-                    radius.hypot(0.5 * length),
-                ),
-                Shape::Box { size } => {
-                    let h = size / 2.0;
-                    (
-                        Some(ConvexShape::Cuboid(Cuboid::new(Vector::new(h.x + 0.0, h.y + 0.0, h.z + 0.0)))),
-                        h.norm(),
-                    )
-                }
-                Shape::Ellipsoid { radii } => (
-                    Some(ConvexShape::Ellipsoid(Ellipsoid { radii: Vector::new(radii.x, radii.y, radii.z) })),
-                    radii.max(),
-                ),
                 Shape::Mesh { .. } => match &g.hull {
                     Some(h) => {
                         let points: Vec<Vector> = h.iter().map(|v| Vector::new(v.x, v.y, v.z)).collect();
@@ -102,6 +96,10 @@ impl CollisionModel {
                     None => (None, 0.0),
                 },
                 Shape::Plane { .. } | Shape::Hfield { .. } => (None, f64::INFINITY),
+                primitive => match ConvexShape::of_primitive(primitive) {
+                    Some((s, r)) => (Some(s), r),
+                    None => (None, 0.0),
+                },
             };
             shapes.push(shape);
             rbound.push(r);

@@ -29,6 +29,9 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let welded = welded_to_world(spec);
     let mut meshes = crate::io::geom_mass::MeshCache::default();
     let mut hulls = crate::io::geom_hull::HullCache::default();
+    // The lazily read triangles and hulls of mesh geoms, one per file and scale.
+    let mut geom_meshes: HashMap<(std::path::PathBuf, [u64; 3]), std::sync::Arc<crate::collision::GeomMesh>> =
+        HashMap::new();
     let mut warnings = spec.warnings.clone();
     // Pass 0: every link's own mass properties (explicit or from its geoms), with the compiler's
     // bounds; then `settotalmass` scales the moving links.
@@ -177,6 +180,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             x_body_frame: x_body_link,
             inertia: i_link,
             mocap,
+            site: None,
         });
         for f in &link.frames {
             frames.push(Frame {
@@ -186,6 +190,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 x_body_frame: x_body_link * f.x_link_frame,
                 inertia: RigidInertia::zero(),
                 mocap,
+                site: f.site,
             });
         }
         for (g, &mass) in link.geoms.iter().zip(&geom_masses[li]) {
@@ -202,6 +207,20 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 mass,
                 contact: g.contact,
                 hull,
+                group: g.group,
+                rgba: g.rgba,
+                material_rgba: g.material_rgba,
+                mesh: match &g.shape {
+                    Shape::Mesh { path, scale } => Some(
+                        geom_meshes
+                            .entry((path.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()]))
+                            .or_insert_with(|| {
+                                std::sync::Arc::new(crate::collision::GeomMesh::new(path.clone(), *scale))
+                            })
+                            .clone(),
+                    ),
+                    _ => None,
+                },
             });
         }
     }

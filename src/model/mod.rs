@@ -150,6 +150,10 @@ pub struct Frame {
     /// The mocap body carrying the frame (index in `Data::mocap_pos`), if any: its world pose is
     /// then the mocap pose composed with `x_body_frame`.
     pub mocap: Option<usize>,
+    /// An MJCF site's shape and size (MuJoCo's `site_type` and `site_size`: a sphere of radius
+    /// 0.005 unless the file says otherwise), which the touch sensor's zone, `insidesite` and
+    /// contact-sensor site filters use; None for frames that are not sites.
+    pub site: Option<crate::mass::Primitive>,
 }
 
 /// A geometry of the model file: collision shape (when `collision`) and mass contribution.
@@ -176,6 +180,18 @@ pub struct Geom {
     /// For a colliding mesh: the vertices of its convex hull in the geom frame (MuJoCo collides
     /// meshes by their hulls).
     pub hull: Option<std::sync::Arc<Vec<Vec3>>>,
+    /// MJCF `group` (MuJoCo's `geom_group`; 0 by default): ray casting can select groups.
+    pub group: i32,
+    /// MJCF `rgba` (MuJoCo's `geom_rgba`; 0.5 0.5 0.5 1 by default): ray casting skips a geom
+    /// whose alpha is 0 when it has no material.
+    pub rgba: [f32; 4],
+    /// The `rgba` of the geom's material, if it has one (MuJoCo's `mat_rgba`): ray casting then
+    /// skips the geom when that alpha is 0, whatever its own.
+    pub material_rgba: Option<[f32; 4]>,
+    /// For any mesh geom (visual ones too): its file's triangles and convex hull, read on first
+    /// use by ray casting and geom distances ([`crate::collision::GeomMesh`]); geoms using the
+    /// same file and scale share one.
+    pub mesh: Option<std::sync::Arc<crate::collision::GeomMesh>>,
 }
 
 /// The compiled, immutable model. Build it with a loader (e.g. [`crate::io::load`]) or by

@@ -109,6 +109,8 @@ pub struct FrameSpec {
     pub kind: super::FrameKind,
     /// Pose of the frame in the link frame.
     pub x_link_frame: Transform,
+    /// An MJCF site's shape and size (MuJoCo's `site_type`, `site_size`); None for other frames.
+    pub site: Option<crate::mass::Primitive>,
 }
 
 /// Joint types as model files name them.
@@ -315,6 +317,9 @@ pub enum Shape {
     },
 }
 
+/// MuJoCo's default `geom_rgba`.
+pub const DEFAULT_GEOM_RGBA: [f32; 4] = [0.5, 0.5, 0.5, 1.0];
+
 /// A visual or collision geometry of a link.
 #[derive(Clone, Debug)]
 pub struct GeomSpec {
@@ -334,8 +339,12 @@ pub struct GeomSpec {
     pub distribution: Distribution,
     /// For meshes: how MuJoCo computes its inertia (`<mesh inertia>`).
     pub mesh_inertia: crate::mass::MeshInertia,
-    /// MJCF `group`.
+    /// MJCF `group` (0 by default).
     pub group: i32,
+    /// MJCF `rgba` (MuJoCo's `geom_rgba`, 0.5 0.5 0.5 1 by default).
+    pub rgba: [f32; 4],
+    /// The `rgba` of the geom's MJCF `material`, if it names one (MuJoCo's `mat_rgba`).
+    pub material_rgba: Option<[f32; 4]>,
     /// Contact parameters (MJCF `contype`, `conaffinity`, `condim`, `priority`, `friction`,
     /// `solmix`, `solref`, `solimp`, `margin`, `gap`; MuJoCo's defaults for URDF).
     pub contact: GeomContact,
@@ -399,6 +408,8 @@ impl GeomSpec {
             distribution: Distribution::Volume,
             mesh_inertia: Default::default(),
             group: 0,
+            rgba: DEFAULT_GEOM_RGBA,
+            material_rgba: None,
             contact: GeomContact::default(),
         }
     }

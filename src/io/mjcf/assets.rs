@@ -1,5 +1,6 @@
-//! `<asset>`: mesh files (with their default class, scale and inertia mode) by name. Textures,
-//! materials and height fields are accepted; they do not affect the dynamics.
+//! `<asset>`: mesh files (with their default class, scale and inertia mode) and material colours
+//! (`rgba`, which ray casting filters on) by name. Textures, the other material attributes and
+//! height fields are accepted; they do not affect the dynamics.
 
 use super::defaults::{Defaults, MAIN};
 use super::xml::Element;
@@ -80,6 +81,23 @@ pub(crate) fn meshes(
             }
             let scale = a.vec3("scale")?.unwrap_or(Vec3::repeat(1.0));
             out.insert(name, MeshAsset { path, scale, inertia });
+        }
+    }
+    Ok(out)
+}
+
+/// MuJoCo's default material colour (`mat_rgba`).
+const DEFAULT_MATERIAL_RGBA: [f32; 4] = [1.0, 1.0, 1.0, 1.0];
+
+/// The `rgba` of every named `<material>` (over its default class; MuJoCo's default 1 1 1 1).
+pub(crate) fn materials(root: &Element, defaults: &Defaults) -> Result<HashMap<String, [f32; 4]>, LoadError> {
+    let mut out = HashMap::new();
+    for section in root.children_named("asset") {
+        for e in section.children_named("material") {
+            let a = defaults.resolve(e, MAIN)?;
+            let Some(name) = a.text("name") else { continue };
+            let rgba = a.array::<4>("rgba")?.map_or(DEFAULT_MATERIAL_RGBA, |c| c.map(|x| x as f32));
+            out.insert(name.to_string(), rgba);
         }
     }
     Ok(out)

@@ -13,7 +13,7 @@
 use super::assets::MeshAsset;
 use super::attrs::Attrs;
 use super::defaults::{Defaults, MAIN};
-use super::geom::{geom, site_pose};
+use super::geom::{geom, site};
 use super::orientation::{axis_angle_matrix, rotation};
 use super::xml::Element;
 use super::{Compiler, InertiaFromGeom};
@@ -38,6 +38,7 @@ pub(crate) struct TreeBuilder<'a> {
     compiler: &'a Compiler,
     defaults: &'a Defaults,
     meshes: &'a HashMap<String, MeshAsset>,
+    materials: &'a HashMap<String, [f32; 4]>,
     pub links: Vec<LinkSpec>,
     pub warnings: Vec<String>,
     /// Passive elements of bodies and joints that are parsed, not simulated.
@@ -52,11 +53,13 @@ impl<'a> TreeBuilder<'a> {
         compiler: &'a Compiler,
         defaults: &'a Defaults,
         meshes: &'a HashMap<String, MeshAsset>,
+        materials: &'a HashMap<String, [f32; 4]>,
     ) -> Self {
         Self {
             compiler,
             defaults,
             meshes,
+            materials,
             links: Vec::new(),
             warnings: Vec::new(),
             kept: Vec::new(),
@@ -298,18 +301,26 @@ impl<'a> TreeBuilder<'a> {
     ) -> Result<(), LoadError> {
         for (ge, xf, class) in &content.geoms {
             let a = self.defaults.resolve(ge, class)?;
-            let g = geom(&a, &(x * *xf), self.compiler, self.meshes, infer_inertia)?;
+            let g = geom(&a, &(x * *xf), self.compiler, self.meshes, self.materials, infer_inertia)?;
             self.links[link].geoms.push(g);
         }
         for (se, xf, class) in &content.sites {
             let a = self.defaults.resolve(se, class)?;
-            let pose = site_pose(&a, &self.compiler.angles)?;
+            let class_attrs = self.defaults.class_defaults_under(se, "site", class)?;
+            let (pose, shape) = site(&a, &class_attrs, &self.compiler.angles)?;
             let Some(name) = a.text("name") else { continue };
+            if shape.is_none() {
+                self.warnings.push(format!(
+                    "{}: site '{name}' is a mesh site: its shape is not kept (a touch sensor, insidesite or contact-sensor filter on it is not computed)",
+                    se.loc
+                ));
+            }
             self.links[link].frames.push(FrameSpec {
                 name: name.to_string(),
                 loc: se.loc.clone(),
                 kind: FrameKind::Site,
                 x_link_frame: x * *xf * pose,
+                site: shape,
             });
         }
         Ok(())

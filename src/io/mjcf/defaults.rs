@@ -134,7 +134,18 @@ impl Defaults {
 
     /// The defaults alone that [`Defaults::resolve_as`] puts under `element`'s own attributes.
     pub fn class_defaults(&self, element: &Element, default_tag: &str) -> Result<Attrs, LoadError> {
-        let class = self.class_of(element, MAIN)?;
+        self.class_defaults_under(element, default_tag, MAIN)
+    }
+
+    /// [`Defaults::class_defaults`] of an element inside a body or frame whose `childclass` is
+    /// `childclass`.
+    pub fn class_defaults_under(
+        &self,
+        element: &Element,
+        default_tag: &str,
+        childclass: &str,
+    ) -> Result<Attrs, LoadError> {
+        let class = self.class_of(element, childclass)?;
         let empty = Vec::new();
         let defaults = class.by_tag.get(default_tag).unwrap_or(&empty);
         Ok(Attrs::new(&element.tag, &element.loc, defaults, &[]))

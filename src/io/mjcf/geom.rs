@@ -2,15 +2,17 @@
 //! default), `size` in half-lengths, `fromto` (capsule, cylinder, box, ellipsoid: centre at the
 //! midpoint, z along the segment, half-length |to − from|/2 into size[1] — size[2] for boxes and
 //! ellipsoids, whose size[1] becomes size[0]), `mass` or `density` (1000 kg/m³ by default),
-//! `shellinertia`, and the mesh asset a mesh geom names.
+//! `shellinertia`, the mesh asset a mesh geom names, `group`, `rgba` and the `rgba` of the
+//! `material` it names (what ray casting filters on); a site's `type` and `size` (MuJoCo's
+//! defaults: a sphere of 0.005).
 
 use super::assets::MeshAsset;
 use super::attrs::Attrs;
 use super::orientation::{rotation, z_to_matrix, AngleConvention};
 use super::Compiler;
 use crate::io::LoadError;
-use crate::mass::{Distribution, GeomMass};
-use crate::model::spec::{GeomContact, GeomSpec, Shape};
+use crate::mass::{Distribution, GeomMass, Primitive};
+use crate::model::spec::{GeomContact, GeomSpec, Shape, DEFAULT_GEOM_RGBA};
 use crate::spatial::{Transform, Vec3};
 use std::collections::HashMap;
 
@@ -18,12 +20,14 @@ const GEOM_TYPES: [&str; 9] =
     ["plane", "hfield", "sphere", "capsule", "ellipsoid", "cylinder", "box", "mesh", "sdf"];
 
 /// The placement and size of a geom or site after `fromto`: pose in its parent frame and the size
-/// vector (half-lengths).
-fn placement(a: &Attrs, gtype: &str, angles: &AngleConvention) -> Result<(Transform, [f64; 3]), LoadError> {
-    let mut size = [0.0; 3];
-    if let Some(v) = a.some_numbers("size", 1, 3)? {
-        size[..v.len()].copy_from_slice(&v);
-    }
+/// vector (half-lengths), `size` holding the sizes read so far (the `size` attribute over the
+/// defaults).
+fn placement(
+    a: &Attrs,
+    gtype: &str,
+    angles: &AngleConvention,
+    mut size: [f64; 3],
+) -> Result<(Transform, [f64; 3]), LoadError> {
     if let Some(ft) = a.array::<6>("fromto")? {
         if a.vec3("pos")?.is_some_and(|p| p != Vec3::zeros()) {
             return Err(
@@ -54,10 +58,45 @@ fn placement(a: &Attrs, gtype: &str, angles: &AngleConvention) -> Result<(Transf
     Ok((Transform::new(rotation(a, angles)?, pos), size))
 }
 
-/// A site: its pose in the parent frame.
-pub(crate) fn site_pose(a: &Attrs, angles: &AngleConvention) -> Result<Transform, LoadError> {
+/// MuJoCo's site size where the file gives none (`mjCSite`: 0.005 for each entry).
+const SITE_SIZE: f64 = 0.005;
+
+/// A site: its pose in the parent frame and its shape (MuJoCo's `site_type`, `site_size`), None for
+/// a mesh site (drawn only: no sensor can use its shape). `class` holds the attributes of the
+/// site's default class alone: a partial `size` overrides the class's entry by entry, and entries
+/// given by neither keep MuJoCo's 0.005 (`size="0.01"` on a box is 0.01 × 0.005 × 0.005).
+pub(crate) fn site(
+    a: &Attrs,
+    class: &Attrs,
+    angles: &AngleConvention,
+) -> Result<(Transform, Option<Primitive>), LoadError> {
     let gtype = a.keyword("type", &GEOM_TYPES)?.unwrap_or_else(|| "sphere".into());
-    Ok(placement(a, &gtype, angles)?.0)
+    if matches!(gtype.as_str(), "plane" | "hfield" | "sdf") {
+        return Err(a.error("type", format!("is '{gtype}'; a site is a sphere, capsule, ellipsoid, cylinder, box or mesh (as MuJoCo requires)")));
+    }
+    let mut size = [SITE_SIZE; 3];
+    a.fill_over(class, "size", &mut size)?;
+    let (pose, size) = placement(a, &gtype, angles, size)?;
+    let used = match gtype.as_str() {
+        "sphere" => 1,
+        "capsule" | "cylinder" => 2,
+        "mesh" => 0,
+        _ => 3,
+    };
+    if let Some(k) = size[..used].iter().position(|&s| s <= 0.0) {
+        return Err(
+            a.error("size", format!("of a {gtype} site has entry {k} = {}; it must be positive", size[k]))
+        );
+    }
+    let shape = match gtype.as_str() {
+        "sphere" => Some(Primitive::Sphere { radius: size[0] }),
+        "capsule" => Some(Primitive::Capsule { radius: size[0], half_length: size[1] }),
+        "cylinder" => Some(Primitive::Cylinder { radius: size[0], half_length: size[1] }),
+        "box" => Some(Primitive::Box { half_extents: Vec3::from(size) }),
+        "ellipsoid" => Some(Primitive::Ellipsoid { radii: Vec3::from(size) }),
+        _ => None,
+    };
+    Ok((pose, shape))
 }
 
 /// A geom as a spec geom placed in its link (`x_link_parent`: pose of the enclosing frame).
@@ -66,10 +105,15 @@ pub(crate) fn geom(
     x_link_parent: &Transform,
     compiler: &Compiler,
     meshes: &HashMap<String, MeshAsset>,
+    materials: &HashMap<String, [f32; 4]>,
     infer_inertia: bool,
 ) -> Result<GeomSpec, LoadError> {
     let gtype = a.keyword("type", &GEOM_TYPES)?.unwrap_or_else(|| "sphere".into());
-    let (x_parent_geom, size) = placement(a, &gtype, &compiler.angles)?;
+    let mut size = [0.0; 3];
+    if let Some(v) = a.some_numbers("size", 1, 3)? {
+        size[..v.len()].copy_from_slice(&v);
+    }
+    let (x_parent_geom, size) = placement(a, &gtype, &compiler.angles, size)?;
     let positive = |n: usize| -> Result<(), LoadError> {
         if size[..n].iter().any(|&s| s <= 0.0) {
             return Err(a.error(
@@ -159,6 +203,24 @@ pub(crate) fn geom(
         GeomMass::Density(rho)
     };
     let contact = contact_parameters(a)?;
+    let rgba = match a.array::<4>("rgba")? {
+        Some(c) => c.map(|x| x as f32),
+        None => DEFAULT_GEOM_RGBA,
+    };
+    let material_rgba = match a.text("material") {
+        None => None,
+        Some(name) => match materials.get(name) {
+            Some(c) => Some(*c),
+            None => {
+                return Err(LoadError::UnknownReference {
+                    loc: a.loc.clone(),
+                    element: "geom".into(),
+                    kind: "material",
+                    target: name.to_string(),
+                })
+            }
+        },
+    };
     Ok(GeomSpec {
         name: a.text("name").unwrap_or("").to_string(),
         loc: a.loc.clone(),
@@ -169,6 +231,8 @@ pub(crate) fn geom(
         distribution: if shell { Distribution::Shell } else { Distribution::Volume },
         mesh_inertia,
         group: group as i32,
+        rgba,
+        material_rgba,
         contact,
     })
 }

@@ -117,7 +117,8 @@ fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<Mo
     let (options, gravity) = sections::options(root)?;
     let defaults = defaults::Defaults::build(root)?;
     let meshes = assets::meshes(root, &defaults, &compiler, &root.loc.file)?;
-    let mut builder = body::TreeBuilder::new(&compiler, &defaults, &meshes);
+    let materials = assets::materials(root, &defaults)?;
+    let mut builder = body::TreeBuilder::new(&compiler, &defaults, &meshes, &materials);
     builder.worldbody(root)?;
     warnings.append(&mut builder.warnings);
     let keyframes = sections::keyframes(root)?;
