@@ -106,19 +106,6 @@ pub(crate) fn compile_sensors(
     Ok((out, adr))
 }
 
-/// The types whose inputs are still being built (geometric queries), with what they wait for.
-fn pending(kind: SensorType, object: SensorObject) -> Option<String> {
-    use SensorType::*;
-    let why = match (kind, object) {
-        (Touch | Rangefinder | InsideSite | GeomDist | GeomNormal | GeomFromTo, _)
-        | (Contact, SensorObject::Site(_)) => {
-            "its geometric query (ray casting, site zones, geom distances) is not implemented yet"
-        }
-        _ => return None,
-    };
-    Some(why.into())
-}
-
 fn sensor(e: &Element, names: &Names, model: &Model, id: usize) -> Result<Sensor, LoadError> {
     use SensorType::*;
     let kind = SensorType::from_tag(&e.kind).ok_or_else(|| invalid(e, "unknown sensor type"))?;
@@ -317,9 +304,6 @@ fn sensor(e: &Element, names: &Names, model: &Model, id: usize) -> Result<Sensor
             );
             dim = Some(0);
         }
-    }
-    if not_computed.is_none() {
-        not_computed = pending(kind, object);
     }
     if cutoff > 0.0
         && (datatype == SensorDataType::Quaternion

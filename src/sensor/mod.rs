@@ -18,6 +18,7 @@
 
 mod acceleration;
 mod contact_sensor;
+mod geometry;
 pub(crate) mod objects;
 mod position;
 mod subtree;
@@ -68,7 +69,7 @@ impl SensorNeeds {
                 )
             }),
             quats: has(&|k| k == FrameQuat),
-            subtree_com: has(&|k| matches!(k, SubtreeCom | SubtreeLinVel | SubtreeAngMom)),
+            subtree_com: has(&|k| matches!(k, SubtreeCom | SubtreeLinVel | SubtreeAngMom | InsideSite)),
             subtree_velocities: has(&|k| matches!(k, SubtreeLinVel | SubtreeAngMom)),
             kinetic: has(&|k| k == EKinetic),
             rne_post: has(&|k| matches!(k, Accelerometer | Force | Torque | FrameLinAcc | FrameAngAcc)),
@@ -152,12 +153,24 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
         let armature: f64 = model.dof_armature.iter().zip(v).map(|(a, vi)| 0.5 * a * vi * vi).sum();
         work.kinetic = bodies + armature;
     }
-    let inside_site = |_f: usize, _p: &crate::spatial::Vec3| true;
+    let inside_site = |f: usize, p: &crate::spatial::Vec3| geometry::inside_site_zone(model, data, f, p);
     for s in model.sensors.iter().filter(|s| s.is_computed()) {
         let out = &mut sensordata.as_mut_slice()[s.adr..s.adr + s.dim];
         match (s.stage, s.contact) {
             (_, Some(spec)) => {
                 contact_sensor::compute(model, data, s, &spec, &inside_site, &mut work.matches, out)
+            }
+            _ if matches!(
+                s.kind,
+                SensorType::Touch
+                    | SensorType::Rangefinder
+                    | SensorType::InsideSite
+                    | SensorType::GeomDist
+                    | SensorType::GeomNormal
+                    | SensorType::GeomFromTo
+            ) =>
+            {
+                geometry::compute(model, data, &work, s, out)
             }
             (SensorStage::Position, _) => position::compute(model, data, &work, s, q, out),
             (SensorStage::Velocity, _) => velocity::compute(model, data, &work, s, v, out),
