@@ -60,8 +60,8 @@ pub enum InputError {
         /// The value (NaN or ±∞).
         value: f64,
     },
-    /// A value is outside what the function accepts (a zero ray direction, a frame that is not a
-    /// site, …).
+    /// A value is outside what the function accepts (a step size of 0, negative or NaN; a zero ray
+    /// direction; a frame that is not a site, …).
     #[error("{function}: {argument} {detail}")]
     Value {
         /// The function called.

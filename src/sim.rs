@@ -52,6 +52,34 @@ pub enum SimError {
         /// max |φ| of the equality constraints at the last iterate.
         constraint: f64,
     },
+    /// The adaptive integrator stopped before the end of a step: with contact, limit or friction
+    /// rows it ran past its work budget (the constraint forces are only as accurate as their solve
+    /// and switch with the rows, so error control cannot meet tight tolerances), or its step size
+    /// collapsed. The state is left where error control stopped.
+    #[error("the adaptive integrator stopped at t = {} s in step {step}: {why}; the state is left where error control stopped; use a fixed-step integrator (euler or implicitfast at the model's timestep, rk4 for accuracy) for contact-rich motion, or looser tolerances (SimOptions::tolerances, --rtol/--atol; now rtol {rtol:e}, atol {atol:e})", display_time(*.time))]
+    AdaptiveStalled {
+        /// Simulation time where the stepper stopped (s).
+        time: f64,
+        /// The step's number.
+        step: u64,
+        /// Why, with the figures (work done against fixed steps, the last step size and error).
+        why: String,
+        /// The relative tolerance in use.
+        rtol: f64,
+        /// The absolute tolerance in use.
+        atol: f64,
+    },
+    /// A step was asked for after a failed one (diverged, not converged, stalled) without the
+    /// state being reset or set since: stepping on would step the failed state.
+    #[error("step refused: step {step} failed at t = {} s ({cause}); reset the state (reset, reset_keyframe) or set it (Simulation::set_state, Data::set_state) before stepping again", display_time(*.time))]
+    Refused {
+        /// The failed step's number.
+        step: u64,
+        /// The time when it failed (s).
+        time: f64,
+        /// What went wrong.
+        cause: &'static str,
+    },
     /// A state given to the simulation has the wrong length or a non-finite value.
     #[error("invalid initial state: {0}")]
     BadState(String),
@@ -93,7 +121,8 @@ pub struct Simulation {
     pub stepper: Box<dyn Stepper>,
     /// The step size used by [`step`](Self::step). For a fixed-step integrator it is also the
     /// model's timestep (soft constraints' `refsafe`, `actearly`): set here after
-    /// [`new`](Self::new), the model follows at the next step.
+    /// [`new`](Self::new), the model follows at the next step. [`set_timestep`](Self::set_timestep)
+    /// checks the value; [`step`](Self::step) refuses 0, negative and non-finite values.
     pub timestep: f64,
     /// Steps taken since [`new`](Self::new).
     pub steps: u64,
@@ -216,6 +245,7 @@ impl Simulation {
         }
         self.data.qpos.copy_from_slice(q);
         self.data.qvel.copy_from_slice(v);
+        self.data.stepper.failed = None;
         Ok(())
     }
 
@@ -252,7 +282,34 @@ impl Simulation {
     }
 
     /// Advances one step of `timestep`; a non-finite result is reported, never propagated.
+    ///
+    /// # Errors
+    /// [`SimError::Input`] for a `timestep` of 0, negative or not finite; after a step that
+    /// failed ([`SimError::Diverged`], [`SimError::NotConverged`], [`SimError::AdaptiveStalled`])
+    /// every further step is [`SimError::Refused`] until the state is set
+    /// ([`set_state`](Self::set_state)) or reset ([`reset`](crate::model::reset::reset) on
+    /// `data`).
     pub fn step(&mut self) -> Result<StepReport, SimError> {
+        if let Some(f) = &self.data.stepper.failed {
+            return Err(f.refusal());
+        }
+        crate::integrate::check_timestep("Simulation::step", "Simulation::timestep", self.timestep)?;
+        let result = self.step_unguarded();
+        if let Err(e) = &result {
+            self.data.stepper.failed = crate::integrate::FailedStep::of(e, self.steps + 1, self.data.time);
+        }
+        result
+    }
+
+    /// Sets the step size of [`step`](Self::step) (see [`timestep`](Self::timestep)); rejects 0,
+    /// negative and non-finite values.
+    pub fn set_timestep(&mut self, timestep: f64) -> Result<(), SimError> {
+        crate::integrate::check_timestep("Simulation::set_timestep", "timestep", timestep)?;
+        self.timestep = timestep;
+        Ok(())
+    }
+
+    fn step_unguarded(&mut self) -> Result<StepReport, SimError> {
         let d = &mut self.data;
         let (t, q, v) = (d.time, d.qpos.as_slice(), d.qvel.as_slice());
         if let Some(f) = self.controller.as_mut() {
@@ -264,8 +321,37 @@ impl Simulation {
         // `timestep` may have been set after `new`.
         self.sync_timestep();
         let mut report = self.stepper.step(&self.model, &mut self.data, self.timestep);
+        // The next soft solve's warm start: this step's acceleration, rows or not (MuJoCo's
+        // mj_advance), so that a solve with no iterations starts where the motion is.
+        self.data.qacc_warmstart.copy_from(&self.data.qacc);
         if self.model.plan.solver.soft_weights().is_some() && self.data.nefc > 0 {
             report.solver_improvement = self.data.solver_improvement;
+        }
+        if let Some(s) = self.stepper.stalled() {
+            let why = if s.collapsed {
+                format!(
+                    "its step size collapsed to {:.3e} s (error estimate {:.3e} of the tolerance)",
+                    s.h, s.error
+                )
+            } else {
+                format!(
+                    "with contact, limit or friction rows it took {} force evaluations where fixed rk4 steps of the model's timestep ({} s) take {} (budget {}x + {}; last step size {:.3e} s, error estimate {:.3e} of the tolerance): the constraint forces are only as accurate as their solve and switch with the rows, so the error estimate cannot get under these tolerances",
+                    s.evaluations,
+                    self.model.options.timestep,
+                    s.fixed_step_evaluations,
+                    crate::integrate::BUDGET_FACTOR,
+                    crate::integrate::BUDGET_GRACE,
+                    s.h,
+                    s.error
+                )
+            };
+            return Err(SimError::AdaptiveStalled {
+                time: self.data.time,
+                step: self.steps + 1,
+                why,
+                rtol: s.tolerances[0],
+                atol: s.tolerances[1],
+            });
         }
         if let Some(f) = self.stepper.failure() {
             return Err(SimError::NotConverged {

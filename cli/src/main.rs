@@ -107,6 +107,10 @@ enum Command {
         /// repeatable.
         #[arg(long = "jacobian")]
         jacobians: Vec<String>,
+        /// Only the smooth kernels (M, bias, ABA's qacc, poses, energies, Jacobians): no
+        /// `forward` block and no sensors.
+        #[arg(long)]
+        kernels_only: bool,
     },
     /// Simulate from a keyframe, a given state, or the model's reference configuration at rest,
     /// under gravity, with zero torques.
@@ -294,8 +298,8 @@ fn main() -> ExitCode {
             };
             workprec::run(&options, &request)
         }
-        Some(Command::Eval { model, states, json: _, jacobians }) => {
-            eval::run(&model, &options, &states, &jacobians, mode)
+        Some(Command::Eval { model, states, json: _, jacobians, kernels_only }) => {
+            eval::run(&model, &options, &states, &jacobians, mode, kernels_only)
         }
         Some(Command::Simulate {
             model,

@@ -12,10 +12,22 @@
 //! accepted when that is ≤ 1, and the next size is h·min(5, max(0.2, 0.9·err^(−1/5))).
 //! Actuator activations are components of the same ODE (their rates `act_dot`, their error in the
 //! norm with s = max(|w₀|, |w₁|)), clamped to `actrange` after each accepted internal step.
+//!
+//! **Limits.** Error control assumes a smooth right-hand side. With contact, limit or friction
+//! rows the accelerations are only as accurate as the constraint solve (the soft solver stops at
+//! its `tolerance`) and switch with the rows, so the error estimate has a floor that tight
+//! tolerances cannot get under: the step size then collapses (a box resting on a floor at
+//! rtol 1e-12 took minutes for 0.1 s). The stepper therefore keeps a work budget while such rows
+//! exist: [`BUDGET_FACTOR`] times the force evaluations of fixed RK4 steps of the model's
+//! timestep over the same time, plus [`BUDGET_GRACE`]; past it, it stops with an
+//! [`AdaptiveStall`] (reported by [`Simulation::step`](crate::sim::Simulation::step) as
+//! [`SimError::AdaptiveStalled`](crate::sim::SimError::AdaptiveStalled)), as it does when the
+//! step size collapses below 1e-14 of the interval.
 
 use super::stage::{evaluate_stage, StageInput};
 use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::forward::clamp_activations;
+use crate::model::EfcType;
 use crate::model::{integrate_configuration_unchecked, Data, JointKind, Model};
 use nalgebra::DVector;
 
@@ -39,6 +51,33 @@ pub const DEFAULT_RTOL: f64 = 1e-8;
 /// Default absolute tolerance of `--integrator adaptive`.
 pub const DEFAULT_ATOL: f64 = 1e-10;
 
+/// The adaptive stepper's work budget while contact, limit or friction rows exist: this many
+/// times the force evaluations of fixed RK4 steps (4 per step) of the model's timestep.
+pub const BUDGET_FACTOR: f64 = 10.0;
+/// Force evaluations allowed beyond the budget (100 attempts of 7 stages: the start, where the
+/// first step size is found, and the transients of contacts coming and going).
+pub const BUDGET_GRACE: f64 = 700.0;
+
+/// Why the adaptive stepper stopped before the end of its interval (the state is left where
+/// error control stopped).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptiveStall {
+    /// Force evaluations (7 per attempt) since the stepper was built.
+    pub evaluations: u64,
+    /// What fixed RK4 steps of the model's timestep would have taken over the same time.
+    pub fixed_step_evaluations: u64,
+    /// Whether contact, limit or friction rows existed (the work budget applies then).
+    pub rows: bool,
+    /// Whether the step size collapsed (below 1e-14 of the interval) rather than the budget ran out.
+    pub collapsed: bool,
+    /// The last attempted internal step size (s).
+    pub h: f64,
+    /// The last attempt's scaled error norm.
+    pub error: f64,
+    /// The tolerances in use (rtol, atol).
+    pub tolerances: [f64; 2],
+}
+
 /// Dormand–Prince 5(4) stepper with error control.
 pub struct DormandPrince54 {
     /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
@@ -60,6 +99,13 @@ pub struct DormandPrince54 {
     /// Per dof: the qpos index of a flat coordinate, None for the rotation-vector coordinates
     /// of quaternion joints.
     flat_qpos: Vec<Option<usize>>,
+    /// Force evaluations since the stepper was built, and the simulated time they covered.
+    evaluations: u64,
+    covered: f64,
+    /// Whether the last attempt had contact, limit or friction rows.
+    rows: bool,
+    /// Why the last step stopped early, if it did.
+    stall: Option<AdaptiveStall>,
 }
 
 impl DormandPrince54 {
@@ -87,13 +133,23 @@ impl DormandPrince54 {
             act_rate: std::array::from_fn(|_| DVector::zeros(model.na())),
             act_stage: DVector::zeros(model.na()),
             flat_qpos,
+            evaluations: 0,
+            covered: 0.0,
+            rows: false,
+            stall: None,
         }
+    }
+
+    /// The force evaluations fixed RK4 steps of the model's timestep take over `time`.
+    fn fixed_step_evaluations(model: &Model, time: f64) -> f64 {
+        4.0 * (time / model.options.timestep).ceil().max(1.0)
     }
 
     /// One internal step of size h from `state` (left unchanged); the stages are left in the
     /// buffers. Returns the scaled error norm.
     fn attempt(&mut self, model: &Model, data: &mut Data, state: &State, h: f64) -> f64 {
-        // The first stage picks the limit and contact rows; the later ones keep them.
+        // The first stage picks the limit and contact rows; the later ones keep them. `rows`
+        // says whether any stage had contact, limit or friction rows (the work budget).
         data.thaw_rows();
         for i in 0..7 {
             self.v_stage.copy_from(&state.v);
@@ -114,7 +170,9 @@ impl DormandPrince54 {
             self.act_rate[i].copy_from(&data.act_dot);
             if i == 0 {
                 data.freeze_rows(false);
+                self.rows = false;
             }
+            self.rows |= data.efc_type[..data.nefc].iter().any(|t| *t != EfcType::Equality);
         }
         // Stage 7 sits at the fifth-order solution (C[6] = 1, A[6] = B5): θ and v_stage hold
         // y₅ − y₀ in θ and y₅ in v.
@@ -162,7 +220,11 @@ impl Stepper for DormandPrince54 {
         5
     }
     fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
+        self.stall = None;
         self.step_moved(model, data, h)
+    }
+    fn stalled(&self) -> Option<AdaptiveStall> {
+        self.stall
     }
 }
 
@@ -172,10 +234,11 @@ impl Advance for DormandPrince54 {
     }
 
     fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
-        let t_end = state.time + h;
+        let (t_start, t_end) = (state.time, state.time + h);
         let mut h_try = self.h_proposed.unwrap_or(h).min(h);
         let mut max_err: f64 = 0.0;
         let (mut accepted, mut rejected) = (0u32, 0u32);
+        let mut rows_seen = false;
         loop {
             let remaining = t_end - state.time;
             if remaining <= 1e-14 * t_end.abs().max(h) {
@@ -184,6 +247,10 @@ impl Advance for DormandPrince54 {
             let last = h_try >= remaining;
             let h_step = if last { remaining } else { h_try };
             let err = self.attempt(model, data, state, h_step);
+            self.evaluations += 7;
+            let fixed = Self::fixed_step_evaluations(model, self.covered + (state.time - t_start));
+            rows_seen |= self.rows;
+            let over_budget = rows_seen && self.evaluations as f64 > BUDGET_FACTOR * fixed + BUDGET_GRACE;
             let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
             if err <= 1.0 && err.is_finite() {
                 state.v.copy_from(&self.v_stage);
@@ -199,23 +266,35 @@ impl Advance for DormandPrince54 {
             } else {
                 rejected += 1;
                 h_try = h_step * if err.is_finite() { factor.min(1.0) } else { 0.2 };
-                if h_try < 1e-14 * h || rejected > 100_000 {
-                    // Give up on this interval: the state stays where error control stopped,
-                    // and the report says so.
-                    self.h_proposed = Some(h_try);
-                    return StepReport {
-                        accepted: false,
-                        h_used: state.time - (t_end - h),
-                        h_next: h_try,
-                        error_estimate: Some(err),
-                        substeps: accepted,
-                        rejected,
-                        ..StepReport::fixed_step(h, correct_drift(model, data, state, h))
-                    };
-                }
+            }
+            let collapsed = h_try < 1e-14 * h || rejected > 100_000;
+            if collapsed || (over_budget && state.time != t_end) {
+                // Give up on this interval: the state stays where error control stopped,
+                // and the report says so.
+                self.covered += state.time - t_start;
+                self.stall = Some(AdaptiveStall {
+                    evaluations: self.evaluations,
+                    fixed_step_evaluations: Self::fixed_step_evaluations(model, self.covered) as u64,
+                    rows: rows_seen,
+                    collapsed,
+                    h: h_step,
+                    error: err,
+                    tolerances: [self.rtol, self.atol],
+                });
+                self.h_proposed = Some(h_try);
+                return StepReport {
+                    accepted: false,
+                    h_used: state.time - (t_end - h),
+                    h_next: h_try,
+                    error_estimate: Some(err),
+                    substeps: accepted,
+                    rejected,
+                    ..StepReport::fixed_step(h, correct_drift(model, data, state, h))
+                };
             }
         }
         self.h_proposed = Some(h_try);
+        self.covered += h;
         StepReport {
             h_next: h_try,
             error_estimate: Some(max_err),

@@ -19,15 +19,16 @@ mod stage;
 mod step;
 mod variational;
 
-pub use adaptive::{DormandPrince54, DEFAULT_ATOL, DEFAULT_RTOL};
+pub use adaptive::{AdaptiveStall, DormandPrince54, BUDGET_FACTOR, BUDGET_GRACE, DEFAULT_ATOL, DEFAULT_RTOL};
 pub use euler::SemiImplicitEuler;
 pub use implicit::Implicit;
 pub(crate) use implicit_fast::add_force_derivative;
 pub use implicit_fast::ImplicitFast;
 pub use lagrangian_terms::LagrangianTerms;
 pub use rk4::RungeKutta4;
-pub use step::step;
+pub(crate) use step::check_timestep;
 pub(crate) use step::StepperSlot;
+pub use step::{step, FailedStep};
 pub use variational::{Variational, CONSTRAINT_TOL, RESIDUAL_TOL};
 
 use crate::model::{options, Data, Model};
@@ -170,6 +171,11 @@ pub trait Stepper: Send {
     fn step(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport;
     /// Why the last step was not taken, if it was not (a Newton iteration that failed).
     fn failure(&self) -> Option<StepFailure> {
+        None
+    }
+    /// Why the last step of an adaptive stepper stopped before the end of its interval, if it
+    /// did (its work budget with contacts, or a collapsed step size).
+    fn stalled(&self) -> Option<AdaptiveStall> {
         None
     }
 }

@@ -16,6 +16,40 @@ pub(crate) struct StepperSlot {
     stepper: Option<Box<dyn Stepper>>,
     /// Steps taken by [`step`] since the data was made or reset (for the divergence report).
     pub steps: u64,
+    /// The step that failed (diverged, did not converge, stalled), if one did since the state
+    /// was last reset or set: [`step`] and [`Simulation::step`](crate::sim::Simulation::step)
+    /// refuse to go on from it ([`SimError::Refused`]).
+    pub failed: Option<FailedStep>,
+}
+
+/// A step that failed: its number, the time it started from, and what went wrong.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FailedStep {
+    /// The step's number.
+    pub step: u64,
+    /// The simulation time when it failed (s).
+    pub time: f64,
+    /// What went wrong (the error's kind).
+    pub cause: &'static str,
+}
+
+impl FailedStep {
+    /// The record of `error` from step `step` at `time` (None for an error that left the state
+    /// untouched: a call refused on its input, or a refusal itself).
+    pub(crate) fn of(error: &SimError, step: u64, time: f64) -> Option<Self> {
+        let cause = match error {
+            SimError::Diverged { .. } => "the state became non-finite",
+            SimError::NotConverged { .. } => "the implicit step did not converge",
+            SimError::AdaptiveStalled { .. } => "the adaptive integrator stopped",
+            _ => return None,
+        };
+        Some(Self { step, time, cause })
+    }
+
+    /// The refusal of a step after this failure.
+    pub(crate) fn refusal(&self) -> SimError {
+        SimError::Refused { step: self.step, time: self.time, cause: self.cause }
+    }
 }
 
 impl StepperSlot {
@@ -39,7 +73,7 @@ impl StepperSlot {
 
 impl Clone for StepperSlot {
     fn clone(&self) -> Self {
-        Self { built_for: None, stepper: None, steps: self.steps }
+        Self { built_for: None, stepper: None, steps: self.steps, failed: self.failed.clone() }
     }
 }
 
@@ -58,8 +92,12 @@ impl std::fmt::Debug for StepperSlot {
 /// step, the other buffers of `data` hold the last stage's `forward`.
 ///
 /// # Errors
-/// [`SimError::Input`] when `data` was not made for `model` (its state has other sizes);
-/// [`SimError::Diverged`] when the state became non-finite, naming the joint where it started.
+/// [`SimError::Input`] when `data` was not made for `model` (its state has other sizes) or the
+/// model's timestep is 0, negative or not finite;
+/// [`SimError::Diverged`] when the state became non-finite, naming the joint where it started;
+/// [`SimError::Refused`] for every step after one that failed, until the state is reset
+/// ([`reset`](crate::model::reset::reset), [`reset_keyframe`](crate::model::reset::reset_keyframe))
+/// or set ([`Data::set_state`]).
 ///
 /// # Example
 /// ```
@@ -77,9 +115,16 @@ impl std::fmt::Debug for StepperSlot {
 /// ```
 pub fn step(model: &Model, data: &mut Data) -> Result<StepReport, SimError> {
     data.check_sizes(model, "step")?;
+    if let Some(f) = &data.stepper.failed {
+        return Err(f.refusal());
+    }
     let h = model.options.timestep;
+    check_timestep("step", "model.options.timestep", h)?;
     let mut slot = std::mem::take(&mut data.stepper);
     let report = slot.ensure(model).step(model, data, h);
+    // The next soft solve's warm start: this step's acceleration, rows or not (MuJoCo's
+    // mj_advance), so that a solve with no iterations starts where the motion is.
+    data.qacc_warmstart.copy_from(&data.qacc);
     slot.steps += 1;
     let steps = slot.steps;
     data.stepper = slot;
@@ -87,11 +132,51 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepReport, SimError> {
         format!(
             "reduce the model's timestep (now {h} s, `options.timestep`), or use a more stable integrator (`options.integrator`: rk4, or implicit for stiff damping); if it persists, check the model's stiffnesses and inertias"
         )
-    })?;
+    })
+    .inspect_err(|e| data.stepper.failed = FailedStep::of(e, steps, data.time))?;
     Ok(report)
 }
 
+/// `Ok` when the step size `h` is finite and positive, else [`InputError::Value`].
+pub(crate) fn check_timestep(
+    function: &'static str,
+    argument: &'static str,
+    h: f64,
+) -> Result<(), InputError> {
+    if h.is_finite() && h > 0.0 {
+        Ok(())
+    } else {
+        Err(InputError::Value {
+            function,
+            argument,
+            detail: format!("is {h}; it must be a finite step size > 0 s"),
+        })
+    }
+}
+
 impl Data {
+    /// The step that failed since the state was last reset or set, if one did (steps are
+    /// refused until then).
+    pub fn failed_step(&self) -> Option<&FailedStep> {
+        self.stepper.failed.as_ref()
+    }
+
+    /// Sets the state (`qpos`, `qvel`) and lets [`step`] go on after a failed step; rejects
+    /// wrong lengths and non-finite values (nothing is changed then).
+    ///
+    /// # Errors
+    /// [`InputError::Length`] or [`InputError::NonFinite`] naming the argument.
+    pub fn set_state(&mut self, model: &Model, q: &[f64], v: &[f64]) -> Result<(), InputError> {
+        InputError::check_len("Data::set_state", "q", q.len(), model.nq, "nq")?;
+        InputError::check_len("Data::set_state", "v", v.len(), model.nv, "nv")?;
+        InputError::check_finite("Data::set_state", "q", q)?;
+        InputError::check_finite("Data::set_state", "v", v)?;
+        self.qpos.copy_from_slice(q);
+        self.qvel.copy_from_slice(v);
+        self.stepper.failed = None;
+        Ok(())
+    }
+
     /// `Ok` when this data's state and inputs have `model`'s sizes (nq, nv, na, nu), else
     /// [`InputError::Length`] naming the first that differs and the function `function`.
     pub fn check_sizes(&self, model: &Model, function: &'static str) -> Result<(), InputError> {

@@ -257,12 +257,17 @@ pub struct Data {
     /// the motion, max |M⁻¹Jᵀ Δλ| (an acceleration, or a velocity at the velocity level); 0 after a
     /// direct solve.
     pub efc_residual: f64,
-    /// Whether the last iterative solve met its tolerance within its iteration limit.
+    /// Whether the last iterative solve met its tolerance within its iteration limit (exact
+    /// mode's Coulomb solve; soft mode's Newton, CG and PGS by MuJoCo's criterion).
     pub efc_converged: bool,
     /// Iterative solves since `Data::new` that stopped at their iteration limit (or on a
     /// non-finite value) without meeting the tolerance, and the largest residual they left.
+    /// Exact mode: Coulomb solves. Soft mode: every solve whose scaled gradient and scaled
+    /// improvement both stayed at or above `<option tolerance>` after `<option iterations>`.
     pub efc_unconverged: u64,
-    /// The largest residual an unconverged iterative solve left.
+    /// The largest residual an unconverged iterative solve left: exact mode, max |M⁻¹Jᵀ Δλ| of
+    /// its last sweep; soft mode, the scaled gradient norm (Newton, CG; MuJoCo's
+    /// `solver_gradient`) or the last sweep's scaled cost improvement (PGS).
     pub efc_unconverged_residual: f64,
     /// The exact solver's workspace (Delassus matrix, factors, warm start, active set).
     pub(crate) exact: ExactWork,

@@ -50,7 +50,19 @@ fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
 
 /// Evaluates one state: M, bias, qacc, poses of every frame, energies, com, and the requested
 /// frame Jacobians (world-aligned).
-pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]) -> Result<Value, CliError> {
+///
+/// With `kernels_only`, the smooth kernels alone: no `forward` pipeline and no sensors (what the
+/// corpus cross-validation compares; a model loaded with `--accept-nonphysical-inertia` may have a
+/// pipeline that is not finite where the kernels are), and an ABA `qacc` that is not finite — M
+/// singular at the state — is left out with the reason in `qacc_error` (M, bias and poses are
+/// still compared).
+pub fn evaluate(
+    model: &Model,
+    data: &mut Data,
+    s: &StateIn,
+    jacobians: &[usize],
+    kernels_only: bool,
+) -> Result<Value, CliError> {
     let zeros = vec![0.0; model.nv];
     let v = s.v.as_deref().unwrap_or(&zeros);
     let tau = s.tau.as_deref().unwrap_or(&zeros);
@@ -82,8 +94,19 @@ pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, jacobians: &[usize]
         }
         out["jacobians"] = Value::Object(jmap);
     }
-    out["forward"] = forward_json(model, data, s, v, tau);
-    out["sensors"] = sensors_json(model, data);
+    if kernels_only {
+        if out["qacc"].as_array().is_some_and(|a| a.iter().any(|x| !x.as_f64().is_some_and(f64::is_finite))) {
+            let map = out.as_object_mut().expect("an object");
+            map.remove("qacc");
+            map.insert(
+                "qacc_error".into(),
+                json!("ABA's qacc is not finite: the mass matrix is singular at this state (a massless floating or moving body)"),
+            );
+        }
+    } else {
+        out["forward"] = forward_json(model, data, s, v, tau);
+        out["sensors"] = sensors_json(model, data);
+    }
     Ok(out)
 }
 
@@ -272,6 +295,7 @@ pub fn run(
     states: &Path,
     jacobians: &[String],
     mode: Option<ConstraintMode>,
+    kernels_only: bool,
 ) -> Result<(), CliError> {
     let mut model = load(path, options)?;
     if let Some(mode) = mode {
@@ -302,7 +326,7 @@ pub fn run(
         "{\"states\": [{\"q\": [...], \"v\": [...], \"tau\": [...], \"ctrl\": [...], \"act\": [...]}]}";
     let total = for_each_state(reader, &file, expected, &mut |i, s: StateIn| {
         check_state(&model, &file, i, &s)?;
-        let mut result = evaluate(&model, &mut data, &s, &frame_ids)?;
+        let mut result = evaluate(&model, &mut data, &s, &frame_ids, kernels_only)?;
         if let Some(path) = first_null(&result) {
             let reason = format!("states[{i}]: {} is not finite (NaN or infinite)", describe(&path));
             failed += 1;

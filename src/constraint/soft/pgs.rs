@@ -172,7 +172,7 @@ fn surface_fista(b: &[[f64; 6]; 6], g: &[f64; 6], dim: usize, start: [f64; 6]) -
 }
 
 /// Solves the soft problem by PGS; writes the same outputs as
-/// `solve_primal`.
+/// `solve_primal` (the unconverged count included).
 pub fn solve_pgs(model: &Model, data: &mut Data, s: Settings) {
     let nv = model.nv;
     let n = data.nefc;
@@ -272,4 +272,13 @@ pub fn solve_pgs(model: &Model, data: &mut Data, s: Settings) {
     data.solver_niter = iter;
     data.solver_improvement = improvement.abs();
     data.solver_gradient = 0.0;
+    // MuJoCo's criterion (the last sweep's scaled improvement below the tolerance; the creep test
+    // above only makes more sweeps): a solve that swept to its limit without meeting it is
+    // counted, with that improvement as the residual (none to count with no sweep: iterations 0).
+    let converged = improvement.abs() < s.tolerance;
+    data.efc_converged = converged;
+    if !converged && iter > 0 {
+        data.efc_unconverged += 1;
+        data.efc_unconverged_residual = data.efc_unconverged_residual.max(improvement.abs());
+    }
 }

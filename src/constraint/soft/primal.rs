@@ -85,7 +85,8 @@ fn mul_m(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
 
 /// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
 /// `qfrc_smooth`, `qacc_smooth`, the mass matrix and its factor: writes `qacc`, `efc_force`,
-/// `efc_state`, `qfrc_constraint`, `solver_niter`, `solver_improvement`, `solver_gradient`.
+/// `efc_state`, `qfrc_constraint`, `solver_niter`, `solver_improvement`, `solver_gradient`,
+/// `efc_converged`, and counts a solve that stopped at the iteration limit in `efc_unconverged`.
 pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings) {
     let nv = model.nv;
     let nefc = data.nefc;
@@ -161,6 +162,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     let mut gradient;
     let mut iter = 0;
     let mut have_dir = false;
+    let mut stalled = false;
     loop {
         // g = M a − qfrc_smooth − Jᵀ f.
         for k in 0..nv {
@@ -228,6 +230,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         let alpha = line_search(&rows, &soft.jar, &soft.jv, &mut soft.jar_trial, g0, dmd, s);
         if alpha == 0.0 {
             // No descent along the direction (the minimum to round-off).
+            stalled = true;
             break;
         }
         qacc.axpy(alpha, &soft.dir, 1.0);
@@ -250,6 +253,15 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     data.solver_niter = iter;
     data.solver_improvement = if improvement.is_finite() { improvement } else { 0.0 };
     data.solver_gradient = gradient;
+    // MuJoCo's criterion: converged when the scaled gradient or improvement fell below the
+    // tolerance (or the line search found no descent: the minimum to round-off); else the solve
+    // stopped at its iteration limit, counted with its scaled gradient as the residual.
+    let converged = stalled || gradient < s.tolerance || improvement < s.tolerance;
+    data.efc_converged = converged;
+    if !converged {
+        data.efc_unconverged += 1;
+        data.efc_unconverged_residual = data.efc_unconverged_residual.max(gradient);
+    }
 }
 
 /// The step α ≥ 0 minimizing the cost along the direction: g0 + α dmd + ds/dα = 0 with ds/dα
