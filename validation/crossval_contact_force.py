@@ -24,13 +24,13 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import crossval_soft  # noqa: E402
+import crossval_common  # noqa: E402
 from crossval_soft import ROOT, lagrange_eval, match_contacts, random_states, tight_copy  # noqa: E402
 
 # Both Newton solves run to round-off (tolerance 1e-30 never stops them early): at crossval_soft's
 # 1e-15, sliding elliptic contacts on go1 stop up to 1.4e-9 apart (10 against 14 iterations), a
 # difference of convergence, not of the contact force's definition.
-crossval_soft.TIGHT = crossval_soft.TIGHT.replace('tolerance="1e-15"', 'tolerance="1e-30"').replace(
+crossval_common.TIGHT = crossval_common.TIGHT.replace('tolerance="1e-15"', 'tolerance="1e-30"').replace(
     'ls_tolerance="1e-12"', 'ls_tolerance="1e-15"')
 
 REL_CONTACT_FORCE = 1e-9

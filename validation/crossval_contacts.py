@@ -35,8 +35,6 @@ Exit status 1 on any failure.
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import re
 import shutil
 import subprocess
@@ -49,7 +47,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from crossval_common import quat_wxyz_to_mat  # noqa: E402
+from crossval_common import lagrange_eval_json, quat_wxyz_to_mat  # noqa: E402
 from crossval_constraints import pin_model_from_mujoco, rel_to_ref  # noqa: E402
 from crossval_corpus import REPO  # noqa: E402
 
@@ -111,19 +109,10 @@ def touching_go1_state(mj, m, rng) -> np.ndarray:
 
 
 def lagrange_eval(binary: Path, scene: Path, states: list[dict]) -> list[dict]:
-    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
-        json.dump({"states": states}, f)
-        path = f.name
-    try:
-        # Contacts only: limits, friction loss and actuators are off on every side.
-        p = subprocess.run([str(binary), "eval", str(scene), "--states", path, "--json", "--constraints", "exact",
-                            "--disable", "limit", "--disable", "frictionloss", "--disable", "actuation",
-                            "--disable", "equality"], capture_output=True, text=True, timeout=300)
-    finally:
-        os.unlink(path)
-    if p.returncode != 0:
-        raise RuntimeError("lagrange eval failed: " + (p.stderr or p.stdout)[:400])
-    return json.loads(p.stdout)["results"]
+    # Contacts only: limits, friction loss and actuators are off on every side.
+    return lagrange_eval_json(binary, scene, states, ["--constraints", "exact", "--disable", "limit", "--disable",
+                                                      "frictionloss", "--disable", "actuation", "--disable",
+                                                      "equality"])["results"]
 
 
 class References:

