@@ -321,6 +321,35 @@ pub fn for_each_ancestor_dof(
     }
 }
 
+/// Calls `column(k, lin, ang)` for every degree of freedom `k` on the path from body `b` to the
+/// root with the velocity its unit rate gives the body point at world position `p`: linear `lin`
+/// of that point and angular `ang`, world axes (MuJoCo's `mj_jac` columns). The columns of all
+/// other degrees of freedom are zero. Each column is formed about the moving body's own origin,
+/// `R v + R ω × (p − p_b)`, not as `s_world.lin + ω × p` about the world origin
+/// ([`for_each_ancestor_dof`]): far from the world origin the latter's two terms of size |p|
+/// cancel and take the lever arm's digits with them. Needs [`forward_kinematics`] (or any pass
+/// that fills `x_world_body` and `s_body`) at the same q.
+#[inline]
+pub fn for_each_ancestor_dof_at(
+    model: &Model,
+    x_world_body: &[Transform],
+    s_body: &[Motion],
+    mut b: usize,
+    p: &Vec3,
+    mut column: impl FnMut(usize, Vec3, Vec3),
+) {
+    while b != 0 {
+        let j = model.joint_of(b);
+        let x = &x_world_body[b];
+        let r = p - x.pos;
+        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+            let ang = x.rot * s_body[k].ang;
+            column(k, x.rot * s_body[k].lin + ang.cross(&r), ang);
+        }
+        b = model.bodies[b].parent;
+    }
+}
+
 /// Jacobian of frame `frame` into `jac` (6 × nv): rows 0–2 linear, rows 3–5 angular velocity, in
 /// `reference` coordinates (the row order of Pinocchio). Columns of degrees of freedom that do not
 /// move the frame are zero. Needs [`forward_kinematics`] at the same q.
@@ -353,11 +382,30 @@ pub(crate) fn frame_jacobian_unchecked(
 ) {
     jac.fill(0.0);
     let x_world_frame = &data.x_world_frame[frame];
-    for_each_ancestor_dof(model, &data.x_world_body, &data.s_body, model.frames[frame].body, |k, s_world| {
-        let (lin, ang) = express(&s_world, x_world_frame, reference);
-        jac.fixed_view_mut::<3, 1>(0, k).copy_from(&lin);
-        jac.fixed_view_mut::<3, 1>(3, k).copy_from(&ang);
-    });
+    let (b, rot_world_frame) = (model.frames[frame].body, &x_world_frame.rot);
+    if reference == ReferenceFrame::World {
+        for_each_ancestor_dof(model, &data.x_world_body, &data.s_body, b, |k, s_world| {
+            jac.fixed_view_mut::<3, 1>(0, k).copy_from(&s_world.lin);
+            jac.fixed_view_mut::<3, 1>(3, k).copy_from(&s_world.ang);
+        });
+        return;
+    }
+    // About the frame's origin directly (no round trip through the world origin).
+    for_each_ancestor_dof_at(
+        model,
+        &data.x_world_body,
+        &data.s_body,
+        b,
+        &x_world_frame.pos,
+        |k, lin, ang| {
+            let (lin, ang) = match reference {
+                ReferenceFrame::Local => (rot_world_frame.tr_mul(&lin), rot_world_frame.tr_mul(&ang)),
+                _ => (lin, ang),
+            };
+            jac.fixed_view_mut::<3, 1>(0, k).copy_from(&lin);
+            jac.fixed_view_mut::<3, 1>(3, k).copy_from(&ang);
+        },
+    );
 }
 
 /// Spatial acceleration of every body at zero joint acceleration and without gravity, body

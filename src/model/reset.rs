@@ -44,6 +44,7 @@ pub fn reset(model: &Model, data: &mut Data) -> Result<(), InputError> {
     data.nefc = 0;
     data.thaw_rows();
     data.stepper.steps = 0;
+    data.warnings.clear();
     Ok(())
 }
 
