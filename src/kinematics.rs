@@ -300,7 +300,9 @@ fn express(m_world: &Motion, x_world_frame: &Transform, reference: ReferenceFram
 
 /// Calls `column(k, s_world)` for every degree of freedom `k` on the path from body `b` to the
 /// root, with its motion-subspace column `s_world` in world coordinates (about the world origin).
-/// The columns of all other degrees of freedom of a Jacobian of body `b` are zero. Needs
+/// The columns of all other degrees of freedom of a Jacobian of body `b` are zero. Far from the
+/// world origin a point velocity formed from these columns (`lin + ang × p`) loses digits to
+/// cancellation: use [`for_each_ancestor_dof_at`] for a point's. Needs
 /// [`forward_kinematics`] (or any pass that fills `x_world_body` and `s_body`) at the same q.
 /// `x_world_body` and `s_body` are those buffers of [`Data`] (passed apart so that the caller may
 /// write another buffer of the same `Data`).
