@@ -283,21 +283,6 @@ pub enum ReferenceFrame {
     World,
 }
 
-/// Expresses a spatial velocity given in world coordinates (about the world origin) in `reference`
-/// for a frame at pose `x_world_frame`; returns (linear, angular).
-#[inline]
-fn express(m_world: &Motion, x_world_frame: &Transform, reference: ReferenceFrame) -> (Vec3, Vec3) {
-    let p = &x_world_frame.pos;
-    match reference {
-        ReferenceFrame::World => (m_world.lin, m_world.ang),
-        ReferenceFrame::LocalWorldAligned => (m_world.lin + m_world.ang.cross(p), m_world.ang),
-        ReferenceFrame::Local => {
-            let lin = m_world.lin + m_world.ang.cross(p);
-            (x_world_frame.rot.tr_mul(&lin), x_world_frame.rot.tr_mul(&m_world.ang))
-        }
-    }
-}
-
 /// Calls `column(k, s_world)` for every degree of freedom `k` on the path from body `b` to the
 /// root, with its motion-subspace column `s_world` in world coordinates (about the world origin).
 /// The columns of all other degrees of freedom of a Jacobian of body `b` are zero. Far from the
@@ -474,8 +459,20 @@ pub(crate) fn frame_velocity_unchecked(
     reference: ReferenceFrame,
 ) -> (Vec3, Vec3) {
     let b = model.frames[frame].body;
-    let v_world = data.x_world_body[b].act_motion(&data.v_body[b]);
-    express(&v_world, &data.x_world_frame[frame], reference)
+    let x_world_body = &data.x_world_body[b];
+    if reference == ReferenceFrame::World {
+        let v_world = x_world_body.act_motion(&data.v_body[b]);
+        return (v_world.lin, v_world.ang);
+    }
+    // The frame origin's velocity from the body's own origin (R v + R ω × (p − p_b)), not through
+    // the world origin: no cancellation far from it.
+    let x_world_frame = &data.x_world_frame[frame];
+    let ang = x_world_body.rot * data.v_body[b].ang;
+    let lin = x_world_body.rot * data.v_body[b].lin + ang.cross(&(x_world_frame.pos - x_world_body.pos));
+    match reference {
+        ReferenceFrame::Local => (x_world_frame.rot.tr_mul(&lin), x_world_frame.rot.tr_mul(&ang)),
+        _ => (lin, ang),
+    }
 }
 
 #[cfg(test)]

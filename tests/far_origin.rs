@@ -119,3 +119,37 @@ fn translated_trajectories_follow_the_original() {
         assert!(gap.is_finite() && gap <= 1e4 * far_origin_tol(d, 0.1), "{d:e} m: {gap:e}");
     }
 }
+
+/// Frame Jacobians and velocities in the frame's own and world-aligned axes (every frame of go1)
+/// are those of the scene at the origin, to the state's round-off.
+#[test]
+fn frame_jacobians_and_velocities_far_away() {
+    use lagrange::kinematics::{
+        forward_kinematics, forward_velocities, frame_jacobian, frame_velocity, ReferenceFrame,
+    };
+    let (model, q, v) = go1_settled();
+    let at = |offset: &Vec3| {
+        let moved = translate_scene(&model, offset);
+        let mut data = Data::new(&moved);
+        let q = translate_q(&model, &q, offset);
+        forward_kinematics(&moved, &mut data, &q).unwrap();
+        forward_velocities(&moved, &mut data, &v).unwrap();
+        let mut out = Vec::new();
+        let mut jac = nalgebra::DMatrix::zeros(6, moved.nv);
+        for f in 0..moved.frames.len() {
+            for reference in [ReferenceFrame::Local, ReferenceFrame::LocalWorldAligned] {
+                frame_jacobian(&moved, &data, f, reference, &mut jac).unwrap();
+                out.extend_from_slice(jac.as_slice());
+                let (lin, ang) = frame_velocity(&moved, &data, f, reference).unwrap();
+                out.extend(lin.iter().chain(ang.iter()));
+            }
+        }
+        out
+    };
+    let origin = at(&Vec3::zeros());
+    for d in [1e3, 1e5, 1e6] {
+        let err = rel_err_vec(&at(&(direction() * d)), &origin);
+        println!("go1 frame Jacobians and velocities at {d:e} m: {err:.1e}");
+        assert!(err <= far_origin_tol(d, 0.1), "{d:e} m: {err:e}");
+    }
+}
