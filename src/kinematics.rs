@@ -283,24 +283,11 @@ pub enum ReferenceFrame {
     World,
 }
 
-/// Expresses a spatial velocity given in world coordinates (about the world origin) in `reference`
-/// for a frame at pose `x_world_frame`; returns (linear, angular).
-#[inline]
-fn express(m_world: &Motion, x_world_frame: &Transform, reference: ReferenceFrame) -> (Vec3, Vec3) {
-    let p = &x_world_frame.pos;
-    match reference {
-        ReferenceFrame::World => (m_world.lin, m_world.ang),
-        ReferenceFrame::LocalWorldAligned => (m_world.lin + m_world.ang.cross(p), m_world.ang),
-        ReferenceFrame::Local => {
-            let lin = m_world.lin + m_world.ang.cross(p);
-            (x_world_frame.rot.tr_mul(&lin), x_world_frame.rot.tr_mul(&m_world.ang))
-        }
-    }
-}
-
 /// Calls `column(k, s_world)` for every degree of freedom `k` on the path from body `b` to the
 /// root, with its motion-subspace column `s_world` in world coordinates (about the world origin).
-/// The columns of all other degrees of freedom of a Jacobian of body `b` are zero. Needs
+/// The columns of all other degrees of freedom of a Jacobian of body `b` are zero. Far from the
+/// world origin a point velocity formed from these columns (`lin + ang × p`) loses digits to
+/// cancellation: use [`for_each_ancestor_dof_at`] for a point's. Needs
 /// [`forward_kinematics`] (or any pass that fills `x_world_body` and `s_body`) at the same q.
 /// `x_world_body` and `s_body` are those buffers of [`Data`] (passed apart so that the caller may
 /// write another buffer of the same `Data`).
@@ -316,6 +303,35 @@ pub fn for_each_ancestor_dof(
         let j = model.joint_of(b);
         for k in j.dof_adr..j.dof_adr + j.kind.nv() {
             column(k, x_world_body[b].act_motion(&s_body[k]));
+        }
+        b = model.bodies[b].parent;
+    }
+}
+
+/// Calls `column(k, lin, ang)` for every degree of freedom `k` on the path from body `b` to the
+/// root with the velocity its unit rate gives the body point at world position `p`: linear `lin`
+/// of that point and angular `ang`, world axes (MuJoCo's `mj_jac` columns). The columns of all
+/// other degrees of freedom are zero. Each column is formed about the moving body's own origin,
+/// `R v + R ω × (p − p_b)`, not as `s_world.lin + ω × p` about the world origin
+/// ([`for_each_ancestor_dof`]): far from the world origin the latter's two terms of size |p|
+/// cancel and take the lever arm's digits with them. Needs [`forward_kinematics`] (or any pass
+/// that fills `x_world_body` and `s_body`) at the same q.
+#[inline]
+pub fn for_each_ancestor_dof_at(
+    model: &Model,
+    x_world_body: &[Transform],
+    s_body: &[Motion],
+    mut b: usize,
+    p: &Vec3,
+    mut column: impl FnMut(usize, Vec3, Vec3),
+) {
+    while b != 0 {
+        let j = model.joint_of(b);
+        let x = &x_world_body[b];
+        let r = p - x.pos;
+        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+            let ang = x.rot * s_body[k].ang;
+            column(k, x.rot * s_body[k].lin + ang.cross(&r), ang);
         }
         b = model.bodies[b].parent;
     }
@@ -353,11 +369,30 @@ pub(crate) fn frame_jacobian_unchecked(
 ) {
     jac.fill(0.0);
     let x_world_frame = &data.x_world_frame[frame];
-    for_each_ancestor_dof(model, &data.x_world_body, &data.s_body, model.frames[frame].body, |k, s_world| {
-        let (lin, ang) = express(&s_world, x_world_frame, reference);
-        jac.fixed_view_mut::<3, 1>(0, k).copy_from(&lin);
-        jac.fixed_view_mut::<3, 1>(3, k).copy_from(&ang);
-    });
+    let (b, rot_world_frame) = (model.frames[frame].body, &x_world_frame.rot);
+    if reference == ReferenceFrame::World {
+        for_each_ancestor_dof(model, &data.x_world_body, &data.s_body, b, |k, s_world| {
+            jac.fixed_view_mut::<3, 1>(0, k).copy_from(&s_world.lin);
+            jac.fixed_view_mut::<3, 1>(3, k).copy_from(&s_world.ang);
+        });
+        return;
+    }
+    // About the frame's origin directly (no round trip through the world origin).
+    for_each_ancestor_dof_at(
+        model,
+        &data.x_world_body,
+        &data.s_body,
+        b,
+        &x_world_frame.pos,
+        |k, lin, ang| {
+            let (lin, ang) = match reference {
+                ReferenceFrame::Local => (rot_world_frame.tr_mul(&lin), rot_world_frame.tr_mul(&ang)),
+                _ => (lin, ang),
+            };
+            jac.fixed_view_mut::<3, 1>(0, k).copy_from(&lin);
+            jac.fixed_view_mut::<3, 1>(3, k).copy_from(&ang);
+        },
+    );
 }
 
 /// Spatial acceleration of every body at zero joint acceleration and without gravity, body
@@ -424,8 +459,20 @@ pub(crate) fn frame_velocity_unchecked(
     reference: ReferenceFrame,
 ) -> (Vec3, Vec3) {
     let b = model.frames[frame].body;
-    let v_world = data.x_world_body[b].act_motion(&data.v_body[b]);
-    express(&v_world, &data.x_world_frame[frame], reference)
+    let x_world_body = &data.x_world_body[b];
+    if reference == ReferenceFrame::World {
+        let v_world = x_world_body.act_motion(&data.v_body[b]);
+        return (v_world.lin, v_world.ang);
+    }
+    // The frame origin's velocity from the body's own origin (R v + R ω × (p − p_b)), not through
+    // the world origin: no cancellation far from it.
+    let x_world_frame = &data.x_world_frame[frame];
+    let ang = x_world_body.rot * data.v_body[b].ang;
+    let lin = x_world_body.rot * data.v_body[b].lin + ang.cross(&(x_world_frame.pos - x_world_body.pos));
+    match reference {
+        ReferenceFrame::Local => (x_world_frame.rot.tr_mul(&lin), x_world_frame.rot.tr_mul(&ang)),
+        _ => (lin, ang),
+    }
 }
 
 #[cfg(test)]

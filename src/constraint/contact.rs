@@ -24,7 +24,7 @@
 //! cylinder on a plane, and for box and mesh vertices; the rotation of n for two curved bodies in
 //! contact is neglected — a second-order drift that the steppers' projection removes).
 
-use crate::kinematics::{for_each_ancestor_dof, point_bias_acceleration};
+use crate::kinematics::{for_each_ancestor_dof_at, point_bias_acceleration};
 use crate::model::spec::Shape;
 use crate::model::{Contact, Data, EfcType, Model};
 use crate::spatial::Vec3;
@@ -86,10 +86,9 @@ pub(crate) fn add_contact_jacobian(model: &Model, data: &mut Data, contact: &Con
     let bodies = [model.geoms[contact.geom[0]].body, model.geoms[contact.geom[1]].body];
     let Data { efc_j, x_world_body, s_body, .. } = data;
     for (body, sign) in bodies.into_iter().zip([-1.0, 1.0]) {
-        for_each_ancestor_dof(model, x_world_body, s_body, body, |k, s_world| {
-            let lin = s_world.lin + s_world.ang.cross(&p);
+        for_each_ancestor_dof_at(model, x_world_body, s_body, body, &p, |k, lin, ang| {
             for i in 0..dim {
-                let value = if i < 3 { dirs[i].dot(&lin) } else { dirs[i - 3].dot(&s_world.ang) };
+                let value = if i < 3 { dirs[i].dot(&lin) } else { dirs[i - 3].dot(&ang) };
                 efc_j[(r + i, k)] += sign * value;
             }
         });

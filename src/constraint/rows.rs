@@ -20,7 +20,7 @@ use crate::collision::{collide, CollisionModel, EXACT_REACH};
 use crate::error::{check, InputError};
 use crate::kinematics::body_poses;
 use crate::kinematics::{
-    bias_accelerations_unchecked, for_each_ancestor_dof, forward_kinematics_unchecked,
+    bias_accelerations_unchecked, for_each_ancestor_dof_at, forward_kinematics_unchecked,
     forward_velocities_unchecked, point_bias_acceleration,
 };
 use crate::model::{Data, EfcType, EqualityKind, Model, TendonKind};
@@ -577,12 +577,11 @@ fn point_rows(
     rotation: bool,
 ) {
     let Data { efc_j, x_world_body, s_body, .. } = data;
-    for_each_ancestor_dof(model, x_world_body, s_body, b, |k, s_world| {
-        let lin = s_world.lin + s_world.ang.cross(p);
+    for_each_ancestor_dof_at(model, x_world_body, s_body, b, p, |k, lin, ang| {
         for i in 0..3 {
             efc_j[(r + i, k)] += sign * lin[i];
             if rotation {
-                efc_j[(r + 3 + i, k)] += sign * scale * s_world.ang[i];
+                efc_j[(r + 3 + i, k)] += sign * scale * ang[i];
             }
         }
     });

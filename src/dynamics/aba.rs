@@ -1,14 +1,23 @@
 //! Articulated-body algorithm for forward dynamics (RBDA §7.3, Table 7.1).
 
+use crate::dynamics::crba::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
+use crate::dynamics::rnea::rnea_unchecked;
 use crate::error::{check, InputError};
 use crate::kinematics::{joint_velocity, update_joint};
+use crate::model::warning::MIN_PIVOT;
 use crate::model::{Data, Model};
 use crate::spatial::{ArticulatedInertia, Force, Motion, Vec3};
 use nalgebra::{DVector, Matrix6};
 
 /// Forward dynamics q̈ = M(q)⁻¹ (τ − c(q, v)) into `data.aba_qacc` (and returned), in O(n), armature
-/// included. A joint whose articulated inertia is singular (a massless subtree) yields non-finite
-/// accelerations, which the simulator reports as an error.
+/// included.
+///
+/// A mass matrix singular at q (duplicated joints, a moving body without mass or inertia: a
+/// joint's articulated inertia D = Sᵀ Iᴬ S below MuJoCo's `mjMINVAL` = 1e-15, [`MIN_PIVOT`]) gives
+/// MuJoCo 4.0's regularized result instead of ABA's division by a vanishing D: q̈ from M's LᵀDL
+/// factor with its small pivots raised to 1e-15 ([`factorize_mass_matrix`]), warned in
+/// `data.warnings.inertia` (the dofs named). ABA's D of a dof is that factor's pivot, so the
+/// same states are caught; the extra cost is a comparison per body on regular states.
 ///
 /// On x86-64 CPUs with AVX2 the kernel runs compiled for AVX2 (chosen at run time): the same
 /// operations in the same order, so the same bits (`avx2_kernel_is_bit_for_bit`), in fewer,
@@ -43,10 +52,33 @@ pub(crate) fn aba_unchecked<'d>(
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (checked just above), all `aba_avx2` requires.
         unsafe { aba_avx2(model, data, q, v, tau) };
+        regularize_singular(model, data, q, v, tau);
         return &data.aba_qacc;
     }
     aba_kernel(model, data, q, v, tau);
+    regularize_singular(model, data, q, v, tau);
     &data.aba_qacc
+}
+
+/// After ABA: when a joint's D was below [`MIN_PIVOT`] (D⁻¹'s first entry beyond 1e15, or not
+/// finite: a singular multi-dof D leaves NaN there), `data.aba_qacc` = M⁻¹ (τ − c) with M's
+/// regularized factor (MuJoCo's `mj_factorM` and `mj_solveM` at a singular M).
+#[inline]
+fn regularize_singular(model: &Model, data: &mut Data, q: &[f64], v: &[f64], tau: &[f64]) {
+    if (1..model.nbody()).all(|b| data.d_inv[b][(0, 0)].abs() <= 1.0 / MIN_PIVOT) {
+        return;
+    }
+    crba_unchecked(model, data, q);
+    factorize_mass_matrix(model, data);
+    data.aba_qacc.fill(0.0);
+    let mut x = std::mem::take(&mut data.aba_qacc);
+    // c(q, v) into data.tau: RNEA at zero acceleration.
+    rnea_unchecked(model, data, q, v, x.as_slice());
+    for k in 0..model.nv {
+        x[k] = tau[k] - data.tau[k];
+    }
+    solve_with_factor_unchecked(model, &data.mass_factor, x.as_mut_slice());
+    data.aba_qacc = x;
 }
 
 /// [`aba_kernel`] compiled for AVX2 (no fused multiply–add: the bits of the baseline build).

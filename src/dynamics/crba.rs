@@ -3,6 +3,7 @@
 
 use crate::error::{check, InputError};
 use crate::kinematics::body_world_pose;
+use crate::model::warning::MIN_PIVOT;
 use crate::model::{Data, HingeAxis, JointKind, Model, NO_DOF};
 #[cfg(target_arch = "x86_64")]
 use crate::spatial::fused::Fused;
@@ -12,10 +13,18 @@ use nalgebra::{DMatrix, DVector, Vector3};
 
 /// Joint-space inertia matrix M(q), armature included, into `data.mass_matrix` (and returned).
 ///
-/// The composite-rigid-body algorithm (RBDA §6.2, Table 6.2) evaluated in world coordinates: composite
+/// The composite-rigid-body algorithm (RBDA §6.2, Table 6.2) evaluated in world axes: composite
 /// inertias then add without change of frame, and the entry `M[i][j]` for j an ancestor degree of
-/// freedom is the plain product S_jᵀ (Iᶜ_i S_i) of world-frame vectors, so the walk up the tree
+/// freedom is the plain product S_jᵀ (Iᶜ_i S_i) of world-axis vectors, so the walk up the tree
 /// transforms nothing.
+///
+/// The moments are taken about each tree's own origin (its root body's position,
+/// `data.p_world_tree`), not the world origin, as MuJoCo's `mj_crb` works about each tree's centre
+/// of mass (`subtree_com` of the root, engine_core_smooth.c): the poses of a tree are composed from
+/// its root placed at zero, so M does not depend on where the tree stands. About the world origin
+/// a body at distance d has moments of size m d² whose differences make M's entries: at d = 1e6 m
+/// and a 0.1 m link, 12 of the 16 digits were lost. `data.x_world_body` is the world pose again on
+/// return (the tree's origin added back).
 ///
 /// On x86-64 CPUs with AVX2 and FMA3 the kernel runs compiled for them (chosen at run time), its
 /// products and sums fused into multiply–adds ([`fused`]): one rounding instead of two, fewer and
@@ -91,6 +100,7 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
         }
     }
     let nv = model.nv;
+    // The base's pose about its tree's origin: its rotation, at zero.
     let x_world_base = if floating_base { data.x_world_body[1] } else { Transform::identity() };
     // Only the entries (k, l) of l on the ancestor chain of k (and their mirror) are written: the
     // others are zero from `Data::new` and never change (RBDA §6.3, the tree's sparsity).
@@ -130,11 +140,17 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
             data.i_composite[p] += &i_c;
         }
     }
+    // Back to world positions (pass 2 read no pose but the base's, taken above).
+    for b in 1..model.nbody() {
+        data.x_world_body[b].pos += data.p_world_tree[b];
+    }
 }
 
-/// Pass 1 of [`crba_kernel`] for body b: its joint, its world pose, the world-frame columns of
-/// its degrees of freedom (none for a floating base, `no_columns`) and its world-frame inertia.
-/// `HINGE`: b's joint is a hinge about a coordinate axis, whose column is (R a, p × R a).
+/// Pass 1 of [`crba_kernel`] for body b: its joint, its pose about its tree's origin (world axes;
+/// a tree's root body is placed at zero and its world position kept in `data.p_world_tree`), the
+/// columns of its degrees of freedom in those coordinates (none for a floating base,
+/// `no_columns`) and its inertia in them. `HINGE`: b's joint is a hinge about a coordinate axis,
+/// whose column is (R a, p × R a).
 #[inline(always)]
 fn body_pass<A: MulAdd, const HINGE: bool>(
     model: &Model,
@@ -143,7 +159,14 @@ fn body_pass<A: MulAdd, const HINGE: bool>(
     q: &[f64],
     no_columns: bool,
 ) {
-    let x_world_body = body_world_pose::<A, HINGE>(model, data, b, q);
+    let mut x_world_body = body_world_pose::<A, HINGE>(model, data, b, q);
+    let parent = model.bodies[b].parent;
+    if parent == 0 {
+        data.p_world_tree[b] = x_world_body.pos;
+        x_world_body.pos = Vector3::zeros();
+    } else {
+        data.p_world_tree[b] = data.p_world_tree[parent];
+    }
     data.x_world_body[b] = x_world_body;
     let j = model.joint_of(b);
     if HINGE {
@@ -202,8 +225,9 @@ fn column<A: MulAdd, const MIRROR: bool>(
 }
 
 /// The 6×6 block of M on a floating base's own degrees of freedom, from the whole robot's
-/// composite inertia `i_c` (world coordinates: mass m, first moment h and rotational inertia I_O
-/// about the world origin) and the base pose (R, p); `block[k][l]` = M[l][k] (l ≤ k filled).
+/// composite inertia `i_c` (world axes: mass m, first moment h and rotational inertia I_O about
+/// the reference point O) and the base pose (R, p) about O; `block[k][l]` = M[l][k] (l ≤ k
+/// filled). [`crba_kernel`] takes O at the base's own origin (its tree's), so p = 0 there.
 ///
 /// The base's columns are (0, eᵢ) (linear velocity, world axes) and (uᵢ, p × uᵢ) with uᵢ = R eᵢ
 /// (angular velocity, base axes). With h_p = h − m p the first moment about the base origin and
@@ -263,11 +287,18 @@ fn for_each_run(model: &Model, from: usize, mut run: impl FnMut(usize, usize)) {
 /// ancestor i of k is the part of k's chain below i, so the update `L[i][j] −= a L[k][j]` over
 /// the chain of i (RBDA Table 6.3) may run over all j ≤ i: one contiguous, vectorizable slice of
 /// two columns instead of a walk through λ; the extra terms subtract zeros.
+///
+/// A pivot below [`MIN_PIVOT`] (a mass matrix singular at this state: duplicated joints, a moving
+/// body without mass or inertia, or not positive) is raised to it, as MuJoCo 4.0's `mj_factorI`
+/// does, and recorded in `data.warnings` (`inertia`, with the dofs): the solve then gives
+/// MuJoCo's regularized accelerations instead of NaN.
 pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
     let lambda = &model.dof_parent[..model.nv];
     let nv = model.nv;
-    let m = data.mass_matrix.as_slice();
-    let h = data.mass_factor.as_mut_slice();
+    let Data { mass_matrix, mass_factor, warnings, .. } = data;
+    let m = mass_matrix.as_slice();
+    let h = mass_factor.as_mut_slice();
+    let mut singular = None;
     // The upper triangle of M (column k of M holds M[j][k] = M[k][j], j ≤ k; zero off the chain).
     for k in 0..nv {
         h[k * nv..k * nv + k + 1].copy_from_slice(&m[k * nv..k * nv + k + 1]);
@@ -275,7 +306,16 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
     for k in (0..nv).rev() {
         let (before, rest) = h.split_at_mut(k * nv);
         let col_k = &mut rest[..nv];
-        let d_k = col_k[k];
+        let mut d_k = col_k[k];
+        if d_k < MIN_PIVOT {
+            if singular.is_none() {
+                warnings.inertia_dofs.fill(false);
+                singular = Some(k);
+            }
+            warnings.pivot_raised(k);
+            d_k = MIN_PIVOT;
+            col_k[k] = d_k;
+        }
         let mut i = lambda[k];
         while i != NO_DOF {
             let a = col_k[i] / d_k;
@@ -286,6 +326,9 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
             col_k[i] = a;
             i = lambda[i];
         }
+    }
+    if let Some(first) = singular {
+        warnings.singular_factor(first);
     }
 }
 

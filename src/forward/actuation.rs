@@ -26,6 +26,7 @@ use crate::error::{check, InputError};
 use crate::kinematics::forward_kinematics_unchecked;
 pub use crate::model::actuator::unsimulated_reason;
 use crate::model::actuator::{BiasType, GainType, Transmission};
+use crate::model::warning::MAX_CTRL;
 use crate::model::{Data, Model};
 
 /// Each actuator's `biasprm[2]` as MuJoCo 4.0's `mj_setConst` resolves it: a position-like
@@ -66,6 +67,19 @@ pub fn resolved_bias_velocity(model: &Model) -> Vec<f64> {
         .collect()
 }
 
+/// Actuator i's control, clamped to its `ctrlrange` unless `clampctrl` is disabled.
+fn clamped_ctrl(model: &Model, data: &Data, i: usize) -> f64 {
+    match (model.options.flags.clampctrl, model.actuators[i].ctrlrange) {
+        (true, Some([lo, hi])) => data.ctrl[i].clamp(lo, hi),
+        _ => data.ctrl[i],
+    }
+}
+
+/// MuJoCo's `mju_isBad`: NaN or beyond ±mjMAXVAL.
+fn is_bad(x: f64) -> bool {
+    x.is_nan() || x.abs() > MAX_CTRL
+}
+
 /// The actuation stage at (q, v) with `data.ctrl` and `data.act`: `actuator_length`,
 /// `actuator_velocity`, `actuator_moment`, `act_dot`, `actuator_force` and `qfrc_actuator` (zero
 /// for actuators not simulated); `bias_velocity` is [`resolved_bias_velocity`] (the plan holds
@@ -99,10 +113,16 @@ pub(crate) fn actuation_unchecked(
     bias_velocity: &[f64],
 ) {
     data.qfrc_actuator.fill(0.0);
-    let clamp = model.options.flags.clampctrl;
     if model.actuators.iter().any(|a| needs_poses(a) && unsimulated_reason(model, a).is_none()) {
         forward_kinematics_unchecked(model, data, q);
     }
+    // MuJoCo's mjWARN_BADCTRL (mj_fwdActuation): a control NaN, infinite or beyond ±MAX_CTRL
+    // after its range clamp zeroes every control of this evaluation, with a warning.
+    let bad = (0..model.actuators.len()).find(|&i| is_bad(clamped_ctrl(model, data, i)));
+    if let Some(i) = bad {
+        data.warnings.bad_control(i);
+    }
+    let zeroed = bad.is_some();
     let mut act_adr = 0;
     for (i, a) in model.actuators.iter().enumerate() {
         let act_index = (a.actnum() == 1).then_some(act_adr);
@@ -121,10 +141,7 @@ pub(crate) fn actuation_unchecked(
         let poses = Poses { x_world_body, s_body, x_world_frame };
         let length = transmission(model, a, q, poses, actuator_moment, i);
         let velocity = actuator_moment.row(i).iter().zip(v).map(|(m, v)| m * v).sum::<f64>();
-        let mut ctrl = data.ctrl[i];
-        if let (true, Some([lo, hi])) = (clamp, a.ctrlrange) {
-            ctrl = ctrl.clamp(lo, hi);
-        }
+        let ctrl = if zeroed { 0.0 } else { clamped_ctrl(model, data, i) };
         // The input of the gain: the control, or the activation (the next one with actearly).
         let input = match act_index {
             None => ctrl,
@@ -225,6 +242,8 @@ pub fn add_actuator_velocity_derivative(
     let nv = model.nv;
     let mut any = false;
     let mut act_adr = 0;
+    // Bad controls are zeroed here too (the actuation stage's rule).
+    let zeroed = (0..model.actuators.len()).any(|i| is_bad(clamped_ctrl(model, data, i)));
     for (i, a) in model.actuators.iter().enumerate() {
         let act_index = (a.actnum() == 1).then_some(act_adr);
         act_adr += a.actnum();
@@ -240,6 +259,7 @@ pub fn add_actuator_velocity_derivative(
         let mut d = if a.biastype == BiasType::Affine { bias_velocity[i] } else { 0.0 };
         if a.gaintype == GainType::Affine && a.gainprm[2] != 0.0 {
             let x = match act_index {
+                None if zeroed => 0.0,
                 None => data.ctrl[i],
                 Some(j) if a.actearly => {
                     next_activation(a, data.act[j], data.act_dot[j], model.options.timestep)

@@ -28,7 +28,7 @@
 //! r reaches the crank pin. When the rod cannot reach (the square root's argument ≤ 0) MuJoCo
 //! takes length a·d and derivatives d (w.r.t. a) and a (w.r.t. d); so does this.
 
-use crate::kinematics::for_each_ancestor_dof;
+use crate::kinematics::for_each_ancestor_dof_at;
 use crate::model::actuator::{Actuator, Transmission};
 use crate::model::{JointKind, Model, TendonKind};
 use crate::spatial::{Mat3, Motion, Transform, Vec3};
@@ -105,14 +105,13 @@ fn add_projected_jacobian(
     moment: &mut DMatrix<f64>,
     i: usize,
 ) {
-    for_each_ancestor_dof(model, poses.x_world_body, poses.s_body, body, |k, s_world| {
+    for_each_ancestor_dof_at(model, poses.x_world_body, poses.s_body, body, p, |k, lin, ang| {
         if let Some(o) = other {
             if is_ancestor_or_self(model, model.dof_body[k], o) {
                 return;
             }
         }
-        let lin = s_world.lin + s_world.ang.cross(p);
-        moment[(i, k)] += sign * (w_lin.dot(&lin) + w_ang.dot(&s_world.ang));
+        moment[(i, k)] += sign * (w_lin.dot(&lin) + w_ang.dot(&ang));
     });
 }
 
@@ -204,14 +203,27 @@ pub(crate) fn transmission(
             let g = gear[0];
             // Through d: + the crank pin's Jacobian, − the slider site's; through a: ω × a.
             let crank_body = model.frames[*cranksite].body;
-            for_each_ancestor_dof(model, poses.x_world_body, poses.s_body, crank_body, |k, s| {
-                moment[(i, k)] += g * dl_dd.dot(&(s.lin + s.ang.cross(&xc.pos)));
-            });
+            for_each_ancestor_dof_at(
+                model,
+                poses.x_world_body,
+                poses.s_body,
+                crank_body,
+                &xc.pos,
+                |k, lin, _| {
+                    moment[(i, k)] += g * dl_dd.dot(&lin);
+                },
+            );
             let slider_body = model.frames[*slidersite].body;
-            for_each_ancestor_dof(model, poses.x_world_body, poses.s_body, slider_body, |k, s| {
-                let lin = s.lin + s.ang.cross(&xs.pos);
-                moment[(i, k)] += g * (dl_da.dot(&s.ang.cross(&axis)) - dl_dd.dot(&lin));
-            });
+            for_each_ancestor_dof_at(
+                model,
+                poses.x_world_body,
+                poses.s_body,
+                slider_body,
+                &xs.pos,
+                |k, lin, ang| {
+                    moment[(i, k)] += g * (dl_da.dot(&ang.cross(&axis)) - dl_dd.dot(&lin));
+                },
+            );
             g * length
         }
         Transmission::Body(_) => 0.0,

@@ -9,7 +9,7 @@
 //! with S_k the dof's motion subspace in world coordinates about the world origin and p the centre
 //! of mass in the world (the wrench moved to the origin), i.e. Q = J_pᵀ f + J_ωᵀ τ.
 
-use crate::kinematics::{body_poses, for_each_ancestor_dof};
+use crate::kinematics::{body_poses, for_each_ancestor_dof_at};
 use crate::model::{Data, FrameKind, Model};
 use crate::spatial::Vec3;
 
@@ -35,10 +35,18 @@ pub(crate) fn accumulate_xfrc(model: &Model, data: &mut Data, q: &[f64]) {
         let f = Vec3::new(w[0], w[1], w[2]);
         let com_world =
             data.x_world_body[frame.body].act_point(&frame.x_body_frame.act_point(&frame.inertia.com()));
-        let torque_origin = Vec3::new(w[3], w[4], w[5]) + com_world.cross(&f);
+        let torque = Vec3::new(w[3], w[4], w[5]);
         let qfrc = &mut data.qfrc_xfrc;
-        for_each_ancestor_dof(model, &data.x_world_body, &data.s_body, frame.body, |k, s| {
-            qfrc[k] += s.lin.dot(&f) + s.ang.dot(&torque_origin);
-        });
+        // The point Jacobian at the centre of mass (not the world origin's: digits far away).
+        for_each_ancestor_dof_at(
+            model,
+            &data.x_world_body,
+            &data.s_body,
+            frame.body,
+            &com_world,
+            |k, lin, ang| {
+                qfrc[k] += lin.dot(&f) + ang.dot(&torque);
+            },
+        );
     }
 }

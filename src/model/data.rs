@@ -138,9 +138,14 @@ pub struct Data {
     pub x_world_frame: Vec<Transform>,
     /// Motion subspace column of each degree of freedom, in its body's coordinates.
     pub s_body: Vec<Motion>,
-    /// Motion subspace column of each degree of freedom in world coordinates (CRBA's; not formed
-    /// for a floating base, whose block of M CRBA takes from the composite inertia directly).
+    /// Motion subspace column of each degree of freedom in world axes about its tree's origin
+    /// (`p_world_tree`; CRBA's; not formed for a floating base, whose block of M CRBA takes from
+    /// the composite inertia directly).
     pub s_world: Vec<Motion>,
+    /// For each body, the world position of its tree's origin, the origin of its root body (the
+    /// ancestor whose parent is the world): CRBA's reference point, as MuJoCo's `subtree_com` of
+    /// the root is `mj_crb`'s (a world-origin reference loses digits with distance).
+    pub p_world_tree: Vec<Vec3>,
     /// Spatial velocity of each body, body coordinates.
     pub v_body: Vec<Motion>,
     /// Spatial acceleration of each body (including the gravity offset in RNEA/ABA), body coords.
@@ -149,7 +154,8 @@ pub struct Data {
     pub c_body: Vec<Motion>,
     /// Net spatial force on each body (RNEA) or articulated bias force (ABA), body coordinates.
     pub f_body: Vec<Force>,
-    /// Composite rigid-body inertia of each subtree (CRBA), world coordinates.
+    /// Composite rigid-body inertia of each subtree (CRBA), world axes about the tree's origin
+    /// (`p_world_tree`).
     pub i_composite: Vec<RigidInertia>,
     /// Articulated-body inertia of each body (ABA), body coordinates.
     pub i_articulated: Vec<ArticulatedInertia>,
@@ -269,6 +275,9 @@ pub struct Data {
     /// its last sweep; soft mode, the scaled gradient norm (Newton, CG; MuJoCo's
     /// `solver_gradient`) or the last sweep's scaled cost improvement (PGS).
     pub efc_unconverged_residual: f64,
+    /// Run-time warnings (MuJoCo's `d->warning`): a singular mass matrix regularized, bad
+    /// controls zeroed ([`Warnings`](super::Warnings)).
+    pub warnings: super::Warnings,
     /// The exact solver's workspace (Delassus matrix, factors, warm start, active set).
     pub(crate) exact: ExactWork,
     /// Which limit and contact rows exist within a step ([`RowLifecycle`]).
@@ -364,6 +373,7 @@ impl Data {
             x_world_frame: vec![Transform::identity(); model.frames.len()],
             s_body: vec![Motion::zero(); nv],
             s_world: vec![Motion::zero(); nv],
+            p_world_tree: vec![Vec3::zeros(); nb],
             v_body: vec![Motion::zero(); nb],
             a_body: vec![Motion::zero(); nb],
             c_body: vec![Motion::zero(); nb],
@@ -414,6 +424,7 @@ impl Data {
             efc_converged: true,
             efc_unconverged: 0,
             efc_unconverged_residual: 0.0,
+            warnings: super::Warnings::new(nv),
             exact: ExactWork::new(nv, nefc),
             lifecycle: RowLifecycle::new(model),
             stepper: StepperSlot::for_model(model),

@@ -16,6 +16,7 @@ pub mod options;
 pub mod reset;
 pub mod spec;
 pub mod tendon;
+pub mod warning;
 
 pub use actuator::Actuator;
 pub use collision_pairs::CollisionPair;
@@ -27,6 +28,7 @@ pub use joint::{axis_angle, HingeAxis, JointKind};
 pub use links::Links;
 pub use options::{Flags, Options};
 pub use tendon::{Tendon, TendonKind};
+pub use warning::{WarningStat, Warnings};
 
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
 use std::path::PathBuf;

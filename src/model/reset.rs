@@ -7,7 +7,8 @@ use crate::error::InputError;
 
 /// Resets `data` to `model`'s reference state: time 0, `qpos` = `qpos0`, and zero velocities,
 /// activations, controls and applied forces (`qfrc_applied`, `xfrc_applied`); the solvers' warm starts are cleared, so the next
-/// step is the first of a new run (MuJoCo's `mj_resetData`). Allocates nothing. The output
+/// step is the first of a new run, and the run-time warnings (`data.warnings`) are cleared
+/// (MuJoCo's `mj_resetData`). Allocates nothing. The output
 /// buffers keep their values until the next `forward`.
 ///
 /// # Errors
@@ -45,6 +46,7 @@ pub fn reset(model: &Model, data: &mut Data) -> Result<(), InputError> {
     data.thaw_rows();
     data.stepper.steps = 0;
     data.stepper.failed = None;
+    data.warnings.clear();
     Ok(())
 }
 

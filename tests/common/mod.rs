@@ -643,3 +643,62 @@ pub const GEOMQ_DIST_ABS: f64 = 1e-9;
 /// where both surfaces are smooth. Measured differences: up to 4e-8 apart, 1.7e-7 overlapping
 /// (EPA); 1e-6.
 pub const GEOMQ_FROMTO_CURVED_ABS: f64 = 1e-6;
+
+// ------------------------------------------------------------------------------------------------
+// Translation invariance (tests/far_origin.rs)
+// ------------------------------------------------------------------------------------------------
+
+/// Relative tolerance on M, qacc and contact forces of a scene translated by `distance` metres
+/// against the same scene at the origin, for a scene whose shortest length that matters (a lever
+/// arm, a penetration depth) is `length` metres.
+///
+/// A coordinate of size d is stored to half an ulp, ≤ ε·d (ε = 2.2e-16): every body position,
+/// geom position and contact point of the translated scene carries that absolute error (the
+/// state itself does: a free body's qpos is its world position). Differences of such positions
+/// (lever arms, penetrations) are then known to ε·d / length relative, and every output computed
+/// from them to a small multiple of that. A computation free of other losses (about a local
+/// point, not the world origin) stays within 100 times that bound; one that works about the
+/// world origin loses (d / length)² ε instead (1e6 m, 0.1 m: 2e-2), far above it.
+pub fn far_origin_tol(distance: f64, length: f64) -> f64 {
+    ALGO_REL + 100.0 * f64::EPSILON * distance / length
+}
+
+/// `model` with everything fixed to the world moved by `offset`: the geoms and frames on the world
+/// body and the placement of every tree root without a free joint (a free root moves with its
+/// qpos: [`translate_q`]). Models with mocap bodies are not handled.
+pub fn translate_scene(model: &Model, offset: &Vec3) -> Model {
+    let mut moved = model.clone();
+    for g in moved.geoms.iter_mut().filter(|g| g.body == 0) {
+        g.x_body_geom.pos += offset;
+    }
+    for f in moved.frames.iter_mut().filter(|f| f.body == 0) {
+        f.x_body_frame.pos += offset;
+    }
+    for b in 1..moved.nbody() {
+        if moved.bodies[b].parent == 0 && !matches!(moved.joint_of(b).kind, JointKind::Free) {
+            moved.bodies[b].x_parent_joint.pos += offset;
+        }
+    }
+    moved
+}
+
+/// `q` with every free tree root moved by `offset` (the state of [`translate_scene`]'s model).
+pub fn translate_q(model: &Model, q: &[f64], offset: &Vec3) -> Vec<f64> {
+    let mut q = q.to_vec();
+    for b in 1..model.nbody() {
+        let j = model.joint_of(b);
+        if model.bodies[b].parent == 0 && matches!(j.kind, JointKind::Free) {
+            for i in 0..3 {
+                q[j.qpos_adr + i] += offset[i];
+            }
+        }
+    }
+    q
+}
+
+/// Relative tolerance on the accelerations of a mass matrix singular at the state
+/// (`tests/warnings.rs`) against MuJoCo's: both raise the same factor pivot to 1e-15 and solve,
+/// so a direction with a force on it gets ~f / 1e-15; the pivot replaced is round-off of order
+/// ε |M| (≈ 1e-17 here) in either engine before the raise, and the other pivots and the solve
+/// agree to round-off: 1e-9 allows for a few ulps of difference in the O(1) entries of L.
+pub const SINGULAR_REL: f64 = 1e-9;
