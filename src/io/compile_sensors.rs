@@ -270,6 +270,9 @@ fn sensor(e: &Element, names: &Names, model: &Model, id: usize) -> Result<Sensor
                     _ => return Err(invalid(e, "'num' must be positive in sensor")),
                 },
             };
+            if reduce == 3 && spec >> 7 != 0 {
+                return Err(invalid(e, "netforce reduction is incompatible with linvel or angvel"));
+            }
             dim = Some(slot_size(&CONTACT_FIELDS, spec) * num);
             contact = Some(ContactSensorSpec { dataspec: spec, reduce, num });
         }

@@ -2,7 +2,9 @@
 //! two criteria (a site's zone, a body, a subtree or a geom on either side), reduced to `num` slots
 //! — the first found, the nearest (`mindist`), the strongest (`maxforce`) or one net wrench
 //! (`netforce`) — each slot holding the requested fields: found (the number of matches), force and
-//! torque in the contact frame, distance, position, normal and first tangent. The normal points
+//! torque in the contact frame, distance, position, normal, first tangent, and the velocity of
+//! geom 2's body relative to geom 1's at the contact point (linear, angular; contact frame,
+//! MuJoCo 4.0's `linvel`, `angvel`). The normal points
 //! away from the first criterion's object: where the contact lists that object second, the slot's
 //! frame is turned half a turn about the tangent-2 axis (normal and tangent negated, the z of force
 //! and torque negated, MuJoCo's `copySensorData`).
@@ -10,6 +12,7 @@
 //! `netforce`: the matched contacts' wrenches (each negated when flipped) summed in world axes
 //! about their force-weighted centroid p = Σ |f_i| p_i / Σ |f_i|, τ = Σ (R_iᵀ τ_i + (p_i − p) × R_iᵀ f_i).
 
+use super::objects::point_velocity;
 use super::types::{ContactSensorSpec, Sensor, SensorObject, CONTACT_FIELDS};
 use crate::constraint::contact_force::contact_force;
 use crate::model::{Data, Model};
@@ -153,7 +156,17 @@ pub(crate) fn compute(
                 "dist" => o[0] = contact.dist,
                 "pos" => o.copy_from_slice(contact.pos.as_slice()),
                 "normal" => o.copy_from_slice((contact.frame.row(0).transpose() * sign).as_slice()),
-                _ => o.copy_from_slice((contact.frame.row(1).transpose() * sign).as_slice()),
+                "tangent" => o.copy_from_slice((contact.frame.row(1).transpose() * sign).as_slice()),
+                field => {
+                    // Geom 2's point relative to geom 1's, in the contact frame.
+                    let [g1, g2] = contact.geom;
+                    let (w1, v1) = point_velocity(data, model.geoms[g1].body, &contact.pos);
+                    let (w2, v2) = point_velocity(data, model.geoms[g2].body, &contact.pos);
+                    let rel = if field == "linvel" { v2 - v1 } else { w2 - w1 };
+                    let mut x = contact.frame * rel;
+                    x[2] *= sign;
+                    o.copy_from_slice(x.as_slice());
+                }
             }
             k += n;
         }
@@ -200,7 +213,8 @@ fn netforce(model: &Model, data: &Data, spec: &ContactSensorSpec, matches: &[Mat
             "dist" => o[0] = 0.0,
             "pos" => o.copy_from_slice(point.as_slice()),
             "normal" => o[0] = 1.0,
-            _ => o[1] = 1.0,
+            "tangent" => o[1] = 1.0,
+            _ => {}
         }
         k += n;
     }

@@ -60,6 +60,8 @@ impl SensorNeeds {
         use SensorType::*;
         let computed = || model.sensors.iter().filter(|s| s.is_computed() && model.options.flags.sensor);
         let has = |f: &dyn Fn(SensorType) -> bool| computed().any(|s| f(s.kind));
+        // Contact sensors reporting velocities (linvel, angvel: the last two fields).
+        let contact_velocities = computed().any(|s| s.contact.is_some_and(|c| c.dataspec >> 7 != 0));
         SensorNeeds {
             any: computed().next().is_some(),
             velocities: has(&|k| {
@@ -67,7 +69,7 @@ impl SensorNeeds {
                     k,
                     Velocimeter | Gyro | FrameLinVel | FrameAngVel | SubtreeLinVel | SubtreeAngMom | EKinetic
                 )
-            }),
+            }) || contact_velocities,
             quats: has(&|k| k == FrameQuat),
             subtree_com: has(&|k| matches!(k, SubtreeCom | SubtreeLinVel | SubtreeAngMom | InsideSite)),
             subtree_velocities: has(&|k| matches!(k, SubtreeLinVel | SubtreeAngMom)),

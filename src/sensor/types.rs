@@ -224,7 +224,7 @@ pub enum SensorObject {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ContactSensorSpec {
     /// The fields of each slot (bits of [`CONTACT_FIELDS`] in its order: found, force, torque,
-    /// dist, pos, normal, tangent).
+    /// dist, pos, normal, tangent, linvel, angvel).
     pub dataspec: u32,
     /// The reduction: 0 none (first found), 1 mindist, 2 maxforce, 3 netforce.
     pub reduce: u8,
@@ -232,9 +232,19 @@ pub struct ContactSensorSpec {
     pub num: usize,
 }
 
-/// The contact sensor's fields (MJCF `data` keywords) and their sizes, in MuJoCo's order.
-pub const CONTACT_FIELDS: [(&str, usize); 7] =
-    [("found", 1), ("force", 3), ("torque", 3), ("dist", 1), ("pos", 3), ("normal", 3), ("tangent", 3)];
+/// The contact sensor's fields (MJCF `data` keywords) and their sizes, in MuJoCo 4.0's order
+/// (`mjtConDataField`).
+pub const CONTACT_FIELDS: [(&str, usize); 9] = [
+    ("found", 1),
+    ("force", 3),
+    ("torque", 3),
+    ("dist", 1),
+    ("pos", 3),
+    ("normal", 3),
+    ("tangent", 3),
+    ("linvel", 3),
+    ("angvel", 3),
+];
 
 /// The rangefinder's fields (MJCF `data` keywords) and their sizes, in MuJoCo's order.
 pub const RAY_FIELDS: [(&str, usize); 6] =
