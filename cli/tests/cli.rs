@@ -396,3 +396,31 @@ fn simulate_warns_when_a_passive_scene_gains_or_loses_energy() {
     let (_, out, _) = lagrange(&["simulate", "models/ur5/ur5.urdf", "--duration", "2"]);
     assert!(!out.contains("energy of this passive scene"), "{out}");
 }
+
+/// MuJoCo's run-time warnings reach the user: `simulate` prints and reports them (a bad control
+/// names its actuator), `eval` lists them per state (a singular mass matrix names its joints).
+#[test]
+fn simulate_and_eval_report_mujocos_run_time_warnings() {
+    let (ok, out, err) = lagrange(&[
+        "simulate",
+        "tests/data/mjcf/warnings/bad_ctrl.xml",
+        "--ctrl",
+        "nan,0.5",
+        "--duration",
+        "0.01",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let summary: Value = serde_json::from_str(&out).unwrap();
+    let warnings = summary["warnings"].as_array().unwrap();
+    assert!(warnings.iter().any(|w| w.as_str().unwrap().contains("'m_free'")), "{warnings:?}");
+    let states = std::env::temp_dir().join(format!("lagrange-cli-{}-warnings.json", std::process::id()));
+    std::fs::write(&states, r#"{"states": [{"q": [0.1, 0.2, 0.3, 0.1, 0.2]}]}"#).unwrap();
+    let (ok, out, err) =
+        lagrange(&["eval", "tests/data/mjcf/warnings/dup_hinges.xml", "--states", states.to_str().unwrap()]);
+    std::fs::remove_file(&states).ok();
+    assert!(ok, "{err}");
+    let doc: Value = serde_json::from_str(&out).unwrap();
+    let w = doc["results"][0]["warnings"][0].as_str().unwrap();
+    assert!(w.contains("singular") && w.contains("'a'"), "{w}");
+}

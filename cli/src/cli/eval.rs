@@ -106,6 +106,10 @@ pub fn evaluate(
     } else {
         out["forward"] = forward_json(model, data, s, v, tau);
         out["sensors"] = sensors_json(model, data);
+        let warnings = data.warnings.messages(model);
+        if !warnings.is_empty() {
+            out["warnings"] = json!(warnings);
+        }
     }
     Ok(out)
 }
@@ -151,6 +155,7 @@ fn forward_json(model: &Model, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f
     data.qpos.copy_from_slice(&s.q);
     data.qvel.copy_from_slice(v);
     data.time = s.time.unwrap_or(0.0);
+    data.warnings.clear();
     forward(model, data);
     let mut constraints = Vec::new();
     let file = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();

@@ -79,6 +79,9 @@ pub struct Summary {
     pub integrator: &'static str,
     /// The computed sensors at the final state (`{"NAME": [values]}`).
     pub sensors: serde_json::Value,
+    /// MuJoCo's run-time warnings raised during the run (a singular mass matrix regularized, bad
+    /// controls zeroed), worded with the joints and actuators.
+    pub warnings: Vec<String>,
     /// Nothing adds or removes energy (no damping, friction loss, actuators, joint limits or
     /// contacts): the energy drift measures the integration error alone.
     pub passive: bool,
@@ -357,6 +360,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     };
     Ok(Summary {
         sensors,
+        warnings: sim.data.warnings.messages(model),
         passive,
         contacts_dropped: sim.data.contacts_dropped,
         constrained: sim.model.plan.has_constraints(),
@@ -587,6 +591,7 @@ pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
         "v": s.final_state.v.as_slice(),
         "act": s.final_state.act.as_slice(),
         "sensors": s.sensors,
+        "warnings": s.warnings,
     });
     if let Some(i) = &s.interrupted {
         out["interrupted"] = json!({
@@ -631,6 +636,9 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
     }
     for note in &s.notes {
         let _ = writeln!(out, "note: {note}");
+    }
+    for w in &s.warnings {
+        let _ = writeln!(out, "warning: {w}");
     }
     let _ = writeln!(
         out,
