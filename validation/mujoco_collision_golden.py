@@ -42,7 +42,7 @@ import mujoco
 import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from mujoco_golden import dump, roundoff_difference  # noqa: E402
+from mujoco_golden import check_status, dump  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parent.parent
 OUT_DIR = REPO / "tests" / "data" / "mujoco" / "collision"
@@ -528,13 +528,7 @@ def main() -> int:
         n_cases = sum(len(s["cases"]) for s in doc["scenes"])
         n_contacts = sum(len(c["contacts"]) for s in doc["scenes"] for c in s["cases"])
         if args.check:
-            if old == text:
-                status = "ok"
-            elif old is None:
-                status = "MISSING"
-            else:
-                worst = roundoff_difference(json.loads(old), doc)
-                status = "DIFFERS" if worst is None or worst > CHECK_REL else "ok (round-off %.1e)" % worst
+            status = check_status(old, text, doc, CHECK_REL)
             if not status.startswith("ok"):
                 stale.append(out.relative_to(REPO).as_posix())
         else:

@@ -52,7 +52,7 @@ import mujoco
 import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from mujoco_golden import dump, roundoff_difference  # noqa: E402
+from mujoco_golden import check_status, dump  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parent.parent
 OUT_DIR = REPO / "tests" / "data" / "mujoco_geomq"
@@ -573,13 +573,7 @@ def main() -> int:
         old = out.read_text() if out.exists() else None
         doc = json.loads(text)
         if args.check:
-            if old == text:
-                status = "ok"
-            elif old is None:
-                status = "MISSING"
-            else:
-                worst = roundoff_difference(json.loads(old), doc)
-                status = "DIFFERS" if worst is None or worst > CHECK_REL else "ok (round-off %.1e)" % worst
+            status = check_status(old, text, doc, CHECK_REL)
             if not status.startswith("ok"):
                 stale.append(out.relative_to(REPO).as_posix())
         else:

@@ -413,6 +413,18 @@ def _magnitude(x) -> float:
     return 0.0
 
 
+def check_status(old: str | None, text: str, doc, rel: float) -> str:
+    """The --check verdict of a reference-data script on one file: "ok" when the committed text
+    `old` equals the recomputed `text`, "ok (round-off …)" when they differ by at most `rel`
+    (roundoff_difference), else "MISSING" or "DIFFERS"."""
+    if old == text:
+        return "ok"
+    if old is None:
+        return "MISSING"
+    worst = roundoff_difference(json.loads(old), doc)
+    return "DIFFERS" if worst is None or worst > rel else f"ok (round-off {worst:.1e})"
+
+
 def roundoff_difference(a, b, scale: float = 0.0) -> float | None:
     """Largest relative difference between two JSON documents of the same structure, or None when
     keys, lengths, strings or types differ. Each number is measured against the largest magnitude

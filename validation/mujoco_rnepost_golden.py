@@ -42,7 +42,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import crossval_soft as cs  # noqa: E402
-from mujoco_golden import dump, roundoff_difference  # noqa: E402
+from crossval_common import TIGHT  # noqa: E402
+from mujoco_golden import check_status, dump  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "tests/data/mujoco_rnepost"
@@ -115,7 +116,7 @@ def scene_doc(index: int, name: str) -> dict:
         "generated_by": SCRIPT + " (do not edit)",
         "mujoco": mj.__version__,
         "model": rel,
-        "options": "tight copy of validation/crossval_soft.py: " + cs.TIGHT.removeprefix("<option "),
+        "options": "tight copy of validation/crossval_common.py: " + TIGHT.removeprefix("<option "),
         "bodies": [m.body(b).name for b in range(m.nbody)],
         "body_parentid": m.body_parentid.tolist(),
         "body_rootid": m.body_rootid.tolist(),
@@ -138,13 +139,7 @@ def main() -> int:
         out = OUT / f"{name}.json"
         old = out.read_text() if out.exists() else None
         if args.check:
-            if old == text:
-                status = "ok"
-            elif old is None:
-                status = "MISSING"
-            else:
-                worst = roundoff_difference(json.loads(old), doc)
-                status = "DIFFERS" if worst is None or worst > CHECK_REL else f"ok (round-off {worst:.1e})"
+            status = check_status(old, text, doc, CHECK_REL)
             if not status.startswith("ok"):
                 stale.append(out.relative_to(ROOT).as_posix())
         else:

@@ -30,6 +30,7 @@ use super::box_primitive;
 use super::convex::{support_distance, swept_spheres, ConvexShape, PairPoint};
 use super::plane::{self, PlanePoint};
 use crate::error::InputError;
+use crate::model::collision_pairs::type_rank;
 use crate::model::spec::Shape;
 use crate::model::{Data, Geom, Model};
 use crate::spatial::{Transform, Vec3};
@@ -43,20 +44,6 @@ pub struct GeomDistance {
     /// From the point on geom 1's surface to the point on geom 2's (world), when the distance is
     /// below `distmax` (MuJoCo's `fromto`, which is zero otherwise).
     pub fromto: Option<[Vec3; 2]>,
-}
-
-/// MuJoCo's geom type order (`mjtGeom`): a pair's collision function takes the lower type first.
-fn type_rank(shape: &Shape) -> u8 {
-    match shape {
-        Shape::Plane { .. } => 0,
-        Shape::Hfield { .. } => 1,
-        Shape::Sphere { .. } => 2,
-        Shape::Capsule { .. } => 3,
-        Shape::Ellipsoid { .. } => 4,
-        Shape::Cylinder { .. } => 5,
-        Shape::Box { .. } => 6,
-        Shape::Mesh { .. } => 7,
-    }
 }
 
 /// The signed distance between geoms `geom1` and `geom2` (indices in `Model::geoms`) at the poses
@@ -141,6 +128,7 @@ pub(crate) fn geom_distance_unchecked(
     let pose = |g: &Geom| data.attached_pose(g.body, g.mocap, &g.x_body_geom);
     let (user1, user2) = (&model.geoms[geom1], &model.geoms[geom2]);
     // MuJoCo's order: the lower type first; `flip` when that swaps the caller's geoms.
+    // MuJoCo's geom type order (`mjtGeom`): a pair's collision function takes the lower type first.
     let flip = type_rank(&user1.shape) > type_rank(&user2.shape);
     let (ga, gb) = if flip { (user2, user1) } else { (user1, user2) };
     let (xa, xb) = (pose(ga), pose(gb));
