@@ -294,6 +294,8 @@ impl Simulation {
             return Err(f.refusal());
         }
         crate::integrate::check_timestep("Simulation::step", "Simulation::timestep", self.timestep)?;
+        let (model, d) = (&self.model, &mut self.data);
+        d.warnings.check_quaternions(model, d.qpos.as_slice());
         let result = self.step_unguarded();
         if let Err(e) = &result {
             self.data.stepper.failed = crate::integrate::FailedStep::of(e, self.steps + 1, self.data.time);

@@ -232,7 +232,7 @@ fn every_kernel_refuses_wrong_lengths() {
 
 /// A zero or vanishing quaternion in the state reads as the identity, as MuJoCo normalizes it
 /// (free and ball joints): finite accelerations equal to those at the identity, and a step that
-/// stays finite — never NaN in an output.
+/// stays finite — never NaN in an output; each such read is a warning naming the joint.
 #[test]
 fn a_zero_quaternion_is_the_identity() {
     let model = Model::from_str(
@@ -245,12 +245,17 @@ fn a_zero_quaternion_is_the_identity() {
     data.qvel.copy_from_slice(&[0.1, 0.2, 0.3, 0.5, -0.4, 0.3, 1.0, 0.0, -1.0]);
     forward(&model, &mut data);
     let at_identity = data.qacc.clone();
+    assert_eq!(data.warnings.zero_quat.number, 0, "unit quaternions raise nothing");
     for tiny in [0.0, 1e-300] {
         data.qpos.as_mut_slice()[3..7].copy_from_slice(&[tiny, 0.0, 0.0, 0.0]);
         data.qpos.as_mut_slice()[7..11].copy_from_slice(&[0.0, tiny, 0.0, tiny]);
         forward(&model, &mut data);
         assert_eq!(data.qacc, at_identity, "quaternions of norm {tiny}");
     }
+    // Two forwards, two zero quaternions each; the ball joint (index 1) is the last.
+    assert_eq!((data.warnings.zero_quat.number, data.warnings.zero_quat.last_info), (4, 1));
     step(&model, &mut data).unwrap();
     assert!(data.qpos.iter().chain(data.qvel.iter()).all(|x| x.is_finite()), "{:?}", data.qpos);
+    let message = data.warnings.messages(&model).join("\n");
+    assert!(message.contains("zero quaternion") && message.contains("joint"), "{message}");
 }

@@ -47,6 +47,7 @@ pub fn forward(model: &Model, data: &mut Data) {
     // no allocation) and back.
     let q = std::mem::take(&mut data.qpos);
     let v = std::mem::take(&mut data.qvel);
+    data.warnings.check_quaternions(model, q.as_slice());
     forward_at(model, data, q.as_slice(), v.as_slice());
     crate::sensor::compute_at(model, data, q.as_slice(), v.as_slice(), data.time);
     data.qpos = q;

@@ -120,6 +120,8 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepReport, SimError> {
     }
     let h = model.options.timestep;
     check_timestep("step", "model.options.timestep", h)?;
+    let (q, warnings) = (data.qpos.as_slice(), &mut data.warnings);
+    warnings.check_quaternions(model, q);
     let mut slot = std::mem::take(&mut data.stepper);
     let report = slot.ensure(model).step(model, data, h);
     // The next soft solve's warm start: this step's acceleration, rows or not (MuJoCo's

@@ -48,6 +48,10 @@ pub struct Warnings {
     /// all controls were taken as zero for that evaluation (`data.ctrl` itself is left as set).
     /// `last_info`: the first bad actuator.
     pub bad_ctrl: WarningStat,
+    /// A free or ball joint's quaternion in `qpos` was zero (or shorter than 1e-15) at a
+    /// `forward` or the start of a `step`: it reads as the identity, as MuJoCo's `mju_normalize4`
+    /// makes it (MuJoCo itself does not warn). `last_info`: the joint (index in `Model::joints`).
+    pub zero_quat: WarningStat,
 }
 
 impl Warnings {
@@ -58,19 +62,36 @@ impl Warnings {
 
     /// Whether any warning was raised.
     pub fn any(&self) -> bool {
-        self.inertia.number > 0 || self.bad_ctrl.number > 0
+        self.inertia.number > 0 || self.bad_ctrl.number > 0 || self.zero_quat.number > 0
     }
 
     /// Resets every counter (MuJoCo's `mj_resetData` does).
     pub fn clear(&mut self) {
         self.inertia = WarningStat::default();
         self.bad_ctrl = WarningStat::default();
+        self.zero_quat = WarningStat::default();
         self.inertia_dofs.fill(false);
     }
 
     /// Records the pivot of dof `k` raised to [`MIN_PIVOT`] (called during the factorization).
     pub(crate) fn pivot_raised(&mut self, k: usize) {
         self.inertia_dofs[k] = true;
+    }
+
+    /// Counts the free and ball joints whose quaternion in `q` is zero (they read as the identity).
+    pub(crate) fn check_quaternions(&mut self, model: &Model, q: &[f64]) {
+        for (j, joint) in model.joints.iter().enumerate() {
+            let off = match joint.kind {
+                super::JointKind::Free => 3,
+                super::JointKind::Ball => 0,
+                _ => continue,
+            };
+            let a = joint.qpos_adr + off;
+            let n2: f64 = q[a..a + 4].iter().map(|x| x * x).sum();
+            if n2.sqrt() < 1e-15 {
+                self.zero_quat.raise(j);
+            }
+        }
     }
 
     /// Records a bad control at actuator `i`.
@@ -113,6 +134,16 @@ impl Warnings {
                  actuator '{name}', index {i}): all controls were taken as zero, as MuJoCo does \
                  (mjWARN_BADCTRL)",
                 self.bad_ctrl.number
+            ));
+        }
+        if self.zero_quat.number > 0 {
+            let j = self.zero_quat.last_info;
+            let name = model.joints.get(j).map(|j| j.name.as_str()).unwrap_or("");
+            out.push(format!(
+                "a zero quaternion in qpos {} time(s) (last at the joint '{name}'): it was read as the \
+                 identity, as MuJoCo's mju_normalize4 does; set a unit quaternion [1, 0, 0, 0] for \
+                 the joint's orientation",
+                self.zero_quat.number
             ));
         }
         out
