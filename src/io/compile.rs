@@ -328,13 +328,12 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             let li = frame_spec_link[f];
             let link = &spec.links[li];
             let i_com = frames[f].inertia.i_com();
-            let quat_of = |r: &Mat3| crate::spatial::Transform::new(*r, Vec3::zeros()).quat_wxyz();
             match &link.inertial {
                 // `diaginertia`: the file's frame as it is; `fullinertia`: its principal axes
                 // found in the file's frame, as MuJoCo's compiler does.
                 Some(i) if !link.inertia_from_geoms => {
                     let diagonal = (0..3).all(|r| (0..3).all(|c| r == c || i.inertia[(r, c)] == 0.0));
-                    let q = quat_of(&i.x_link_inertial.rot);
+                    let q = crate::sensor::objects::rot_quat(&i.x_link_inertial.rot);
                     if diagonal {
                         q
                     } else {

@@ -37,3 +37,19 @@ pub enum TendonKind {
         path: Vec<String>,
     },
 }
+
+/// Fixed tendon `t`'s length Σ coefᵢ·q[joint i] over configuration `x`, or with `velocity` its
+/// rate Σ coefᵢ·v[joint i] over velocity `x` (MuJoCo's `ten_length`, `ten_velocity`); 0 for a
+/// spatial tendon (not simulated).
+pub(crate) fn fixed_tendon(model: &super::Model, t: usize, x: &[f64], velocity: bool) -> f64 {
+    match &model.tendons[t].kind {
+        TendonKind::Fixed { joints } => joints
+            .iter()
+            .map(|&(j, c)| {
+                let joint = &model.joints[j];
+                c * x[if velocity { joint.dof_adr } else { joint.qpos_adr }]
+            })
+            .sum(),
+        TendonKind::Spatial { .. } => 0.0,
+    }
+}

@@ -39,7 +39,7 @@ pub(crate) fn normalize_quat(q: &[f64]) -> Quat {
 }
 
 /// The quaternion of a fixed rotation (w ≥ 0); exactly the identity for the identity matrix.
-fn rot_quat(r: &Mat3) -> Quat {
+pub(crate) fn rot_quat(r: &Mat3) -> Quat {
     if *r == Mat3::identity() {
         [1.0, 0.0, 0.0, 0.0]
     } else {

@@ -6,26 +6,13 @@
 use super::objects::{mul_quat, neg_quat, normalize_quat, object_pose, object_quat};
 use super::types::{Sensor, SensorObject, SensorType};
 use super::SensorWork;
-use crate::model::{Data, EfcType, Model, TendonKind};
+use crate::model::tendon::fixed_tendon;
+use crate::model::{Data, EfcType, Model};
 use crate::spatial::Vec3;
 
 /// The first row of kind `kind` for element `id` (MuJoCo reads the first matching row).
 pub(crate) fn limit_row(data: &Data, kind: EfcType, id: usize) -> Option<usize> {
     (data.ne + data.nf..data.nefc).find(|&r| data.efc_type[r] == kind && data.efc_id[r] == id)
-}
-
-/// A fixed tendon's length Σ coefᵢ·xᵢ over `x` (q for the length, v for the velocity).
-pub(crate) fn fixed_tendon(model: &Model, t: usize, x: &[f64], velocity: bool) -> f64 {
-    match &model.tendons[t].kind {
-        TendonKind::Fixed { joints } => joints
-            .iter()
-            .map(|&(j, c)| {
-                let joint = &model.joints[j];
-                c * x[if velocity { joint.dof_adr } else { joint.qpos_adr }]
-            })
-            .sum(),
-        TendonKind::Spatial { .. } => 0.0,
-    }
 }
 
 fn copy3(out: &mut [f64], v: &Vec3) {

@@ -11,9 +11,10 @@
 //! the last term the transport by the rotating frame (MuJoCo adds (p − p_r) × ω_r).
 
 use super::objects::{object_pose, object_velocity};
-use super::position::{fixed_tendon, limit_row};
+use super::position::limit_row;
 use super::types::{Sensor, SensorObject, SensorType};
 use super::SensorWork;
+use crate::model::tendon::fixed_tendon;
 use crate::model::{Data, EfcType, Model};
 use crate::spatial::Vec3;
 

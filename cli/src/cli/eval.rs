@@ -105,23 +105,13 @@ pub fn evaluate(
         }
     } else {
         out["forward"] = forward_json(model, data, s, v, tau);
-        out["sensors"] = sensors_json(model, data);
+        out["sensors"] = super::sensor_columns::to_json(model, data.sensordata.as_slice());
         let warnings = data.warnings.messages(model);
         if !warnings.is_empty() {
             out["warnings"] = json!(warnings);
         }
     }
     Ok(out)
-}
-
-/// Every computed sensor's values after `forward` at the state, by [`Sensor::label`]
-/// (`lagrange::sensor::Sensor::label`: its name, or `TYPE#ID` when unnamed).
-pub fn sensors_json(model: &Model, data: &Data) -> Value {
-    let mut map = Map::new();
-    for s in model.sensors.iter().filter(|s| s.is_computed() && model.options.flags.sensor) {
-        map.insert(s.label(), json!(data.sensordata.as_slice()[s.adr..s.adr + s.dim]));
-    }
-    Value::Object(map)
 }
 
 /// The sensors not computed, by label, with the reason.

@@ -1,6 +1,6 @@
-//! The sensors in `simulate`'s outputs: one CSV column per sensor component (`sensor:NAME[i]`)
-//! and the `--json` summary's `"sensors"` at the final state. Each row's sensors are those of the
-//! row's state: `forward` on a scratch copy of the inputs and state (the simulation's own `Data`,
+//! The sensors in the command line's outputs: one CSV column per sensor component
+//! (`sensor:NAME[i]`), the `simulate --json` summary's and each `eval` result's `"sensors"`.
+//! Each CSV row's sensors are those of the row's state: `forward` on a scratch copy of the inputs and state (the simulation's own `Data`,
 //! warm starts included, is untouched, so writing them does not change the trajectory).
 
 use lagrange::forward::forward;

@@ -200,10 +200,10 @@ fn joint_limit_sides(l: &LimitRow, q: &[f64], margin: f64) -> [Option<(f64, Vec3
 /// (distance, sign of J = ±∂L/∂q); none for an unlimited or spatial tendon.
 fn tendon_limit_sides(model: &Model, t: usize, q: &[f64]) -> [Option<(f64, f64)>; 2] {
     let tendon = &model.tendons[t];
-    let (Some(range), TendonKind::Fixed { joints }) = (tendon.range, &tendon.kind) else {
+    let (Some(range), TendonKind::Fixed { .. }) = (tendon.range, &tendon.kind) else {
         return [None, None];
     };
-    let length: f64 = joints.iter().map(|&(j, c)| c * q[model.joints[j].qpos_adr]).sum();
+    let length = crate::model::tendon::fixed_tendon(model, t, q, false);
     let within = |dist: f64, sign: f64| (dist < tendon.soft.margin).then_some((dist, sign));
     [within(length - range[0], 1.0), within(range[1] - length, -1.0)]
 }
