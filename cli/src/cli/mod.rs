@@ -7,11 +7,14 @@ pub mod eval;
 pub mod eval_stream;
 pub mod finite_json;
 pub mod info;
+pub mod input_schedule;
 pub mod interrupt;
 pub mod output_file;
+pub mod plot_file;
 pub mod sensor_columns;
 pub mod simulate;
 pub mod stdout;
+pub mod trajectory_csv;
 pub mod workprec;
 pub mod workprec_plot;
 
