@@ -319,7 +319,11 @@ pub fn run(
     let (mut failed, mut first) = (0usize, Vec::new());
     let expected =
         "{\"states\": [{\"q\": [...], \"v\": [...], \"tau\": [...], \"ctrl\": [...], \"act\": [...]}]}";
+    let progress = super::progress::bar(None, "states");
     let total = for_each_state(reader, &file, expected, &mut |i, s: StateIn| {
+        if i % 64 == 0 {
+            progress.set_position(i as u64);
+        }
         check_state(&model, &file, i, &s)?;
         let mut result = evaluate(&model, &mut data, &s, &frame_ids, kernels_only)?;
         if let Some(path) = first_null(&result) {
@@ -335,6 +339,7 @@ pub fn run(
         }
         out.json(&result)
     })?;
+    progress.finish_and_clear();
     // `sensors_not_computed` sorts after `results`: the key order stays serde_json's.
     out.print("],\"sensors_not_computed\":")?;
     out.json(&sensors_not_computed_json(&model))?;

@@ -11,6 +11,7 @@ pub mod input_schedule;
 pub mod interrupt;
 pub mod output_file;
 pub mod plot_file;
+pub mod progress;
 pub mod sensor_columns;
 pub mod simulate;
 pub mod stdout;

@@ -13,7 +13,7 @@ use super::sensor_columns;
 use super::stdout;
 use super::trajectory_csv::{self, RowProbe, TrajectoryCsv};
 use super::CliError;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::DriftCorrection;
 use lagrange::integrate::{IntegratorKind, State};
@@ -270,16 +270,8 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         }
         None => None,
     };
-    let progress = if steps >= 20_000 {
-        let bar = ProgressBar::new(steps);
-        bar.set_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, eta {eta}")
-                .expect("static template"),
-        );
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
+    let progress =
+        if steps >= 20_000 { super::progress::bar(Some(steps), "steps") } else { ProgressBar::hidden() };
     let energy_start = {
         let (kinetic, potential) = sim.energies();
         kinetic + potential

@@ -712,7 +712,9 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
     }
     let mut rows = Vec::new();
     let mut failures = Vec::new();
+    let progress = super::progress::bar(Some(runs.len() as u64), "runs");
     for (spec, dt, rtol) in runs {
+        progress.inc(1);
         let setting = match (dt, rtol) {
             (Some(dt), _) => format!("dt {}", fmt_num(dt)),
             (_, Some(r)) => format!("rtol {}", fmt_num(r)),
@@ -784,6 +786,7 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
         };
         write_reference(path, &setup, &reference, energy_scale, meta, &dts, options)?;
     }
+    progress.finish_and_clear();
     let measurement = Measurement {
         rows,
         failures,
