@@ -1,5 +1,5 @@
 //! `lagrange eval MODEL --states FILE`: one process evaluates a batch of states (the interface the
-//! validation scripts use; schema in the README). The states are read one at a time
+//! validation scripts use; schema in docs/cli.md). The states are read one at a time
 //! ([`super::eval_stream`]) and each result is written as soon as it is computed, so memory does not
 //! grow with the number of states. A state whose result has a non-finite number gets an
 //! `{"error": "..."}` entry in its place (naming the quantity) and the run ends with
@@ -131,7 +131,7 @@ pub fn sensors_not_computed_json(model: &Model) -> Value {
 }
 
 /// The staged forward pipeline at the state: `qacc` (constrained), its parts, and one entry per
-/// active constraint with its multipliers and residuals (README, "eval").
+/// active constraint with its multipliers and residuals (docs/cli.md, "eval").
 fn forward_json(model: &Model, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f64]) -> Value {
     data.qfrc_applied.copy_from_slice(tau);
     data.ctrl.fill(0.0);

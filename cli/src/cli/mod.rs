@@ -67,7 +67,7 @@ pub enum CliError {
 }
 
 impl CliError {
-    /// The process exit status this error ends the run with (README, "Exit status").
+    /// The process exit status this error ends the run with (docs/cli.md, "Exit status").
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Interrupted(_) => EXIT_INTERRUPTED,

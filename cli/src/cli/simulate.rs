@@ -548,7 +548,7 @@ fn track_limit_excursions(model: &Model, qpos: &[f64], excursions: &mut [f64]) {
     }
 }
 
-/// The `simulate --json` summary: one object (README, "simulate").
+/// The `simulate --json` summary: one object (docs/cli.md, "simulate").
 pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
     let simulated = s.steps as f64 * s.dt;
     let mut out = json!({
