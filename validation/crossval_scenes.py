@@ -34,6 +34,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import platform
 import subprocess
 import sys
@@ -350,7 +351,9 @@ def write_bench(rows, version, timers: bool) -> None:
     step_ratios = [r["c"]["lg_step"] / r["c"]["mj_step"] for r in rows]
     lines = [BENCH_SECTION, "",
              f"Written by `validation/crossval_scenes` on {time.strftime('%Y-%m-%d', time.gmtime())} (UTC), lagrange "
-             f"{commit()}, MuJoCo {version}, {platform.machine()}, not pinned, machine load not controlled. Report only. "
+             f"{commit()}, MuJoCo {version}, {platform.machine()}, not pinned, machine load not controlled (load average "
+             f"{' '.join(f'{x:.2f}' for x in os.getloadavg())} on {os.cpu_count()} CPUs when written: with more "
+             f"runnable processes than CPUs, figures move by 2× from run to run). Report only. "
              f"The scenes of the Contact scenes section of validation/report.md as shipped (their own solver options), "
              f"from their keyframes. MuJoCo: `mjTIMER_STEP` and `mjTIMER_POS_COLLISION` per step over {BENCH_STEPS} "
              f"`mj_step` (a C clock as `mjcb_time`), the best of 3 runs. lagrange, in the same script run: the mean µs per "
