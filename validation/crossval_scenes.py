@@ -308,8 +308,9 @@ def ratio(a: float, b: float) -> str:
 
 def commit() -> str:
     sha = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO, capture_output=True, text=True).stdout.strip()
-    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=REPO, capture_output=True,
-                           text=True).stdout.strip()
+    # The two files this script writes do not count as changes.
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", ".", ":!validation/report.md",
+                            ":!validation/bench.md"], cwd=REPO, capture_output=True, text=True).stdout.strip()
     return sha + (" + uncommitted changes" if dirty else "")
 
 
