@@ -2,9 +2,11 @@
 //! per-step controls, spread over threads with rayon and the GIL released (the pattern of
 //! `lagrange::batch`, with controls per step, activations and sensors recorded).
 //!
-//! Each rollout steps its own fresh `Data`, exactly as `Data(m)`, setting the state, then per
-//! step `d.ctrl[:] = controls[k]` and `step(m, d)` would from Python, and nothing is shared
-//! mutably between rollouts: the result is bit for bit the same for any thread count.
+//! Each rollout steps a `Data` reset to the state `Data(m)` starts from (a worker's, reused:
+//! `Data::new` costs milliseconds with contacts), exactly as setting the state, then per step
+//! `d.ctrl[:] = controls[k]` and `step(m, d)` would from Python, and nothing is shared mutably
+//! between rollouts: the result is bit for bit the same for any thread count
+//! (python/tests/test_rollout.py).
 
 use crate::arrays;
 use crate::error;
@@ -44,10 +46,13 @@ fn record(data: &Data, out: &mut Out<'_>, k: usize) {
     out.time[k] = data.time;
 }
 
-/// One rollout from `state` ([qpos, qvel, act]) under `controls` (nstep × nu) into `out`; on a
-/// failed step, the rows after it are NaN and the error is returned.
+/// One rollout from `state` ([qpos, qvel, act]) under `controls` (nstep × nu) into `out`, in
+/// `data` (a worker's, reset here: `reset` leaves a `Data` as `Data::new` made it, warm starts,
+/// contacts, stepper and failure state included, and `Data::new` costs milliseconds for a model
+/// with contacts); on a failed step, the rows after it are NaN and the error is returned.
 fn run_one(
     model: &Model,
+    data: &mut Data,
     state: &[f64],
     controls: &[f64],
     nstep: usize,
@@ -55,14 +60,14 @@ fn run_one(
 ) -> Result<(), String> {
     let (nq, nv, nu) = (model.nq, model.nv, model.actuators.len());
     let ns = model.nsensordata;
-    let mut data = Data::new(model);
+    lagrange::prelude::reset(model, data).map_err(|e| e.to_string())?;
     data.qpos.copy_from_slice(&state[..nq]);
     data.qvel.copy_from_slice(&state[nq..nq + nv]);
     data.act.copy_from_slice(&state[nq + nv..]);
-    record(&data, out, 0);
+    record(data, out, 0);
     for k in 0..nstep {
         data.ctrl.copy_from_slice(&controls[k * nu..(k + 1) * nu]);
-        if let Err(e) = lagrange::prelude::step(model, &mut data) {
+        if let Err(e) = lagrange::prelude::step(model, data) {
             for buffer in [&mut *out.qpos, &mut *out.qvel, &mut *out.act, &mut *out.sensordata] {
                 let n = buffer.len() / (nstep + 1);
                 buffer[(k + 1) * n..].fill(f64::NAN);
@@ -73,10 +78,10 @@ fn run_one(
         }
         // A step leaves the sensors of the state it started from (MuJoCo's mj_step).
         out.sensordata[k * ns..(k + 1) * ns].copy_from_slice(data.sensordata.as_slice());
-        record(&data, out, k + 1);
+        record(data, out, k + 1);
     }
     // The sensors of the last state, under the last controls.
-    lagrange::prelude::forward(model, &mut data);
+    lagrange::prelude::forward(model, data);
     out.sensordata[nstep * ns..].copy_from_slice(data.sensordata.as_slice());
     Ok(())
 }
@@ -148,12 +153,14 @@ pub fn rollout<'py>(
             .zip(chunks(&mut sensordata, rows * ns, nbatch))
             .map(|((((qpos, qvel), act), time), sensordata)| Out { qpos, qvel, act, time, sensordata })
             .collect();
-        let work = |(i, mut out): (usize, Out<'_>)| {
+        let work = |data: &mut Data, (i, mut out): (usize, Out<'_>)| {
             let state = &states[i * nstate..(i + 1) * nstate];
             let controls = &controls[i * nstep * nu..(i + 1) * nstep * nu];
-            run_one(&model, state, controls, nstep, &mut out).err()
+            run_one(&model, data, state, controls, nstep, &mut out).err()
         };
-        let run = || outs.into_par_iter().enumerate().map(work).collect::<Vec<_>>();
+        // One Data per rayon job (not per rollout), reset before each rollout.
+        let run =
+            || outs.into_par_iter().enumerate().map_init(|| Data::new(&model), work).collect::<Vec<_>>();
         match threads {
             Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
                 Ok(pool) => pool.install(run),

@@ -194,3 +194,25 @@ def test_gil_released_while_stepping(pendulum):
     done.set()
     t.join()
     assert len(ticks) > 100
+
+
+@pytest.mark.parametrize("integrator", ["Euler", "RK4", "implicit", "implicitfast"])
+def test_buffers_never_move(integrator):
+    """Every viewed buffer keeps its address through forward, steps of each integrator, reset
+    and keyframes: the library moves buffers out and back within a call, never reallocates."""
+    xml = PENDULUM.replace('<option timestep="0.01"/>', f'<option timestep="0.01" integrator="{integrator}"/>')
+    m = lagrange.Model.from_string(xml)
+    d = lagrange.Data(m)
+    names = ["qpos", "qvel", "act", "ctrl", "qfrc_applied", "xfrc_applied", "mocap_pos", "mocap_quat", "qacc",
+             "qfrc_constraint", "qfrc_bias", "qfrc_passive", "qfrc_actuator", "actuator_force", "sensordata"]
+    views = {n: getattr(d, n) for n in names}
+    address = {n: v.__array_interface__["data"][0] for n, v in views.items()}
+    lagrange.reset_keyframe(m, d, "up")
+    lagrange.forward(m, d)
+    lagrange.step(m, d, nstep=20)
+    lagrange.rnea(m, d, np.array([0.1]), np.zeros(1), np.zeros(1))
+    for n in names:
+        assert getattr(d, n).__array_interface__["data"][0] == address[n], n
+    assert views["qpos"][0] == d.qpos[0] != 1.5 and views["sensordata"][1] == d.sensordata[1]
+    lagrange.reset(m, d)
+    assert all(getattr(d, n).__array_interface__["data"][0] == address[n] for n in names)

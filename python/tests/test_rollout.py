@@ -69,10 +69,12 @@ def test_rollout_without_controls_and_failures():
     # A spring far too stiff for the step: it diverges from a displaced start, not from rest.
     m = lagrange.Model.from_string("""<mujoco><option timestep="0.01" gravity="0 0 0"/><worldbody><body>
         <joint type="slide" axis="0 0 1" stiffness="1e10"/><geom size="0.1" mass="1"/></body></worldbody></mujoco>""")
-    states = np.array([[0.0, 0.0], [1.0, 0.0]])
-    out = lagrange.rollout(m, states, nstep=100)
+    states = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]])
+    out = lagrange.rollout(m, states, nstep=100, threads=1)
     assert out["error"][0] is None and "diverged" in out["error"][1].lower()
     assert np.all(np.isfinite(out["qpos"][0])) and np.isnan(out["qpos"][1, -1, 0])
+    # The rollouts after a failed one (on the same worker's Data) are unaffected.
+    assert out["error"][2] is None and np.array_equal(out["qpos"][2], out["qpos"][0])
     assert np.array_equal(out["time"][0, :4], [0.0, 0.01, 0.02, 0.03])
     empty = lagrange.rollout(m, np.zeros((0, 2)), nstep=2)
     assert empty["qpos"].shape == (0, 3, 1)

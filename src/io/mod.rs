@@ -102,6 +102,17 @@ pub fn load_urdf_str(text: &str, path: &Path, options: &LoadOptions) -> Result<M
 /// # Errors
 /// [`LoadError`] naming the line, element and what is wrong;
 /// [`LoadError::UnsupportedFormat`] when the root element is neither.
+///
+/// # Example
+/// ```
+/// use lagrange::io::{load_str, LoadOptions};
+/// let options = LoadOptions { disabled_flags: vec!["gravity".into()], ..Default::default() };
+/// let xml = "<mujoco><worldbody><body><freejoint/><geom size='0.1'/></body></worldbody></mujoco>";
+/// let model = load_str(xml, std::path::Path::new("ball.xml"), &options)?;
+/// assert_eq!((model.nv, model.gravity.z), (6, 0.0));
+/// assert!(load_str("<html/>", std::path::Path::new("page.xml"), &options).is_err());
+/// # Ok::<(), lagrange::io::LoadError>(())
+/// ```
 pub fn load_str(text: &str, path: &Path, options: &LoadOptions) -> Result<Model, LoadError> {
     let mut spec = match format_of(text) {
         Some("urdf") => urdf::parse(text, path, options)?,
