@@ -57,3 +57,16 @@ def rel_err(a, b) -> float:
     """max |a - b| / max(1, max |b|)."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     return float(np.max(np.abs(a - b), initial=0.0) / max(1.0, float(np.max(np.abs(b), initial=0.0))))
+
+
+@pytest.fixture(scope="session")
+def cluster():
+    """A local Ray cluster of 2 CPUs for the session (the running one if Ray is initialized)."""
+    ray = pytest.importorskip("ray")
+    started = not ray.is_initialized()
+    if started:
+        os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
+        ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, configure_logging=False)
+    yield ray
+    if started:
+        ray.shutdown()

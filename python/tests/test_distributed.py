@@ -1,10 +1,8 @@
 """`lagrange.distributed.rollout` on a local Ray cluster of 2 worker CPUs: the same arrays as
-`lagrange.rollout`, bit for bit, with the model given as a path or as a Model from text, in
-chunks smaller than the batch; and the sweep helper over model variants."""
+`lagrange.rollout`, bit for bit, with the model given as a path or as a Model, in
+chunks smaller than the batch; and the sweep helper over model variants loaded from text."""
 
 from __future__ import annotations
-
-import os
 
 import numpy as np
 import pytest
@@ -13,18 +11,7 @@ import lagrange
 from conftest import GO1
 from test_rollout import batch
 
-ray = pytest.importorskip("ray")
-
-
-@pytest.fixture(scope="module")
-def cluster():
-    started = not ray.is_initialized()
-    if started:
-        os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
-        ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, configure_logging=False)
-    yield ray
-    if started:
-        ray.shutdown()
+pytest.importorskip("ray")
 
 
 def test_distributed_equals_local(cluster, tmp_path, monkeypatch):
