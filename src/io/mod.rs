@@ -94,6 +94,35 @@ pub fn load_urdf_str(text: &str, path: &Path, options: &LoadOptions) -> Result<M
     compile(&urdf::parse(text, path, options)?)
 }
 
+/// Loads a URDF or MJCF model from text with `options`, telling the format by its root element
+/// (`<robot>` or `<mujoco>`); `path` names it in messages and anchors relative mesh and include
+/// paths (the Python bindings' `Model.from_string` with load options, and the model a
+/// distributed rollout ships to its workers).
+///
+/// # Errors
+/// [`LoadError`] naming the line, element and what is wrong;
+/// [`LoadError::UnsupportedFormat`] when the root element is neither.
+///
+/// # Example
+/// ```
+/// use lagrange::io::{load_str, LoadOptions};
+/// let options = LoadOptions { disabled_flags: vec!["gravity".into()], ..Default::default() };
+/// let xml = "<mujoco><worldbody><body><freejoint/><geom size='0.1'/></body></worldbody></mujoco>";
+/// let model = load_str(xml, std::path::Path::new("ball.xml"), &options)?;
+/// assert_eq!((model.nv, model.gravity.z), (6, 0.0));
+/// assert!(load_str("<html/>", std::path::Path::new("page.xml"), &options).is_err());
+/// # Ok::<(), lagrange::io::LoadError>(())
+/// ```
+pub fn load_str(text: &str, path: &Path, options: &LoadOptions) -> Result<Model, LoadError> {
+    let mut spec = match format_of(text) {
+        Some("urdf") => urdf::parse(text, path, options)?,
+        Some(_) => mjcf::parse_str(text, path, options)?,
+        None => return Err(LoadError::UnsupportedFormat { file: path.display().to_string() }),
+    };
+    disable_flags(&mut spec, &options.disabled_flags)?;
+    compile(&spec)
+}
+
 /// The format of a model text, from its root element: `<robot>` is URDF, `<mujoco>` MJCF.
 fn format_of(text: &str) -> Option<&'static str> {
     let mut rest = text;
