@@ -19,5 +19,5 @@ pub(crate) use rne_post::RnePost;
 pub use rne_post::{
     body_acceleration, external_wrench, interaction_wrench, object_acceleration, rne_post_constraint,
 };
-pub(crate) use rnea::bias_forces_unchecked;
 pub use rnea::{bias_forces, gravity_forces, rnea};
+pub(crate) use rnea::{bias_forces_unchecked, rnea_unchecked};

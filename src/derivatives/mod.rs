@@ -1,0 +1,20 @@
+//! Derivatives of the dynamics for control and learning (issue 33; docs/derivatives.md, the
+//! derivation in docs/physics.md, "Derivatives of the dynamics"): analytic ∂τ/∂q and ∂τ/∂v of
+//! inverse dynamics ([`rnea_derivatives`]), analytic ∂q̈/∂q, ∂q̈/∂v and ∂q̈/∂τ of forward dynamics
+//! ([`aba_derivatives`], and [`smooth_derivatives`] with passive and actuator forces), all into a
+//! preallocated [`DerivativesWork`].
+//!
+//! Conventions: q columns are in each joint's tangent space as MuJoCo's `mj_integratePos` moves
+//! along it (a free joint's translation in its parent's axes, its rotation and a ball's in the
+//! body's axes); velocities, accelerations and forces in lagrange's own (MuJoCo's) coordinates.
+
+mod forward_dynamics;
+mod rnea;
+mod rnea_configuration;
+mod rnea_velocity;
+mod work;
+
+pub use forward_dynamics::{aba_derivatives, smooth_derivatives};
+pub use rnea::rnea_derivatives;
+pub(crate) use rnea_velocity::BiasDerivative;
+pub use work::DerivativesWork;
