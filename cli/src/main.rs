@@ -111,6 +111,11 @@ enum Command {
         /// `forward` block and no sensors.
         #[arg(long)]
         kernels_only: bool,
+        /// Add `"derivatives"` to each state's result (docs/derivatives.md): `all` (RNEA, ABA,
+        /// smooth forward dynamics and the step's transition Jacobians A, B) or `smooth` (without
+        /// the transition).
+        #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "all")]
+        derivatives: Option<eval::Derivatives>,
     },
     /// Simulate from a keyframe, a given state, or the model's reference configuration at rest,
     /// under gravity, with zero torques.
@@ -298,8 +303,8 @@ fn main() -> ExitCode {
             };
             workprec::run(&options, &request)
         }
-        Some(Command::Eval { model, states, json: _, jacobians, kernels_only }) => {
-            eval::run(&model, &options, &states, &jacobians, mode, kernels_only)
+        Some(Command::Eval { model, states, json: _, jacobians, kernels_only, derivatives }) => {
+            eval::run(&model, &options, &states, &jacobians, mode, kernels_only, derivatives)
         }
         Some(Command::Simulate {
             model,
