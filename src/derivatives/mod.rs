@@ -11,13 +11,10 @@
 
 mod forward_dynamics;
 mod rnea;
-mod rnea_configuration;
-mod rnea_velocity;
 mod transition;
 mod work;
 
 pub use forward_dynamics::{aba_derivatives, smooth_derivatives};
 pub use rnea::rnea_derivatives;
-pub(crate) use rnea_velocity::BiasDerivative;
 pub use transition::{transition_jacobians, TransitionOptions, TransitionWork};
 pub use work::DerivativesWork;

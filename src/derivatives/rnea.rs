@@ -1,7 +1,7 @@
 //! [`rnea_derivatives`]: ∂τ/∂q and ∂τ/∂v of inverse dynamics τ = RNEA(q, v, a) (the quantities
 //! of Pinocchio's `computeRNEADerivatives`, in lagrange's coordinates; ∂τ/∂a is the mass
 //! matrix M). Forward-mode differentiation of the recursion, one direction per dof
-//! ([`rnea_configuration`](super::rnea_configuration), [`rnea_velocity`](super::rnea_velocity)).
+//! (`dynamics::rnea_configuration`, `dynamics::rnea_velocity`).
 
 use super::DerivativesWork;
 use crate::dynamics::rnea_unchecked;

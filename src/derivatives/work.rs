@@ -3,8 +3,7 @@
 //! [`smooth_derivatives`](super::smooth_derivatives)), made once per model so that the kernels
 //! allocate nothing.
 
-use super::rnea_configuration::ConfigurationDerivative;
-use super::BiasDerivative;
+use crate::dynamics::{BiasDerivative, ConfigurationDerivative};
 use crate::error::InputError;
 use crate::Model;
 use nalgebra::{DMatrix, DVector};

@@ -11,8 +11,8 @@
 //! actuator part of D is [`add_force_derivative`]'s, shared with implicitfast, which drops ∂c/∂v.
 
 use super::{add_force_derivative, correct_drift, Advance, State, StepReport, Stepper};
-use crate::derivatives::BiasDerivative;
 use crate::dynamics::crba_unchecked;
+use crate::dynamics::BiasDerivative;
 use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
 use crate::model::{integrate_configuration_unchecked, Data, Model};
 use nalgebra::{DMatrix, DVector};
