@@ -36,6 +36,7 @@
 pub mod batch;
 pub mod collision;
 pub mod constraint;
+pub mod derivatives;
 pub mod dynamics;
 pub mod error;
 pub mod forward;

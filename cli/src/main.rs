@@ -116,6 +116,11 @@ enum Command {
         /// collision pass, and the wall times of the steps and of one collision pass.
         #[arg(long, value_name = "N")]
         step: Option<u32>,
+        /// Add `"derivatives"` to each state's result (docs/derivatives.md): `all` (RNEA, ABA,
+        /// smooth forward dynamics and the step's transition Jacobians A, B) or `smooth` (without
+        /// the transition).
+        #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "all")]
+        derivatives: Option<eval::Derivatives>,
     },
     /// Simulate from a keyframe, a given state, or the model's reference configuration at rest,
     /// under gravity, with zero torques.
@@ -316,8 +321,8 @@ fn main() -> ExitCode {
             };
             workprec::run(&options, &request)
         }
-        Some(Command::Eval { model, states, json: _, jacobians, kernels_only, step }) => {
-            eval::run(&model, &options, &states, &jacobians, mode, kernels_only, step)
+        Some(Command::Eval { model, states, json: _, jacobians, kernels_only, step, derivatives }) => {
+            eval::run(&model, &options, &states, &jacobians, mode, kernels_only, step, derivatives)
         }
         Some(Command::Simulate {
             model,

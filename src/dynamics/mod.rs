@@ -1,6 +1,8 @@
 //! Rigid-body dynamics (docs/architecture.md, "Layers"): inverse dynamics (RNEA), the joint-space inertia
 //! matrix (CRBA) and its tree-sparse factorization, forward dynamics (ABA), energy, centre of mass
-//! and momentum, and MuJoCo's per-body accelerations and wrenches after a solve (`rne_post`).
+//! and momentum, MuJoCo's per-body accelerations and wrenches after a solve (`rne_post`), and the
+//! forward-mode derivative passes of RNEA along each dof (`rnea_velocity`, `rnea_configuration`),
+//! which `derivatives` and the implicit stepper use.
 //! Every function writes into [`Data`](crate::Data) and allocates nothing.
 
 mod aba;
@@ -8,6 +10,8 @@ mod crba;
 mod energy;
 pub(crate) mod rne_post;
 mod rnea;
+mod rnea_configuration;
+mod rnea_velocity;
 
 pub use aba::aba;
 pub(crate) use aba::aba_unchecked;
@@ -19,5 +23,7 @@ pub(crate) use rne_post::RnePost;
 pub use rne_post::{
     body_acceleration, external_wrench, interaction_wrench, object_acceleration, rne_post_constraint,
 };
-pub(crate) use rnea::bias_forces_unchecked;
 pub use rnea::{bias_forces, gravity_forces, rnea};
+pub(crate) use rnea::{bias_forces_unchecked, rnea_unchecked};
+pub(crate) use rnea_configuration::ConfigurationDerivative;
+pub(crate) use rnea_velocity::BiasDerivative;

@@ -236,6 +236,43 @@ pub fn add_actuator_velocity_derivative(
     matrix: &mut [f64],
     h: f64,
 ) -> bool {
+    add_actuator_derivative(model, data, matrix, h, false, |a, i, x| {
+        let mut d = if a.biastype == BiasType::Affine { bias_velocity[i] } else { 0.0 };
+        if a.gaintype == GainType::Affine {
+            d += a.gainprm[2] * x;
+        }
+        d
+    })
+}
+
+/// Adds −h · Σᵢ momentᵢᵀ (∂forceᵢ/∂lengthᵢ) momentᵢ to `matrix` (column-major nv × nv), with
+/// ∂force/∂length = b₁ (affine bias) + g₁ · x (affine gain), zero at a `forcerange` bound: the
+/// actuators' configuration derivative ∂qfrc_actuator/∂q with the moment arms held fixed (exact
+/// for hinge and slide joint transmissions and fixed tendons, whose moments do not depend on q;
+/// the moment arms' own q-derivative of site, slider-crank, ball and free transmissions is not
+/// included). Reads the actuation stage's buffers at the same state.
+pub(crate) fn add_actuator_length_derivative(model: &Model, data: &Data, matrix: &mut [f64], h: f64) -> bool {
+    add_actuator_derivative(model, data, matrix, h, true, |a, _, x| {
+        let mut d = if a.biastype == BiasType::Affine { a.biasprm[1] } else { 0.0 };
+        if a.gaintype == GainType::Affine {
+            d += a.gainprm[1] * x;
+        }
+        d
+    })
+}
+
+/// Adds −h · Σᵢ momentᵢᵀ dᵢ momentᵢ to `matrix`, dᵢ = `d(actuator, i, x)` with x the gain's input
+/// (control — clamped to its range with `clamp`, as given otherwise, which is what MuJoCo's
+/// `mjd_actuator_vel` reads — or activation), for the simulated actuators whose force is inside
+/// its range.
+fn add_actuator_derivative(
+    model: &Model,
+    data: &Data,
+    matrix: &mut [f64],
+    h: f64,
+    clamp: bool,
+    d: impl Fn(&crate::model::Actuator, usize, f64) -> f64,
+) -> bool {
     if !model.options.flags.actuation {
         return false;
     }
@@ -256,18 +293,14 @@ pub fn add_actuator_velocity_derivative(
                 continue;
             }
         }
-        let mut d = if a.biastype == BiasType::Affine { bias_velocity[i] } else { 0.0 };
-        if a.gaintype == GainType::Affine && a.gainprm[2] != 0.0 {
-            let x = match act_index {
-                None if zeroed => 0.0,
-                None => data.ctrl[i],
-                Some(j) if a.actearly => {
-                    next_activation(a, data.act[j], data.act_dot[j], model.options.timestep)
-                }
-                Some(j) => data.act[j],
-            };
-            d += a.gainprm[2] * x;
-        }
+        let x = match act_index {
+            None if zeroed => 0.0,
+            None if clamp => clamped_ctrl(model, data, i),
+            None => data.ctrl[i],
+            Some(j) if a.actearly => next_activation(a, data.act[j], data.act_dot[j], model.options.timestep),
+            Some(j) => data.act[j],
+        };
+        let d = d(a, i, x);
         if d == 0.0 {
             continue;
         }

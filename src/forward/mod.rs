@@ -25,10 +25,10 @@ mod xfrc;
 
 pub use activation::{activation_rate, next_activation};
 pub(crate) use activation::{advance_activations, clamp_activations};
-pub(crate) use actuation::actuation_unchecked;
 pub use actuation::{
     actuation, add_actuator_velocity_derivative, resolved_bias_velocity, unsimulated_reason,
 };
+pub(crate) use actuation::{actuation_unchecked, add_actuator_length_derivative};
 
 pub use crate::constraint::DriftCorrection;
 pub use plan::{Plan, Stage, StageKind, Status};
@@ -121,7 +121,7 @@ pub(crate) fn passive(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
 
 /// The driving force on dof k: actuator plus applied, clamped to the dof's effort limit (URDF
 /// `<limit effort>` with `--clamp-effort`; +∞ otherwise).
-fn drive(model: &Model, data: &Data, k: usize) -> f64 {
+pub(crate) fn drive(model: &Model, data: &Data, k: usize) -> f64 {
     let limit = model.dof_effort_limit[k];
     (data.qfrc_actuator[k] + data.qfrc_applied[k]).clamp(-limit, limit)
 }

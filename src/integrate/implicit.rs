@@ -10,9 +10,9 @@
 //! (M − h D is M, positive definite, plus a small perturbation for reasonable h). The passive and
 //! actuator part of D is [`add_force_derivative`]'s, shared with implicitfast, which drops ∂c/∂v.
 
-use super::bias_derivative::BiasDerivative;
 use super::{add_force_derivative, correct_drift, Advance, State, StepReport, Stepper};
 use crate::dynamics::crba_unchecked;
+use crate::dynamics::BiasDerivative;
 use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
 use crate::model::{integrate_configuration_unchecked, Data, Model};
 use nalgebra::{DMatrix, DVector};

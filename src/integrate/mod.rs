@@ -9,7 +9,6 @@
 //! φ(q) = 0 and v onto J v = 0, as its [`DriftCorrection`](crate::constraint::DriftCorrection) says.
 
 mod adaptive;
-mod bias_derivative;
 mod euler;
 mod implicit;
 mod implicit_fast;

@@ -57,7 +57,9 @@ N_STATES = 64
 N_CHECK = 4  # states whose results are compared across engines
 CHECK_TOL = REF_REL  # relative (crossval_common.rel_err), per quantity and state: 1e-9
 ENGINES = ("pinocchio", "mujoco", "lagrange")
-OPS = [("fk", "FK + frames"), ("rnea", "RNEA"), ("crba", "CRBA"), ("aba", "ABA"), ("factor_solve", "LᵀDL factor + solve")]
+OPS = [("fk", "FK + frames"), ("rnea", "RNEA"), ("crba", "CRBA"), ("aba", "ABA"), ("factor_solve", "LᵀDL factor + solve"),
+       ("rnea_derivatives", "RNEA derivatives"), ("aba_derivatives", "ABA derivatives"),
+       ("aba_fd", "ABA derivatives by forward differences")]
 
 
 @dataclass

@@ -15,11 +15,13 @@
 // same operation to the three programs in turn (interleaved), many times.
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 #include <pinocchio/algorithm/cholesky.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
 
 #include <chrono>
 #include <cstdio>
@@ -168,7 +170,7 @@ int main(int argc, char** argv) {
   }
 
   Vec x(nv);
-  std::printf("{\"ready\":[\"fk\",\"rnea\",\"crba\",\"crba_world\",\"aba\",\"aba_world\",\"factor_solve\"]}\n");
+  std::printf("{\"ready\":[\"fk\",\"rnea\",\"crba\",\"crba_world\",\"aba\",\"aba_world\",\"factor_solve\",\"rnea_derivatives\",\"aba_derivatives\"]}\n");
   std::fflush(stdout);
   char op_buf[64];
   double budget_ms = 0.0;
@@ -211,6 +213,20 @@ int main(int argc, char** argv) {
             pinocchio::cholesky::solve(model, data, x);
             return x[0];
           });
+    } else if (op == "rnea_derivatives") {
+      // ∂τ/∂q, ∂τ/∂v (and ∂τ/∂a = M) of RNEA.
+      time_per_state(robot, "rnea_derivatives", n, budget_ms, [&](size_t s) {
+        const State& st = states[s];
+        pinocchio::computeRNEADerivatives(model, data, st.q, st.v, st.a);
+        return data.dtau_dq(0, 0);
+      });
+    } else if (op == "aba_derivatives") {
+      // ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = M⁻¹ of ABA.
+      time_per_state(robot, "aba_derivatives", n, budget_ms, [&](size_t s) {
+        const State& st = states[s];
+        pinocchio::computeABADerivatives(model, data, st.q, st.v, st.tau);
+        return data.ddq_dq(0, 0);
+      });
     } else {
       std::fprintf(stderr, "bench_pinocchio: unknown operation %s\n", op_buf);
       return 2;

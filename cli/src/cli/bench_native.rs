@@ -10,9 +10,11 @@
 //! The driver sends the same operation to the three programs in turn (interleaved), many times.
 
 use super::CliError;
+use lagrange::derivatives::{aba_derivatives, rnea_derivatives, DerivativesWork};
 use lagrange::dynamics::{aba, crba, crba_upper, factorize_mass_matrix, rnea, solve_mass_matrix};
 use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::forward_kinematics;
+use lagrange::model::integrate_configuration;
 use lagrange::{Data, Model};
 use nalgebra::DVector;
 use serde_json::json;
@@ -137,7 +139,12 @@ pub fn run(path: &Path, options: &LoadOptions, states_file: &Path, robot: &str) 
     let last_frame = model.frames.len().checked_sub(1);
     let st = &states;
     let m = &model;
-    emit(&json!({"ready": ["fk", "rnea", "crba", "aba", "factor_solve"]}))?;
+    let mut work = DerivativesWork::new(&model);
+    // Forward differences of ABA (the baseline the analytic derivatives are measured against).
+    let (mut q_fd, mut v_fd, mut e_fd) = (vec![0.0; model.nq], vec![0.0; nv], vec![0.0; nv]);
+    emit(
+        &json!({"ready": ["fk", "rnea", "crba", "aba", "factor_solve", "rnea_derivatives", "aba_derivatives", "aba_fd"]}),
+    )?;
     for line in std::io::stdin().lock().lines() {
         let line = line.map_err(|source| CliError::Io { file: "stdin".into(), source })?;
         let mut words = line.split_ascii_whitespace();
@@ -180,6 +187,42 @@ pub fn run(path: &Path, options: &LoadOptions, states_file: &Path, robot: &str) 
                     solve_mass_matrix(m, d, x).map_or(f64::NAN, |()| x[0])
                 },
             ),
+            "rnea_derivatives" => time_op(
+                &mut (&mut data, &mut work),
+                n,
+                budget_ms,
+                |_, _| {},
+                |(d, w), s| {
+                    rnea_derivatives(m, d, w, &st[s].q, &st[s].v, &st[s].a)
+                        .map_or(f64::NAN, |()| w.dtau_dq[(0, 0)])
+                },
+            ),
+            "aba_derivatives" => time_op(
+                &mut (&mut data, &mut work),
+                n,
+                budget_ms,
+                |_, _| {},
+                |(d, w), s| {
+                    aba_derivatives(m, d, w, &st[s].q, &st[s].v, &st[s].tau)
+                        .map_or(f64::NAN, |()| w.dqacc_dq[(0, 0)])
+                },
+            ),
+            // ∂q̈/∂q and ∂q̈/∂v by forward differences: 1 + 2 nv ABA calls (∂q̈/∂τ = M⁻¹ not included).
+            "aba_fd" => time_op(&mut data, n, budget_ms, none, |d, s| {
+                let mut sink = 0.0;
+                let Ok(a0) = aba(m, d, &st[s].q, &st[s].v, &st[s].tau).map(|a| a[0]) else { return f64::NAN };
+                for k in 0..nv {
+                    q_fd.copy_from_slice(&st[s].q);
+                    e_fd.fill(0.0);
+                    e_fd[k] = 1.0;
+                    let _ = integrate_configuration(m, &mut q_fd, &e_fd, 1e-6);
+                    sink += aba(m, d, &q_fd, &st[s].v, &st[s].tau).map_or(f64::NAN, |a| a[0]) - a0;
+                    v_fd.copy_from_slice(&st[s].v);
+                    v_fd[k] += 1e-6;
+                    sink += aba(m, d, &st[s].q, &v_fd, &st[s].tau).map_or(f64::NAN, |a| a[0]) - a0;
+                }
+                sink
+            }),
             _ => return Err(CliError::Usage(format!("bench-native: unknown operation {op}"))),
         };
         emit(&json!({"engine": "lagrange", "robot": robot, "op": op, "us": us}))?;

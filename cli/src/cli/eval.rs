@@ -11,6 +11,10 @@ use super::stdout::Stdout;
 use super::CliError;
 use lagrange::constraint::contact_force::contact_force;
 use lagrange::constraint::ConstraintMode;
+use lagrange::derivatives::{
+    aba_derivatives, rnea_derivatives, smooth_derivatives, transition_jacobians, DerivativesWork,
+    TransitionOptions, TransitionWork,
+};
 use lagrange::dynamics::{aba, bias_forces, center_of_mass, crba, kinetic_energy, potential_energy};
 use lagrange::forward::forward;
 use lagrange::io::{load, LoadOptions};
@@ -48,6 +52,61 @@ pub struct StateIn {
     pub qacc_warmstart: Option<Vec<f64>>,
 }
 
+/// What `eval --derivatives` adds to each state's result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Derivatives {
+    /// RNEA, ABA and smooth forward-dynamics derivatives and the step's transition Jacobians.
+    All,
+    /// Without the transition Jacobians.
+    Smooth,
+}
+
+/// Buffers of the derivatives, made once per run.
+pub struct DerivativeBuffers {
+    which: Derivatives,
+    work: DerivativesWork,
+    transition: TransitionWork,
+}
+
+impl DerivativeBuffers {
+    /// Buffers for `model`.
+    pub fn new(model: &Model, which: Derivatives) -> Self {
+        Self { which, work: DerivativesWork::new(model), transition: TransitionWork::new(model) }
+    }
+}
+
+/// `"derivatives"` of one state, after [`forward_json`] left the state in `data`: `rnea` at
+/// (q, v, forward's qacc), `aba` of the printed ABA `qacc` (τ = the state's tau), `smooth` of
+/// `forward.qacc_smooth` (passive, actuator and applied forces differentiated), `transition`
+/// (A, B of one step, as MuJoCo's `mjd_transitionFD`, centred, ε = 1e-6) unless `smooth`.
+fn derivatives_json(
+    model: &Model,
+    data: &mut Data,
+    s: &StateIn,
+    v: &[f64],
+    tau: &[f64],
+    d: &mut DerivativeBuffers,
+) -> Result<Value, CliError> {
+    let qacc = data.qacc.clone();
+    let w = &mut d.work;
+    rnea_derivatives(model, data, w, &s.q, v, qacc.as_slice())?;
+    let rnea = json!({"dtau_dq": rows(&w.dtau_dq), "dtau_dv": rows(&w.dtau_dv)});
+    aba_derivatives(model, data, w, &s.q, v, tau)?;
+    let aba = json!({"dqacc_dq": rows(&w.dqacc_dq), "dqacc_dv": rows(&w.dqacc_dv), "dqacc_dtau": rows(&w.dqacc_dtau)});
+    smooth_derivatives(model, data, w)?;
+    let smooth = json!({"dqacc_dq": rows(&w.dqacc_dq), "dqacc_dv": rows(&w.dqacc_dv), "dqacc_dtau": rows(&w.dqacc_dtau)});
+    let mut out = json!({"rnea": rnea, "aba": aba, "smooth": smooth});
+    if d.which == Derivatives::All {
+        data.qacc_warmstart.copy_from(&qacc);
+        out["transition"] =
+            match transition_jacobians(model, data, &mut d.transition, &TransitionOptions::default()) {
+                Ok(()) => json!({"A": rows(&d.transition.a), "B": rows(&d.transition.b)}),
+                Err(e) => json!({"error": e.to_string()}),
+            };
+    }
+    Ok(out)
+}
+
 fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
     (0..m.nrows()).map(|r| m.row(r).iter().copied().collect()).collect()
 }
@@ -66,6 +125,7 @@ pub fn evaluate(
     s: &StateIn,
     jacobians: &[usize],
     kernels_only: bool,
+    derivatives: Option<&mut DerivativeBuffers>,
 ) -> Result<Value, CliError> {
     let zeros = vec![0.0; model.nv];
     let v = s.v.as_deref().unwrap_or(&zeros);
@@ -110,6 +170,9 @@ pub fn evaluate(
     } else {
         out["forward"] = forward_json(model, data, s, v, tau);
         out["sensors"] = super::sensor_columns::to_json(model, data.sensordata.as_slice());
+        if let Some(d) = derivatives {
+            out["derivatives"] = derivatives_json(model, data, s, v, tau, d)?;
+        }
         let warnings = data.warnings.messages(model);
         if !warnings.is_empty() {
             out["warnings"] = json!(warnings);
@@ -290,6 +353,8 @@ fn check_state(model: &Model, file: &str, i: usize, s: &StateIn) -> Result<(), C
 
 /// Runs `eval`, printing `{"results": [...]}`; with `step` = Some(N), each result is the state
 /// after N steps ([`super::eval_step`]).
+// One argument per command-line option of `eval`, passed through from clap.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     path: &Path,
     options: &LoadOptions,
@@ -298,8 +363,21 @@ pub fn run(
     mode: Option<ConstraintMode>,
     kernels_only: bool,
     step: Option<u32>,
+    derivatives: Option<Derivatives>,
 ) -> Result<(), CliError> {
     let step = step.map(super::eval_step::check_steps).transpose()?;
+    if kernels_only && derivatives.is_some() {
+        return Err(CliError::Usage(
+            "--derivatives needs the forward pipeline (its qacc, actuators and step): drop --kernels-only"
+                .into(),
+        ));
+    }
+    if step.is_some() && derivatives.is_some() {
+        return Err(CliError::Usage(
+            "--step prints the states after the steps, --derivatives those of the given states: use one at a time"
+                .into(),
+        ));
+    }
     let mut model = load(path, options)?;
     if let Some(mode) = mode {
         model.set_constraint_mode(mode);
@@ -317,6 +395,7 @@ pub fn run(
         .map(|f| std::io::BufReader::with_capacity(1 << 16, f))
         .map_err(|source| CliError::Io { file: file.clone(), source })?;
     let mut data = Data::new(&model);
+    let mut buffers = derivatives.map(|which| DerivativeBuffers::new(&model, which));
     let mut out = Stdout::lock();
     // The output is `{"constraints": {...}, "results": [...]}`, keys in serde_json's (sorted)
     // order: byte for byte what serializing the whole object at once gives.
@@ -335,7 +414,7 @@ pub fn run(
         check_state(&model, &file, i, &s)?;
         let mut result = match step {
             Some(n) => super::eval_step::evaluate(&model, &mut data, &s, n)?,
-            None => evaluate(&model, &mut data, &s, &frame_ids, kernels_only)?,
+            None => evaluate(&model, &mut data, &s, &frame_ids, kernels_only, buffers.as_mut())?,
         };
         if let Some(path) = first_null(&result) {
             let reason = format!("states[{i}]: {} is not finite (NaN or infinite)", describe(&path));

@@ -1,5 +1,6 @@
 //! ∂c/∂v, the velocity derivative of the bias forces c(q, v) = RNEA(q, v, 0) (MuJoCo's
-//! `qfrc_bias`; the quantity of its `mjd_rne_vel`), by differentiating the recursive Newton–Euler
+//! `qfrc_bias`; the quantity of its `mjd_rne_vel`) — also ∂τ/∂v of RNEA(q, v, a), which the
+//! acceleration does not enter — by differentiating the recursive Newton–Euler
 //! recursion (RBDA §5.3, Table 5.1) in the direction of each degree of freedom — forward-mode
 //! differentiation of the recursion, exact to rounding, not finite differences. With q fixed the
 //! joint transforms and motion subspaces S are constant, and for a direction δv:
@@ -47,6 +48,11 @@ impl BiasDerivative {
             in_subtree: vec![false; nb],
             dbias_dv: DMatrix::zeros(model.nv, model.nv),
         }
+    }
+
+    /// Bodies the buffers were made for.
+    pub fn nbody(&self) -> usize {
+        self.v_body.len()
     }
 
     /// Fills [`dbias_dv`](Self::dbias_dv) at (q, v); updates the joint transforms and motion

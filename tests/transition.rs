@@ -1,0 +1,133 @@
+//! Transition Jacobians of a step (`lagrange::derivatives::transition_jacobians`) against MuJoCo
+//! 4.0's `mjd_transitionFD` (golden data in `tests/data/mujoco/transition/`, from
+//! `validation/mujoco_transition_golden.py`): the go1 standing and walking on its floor, the
+//! humanoid falling onto its floor, the contact-free panda arm (implicitfast), at
+//! `TRANSITION_REL` where every nudged step keeps the nominal contact set; plus the
+//! library's own checks (state restored, forward vs centred).
+
+mod common;
+
+use common::*;
+use lagrange::derivatives::{transition_jacobians, TransitionOptions, TransitionWork};
+use lagrange::Data;
+use serde::Deserialize;
+
+#[derive(Deserialize)]
+struct Golden {
+    model: String,
+    eps: f64,
+    centered: bool,
+    states: Vec<State>,
+}
+
+#[derive(Deserialize)]
+struct State {
+    qpos: Vec<f64>,
+    qvel: Vec<f64>,
+    act: Vec<f64>,
+    ctrl: Vec<f64>,
+    qacc_warmstart: Vec<f64>,
+    ncon: usize,
+    contact_set_same: bool,
+    #[serde(rename = "A")]
+    a: Vec<Vec<f64>>,
+    #[serde(rename = "B")]
+    b: Vec<Vec<f64>>,
+}
+
+fn rows(m: &[Vec<f64>]) -> nalgebra::DMatrix<f64> {
+    let (r, c) = (m.len(), m.first().map_or(0, |x| x.len()));
+    nalgebra::DMatrix::from_fn(r, c, |i, j| m[i][j])
+}
+
+fn check_scene(scene: &str) {
+    let file = repo_path(&format!("tests/data/mujoco/transition/{scene}.json"));
+    let golden: Golden = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    let model = tight_model(repo_path(&golden.model).to_str().unwrap());
+    let mut data = Data::new(&model);
+    let mut work = TransitionWork::new(&model);
+    let options = TransitionOptions { eps: golden.eps, centered: golden.centered };
+    for (s, st) in golden.states.iter().enumerate() {
+        data.qpos.copy_from_slice(&st.qpos);
+        data.qvel.copy_from_slice(&st.qvel);
+        data.act.copy_from_slice(&st.act);
+        data.ctrl.copy_from_slice(&st.ctrl);
+        data.qacc_warmstart.copy_from_slice(&st.qacc_warmstart);
+        transition_jacobians(&model, &mut data, &mut work, &options).unwrap();
+        assert_eq!(data.qpos.as_slice(), &st.qpos[..], "{scene}: the state is restored");
+        let at = |w: &str| format!("{scene} state {s} ({} contacts) {w}", st.ncon);
+        // [A B], the Jacobian of x′ in (x, u), norm-wise: B alone can be all but zero (forces at
+        // their range bounds) and a one-sided difference at a control bound carries ε|x′|/ε.
+        let ours = nalgebra::DMatrix::from_fn(work.a.nrows(), work.a.ncols() + work.b.ncols(), |i, j| {
+            if j < work.a.ncols() {
+                work.a[(i, j)]
+            } else {
+                work.b[(i, j - work.a.ncols())]
+            }
+        });
+        let (ga, gb) = (rows(&st.a), if st.b.is_empty() { work.b.clone() } else { rows(&st.b) });
+        let theirs = nalgebra::DMatrix::from_fn(ga.nrows(), ga.ncols() + gb.ncols(), |i, j| {
+            if j < ga.ncols() {
+                ga[(i, j)]
+            } else {
+                gb[(i, j - ga.ncols())]
+            }
+        });
+        let e = rel_err_mat(&ours, &theirs);
+        if st.contact_set_same {
+            assert_close_mat(&at("[A B]"), &ours, &theirs, TRANSITION_REL);
+            println!(
+                "{}: A alone {:.2e}, B alone {:.2e}",
+                at(""),
+                rel_err_mat(&work.a, &ga),
+                rel_err_mat(&work.b, &gb)
+            );
+        } else {
+            println!("{}: contact set changes under the nudges; [A B] {e:.2e} (reported)", at(""));
+        }
+    }
+}
+
+#[test]
+fn transition_go1_standing() {
+    check_scene("go1_standing");
+}
+
+#[test]
+fn transition_go1_walking() {
+    check_scene("go1_walking");
+}
+
+#[test]
+fn transition_humanoid_floor() {
+    check_scene("humanoid_floor");
+}
+
+#[test]
+fn transition_panda_contact_free() {
+    check_scene("panda_free");
+}
+
+/// Forward differences agree with centred ones to O(ε) on the contact-free arm, and a bad ε is
+/// an error that leaves the state alone.
+#[test]
+fn forward_differences_and_bad_eps() {
+    let model = tight_model(repo_path("models/mjcf/franka_emika_panda/panda.xml").to_str().unwrap());
+    let mut data = Data::new(&model);
+    // Away from the joint limits (the fingers' lower limit is their qpos0).
+    data.qpos[3] = -1.5;
+    data.qpos[5] = 1.5;
+    data.qpos[7] = 0.02;
+    data.qpos[8] = 0.02;
+    let mut work = TransitionWork::new(&model);
+    transition_jacobians(&model, &mut data, &mut work, &TransitionOptions::default()).unwrap();
+    let centred = (work.a.clone(), work.b.clone());
+    let forward = TransitionOptions { eps: 1e-7, centered: false };
+    transition_jacobians(&model, &mut data, &mut work, &forward).unwrap();
+    assert_close_mat("forward vs centred A", &work.a, &centred.0, 1e-4);
+    assert_close_mat("forward vs centred B", &work.b, &centred.1, 1e-4);
+    let q = data.qpos.clone();
+    let bad = TransitionOptions { eps: -1.0, centered: true };
+    assert!(transition_jacobians(&model, &mut data, &mut work, &bad).is_err());
+    assert_eq!(data.qpos, q);
+}
