@@ -10,17 +10,18 @@
 //! capsule–capsule/box, box–box). `mjc_Convex` runs GJK and EPA on the geoms (each inflated by
 //! half the pair's margin + gap) and then, with `multiccd` on:
 //!
-//! - **box and mesh against box and mesh, margin + gap = 0** (`maxContacts` 4, `mj_maxContact`
-//!   4): the polytope path. From EPA's penetration direction MuJoCo finds the faces of both
+//! - **box and mesh against box and mesh** (`mj_maxContact` 4, 5 with a margin): the polytope
+//!   path. From EPA's penetration direction MuJoCo finds the faces of both
 //!   geoms at their contact features; two faces within ~5.1° of opposite (normals' dot below
 //!   −0.996) clip one another: the face of geom 1 clips geom 2's face polygon (Sutherland–
-//!   Hodgman), the clipped vertices not below geom 1's face plane are dropped, more than four are
+//!   Hodgman), the clipped vertices farther than the margin + gap above geom 1's face plane are
+//!   dropped (MuJoCo 4.0 clips margin pairs too; its older source turned them), more than four are
 //!   pruned to a quadrilateral of largest area. Failing that, an edge of the lower-dimensional
 //!   feature within ~5.1° of parallel to a face of the other (|dot| below 0.0888) is clipped
 //!   against that face (its two farthest points). Otherwise the single EPA point stays. Each point
 //!   has its own depth (below the clipping face), its normal along the clipped face's normal.
-//! - **a capsule or a cylinder with anything but a sphere or an ellipsoid, and box or mesh pairs
-//!   with margin + gap > 0** (`mj_maxContact` 5): the perturbation path. Both geoms are turned by
+//! - **a capsule or a cylinder with anything but a sphere or an ellipsoid** (`mj_maxContact` 5):
+//!   the perturbation path. Both geoms are turned by
 //!   ±1e-3 rad about the two tangents of the first contact (geom 1 one way, geom 2 the other,
 //!   about the contact point) and the solver rerun; each new contact farther than
 //!   1e-3 × the smaller bounding radius from all earlier ones is added with the first contact's
@@ -232,6 +233,7 @@ pub fn polytope_contacts(
     x2: &Transform,
     s2: &ConvexShape,
     first: PairPoint,
+    margin: f64,
     emit: &mut dyn FnMut(PairPoint),
 ) -> usize {
     let (Some(p1), Some(p2)) = (Poly::of(s1), Poly::of(s2)) else {
@@ -260,11 +262,11 @@ pub fn polytope_contacts(
             }
         }
         let mut count = 0;
-        let mut out = |w1: Vec3, w2: Vec3, dist: f64, swap: bool| {
+        // The normal is the clipped face's reversed (face–face), the face's (an edge of geom 2)
+        // or the face's reversed (an edge of geom 1): the direction from w1 to w2 of a penetrating
+        // point, kept for the points within the margin above the face.
+        let mut out = |w1: Vec3, w2: Vec3, dist: f64, swap: bool, normal: Vec3| {
             let (w1, w2) = if swap { (w2, w1) } else { (w1, w2) };
-            let d = w1 - w2;
-            let norm = d.norm();
-            let normal = if norm > MINVAL { d / norm } else { Vec3::x() };
             emit(PairPoint { p1: w1, p2: w2, normal, dist });
             count += 1;
         };
@@ -273,8 +275,8 @@ pub fn polytope_contacts(
             let (n2, f2) = s.normals2[j];
             face_polygon(&p1, x1, f1, &mut tmp, &mut s.face1);
             face_polygon(&p2, x2, f2, &mut tmp, &mut s.face2);
-            clip(&s.face1, &s.face2, &n1, &n2, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
-                out(w1, w2, d, false)
+            clip(&s.face1, &s.face2, &n1, &n2, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
+                out(w1, w2, d, false, -n2)
             });
         } else if dim1 < 3 && dim1 <= dim2 {
             // An edge of geom 1 against a face of geom 2.
@@ -285,8 +287,8 @@ pub fn polytope_contacts(
                 let edge = [s.face1[2 * e], s.face1[2 * e + 1]];
                 s.face1.clear();
                 s.face1.extend_from_slice(&edge);
-                clip(&s.face2, &s.face1, &n2, &-n2, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
-                    out(w1, w2, d, true)
+                clip(&s.face2, &s.face1, &n2, &-n2, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
+                    out(w1, w2, d, true, -n2)
                 });
             }
         } else if dim2 < 3 {
@@ -298,8 +300,8 @@ pub fn polytope_contacts(
                 let edge = [s.face2[2 * e], s.face2[2 * e + 1]];
                 s.face2.clear();
                 s.face2.extend_from_slice(&edge);
-                clip(&s.face1, &s.face2, &n1, &-n1, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
-                    out(w1, w2, d, false)
+                clip(&s.face1, &s.face2, &n1, &-n1, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
+                    out(w1, w2, d, false, n1)
                 });
             }
         }
@@ -333,11 +335,13 @@ fn edge_face(edges: &[Vec3], faces: &[(Vec3, u32)]) -> Option<(usize, usize)> {
 /// witness points (on `face`'s plane along `wit_dir`, on `clipped_in`) and signed distance below
 /// the face: MuJoCo's `polygonClip`, with its pruning to the largest quadrilateral (more than 4
 /// points) and to the two farthest points (an edge).
+#[allow(clippy::too_many_arguments)]
 fn clip(
     face: &[Vec3],
     clipped_in: &[Vec3],
     n: &Vec3,
     wit_dir: &Vec3,
+    margin: f64,
     poly: &mut Vec<Vec3>,
     next: &mut Vec<Vec3>,
     out: &mut dyn FnMut(Vec3, Vec3, f64),
@@ -380,12 +384,12 @@ fn clip(
         }
         std::mem::swap(poly, next);
     }
-    poly.retain(|p| (p - face[0]).dot(n) <= 0.0);
+    poly.retain(|p| (p - face[0]).dot(n) <= margin);
     if poly.is_empty() {
         return;
     }
-    // MuJoCo 4.0: the point on the face's plane (along its normal) and, from it, one along
-    // `wit_dir` by the distance (the snapshot of MuJoCo's source kept the clipped vertex itself;
+    // MuJoCo 4.0: the point on the face's plane (along its normal) and, from it, one against
+    // `wit_dir` by the signed distance (the snapshot of MuJoCo's source kept the clipped vertex itself;
     // the live 4.0.0 contacts show this form).
     // The distance is the one below the face scaled by the cosine between the face's normal and
     // `wit_dir` (the live contacts again).
@@ -393,7 +397,7 @@ fn clip(
         let d = (v - face[0]).dot(n);
         let w1 = v - n * d;
         let dist = -d * n.dot(wit_dir);
-        (w1, w1 + wit_dir * dist.abs(), dist)
+        (w1, w1 - wit_dir * dist, dist)
     };
     let mut report = |v: &Vec3| {
         let (w1, w2, d) = witness(v);
@@ -529,7 +533,7 @@ pub fn perturbed_contacts(
 
 /// The contacts of a convex pair beyond GJK/EPA's first point `first` (already penetrating or
 /// within `within`), as MuJoCo's `mjc_Convex` finds them with `multiccd` on (the caller asks only
-/// for pairs whose contact limit exceeds one): polytopes without margin + gap by clipping
+/// for pairs whose contact limit exceeds one): polytopes by clipping
 /// ([`polytope_contacts`], which emits `first` itself when nothing lines up), the other pairs by
 /// perturbation ([`perturbed_contacts`], after `first`). `rbound` is the smaller bounding radius.
 #[allow(clippy::too_many_arguments)]
@@ -545,9 +549,9 @@ pub fn convex_contacts(
     emit: &mut dyn FnMut(PairPoint),
 ) {
     let polytopes = Poly::of(s1).is_some() && Poly::of(s2).is_some();
-    if polytopes && margin_gap == 0.0 {
-        if first.dist < 0.0 {
-            polytope_contacts(x1, s1, x2, s2, first, emit);
+    if polytopes {
+        if first.dist < margin_gap {
+            polytope_contacts(x1, s1, x2, s2, first, margin_gap, emit);
         } else {
             emit(first);
         }

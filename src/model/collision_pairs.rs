@@ -64,7 +64,7 @@ pub fn type_rank(shape: &Shape) -> u8 {
 /// 2; the convex pairs (`mjc_Convex`, see `collision::multiccd`) 1 with a sphere or an ellipsoid
 /// or when `multiccd` is off, else 5 with a capsule or a cylinder (one contact and four at
 /// perturbed poses), 4 for boxes and meshes without margin (face clipping pruned to a
-/// quadrilateral) and 5 with one (perturbed poses); every other pair 1.
+/// quadrilateral) and 5 with one; every other pair 1.
 fn max_contacts(a: &Shape, b: &Shape, multiccd: bool, has_margin: bool) -> usize {
     use Shape::*;
     match (a, b) {
