@@ -20,22 +20,27 @@
 //!   feature within ~5.1° of parallel to a face of the other (|dot| below 0.0888) is clipped
 //!   against that face (its two farthest points). Otherwise the single EPA point stays. Each point
 //!   has its own depth (below the clipping face), its normal along the clipped face's normal.
-//! - **a capsule or a cylinder with anything but a sphere or an ellipsoid** (`mj_maxContact` 5):
-//!   the perturbation path. Both geoms are turned by
-//!   ±1e-3 rad about the two tangents of the first contact (geom 1 one way, geom 2 the other,
-//!   about the contact point) and the solver rerun; each new contact farther than
-//!   1e-3 × the smaller bounding radius from all earlier ones is added with the first contact's
-//!   distance.
+//! - **a capsule or a cylinder against a box or a mesh** (`mj_maxContact` 5): MuJoCo's source
+//!   snapshot turns both geoms by ±1e-3 rad about the contact's tangents and reruns the solver;
+//!   the live 4.0.0 does not (its contacts show it): a capsule's segment, or a cylinder's side
+//!   line, within ~5.1° of parallel to a face of the polytope is clipped by the face (points on
+//!   the surface and on the face's plane, normal the face's reversed: a capsule lying on a face
+//!   gets its two ends); a cylinder's cap within ~5.1° of facing a face is clipped as a polygon
+//!   (four rim points at 22.5° + k·90° for a cylinder standing on a face — lagrange takes the cap
+//!   as a regular octagon at 22.5° + k·45°, which reproduces that); otherwise one contact.
+//! - **capsule–cylinder, cylinder–cylinder** (`mj_maxContact` 5): one contact at every pose
+//!   measured (lagrange gives one).
 //! - **a sphere or an ellipsoid**: one contact.
 //!
-//! With `multiccd` off every convex pair gives one contact. lagrange reproduces both paths on its
-//! own GJK/EPA ([`super::convex`]): the contact features are the vertices of each geom within a
-//! small tolerance of its support plane along the EPA normal (MuJoCo reads them off EPA's final
-//! face), and when several face pairs are within the tolerance the most nearly opposite is taken
-//! (MuJoCo takes the first in its polygon order).
+//! With `multiccd` off every convex pair gives one contact. lagrange reproduces these on its own
+//! GJK/EPA ([`super::convex`]): the contact features are the vertices of each geom within a small
+//! tolerance of its support plane along the EPA normal (MuJoCo reads them off EPA's final face),
+//! and when several face pairs are within the tolerance the most nearly opposite is taken (MuJoCo
+//! takes the first in its polygon order). The witness points follow the live 4.0.0, not the
+//! snapshot (see [`polytope_contacts`]' clipping).
 
 use super::convex::{ConvexShape, PairPoint};
-use crate::spatial::{Mat3, Transform, Vec3};
+use crate::spatial::{Transform, Vec3};
 use parry3d_f64::math::Vector;
 use std::cell::RefCell;
 
@@ -45,11 +50,6 @@ const FACE_TOL: f64 = 0.996;
 const EDGE_TOL: f64 = 0.0888;
 /// MuJoCo's `mjMINVAL`.
 const MINVAL: f64 = 1e-15;
-/// The perturbation angle of the perturbation path (rad).
-const PERTURBATION: f64 = 1e-3;
-/// Distinct contacts of the perturbation path are farther apart than this fraction of the
-/// smaller bounding radius.
-const DISTINCT: f64 = 1e-3;
 
 /// Scratch buffers of the clipping, reused per thread (no allocation once grown).
 #[derive(Default)]
@@ -484,58 +484,11 @@ fn largest_quad(p: &[Vec3]) -> [usize; 4] {
     res
 }
 
-/// The rotation by `angle` about unit `axis`.
-fn axis_angle(axis: &Vec3, angle: f64) -> Mat3 {
-    nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(*axis), angle).into_inner()
-}
-
-/// `x` turned by `rot` about world point `c`.
-fn rotate_about(x: &Transform, rot: &Mat3, c: &Vec3) -> Transform {
-    let rel = c - x.pos;
-    Transform::new(rot * x.rot, x.pos - (rot * rel - rel))
-}
-
-/// MuJoCo's perturbation path (module documentation): from the first contact `first`, the
-/// contacts of the pair with geom 1 turned by ±[`PERTURBATION`] about the contact's tangents and
-/// geom 2 the other way, about the contact point, found by `solve` at those poses; each one
-/// farther than [`DISTINCT`] × `rbound` (the smaller bounding radius) from all earlier contacts
-/// (`first` included) is emitted with `first`'s distance. Returns how many were emitted.
-pub fn perturbed_contacts(
-    x1: &Transform,
-    x2: &Transform,
-    first: &PairPoint,
-    rbound: f64,
-    solve: &mut dyn FnMut(&Transform, &Transform) -> Option<PairPoint>,
-    emit: &mut dyn FnMut(PairPoint),
-) -> usize {
-    let frame = super::contact_frame(&first.normal, None);
-    let c = (first.p1 + first.p2) * 0.5;
-    let tol = DISTINCT * rbound;
-    let mut found = [c; 5];
-    let mut count = 1;
-    for axis in [frame.row(1).transpose(), frame.row(2).transpose()] {
-        for angle in [-PERTURBATION, PERTURBATION] {
-            let rot = axis_angle(&axis, angle);
-            let y1 = rotate_about(x1, &rot, &c);
-            let y2 = rotate_about(x2, &rot.transpose(), &c);
-            let Some(p) = solve(&y1, &y2) else { continue };
-            let pos = (p.p1 + p.p2) * 0.5;
-            if found[..count].iter().any(|q| (q - pos).norm() <= tol) {
-                continue;
-            }
-            found[count] = pos;
-            count += 1;
-            emit(PairPoint { dist: first.dist, ..p });
-        }
-    }
-    count - 1
-}
-
-/// The contacts of a convex pair beyond GJK/EPA's first point `first` (already penetrating or
-/// within `within`), as MuJoCo's `mjc_Convex` finds them with `multiccd` on (the caller asks only
-/// for pairs whose contact limit exceeds one): polytopes by clipping
-/// ([`polytope_contacts`], which emits `first` itself when nothing lines up), the other pairs by
-/// perturbation ([`perturbed_contacts`], after `first`). `rbound` is the smaller bounding radius.
+/// The contacts of a convex pair from GJK/EPA's first point `first` (penetrating or within the
+/// margin + gap), as MuJoCo 4.0 gives them with `multiccd` on (the caller asks only for pairs
+/// whose contact limit exceeds one; module documentation): polytopes by face and edge clipping
+/// ([`polytope_contacts`]), a capsule or a cylinder's side against a polytope face by segment
+/// clipping, a cylinder's cap against a polytope face as an octagon; `first` alone otherwise.
 #[allow(clippy::too_many_arguments)]
 pub fn convex_contacts(
     x1: &Transform,
@@ -544,8 +497,6 @@ pub fn convex_contacts(
     s2: &ConvexShape,
     first: PairPoint,
     margin_gap: f64,
-    within: f64,
-    rbound: f64,
     emit: &mut dyn FnMut(PairPoint),
 ) {
     let polytopes = Poly::of(s1).is_some() && Poly::of(s2).is_some();
@@ -557,7 +508,131 @@ pub fn convex_contacts(
         }
         return;
     }
-    emit(first);
-    let mut solve = |y1: &Transform, y2: &Transform| super::convex::support_pair(y1, s1, y2, s2, within);
-    perturbed_contacts(x1, x2, &first, rbound, &mut solve, emit);
+    match (s1, Poly::of(s2)) {
+        (ConvexShape::Capsule(c), Some(p2)) => {
+            let (a, b) = (c.segment.a, c.segment.b);
+            let seg = [x1.act_point(&Vec3::new(a.x, a.y, a.z)), x1.act_point(&Vec3::new(b.x, b.y, b.z))];
+            segment_polytope(x1, seg, c.radius, x2, &p2, first, margin_gap, emit);
+        }
+        (ConvexShape::Cylinder(c), Some(p2)) => {
+            // The side's line at the contact when the axis is within ~5.1° of the contact plane;
+            // the cap as an octagon when it is within ~5.1° of the normal; else one contact.
+            let axis = x1.rot.column(2).into_owned();
+            let along = axis.dot(&first.normal);
+            if along.abs() < EDGE_TOL {
+                let radial = (first.normal - axis * along).normalize();
+                let centre = x1.pos + radial * c.radius;
+                let h = axis * c.half_height;
+                segment_polytope(x1, [centre - h, centre + h], 0.0, x2, &p2, first, margin_gap, emit);
+            } else if along.abs() > FACE_TOL {
+                cap_polytope(x1, c.radius, c.half_height, along.signum(), x2, &p2, first, margin_gap, emit);
+            } else {
+                emit(first);
+            }
+        }
+        // Capsule–cylinder, cylinder–cylinder: MuJoCo 4.0 gives these one contact at the poses
+        // measured (its source snapshot turned the geoms).
+        _ => emit(first),
+    }
+}
+
+/// A cylinder's cap (geom 1; `side` +1 the top, −1 the bottom) against a box or mesh hull: the
+/// cap as a regular octagon (vertices at 22.5° + k·45° about the cylinder's x axis, on the rim),
+/// clipped against the polytope's face opposite it like two polytope faces (MuJoCo 4.0's contacts
+/// of a cylinder standing on a face are four rim points at such angles: read from its contacts,
+/// its source snapshot turned the geoms). `first` alone when no face is opposite.
+#[allow(clippy::too_many_arguments)]
+fn cap_polytope(
+    x1: &Transform,
+    r: f64,
+    h: f64,
+    side: f64,
+    x2: &Transform,
+    p2: &Poly,
+    first: PairPoint,
+    margin: f64,
+    emit: &mut dyn FnMut(PairPoint),
+) {
+    let axis = x1.rot.column(2).into_owned();
+    let (e1, e2) = (x1.rot.column(0).into_owned(), x1.rot.column(1).into_owned());
+    let n1 = axis * side;
+    let centre = x1.pos + n1 * h;
+    let n = first.normal;
+    let emitted = SCRATCH.with(|s| {
+        let s = &mut *s.borrow_mut();
+        let mut tmp = std::mem::take(&mut s.tmp);
+        let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
+        support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
+        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.normals2);
+        let opposite = s
+            .normals2
+            .iter()
+            .copied()
+            .filter(|(m, _)| m.dot(&n1) < -FACE_TOL)
+            .min_by(|a, b| a.0.dot(&n1).total_cmp(&b.0.dot(&n1)));
+        let mut count = 0;
+        if let Some((n2, f2)) = opposite {
+            // Clockwise seen from outside the cap.
+            s.face1.clear();
+            for k in 0..8 {
+                let t = (22.5 + 45.0 * k as f64).to_radians() * -side;
+                s.face1.push(centre + (e1 * t.cos() + e2 * t.sin()) * r);
+            }
+            face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
+            clip(&s.face1, &s.face2, &n1, &n2, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
+                emit(PairPoint { p1: w1, p2: w2, normal: -n2, dist: d });
+                count += 1;
+            });
+        }
+        s.tmp = tmp;
+        count
+    });
+    if emitted == 0 {
+        emit(first);
+    }
+}
+
+/// A segment of geom 1 (a capsule's, radius `r`; a cylinder's side line, radius 0) against a box
+/// or mesh hull from the first contact `first`, as MuJoCo 4.0 gives it (read from its contacts:
+/// its source snapshot turned the geoms instead): when the segment lies within ~5.1° of parallel
+/// to a face of the polytope at the contact, the segment clipped by that face's sides, each point
+/// within `margin` of the face (less the radius) a contact — on geom 1's surface and on the face's
+/// plane, normal the face's reversed, distance to the face less the radius (the two farthest when
+/// more). Otherwise `first` alone.
+#[allow(clippy::too_many_arguments)]
+fn segment_polytope(
+    x1: &Transform,
+    seg: [Vec3; 2],
+    r: f64,
+    x2: &Transform,
+    p2: &Poly,
+    first: PairPoint,
+    margin: f64,
+    emit: &mut dyn FnMut(PairPoint),
+) {
+    let n = first.normal;
+    let emitted = SCRATCH.with(|s| {
+        let s = &mut *s.borrow_mut();
+        let mut tmp = std::mem::take(&mut s.tmp);
+        let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
+        support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
+        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.normals2);
+        s.face1.clear();
+        s.face1.extend_from_slice(&seg);
+        let mut count = 0;
+        if let Some((_, j)) = edge_face(&s.face1, &s.normals2) {
+            let (n2, f2) = s.normals2[j];
+            face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
+            clip(&s.face2, &s.face1, &n2, &-n2, margin + r, &mut s.poly, &mut s.clipped, &mut |_, v, _| {
+                let d = (v - s.face2[0]).dot(&n2);
+                emit(PairPoint { p1: v - n2 * r, p2: v - n2 * d, normal: -n2, dist: d - r });
+                count += 1;
+            });
+        }
+        s.tmp = tmp;
+        count
+    });
+    if emitted == 0 {
+        emit(first);
+    }
 }

@@ -114,8 +114,8 @@ pub struct Flags {
     /// Discrete-time inverse dynamics (`mjENBL_INVDISCRETE`); lagrange does not read it.
     pub invdiscrete: bool,
     /// Multi-point convex collision detection (MuJoCo 4.0's `mjDSBL_MULTICCD`, on by default):
-    /// several contacts for box and mesh pairs (face clipping) and for capsule and cylinder pairs
-    /// (perturbed poses); off, one contact per convex pair (`collision::multiccd`).
+    /// several contacts for box and mesh pairs and for capsules and cylinders against them (face,
+    /// edge and segment clipping); off, one contact per convex pair (`collision::multiccd`).
     pub multiccd: bool,
     /// Constraint island discovery (`mjENBL_ISLAND`); islands are solved as one problem, listed by
     /// `info`.
