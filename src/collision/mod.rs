@@ -31,6 +31,7 @@ pub mod geom_distance;
 mod gjk;
 pub mod inside;
 pub mod mesh;
+pub mod multiccd;
 pub mod plane;
 pub mod ray;
 
@@ -241,6 +242,16 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
             },
         };
         if let Some(p) = point {
+            if let (true, Some(s1), Some(s2)) = (pair.max_contacts > 1, &cm.shapes[g1], &cm.shapes[g2]) {
+                // Feature ids: the order of the points (distinct within the pair).
+                let mut k = 0;
+                let mut out = |q: PairPoint| {
+                    push(q.p1, q.p2, q.normal, q.dist, None, k);
+                    k += 1;
+                };
+                multiccd::convex_contacts(&x1, s1, &x2, s2, p, pair.margin + pair.gap, &mut out);
+                continue;
+            }
             push(p.p1, p.p2, p.normal, p.dist, None, 0);
         }
     }

@@ -59,17 +59,28 @@ pub fn type_rank(shape: &Shape) -> u8 {
     }
 }
 
-/// The most contacts a pair of these shapes yields (MuJoCo's closed forms): box against box 8,
-/// plane against box, cylinder or mesh hull 4, plane or box against a capsule 2, every other
-/// pair 1.
-fn max_contacts(a: &Shape, b: &Shape) -> usize {
+/// The most contacts a pair of these shapes yields (MuJoCo's closed forms and `mj_maxContact`):
+/// box against box 8, plane against box, cylinder or mesh hull 4, plane or box against a capsule
+/// 2; the convex pairs (`mjc_Convex`, see `collision::multiccd`) 1 with a sphere or an ellipsoid
+/// or when `multiccd` is off, else 5 with a capsule or a cylinder, 4 for boxes and meshes
+/// without margin (face clipping pruned to a quadrilateral) and 5 with one; every other pair 1.
+fn max_contacts(a: &Shape, b: &Shape, multiccd: bool, has_margin: bool) -> usize {
+    use Shape::*;
     match (a, b) {
-        (Shape::Box { .. }, Shape::Box { .. }) => 8,
-        (Shape::Plane { .. }, Shape::Box { .. } | Shape::Cylinder { .. } | Shape::Mesh { .. }) => 4,
-        (Shape::Plane { .. }, Shape::Capsule { .. })
-        | (Shape::Capsule { .. }, Shape::Box { .. })
-        | (Shape::Box { .. }, Shape::Capsule { .. }) => 2,
-        _ => 1,
+        (Box { .. }, Box { .. }) => 8,
+        (Plane { .. }, Box { .. } | Cylinder { .. } | Mesh { .. }) => 4,
+        (Plane { .. }, Capsule { .. }) | (Capsule { .. }, Box { .. }) | (Box { .. }, Capsule { .. }) => 2,
+        (Plane { .. } | Hfield { .. }, _) | (_, Plane { .. } | Hfield { .. }) => 1,
+        // Closed forms of one contact.
+        (Sphere { .. } | Capsule { .. }, Sphere { .. } | Capsule { .. })
+        | (Sphere { .. }, Box { .. })
+        | (Box { .. }, Sphere { .. }) => 1,
+        // The convex solver.
+        (Sphere { .. } | Ellipsoid { .. }, _) | (_, Sphere { .. } | Ellipsoid { .. }) => 1,
+        _ if !multiccd => 1,
+        (Capsule { .. } | Cylinder { .. }, _) | (_, Capsule { .. } | Cylinder { .. }) => 5,
+        _ if has_margin => 5,
+        _ => 4,
     }
 }
 
@@ -140,7 +151,7 @@ pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
             margin: p.margin,
             gap: p.gap,
             pair: Some(k),
-            max_contacts: max_contacts(s1, s2),
+            max_contacts: max_contacts(s1, s2, flags.multiccd, p.margin + p.gap > 0.0),
         });
     }
     let explicit = out.len();
@@ -199,7 +210,12 @@ pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
                 margin: c1.margin + c2.margin,
                 gap: c1.gap + c2.gap,
                 pair: None,
-                max_contacts: max_contacts(&model.geoms[geom[0]].shape, &model.geoms[geom[1]].shape),
+                max_contacts: max_contacts(
+                    &model.geoms[geom[0]].shape,
+                    &model.geoms[geom[1]].shape,
+                    flags.multiccd,
+                    c1.margin + c2.margin + c1.gap + c2.gap > 0.0,
+                ),
             });
         }
     }

@@ -96,7 +96,9 @@ pub struct Flags {
     pub sensor: bool,
     /// Mid-phase collision filtering (`mjDSBL_MIDPHASE`); lagrange does not read it.
     pub midphase: bool,
-    /// MuJoCo's native convex collision detection (`mjDSBL_NATIVECCD`); lagrange does not read it.
+    /// MuJoCo's native convex collision detection (`mjDSBL_NATIVECCD`, on by default; off,
+    /// MuJoCo uses libccd's MPR); lagrange's convex pairs always follow the native solver's
+    /// contact rules (see `collision::multiccd`).
     pub nativeccd: bool,
     /// Implicit joint damping in the Euler integrator (`mjDSBL_EULERDAMP`).
     pub eulerdamp: bool,
@@ -111,7 +113,9 @@ pub struct Flags {
     pub fwdinv: bool,
     /// Discrete-time inverse dynamics (`mjENBL_INVDISCRETE`); lagrange does not read it.
     pub invdiscrete: bool,
-    /// Multi-point convex collision detection (`mjENBL_MULTICCD`); lagrange does not read it.
+    /// Multi-point convex collision detection (MuJoCo 4.0's `mjDSBL_MULTICCD`, on by default):
+    /// several contacts for box and mesh pairs and for capsules and cylinders against them (face,
+    /// edge and segment clipping); off, one contact per convex pair (`collision::multiccd`).
     pub multiccd: bool,
     /// Constraint island discovery (`mjENBL_ISLAND`); islands are solved as one problem, listed by
     /// `info`.
@@ -143,7 +147,7 @@ impl Default for Flags {
             energy: false,
             fwdinv: false,
             invdiscrete: false,
-            multiccd: false,
+            multiccd: true,
             island: false,
         }
     }
@@ -255,6 +259,12 @@ pub struct Options {
     /// The global magnetic flux in the world frame, read by magnetometer sensors (MuJoCo's
     /// `magnetic`, default (0, −0.5, 0)).
     pub magnetic: [f64; 3],
+    /// Tolerance of MuJoCo's convex collision solver (`ccd_tolerance`, 1e-6); lagrange's GJK and
+    /// EPA run to round-off and do not read it.
+    pub ccd_tolerance: f64,
+    /// Iteration limit of MuJoCo's convex collision solver (`ccd_iterations`, 35); not read by
+    /// lagrange's GJK and EPA (which converge to round-off).
+    pub ccd_iterations: u32,
     /// The `<flag>` switches.
     pub flags: Flags,
 }
@@ -277,6 +287,8 @@ impl Default for Options {
             viscosity: 0.0,
             wind: [0.0; 3],
             magnetic: [0.0, -0.5, 0.0],
+            ccd_tolerance: 1e-6,
+            ccd_iterations: 35,
             flags: Flags::default(),
         }
     }

@@ -125,6 +125,7 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
             ("iterations", &mut o.iterations),
             ("ls_iterations", &mut o.ls_iterations),
             ("noslip_iterations", &mut o.noslip_iterations),
+            ("ccd_iterations", &mut o.ccd_iterations),
         ] {
             if let Some(v) = a.real(attr)? {
                 if v < 0.0 || v.fract() != 0.0 {
@@ -139,6 +140,7 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
             ("impratio", &mut o.impratio),
             ("density", &mut o.density),
             ("viscosity", &mut o.viscosity),
+            ("ccd_tolerance", &mut o.ccd_tolerance),
         ] {
             if let Some(v) = a.real(attr)? {
                 if v < 0.0 {

@@ -1,0 +1,638 @@
+//! MuJoCo 4.0's multi-point contacts of convex pairs (`multiccd`, `mjDSBL_MULTICCD`: on by
+//! default; MuJoCo's `mjc_Convex` in engine_collision_convex.c and `multicontact` /
+//! `polygonClip` in engine_collision_gjk.c, read for their semantics; written here anew).
+//!
+//! # Which pairs MuJoCo sends through its convex solver
+//! MuJoCo's collision table (`mjCOLLISIONFUNC`, engine_collision_driver.c) calls `mjc_Convex` for
+//! sphere–ellipsoid, sphere–mesh, capsule–ellipsoid, capsule–cylinder, capsule–mesh, ellipsoid
+//! against ellipsoid, cylinder, box and mesh, cylinder against cylinder, box and mesh, box–mesh and
+//! mesh–mesh; every other pair has a closed form (planes, sphere–sphere/capsule/cylinder/box,
+//! capsule–capsule/box, box–box). `mjc_Convex` runs GJK and EPA on the geoms (each inflated by
+//! half the pair's margin + gap) and then, with `multiccd` on:
+//!
+//! - **box and mesh against box and mesh** (`mj_maxContact` 4, 5 with a margin): the polytope
+//!   path. From EPA's penetration direction MuJoCo finds the faces of both
+//!   geoms at their contact features; two faces within ~5.1° of opposite (normals' dot below
+//!   −0.996) clip one another: the face of geom 1 clips geom 2's face polygon (Sutherland–
+//!   Hodgman), the clipped vertices farther than the margin + gap above geom 1's face plane are
+//!   dropped (MuJoCo 4.0 clips margin pairs too; its older source turned them), more than four are
+//!   pruned to a quadrilateral of largest area. Failing that, an edge of the lower-dimensional
+//!   feature within ~5.1° of parallel to a face of the other (|dot| below 0.0888) is clipped
+//!   against that face (its two farthest points). Otherwise the single EPA point stays. Each point
+//!   has its own depth (below the clipping face), its normal along the clipped face's normal.
+//! - **a capsule or a cylinder against a box or a mesh** (`mj_maxContact` 5): MuJoCo's source
+//!   snapshot turns both geoms by ±1e-3 rad about the contact's tangents and reruns the solver;
+//!   the live 4.0.0 does not (its contacts show it): a capsule's segment, or a cylinder's side
+//!   line, within ~5.1° of parallel to a face of the polytope is clipped by the face (points on
+//!   the surface and on the face's plane, normal the face's reversed: a capsule lying on a face
+//!   gets its two ends); a cylinder's cap within ~5.1° of facing a face is clipped as a polygon
+//!   (four rim points at 22.5° + k·90° for a cylinder standing on a face — lagrange takes the cap
+//!   as a regular octagon at 22.5° + k·45°, which reproduces that); otherwise one contact.
+//! - **capsule–cylinder, cylinder–cylinder** (`mj_maxContact` 5): one contact at every pose
+//!   measured (lagrange gives one).
+//! - **a sphere or an ellipsoid**: one contact.
+//!
+//! With `multiccd` off every convex pair gives one contact. lagrange reproduces these on its own
+//! GJK/EPA ([`super::convex`]): the contact features are the vertices of each geom within a small
+//! tolerance of its support plane along the EPA normal (MuJoCo reads them off EPA's final face),
+//! and when several face pairs are within the tolerance the most nearly opposite is taken (MuJoCo
+//! takes the first in its polygon order). The witness points follow the live 4.0.0, not the
+//! snapshot (see [`polytope_contacts`]' clipping).
+
+use super::convex::{ConvexShape, PairPoint};
+use crate::spatial::{Transform, Vec3};
+use parry3d_f64::math::Vector;
+use std::cell::RefCell;
+
+/// Cosine above which two face normals count as opposite (MuJoCo's `mjFACE_TOL`, ~5.1°).
+const FACE_TOL: f64 = 0.996;
+/// |cosine| below which an edge counts as parallel to a face (MuJoCo's `mjEDGE_TOL`, ~5.1°).
+const EDGE_TOL: f64 = 0.0888;
+/// MuJoCo's `mjMINVAL`.
+const MINVAL: f64 = 1e-15;
+
+/// Scratch buffers of the clipping, reused per thread (no allocation once grown).
+#[derive(Default)]
+struct Scratch {
+    face1: Vec<Vec3>,
+    face2: Vec<Vec3>,
+    poly: Vec<Vec3>,
+    clipped: Vec<Vec3>,
+    normals1: Vec<(Vec3, u32)>,
+    normals2: Vec<(Vec3, u32)>,
+    feature1: Vec<u32>,
+    feature2: Vec<u32>,
+    tmp: Vec<u32>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+/// A polytope geom: a box (half-extents) or a mesh's hull.
+enum Poly<'a> {
+    Cuboid(Vec3),
+    Hull(&'a parry3d_f64::shape::ConvexPolyhedron),
+}
+
+impl<'a> Poly<'a> {
+    fn of(shape: &'a ConvexShape) -> Option<Self> {
+        match shape {
+            ConvexShape::Cuboid(c) => {
+                let h = c.half_extents;
+                Some(Poly::Cuboid(Vec3::new(h.x, h.y, h.z)))
+            }
+            ConvexShape::Hull(p) => Some(Poly::Hull(p)),
+            _ => None,
+        }
+    }
+
+    fn nvert(&self) -> usize {
+        match self {
+            Poly::Cuboid(_) => 8,
+            Poly::Hull(p) => p.points().len(),
+        }
+    }
+
+    /// Vertex `i` in the geom frame (box corner i: bit 0 +x, bit 1 +y, bit 2 +z).
+    fn vertex(&self, i: u32) -> Vec3 {
+        match self {
+            Poly::Cuboid(h) => Vec3::new(
+                if i & 1 != 0 { h.x } else { -h.x },
+                if i & 2 != 0 { h.y } else { -h.y },
+                if i & 4 != 0 { h.z } else { -h.z },
+            ),
+            Poly::Hull(p) => {
+                let v: Vector = p.points()[i as usize];
+                Vec3::new(v.x, v.y, v.z)
+            }
+        }
+    }
+
+    fn nface(&self) -> usize {
+        match self {
+            Poly::Cuboid(_) => 6,
+            Poly::Hull(p) => p.faces().len(),
+        }
+    }
+
+    /// Outward normal of face `f` in the geom frame (box face 2a: +axis a, 2a+1: −axis a).
+    fn face_normal(&self, f: u32) -> Vec3 {
+        match self {
+            Poly::Cuboid(_) => {
+                let mut n = Vec3::zeros();
+                n[(f / 2) as usize] = if f.is_multiple_of(2) { 1.0 } else { -1.0 };
+                n
+            }
+            Poly::Hull(p) => {
+                let n = p.faces()[f as usize].normal;
+                Vec3::new(n.x, n.y, n.z)
+            }
+        }
+    }
+
+    /// The vertices of face `f`, clockwise seen from outside (MuJoCo's order: its box faces
+    /// corner for corner, a mesh polygon reversed), into `out`.
+    fn face_vertices(&self, f: u32, out: &mut Vec<u32>) {
+        out.clear();
+        match self {
+            Poly::Cuboid(_) => {
+                const BOX_FACES: [[u32; 4]; 6] =
+                    [[7, 3, 1, 5], [2, 6, 4, 0], [2, 3, 7, 6], [4, 5, 1, 0], [6, 7, 5, 4], [3, 2, 0, 1]];
+                out.extend_from_slice(&BOX_FACES[f as usize]);
+            }
+            Poly::Hull(p) => {
+                let face = p.faces()[f as usize];
+                let start = face.first_vertex_or_edge as usize;
+                let n = face.num_vertices_or_edges as usize;
+                out.extend(p.vertices_adj_to_face()[start..start + n].iter().rev());
+            }
+        }
+    }
+
+    /// Whether face `f` holds vertex `v`.
+    fn face_has(&self, f: u32, v: u32, tmp: &mut Vec<u32>) -> bool {
+        self.face_vertices(f, tmp);
+        tmp.contains(&v)
+    }
+}
+
+/// The vertices of `poly` (at pose `x`) within `tol` of its support plane along world `dir`.
+fn support_feature(poly: &Poly, x: &Transform, dir: &Vec3, tol: f64, out: &mut Vec<u32>) {
+    out.clear();
+    let local = x.rot.transpose() * dir;
+    let mut best = f64::NEG_INFINITY;
+    for i in 0..poly.nvert() as u32 {
+        best = best.max(poly.vertex(i).dot(&local));
+    }
+    for i in 0..poly.nvert() as u32 {
+        if poly.vertex(i).dot(&local) >= best - tol {
+            out.push(i);
+        }
+    }
+}
+
+/// The faces holding every vertex of `feature` (one face, the one most along `dir`, when the
+/// feature has three or more vertices), with their world normals.
+fn feature_faces(
+    poly: &Poly,
+    x: &Transform,
+    feature: &[u32],
+    dir: &Vec3,
+    tmp: &mut Vec<u32>,
+    out: &mut Vec<(Vec3, u32)>,
+) {
+    out.clear();
+    for f in 0..poly.nface() as u32 {
+        if feature.iter().take(3).all(|&v| poly.face_has(f, v, tmp)) {
+            out.push((x.rot * poly.face_normal(f), f));
+        }
+    }
+    if feature.len() >= 3 && out.len() > 1 {
+        let best = out.iter().copied().max_by(|a, b| a.0.dot(dir).total_cmp(&b.0.dot(dir)));
+        out.clear();
+        out.extend(best);
+    }
+}
+
+/// The world polygon of face `f` (clockwise seen from outside) into `out`.
+fn face_polygon(poly: &Poly, x: &Transform, f: u32, tmp: &mut Vec<u32>, out: &mut Vec<Vec3>) {
+    poly.face_vertices(f, tmp);
+    out.clear();
+    out.extend(tmp.iter().map(|&v| x.act_point(&poly.vertex(v))));
+}
+
+/// The edges of a feature of one or two vertices as (start, end) world points: the edge itself,
+/// or every edge from the vertex (along the faces around it).
+fn feature_edges(poly: &Poly, x: &Transform, feature: &[u32], tmp: &mut Vec<u32>, out: &mut Vec<Vec3>) {
+    out.clear();
+    let v0 = feature[0];
+    let p0 = x.act_point(&poly.vertex(v0));
+    if feature.len() == 2 {
+        out.push(p0);
+        out.push(x.act_point(&poly.vertex(feature[1])));
+        return;
+    }
+    for f in 0..poly.nface() as u32 {
+        poly.face_vertices(f, tmp);
+        if let Some(k) = tmp.iter().position(|&v| v == v0) {
+            // MuJoCo's: the polygon's previous vertex in its own (counter-clockwise) order.
+            let prev = tmp[(k + 1) % tmp.len()];
+            out.push(p0);
+            out.push(x.act_point(&poly.vertex(prev)));
+        }
+    }
+}
+
+/// The contacts of two polytopes (boxes, mesh hulls) from EPA's penetrating point `first`, by
+/// MuJoCo's face and edge clipping (module documentation); `emit` receives each (the single
+/// `first` when no faces or edges line up). Returns the number emitted.
+pub fn polytope_contacts(
+    x1: &Transform,
+    s1: &ConvexShape,
+    x2: &Transform,
+    s2: &ConvexShape,
+    first: PairPoint,
+    margin: f64,
+    emit: &mut dyn FnMut(PairPoint),
+) -> usize {
+    let (Some(p1), Some(p2)) = (Poly::of(s1), Poly::of(s2)) else {
+        emit(first);
+        return 1;
+    };
+    SCRATCH.with(|s| {
+        let s = &mut *s.borrow_mut();
+        let n = first.normal;
+        let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
+        let tol = 1e-9 * scale;
+        let mut tmp = std::mem::take(&mut s.tmp);
+        support_feature(&p1, x1, &n, tol, &mut s.feature1);
+        support_feature(&p2, x2, &-n, tol, &mut s.feature2);
+        feature_faces(&p1, x1, &s.feature1, &n, &mut tmp, &mut s.normals1);
+        feature_faces(&p2, x2, &s.feature2, &-n, &mut tmp, &mut s.normals2);
+        let (dim1, dim2) = (s.feature1.len().min(3), s.feature2.len().min(3));
+        // The most nearly opposite face pair within the tolerance.
+        let mut aligned: Option<(f64, usize, usize)> = None;
+        for (i, (a, _)) in s.normals1.iter().enumerate() {
+            for (j, (b, _)) in s.normals2.iter().enumerate() {
+                let c = a.dot(b);
+                if c < -FACE_TOL && aligned.is_none_or(|(best, ..)| c < best) {
+                    aligned = Some((c, i, j));
+                }
+            }
+        }
+        let mut count = 0;
+        // The normal is the clipped face's reversed (face–face), the face's (an edge of geom 2)
+        // or the face's reversed (an edge of geom 1): the direction from w1 to w2 of a penetrating
+        // point, kept for the points within the margin above the face.
+        let mut out = |w1: Vec3, w2: Vec3, dist: f64, swap: bool, normal: Vec3| {
+            let (w1, w2) = if swap { (w2, w1) } else { (w1, w2) };
+            emit(PairPoint { p1: w1, p2: w2, normal, dist });
+            count += 1;
+        };
+        if let Some((_, i, j)) = aligned {
+            let (n1, f1) = s.normals1[i];
+            let (n2, f2) = s.normals2[j];
+            face_polygon(&p1, x1, f1, &mut tmp, &mut s.face1);
+            face_polygon(&p2, x2, f2, &mut tmp, &mut s.face2);
+            clip(&s.face1, &s.face2, &n1, &n2, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
+                out(w1, w2, d, false, -n2)
+            });
+        } else if dim1 < 3 && dim1 <= dim2 {
+            // An edge of geom 1 against a face of geom 2.
+            feature_edges(&p1, x1, &s.feature1, &mut tmp, &mut s.face1);
+            if let Some((e, j)) = edge_face(&s.face1, &s.normals2) {
+                let (n2, f2) = s.normals2[j];
+                face_polygon(&p2, x2, f2, &mut tmp, &mut s.face2);
+                let edge = [s.face1[2 * e], s.face1[2 * e + 1]];
+                s.face1.clear();
+                s.face1.extend_from_slice(&edge);
+                clip(&s.face2, &s.face1, &n2, &-n2, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
+                    out(w1, w2, d, true, -n2)
+                });
+            }
+        } else if dim2 < 3 {
+            // An edge of geom 2 against a face of geom 1.
+            feature_edges(&p2, x2, &s.feature2, &mut tmp, &mut s.face2);
+            if let Some((e, i)) = edge_face(&s.face2, &s.normals1) {
+                let (n1, f1) = s.normals1[i];
+                face_polygon(&p1, x1, f1, &mut tmp, &mut s.face1);
+                let edge = [s.face2[2 * e], s.face2[2 * e + 1]];
+                s.face2.clear();
+                s.face2.extend_from_slice(&edge);
+                clip(&s.face1, &s.face2, &n1, &-n1, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
+                    out(w1, w2, d, false, n1)
+                });
+            }
+        }
+        s.tmp = tmp;
+        if count == 0 {
+            emit(first);
+            count = 1;
+        }
+        count
+    })
+}
+
+/// The edge (index into `edges`' pairs) most nearly parallel to one of the faces (index into
+/// `faces`), within [`EDGE_TOL`].
+fn edge_face(edges: &[Vec3], faces: &[(Vec3, u32)]) -> Option<(usize, usize)> {
+    let mut best: Option<(f64, usize, usize)> = None;
+    for (j, (n, _)) in faces.iter().enumerate() {
+        for e in 0..edges.len() / 2 {
+            let d = (edges[2 * e + 1] - edges[2 * e]).normalize();
+            let c = d.dot(n).abs();
+            if c < EDGE_TOL && best.is_none_or(|(b, ..)| c < b) {
+                best = Some((c, e, j));
+            }
+        }
+    }
+    best.map(|(_, e, j)| (e, j))
+}
+
+/// Clips polygon (or edge) `clipped_in` by face polygon `face` (outward normal `n`, vertices
+/// clockwise about it), keeps the points not above the face's plane and reports each as
+/// witness points (on `face`'s plane along `wit_dir`, on `clipped_in`) and signed distance below
+/// the face: MuJoCo's `polygonClip`, with its pruning to the largest quadrilateral (more than 4
+/// points) and to the two farthest points (an edge).
+#[allow(clippy::too_many_arguments)]
+fn clip(
+    face: &[Vec3],
+    clipped_in: &[Vec3],
+    n: &Vec3,
+    wit_dir: &Vec3,
+    margin: f64,
+    poly: &mut Vec<Vec3>,
+    next: &mut Vec<Vec3>,
+    out: &mut dyn FnMut(Vec3, Vec3, f64),
+) {
+    if face.len() < 3 {
+        return;
+    }
+    poly.clear();
+    poly.extend_from_slice(clipped_in);
+    let m = face.len();
+    for k in 0..m {
+        let (a, b) = (face[k], face[(k + 1) % m]);
+        // Inward normal of the side plane through edge a→b (clockwise about n).
+        let pn = (b - a).cross(n).normalize();
+        let pd = pn.dot(&a);
+        let inside = |p: &Vec3| (p - a).dot(&pn) > -MINVAL;
+        next.clear();
+        let np = poly.len();
+        for i in 0..np {
+            let (p, q) = (poly[i], poly[(i + 1) % np]);
+            let (ip, iq) = (inside(&p), inside(&q));
+            if !ip && !iq {
+                continue;
+            }
+            if ip && iq {
+                next.push(q);
+                continue;
+            }
+            let pq = q - p;
+            let den = pn.dot(&pq);
+            if den != 0.0 {
+                let t = (pd - pn.dot(&p)) / den;
+                if (0.0..=1.0).contains(&t) {
+                    next.push(p + pq * t);
+                }
+            }
+            if iq {
+                next.push(q);
+            }
+        }
+        std::mem::swap(poly, next);
+    }
+    poly.retain(|p| (p - face[0]).dot(n) <= margin);
+    if poly.is_empty() {
+        return;
+    }
+    // MuJoCo 4.0: the point on the face's plane (along its normal) and, from it, one against
+    // `wit_dir` by the signed distance (the snapshot of MuJoCo's source kept the clipped vertex itself;
+    // the live 4.0.0 contacts show this form).
+    // The distance is the one below the face scaled by the cosine between the face's normal and
+    // `wit_dir` (the live contacts again).
+    let witness = |v: &Vec3| {
+        let d = (v - face[0]).dot(n);
+        let w1 = v - n * d;
+        let dist = -d * n.dot(wit_dir);
+        (w1, w1 - wit_dir * dist, dist)
+    };
+    let mut report = |v: &Vec3| {
+        let (w1, w2, d) = witness(v);
+        out(w1, w2, d);
+    };
+    if poly.len() > 4 {
+        let q = largest_quad(poly);
+        for i in q {
+            report(&poly[i]);
+        }
+        return;
+    }
+    if clipped_in.len() == 2 && poly.len() > 2 {
+        let (mut b1, mut b2, mut d) = (0, 1, 0.0);
+        for i in 0..poly.len() {
+            for j in i + 1..poly.len() {
+                let d2 = (poly[j] - poly[i]).norm_squared();
+                if d2 > d {
+                    (b1, b2, d) = (i, j, d2);
+                }
+            }
+        }
+        report(&poly[b1]);
+        report(&poly[b2]);
+        return;
+    }
+    for v in poly.iter() {
+        report(v);
+    }
+}
+
+/// Area of quadrilateral abcd (half the norm of the sum of its two diagonal-split cross products).
+fn area4(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> f64 {
+    0.5 * ((d - a).cross(&(b - d)) + (c - b).cross(&(a - c))).norm()
+}
+
+/// Four vertices of a convex polygon (more than four vertices) spanning a quadrilateral of
+/// large area: MuJoCo's `polygonQuad` search (each corner advanced while the area grows), which
+/// depends on where the polygon starts (not always the largest).
+fn largest_quad(p: &[Vec3]) -> [usize; 4] {
+    let n = p.len();
+    let next = |i: usize| (i + 1) % n;
+    let (mut b, mut c, mut d) = (1, 2, 3);
+    let mut res = [0, 1, 2, 3];
+    let mut m = area4(&p[0], &p[1], &p[2], &p[3]);
+    for a in 0..n {
+        loop {
+            let m_next = area4(&p[a], &p[b], &p[c], &p[next(d)]);
+            if m_next <= m {
+                break;
+            }
+            m = m_next;
+            d = next(d);
+            res = [a, b, c, d];
+            loop {
+                let m_next = area4(&p[a], &p[b], &p[next(c)], &p[d]);
+                if m_next <= m {
+                    break;
+                }
+                m = m_next;
+                c = next(c);
+                res = [a, b, c, d];
+            }
+            loop {
+                let m_next = area4(&p[a], &p[next(b)], &p[c], &p[d]);
+                if m_next <= m {
+                    break;
+                }
+                m = m_next;
+                b = next(b);
+                res = [a, b, c, d];
+            }
+        }
+        if b == a {
+            b = next(b);
+            if c == b {
+                c = next(c);
+                if d == c {
+                    d = next(d);
+                }
+            }
+        }
+    }
+    res
+}
+
+/// The contacts of a convex pair from GJK/EPA's first point `first` (penetrating or within the
+/// margin + gap), as MuJoCo 4.0 gives them with `multiccd` on (the caller asks only for pairs
+/// whose contact limit exceeds one; module documentation): polytopes by face and edge clipping
+/// ([`polytope_contacts`]), a capsule or a cylinder's side against a polytope face by segment
+/// clipping, a cylinder's cap against a polytope face as an octagon; `first` alone otherwise.
+#[allow(clippy::too_many_arguments)]
+pub fn convex_contacts(
+    x1: &Transform,
+    s1: &ConvexShape,
+    x2: &Transform,
+    s2: &ConvexShape,
+    first: PairPoint,
+    margin_gap: f64,
+    emit: &mut dyn FnMut(PairPoint),
+) {
+    let polytopes = Poly::of(s1).is_some() && Poly::of(s2).is_some();
+    if polytopes {
+        if first.dist < margin_gap {
+            polytope_contacts(x1, s1, x2, s2, first, margin_gap, emit);
+        } else {
+            emit(first);
+        }
+        return;
+    }
+    match (s1, Poly::of(s2)) {
+        (ConvexShape::Capsule(c), Some(p2)) => {
+            let (a, b) = (c.segment.a, c.segment.b);
+            let seg = [x1.act_point(&Vec3::new(a.x, a.y, a.z)), x1.act_point(&Vec3::new(b.x, b.y, b.z))];
+            segment_polytope(x1, seg, c.radius, x2, &p2, first, margin_gap, emit);
+        }
+        (ConvexShape::Cylinder(c), Some(p2)) => {
+            // The side's line at the contact when the axis is within ~5.1° of the contact plane;
+            // the cap as an octagon when it is within ~5.1° of the normal; else one contact.
+            let axis = x1.rot.column(2).into_owned();
+            let along = axis.dot(&first.normal);
+            if along.abs() < EDGE_TOL {
+                let radial = (first.normal - axis * along).normalize();
+                let centre = x1.pos + radial * c.radius;
+                let h = axis * c.half_height;
+                segment_polytope(x1, [centre - h, centre + h], 0.0, x2, &p2, first, margin_gap, emit);
+            } else if along.abs() > FACE_TOL {
+                cap_polytope(x1, c.radius, c.half_height, along.signum(), x2, &p2, first, margin_gap, emit);
+            } else {
+                emit(first);
+            }
+        }
+        // Capsule–cylinder, cylinder–cylinder: MuJoCo 4.0 gives these one contact at the poses
+        // measured (its source snapshot turned the geoms).
+        _ => emit(first),
+    }
+}
+
+/// A cylinder's cap (geom 1; `side` +1 the top, −1 the bottom) against a box or mesh hull: the
+/// cap as a regular octagon (vertices at 22.5° + k·45° about the cylinder's x axis, on the rim),
+/// clipped against the polytope's face opposite it like two polytope faces (MuJoCo 4.0's contacts
+/// of a cylinder standing on a face are four rim points at such angles: read from its contacts,
+/// its source snapshot turned the geoms). `first` alone when no face is opposite.
+#[allow(clippy::too_many_arguments)]
+fn cap_polytope(
+    x1: &Transform,
+    r: f64,
+    h: f64,
+    side: f64,
+    x2: &Transform,
+    p2: &Poly,
+    first: PairPoint,
+    margin: f64,
+    emit: &mut dyn FnMut(PairPoint),
+) {
+    let axis = x1.rot.column(2).into_owned();
+    let (e1, e2) = (x1.rot.column(0).into_owned(), x1.rot.column(1).into_owned());
+    let n1 = axis * side;
+    let centre = x1.pos + n1 * h;
+    let n = first.normal;
+    let emitted = SCRATCH.with(|s| {
+        let s = &mut *s.borrow_mut();
+        let mut tmp = std::mem::take(&mut s.tmp);
+        let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
+        support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
+        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.normals2);
+        let opposite = s
+            .normals2
+            .iter()
+            .copied()
+            .filter(|(m, _)| m.dot(&n1) < -FACE_TOL)
+            .min_by(|a, b| a.0.dot(&n1).total_cmp(&b.0.dot(&n1)));
+        let mut count = 0;
+        if let Some((n2, f2)) = opposite {
+            // Clockwise seen from outside the cap.
+            s.face1.clear();
+            for k in 0..8 {
+                let t = (22.5 + 45.0 * k as f64).to_radians() * -side;
+                s.face1.push(centre + (e1 * t.cos() + e2 * t.sin()) * r);
+            }
+            face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
+            clip(&s.face1, &s.face2, &n1, &n2, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
+                emit(PairPoint { p1: w1, p2: w2, normal: -n2, dist: d });
+                count += 1;
+            });
+        }
+        s.tmp = tmp;
+        count
+    });
+    if emitted == 0 {
+        emit(first);
+    }
+}
+
+/// A segment of geom 1 (a capsule's, radius `r`; a cylinder's side line, radius 0) against a box
+/// or mesh hull from the first contact `first`, as MuJoCo 4.0 gives it (read from its contacts:
+/// its source snapshot turned the geoms instead): when the segment lies within ~5.1° of parallel
+/// to a face of the polytope at the contact, the segment clipped by that face's sides, each point
+/// within `margin` of the face (less the radius) a contact — on geom 1's surface and on the face's
+/// plane, normal the face's reversed, distance to the face less the radius (the two farthest when
+/// more). Otherwise `first` alone.
+#[allow(clippy::too_many_arguments)]
+fn segment_polytope(
+    x1: &Transform,
+    seg: [Vec3; 2],
+    r: f64,
+    x2: &Transform,
+    p2: &Poly,
+    first: PairPoint,
+    margin: f64,
+    emit: &mut dyn FnMut(PairPoint),
+) {
+    let n = first.normal;
+    let emitted = SCRATCH.with(|s| {
+        let s = &mut *s.borrow_mut();
+        let mut tmp = std::mem::take(&mut s.tmp);
+        let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
+        support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
+        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.normals2);
+        s.face1.clear();
+        s.face1.extend_from_slice(&seg);
+        let mut count = 0;
+        if let Some((_, j)) = edge_face(&s.face1, &s.normals2) {
+            let (n2, f2) = s.normals2[j];
+            face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
+            clip(&s.face2, &s.face1, &n2, &-n2, margin + r, &mut s.poly, &mut s.clipped, &mut |_, v, _| {
+                let d = (v - s.face2[0]).dot(&n2);
+                emit(PairPoint { p1: v - n2 * r, p2: v - n2 * d, normal: -n2, dist: d - r });
+                count += 1;
+            });
+        }
+        s.tmp = tmp;
+        count
+    });
+    if emitted == 0 {
+        emit(first);
+    }
+}
