@@ -7,7 +7,9 @@ Run from the repository root with the validation venv (see validation/README.md)
     python validation/mujoco_collision_golden.py --check    # recompute in memory, exit 1 if a file differs beyond round-off
 
 One file per pair type: the closed forms lagrange follows point for point (sphere-box,
-capsule-box, box-box: MuJoCo's mjc_SphereBox, mjc_CapsuleBox, mjc_BoxBox) and, as regression,
+capsule-box, box-box, sphere-cylinder: MuJoCo's mjc_SphereBox, mjc_CapsuleBox, mjc_BoxBox,
+mjc_SphereCylinder), plane-mesh with one vertex below the plane (corpus meshes under
+tests/data/meshes/mujoco: MuJoCo's f32 vertices in the mesh's inertial frame) and, as regression,
 sphere-sphere, sphere-capsule, capsule-capsule and plane against sphere, capsule, box and
 cylinder. Each file holds a few scenes (an MJCF text: two free bodies with one geom each, or a
 world plane and one free body; margins and gaps nonzero in some) and, per scene, cases: the
@@ -105,12 +107,22 @@ def unit(rng) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def mjcf(name: str, geom1: str | None, geom2: str, margins: tuple, offset: str = "") -> str:
-    """Two free bodies with one geom each (geom1 None: a world plane and one free body)."""
+# Mesh scenes name their files relative to this directory, written as MESHDIR_TOKEN in the MJCF
+# text (the test substitutes its own checkout's path).
+MESH_DIR = REPO / "tests" / "data" / "meshes" / "mujoco"
+MESHDIR_TOKEN = "@MESHDIR@"
+
+
+def mjcf(name: str, geom1: str | None, geom2: str, margins: tuple, offset: str = "", assets: str = "") -> str:
+    """Two free bodies with one geom each (geom1 None: a world plane and one free body); `assets`
+    the <asset> children (meshes, files under MESHDIR_TOKEN)."""
     margin, gap = margins
     extra = f' margin="{margin!r}" gap="{gap!r}"' if margin or gap else ""
-    parts = [f'<mujoco model="{name}">', '<compiler angle="radian"/>',
-             '<option><flag contact="enable"/></option>', "<worldbody>"]
+    compiler = f'<compiler angle="radian" meshdir="{MESHDIR_TOKEN}"/>' if assets else '<compiler angle="radian"/>'
+    parts = [f'<mujoco model="{name}">', compiler, '<option><flag contact="enable"/></option>']
+    if assets:
+        parts.append(f"<asset>{assets}</asset>")
+    parts.append("<worldbody>")
     if geom1 is None:
         parts.append(f'<geom name="plane" {PLANE}{extra}/>')
     else:
@@ -121,16 +133,17 @@ def mjcf(name: str, geom1: str | None, geom2: str, margins: tuple, offset: str =
 
 
 class Scene:
-    def __init__(self, name: str, geom1: str | None, geom2: str, margins: tuple, offset: str = ""):
+    def __init__(self, name: str, geom1: str | None, geom2: str, margins: tuple, offset: str = "", assets: str = ""):
         self.name = name
         self.plane = geom1 is None
-        self.xml = mjcf(name, geom1, geom2, margins, offset)
-        self.m = mujoco.MjModel.from_xml_string(self.xml)
+        self.xml = mjcf(name, geom1, geom2, margins, offset, assets)
+        text = self.xml.replace(MESHDIR_TOKEN, str(MESH_DIR))
+        self.m = mujoco.MjModel.from_xml_string(text)
         self.d = mujoco.MjData(self.m)
         self.margin = 2 * margins[0]
         self.reach = 2 * (margins[0] + margins[1])
         # The same scene with a large margin: its smallest contact distance places random poses.
-        self.oracle = mujoco.MjModel.from_xml_string(self.xml)
+        self.oracle = mujoco.MjModel.from_xml_string(text)
         self.oracle.geom_margin[:] = 2.0
         self.od = mujoco.MjData(self.oracle)
 
@@ -445,6 +458,39 @@ def capsule_capsule() -> list:
                  s.record("coincident_centres", "degenerate", ORIGIN, at(0, 0, 0, q=Q_ZX))], 10)]
 
 
+def sphere_cylinder() -> list:
+    """MuJoCo's mjc_SphereCylinder: side, cap (touching exactly at 0 included), rim, the centre
+    inside nearer the cap or the side (a tie goes to the side), the centre on the axis (coincident
+    centres of its sphere–sphere: the normal is z1 x z2, or x)."""
+    out = []
+    s = Scene("sphere_cylinder", SPHERE, CYLINDER, NO_MARGIN)
+    tilted = axis_angle((1, 0, 0), 0.5)
+    cases = [
+        s.record("touch_cap", "touching", at(0.0625, 0.0, 0.375), ORIGIN),
+        s.record("touch_cap_bottom", "touching", at(-0.0625, 0.03125, -0.375), ORIGIN),
+        s.record("touch_side", "touching", at(0.25, 0.0, 0.0625), ORIGIN),
+        s.record("cap", "penetrating", at(0.03125, 0.03125, 0.34375), ORIGIN),
+        s.record("side", "penetrating", at(0.21875, 0.0, 0.1), ORIGIN),
+        s.record("rim", "penetrating", at(0.1875, 0.0, 0.3125), ORIGIN),
+        s.record("rim_bottom", "penetrating", at(0.0, -0.1875, -0.3125), ORIGIN),
+        s.record("inside_near_cap", "degenerate", at(0.0, 0.03125, 0.1875), ORIGIN),
+        s.record("inside_near_side", "degenerate", at(0.09375, 0.0, 0.0), ORIGIN),
+        s.record("inside_tie", "degenerate", at(0.0625, 0.0, 0.1875), ORIGIN),
+        s.record("centre_on_axis", "degenerate", ORIGIN, ORIGIN),
+        s.record("centre_on_axis_turned", "degenerate", at(0.0, 0.0, 0.0625, q=tilted), ORIGIN),
+        s.record("turned", "penetrating", at(0.1, 0.15, 0.2), at(0.0, 0.0, 0.0, q=axis_angle((1, 2, 0.5), 0.8))),
+    ]
+    out.append((s, cases, 16))
+    s = Scene("sphere_cylinder_margin", SPHERE, CYLINDER, MARGIN)
+    out.append((s, [s.record("touch_cap", "touching", at(0.0625, 0.0, 0.375), ORIGIN),
+                    s.record("cap_within_margin", "within_margin", at(0.0, 0.0, 0.390625), ORIGIN),
+                    s.record("side_within_margin", "within_margin", at(0.265625, 0.0, 0.0), ORIGIN)], 12))
+    # The cylinder on body 1: MuJoCo's geom 1 is still the sphere (lower type).
+    s = Scene("cylinder_sphere_order", CYLINDER, SPHERE, MARGIN_GAP)
+    out.append((s, [s.record("cap", "penetrating", ORIGIN, at(0.03125, 0.0, -0.34375))], 6))
+    return out
+
+
 def plane_sphere() -> list:
     s = Scene("plane_sphere", None, SPHERE, MARGIN)
     return [(s, [s.record("touch", "touching", None, at(0.25, -0.5, 0.125))], 6)]
@@ -471,6 +517,50 @@ def plane_cylinder() -> list:
                  s.record("on_side", "penetrating", None, at(0.0, 0.0, 0.109375, q=Q_ZX))], 8)]
 
 
+# Corpus meshes (tests/data/meshes/mujoco, with their licences): a Franka link (276 vertices, a hull
+# of 46: MuJoCo's hill-climbing support), a Barkour leg part and a small bone (5.7 mm).
+MESHES = [("link0", "franka_emika_panda/link0_11.obj"), ("abduction", "google_barkour_vb/abduction.stl"),
+          ("femoris", "dm_control/BONEFemoris_fabellae_L_1.stl")]
+
+
+def mesh_scene(kind: str, name: str, file: str, margins: tuple) -> Scene:
+    assets = f'<mesh name="{name}" file="{file}"/>'
+    geom = f'type="mesh" mesh="{name}"'
+    return Scene(f"{kind}_{name}", None, geom, margins, assets=assets)
+
+
+def world_vertices(s: Scene, mesh: int) -> np.ndarray:
+    """World positions of mesh `mesh`'s vertices at the scene's current state (after record)."""
+    g = int(np.flatnonzero(s.m.geom_dataid == mesh)[0])
+    adr, num = s.m.mesh_vertadr[mesh], s.m.mesh_vertnum[mesh]
+    v = s.m.mesh_vert[adr:adr + num].astype(float)
+    return v @ s.d.geom_xmat[g].reshape(3, 3).T + s.d.geom_xpos[g]
+
+
+def plane_mesh() -> list:
+    """Meshes at random orientations just touching the plane: one vertex alone below it (MuJoCo's
+    mesh vertices are f32 in its inertial frame: the contact is that vertex), and lifted beyond
+    it. Poses with more than one vertex below the plane (where MuJoCo 4.0 adds vertices of a hull
+    polygon) are skipped here: lagrange does not select those yet."""
+    out = []
+    for name, file in MESHES:
+        s = mesh_scene("plane_mesh", name, file, NO_MARGIN)
+        rng = np.random.default_rng([SEED, zlib.crc32(s.name.encode())])
+        cases = []
+        while len(cases) < 16:
+            kind = "outside" if len(cases) % 4 == 3 else "penetrating"
+            target = rng.uniform(1e-6, 1e-4) * (1 if kind == "outside" else -1)
+            q2 = s.place(None, random_quat(rng), np.array([0.0, 0.0, 1.0]), target, start=(0.0, 0.0, -1.0))
+            if q2 is None:
+                continue
+            case = s.record(f"vertex{len(cases)}", kind, None, q2)
+            below = {tuple(p) for p in world_vertices(s, 0) if p[2] <= 0.0}
+            if len(case["contacts"]) <= 1 and len(below) <= 1:
+                cases.append(case)
+        out.append((s, cases, 0))
+    return out
+
+
 PAIRS = {
     "sphere_box": sphere_box,
     "capsule_box": capsule_box,
@@ -482,6 +572,8 @@ PAIRS = {
     "plane_capsule": plane_capsule,
     "plane_box": plane_box,
     "plane_cylinder": plane_cylinder,
+    "plane_mesh": plane_mesh,
+    "sphere_cylinder": sphere_cylinder,
 }
 
 

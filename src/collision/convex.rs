@@ -15,7 +15,7 @@ thread_local! {
     /// The EPA workspace of this thread, reused so that overlapping pairs do not allocate.
     static EPA_WORK: RefCell<EPA> = RefCell::new(EPA::new());
 }
-use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, SupportMap};
+use parry3d_f64::shape::{Ball, Capsule, Cuboid, Cylinder, SupportMap};
 
 /// An ellipsoid with semi-axes `radii` about its frame's axes.
 #[derive(Clone, Debug)]
@@ -50,8 +50,8 @@ pub enum ConvexShape {
     Cylinder(Cylinder),
     /// An ellipsoid.
     Ellipsoid(Ellipsoid),
-    /// A mesh's convex hull.
-    Hull(ConvexPolyhedron),
+    /// A mesh's convex hull, with its vertex adjacency for hill-climbing support queries.
+    Hull(Box<super::hull_support::HullSupport>),
 }
 
 impl SupportMap for ConvexShape {

@@ -105,7 +105,8 @@ impl GeomMesh {
                 let points: Vec<Vector> = hull.vertices.iter().map(|v| Vector::new(v.x, v.y, v.z)).collect();
                 let polyhedron = ConvexPolyhedron::from_convex_hull(&points)
                     .ok_or_else(|| "its convex hull is degenerate".to_string())?;
-                Ok(MeshHull { vertices: hull.vertices, shape: ConvexShape::Hull(polyhedron) })
+                let shape = ConvexShape::Hull(Box::new(super::hull_support::HullSupport::new(polyhedron)));
+                Ok(MeshHull { vertices: hull.vertices, shape })
             })
             .as_ref()
             .map_err(String::as_str)

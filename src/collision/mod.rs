@@ -6,10 +6,13 @@
 //! "Computation → Collision detection").
 //!
 //! A bounding-sphere test rejects far pairs first (MuJoCo's `mj_filterSphere`); the narrow phase
-//! is closed form for planes ([`plane`]), spheres and capsules, and boxes against spheres,
+//! is closed form for planes ([`plane`]), spheres and capsules, spheres against cylinders
+//! ([`sphere_cylinder`]), and boxes against spheres,
 //! capsules ([`box_primitive`]) and boxes ([`box_box`]) with MuJoCo's multi-point manifolds, and
 //! GJK/EPA on support maps for the other convex pairs ([`convex`]). Meshes collide by their
-//! convex hulls; height fields are not collided yet (`info` lists them).
+//! convex hulls, whose support points are found by hill climbing on the hull's edges
+//! ([`hull_support`], as MuJoCo's mesh graph); height fields are not collided yet (`info` lists
+//! them).
 //!
 //! `collide` reports the contacts closer than the pair's margin + gap plus `reach`: MuJoCo's rule
 //! with `reach` = 0 (contacts in the gap are reported without rows: rows exist below the margin,
@@ -29,11 +32,13 @@ pub mod convex;
 mod frame;
 pub mod geom_distance;
 mod gjk;
+pub mod hull_support;
 pub mod inside;
 pub mod mesh;
 pub mod multiccd;
 pub mod plane;
 pub mod ray;
+pub mod sphere_cylinder;
 
 pub use convex::{ConvexShape, Ellipsoid};
 pub use frame::contact_frame;
@@ -92,7 +97,8 @@ impl CollisionModel {
                     Some(h) => {
                         let points: Vec<Vector> = h.iter().map(|v| Vector::new(v.x, v.y, v.z)).collect();
                         let r = h.iter().map(|v| v.norm()).fold(0.0, f64::max);
-                        (ConvexPolyhedron::from_convex_hull(&points).map(ConvexShape::Hull), r)
+                        let hull = ConvexPolyhedron::from_convex_hull(&points);
+                        (hull.map(|p| ConvexShape::Hull(Box::new(hull_support::HullSupport::new(p)))), r)
                     }
                     None => (None, 0.0),
                 },
@@ -194,8 +200,9 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
             }
             continue;
         }
-        // Boxes against spheres, capsules and boxes: MuJoCo's closed forms (geom 1 the lower
-        // type; a pair given the other way round is swapped and its normal turned back).
+        // Boxes against spheres, capsules and boxes, spheres against cylinders: MuJoCo's closed
+        // forms (geom 1 the lower type; a pair given the other way round is swapped and its normal
+        // turned back).
         let mut emit = |p: PairPoint, feature: u32, swap: bool| match swap {
             false => push(p.p1, p.p2, p.normal, p.dist, None, feature),
             true => push(p.p2, p.p1, -p.normal, p.dist, None, feature),
@@ -215,6 +222,18 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
                     if let Shape::Box { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
                 let mut out = |p, f| emit(p, f, swap);
                 box_primitive::capsule_box(&xc, *radius, 0.5 * length, &xb, &(size / 2.0), within, &mut out);
+                true
+            }
+            (Shape::Sphere { radius }, Shape::Cylinder { radius: rc, length })
+            | (Shape::Cylinder { radius: rc, length }, Shape::Sphere { radius }) => {
+                let (xs, xc, swap) =
+                    if let Shape::Cylinder { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
+                let z = xs.rot.column(2).into_owned();
+                if let Some(p) =
+                    sphere_cylinder::sphere_cylinder(&xs.pos, &z, *radius, &xc, *rc, 0.5 * length, within)
+                {
+                    emit(p, 0, swap);
+                }
                 true
             }
             (Shape::Box { size: s1 }, Shape::Box { size: s2 }) => {

@@ -82,7 +82,7 @@ impl<'a> Poly<'a> {
                 let h = c.half_extents;
                 Some(Poly::Cuboid(Vec3::new(h.x, h.y, h.z)))
             }
-            ConvexShape::Hull(p) => Some(Poly::Hull(p)),
+            ConvexShape::Hull(s) => Some(Poly::Hull(s.polyhedron())),
             _ => None,
         }
     }

@@ -1,20 +1,34 @@
 //! Convex hulls of mesh geoms that take part in collisions: MuJoCo collides a mesh by its convex
 //! hull (MuJoCo documentation, "Modeling → Meshes": "the collision geometry of a mesh is its convex
 //! hull"). The hull is computed once per compile with parry's quickhull (`mass::convex_hull`, MuJoCo's degeneracy checks), in the mesh file's frame
-//! after scaling (the frame in which lagrange places a mesh geom); each file and scale is read once.
+//! after scaling (the frame in which lagrange places a mesh geom); each file, scale and inertia
+//! mode is read once.
+//!
+//! The hull's vertices are placed where MuJoCo's collision reads them (`mjCMesh::Process`,
+//! user_mesh.cc): MuJoCo moves a mesh to its inertial frame — the centre of mass `c` of the mesh's
+//! `inertia` mode, axes the principal axes `R` of its compiler's eigen-solver — and stores each
+//! vertex `Rᵀ (v − c)` as an `f32` (`mesh_vert`); its geom frame is the file frame moved by
+//! (c, R). Each hull vertex here is that `f32` vertex mapped back to the file frame,
+//! `c + R f32(Rᵀ (v − c))`, so that world points agree with MuJoCo's to f64 round-off (the `f32`
+//! rounding moved them by up to ~6e-8 of the mesh's size). Which way each coordinate rounds
+//! depends on c and R to ~1e-13 m, so they are computed here with MuJoCo's own sums
+//! (`ComputeFaceCentroid`, `ComputeVolume`, `ComputeInertia`) and its compiler's Jacobi
+//! eigen-solver (`mjuu_eig3` as MuJoCo 4.0 runs it: tangent half-angles, stopping when the largest
+//! off-diagonal entry is below 1e-12 of its diagonal or the rotation's cosine above 1 − 1e-12),
+//! not with lagrange's mass module (which converges further: its axes differ by up to ~1e-8).
 
 use super::{LinkWord, LoadError};
 use crate::mass;
 use crate::model::spec::{GeomSpec, Shape};
-use crate::spatial::Vec3;
+use crate::spatial::{quat_to_matrix, Mat3, Vec3};
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-/// Hull vertices by (file, scale).
+/// Hull vertices by (file, scale, inertia mode).
 #[derive(Default)]
 pub struct HullCache {
-    entries: HashMap<(PathBuf, [u64; 3]), Arc<Vec<Vec3>>>,
+    entries: HashMap<(PathBuf, [u64; 3], mass::MeshInertia), Arc<Vec<Vec3>>>,
 }
 
 /// The hull vertices of `g` if it is a colliding mesh geom (None for primitives and for meshes
@@ -34,7 +48,7 @@ pub fn geom_hull(
     if !g.collision {
         return Ok(None);
     }
-    let key = (path.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()]);
+    let key = (path.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()], g.mesh_inertia);
     if let Some(h) = cache.entries.get(&key) {
         return Ok(Some(h.clone()));
     }
@@ -60,7 +74,169 @@ pub fn geom_hull(
         mass::MeshError::Hull { detail } => err(detail),
         other => err(other.to_string()),
     })?;
-    let vertices = Arc::new(hull.vertices);
+    let mut vertices = hull.vertices;
+    if let Some((com, r)) = mujoco_mesh_frame(&mesh, g.mesh_inertia) {
+        round_as_mujoco(&mut vertices, &com, &r);
+    }
+    let vertices = Arc::new(vertices);
     cache.entries.insert(key, vertices.clone());
     Ok(Some(vertices))
+}
+
+/// Moves `vertices` (file frame) to where MuJoCo's `f32` copies of them lie (see the module
+/// documentation): `c + R f32(Rᵀ (v − c))`, `c` the mesh's centre of mass and `R` its principal
+/// axes as MuJoCo's compiler finds them ([`mujoco_mesh_frame`]).
+pub(crate) fn round_as_mujoco(vertices: &mut [Vec3], com: &Vec3, r: &Mat3) {
+    for v in vertices {
+        let local = r.transpose() * (*v - com);
+        let stored = local.map(|a| f64::from(a as f32));
+        *v = com + r * stored;
+    }
+}
+
+/// Area (0 below 1e-15 of twice it, as MuJoCo ignores such faces), unit normal and centre of a
+/// triangle (`triangle` in user_mesh.cc).
+fn triangle(a: &Vec3, b: &Vec3, c: &Vec3) -> (f64, Vec3, Vec3) {
+    let center = (a + b + c) / 3.0;
+    let n = (b - a).cross(&(c - a));
+    let len = n.dot(&n).sqrt();
+    if len < 1e-15 {
+        return (0.0, n, center);
+    }
+    (0.5 * len, n / len, center)
+}
+
+/// MuJoCo's inertial frame of a mesh (`mjCMesh::Process`): the centre of mass of its `mode`
+/// (legacy or exact; None for convex and shell meshes, and for a mesh without volume, whose
+/// vertices are then kept as read) and the principal axes of its inertia about it, summed in
+/// MuJoCo's order.
+fn mujoco_mesh_frame(mesh: &mass::TriangleMesh, mode: mass::MeshInertia) -> Option<(Vec3, Mat3)> {
+    let legacy = match mode {
+        mass::MeshInertia::Legacy => true,
+        mass::MeshInertia::Exact => false,
+        mass::MeshInertia::Convex | mass::MeshInertia::Shell => return None,
+    };
+    let corners = |t: &[u32; 3]| t.map(|i| mesh.vertices[i as usize]);
+    let (mut facecen, mut total_area) = (Vec3::zeros(), 0.0);
+    for t in &mesh.triangles {
+        let [a, b, c] = corners(t);
+        let (area, _, center) = triangle(&a, &b, &c);
+        facecen += center * area;
+        total_area += area;
+    }
+    if total_area.is_nan() || total_area < 1e-15 {
+        return None;
+    }
+    facecen /= total_area;
+    let (mut com, mut total_volume) = (Vec3::zeros(), 0.0);
+    for t in &mesh.triangles {
+        let [a, b, c] = corners(t);
+        let (area, normal, center) = triangle(&a, &b, &c);
+        let mut volume = (center - facecen).dot(&normal) * area / 3.0;
+        if legacy {
+            volume = volume.abs();
+        }
+        total_volume += volume;
+        com += (center * 3.0 / 4.0 + facecen / 4.0) * volume;
+    }
+    if total_volume.is_nan() || total_volume < 1e-15 {
+        return None;
+    }
+    com /= total_volume;
+    // Products of inertia about the centre of mass (`ComputeInertia`).
+    const K: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
+    let mut p = [0.0; 6];
+    for t in &mesh.triangles {
+        let [d, e, f] = corners(t).map(|v| v - com);
+        let (area, normal, center) = triangle(&d, &e, &f);
+        let mut volume = center.dot(&normal) * area / 3.0;
+        if legacy {
+            volume = volume.abs();
+        }
+        for (j, &(k0, k1)) in K.iter().enumerate() {
+            p[j] += volume / 20.0
+                * (2.0 * (d[k0] * d[k1] + e[k0] * e[k1] + f[k0] * f[k1])
+                    + d[k0] * e[k1]
+                    + d[k1] * e[k0]
+                    + d[k0] * f[k1]
+                    + d[k1] * f[k0]
+                    + e[k0] * f[k1]
+                    + e[k1] * f[k0]);
+        }
+    }
+    let inert = Mat3::new(p[1] + p[2], -p[3], -p[4], -p[3], p[0] + p[2], -p[5], -p[4], -p[5], p[0] + p[1]);
+    let [w, x, y, z] = eig3_quat(&inert);
+    Some((com, quat_to_matrix(w, x, y, z)))
+}
+
+/// MuJoCo's normalisation of a quaternion (`mjuu_normvec`: left alone within 1e-14 of unit length).
+fn norm_quat(q: [f64; 4]) -> [f64; 4] {
+    let n = q.iter().map(|a| a * a).sum::<f64>();
+    if n < 1e-14 {
+        return q;
+    }
+    let n = n.sqrt();
+    if (n - 1.0).abs() > 1e-14 {
+        q.map(|a| a / n)
+    } else {
+        q
+    }
+}
+
+fn mul_quat(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+/// The orientation of the principal axes of a symmetric tensor as MuJoCo 4.0's compiler finds it
+/// for meshes (see the module documentation), moments in decreasing order.
+fn eig3_quat(inert: &Mat3) -> [f64; 4] {
+    const EPS: f64 = 1e-12;
+    let mut quat = [1.0, 0.0, 0.0, 0.0];
+    let mut eig = [0.0; 3];
+    for _ in 0..500 {
+        let e = quat_to_matrix(quat[0], quat[1], quat[2], quat[3]);
+        let d = e.transpose() * inert * e;
+        eig = [d[(0, 0)], d[(1, 1)], d[(2, 2)]];
+        let (rk, ck, rotk) = if d[(0, 1)].abs() > d[(0, 2)].abs() && d[(0, 1)].abs() > d[(1, 2)].abs() {
+            (0, 1, 2)
+        } else if d[(0, 2)].abs() > d[(1, 2)].abs() {
+            (0, 2, 1)
+        } else {
+            (1, 2, 0)
+        };
+        let off = d[(rk, ck)];
+        if off.abs() < EPS * d[(rk, rk)].abs().max(d[(ck, ck)].abs()) {
+            break;
+        }
+        let tau = (d[(ck, ck)] - d[(rk, rk)]) / (2.0 * off);
+        let t = if tau >= 0.0 {
+            1.0 / (tau + (1.0 + tau * tau).sqrt())
+        } else {
+            -1.0 / (-tau + (1.0 + tau * tau).sqrt())
+        };
+        if 1.0 / (1.0 + t * t).sqrt() > 1.0 - EPS {
+            break;
+        }
+        let (s, c) = (0.5 * t.atan()).sin_cos();
+        let mut r = [c, 0.0, 0.0, 0.0];
+        r[rotk + 1] = if rotk == 1 { s } else { -s };
+        quat = norm_quat(mul_quat(&quat, &norm_quat(r)));
+    }
+    for j in 0..3 {
+        let j1 = j % 2;
+        if eig[j1] + EPS < eig[j1 + 1] {
+            eig.swap(j1, j1 + 1);
+            // MuJoCo's literal (1e-16 from FRAC_1_SQRT_2): the quaternion follows it to the bit.
+            #[allow(clippy::approx_constant)]
+            let mut r = [0.707106781186548, 0.0, 0.0, 0.0];
+            r[(j1 + 2) % 3 + 1] = r[0];
+            quat = norm_quat(mul_quat(&quat, &r));
+        }
+    }
+    quat
 }
