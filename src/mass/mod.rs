@@ -13,12 +13,14 @@
 //! - `topology`: closedness and orientation of a mesh ([`Topology`]).
 //! - `principal`: principal moments and axes, parallel-axis shift, tensor rotation,
 //!   composition.
+//! - `eig3`: principal axes oriented as MuJoCo's compiler orients them (bodies, mesh frames).
 //! - `error`: [`MeshError`], whose messages name the defect and the fix.
 //!
 //! The convex hull (convex mode) is parry3d-f64's; every other integral is computed here, in
 //! MuJoCo's order of operations (`mjCMesh::Process`), because MuJoCo's legacy mode (its default)
 //! has no counterpart in parry and the other modes must agree with MuJoCo to round-off.
 
+pub(crate) mod eig3;
 mod error;
 mod fast_hash;
 mod mesh;

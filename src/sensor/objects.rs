@@ -10,32 +10,11 @@ use super::types::SensorObject;
 use crate::model::{Data, JointKind, Model};
 use crate::spatial::{quat_to_matrix, Mat3, Transform, Vec3};
 
-/// A quaternion `[w, x, y, z]`.
-pub(crate) type Quat = [f64; 4];
-
-/// The Hamilton product a ⊗ b (MuJoCo's `mju_mulQuat`).
-pub(crate) fn mul_quat(a: &Quat, b: &Quat) -> Quat {
-    [
-        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
-        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
-        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
-        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
-    ]
-}
+pub(crate) use crate::mass::eig3::{self, mul_quat, normalize_quat, Quat};
 
 /// The conjugate (inverse of a unit quaternion, MuJoCo's `mju_negQuat`).
 pub(crate) fn neg_quat(q: &Quat) -> Quat {
     [q[0], -q[1], -q[2], -q[3]]
-}
-
-/// q / |q|, the identity for a zero quaternion (MuJoCo's `mju_normalize4`).
-pub(crate) fn normalize_quat(q: &[f64]) -> Quat {
-    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
-    if n < 1e-15 || !n.is_finite() {
-        [1.0, 0.0, 0.0, 0.0]
-    } else {
-        [q[0] / n, q[1] / n, q[2] / n, q[3] / n]
-    }
 }
 
 /// The quaternion of a fixed rotation (w ≥ 0); exactly the identity for the identity matrix.
@@ -86,55 +65,10 @@ fn frame_quat(model: &Model, data: &Data, quats: &[Quat], f: usize) -> Quat {
     mul_quat(&base, &rot_quat(&frame.x_body_frame.rot))
 }
 
-/// The principal axes of a symmetric inertia tensor as MuJoCo's compiler orients them
-/// (`mjuu_eig3`, user_util.cc): cyclic Jacobi rotations, each about the axis of the largest
-/// off-diagonal entry, accumulated as quaternions from the identity, then the moments sorted in
-/// decreasing order by quarter turns — so that a body's inertial frame (`body_iquat`) and the
-/// sensors reading it have MuJoCo's axes and signs. The half-angle of each rotation is taken from
-/// its tangent (not from √((1 − cos)/2), which cancels to zero below 1e-8 rad), and the sweeps run
-/// until the off-diagonal entries are round-off: equal to MuJoCo 4.0's `body_iquat` to 2e-16
-/// (tests/data/mjcf/sensors/frames.xml).
+/// The principal axes of a symmetric inertia tensor as MuJoCo's compiler orients a body's
+/// (`body_iquat`; [`crate::mass::eig3`]).
 pub(crate) fn principal_quat(inertia: &Mat3) -> Quat {
-    let normalize = |q: Quat| normalize_quat(&q);
-    let mut quat: Quat = [1.0, 0.0, 0.0, 0.0];
-    let mut eig = [0.0; 3];
-    for _ in 0..500 {
-        let e = quat_to_matrix(quat[0], quat[1], quat[2], quat[3]);
-        let d = e.transpose() * inertia * e;
-        eig = [d[(0, 0)], d[(1, 1)], d[(2, 2)]];
-        let (rk, ck, rotk) = if d[(0, 1)].abs() > d[(0, 2)].abs() && d[(0, 1)].abs() > d[(1, 2)].abs() {
-            (0, 1, 2)
-        } else if d[(0, 2)].abs() > d[(1, 2)].abs() {
-            (0, 2, 1)
-        } else {
-            (1, 2, 0)
-        };
-        let off = d[(rk, ck)];
-        if off.abs() <= 1e-16 * d[(rk, rk)].abs().max(d[(ck, ck)].abs()) || off == 0.0 {
-            break;
-        }
-        let tau = (d[(ck, ck)] - d[(rk, rk)]) / (2.0 * off);
-        let t = if tau >= 0.0 {
-            1.0 / (tau + (1.0 + tau * tau).sqrt())
-        } else {
-            -1.0 / (-tau + (1.0 + tau * tau).sqrt())
-        };
-        let (s, c) = (0.5 * t.atan()).sin_cos();
-        let mut r = [c, 0.0, 0.0, 0.0];
-        r[rotk + 1] = if rotk == 1 { s } else { -s };
-        quat = normalize(mul_quat(&quat, &r));
-    }
-    const EPS: f64 = 1e-12;
-    for j in 0..3 {
-        let j1 = j % 2;
-        if eig[j1] + EPS < eig[j1 + 1] {
-            eig.swap(j1, j1 + 1);
-            let mut r = [std::f64::consts::FRAC_1_SQRT_2, 0.0, 0.0, 0.0];
-            r[(j1 + 2) % 3 + 1] = std::f64::consts::FRAC_1_SQRT_2;
-            quat = normalize(mul_quat(&quat, &r));
-        }
-    }
-    quat
+    eig3::principal_quat(inertia, &eig3::BODY)
 }
 
 /// The inertial frame of MuJoCo body `b` in its own frame: centre of mass and principal axes
