@@ -702,3 +702,12 @@ pub fn translate_q(model: &Model, q: &[f64], offset: &Vec3) -> Vec<f64> {
 /// ε |M| (≈ 1e-17 here) in either engine before the raise, and the other pivots and the solve
 /// agree to round-off: 1e-9 allows for a few ulps of difference in the O(1) entries of L.
 pub const SINGULAR_REL: f64 = 1e-9;
+
+/// Relative tolerance of the poses and joint values in the viewer's pages (`cli/tests/viewer.rs`):
+/// they are stored as f32, whose rounding is 2⁻²⁴ ≈ 6e-8 of a value; 1e-7 allows one rounding.
+pub const VIEW_F32_REL: f64 = 1e-7;
+
+/// How far (CSS pixels) the drawn pixels of a model may reach outside the box its geoms' bounding
+/// boxes project to in the viewer's browser tests (`cli/tests/viewer_browser.rs`): antialiasing
+/// spreads an edge by a pixel; 3 allows for it and for the arrows' and grid's rasterization.
+pub const VIEW_BOX_MARGIN_PX: f64 = 3.0;

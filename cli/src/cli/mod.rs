@@ -9,9 +9,11 @@ pub mod finite_json;
 pub mod info;
 pub mod interrupt;
 pub mod output_file;
+pub mod run_plot;
 pub mod sensor_columns;
 pub mod simulate;
 pub mod stdout;
+pub mod view;
 pub mod workprec;
 pub mod workprec_plot;
 

@@ -64,7 +64,7 @@ pub fn check_path(path: &Path) -> Result<(), CliError> {
 }
 
 /// Registers a system TrueType font as plotters' "sans-serif" (once).
-fn register_font() -> Result<(), CliError> {
+pub fn register_font() -> Result<(), CliError> {
     use std::sync::OnceLock;
     static DONE: OnceLock<Result<(), String>> = OnceLock::new();
     DONE.get_or_init(|| {
