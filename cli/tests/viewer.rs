@@ -307,3 +307,27 @@ fn live_mode_serves_the_page_and_streams_frames_then_exits() {
     assert!(status.success(), "{rest}");
     assert!(rest.contains("the live run ended at t = 1.500 s"), "{rest}");
 }
+
+#[cfg(unix)]
+#[test]
+fn live_mode_without_duration_ends_cleanly_on_ctrl_c() {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_lagrange"))
+        .args(["view", "models/textbook/drop.xml", "--live", "--port", "0"])
+        .current_dir(root())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    stdout.read_line(&mut line).unwrap();
+    assert!(line.contains("until Ctrl-C"), "{line}");
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    // SIGINT, as Ctrl-C in a terminal sends it (to this child only, by its id).
+    let pid = i32::try_from(child.id()).unwrap();
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGINT) }, 0);
+    let status = child.wait().unwrap();
+    let mut rest = String::new();
+    stdout.read_to_string(&mut rest).unwrap();
+    assert!(status.success(), "{status:?}: {rest}");
+    assert!(rest.contains("the live run interrupted at t = "), "{rest}");
+}
