@@ -378,9 +378,12 @@
     return { x0, y0, x1, y1 };
   }
 
+  // Getters are defined on the state itself (Object.assign would copy their values once).
+  Object.defineProperties(state, {
+    nframes: { get: () => frames.length, enumerable: true },
+    time: { get: () => (frames.length ? frames[state.frame].time : 0), enumerable: true },
+  });
   window.lagrangeViewer = Object.assign(state, {
-    get nframes() { return frames.length; },
-    get time() { return frames.length ? frames[state.frame].time : 0; },
     setFrame, play: () => setPlaying(true), pause: () => setPlaying(false),
     project, projectedBox,
     canvas: () => { const r = renderer.domElement.getBoundingClientRect(); return { x: r.left, y: r.top, width: r.width, height: r.height }; },

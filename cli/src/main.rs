@@ -1,4 +1,4 @@
-//! The `lagrange` command line: `info`, `eval`, `simulate`, `bench`, `workprec`; with no arguments it simulates the
+//! The `lagrange` command line: `info`, `eval`, `simulate`, `bench`, `workprec`, `view`; with no arguments it simulates the
 //! embedded default scene (the Go1 quadruped standing on its servos, soft contacts) and prints the summary.
 //! Exit status (README, "Exit status"): 0 success, 1 error, 2 command-line usage (clap), 3 `eval` with
 //! failed states, 130 interrupted by a signal, 141 stdout closed by its reader.

@@ -99,6 +99,21 @@ fn range<'a>(lines: impl Iterator<Item = &'a Vec<f64>>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// An axis label: plain below 1e4 and above 1e-3 (to 4 significant digits), else scientific.
+fn label(y: f64) -> String {
+    if y == 0.0 || (1e-3..1e4).contains(&y.abs()) {
+        let text = format!("{y:.4}");
+        let text = text.trim_end_matches('0').trim_end_matches('.');
+        if text == "-0" {
+            "0".into()
+        } else {
+            text.into()
+        }
+    } else {
+        format!("{y:.2e}")
+    }
+}
+
 fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     time: &[f64],
@@ -123,7 +138,7 @@ where
         .configure_mesh()
         .x_desc("time (s)")
         .y_desc(y_desc)
-        .y_label_formatter(&|y| format!("{y:.3e}"))
+        .y_label_formatter(&|y| label(*y))
         .label_style(("sans-serif", 12))
         .draw()
         .map_err(err)?;

@@ -121,7 +121,19 @@ fn run_live(mut sim: Simulation, request: &Request, state: simulate::InitialStat
     sim.set_act(&act)?;
     let model = sim.model.clone();
     let (scene_json, warnings) = scene::scene_json(&model);
-    let page = html::page(&scene_json, &scene::Frames::default().to_json(), true);
+    // The page holds the initial state as its frame 0 (the camera frames it); the stream sends
+    // the frames after it.
+    let mut recorder = scene::Recorder::new(&model);
+    let d = &sim.data;
+    recorder.record(
+        &model,
+        d.time,
+        d.qpos.as_slice(),
+        d.qvel.as_slice(),
+        d.act.as_slice(),
+        d.ctrl.as_slice(),
+    );
+    let page = html::page(&scene_json, &recorder.frames.to_json(), true);
     let server = live::Server::start(request.port, page)?;
     interrupt::watch();
     let until = match request.duration {
@@ -135,11 +147,10 @@ fn run_live(mut sim: Simulation, request: &Request, state: simulate::InitialStat
     }
     stdout::print(&text)?;
     let nslot = model.bodies.len() + model.mocap_pose0.len();
-    let mut recorder = scene::Recorder::new(&model);
     let interval = 1.0 / request.fps;
     let wall0 = Instant::now();
     let mut result = Ok(());
-    for k in 0u64.. {
+    for k in 1u64.. {
         let t = k as f64 * interval;
         if request.duration.is_some_and(|d| t > d + 1e-12) || interrupt::requested() {
             break;
