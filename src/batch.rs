@@ -60,6 +60,20 @@ pub struct Rollout {
 
 /// Rolls `model` out from each of `states` for `options.steps` steps, in parallel; results in the
 /// order of `states`.
+///
+/// ```
+/// use lagrange::batch::{rollout, BatchOptions, InitialState};
+/// use lagrange::prelude::*;
+/// use std::sync::Arc;
+/// let model = Arc::new(Model::from_file("models/textbook/double_pendulum.xml")?);
+/// let states: Vec<InitialState> =
+///     (0..4).map(|i| InitialState { q: vec![0.1 * i as f64, 0.0], v: vec![0.0; 2] }).collect();
+/// let options = BatchOptions { steps: 100, ..BatchOptions::default() };
+/// let results = rollout(&model, &states, &options);
+/// assert_eq!(results.len(), 4);
+/// assert_eq!(results[0].as_ref().unwrap().steps, 100);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn rollout(
     model: &Arc<Model>,
     states: &[InitialState],

@@ -153,6 +153,23 @@ impl Simulation {
     /// the model: as MuJoCo's `opt.timestep`, the step is also what the soft constraints'
     /// `refsafe` time constant (at least 2 · timestep) and the actuators' `actearly` look ahead
     /// by are computed from. The adaptive integrator's steps vary: its model keeps the file's.
+    ///
+    /// ```
+    /// use lagrange::prelude::*;
+    /// use std::sync::Arc;
+    /// let model = Arc::new(Model::from_file("models/ur5/ur5.urdf")?);
+    /// let mut sim = Simulation::new(model, &SimOptions::default());
+    /// sim.set_torque_controller(|_t, q, v, tau| {
+    ///     for i in 0..q.len() {
+    ///         tau[i] = -50.0 * q[i] - 5.0 * v[i]; // a PD law on every joint
+    ///     }
+    /// });
+    /// for _ in 0..100 {
+    ///     sim.step()?;
+    /// }
+    /// assert!((sim.data.time - 0.2).abs() < 1e-12); // 100 steps of MuJoCo's default 2 ms
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn new(model: Arc<Model>, options: &SimOptions) -> Self {
         let mut notes = Vec::new();
         let integrator = options.integrator.unwrap_or_else(|| {

@@ -98,7 +98,7 @@ fn trajectory_gap(model: &Model, q: &[f64], v: &[f64], offset: &Vec3, steps: usi
 }
 
 /// How far a translated scene's trajectory follows the original over 1000 steps (2 s): reported
-/// (README "Far from the origin"), beside MuJoCo's on the same scene
+/// (docs/library.md, "Far from the origin"), beside MuJoCo's on the same scene
 /// (validation/far_origin_trajectory.py). The gap grows with the distance as the state's own
 /// round-off does (ε d per step, amplified by the contacts' sensitivity); the bound only catches
 /// a return to the world-origin formulas (which gave 1.4e-3 at 1e5 m).

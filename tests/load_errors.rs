@@ -296,11 +296,12 @@ fn inertia_violating_the_triangle_inequality() {
 
 #[test]
 fn unresolvable_package_uri() {
-    let mesh = r#"    <visual>
+    // A collision mesh takes part in contact: it must be found.
+    let mesh = r#"    <collision>
       <geometry>
         <mesh filename="package://lagrange_no_such_pkg/meshes/b.stl"/>
       </geometry>
-    </visual>"#;
+    </collision>"#;
     let text = two_links("fixed", "", mesh);
     let options =
         LoadOptions { package_dirs: vec![PathBuf::from("/nonexistent/lagrange/pkgs")], ..Default::default() };
@@ -414,7 +415,7 @@ fn root_element_is_not_robot() {
 
 #[test]
 fn unreadable_number_is_located() {
-    // urdf-rs rejects the file; the loader finds the element and line.
+    // The value checks reject the file; the loader finds the element and line.
     let text = two_links("fixed", r#"    <origin xyz="1 2" rpy="0 0 0"/>"#, "");
     let (e, file) = load_err("bad_number", &text);
     let line = line_of(&text, "<origin");
@@ -579,7 +580,7 @@ fn floating_root_joint_name_clash() {
 
 #[test]
 fn urdf_1_2_checks_are_located() {
-    // Checks urdf-rs makes for `version="1.2"` files are reported at the element they concern.
+    // urdfdom's checks for `version="1.2"` files are reported at the element they concern.
     let text = r#"<robot name="r" version="1.2">
   <link name="a">
     <inertial>
@@ -604,7 +605,10 @@ fn urdf_1_2_checks_are_located() {
   </joint>
 </robot>"#;
     let (e, file) = load_err("v12_limit", text);
-    assert_mentions(&e.to_string(), &[&format!("{file}:4:"), "joint [j]", "upper position limit"]);
+    assert_mentions(
+        &e.to_string(),
+        &[&format!("{file}:4:"), "joint 'j'", "upper position limit", "URDF ≥ 1.2"],
+    );
 }
 
 #[test]
@@ -628,6 +632,29 @@ fn a_missing_visual_mesh_is_a_warning_and_the_visual_is_dropped() {
             &format!("{}:{line}", path.display()),
             "/nonexistent/lagrange/TrunkYaw.mesh",
             "does not exist",
+            "visual dropped",
+        ],
+    );
+}
+
+#[test]
+fn a_visual_mesh_under_an_unresolved_package_is_a_warning() {
+    // Issue 31: a `.dae` under an unresolved `package://` must not stop the load (visual meshes
+    // never take part in the dynamics); the warning names the package and the places searched.
+    let mesh = r#"    <visual><geometry><mesh filename="package://lagrange_no_such_pkg/meshes/b.dae"/></geometry></visual>"#;
+    let text = two_links("fixed", "", mesh);
+    let path = write_urdf("visual_package_missing", &text);
+    let options =
+        LoadOptions { package_dirs: vec![PathBuf::from("/nonexistent/lagrange/pkgs")], ..Default::default() };
+    let model = load(&path, &options).expect("a visual mesh cannot stop the load");
+    assert!(model.geoms.is_empty(), "{:?}", model.geoms);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    let line = line_of(&text, "<mesh ");
+    assert_mentions(
+        &model.warnings[0],
+        &[
+            &format!("{}:{line}", path.display()),
+            "package 'lagrange_no_such_pkg' not found",
             "visual dropped",
         ],
     );

@@ -1,6 +1,6 @@
 //! The `lagrange` command line: `info`, `eval`, `simulate`, `bench`, `workprec`, `view`; with no arguments it simulates the
 //! embedded default scene (the Go1 quadruped standing on its servos, soft contacts) and prints the summary.
-//! Exit status (README, "Exit status"): 0 success, 1 error, 2 command-line usage (clap), 3 `eval` with
+//! Exit status (docs/cli.md, "Exit status"): 0 success, 1 error, 2 command-line usage (clap), 3 `eval` with
 //! failed states, 130 interrupted by a signal, 141 stdout closed by its reader.
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -153,7 +153,20 @@ enum Command {
         /// keyframe's `ctrl`, else zero).
         #[arg(long, allow_hyphen_values = true)]
         ctrl: Option<String>,
-        /// Write the trajectory (time, q, v, energy, constraint violation per step) to this CSV file.
+        /// Controls over time: a CSV file with header `time,ACTUATOR,...` (any subset of the
+        /// actuators; interpolated as --input-interp says, the last row held).
+        #[arg(long, value_name = "FILE")]
+        ctrl_file: Option<PathBuf>,
+        /// Applied joint forces over time (MuJoCo's qfrc_applied; drives URDF robots): a CSV file
+        /// with header `time,JOINT,...` (a one-dof joint by name, any dof as JOINT[k]).
+        #[arg(long, value_name = "FILE")]
+        tau_file: Option<PathBuf>,
+        /// Values of --ctrl-file and --tau-file between their rows: `linear` interpolation or
+        /// `hold` (zero-order hold).
+        #[arg(long, value_enum, default_value_t = cli::input_schedule::Interp::Linear)]
+        input_interp: cli::input_schedule::Interp,
+        /// Write the trajectory to this CSV file: time, q, v, act, ctrl, actuator_force, energy,
+        /// constraint violation and sensors per step.
         /// The file is replaced only when the run completes; a run that stops early keeps its
         /// rows in NAME.partial.csv.
         #[arg(long)]
@@ -371,6 +384,9 @@ fn main() -> ExitCode {
             q0,
             v0,
             ctrl,
+            ctrl_file,
+            tau_file,
+            input_interp,
             out,
             max_output_bytes,
             view,
@@ -393,6 +409,9 @@ fn main() -> ExitCode {
                 q0,
                 v0,
                 ctrl,
+                ctrl_file,
+                tau_file,
+                input_interp,
                 out,
                 max_output_bytes,
                 view,

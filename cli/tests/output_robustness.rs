@@ -1,4 +1,4 @@
-//! The command line's output guarantees (README, "Output files and exit status"), end to end on
+//! The command line's output guarantees (docs/cli.md, "Output files, interruption and exit status"), end to end on
 //! small inputs: an interrupted or killed `simulate` leaves the previous `--out` file intact (and
 //! an interrupted one keeps its whole rows in `NAME.partial.csv`); a diverging run keeps finite
 //! rows only; a full disk and a closed pipe are a typed error and a quiet exit, never a panic;

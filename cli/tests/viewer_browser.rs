@@ -220,10 +220,10 @@ struct Image {
 
 impl Image {
     fn from_png(bytes: &[u8]) -> Image {
-        let mut decoder = png::Decoder::new(bytes);
+        let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
         decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
         let mut reader = decoder.read_info().unwrap();
-        let mut buf = vec![0; reader.output_buffer_size()];
+        let mut buf = vec![0; reader.output_buffer_size().expect("a screenshot's size fits in memory")];
         let info = reader.next_frame(&mut buf).unwrap();
         let channels = info.color_type.samples();
         let rgb = buf[..info.buffer_size()].chunks(channels).map(|c| [c[0], c[1], c[2]]).collect();

@@ -1,4 +1,4 @@
-//! End-to-end tests of `lagrange workprec` (README, "workprec"): the JSON has exactly the
+//! End-to-end tests of `lagrange workprec` (docs/cli.md, "workprec"): the JSON has exactly the
 //! documented keys, the errors on the double pendulum fall with the step size at each method's
 //! order (RK4 4, semi-implicit Euler 1) and with the adaptive method's tolerance, the plot files
 //! are written, saved and extra rows are merged, the reference dump holds the trajectory, and bad

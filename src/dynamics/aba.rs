@@ -26,6 +26,18 @@ use nalgebra::{DVector, Matrix6};
 /// # Errors
 /// [`InputError::Length`] when q is not nq long, v or tau not nv long, or `data` was made for
 /// another model; nothing is computed then.
+///
+/// ```
+/// use lagrange::prelude::*;
+/// let model = Model::from_file("models/ur5/ur5.urdf")?;
+/// let mut data = Data::new(&model);
+/// let (q, v) = (vec![0.1; 6], vec![0.0; 6]);
+/// // The torques RNEA says hold the arm still give zero acceleration back.
+/// let tau = lagrange::dynamics::rnea(&model, &mut data, &q, &v, &[0.0; 6])?.clone();
+/// let qacc = lagrange::dynamics::aba(&model, &mut data, &q, &v, tau.as_slice())?;
+/// assert!(qacc.amax() < 1e-9);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn aba<'d>(
     model: &Model,
     data: &'d mut Data,

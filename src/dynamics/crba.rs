@@ -34,6 +34,16 @@ use nalgebra::{DMatrix, DVector, Vector3};
 ///
 /// # Errors
 /// [`InputError::Length`] when q is not nq long or `data` was made for another model.
+///
+/// ```
+/// use lagrange::prelude::*;
+/// let model = Model::from_file("models/ur5/ur5.urdf")?;
+/// let mut data = Data::new(&model);
+/// let m = lagrange::dynamics::crba(&model, &mut data, &[0.1; 6])?;
+/// assert_eq!((m.nrows(), m.ncols()), (6, 6));
+/// assert!((m[(1, 2)] - m[(2, 1)]).abs() < 1e-12); // symmetric
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>, InputError> {
     check::data("crba", model, data)?;
     check::q("crba", model, q)?;

@@ -12,6 +12,16 @@ use nalgebra::DVector;
 /// # Errors
 /// [`InputError::Length`] when q is not nq long, v or qacc not nv long, or `data` was made for
 /// another model.
+///
+/// ```
+/// use lagrange::prelude::*;
+/// let model = Model::from_file("models/ur5/ur5.urdf")?;
+/// let mut data = Data::new(&model);
+/// let (q, v, qacc) = (vec![0.1; 6], vec![0.0; 6], vec![0.0; 6]);
+/// let tau = lagrange::dynamics::rnea(&model, &mut data, &q, &v, &qacc)?;
+/// assert!(tau[1].abs() > 1.0); // the shoulder holds the arm against gravity
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn rnea<'d>(
     model: &Model,
     data: &'d mut Data,

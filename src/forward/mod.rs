@@ -42,6 +42,17 @@ use crate::model::{Data, Model};
 /// Forward dynamics at the state in `data` (`qpos`, `qvel`, `act`, `ctrl`, `qfrc_applied`):
 /// every stage of the model's [`Plan`] that runs, in order (MuJoCo's `mj_forward`). The result
 /// is `data.qacc`; the other stages' outputs are in their named buffers.
+///
+/// ```
+/// use lagrange::prelude::*;
+/// let model = Model::from_file("models/mjcf/unitree_go1/scene.xml")?;
+/// let mut data = Data::new(&model);
+/// reset_keyframe(&model, &mut data, "home")?;
+/// forward(&model, &mut data);
+/// assert!(data.qacc.iter().all(|a| a.is_finite()));
+/// assert!(contacts(&model, &data).any(|c| c.active)); // the feet touch the floor
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn forward(model: &Model, data: &mut Data) {
     // The stages read the state beside the buffers they write: moved out for the call (no copy,
     // no allocation) and back.

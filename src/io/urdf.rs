@@ -1,12 +1,12 @@
 //! URDF loader: text → [`ModelSpec`] (docs/architecture.md, "Layers").
 //!
-//! Two passes over the text. `roxmltree` first checks the XML (its errors carry line and column)
-//! and indexes every `<link>` and `<joint>` (with their `<inertial>`, `<visual>`, `<collision>`,
-//! `<mesh>` and `<axis>`) by source line, catching what needs a line to be reported well: missing
-//! names, unknown joint types, joints without `<parent>`/`<child>`, duplicate names. `urdf-rs` then
-//! reads the data; its i-th link/joint is the i-th `<link>`/`<joint>` element of the file. Finally
-//! the tree is checked (one root, no cycles, every link has at most one parent joint) and the links
-//! are laid out in depth-first pre-order from the root, children in file order of their joints —
+//! One parse with `roxmltree` (its errors carry line and column). The loader first indexes every
+//! `<link>` and `<joint>` (with their `<inertial>`, `<visual>`, `<collision>`, `<mesh>` and
+//! `<axis>`) by source line, catching what needs a line to be reported well: missing names,
+//! unknown joint types, joints without `<parent>`/`<child>`, duplicate names; then checks every
+//! value it will read ([`values`]: missing or unreadable attributes, the URDF version's rules) and
+//! reads them from the same tree. Finally the tree is checked (one root, no cycles, every link has
+//! at most one parent joint) and the links are laid out in depth-first pre-order from the root, children in file order of their joints —
 //! MuJoCo's order, which the rest of the engine relies on (docs/architecture.md, "Conventions").
 //!
 //! Semantics follow the URDF specification (<http://wiki.ros.org/urdf/XML>): `<origin rpy>` is a
@@ -20,12 +20,16 @@ use crate::model::spec::{
     GeomSpec, InertialSpec, JointSpec, JointType, LinkSpec, MassRules, MimicSpec, ModelSpec, Shape,
 };
 use crate::model::{FrameKind, SourceLoc};
-use crate::spatial::{Mat3, Transform, Vec3};
-use roxmltree::{Document, Node, ParsingOptions};
+use crate::spatial::{Mat3, Vec3};
+use roxmltree::{Document, Node, NodeId, ParsingOptions};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use values::{child, number, numbers, origin, Version};
 
-/// URDF joint type names and what they become. `spherical` is an extension that urdf-rs reads.
+mod values;
+
+/// URDF joint type names and what they become. `spherical` is an extension (urdf-rs and some
+/// exporters write it): a ball joint.
 const JOINT_TYPES: [(&str, JointType); 7] = [
     ("revolute", JointType::Revolute),
     ("continuous", JointType::Continuous),
@@ -56,28 +60,12 @@ pub fn parse(text: &str, path: &Path, options: &LoadOptions) -> Result<ModelSpec
     // Resource limits before the second (slower) parse: the link and dof counts.
     let nv = index.joints.iter().map(|j| j.jtype.nv()).sum();
     crate::io::plausibility::check_counts(&ctx.file, crate::io::LinkWord::Link, index.links.len(), nv)?;
-    // A material <texture> without a file name (which urdf-rs rejects) only affects drawing: it
-    // is blanked out, keeping every byte offset, with a warning.
-    let mut warnings = Vec::new();
-    let mut cleaned: Option<String> = None;
-    for node in doc.descendants().filter(|n| is(n, "texture") && n.attribute("filename").is_none()) {
-        let range = node.range();
-        let text = cleaned.get_or_insert_with(|| text.to_string());
-        text.replace_range(range.clone(), &" ".repeat(range.len()));
-        warnings.push(format!(
-            "{}: <texture> without a filename ignored (it only affects drawing)",
-            ctx.loc(node)
-        ));
+    if let Some(e) = values::check_values(doc.root_element(), &ctx, index.version_1_2) {
+        return Err(e);
     }
-    let urdf_text = cleaned.as_deref().unwrap_or(text);
-    let robot =
-        urdf_rs::read_from_string(urdf_text).map_err(|e| diagnose(&doc, &ctx, &index, &e.to_string()))?;
-    index.check_matches(&robot, &ctx, &doc)?;
     let tree = Tree::build(&index, &ctx)?;
-    let mut spec = build_spec(&robot, &index, &tree, path, options)?;
+    let mut spec = build_spec(&doc, &ctx, &index, &tree, path, options)?;
     spec.elements.extend(transmissions(&doc, &ctx));
-    warnings.append(&mut spec.warnings);
-    spec.warnings = warnings;
     Ok(spec)
 }
 
@@ -106,6 +94,7 @@ impl Ctx {
 
 /// Where a `<visual>` or `<collision>` is.
 struct GeomIndex {
+    node: NodeId,
     collision: bool,
     loc: SourceLoc,
     /// Location of its `<mesh>`, if the geometry is a mesh.
@@ -114,6 +103,7 @@ struct GeomIndex {
 
 /// What the first pass learned about a `<link>`.
 struct LinkIndex {
+    node: NodeId,
     name: String,
     loc: SourceLoc,
     inertial_loc: Option<SourceLoc>,
@@ -123,6 +113,7 @@ struct LinkIndex {
 
 /// What the first pass learned about a `<joint>`.
 struct JointIndex {
+    node: NodeId,
     name: String,
     loc: SourceLoc,
     jtype: JointType,
@@ -131,13 +122,14 @@ struct JointIndex {
     axis_loc: Option<SourceLoc>,
     /// Location of its `<mimic>`, if any.
     mimic_loc: Option<SourceLoc>,
-    has_limit: bool,
 }
 
 /// The positions of all links and joints (first pass, roxmltree).
 struct Index {
     links: Vec<LinkIndex>,
     joints: Vec<JointIndex>,
+    /// `version` of `<robot>`.
+    version: Version,
     /// `version` of `<robot>` is 1.2 or later (changes limit defaults).
     version_1_2: bool,
 }
@@ -163,12 +155,9 @@ impl Index {
                 ),
             ));
         }
-        let version_1_2 = robot
-            .attribute("version")
-            .and_then(|v| v.trim().split_once('.'))
-            .and_then(|(a, b)| Some((a.parse::<u32>().ok()?, b.parse::<u32>().ok()?)))
-            .is_some_and(|v| v >= (1, 2));
-        let mut index = Index { links: Vec::new(), joints: Vec::new(), version_1_2 };
+        let version = Version::of(robot);
+        let version_1_2 = version >= Version(1, 2);
+        let mut index = Index { links: Vec::new(), joints: Vec::new(), version, version_1_2 };
         let mut link_names: HashMap<&str, ()> = HashMap::new();
         let mut joint_names: HashMap<&str, ()> = HashMap::new();
         for node in elements(robot) {
@@ -200,23 +189,6 @@ impl Index {
         }
         Ok(index)
     }
-
-    /// Checks that urdf-rs saw the same links and joints in the same order.
-    fn check_matches(&self, robot: &urdf_rs::Robot, ctx: &Ctx, doc: &Document) -> Result<(), LoadError> {
-        let same_links = robot.links.len() == self.links.len()
-            && robot.links.iter().zip(&self.links).all(|(a, b)| a.name == b.name);
-        let same_joints = robot.joints.len() == self.joints.len()
-            && robot.joints.iter().zip(&self.joints).all(|(a, b)| a.name == b.name);
-        if same_links && same_joints {
-            return Ok(());
-        }
-        Err(ctx.invalid(
-            doc.root_element(),
-            "the URDF reader (urdf-rs) and the XML index disagree on the links and joints of the file \
-             (loader bug); please report it with this file"
-                .into(),
-        ))
-    }
 }
 
 /// The `name` attribute of a `<link>` or `<joint>`, which must be there and non-empty.
@@ -230,8 +202,13 @@ fn required_name<'a>(ctx: &Ctx, node: Node<'a, '_>, what: &str) -> Result<&'a st
 }
 
 fn index_link(ctx: &Ctx, node: Node, name: &str) -> Result<LinkIndex, LoadError> {
-    let mut link =
-        LinkIndex { name: name.to_string(), loc: ctx.loc(node), inertial_loc: None, geoms: Vec::new() };
+    let mut link = LinkIndex {
+        node: node.id(),
+        name: name.to_string(),
+        loc: ctx.loc(node),
+        inertial_loc: None,
+        geoms: Vec::new(),
+    };
     for child in elements(node) {
         match child.tag_name().name() {
             "inertial" => {
@@ -250,6 +227,7 @@ fn index_link(ctx: &Ctx, node: Node, name: &str) -> Result<LinkIndex, LoadError>
                     .flat_map(|g| g.children())
                     .find(|m| is(m, "mesh"));
                 link.geoms.push(GeomIndex {
+                    node: child.id(),
                     collision: tag == "collision",
                     loc: ctx.loc(child),
                     mesh_loc: mesh.map(|m| ctx.loc(m)),
@@ -293,6 +271,7 @@ fn index_joint(ctx: &Ctx, node: Node, name: &str) -> Result<JointIndex, LoadErro
     let parent = link_of("parent")?;
     let child = link_of("child")?;
     Ok(JointIndex {
+        node: node.id(),
         name: name.to_string(),
         loc,
         jtype,
@@ -300,7 +279,6 @@ fn index_joint(ctx: &Ctx, node: Node, name: &str) -> Result<JointIndex, LoadErro
         child,
         axis_loc: elements(node).find(|c| is(c, "axis")).map(|a| ctx.loc(a)),
         mimic_loc: elements(node).find(|c| is(c, "mimic")).map(|m| ctx.loc(m)),
-        has_limit: elements(node).any(|c| is(&c, "limit")),
     })
 }
 
@@ -468,9 +446,10 @@ fn transmissions(doc: &Document, ctx: &Ctx) -> Vec<crate::model::Element> {
         .collect()
 }
 
-/// Turns the urdf-rs data into the spec, in tree order.
+/// Reads the links and joints into the spec, in tree order.
 fn build_spec(
-    robot: &urdf_rs::Robot,
+    doc: &Document,
+    ctx: &Ctx,
     index: &Index,
     tree: &Tree,
     path: &Path,
@@ -483,6 +462,7 @@ fn build_spec(
     let search_dirs = package_search_dirs(&options.package_dirs);
     let base = base_dir(path);
     let mut warnings = Vec::new();
+    let node = |id: NodeId| doc.get_node(id).expect("index of this document");
 
     let mut links = Vec::with_capacity(tree.order.len());
     for &li in &tree.order {
@@ -490,16 +470,19 @@ fn build_spec(
         let (parent, joint) = match tree.parent_joint[li] {
             Some(ji) => {
                 let parent = spec_index[tree.joint_parent[ji]];
-                (Some(parent), joint_spec(&robot.joints[ji], &index.joints[ji], index, options)?)
+                let ji = &index.joints[ji];
+                (Some(parent), joint_spec(ctx, node(ji.node), ji, index, options)?)
             }
             None => (None, root_joint(link_index, index, options)?),
         };
-        let urdf_link = &robot.links[li];
-        let inertial = match &link_index.inertial_loc {
-            Some(loc) => Some(inertial_spec(&urdf_link.inertial, &link_index.name, loc)?),
-            None => None,
+        let link_node = node(link_index.node);
+        let inertial = match (&link_index.inertial_loc, child(link_node, "inertial")) {
+            (Some(loc), Some(inertial)) => {
+                Some(inertial_spec(ctx, inertial, index.version, &link_index.name, loc)?)
+            }
+            _ => None,
         };
-        let geoms = geom_specs(urdf_link, link_index, &base, &search_dirs, &mut warnings)?;
+        let geoms = geom_specs(ctx, doc, link_index, index.version, &base, &search_dirs, &mut warnings)?;
         links.push(LinkSpec {
             name: link_index.name.clone(),
             loc: link_index.loc.clone(),
@@ -514,7 +497,7 @@ fn build_spec(
         });
     }
     Ok(ModelSpec {
-        name: robot.name.clone(),
+        name: doc.root_element().attribute("name").unwrap_or("").to_string(),
         source: Some(path.to_path_buf()),
         gravity: Vec3::new(0.0, 0.0, -9.81),
         links,
@@ -551,16 +534,9 @@ fn root_joint(root: &LinkIndex, index: &Index, options: &LoadOptions) -> Result<
     Ok(JointSpec::new(name, JointType::Fixed, root.loc.clone()))
 }
 
-fn pose(p: &urdf_rs::Pose) -> Transform {
-    Transform::from_xyz_rpy(p.xyz.0, p.rpy.0)
-}
-
-fn finite_pose(p: &urdf_rs::Pose) -> bool {
-    p.xyz.iter().chain(p.rpy.iter()).all(|x| x.is_finite())
-}
-
 fn joint_spec(
-    j: &urdf_rs::Joint,
+    ctx: &Ctx,
+    node: Node,
     ji: &JointIndex,
     index: &Index,
     options: &LoadOptions,
@@ -571,22 +547,16 @@ fn joint_spec(
         detail,
     };
     let name = &ji.name;
-    if !finite_pose(&j.origin) {
-        return Err(invalid(
-            &ji.loc,
-            "joint",
-            format!(
-                "joint '{name}': <origin> has a non-finite value (xyz {:?}, rpy {:?}); give finite numbers",
-                j.origin.xyz.0, j.origin.rpy.0
-            ),
-        ));
-    }
     let mut spec = JointSpec::new(name, ji.jtype, ji.loc.clone());
-    spec.x_parent_joint = pose(&j.origin);
-    let axis = j.axis.xyz.0;
+    spec.x_parent_joint = origin(ctx, node, index.version, &format!("joint '{name}'"))?;
+    let axis = child(node, "axis").and_then(|a| numbers::<3>(a, "xyz")).unwrap_or([1.0, 0.0, 0.0]);
     spec.axis = Vec3::new(axis[0], axis[1], axis[2]);
-    if matches!(ji.jtype, JointType::Revolute | JointType::Prismatic) && ji.has_limit {
-        let (lower, upper) = (j.limit.lower, j.limit.upper);
+    let limit = match child(node, "limit") {
+        Some(l) => Some(values::limit(ctx, node, l, index.version, name)?),
+        None => None,
+    };
+    if let (Some(limit), JointType::Revolute | JointType::Prismatic) = (&limit, ji.jtype) {
+        let (lower, upper) = (limit.lower, limit.upper);
         // URDF ≥ 1.2 writes "no limit" as ±inf; both infinite means unlimited.
         let unlimited = index.version_1_2 && lower == f64::NEG_INFINITY && upper == f64::INFINITY;
         if lower.is_nan() || upper.is_nan() {
@@ -601,11 +571,14 @@ fn joint_spec(
         }
     }
     // `--clamp-effort`: a positive, finite effort bounds the joint's torque (0 or none: unbounded).
-    if options.clamp_effort && ji.has_limit && j.limit.effort.is_finite() && j.limit.effort > 0.0 {
-        spec.effort_limit = Some(j.limit.effort);
+    if let Some(limit) =
+        limit.as_ref().filter(|l| options.clamp_effort && l.effort.is_finite() && l.effort > 0.0)
+    {
+        spec.effort_limit = Some(limit.effort);
     }
-    if let Some(d) = &j.dynamics {
-        for (what, v) in [("damping", d.damping), ("friction", d.friction)] {
+    if let Some(d) = child(node, "dynamics") {
+        for (what, slot) in [("damping", &mut spec.damping), ("friction", &mut spec.friction)] {
+            let v = number(d, what).unwrap_or(0.0);
             if !v.is_finite() || v < 0.0 {
                 return Err(invalid(
                     &ji.loc,
@@ -613,16 +586,15 @@ fn joint_spec(
                     format!("joint '{name}': <dynamics {what}=\"{v}\"> must be a finite number ≥ 0; fix it"),
                 ));
             }
+            *slot = v;
         }
-        spec.damping = d.damping;
-        spec.friction = d.friction;
     }
     // The leader is resolved, and mimic chains checked, by the compile step.
-    if let Some(m) = &j.mimic {
+    if let Some(m) = child(node, "mimic") {
         let mimic = MimicSpec {
-            leader: m.joint.clone(),
-            multiplier: m.multiplier.unwrap_or(1.0),
-            offset: m.offset.unwrap_or(0.0),
+            leader: m.attribute("joint").unwrap_or("").to_string(),
+            multiplier: number(m, "multiplier").unwrap_or(1.0),
+            offset: number(m, "offset").unwrap_or(0.0),
             loc: ji.mimic_loc.clone().unwrap_or_else(|| ji.loc.clone()),
         };
         if !mimic.multiplier.is_finite() || !mimic.offset.is_finite() {
@@ -644,68 +616,59 @@ fn joint_spec(
     Ok(spec)
 }
 
-fn inertial_spec(i: &urdf_rs::Inertial, link: &str, loc: &SourceLoc) -> Result<InertialSpec, LoadError> {
-    if !finite_pose(&i.origin) {
-        return Err(LoadError::Invalid {
-            loc: loc.clone(),
-            element: "inertial".into(),
-            detail: format!(
-                "link '{link}': the <origin> of <inertial> has a non-finite value; give finite numbers"
-            ),
-        });
-    }
-    let t = &i.inertia;
-    let inertia = Mat3::new(t.ixx, t.ixy, t.ixz, t.ixy, t.iyy, t.iyz, t.ixz, t.iyz, t.izz);
-    Ok(InertialSpec { mass: i.mass.value, x_link_inertial: pose(&i.origin), inertia, loc: loc.clone() })
+fn inertial_spec(
+    ctx: &Ctx,
+    node: Node,
+    version: Version,
+    link: &str,
+    loc: &SourceLoc,
+) -> Result<InertialSpec, LoadError> {
+    let x_link_inertial = origin(ctx, node, version, &format!("link '{link}': <inertial>"))?;
+    let mass = child(node, "mass").and_then(|m| number(m, "value")).unwrap_or(0.0);
+    let i = |name: &str| child(node, "inertia").and_then(|n| number(n, name)).unwrap_or(0.0);
+    let (ixx, ixy, ixz, iyy, iyz, izz) = (i("ixx"), i("ixy"), i("ixz"), i("iyy"), i("iyz"), i("izz"));
+    let inertia = Mat3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz);
+    Ok(InertialSpec { mass, x_link_inertial, inertia, loc: loc.clone() })
 }
 
-/// Visuals and collisions of a link in file order, meshes resolved to existing files.
+/// Visuals and collisions of a link in file order, meshes resolved to existing files. A visual
+/// whose mesh cannot be found (missing file, unresolved `package://`) is dropped with a warning:
+/// the engine never uses visual geometry for dynamics (as Pinocchio's kinematic model ignores it).
 fn geom_specs(
-    link: &urdf_rs::Link,
+    ctx: &Ctx,
+    doc: &Document,
     li: &LinkIndex,
+    version: Version,
     base: &Path,
     search_dirs: &[PathBuf],
     warnings: &mut Vec<String>,
 ) -> Result<Vec<GeomSpec>, LoadError> {
-    let (mut visuals, mut collisions) = (link.visual.iter(), link.collision.iter());
     let mut geoms = Vec::with_capacity(li.geoms.len());
     for g in &li.geoms {
-        let next = if g.collision {
-            collisions.next().map(|c| (&c.origin, &c.geometry))
-        } else {
-            visuals.next().map(|v| (&v.origin, &v.geometry))
-        };
-        let Some((origin, geometry)) = next else {
-            return Err(LoadError::Invalid {
-                loc: g.loc.clone(),
-                element: if g.collision { "collision" } else { "visual" }.into(),
-                detail: format!(
-                    "link '{}': the URDF reader (urdf-rs) lost this element (loader bug); please report it",
-                    li.name
-                ),
-            });
-        };
+        let node = doc.get_node(g.node).expect("index of this document");
         let element = if g.collision { "collision" } else { "visual" };
         let bad = |detail: String| LoadError::Invalid {
             loc: g.loc.clone(),
             element: element.into(),
             detail: format!("link '{}': {detail}", li.name),
         };
-        if !finite_pose(origin) {
-            return Err(bad("the <origin> has a non-finite value; give finite numbers".into()));
-        }
-        let size_ok = |vals: &[f64]| vals.iter().all(|v| v.is_finite() && *v >= 0.0);
-        let shape = match geometry {
-            urdf_rs::Geometry::Box { size } => Shape::Box { size: Vec3::new(size[0], size[1], size[2]) },
-            urdf_rs::Geometry::Cylinder { radius, length } => {
-                Shape::Cylinder { radius: *radius, length: *length }
+        let x_link_geom = origin(ctx, node, version, &format!("link '{}': <{element}>", li.name))?;
+        // `check_values` made sure of exactly one known shape with readable sizes.
+        let Some(shape_node) = child(node, "geometry").and_then(|g| elements(g).next()) else {
+            return Err(bad("<geometry> holds no shape".into()));
+        };
+        let n = |name: &str| number(shape_node, name).unwrap_or(f64::NAN);
+        let shape = match shape_node.tag_name().name() {
+            "box" => {
+                let size = numbers::<3>(shape_node, "size").unwrap_or([f64::NAN; 3]);
+                Shape::Box { size: Vec3::new(size[0], size[1], size[2]) }
             }
-            urdf_rs::Geometry::Capsule { radius, length } => {
-                Shape::Capsule { radius: *radius, length: *length }
-            }
-            urdf_rs::Geometry::Sphere { radius } => Shape::Sphere { radius: *radius },
-            urdf_rs::Geometry::Mesh { filename, scale } => {
-                let scale = scale.map_or([1.0; 3], |s| s.0);
+            "cylinder" => Shape::Cylinder { radius: n("radius"), length: n("length") },
+            "capsule" => Shape::Capsule { radius: n("radius"), length: n("length") },
+            "sphere" => Shape::Sphere { radius: n("radius") },
+            "mesh" => {
+                let filename = shape_node.attribute("filename").unwrap_or("");
+                let scale = numbers::<3>(shape_node, "scale").unwrap_or([1.0; 3]);
                 if !scale.iter().all(|s| s.is_finite()) {
                     return Err(bad(format!(
                         "the <mesh> scale {scale:?} has a non-finite value; give finite numbers"
@@ -713,9 +676,7 @@ fn geom_specs(
                 }
                 let loc = g.mesh_loc.clone().unwrap_or_else(|| g.loc.clone());
                 let path = match resolve_mesh(filename, &li.name, &loc, base, search_dirs) {
-                    // A missing file of a visual mesh cannot change the dynamics: the visual is
-                    // dropped with a warning (as Pinocchio's kinematic model ignores it).
-                    Err(e @ LoadError::MeshNotFound { .. }) if !g.collision => {
+                    Err(e) if !g.collision => {
                         warnings.push(format!("{e} [visual dropped]"));
                         continue;
                     }
@@ -723,6 +684,7 @@ fn geom_specs(
                 };
                 Shape::Mesh { path, scale: Vec3::new(scale[0], scale[1], scale[2]) }
             }
+            other => return Err(bad(format!("unknown geometry <{other}>"))),
         };
         let dims: Vec<f64> = match &shape {
             Shape::Box { size } => size.iter().copied().collect(),
@@ -733,12 +695,12 @@ fn geom_specs(
                 Vec::new()
             }
         };
-        if !size_ok(&dims) {
+        if !dims.iter().all(|v| v.is_finite() && *v >= 0.0) {
             return Err(bad(format!(
                 "the geometry has a negative or non-finite size {dims:?}; sizes must be ≥ 0"
             )));
         }
-        geoms.push(GeomSpec { collision: g.collision, ..GeomSpec::new(shape, pose(origin), g.loc.clone()) });
+        geoms.push(GeomSpec { collision: g.collision, ..GeomSpec::new(shape, x_link_geom, g.loc.clone()) });
     }
     Ok(geoms)
 }
@@ -771,167 +733,4 @@ fn resolve_mesh(
             detail: format!("link '{link}': {detail}"),
         }),
     }
-}
-
-/// Turns a urdf-rs failure into an error with a location: first look for the element whose
-/// values urdf-rs cannot read; else use what the message names (a joint, a quoted value).
-fn diagnose(doc: &Document, ctx: &Ctx, index: &Index, message: &str) -> LoadError {
-    let robot = doc.root_element();
-    if let Some(e) = check_values(robot, ctx, index.version_1_2) {
-        return e;
-    }
-    let message = message.trim();
-    let detail = format!("the URDF reader (urdf-rs) rejected the file: {message}; fix the element it names");
-    // "joint [NAME]: ..." (urdf-rs's limit checks).
-    if let Some(name) = message.split_once("joint [").and_then(|(_, r)| r.split_once(']')).map(|(n, _)| n) {
-        if let Some(j) = index.joints.iter().find(|j| j.name == name) {
-            return LoadError::Invalid { loc: j.loc.clone(), element: "joint".into(), detail };
-        }
-    }
-    // "... ATTR ... [VALUE]" (urdf-rs's geometry and quat_xyzw checks name the attribute and
-    // quote its value): the first element with that attribute and value.
-    if let Some(value) = message.rsplit_once('[').and_then(|(_, r)| r.split_once(']')).map(|(v, _)| v.trim())
-    {
-        let culprit = |n: &Node| {
-            n.is_element() && n.attributes().any(|a| a.value().trim() == value && message.contains(a.name()))
-        };
-        if let Some(node) = robot.descendants().find(culprit) {
-            return ctx.invalid(node, detail);
-        }
-    }
-    ctx.invalid(robot, detail)
-}
-
-/// How to read an attribute: the number of floats (0 = any text) and whether it is required.
-type AttrRule = (&'static str, usize, bool);
-
-const INERTIA_ATTRS: [AttrRule; 6] = [
-    ("ixx", 1, true),
-    ("ixy", 1, true),
-    ("ixz", 1, true),
-    ("iyy", 1, true),
-    ("iyz", 1, true),
-    ("izz", 1, true),
-];
-
-/// Finds the first element (among those urdf-rs reads) with a missing or unreadable value.
-fn check_values(robot: Node, ctx: &Ctx, version_1_2: bool) -> Option<LoadError> {
-    for top in elements(robot) {
-        let owner = format!("{} '{}'", top.tag_name().name(), top.attribute("name").unwrap_or(""));
-        let kept: Vec<Node> = match top.tag_name().name() {
-            "link" => elements(top)
-                .filter(|c| matches!(c.tag_name().name(), "inertial" | "visual" | "collision"))
-                .collect(),
-            "joint" => elements(top).collect(),
-            "material" => vec![top],
-            _ => continue,
-        };
-        for node in kept.into_iter().flat_map(|k| k.descendants().filter(|n| n.is_element())) {
-            if let Some(e) = check_element(node, ctx, &owner, version_1_2) {
-                return Some(e);
-            }
-        }
-    }
-    None
-}
-
-fn check_element(node: Node, ctx: &Ctx, owner: &str, version_1_2: bool) -> Option<LoadError> {
-    let tag = node.tag_name().name();
-    let velocity_required = !version_1_2;
-    let (attrs, children): (&[AttrRule], &[&str]) = match tag {
-        "origin" => (&[("xyz", 3, false), ("rpy", 3, false)], &[]),
-        "axis" => (&[("xyz", 3, true)], &[]),
-        "inertial" => (&[], &["mass", "inertia"]),
-        "mass" => (&[("value", 1, true)], &[]),
-        "inertia" => (&INERTIA_ATTRS, &[]),
-        "visual" | "collision" => (&[], &["geometry"]),
-        "box" => (&[("size", 3, true)], &[]),
-        "cylinder" | "capsule" => (&[("radius", 1, true), ("length", 1, true)], &[]),
-        "sphere" => (&[("radius", 1, true)], &[]),
-        "mesh" => (&[("filename", 0, true), ("scale", 3, false)], &[]),
-        "limit" if velocity_required => {
-            (&[("lower", 1, false), ("upper", 1, false), ("effort", 1, false), ("velocity", 1, true)], &[])
-        }
-        "limit" => {
-            (&[("lower", 1, false), ("upper", 1, false), ("effort", 1, false), ("velocity", 1, false)], &[])
-        }
-        "dynamics" => (&[("damping", 1, false), ("friction", 1, false)], &[]),
-        "mimic" => (&[("joint", 0, true), ("multiplier", 1, false), ("offset", 1, false)], &[]),
-        "safety_controller" => (
-            &[
-                ("soft_lower_limit", 1, false),
-                ("soft_upper_limit", 1, false),
-                ("k_position", 1, false),
-                ("k_velocity", 1, true),
-            ],
-            &[],
-        ),
-        "calibration" => (&[("rising", 1, false), ("falling", 1, false)], &[]),
-        "color" => (&[("rgba", 4, true)], &[]),
-        "texture" => (&[("filename", 0, true)], &[]),
-        "material" => (&[("name", 0, true)], &[]),
-        "geometry" => {
-            const SHAPES: [&str; 5] = ["box", "cylinder", "capsule", "sphere", "mesh"];
-            let shapes: Vec<Node> = elements(node).collect();
-            return match shapes.as_slice() {
-                [s] if SHAPES.contains(&s.tag_name().name()) => None,
-                [s] => Some(ctx.invalid(
-                    node,
-                    format!(
-                        "{owner}: unknown geometry <{}>; use one of <box>, <cylinder>, <capsule>, <sphere>, <mesh>",
-                        s.tag_name().name()
-                    ),
-                )),
-                _ => Some(ctx.invalid(
-                    node,
-                    format!(
-                        "{owner}: <geometry> must hold exactly one of <box>, <cylinder>, <capsule>, <sphere>, \
-                         <mesh> (found {})",
-                        shapes.len()
-                    ),
-                )),
-            };
-        }
-        _ => return None,
-    };
-    for &(attr, count, required) in attrs {
-        let Some(value) = node.attribute(attr) else {
-            if required {
-                return Some(
-                    ctx.invalid(
-                        node,
-                        format!("{owner}: <{tag}> has no {attr} attribute; add {attr}=\"...\""),
-                    ),
-                );
-            }
-            continue;
-        };
-        let ok = match count {
-            0 => true,
-            1 => value.trim().parse::<f64>().is_ok(),
-            n => {
-                let parts: Vec<&str> = value.split_whitespace().collect();
-                parts.len() == n && parts.iter().all(|p| p.parse::<f64>().is_ok())
-            }
-        };
-        if !ok {
-            let want = if count == 1 {
-                "a number".to_string()
-            } else {
-                format!("{count} numbers separated by spaces")
-            };
-            return Some(
-                ctx.invalid(
-                    node,
-                    format!("{owner}: <{tag} {attr}=\"{value}\"> is not {want}; fix the value"),
-                ),
-            );
-        }
-    }
-    for &child in children {
-        if !elements(node).any(|c| c.tag_name().name() == child) {
-            return Some(ctx.invalid(node, format!("{owner}: <{tag}> has no <{child}>; add one")));
-        }
-    }
-    None
 }

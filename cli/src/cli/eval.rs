@@ -1,5 +1,5 @@
 //! `lagrange eval MODEL --states FILE`: one process evaluates a batch of states (the interface the
-//! validation scripts use; schema in the README). The states are read one at a time
+//! validation scripts use; schema in docs/cli.md). The states are read one at a time
 //! ([`super::eval_stream`]) and each result is written as soon as it is computed, so memory does not
 //! grow with the number of states. A state whose result has a non-finite number gets an
 //! `{"error": "..."}` entry in its place (naming the quantity) and the run ends with
@@ -131,7 +131,7 @@ pub fn sensors_not_computed_json(model: &Model) -> Value {
 }
 
 /// The staged forward pipeline at the state: `qacc` (constrained), its parts, and one entry per
-/// active constraint with its multipliers and residuals (README, "eval").
+/// active constraint with its multipliers and residuals (docs/cli.md, "eval").
 fn forward_json(model: &Model, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f64]) -> Value {
     data.qfrc_applied.copy_from_slice(tau);
     data.ctrl.fill(0.0);
@@ -319,7 +319,11 @@ pub fn run(
     let (mut failed, mut first) = (0usize, Vec::new());
     let expected =
         "{\"states\": [{\"q\": [...], \"v\": [...], \"tau\": [...], \"ctrl\": [...], \"act\": [...]}]}";
+    let progress = super::progress::bar(None, "states");
     let total = for_each_state(reader, &file, expected, &mut |i, s: StateIn| {
+        if i % 64 == 0 {
+            progress.set_position(i as u64);
+        }
         check_state(&model, &file, i, &s)?;
         let mut result = evaluate(&model, &mut data, &s, &frame_ids, kernels_only)?;
         if let Some(path) = first_null(&result) {
@@ -335,6 +339,7 @@ pub fn run(
         }
         out.json(&result)
     })?;
+    progress.finish_and_clear();
     // `sensors_not_computed` sorts after `results`: the key order stays serde_json's.
     out.print("],\"sensors_not_computed\":")?;
     out.json(&sensors_not_computed_json(&model))?;

@@ -7,12 +7,16 @@ pub mod eval;
 pub mod eval_stream;
 pub mod finite_json;
 pub mod info;
+pub mod input_schedule;
 pub mod interrupt;
 pub mod output_file;
+pub mod plot_file;
+pub mod progress;
 pub mod run_plot;
 pub mod sensor_columns;
 pub mod simulate;
 pub mod stdout;
+pub mod trajectory_csv;
 pub mod view;
 pub mod workprec;
 pub mod workprec_plot;
@@ -65,7 +69,7 @@ pub enum CliError {
 }
 
 impl CliError {
-    /// The process exit status this error ends the run with (README, "Exit status").
+    /// The process exit status this error ends the run with (docs/cli.md, "Exit status").
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Interrupted(_) => EXIT_INTERRUPTED,

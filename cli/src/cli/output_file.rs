@@ -115,15 +115,6 @@ impl OutputFile {
         }
     }
 
-    /// Where the content is being written: the temporary file (or the target written in place),
-    /// for writers that take a path.
-    pub fn path(&self) -> &Path {
-        match &self.kind {
-            Kind::Replace { tmp, .. } => tmp.path(),
-            Kind::Direct(_) => &self.target,
-        }
-    }
-
     /// Writes `bytes` as the whole content.
     pub fn write_all(&mut self, bytes: &[u8]) -> Result<(), CliError> {
         let file = self.label();

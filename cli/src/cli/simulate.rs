@@ -6,13 +6,15 @@
 //! keeps its whole rows — every number finite — in `NAME.partial.csv`.
 
 use super::finite_json::{describe, first_null};
+use super::input_schedule::{self, Interp, Schedule};
 use super::interrupt;
 use super::output_file::{RowError, RowFile};
-use super::sensor_columns::{self, SensorProbe};
+use super::sensor_columns;
 use super::stdout;
+use super::trajectory_csv::{self, RowProbe, TrajectoryCsv};
 use super::CliError;
 use super::{run_plot, view};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::DriftCorrection;
 use lagrange::integrate::{IntegratorKind, State};
@@ -20,7 +22,6 @@ use lagrange::io::{load, LoadOptions};
 use lagrange::sim::{display_time, SimOptions, Simulation};
 use lagrange::Model;
 use serde_json::json;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -54,6 +55,12 @@ pub struct Request {
     pub v0: Option<String>,
     /// Constant controls (comma-separated, one per actuator).
     pub ctrl: Option<String>,
+    /// Controls over time (`--ctrl-file`, [`input_schedule`]).
+    pub ctrl_file: Option<PathBuf>,
+    /// Applied joint forces over time (`--tau-file`).
+    pub tau_file: Option<PathBuf>,
+    /// Interpolation of the input files between their rows.
+    pub input_interp: Interp,
     pub out: Option<PathBuf>,
     /// Most bytes the CSV may take (`--max-output-bytes`; 0: no bound).
     pub max_output_bytes: u64,
@@ -84,6 +91,9 @@ impl Request {
             q0: None,
             v0: None,
             ctrl: None,
+            ctrl_file: None,
+            tau_file: None,
+            input_interp: Interp::Linear,
             out: None,
             max_output_bytes: DEFAULT_MAX_OUTPUT_BYTES,
             view: None,
@@ -266,9 +276,32 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         )));
     }
     let (q0, v0, ctrl, act) = initial_state(model, request)?;
+    let mut ctrl_schedule = match &request.ctrl_file {
+        Some(f) => Some(Schedule::read(f, "--ctrl-file", request.input_interp, |n| {
+            input_schedule::actuator_column(model, n)
+        })?),
+        None => None,
+    };
+    let mut tau_schedule = match &request.tau_file {
+        Some(f) => Some(Schedule::read(f, "--tau-file", request.input_interp, |n| {
+            input_schedule::dof_column(model, n)
+        })?),
+        None => None,
+    };
     sim.set_state(&q0, &v0)?;
     sim.ctrl_mut().copy_from_slice(&ctrl);
     sim.set_act(&act)?;
+    // The inputs of the step from the current state (and of its CSV row).
+    let mut set_inputs = |sim: &mut Simulation| {
+        let t = sim.data.time;
+        if let Some(s) = ctrl_schedule.as_mut() {
+            s.apply(t, sim.ctrl_mut());
+        }
+        if let Some(s) = tau_schedule.as_mut() {
+            s.apply(t, sim.qfrc_applied_mut());
+        }
+    };
+    set_inputs(&mut sim);
     let steps = (request.duration / dt).round() as u64;
     if !(request.view_fps > 0.0 && request.view_fps.is_finite()) {
         return Err(CliError::Usage(format!(
@@ -283,7 +316,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     let view_start = sim.data.time;
     let mut plot_series = request.plot.as_ref().map(|_| run_plot::Series::new(model, steps));
     let mut step_contacts = 0;
-    let mut probe = SensorProbe::new(model);
+    let mut summary_probe = (sensor_columns::count(model) > 0).then(|| RowProbe::new(model)).flatten();
     let limit = if request.max_output_bytes == 0 { u64::MAX } else { request.max_output_bytes };
     if let Some(path) = &request.out {
         check_output_size(model, path, steps, limit)?;
@@ -292,22 +325,15 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     let mut csv = match &request.out {
         Some(path) => {
             let mut w = RowFile::create(path, limit)?;
-            write_header(w.row(), model).map_err(|source| CliError::Io { file: w.label(), source })?;
+            let mut rows = TrajectoryCsv::new(model);
+            rows.header(model, w.row()).map_err(|source| CliError::Io { file: w.label(), source })?;
             end_row(&mut w, limit, 0.0, 0)?;
-            Some(w)
+            Some((w, rows))
         }
         None => None,
     };
-    let progress = if steps >= 20_000 {
-        let bar = ProgressBar::new(steps);
-        bar.set_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, eta {eta}")
-                .expect("static template"),
-        );
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
+    let progress =
+        if steps >= 20_000 { super::progress::bar(Some(steps), "steps") } else { ProgressBar::hidden() };
     let energy_start = {
         let (kinetic, potential) = sim.energies();
         kinetic + potential
@@ -331,9 +357,8 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
             stopped = Some(diverged(&sim, k, &what));
             break;
         }
-        if let Some(w) = csv.as_mut() {
-            let sensordata = probe.as_mut().map(|p| p.read(model, &sim.data));
-            if let Err(e) = csv_row(w, model, &sim, sensordata, (energy, violation[0]), limit, k) {
+        if let Some((w, rows)) = csv.as_mut() {
+            if let Err(e) = csv_row(w, rows, model, &sim, (energy, violation[0]), limit, k) {
                 stopped = Some(e);
                 break;
             }
@@ -373,6 +398,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         };
         wall += t0.elapsed();
         taken = k + 1;
+        set_inputs(&mut sim);
         violation = report.constraint_violation;
         let (contacts, penetration) = contact_summary(&sim.data);
         step_contacts = contacts;
@@ -418,14 +444,14 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     if let Some(e) = stopped {
         let note = match csv {
             // The run's own error comes first; a failure to keep its rows is added to it.
-            Some(w) => partial_note(w).unwrap_or_else(|e| format!("its rows could not be kept: {e}")),
+            Some((w, _)) => partial_note(w).unwrap_or_else(|e| format!("its rows could not be kept: {e}")),
             None => String::new(),
         };
         return Err(e.with_note(&note));
     }
     let interrupted = if interrupted {
         let (partial, note) = match csv {
-            Some(w) => {
+            Some((w, _)) => {
                 let label = w.label();
                 let replaces = w.replaces_a_file();
                 let partial = w.keep_partial()?;
@@ -436,7 +462,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         };
         Some(Interruption { planned_steps: steps, partial, note })
     } else {
-        if let Some(w) = csv {
+        if let Some((w, _)) = csv {
             w.commit()?;
         }
         None
@@ -448,8 +474,8 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         && model.joints.iter().all(|j| j.friction == 0.0)
         && !limited
         && max_contacts == 0;
-    let sensors = match probe.as_mut() {
-        Some(p) => sensor_columns::to_json(model, p.read(model, &sim.data)),
+    let sensors = match summary_probe.as_mut() {
+        Some(p) => sensor_columns::to_json(model, p.read(model, &sim.data).sensordata.as_slice()),
         None => serde_json::json!({}),
     };
     Ok(Summary {
@@ -489,7 +515,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
 
 /// Refuses, before the run, a CSV whose estimated size exceeds `limit`.
 fn check_output_size(model: &Model, path: &Path, steps: u64, limit: u64) -> Result<(), CliError> {
-    let columns = 1 + model.nq + model.nv + model.na() + 2 + sensor_columns::count(model);
+    let columns = trajectory_csv::columns(model).len();
     let rows = steps.saturating_add(1);
     let estimate = rows.saturating_mul(columns as u64).saturating_mul(CSV_BYTES_PER_VALUE);
     if estimate > limit {
@@ -518,15 +544,15 @@ pub fn human_bytes(n: u64) -> String {
 /// Writes the CSV row of the current state (`step`), or the error that stops the run.
 fn csv_row(
     w: &mut RowFile,
+    rows: &mut TrajectoryCsv,
     model: &Model,
     sim: &Simulation,
-    sensordata: Option<&[f64]>,
     (energy, violation): (f64, f64),
     limit: u64,
     step: u64,
 ) -> Result<(), CliError> {
     // Formatting into the row buffer (a Vec) does not fail.
-    write_row(w.row(), model, sim, sensordata, energy, violation)
+    rows.row(model, sim, energy, violation, w.row())
         .map_err(|source| CliError::Io { file: w.label(), source })?;
     end_row(w, limit, sim.data.time, step)
 }
@@ -620,51 +646,7 @@ fn track_limit_excursions(model: &Model, qpos: &[f64], excursions: &mut [f64]) {
     }
 }
 
-fn write_header(w: &mut impl Write, model: &Model) -> std::io::Result<()> {
-    write!(w, "time")?;
-    for j in &model.joints {
-        for k in 0..j.kind.nq() {
-            write!(w, ",q:{}[{k}]", j.name)?;
-        }
-    }
-    for j in &model.joints {
-        for k in 0..j.kind.nv() {
-            write!(w, ",v:{}[{k}]", j.name)?;
-        }
-    }
-    // Actuator activations (MuJoCo's act), one column per actuator with activation dynamics.
-    for (i, a) in model.actuators.iter().enumerate().filter(|(_, a)| a.actnum() == 1) {
-        if a.name.is_empty() {
-            write!(w, ",act:actuator{i}")?;
-        } else {
-            write!(w, ",act:{}", a.name)?;
-        }
-    }
-    write!(w, ",energy,constraint_violation")?;
-    sensor_columns::write_header(w, model)?;
-    writeln!(w)
-}
-
-fn write_row(
-    w: &mut impl Write,
-    model: &Model,
-    sim: &Simulation,
-    sensordata: Option<&[f64]>,
-    energy: f64,
-    violation: f64,
-) -> std::io::Result<()> {
-    write!(w, "{}", display_time(sim.data.time))?;
-    for x in sim.data.qpos.iter().chain(sim.data.qvel.iter()).chain(sim.data.act.iter()) {
-        write!(w, ",{x}")?;
-    }
-    write!(w, ",{energy},{violation}")?;
-    if let Some(sensordata) = sensordata {
-        sensor_columns::write_values(w, model, sensordata)?;
-    }
-    writeln!(w)
-}
-
-/// The `simulate --json` summary: one object (README, "simulate").
+/// The `simulate --json` summary: one object (docs/cli.md, "simulate").
 pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
     let simulated = s.steps as f64 * s.dt;
     let mut out = json!({
@@ -913,6 +895,9 @@ contacts, joint limits and friction loss.
         json: false,
         keyframe: Some("home".into()),
         ctrl: None,
+        ctrl_file: None,
+        tau_file: None,
+        input_interp: Interp::Linear,
         q0: None,
         v0: None,
         out: None,

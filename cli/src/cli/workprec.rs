@@ -13,7 +13,7 @@
 //!
 //! and the CPU time of its stepping loop alone (the thread's CPU time, minimum of `--repeats`
 //! runs; the measured run that records the samples is not timed). Output: a table, the JSON of
-//! the README, a log-log plot ([`super::workprec_plot`]); `--dump-reference` writes the reference
+//! docs/cli.md, a log-log plot ([`super::workprec_plot`]); `--dump-reference` writes the reference
 //! trajectory and the run's settings for `validation/workprec_mujoco.py`.
 
 use super::interrupt;
@@ -105,7 +105,7 @@ pub struct ReferenceSpec {
     pub rtol: Option<f64>,
 }
 
-/// The `workprec --json` object (README, "workprec"): exactly these keys.
+/// The `workprec --json` object (docs/cli.md, "workprec"): exactly these keys.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Report {
     pub model: String,
@@ -712,7 +712,9 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
     }
     let mut rows = Vec::new();
     let mut failures = Vec::new();
+    let progress = super::progress::bar(Some(runs.len() as u64), "runs");
     for (spec, dt, rtol) in runs {
+        progress.inc(1);
         let setting = match (dt, rtol) {
             (Some(dt), _) => format!("dt {}", fmt_num(dt)),
             (_, Some(r)) => format!("rtol {}", fmt_num(r)),
@@ -784,6 +786,7 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
         };
         write_reference(path, &setup, &reference, energy_scale, meta, &dts, options)?;
     }
+    progress.finish_and_clear();
     let measurement = Measurement {
         rows,
         failures,
@@ -797,7 +800,7 @@ fn measure(path: &Path, options: &LoadOptions, request: &Request) -> Result<(Set
 }
 
 /// The reference trajectory and the settings of the run, for `validation/workprec_mujoco.py`
-/// (README, "workprec").
+/// (docs/cli.md, "workprec").
 fn write_reference(
     path: &Path,
     setup: &Setup,

@@ -26,7 +26,8 @@ use std::time::{Duration, Instant};
 pub struct Request {
     /// A `simulate --out` CSV to play (None: one state).
     pub trajectory: Option<PathBuf>,
-    /// The keyframe shown (or the live run's start), and the controls of a trajectory's states.
+    /// The keyframe shown (or the live run's start); its controls act on a trajectory's states
+    /// when the file has no `ctrl` columns.
     pub keyframe: Option<String>,
     /// Constant controls (comma-separated), over the keyframe's.
     pub ctrl: Option<String>,
@@ -72,7 +73,8 @@ pub fn run(path: &Path, options: &LoadOptions, request: &Request) -> Result<(), 
     match &request.trajectory {
         Some(file) => {
             for row in trajectory::read(file, &model, request.fps)? {
-                recorder.record(&model, row.time, &row.qpos, &row.qvel, &row.act, &ctrl);
+                let ctrl = row.ctrl.as_deref().unwrap_or(&ctrl);
+                recorder.record(&model, row.time, &row.qpos, &row.qvel, &row.act, ctrl);
             }
         }
         None => recorder.record(&model, 0.0, &q0, &v0, &act, &ctrl),

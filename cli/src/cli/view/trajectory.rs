@@ -1,11 +1,12 @@
-//! Reading a `lagrange simulate --out` trajectory CSV for the viewer: the header names the
-//! columns (`time`, `q:JOINT[k]`, `v:JOINT[k]`, `act:ACTUATOR`, then energy, violation and
-//! sensors); the rows are kept at the display rate: for each n the row nearest to n / fps after
-//! the first row (the first at or after it less half a row interval), and the last row.
+//! Reading a `lagrange simulate --out` trajectory CSV for the viewer (the `csv` crate; the
+//! format is `super::super::trajectory_csv`'s): the header names the columns (`time`,
+//! `q:JOINT[k]`, `v:JOINT[k]`, `act:ACTUATOR`, `ctrl:ACTUATOR`, then the outputs); the rows are
+//! kept at the display rate: for each n the row nearest to n / fps after the first row (the first
+//! at or after it less half a row interval), and the last row.
 
 use super::super::CliError;
 use lagrange::Model;
-use std::io::{BufRead, BufReader};
+use std::io::BufReader;
 use std::path::Path;
 
 /// One kept row of the trajectory.
@@ -18,6 +19,8 @@ pub struct Row {
     pub qvel: Vec<f64>,
     /// Actuator activations (na).
     pub act: Vec<f64>,
+    /// The controls applied from this state on (one per actuator), when the file has them.
+    pub ctrl: Option<Vec<f64>>,
 }
 
 /// The rows of the CSV at `path` for `model`, sampled at `fps` frames per second.
@@ -30,49 +33,50 @@ pub fn read(path: &Path, model: &Model, fps: f64) -> Result<Vec<Row>, CliError> 
     let bad = |detail: String| CliError::Input { file: file_name.clone(), detail };
     let file =
         std::fs::File::open(path).map_err(|source| CliError::Io { file: file_name.clone(), source })?;
-    let mut lines = BufReader::new(file).lines();
-    let header = match lines.next() {
-        Some(line) => line.map_err(|source| CliError::Io { file: file_name.clone(), source })?,
-        None => {
-            return Err(bad("the file is empty: expected the header of `lagrange simulate --out`".into()))
-        }
+    let mut reader = csv::ReaderBuilder::new().has_headers(true).from_reader(BufReader::new(file));
+    let header = reader.headers().map_err(|e| bad(e.to_string()))?.clone();
+    let index = |prefix: &str| -> Vec<usize> {
+        header.iter().enumerate().filter(|(_, c)| c.starts_with(prefix)).map(|(i, _)| i).collect()
     };
-    let columns: Vec<&str> = header.split(',').collect();
-    let count = |prefix: &str| columns.iter().filter(|c| c.starts_with(prefix)).count();
-    let (nq, nv, na) = (count("q:"), count("v:"), count("act:"));
-    if columns.first() != Some(&"time") || nq != model.nq || nv != model.nv || na != model.na() {
+    let (iq, iv, ia, ic) = (index("q:"), index("v:"), index("act:"), index("ctrl:"));
+    let nu = model.actuators.len();
+    if header.get(0) != Some("time")
+        || iq.len() != model.nq
+        || iv.len() != model.nv
+        || ia.len() != model.na()
+        || !(ic.is_empty() || ic.len() == nu)
+    {
         return Err(bad(format!(
-            "the header has {nq} q, {nv} v and {na} act columns; the model has nq = {}, nv = {}, na = {}: is this a `lagrange simulate --out` file of this model?",
+            "the header has {} q, {} v, {} act and {} ctrl columns; the model has nq = {}, nv = {}, na = {}, nu = {}: is this a `lagrange simulate --out` file of this model?",
+            iq.len(),
+            iv.len(),
+            ia.len(),
+            ic.len(),
             model.nq,
             model.nv,
-            model.na()
+            model.na(),
+            nu
         )));
     }
     let interval = 1.0 / fps;
     let mut rows: Vec<Row> = Vec::new();
     let mut last: Option<Row> = None;
     let mut half_step: Option<f64> = None;
-    for (i, line) in lines.enumerate() {
-        let line = line.map_err(|source| CliError::Io { file: file_name.clone(), source })?;
-        if line.is_empty() {
-            continue;
-        }
-        let values: Result<Vec<f64>, _> =
-            line.split(',').take(1 + nq + nv + na).map(str::parse::<f64>).collect();
-        let values = values.map_err(|e| bad(format!("line {}: {e}", i + 2)))?;
-        if values.len() < 1 + nq + nv + na {
-            return Err(bad(format!(
-                "line {}: {} values, expected at least {}",
-                i + 2,
-                values.len(),
-                1 + nq + nv + na
-            )));
-        }
+    for (i, record) in reader.records().enumerate() {
+        let record = record.map_err(|e| bad(e.to_string()))?;
+        let value = |c: usize| -> Result<f64, CliError> {
+            let text = record.get(c).unwrap_or("");
+            text.trim()
+                .parse::<f64>()
+                .map_err(|e| bad(format!("row {}, column {}: {e} ('{text}')", i + 2, c + 1)))
+        };
+        let take = |cols: &[usize]| cols.iter().map(|&c| value(c)).collect::<Result<Vec<f64>, CliError>>();
         let row = Row {
-            time: values[0],
-            qpos: values[1..1 + nq].to_vec(),
-            qvel: values[1 + nq..1 + nq + nv].to_vec(),
-            act: values[1 + nq + nv..1 + nq + nv + na].to_vec(),
+            time: value(0)?,
+            qpos: take(&iq)?,
+            qvel: take(&iv)?,
+            act: take(&ia)?,
+            ctrl: if ic.is_empty() { None } else { Some(take(&ic)?) },
         };
         // Frame n is the first row at or after n / fps from the first row less half a row
         // interval (the state nearest to n / fps, as `simulate --view` keeps).
