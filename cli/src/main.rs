@@ -111,6 +111,11 @@ enum Command {
         /// `forward` block and no sensors.
         #[arg(long)]
         kernels_only: bool,
+        /// Instead: N steps of the model's integrator from each state (as `mj_step` from
+        /// MuJoCo's state): qpos, qvel, act, time after them, the contacts of the last step's
+        /// collision pass, and the wall times of the steps and of one collision pass.
+        #[arg(long, value_name = "N")]
+        step: Option<u32>,
     },
     /// Simulate from a keyframe, a given state, or the model's reference configuration at rest,
     /// under gravity, with zero torques.
@@ -367,8 +372,8 @@ fn main() -> ExitCode {
             };
             view::run(&model, &options, &request)
         }
-        Some(Command::Eval { model, states, json: _, jacobians, kernels_only }) => {
-            eval::run(&model, &options, &states, &jacobians, mode, kernels_only)
+        Some(Command::Eval { model, states, json: _, jacobians, kernels_only, step }) => {
+            eval::run(&model, &options, &states, &jacobians, mode, kernels_only, step)
         }
         Some(Command::Simulate {
             model,

@@ -42,6 +42,10 @@ pub struct StateIn {
     /// The simulation time (s) the clock sensor reads (default zero).
     #[serde(default)]
     pub time: Option<f64>,
+    /// The soft solver's warm start (MuJoCo's `qacc_warmstart`, nv values; default zero): read
+    /// by `--step` only.
+    #[serde(default)]
+    pub qacc_warmstart: Option<Vec<f64>>,
 }
 
 fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
@@ -254,7 +258,7 @@ fn soft_rows_json(model: &Model, data: &Data) -> Value {
 }
 
 /// A geom's name, or `<body>#<index>` for an unnamed one.
-fn geom_name(model: &Model, g: usize) -> String {
+pub fn geom_name(model: &Model, g: usize) -> String {
     let geom = &model.geoms[g];
     if geom.name.is_empty() {
         format!("{}#{g}", geom.link)
@@ -277,13 +281,15 @@ fn check_state(model: &Model, file: &str, i: usize, s: &StateIn) -> Result<(), C
     check("tau", &s.tau, model.nv)?;
     check("ctrl", &s.ctrl, model.actuators.len())?;
     check("act", &s.act, model.na())?;
+    check("qacc_warmstart", &s.qacc_warmstart, model.nv)?;
     match s.time {
         Some(t) if !t.is_finite() => Err(err("'time' is not finite".to_string())),
         _ => Ok(()),
     }
 }
 
-/// Runs `eval`, printing `{"results": [...]}`.
+/// Runs `eval`, printing `{"results": [...]}`; with `step` = Some(N), each result is the state
+/// after N steps ([`super::eval_step`]).
 pub fn run(
     path: &Path,
     options: &LoadOptions,
@@ -291,7 +297,9 @@ pub fn run(
     jacobians: &[String],
     mode: Option<ConstraintMode>,
     kernels_only: bool,
+    step: Option<u32>,
 ) -> Result<(), CliError> {
+    let step = step.map(super::eval_step::check_steps).transpose()?;
     let mut model = load(path, options)?;
     if let Some(mode) = mode {
         model.set_constraint_mode(mode);
@@ -325,7 +333,10 @@ pub fn run(
             progress.set_position(i as u64);
         }
         check_state(&model, &file, i, &s)?;
-        let mut result = evaluate(&model, &mut data, &s, &frame_ids, kernels_only)?;
+        let mut result = match step {
+            Some(n) => super::eval_step::evaluate(&model, &mut data, &s, n)?,
+            None => evaluate(&model, &mut data, &s, &frame_ids, kernels_only)?,
+        };
         if let Some(path) = first_null(&result) {
             let reason = format!("states[{i}]: {} is not finite (NaN or infinite)", describe(&path));
             failed += 1;

@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod bench_native;
 pub mod eval;
+pub mod eval_step;
 pub mod eval_stream;
 pub mod finite_json;
 pub mod info;
