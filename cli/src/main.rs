@@ -1,11 +1,11 @@
-//! The `lagrange` command line: `info`, `eval`, `simulate`, `bench`, `workprec`; with no arguments it simulates the
+//! The `lagrange` command line: `info`, `eval`, `simulate`, `bench`, `workprec`, `view`; with no arguments it simulates the
 //! embedded default scene (the Go1 quadruped standing on its servos, soft contacts) and prints the summary.
 //! Exit status (docs/cli.md, "Exit status"): 0 success, 1 error, 2 command-line usage (clap), 3 `eval` with
 //! failed states, 130 interrupted by a signal, 141 stdout closed by its reader.
 
 use clap::{Parser, Subcommand, ValueEnum};
 mod cli;
-use cli::{bench, bench_native, eval, info, simulate, workprec};
+use cli::{bench, bench_native, eval, info, simulate, view, workprec};
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::DriftCorrection;
 use lagrange::integrate::IntegratorKind;
@@ -185,6 +185,48 @@ enum Command {
         /// starts, one that reaches it stops (rows kept in NAME.partial.csv); 0: no bound.
         #[arg(long, value_name = "BYTES", default_value_t = simulate::DEFAULT_MAX_OUTPUT_BYTES)]
         max_output_bytes: u64,
+        /// Write the run as a self-contained viewer page (HTML: poses, contact forces, joint
+        /// values per frame; docs/viewer.md).
+        #[arg(long, value_name = "FILE")]
+        view: Option<PathBuf>,
+        /// Frames per second of simulated time kept for --view.
+        #[arg(long, default_value_t = simulate::DEFAULT_VIEW_FPS, allow_hyphen_values = true)]
+        view_fps: f64,
+        /// Plot joint positions, energy, constraint violation and contact count over time
+        /// (.svg or .png).
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
+    },
+    /// Show the model (or a trajectory, or a live simulation) in a browser: writes one
+    /// self-contained HTML page, or serves it on 127.0.0.1 with --live (docs/viewer.md).
+    View {
+        model: PathBuf,
+        /// A `simulate --out` CSV of this model to play (slider, play button, contact forces).
+        #[arg(long)]
+        trajectory: Option<PathBuf>,
+        /// Show this keyframe (the live run starts from it; its controls act on a trajectory's
+        /// recomputed contact forces).
+        #[arg(long)]
+        keyframe: Option<String>,
+        /// Constant controls, comma-separated (one per actuator), over the keyframe's.
+        #[arg(long, allow_hyphen_values = true)]
+        ctrl: Option<String>,
+        /// The page to write (default: MODEL's file name with .html, in the current folder).
+        #[arg(long, value_name = "FILE", conflicts_with = "live")]
+        out: Option<PathBuf>,
+        /// Serve the page on 127.0.0.1 and stream a simulation run in real time (server-sent
+        /// events); prints the URL.
+        #[arg(long)]
+        live: bool,
+        /// The --live server's port (0: any free port).
+        #[arg(long, default_value_t = view::DEFAULT_PORT, requires = "live")]
+        port: u16,
+        /// Simulated seconds of the --live run (default: until Ctrl-C).
+        #[arg(long, requires = "live", allow_hyphen_values = true)]
+        duration: Option<f64>,
+        /// Frames per second kept from --trajectory or streamed by --live.
+        #[arg(long, default_value_t = simulate::DEFAULT_VIEW_FPS, allow_hyphen_values = true)]
+        fps: f64,
     },
     /// Work-precision: each integrator's error against a reference solution (adaptive, rtol
     /// 1e-13) and its CPU time, over step sizes and tolerances; table, JSON, log-log plot.
@@ -321,6 +363,20 @@ fn main() -> ExitCode {
             };
             workprec::run(&options, &request)
         }
+        Some(Command::View { model, trajectory, keyframe, ctrl, out, live, port, duration, fps }) => {
+            let request = view::Request {
+                trajectory,
+                keyframe,
+                ctrl,
+                out,
+                live,
+                port,
+                duration,
+                fps,
+                constraints: mode,
+            };
+            view::run(&model, &options, &request)
+        }
         Some(Command::Eval { model, states, json: _, jacobians, kernels_only, step, derivatives }) => {
             eval::run(&model, &options, &states, &jacobians, mode, kernels_only, step, derivatives)
         }
@@ -343,6 +399,9 @@ fn main() -> ExitCode {
             input_interp,
             out,
             max_output_bytes,
+            view,
+            view_fps,
+            plot,
         }) => simulate::parse_baumgarte(baumgarte.as_deref()).and_then(|baumgarte| {
             let integrator = integrator.map(IntegratorKind::from);
             let tolerances = simulate::parse_tolerances(integrator, rtol, atol)?;
@@ -365,6 +424,9 @@ fn main() -> ExitCode {
                 input_interp,
                 out,
                 max_output_bytes,
+                view,
+                view_fps,
+                plot,
             };
             simulate::run_file(&model, &options, &request)
         }),

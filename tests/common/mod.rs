@@ -714,3 +714,12 @@ pub const DERIV_FD_REL: f64 = 1e-6;
 /// cross-validation level and the differences divide their disagreement by 2ε, so the issue's
 /// 1e-6 relative holds only where both engines' steps agree smoothly (the same contact set).
 pub const TRANSITION_REL: f64 = 1e-6;
+
+/// Relative tolerance of the poses and joint values in the viewer's pages (`cli/tests/viewer.rs`):
+/// they are stored as f32, whose rounding is 2⁻²⁴ ≈ 6e-8 of a value; 1e-7 allows one rounding.
+pub const VIEW_F32_REL: f64 = 1e-7;
+
+/// How far (CSS pixels) the drawn pixels of a model may reach outside the box its geoms' bounding
+/// boxes project to in the viewer's browser tests (`cli/tests/viewer_browser.rs`): antialiasing
+/// spreads an edge by a pixel; 3 allows for it and for the arrows' and grid's rasterization.
+pub const VIEW_BOX_MARGIN_PX: f64 = 3.0;

@@ -13,10 +13,12 @@ pub mod interrupt;
 pub mod output_file;
 pub mod plot_file;
 pub mod progress;
+pub mod run_plot;
 pub mod sensor_columns;
 pub mod simulate;
 pub mod stdout;
 pub mod trajectory_csv;
+pub mod view;
 pub mod workprec;
 pub mod workprec_plot;
 

@@ -13,6 +13,7 @@ use super::sensor_columns;
 use super::stdout;
 use super::trajectory_csv::{self, RowProbe, TrajectoryCsv};
 use super::CliError;
+use super::{run_plot, view};
 use indicatif::ProgressBar;
 use lagrange::constraint::ConstraintMode;
 use lagrange::forward::DriftCorrection;
@@ -63,6 +64,43 @@ pub struct Request {
     pub out: Option<PathBuf>,
     /// Most bytes the CSV may take (`--max-output-bytes`; 0: no bound).
     pub max_output_bytes: u64,
+    /// Write the viewer page of the run here (`--view`).
+    pub view: Option<PathBuf>,
+    /// Frames per second of simulated time the viewer keeps (`--view-fps`).
+    pub view_fps: f64,
+    /// Write the plot of the run here (`--plot`, .svg or .png).
+    pub plot: Option<PathBuf>,
+}
+
+/// The default of `--view-fps`.
+pub const DEFAULT_VIEW_FPS: f64 = 60.0;
+
+impl Request {
+    /// One second from `qpos0` at rest with the model's options, no output files (the fields
+    /// `lagrange view` does not set).
+    pub fn at_rest() -> Self {
+        Request {
+            duration: 1.0,
+            dt: None,
+            integrator: None,
+            tolerances: None,
+            constraints: None,
+            drift: DriftCorrection::default(),
+            json: false,
+            keyframe: None,
+            q0: None,
+            v0: None,
+            ctrl: None,
+            ctrl_file: None,
+            tau_file: None,
+            input_interp: Interp::Linear,
+            out: None,
+            max_output_bytes: DEFAULT_MAX_OUTPUT_BYTES,
+            view: None,
+            view_fps: DEFAULT_VIEW_FPS,
+            plot: None,
+        }
+    }
 }
 
 /// The default of `--max-output-bytes`: 2 GB.
@@ -128,6 +166,8 @@ pub struct Summary {
     pub limit_excursions: Vec<(String, f64)>,
     /// Set when a signal stopped the run before its end (`steps` then counts the steps taken).
     pub interrupted: Option<Interruption>,
+    /// What the run wrote besides the CSV (the viewer page, the plot), one line each.
+    pub outputs: Vec<String>,
 }
 
 /// `--baumgarte α,β` → gains (both finite and ≥ 0).
@@ -180,6 +220,37 @@ pub fn parse_tolerances(
     Ok(Some(pair))
 }
 
+/// The initial state (qpos, qvel, ctrl, act) of a run: `--q0`/`--v0`, else the keyframe's, else
+/// `qpos0` at rest; `--ctrl`, else the keyframe's controls, else zero.
+pub fn initial_state(model: &Model, request: &Request) -> Result<InitialState, CliError> {
+    let (mut q0, mut v0) = (model.qpos0.clone(), vec![0.0; model.nv]);
+    let mut ctrl = vec![0.0; model.actuators.len()];
+    let mut act = vec![0.0; model.na()];
+    if let Some(name) = &request.keyframe {
+        let Some(k) = model.keyframe_id(name).map(|k| &model.keyframes[k]) else {
+            let known: Vec<&str> = model.keyframes.iter().map(|k| k.name.as_str()).collect();
+            return Err(CliError::Usage(format!(
+                "--keyframe {name}: the model has no such keyframe (it has: {})",
+                if known.is_empty() { "none".to_string() } else { known.join(", ") }
+            )));
+        };
+        k.apply(&mut q0, &mut v0, &mut ctrl, &mut act);
+    }
+    if let Some(s) = &request.ctrl {
+        ctrl = parse_list("ctrl", s, model.actuators.len())?;
+    }
+    if let Some(s) = &request.q0 {
+        q0 = parse_list("q0", s, model.nq)?;
+    }
+    if let Some(s) = &request.v0 {
+        v0 = parse_list("v0", s, model.nv)?;
+    }
+    Ok((q0, v0, ctrl, act))
+}
+
+/// (qpos, qvel, ctrl, act).
+pub type InitialState = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// Simulates `model` per `request`, writing the CSV if asked; returns the summary.
 pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     let mut sim = Simulation::new(
@@ -204,29 +275,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
             request.duration
         )));
     }
-    // Initial state: --q0/--v0, else the keyframe's, else qpos0 at rest.
-    let (mut q0, mut v0) = (model.qpos0.clone(), vec![0.0; model.nv]);
-    let mut ctrl = vec![0.0; model.actuators.len()];
-    let mut act = vec![0.0; model.na()];
-    if let Some(name) = &request.keyframe {
-        let Some(k) = model.keyframe_id(name).map(|k| &model.keyframes[k]) else {
-            let known: Vec<&str> = model.keyframes.iter().map(|k| k.name.as_str()).collect();
-            return Err(CliError::Usage(format!(
-                "--keyframe {name}: the model has no such keyframe (it has: {})",
-                if known.is_empty() { "none".to_string() } else { known.join(", ") }
-            )));
-        };
-        k.apply(&mut q0, &mut v0, &mut ctrl, &mut act);
-    }
-    if let Some(s) = &request.ctrl {
-        ctrl = parse_list("ctrl", s, model.actuators.len())?;
-    }
-    if let Some(s) = &request.q0 {
-        q0 = parse_list("q0", s, model.nq)?;
-    }
-    if let Some(s) = &request.v0 {
-        v0 = parse_list("v0", s, model.nv)?;
-    }
+    let (q0, v0, ctrl, act) = initial_state(model, request)?;
     let mut ctrl_schedule = match &request.ctrl_file {
         Some(f) => Some(Schedule::read(f, "--ctrl-file", request.input_interp, |n| {
             input_schedule::actuator_column(model, n)
@@ -254,6 +303,19 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     };
     set_inputs(&mut sim);
     let steps = (request.duration / dt).round() as u64;
+    if !(request.view_fps > 0.0 && request.view_fps.is_finite()) {
+        return Err(CliError::Usage(format!(
+            "--view-fps {}: give a positive number of frames per second, e.g. --view-fps 60",
+            request.view_fps
+        )));
+    }
+    if let Some(path) = &request.plot {
+        run_plot::check_path(path)?;
+    }
+    let mut viewer = request.view.as_ref().map(|_| view::scene::Recorder::new(&sim.model));
+    let view_start = sim.data.time;
+    let mut plot_series = request.plot.as_ref().map(|_| run_plot::Series::new(model, steps));
+    let mut step_contacts = 0;
     let mut summary_probe = (sensor_columns::count(model) > 0).then(|| RowProbe::new(model)).flatten();
     let limit = if request.max_output_bytes == 0 { u64::MAX } else { request.max_output_bytes };
     if let Some(path) = &request.out {
@@ -301,6 +363,24 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
                 break;
             }
         }
+        if let Some(r) = viewer.as_mut() {
+            // Frame n is the state nearest to n / fps after the start.
+            let d = &sim.data;
+            let due = r.frames.len() as f64 / request.view_fps - 0.5 * dt;
+            if d.time - view_start >= due || k == steps {
+                r.record(
+                    &sim.model,
+                    display_time(d.time),
+                    d.qpos.as_slice(),
+                    d.qvel.as_slice(),
+                    d.act.as_slice(),
+                    d.ctrl.as_slice(),
+                );
+            }
+        }
+        if let Some(p) = plot_series.as_mut() {
+            p.push(k, sim.data.time, sim.data.qpos.as_slice(), energy, violation[0], step_contacts);
+        }
         if k == steps {
             break;
         }
@@ -321,6 +401,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         set_inputs(&mut sim);
         violation = report.constraint_violation;
         let (contacts, penetration) = contact_summary(&sim.data);
+        step_contacts = contacts;
         max_contacts = max_contacts.max(contacts);
         max_penetration = max_penetration.max(penetration);
         let soft = sim.model.plan.solver.soft_weights().is_some();
@@ -344,6 +425,22 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         }
     }
     progress.finish_and_clear();
+    // The page and the plot show the run as far as it went, also when it stopped early.
+    let mut outputs = Vec::new();
+    if let (Some(path), Some(r)) = (&request.view, &viewer) {
+        match view::write_page(path, &sim.model, &r.frames) {
+            Ok(line) => outputs.push(line),
+            Err(e) if stopped.is_none() => return Err(e),
+            Err(_) => {}
+        }
+    }
+    if let (Some(path), Some(p)) = (&request.plot, &plot_series) {
+        match run_plot::plot(path, model, p) {
+            Ok(()) => outputs.push(format!("plot written to {}", path.display())),
+            Err(e) if stopped.is_none() => return Err(e),
+            Err(_) => {}
+        }
+    }
     if let Some(e) = stopped {
         let note = match csv {
             // The run's own error comes first; a failure to keep its rows is added to it.
@@ -412,6 +509,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
             .map(|(j, &e)| (j.name.clone(), e))
             .collect(),
         interrupted,
+        outputs,
     })
 }
 
@@ -731,6 +829,9 @@ fn run_model(model: &Model, request: &Request) -> Result<(), CliError> {
         if let (Some(out), None) = (&request.out, &summary.interrupted) {
             text += &format!("trajectory written to {}\n", out.display());
         }
+        for line in &summary.outputs {
+            text += &format!("{line}\n");
+        }
         stdout::print(&text)?;
     }
     interrupted_error(&summary)
@@ -801,6 +902,9 @@ contacts, joint limits and friction loss.
         v0: None,
         out: None,
         max_output_bytes: DEFAULT_MAX_OUTPUT_BYTES,
+        view: None,
+        view_fps: DEFAULT_VIEW_FPS,
+        plot: None,
     };
     let summary = simulate(&model, &request)?;
     let z0 =
