@@ -522,6 +522,20 @@ def report(rbs, samples, by_round, worst, failures, args, seconds: float) -> str
     return "\n".join(lines)
 
 
+def other_sections(path: Path, text: str) -> str:
+    """The `## ` sections of the existing report that this script does not write (appended by
+    validation/crossval_scenes, bench_python.py and the derivatives harness), kept after its own."""
+    if not path.exists():
+        return ""
+    own = {line for line in text.splitlines() if line.startswith("## ")}
+    kept = []
+    for section in ("\n" + path.read_text()).split("\n## ")[1:]:
+        header = "## " + section.splitlines()[0]
+        if header not in own:
+            kept.append("\n## " + section.rstrip("\n") + "\n")
+    return "".join(kept)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", type=Path, default=HERE / "build")
@@ -545,7 +559,7 @@ def main() -> int:
     samples, by_round, checks = run_all(rbs, args, states)
     worst, failures = compare(rbs, checks)
     text = report(rbs, samples, by_round, worst, failures, args, time.perf_counter() - t0)
-    args.out.write_text(text)
+    args.out.write_text(text + other_sections(args.out, text))
     print(text)
     if failures:
         print("bench_native: CHECK FAILED (%d): the engines disagree; see %s" % (len(failures), args.out),
