@@ -22,6 +22,7 @@ from ._lagrange import (
     SimulationError,
     __version__,
     aba,
+    aba_derivatives,
     center_of_mass,
     contact_force,
     crba,
@@ -32,8 +33,10 @@ from ._lagrange import (
     reset,
     reset_keyframe,
     rnea,
+    rnea_derivatives,
     rollout,
     step,
+    transition_jacobians,
 )
 
 __all__ = [
@@ -47,6 +50,7 @@ __all__ = [
     "SimulationError",
     "__version__",
     "aba",
+    "aba_derivatives",
     "center_of_mass",
     "contact_force",
     "crba",
@@ -57,6 +61,8 @@ __all__ = [
     "reset",
     "reset_keyframe",
     "rnea",
+    "rnea_derivatives",
     "rollout",
     "step",
+    "transition_jacobians",
 ]

@@ -184,6 +184,14 @@ def jacobian(m: Model, d: Data, frame: str, reference: str = "local_world_aligne
 def center_of_mass(m: Model, d: Data) -> FloatArray: ...
 def kinetic_energy(m: Model, d: Data, q: FloatArray, v: FloatArray) -> float: ...
 def potential_energy(m: Model, d: Data, q: FloatArray) -> float: ...
+def rnea_derivatives(m: Model, d: Data, q: FloatArray, v: FloatArray, a: FloatArray) -> Tuple[FloatArray, FloatArray]:
+    """(dtau_dq, dtau_dv) of inverse dynamics; q columns in each joint's tangent space."""
+def aba_derivatives(
+    m: Model, d: Data, q: FloatArray, v: FloatArray, tau: FloatArray
+) -> Tuple[FloatArray, FloatArray, FloatArray]:
+    """(dqacc_dq, dqacc_dv, dqacc_dtau = M⁻¹) of unconstrained forward dynamics."""
+def transition_jacobians(m: Model, d: Data, eps: float = 1e-6, centered: bool = True) -> Tuple[FloatArray, FloatArray]:
+    """(A, B) of one step from d's state, as MuJoCo's mjd_transitionFD."""
 def rollout(
     model: Model,
     initial_states: FloatArray,

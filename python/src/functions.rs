@@ -1,6 +1,7 @@
 //! The module functions: MuJoCo's pipeline (`forward`, `step`, `reset`, `reset_keyframe`,
 //! `contact_force`) and Pinocchio's kernels (`rnea`, `crba`, `aba`, `jacobian`,
-//! `center_of_mass`, the energies), each taking `(model, data, …)`.
+//! `center_of_mass`, the energies) and the derivatives (`rnea_derivatives`, `aba_derivatives`,
+//! `transition_jacobians`), each taking `(model, data, …)`.
 
 use crate::arrays;
 use crate::data::PyData;
@@ -27,6 +28,9 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(center_of_mass, m)?)?;
     m.add_function(wrap_pyfunction!(kinetic_energy, m)?)?;
     m.add_function(wrap_pyfunction!(potential_energy, m)?)?;
+    m.add_function(wrap_pyfunction!(rnea_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(aba_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(transition_jacobians, m)?)?;
     Ok(())
 }
 
@@ -311,4 +315,72 @@ pub fn potential_energy(
     let (data, q, _, _) = d.split();
     lagrange::kinematics::forward_kinematics(&model, data, q).map_err(error::input)?;
     Ok(lagrange::dynamics::potential_energy(&model, data))
+}
+
+/// A NumPy matrix returned to Python.
+type Matrix<'py> = Bound<'py, PyArray2<f64>>;
+
+/// Analytic derivatives of inverse dynamics at (q, v, a) (Pinocchio's
+/// `computeRNEADerivatives`): `(dtau_dq, dtau_dv)`, nv × nv each, rows are τ. q columns are in
+/// each joint's tangent space; velocities in lagrange's (MuJoCo's) coordinates — a free joint's
+/// linear velocity in world axes (docs/derivatives.md). ∂τ/∂a is `crba`.
+#[pyfunction]
+pub fn rnea_derivatives<'py>(
+    py: Python<'py>,
+    m: &Bound<'py, PyModel>,
+    mut d: PyRefMut<'py, PyData>,
+    q: &Bound<'py, PyAny>,
+    v: &Bound<'py, PyAny>,
+    a: &Bound<'py, PyAny>,
+) -> PyResult<(Matrix<'py>, Matrix<'py>)> {
+    let model = model_for(m, &d)?;
+    read_args(&mut d, q, Some((v, "v")), Some((a, "a")))?;
+    let mut work = lagrange::derivatives::DerivativesWork::new(&model);
+    let (data, q, v, a) = d.split();
+    lagrange::derivatives::rnea_derivatives(&model, data, &mut work, q, v, a).map_err(error::input)?;
+    Ok((matrix(py, &work.dtau_dq), matrix(py, &work.dtau_dv)))
+}
+
+/// Analytic derivatives of unconstrained forward dynamics q̈ = ABA(q, v, τ) (Pinocchio's
+/// `computeABADerivatives`): `(dqacc_dq, dqacc_dv, dqacc_dtau)`, nv × nv each; the conventions of
+/// `rnea_derivatives`; `dqacc_dtau` = M⁻¹.
+#[pyfunction]
+pub fn aba_derivatives<'py>(
+    py: Python<'py>,
+    m: &Bound<'py, PyModel>,
+    mut d: PyRefMut<'py, PyData>,
+    q: &Bound<'py, PyAny>,
+    v: &Bound<'py, PyAny>,
+    tau: &Bound<'py, PyAny>,
+) -> PyResult<(Matrix<'py>, Matrix<'py>, Matrix<'py>)> {
+    let model = model_for(m, &d)?;
+    read_args(&mut d, q, Some((v, "v")), Some((tau, "tau")))?;
+    let mut work = lagrange::derivatives::DerivativesWork::new(&model);
+    let (data, q, v, tau) = d.split();
+    lagrange::derivatives::aba_derivatives(&model, data, &mut work, q, v, tau).map_err(error::input)?;
+    Ok((matrix(py, &work.dqacc_dq), matrix(py, &work.dqacc_dv), matrix(py, &work.dqacc_dtau)))
+}
+
+/// Transition Jacobians of one step of the model's integrator from the state in `d`, with
+/// constraints and contacts (MuJoCo's `mjd_transitionFD`): `(A, B)`, A of size
+/// (2 nv + na) × (2 nv + na) for x = (q in the tangent space, v, act), B (2 nv + na) × nu for
+/// u = ctrl; finite differences with nudge `eps`, centred by default. `d`'s state is restored.
+/// The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (m, d, eps=1e-6, centered=true))]
+pub fn transition_jacobians<'py>(
+    py: Python<'py>,
+    m: &Bound<'py, PyModel>,
+    mut d: PyRefMut<'py, PyData>,
+    eps: f64,
+    centered: bool,
+) -> PyResult<(Matrix<'py>, Matrix<'py>)> {
+    let model = model_for(m, &d)?;
+    check_state(d.data(), "transition_jacobians")?;
+    let mut work = lagrange::derivatives::TransitionWork::new(&model);
+    let options = lagrange::derivatives::TransitionOptions { eps, centered };
+    let data = d.data();
+    py.detach(|| lagrange::derivatives::transition_jacobians(&model, data, &mut work, &options))
+        .map_err(error::sim)?;
+    Ok((matrix(py, &work.a), matrix(py, &work.b)))
 }
