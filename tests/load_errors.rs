@@ -639,7 +639,7 @@ fn a_missing_visual_mesh_is_a_warning_and_the_visual_is_dropped() {
 
 #[test]
 fn a_visual_mesh_under_an_unresolved_package_is_a_warning() {
-    // Issue 31: a `.dae` under an unresolved `package://` must not stop the load (visual meshes
+    // A `.dae` under an unresolved `package://` must not stop the load (visual meshes
     // never take part in the dynamics); the warning names the package and the places searched.
     let mesh = r#"    <visual><geometry><mesh filename="package://lagrange_no_such_pkg/meshes/b.dae"/></geometry></visual>"#;
     let text = two_links("fixed", "", mesh);

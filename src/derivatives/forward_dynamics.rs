@@ -56,7 +56,7 @@ pub fn aba_derivatives(
 /// depend on the state differentiated too: joint damping (∂/∂v = −d), hinge and slide springs
 /// (∂/∂q = −k) and the actuators' affine gains and biases through their moment arms
 /// (∂force/∂velocity = b₂ + g₂ x, ∂force/∂length = b₁ + g₁ x; see
-/// [`add_actuator_length_derivative`] for what the configuration part leaves out). Not
+/// `forward::actuation::add_actuator_length_derivative` for what the configuration part leaves out). Not
 /// differentiated: the q-dependence of `xfrc_applied`'s Jacobian, and the effort-limit and
 /// `actuatorfrcrange` clamps (a clamped force's derivative is reported as if unclamped).
 /// Results as [`aba_derivatives`], with `work.tau` the total generalized force; runs the passive

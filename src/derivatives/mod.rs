@@ -1,4 +1,4 @@
-//! Derivatives of the dynamics for control and learning (issue 33; docs/derivatives.md, the
+//! Derivatives of the dynamics for control and learning (docs/derivatives.md, the
 //! derivation in docs/physics.md, "Derivatives of the dynamics"): analytic ∂τ/∂q and ∂τ/∂v of
 //! inverse dynamics ([`rnea_derivatives`]), analytic ∂q̈/∂q, ∂q̈/∂v and ∂q̈/∂τ of forward dynamics
 //! ([`aba_derivatives`], and [`smooth_derivatives`] with passive and actuator forces), all into a

@@ -4,7 +4,7 @@
 //! `<link>` and `<joint>` (with their `<inertial>`, `<visual>`, `<collision>`, `<mesh>` and
 //! `<axis>`) by source line, catching what needs a line to be reported well: missing names,
 //! unknown joint types, joints without `<parent>`/`<child>`, duplicate names; then checks every
-//! value it will read ([`values`]: missing or unreadable attributes, the URDF version's rules) and
+//! value it will read (`values`: missing or unreadable attributes, the URDF version's rules) and
 //! reads them from the same tree. Finally the tree is checked (one root, no cycles, every link has
 //! at most one parent joint) and the links are laid out in depth-first pre-order from the root, children in file order of their joints —
 //! MuJoCo's order, which the rest of the engine relies on (docs/architecture.md, "Conventions").
