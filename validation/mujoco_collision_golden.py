@@ -599,22 +599,26 @@ def golden(pair: str) -> str:
     return text
 
 
-def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def run_pair_files(description: str, pairs, golden, out_dir: pathlib.Path, label: str, width: int) -> int:
+    """The command line of a per-pair-type reference-data script (this one and
+    mujoco_convex_golden.py): writes `out_dir/PAIR.json` from `golden(pair)` for each pair type of
+    `pairs`, or with --check recomputes them in memory and exits 1 if a file differs beyond
+    CHECK_REL or a file no pair type produces is there; --only limits it to some pair types."""
+    ap = argparse.ArgumentParser(description=description)
     ap.add_argument("--check", action="store_true", help="recompute in memory; exit 1 if a file differs")
     ap.add_argument("--only", action="append", default=[], help="only this pair type (repeatable)")
     args = ap.parse_args()
-    unknown = set(args.only) - set(PAIRS)
+    unknown = set(args.only) - set(pairs)
     if unknown:
         print("unknown pair type(s): %s" % ", ".join(sorted(unknown)), file=sys.stderr)
         return 2
-    OUT_DIR.mkdir(parents=True, exist_ok=True)
+    out_dir.mkdir(parents=True, exist_ok=True)
     stale = []
-    for pair in PAIRS:
+    for pair in pairs:
         if args.only and pair not in args.only:
             continue
         text = golden(pair)
-        out = OUT_DIR / (pair + ".json")
+        out = out_dir / (pair + ".json")
         old = out.read_text() if out.exists() else None
         doc = json.loads(text)
         n_cases = sum(len(s["cases"]) for s in doc["scenes"])
@@ -627,19 +631,22 @@ def main() -> int:
             status = "unchanged" if old == text else "written"
             if old != text:
                 out.write_text(text)
-        print("%-16s %3d cases %4d contacts  %-9s %s" % (pair, n_cases, n_contacts, status,
-                                                         out.relative_to(REPO).as_posix()))
+        print("%-*s %3d cases %4d contacts  %-9s %s" % (width, pair, n_cases, n_contacts, status,
+                                                        out.relative_to(REPO).as_posix()))
     if not args.only:
-        extra = sorted(p.name for p in OUT_DIR.glob("*.json") if p.stem not in PAIRS)
+        extra = sorted(p.name for p in out_dir.glob("*.json") if p.stem not in pairs)
         for e in extra:
-            print("%-16s EXTRA: no pair type produces it" % e)
+            print("%-*s EXTRA: no pair type produces it" % (width, e))
         if args.check:
             stale += extra
     if args.check and stale:
-        print("collision golden data out of date: %s" % ", ".join(stale), file=sys.stderr)
+        print("%s golden data out of date: %s" % (label, ", ".join(stale)), file=sys.stderr)
         return 1
     return 0
 
+
+def main() -> int:
+    return run_pair_files(__doc__.split("\n\n")[0], PAIRS, golden, OUT_DIR, "collision", 16)
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -22,7 +22,6 @@ numbers relative to the largest magnitude of their quantity (1e-12) and structur
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import pathlib
@@ -36,7 +35,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import mujoco_collision_golden as base  # noqa: E402
 from mujoco_collision_golden import (ORIGIN, Q_I, Q_ZX, Scene, at, axis_angle, placed,  # noqa: E402
                                      qmul, random_cases, resting_cases, yaw_tilt)
-from mujoco_golden import check_status, dump  # noqa: E402
+from mujoco_golden import dump  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parent.parent
 OUT_DIR = REPO / "tests" / "data" / "mujoco" / "convex"
@@ -211,46 +210,7 @@ def golden(pair: str) -> str:
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--check", action="store_true", help="recompute in memory; exit 1 if a file differs")
-    ap.add_argument("--only", action="append", default=[], help="only this pair type (repeatable)")
-    args = ap.parse_args()
-    unknown = set(args.only) - set(PAIRS)
-    if unknown:
-        print("unknown pair type(s): %s" % ", ".join(sorted(unknown)), file=sys.stderr)
-        return 2
-    OUT_DIR.mkdir(parents=True, exist_ok=True)
-    stale = []
-    for pair in PAIRS:
-        if args.only and pair not in args.only:
-            continue
-        text = golden(pair)
-        out = OUT_DIR / (pair + ".json")
-        old = out.read_text() if out.exists() else None
-        doc = json.loads(text)
-        n_cases = sum(len(s["cases"]) for s in doc["scenes"])
-        n_contacts = sum(len(c["contacts"]) for s in doc["scenes"] for c in s["cases"])
-        if args.check:
-            status = check_status(old, text, doc, CHECK_REL)
-            if not status.startswith("ok"):
-                stale.append(out.relative_to(REPO).as_posix())
-        else:
-            status = "unchanged" if old == text else "written"
-            if old != text:
-                out.write_text(text)
-        print("%-20s %3d cases %4d contacts  %-9s %s" % (pair, n_cases, n_contacts, status,
-                                                         out.relative_to(REPO).as_posix()))
-    if not args.only:
-        extra = sorted(p.name for p in OUT_DIR.glob("*.json") if p.stem not in PAIRS)
-        for e in extra:
-            print("%-20s EXTRA: no pair type produces it" % e)
-        if args.check:
-            stale += extra
-    if args.check and stale:
-        print("convex golden data out of date: %s" % ", ".join(stale), file=sys.stderr)
-        return 1
-    return 0
-
+    return base.run_pair_files(__doc__.split("\n\n")[0], PAIRS, golden, OUT_DIR, "convex", 20)
 
 if __name__ == "__main__":
     sys.exit(main())
