@@ -163,3 +163,31 @@ fn bad_input_files_are_refused_with_the_line_and_the_fix() {
         assert!(err.contains(option), "{name}: the message names {option}: {err}");
     }
 }
+
+#[test]
+fn a_non_finite_actuator_force_stops_the_run_instead_of_reaching_the_csv() {
+    // A position servo (kp 1e12) at a finite hinge angle of 1e300 rad: its force kp·(ctrl − q)
+    // overflows to −inf while the state, and its energy, are finite.
+    let servo = MOTOR.replace(
+        "<motor name=\"drive\" joint=\"hinge\"/>",
+        "<position name=\"drive\" joint=\"hinge\" kp=\"1e12\"/>",
+    );
+    let model = temp_file("overflow.xml", &servo);
+    let out = temp_file("overflow.csv", "");
+    std::fs::remove_file(&out).unwrap();
+    let (ok, _, err) = lagrange(&[
+        "simulate",
+        model.to_str().unwrap(),
+        "--duration",
+        "0.1",
+        "--q0",
+        "1e300",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok, "an infinite actuator force was written");
+    assert!(err.contains("actuator_force of 'drive' is -inf") && err.contains("step 0"), "{err}");
+    assert!(!out.exists(), "the CSV target is not written by a stopped run");
+    let partial = std::fs::read_to_string(out.with_extension("partial.csv")).unwrap_or_default();
+    assert!(!partial.contains("inf") && !partial.to_lowercase().contains("nan"), "{partial}");
+}

@@ -11,7 +11,7 @@ use super::interrupt;
 use super::output_file::{RowError, RowFile};
 use super::sensor_columns;
 use super::stdout;
-use super::trajectory_csv::{self, RowProbe, TrajectoryCsv};
+use super::trajectory_csv::{self, RowFailure, RowProbe, TrajectoryCsv};
 use super::CliError;
 use super::{run_plot, view};
 use indicatif::ProgressBar;
@@ -552,8 +552,11 @@ fn csv_row(
     step: u64,
 ) -> Result<(), CliError> {
     // Formatting into the row buffer (a Vec) does not fail.
-    rows.row(model, sim, energy, violation, w.row())
-        .map_err(|source| CliError::Io { file: w.label(), source })?;
+    match rows.row(model, sim, energy, violation, w.row()) {
+        Ok(()) => {}
+        Err(RowFailure::NonFinite(what)) => return Err(diverged(sim, step, &what)),
+        Err(RowFailure::Io(source)) => return Err(CliError::Io { file: w.label(), source }),
+    }
     end_row(w, limit, sim.data.time, step)
 }
 

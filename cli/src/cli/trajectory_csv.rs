@@ -130,7 +130,8 @@ impl TrajectoryCsv {
         Ok(())
     }
 
-    /// Appends the row of `sim`'s current state to `out`.
+    /// Appends the row of `sim`'s current state to `out`, or says which evaluated value (an
+    /// actuator force, a sensor) is not finite: no row with a NaN or an infinity is written.
     pub fn row(
         &mut self,
         model: &Model,
@@ -138,30 +139,76 @@ impl TrajectoryCsv {
         energy: f64,
         violation: f64,
         out: &mut Vec<u8>,
-    ) -> std::io::Result<()> {
+    ) -> Result<(), RowFailure> {
         let d = &sim.data;
+        let Some(mut probe) = self.probe.take() else {
+            self.state_fields(d)?;
+            self.number(energy)?;
+            self.number(violation)?;
+            return self.end(out);
+        };
+        let evaluated = probe.read(model, d);
+        let result = match non_finite(model, evaluated) {
+            Some(what) => Err(RowFailure::NonFinite(what)),
+            None => (|| {
+                self.state_fields(d)?;
+                for &x in evaluated.actuator_force.iter() {
+                    self.number(x)?;
+                }
+                self.number(energy)?;
+                self.number(violation)?;
+                for &x in sensor_columns::values(model, evaluated.sensordata.as_slice()) {
+                    self.number(x)?;
+                }
+                self.end(out)
+            })(),
+        };
+        self.probe = Some(probe);
+        result
+    }
+
+    /// time, qpos, qvel, act, ctrl.
+    fn state_fields(&mut self, d: &Data) -> std::io::Result<()> {
         self.number(display_time(d.time))?;
         for &x in d.qpos.iter().chain(d.qvel.iter()).chain(d.act.iter()).chain(d.ctrl.iter()) {
             self.number(x)?;
         }
-        if let Some(mut probe) = self.probe.take() {
-            let evaluated = probe.read(model, d);
-            let mut result = Ok(());
-            for &x in evaluated.actuator_force.iter() {
-                result = result.and_then(|()| self.number(x));
-            }
-            self.number(energy)?;
-            self.number(violation)?;
-            for &x in sensor_columns::values(model, evaluated.sensordata.as_slice()) {
-                result = result.and_then(|()| self.number(x));
-            }
-            self.probe = Some(probe);
-            result?;
-        } else {
-            self.number(energy)?;
-            self.number(violation)?;
-        }
-        self.writer.write_record(None::<&[u8]>)?;
-        self.take(out)
+        Ok(())
     }
+
+    /// Ends the record and moves it into `out`.
+    fn end(&mut self, out: &mut Vec<u8>) -> Result<(), RowFailure> {
+        self.writer.write_record(None::<&[u8]>).map_err(std::io::Error::from)?;
+        Ok(self.take(out)?)
+    }
+}
+
+/// Why a row was not written.
+#[derive(Debug)]
+pub enum RowFailure {
+    /// A value evaluated at the row's state is not finite (named).
+    NonFinite(String),
+    /// Formatting failed.
+    Io(std::io::Error),
+}
+
+impl From<std::io::Error> for RowFailure {
+    fn from(e: std::io::Error) -> Self {
+        RowFailure::Io(e)
+    }
+}
+
+/// The first actuator force or computed sensor value of `data` that is not finite, named.
+fn non_finite(model: &Model, data: &Data) -> Option<String> {
+    if let Some(i) = data.actuator_force.iter().position(|x| !x.is_finite()) {
+        return Some(format!(
+            "actuator_force of '{}' is {}",
+            actuator_label(model, i),
+            data.actuator_force[i]
+        ));
+    }
+    let bad = sensor_columns::labels(model)
+        .zip(sensor_columns::values(model, data.sensordata.as_slice()))
+        .find(|(_, x)| !x.is_finite());
+    bad.map(|(label, x)| format!("{label} is {x}"))
 }
