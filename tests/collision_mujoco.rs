@@ -19,7 +19,6 @@ mod common;
 
 use common::COLLISION_ABS;
 use lagrange::collision::{collide, CollisionModel};
-use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::forward_kinematics;
 use lagrange::model::spec::Shape;
 use lagrange::model::Contact;
@@ -74,20 +73,13 @@ struct Worst {
 }
 
 fn load_scene(scene: &Scene) -> Model {
-    // One file per call: tests running in parallel load the same scene.
-    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let path: PathBuf = std::env::temp_dir().join(format!(
-        "lagrange-collision-mujoco-{}-{call}-{}.xml",
-        std::process::id(),
-        scene.name
-    ));
     // Mesh scenes name their files under tests/data/meshes/mujoco as `@MESHDIR@`.
     let meshdir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes/mujoco");
-    std::fs::write(&path, scene.mjcf.replace("@MESHDIR@", &meshdir.to_string_lossy())).unwrap();
-    let model = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", scene.name));
-    let _ = std::fs::remove_file(&path);
-    model
+    common::load_mjcf_text(
+        "collision-mujoco",
+        &scene.name,
+        &scene.mjcf.replace("@MESHDIR@", &meshdir.to_string_lossy()),
+    )
 }
 
 /// The compiled model allows each box pair MuJoCo's largest contact count of its collision

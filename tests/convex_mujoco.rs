@@ -15,7 +15,6 @@ mod common;
 
 use common::COLLISION_ABS;
 use lagrange::collision::{collide, CollisionModel};
-use lagrange::io::{load, LoadOptions};
 use lagrange::kinematics::forward_kinematics;
 use lagrange::model::Contact;
 use lagrange::spatial::Vec3;
@@ -51,8 +50,7 @@ struct MjContact {
     dist: f64,
 }
 
-const MESH: &str = "mesh vertices are f64 here, f32 in MuJoCo (2-6e-9 m on the corpus piece); the first \
-    contact of a margin scene comes from MuJoCo's EPA on margin-inflated geoms, which stops at ccd_tolerance; more than \
+const MESH: &str = "the first contact of a margin scene comes from MuJoCo's EPA on margin-inflated geoms, which stops at ccd_tolerance; more than \
     four clipped points are pruned by MuJoCo's quadrilateral search, which starts from MuJoCo's mesh polygon order (not \
     known here); in a few edge contacts MuJoCo's EPA ends on a face with three vertices of one geom and clips an edge \
     where lagrange finds no aligned feature";
@@ -86,18 +84,12 @@ const EXPECTED: &[(&str, usize, usize, &str)] = &[
 ];
 
 fn load_scene(scene: &Scene) -> Model {
-    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let meshdir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes");
-    let path: PathBuf = std::env::temp_dir().join(format!(
-        "lagrange-convex-mujoco-{}-{call}-{}.xml",
-        std::process::id(),
-        scene.name
-    ));
-    std::fs::write(&path, scene.mjcf.replace("MESHDIR", meshdir.to_str().unwrap())).unwrap();
-    let model = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", scene.name));
-    let _ = std::fs::remove_file(&path);
-    model
+    common::load_mjcf_text(
+        "convex-mujoco",
+        &scene.name,
+        &scene.mjcf.replace("MESHDIR", meshdir.to_str().unwrap()),
+    )
 }
 
 fn contacts_at(model: &Model, cm: &CollisionModel, data: &mut Data, qpos: &[f64]) -> Vec<Contact> {

@@ -506,6 +506,20 @@ pub fn repo_path(rel: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
 
+/// Loads MJCF text (a scene of a reference-data file) through a temporary file of its own:
+/// one file per call, as tests running in parallel may load the same scene; `label` names the
+/// test binary in the file name.
+pub fn load_mjcf_text(label: &str, scene: &str, mjcf: &str) -> Model {
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path =
+        std::env::temp_dir().join(format!("lagrange-{label}-{}-{call}-{scene}.xml", std::process::id()));
+    std::fs::write(&path, mjcf).unwrap();
+    let model = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{scene}: {e}"));
+    let _ = std::fs::remove_file(&path);
+    model
+}
+
 /// Loads `models/<name>/<name>.urdf`, with a free root joint if `floating`.
 pub fn load_robot(name: &str, floating: bool) -> Model {
     let path = repo_path(&format!("models/{name}/{name}.urdf"));
