@@ -254,6 +254,26 @@ fn view_refuses_another_models_trajectory_and_a_bad_fps() {
     let (ok, _, err) = lagrange(&["simulate", "models/textbook/drop.xml", "--plot", "x.pdf"]);
     assert!(!ok);
     assert!(err.contains(".svg or .png"), "{err}");
+    // A trajectory with a NaN (an edited file) is refused, never drawn.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let mut fields: Vec<String> = lines[2].split(',').map(str::to_string).collect();
+    fields[1] = "NaN".into();
+    lines[2] = fields.join(",");
+    let edited = temp("pendulum-nan.csv");
+    std::fs::write(&edited, lines.join("\n") + "\n").unwrap();
+    let page = temp("pendulum-nan.html");
+    let (ok, _, err) = lagrange(&[
+        "view",
+        "models/textbook/double_pendulum.xml",
+        "--trajectory",
+        edited.to_str().unwrap(),
+        "--out",
+        page.to_str().unwrap(),
+    ]);
+    assert!(!ok, "a NaN state was drawn");
+    assert!(err.contains("row 3, column 2") && err.contains("not a finite number"), "{err}");
+    assert!(!page.exists());
 }
 
 /// GET `path` from the live server; the raw response.

@@ -66,9 +66,18 @@ pub fn read(path: &Path, model: &Model, fps: f64) -> Result<Vec<Row>, CliError> 
         let record = record.map_err(|e| bad(e.to_string()))?;
         let value = |c: usize| -> Result<f64, CliError> {
             let text = record.get(c).unwrap_or("");
-            text.trim()
+            let x = text
+                .trim()
                 .parse::<f64>()
-                .map_err(|e| bad(format!("row {}, column {}: {e} ('{text}')", i + 2, c + 1)))
+                .map_err(|e| bad(format!("row {}, column {}: {e} ('{text}')", i + 2, c + 1)))?;
+            if !x.is_finite() {
+                return Err(bad(format!(
+                    "row {}, column {}: '{text}' is not a finite number; the page can only show finite states",
+                    i + 2,
+                    c + 1
+                )));
+            }
+            Ok(x)
         };
         let take = |cols: &[usize]| cols.iter().map(|&c| value(c)).collect::<Result<Vec<f64>, CliError>>();
         let row = Row {
