@@ -219,18 +219,47 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         iter += 1;
         match method {
             Primal::Newton => {
+                // H = M + Jᵀ (∂²s) J, lower triangle only, assembled over its nonzeros: the
+                // last pattern's entries cleared, M's tree entries written, the rows' added.
                 let h = &mut soft.hessian;
-                h.copy_from(mass_matrix);
+                for k in 0..nv {
+                    for &j in soft.factor.pattern_row(k) {
+                        h[(k, j)] = 0.0;
+                    }
+                    h[(k, k)] = mass_matrix[(k, k)];
+                    let mut l = model.dof_parent[k];
+                    while l != crate::model::NO_DOF {
+                        h[(k, l)] = mass_matrix[(k, l)];
+                        l = model.dof_parent[l];
+                    }
+                }
+                // The row groups with a Hessian block: single quadratic rows, and an elliptic
+                // contact's rows in its cone zone (one dense block).
+                soft.active_rows.clear();
+                let active = &mut soft.active_rows;
                 rows.hessian(&soft.jar, efc_state, |a, b, w| {
+                    match active.last_mut() {
+                        Some(g) if g.1 >= a.min(b) => g.1 = g.1.max(a.max(b)),
+                        _ => active.push((a, a.max(b))),
+                    }
                     for &p in nz.row(a) {
                         let x = w * efc_j[(a, p)];
                         for &q in nz.row(b) {
-                            h[(p, q)] += x * efc_j[(b, q)];
+                            if p >= q {
+                                h[(p, q)] += x * efc_j[(b, q)];
+                            }
                         }
                     }
                 });
                 soft.dir.copy_from(&soft.grad);
-                if soft.factor.factor(&soft.hessian, nv, 0.0) {
+                if soft.factor.factor_structured(
+                    &soft.hessian,
+                    nv,
+                    &model.dof_parent,
+                    &soft.active_rows,
+                    &nz_start,
+                    &nz_index,
+                ) {
                     soft.factor.solve(soft.dir.as_mut_slice());
                 } else {
                     solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
