@@ -16,7 +16,7 @@ use crate::io::LoadError;
 const UNSUPPORTED: [(&str, &str); 3] = [
     (
         "composite",
-        "MuJoCo would generate a grid of bodies, joints, tendons and equality constraints (a cable, rope or particle set); write those bodies out, or load the model with MuJoCo and save the compiled model (mj_saveLastXML) and load that",
+        "MuJoCo 4.0 rejects it too (\"unrecognized element\"; MuJoCo 3 generated a cable, rope or grid of bodies, joints and tendons from it); write those bodies out, or compile the model with MuJoCo 3 and save it (mj_saveLastXML)",
     ),
     (
         "flexcomp",

@@ -55,8 +55,9 @@ fn expand_children(e: &mut Element, angles: &AngleConvention, budget: &mut usize
 fn copies(r: &Element, angles: &AngleConvention, budget: &mut usize) -> Result<Vec<Element>, LoadError> {
     let a = Attrs::plain(r);
     let count = match a.int("count")? {
-        Some(n) if n >= 1 => n as usize,
-        Some(n) => return Err(a.error("count", format!("is {n}; give a positive number of copies"))),
+        // MuJoCo accepts zero copies (the children vanish).
+        Some(n) if n >= 0 => n as usize,
+        Some(n) => return Err(a.error("count", format!("is {n}; give a number of copies ≥ 0"))),
         None => {
             return Err(LoadError::Invalid {
                 loc: r.loc.clone(),
