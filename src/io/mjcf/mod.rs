@@ -19,6 +19,7 @@ mod contact;
 mod defaults;
 mod equality;
 mod geom;
+mod hfield;
 mod orientation;
 mod schema;
 mod schema_types;
@@ -120,6 +121,7 @@ fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<Mo
     let materials = assets::materials(root, &defaults)?;
     let mut builder = body::TreeBuilder::new(&compiler, &defaults, &meshes, &materials);
     builder.worldbody(root)?;
+    hfield::resolve(&mut builder.links, &hfield::hfields(root, &compiler, &root.loc.file)?)?;
     warnings.append(&mut builder.warnings);
     let keyframes = sections::keyframes(root)?;
     let mut elements = sections::sensors(root)?;
