@@ -39,8 +39,10 @@ pub fn geom_inertia(
         }
         Shape::Box { size } => Primitive::Box { half_extents: size / 2.0 },
         Shape::Ellipsoid { radii } => Primitive::Ellipsoid { radii: *radii },
-        // Planes and height fields carry no mass (MuJoCo gives them zero volume in bodies).
-        Shape::Plane { .. } | Shape::Hfield { .. } => return Ok(RigidInertia::zero()),
+        // Planes carry no mass; a height field weighs as MuJoCo's box of half-extents
+        // size[0], size[1], size[2]/4 + size[3]/2 (its `geom_size`, mjCGeom::SetInertia).
+        Shape::Plane { .. } => return Ok(RigidInertia::zero()),
+        Shape::Hfield { field, .. } => Primitive::Box { half_extents: Vec3::from(field.mass_box()) },
         Shape::Mesh { path, scale } => {
             return mesh_geom_inertia(g, what, link, path, scale, meshes, warnings)
         }

@@ -303,10 +303,12 @@ pub enum Shape {
         /// MJCF `size` as written.
         size: Vec3,
     },
-    /// A height field asset (MJCF), by name.
+    /// A height field asset (MJCF), by name, with its compiled grid.
     Hfield {
         /// The `<hfield>` asset's name.
         name: String,
+        /// The grid and sizes (shared by the geoms naming the asset).
+        field: std::sync::Arc<super::hfield::HeightField>,
     },
     /// A mesh file, resolved to a path on disk, with its scale.
     Mesh {

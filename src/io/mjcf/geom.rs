@@ -146,7 +146,13 @@ pub(crate) fn geom(
             Shape::Ellipsoid { radii: Vec3::from(size) }
         }
         "plane" => Shape::Plane { size: Vec3::from(size) },
-        "hfield" => Shape::Hfield { name: a.text("hfield").unwrap_or("").to_string() },
+        "hfield" => {
+            let Some(name) = a.text("hfield") else {
+                return Err(a.error("hfield", "is missing: a height field geom must name an <hfield> asset"));
+            };
+            // The grid is filled in once the assets are read (`hfield::resolve`).
+            Shape::Hfield { name: name.to_string(), field: Default::default() }
+        }
         "mesh" => {
             let Some(name) = a.text("mesh") else {
                 return Err(a.error("mesh", "is missing: a mesh geom must name a <mesh> asset"));

@@ -21,6 +21,7 @@ mod contact;
 mod defaults;
 mod equality;
 mod geom;
+mod hfield;
 mod orientation;
 mod replicate;
 mod schema;
@@ -131,6 +132,7 @@ fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<Mo
     let materials = assets::materials(root, &defaults)?;
     let mut builder = body::TreeBuilder::new(&compiler, &defaults, &meshes, &materials);
     builder.worldbody(root)?;
+    hfield::resolve(&mut builder.links, &hfield::hfields(root, &compiler, &root.loc.file)?)?;
     warnings.append(&mut builder.warnings);
     let keyframes = sections::keyframes(root)?;
     let mut elements = sections::sensors(root)?;

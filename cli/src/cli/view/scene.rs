@@ -169,7 +169,7 @@ pub fn scene_json(model: &Model) -> (Value, Vec<String>) {
             Shape::Cylinder { radius, length } => ("cylinder", vec![*radius, *length]),
             Shape::Ellipsoid { radii } => ("ellipsoid", radii.iter().copied().collect()),
             Shape::Plane { size } => ("plane", size.iter().copied().collect()),
-            Shape::Hfield { name } => {
+            Shape::Hfield { name, .. } => {
                 warnings.push(format!("geom {i} (height field '{name}') is not drawn"));
                 continue;
             }
