@@ -1,5 +1,5 @@
 //! Plane against a mesh's convex hull as MuJoCo 4.0 does it (`mjc_PlaneConvex`, the plane row of
-//! its collision table): at most three contacts, all hull vertices of one triangle.
+//! its collision table): at most four contacts, hull vertices of the face resting on the plane.
 //!
 //! 1. The hull vertex deepest below the plane (its support point along the plane's −normal,
 //!    found by hill climbing on the hull's edges from the vertex farthest along the nearest of 27
@@ -15,12 +15,17 @@
 //! instead). Each contact lies midway between the vertex and the plane, with the plane's normal
 //! and distance `n·(v − p_plane)`.
 //!
-//! Not yet as MuJoCo: where the facing triangle lies in a flat polygon of the hull (coplanar
-//! triangles, e.g. a quadrilateral), MuJoCo 4.0 takes the polygon's vertices (4 of them in
-//! tests/collision_mujoco.rs's 84 plane–mesh cases), lagrange the triangle's 3 (MuJoCo triangulates
-//! with qhull, lagrange with parry3d's quickhull, so at exact ties the triangle may differ too).
+//! Where the facing triangle and one coplanar neighbour form a flat quadrilateral of the hull (a
+//! box-like mesh resting on a face), MuJoCo 4.0 takes the quadrilateral's four corners, and so
+//! does lagrange (the neighbour's far vertex between the shared edge's ends). Larger flat
+//! polygons keep the triangle's three (not yet compared with MuJoCo; MuJoCo triangulates with
+//! qhull, lagrange with parry3d's quickhull, so at exact ties the triangle may differ too).
 
 use super::plane::PlanePoint;
+
+/// Two hull triangles whose unit normals' dot product exceeds 1 − this lie in one flat face
+/// (the mesh's single-precision vertices tilt coplanar triangles by up to ~1e-7).
+const COPLANAR: f64 = 1e-6;
 use crate::spatial::{Transform, Vec3};
 
 /// A mesh's convex hull prepared for plane contacts: vertices (geom frame), their neighbours and
@@ -92,6 +97,50 @@ impl PlaneHull {
         Some(Self { vertices, adj_start, adj, tri_start, tris, triangles, normals, extrema })
     }
 
+    /// The triangle across edge (v_j, v_{j+1}) of triangle `t` (another incident triangle of both).
+    fn across(&self, t: usize, j: usize) -> Option<usize> {
+        let tri = self.triangles[t];
+        let (a, b) = (tri[j], tri[(j + 1) % 3]);
+        let (s, e) = (self.tri_start[a as usize] as usize, self.tri_start[a as usize + 1] as usize);
+        self.tris[s..e].iter().map(|&u| u as usize).find(|&u| u != t && self.triangles[u].contains(&b))
+    }
+
+    /// Whether triangles `t` and `u` lie in one plane (normals equal to round-off).
+    fn coplanar(&self, t: usize, u: usize) -> bool {
+        self.normals[t].dot(&self.normals[u]) > 1.0 - COPLANAR
+    }
+
+    /// When triangle `t` and exactly one neighbour form a flat quadrilateral of the hull (no
+    /// further coplanar triangle): the shared edge's index j in `t` (edge v_j → v_{j+1}) and the
+    /// neighbour's far vertex.
+    fn coplanar_quad(&self, t: usize) -> Option<(usize, u32)> {
+        let mut found = None;
+        for j in 0..3 {
+            let Some(u) = self.across(t, j) else { continue };
+            if !self.coplanar(t, u) {
+                continue;
+            }
+            if found.is_some() {
+                return None;
+            }
+            found = Some((j, u));
+        }
+        let (j, u) = found?;
+        // The neighbour's two other edges must not continue the polygon.
+        let shared = [self.triangles[t][j], self.triangles[t][(j + 1) % 3]];
+        for i in 0..3 {
+            let edge = [self.triangles[u][i], self.triangles[u][(i + 1) % 3]];
+            if shared.contains(&edge[0]) && shared.contains(&edge[1]) {
+                continue;
+            }
+            if self.across(u, i).is_some_and(|w| w != t && self.coplanar(u, w)) {
+                return None;
+            }
+        }
+        let far = *self.triangles[u].iter().find(|v| !shared.contains(v))?;
+        Some((j, far))
+    }
+
     /// The hull's vertices (geom frame).
     pub fn vertices(&self) -> &[Vec3] {
         &self.vertices
@@ -156,11 +205,33 @@ pub fn plane_mesh(
     }
     let Some(face) = face else { return };
     let tri = hull.triangles[face];
-    let k = tri.iter().position(|&v| v as usize == first).unwrap_or(0);
+    // The face's polygon: the triangle, or the quadrilateral it forms with one coplanar
+    // neighbour (its far vertex inserted between the shared edge's ends, keeping the outward
+    // counter-clockwise order).
+    let mut polygon = [0u32; 4];
+    let len = match hull.coplanar_quad(face) {
+        Some((edge, w)) => {
+            for (slot, v) in polygon.iter_mut().zip(
+                tri.iter()
+                    .take(edge + 1)
+                    .copied()
+                    .chain(std::iter::once(w))
+                    .chain(tri.iter().skip(edge + 1).copied()),
+            ) {
+                *slot = v;
+            }
+            4
+        }
+        None => {
+            polygon[..3].copy_from_slice(&tri);
+            3
+        }
+    };
+    let k = polygon[..len].iter().position(|&v| v as usize == first).unwrap_or(0);
     // MuJoCo's inclusion test: along −normal beyond the geom centre's height less the margin.
     let threshold = n.dot(&(x.pos - plane.pos)) - reach;
-    for step in 1..3 {
-        let i = tri[(k + step) % 3] as usize;
+    for step in 1..len {
+        let i = polygon[(k + step) % len] as usize;
         if down.dot(&hull.vertices[i]) > threshold {
             let q = point(i);
             out(PlanePoint { surface: q, dist: n.dot(&(q - plane.pos)), hint: None, feature: i as u32 });
