@@ -28,6 +28,7 @@
 
 pub mod box_box;
 pub mod box_primitive;
+pub mod broadphase;
 pub mod convex;
 mod frame;
 pub mod geom_distance;
@@ -77,6 +78,8 @@ pub struct CollisionModel {
     /// Per geom, a colliding mesh's hull prepared for plane contacts ([`plane_mesh`]; geoms of one
     /// hull share it).
     pub plane_hulls: Vec<Option<Arc<PlaneHull>>>,
+    /// The sweep and prune over the geoms' boxes ([`broadphase`]).
+    pub sweep: broadphase::Broadphase,
 }
 
 /// The bounding-sphere test of one candidate pair (see [`CollisionModel::broad`]).
@@ -138,7 +141,8 @@ impl CollisionModel {
                 BroadPair { geom: [g1 as u32, g2 as u32], reach: p.margin + p.gap + radii, plane }
             })
             .collect();
-        Self { shapes, rbound, broad, plane_hulls }
+        let sweep = broadphase::Broadphase::new(model, &rbound);
+        Self { shapes, rbound, broad, plane_hulls, sweep }
     }
 }
 
@@ -153,7 +157,28 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
             data.x_world_geom[g] = data.attached_pose(geom.body, geom.mocap, &geom.x_body_geom);
         }
     }
-    for (pair, b) in model.collision_pairs.iter().zip(&cm.broad) {
+    // Sweep and prune narrows the candidate pairs first when there are many (same pairs, same
+    // order as the full loop: see [`broadphase`]).
+    if cm.sweep.sweep {
+        cm.sweep.candidates(&data.x_world_geom, &mut data.broadphase, reach);
+    }
+    // Taken out while contacts are written, put back after (no allocation).
+    let swept = std::mem::take(&mut data.broadphase.pairs);
+    let all = 0..model.collision_pairs.len();
+    let mut next = 0;
+    loop {
+        let idx = if cm.sweep.sweep {
+            match swept.get(next) {
+                Some(&i) => i as usize,
+                None => break,
+            }
+        } else if next < all.end {
+            next
+        } else {
+            break;
+        };
+        next += 1;
+        let (pair, b) = (&model.collision_pairs[idx], &cm.broad[idx]);
         // Bounding spheres (a plane: the other geom's sphere against the plane).
         let (x1, x2) = (&data.x_world_geom[b.geom[0] as usize], &data.x_world_geom[b.geom[1] as usize]);
         let d = x2.pos - x1.pos;
@@ -286,6 +311,7 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
             push(p.p1, p.p2, p.normal, p.dist, None, 0);
         }
     }
+    data.broadphase.pairs = swept;
     // One regularized-cone μ per contact (`contact_mu`): grown with the contact buffer when this
     // pass found more contacts than any before.
     if data.contact_mu.len() < data.contacts.len() {

@@ -336,6 +336,8 @@ pub struct Data {
     /// World pose of each geom that collides, from the last collision pass (MuJoCo's `geom_xpos`,
     /// `geom_xmat`).
     pub x_world_geom: Vec<Transform>,
+    /// The broad phase's per-pass scratch (sweep and prune, `crate::collision::broadphase`).
+    pub(crate) broadphase: crate::collision::broadphase::BroadphaseWork,
     /// Contacts of the last collision pass (MuJoCo's `contact`). Room for
     /// [`INITIAL_CONTACTS`](crate::model::INITIAL_CONTACTS) is reserved; a pass that finds more
     /// grows it (once: the capacity is kept), so no contact is ever dropped.
@@ -449,6 +451,7 @@ impl Data {
             solver_gradient: 0.0,
             soft: SoftWork::new(nv, nefc),
             x_world_geom: vec![Transform::identity(); model.geoms.len()],
+            broadphase: crate::collision::broadphase::BroadphaseWork::new(model),
             contacts: Vec::with_capacity(model.max_contacts().min(crate::model::INITIAL_CONTACTS)),
             sensordata: DVector::zeros(model.nsensordata),
             sensor_work: crate::sensor::SensorWork::new(model),
