@@ -170,6 +170,47 @@ pub fn support_pair(
     (point.dist <= reach).then_some(point)
 }
 
+thread_local! {
+    /// The EPA face features of this thread's last [`mujoco_pair`] (for [`super::multiccd`], which
+    /// the collision pass calls right after it on the same pair).
+    static LAST_FACE: std::cell::Cell<Option<super::ccd::FaceFeatures>> = const { std::cell::Cell::new(None) };
+}
+
+/// The first contact of a convex pair as MuJoCo 4.0's native solver finds it
+/// ([`super::ccd::penetration`]: GJK/EPA on the geoms inflated by half of `margin` each, to the
+/// model's `ccd_tolerance` within `ccd_iterations`): witness points whose midpoint is MuJoCo's
+/// contact position, its normal and the contact distance; None when the inflated geoms do not
+/// overlap.
+pub fn mujoco_pair(
+    x1: &Transform,
+    s1: &ConvexShape,
+    x2: &Transform,
+    s2: &ConvexShape,
+    margin: f64,
+    options: &crate::model::Options,
+) -> Option<PairPoint> {
+    let polytope = |s: &ConvexShape| matches!(s, ConvexShape::Cuboid(_) | ConvexShape::Hull(_));
+    if polytope(s1) && polytope(s2) {
+        // Boxes and meshes against each other keep the exact EPA and multiccd's own feature
+        // search: with MuJoCo's solver 3 fewer box–mesh cases matched (its EPA face on coplanar
+        // facets depends on the hull's vertex order, which is parry's here, not MuJoCo's).
+        LAST_FACE.with(|f| f.set(None));
+        return support_pair(x1, s1, x2, s2, margin);
+    }
+    let c = super::ccd::penetration(
+        s1,
+        x1,
+        s2,
+        x2,
+        margin,
+        options.ccd_tolerance,
+        options.ccd_iterations as usize,
+    );
+    LAST_FACE.with(|f| f.set(c.and_then(|c| c.face)));
+    let c = c?;
+    Some(PairPoint { p1: c.x1, p2: c.x2, normal: c.normal, dist: c.dist })
+}
+
 /// The signed distance of two support-map shapes to f64 round-off, if closer than `reach`: when
 /// they are apart, the distance and witness points of [`super::gjk::separation`] (parry's GJK
 /// stops at a relative gap of ~5e-8, see there), polished on smooth shapes; when they overlap,

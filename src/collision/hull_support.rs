@@ -59,9 +59,21 @@ impl HullSupport {
 
     /// The index (in `polyhedron().points()`) of the vertex farthest along `dir`, by hill climbing.
     pub fn support_index(&self, dir: Vector) -> usize {
+        self.support_index_warm(dir, -1)
+    }
+
+    /// [`Self::support_index`] warm-started as MuJoCo's `mjc_hillclimbSupport`: from the better of
+    /// the grid seed and `cached` (the previous answer of the same query sequence; −1: none).
+    pub fn support_index_warm(&self, dir: Vector, cached: i32) -> usize {
         let points = self.polyhedron.points();
         let cell = |a: f64| (a > 0.4) as usize + 1 - (a < -0.4) as usize;
-        let mut best = self.extrema[9 * cell(dir.x) + 3 * cell(dir.y) + cell(dir.z)] as usize;
+        let seed = self.extrema[9 * cell(dir.x) + 3 * cell(dir.y) + cell(dir.z)] as usize;
+        let mut best = seed;
+        if let Some(c) = usize::try_from(cached).ok().filter(|&c| c < points.len()) {
+            if points[seed].dot(dir) <= points[c].dot(dir) {
+                best = c;
+            }
+        }
         let mut best_dot = points[best].dot(dir);
         loop {
             let current = best;

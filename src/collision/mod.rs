@@ -29,6 +29,7 @@
 pub mod box_box;
 pub mod box_primitive;
 pub mod broadphase;
+mod ccd;
 pub mod convex;
 mod frame;
 pub mod geom_distance;
@@ -293,7 +294,7 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         let point = match (segment(&x1, &geom1.shape), segment(&x2, &geom2.shape)) {
             (Some((s1, r1)), Some((s2, r2))) => convex::swept_spheres(s1, r1, s2, r2, within),
             _ => match (&cm.shapes[g1], &cm.shapes[g2]) {
-                (Some(s1), Some(s2)) => convex::support_pair(&x1, s1, &x2, s2, within),
+                (Some(s1), Some(s2)) => convex::mujoco_pair(&x1, s1, &x2, s2, within, &model.options),
                 _ => None,
             },
         };

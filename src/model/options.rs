@@ -259,11 +259,11 @@ pub struct Options {
     /// The global magnetic flux in the world frame, read by magnetometer sensors (MuJoCo's
     /// `magnetic`, default (0, −0.5, 0)).
     pub magnetic: [f64; 3],
-    /// Tolerance of MuJoCo's convex collision solver (`ccd_tolerance`, 1e-6); lagrange's GJK and
-    /// EPA run to round-off and do not read it.
+    /// Tolerance of MuJoCo's convex collision solver (`ccd_tolerance`, 1e-6), read by lagrange's
+    /// copy of that solver (`collision::ccd`).
     pub ccd_tolerance: f64,
-    /// Iteration limit of MuJoCo's convex collision solver (`ccd_iterations`, 35); not read by
-    /// lagrange's GJK and EPA (which converge to round-off).
+    /// Iteration limit of MuJoCo's convex collision solver (`ccd_iterations`, 35), read by
+    /// lagrange's copy of that solver (`collision::ccd`).
     pub ccd_iterations: u32,
     /// The `<flag>` switches.
     pub flags: Flags,

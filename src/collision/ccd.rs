@@ -1,0 +1,1058 @@
+//! MuJoCo 4.0's native convex collision solver (`mjc_ccd` in engine_collision_gjk.c, its support
+//! functions and `mjc_penetration` in engine_collision_convex.c), read for its semantics and
+//! written anew, so that the convex pairs stop where MuJoCo's stop: GJK with the signed-volume
+//! distance subalgorithm (Montanari et al., ToG 2017) and MuJoCo's Frank–Wolfe duality-gap stop
+//! (`ccd_tolerance`, exact on boxes and meshes without margin), its fallback intersection test on
+//! a tetrahedron, the initial polytope built from GJK's 1-, 2- or 3-simplex, and EPA with MuJoCo's
+//! face map, horizon and bounds (`ccd_tolerance`, `ccd_iterations`). Each geom is inflated by half
+//! the pair's margin (MuJoCo's `support`); spheres and capsules are first shrunk to their centre
+//! and segment (a shallow contact is then the distance of the cores less the radii).
+//!
+//! The result is the EPA face's witness points and, for the multi-point contacts
+//! ([`super::multiccd`]), the geom vertices (box corner bits, hull vertex indices) of the face's
+//! three polytope vertices: MuJoCo reads the contact features off them. No allocation once the
+//! thread's workspace has grown.
+
+use super::convex::ConvexShape;
+use crate::spatial::{Transform, Vec3};
+use std::cell::RefCell;
+
+/// MuJoCo's `mjMINVAL`.
+const MINVAL: f64 = 1e-15;
+/// MuJoCo's `mjMAXVAL`.
+const MAXVAL: f64 = 1e10;
+/// MuJoCo's `mjMAX_LIMIT` (double precision).
+const MAX_LIMIT: f64 = f64::MAX;
+/// Hull size below which MuJoCo scans every mesh vertex instead of hill climbing
+/// (`mjMESH_HILLCLIMB_MIN`).
+const HILLCLIMB_MIN: usize = 10;
+
+/// How one geom's support points are taken: its shape, or (spheres and capsules in the first
+/// pass) its centre or its segment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Core {
+    Shape,
+    Point,
+    Line,
+}
+
+/// One geom as the solver sees it (MuJoCo's `mjCCDObj`).
+pub(crate) struct CcdObj<'a> {
+    shape: &'a ConvexShape,
+    x: &'a Transform,
+    /// The pair's margin: the support adds half of it along the direction.
+    margin: f64,
+    core: Core,
+    /// The last support vertex (box corner bits, hull vertex index; −1 for curved shapes).
+    vertindex: i32,
+    /// The hill climb's warm start (−1: none yet).
+    meshindex: i32,
+}
+
+impl<'a> CcdObj<'a> {
+    /// Geom `shape` at pose `x`, inflated by half of `margin`.
+    pub(crate) fn new(shape: &'a ConvexShape, x: &'a Transform, margin: f64) -> Self {
+        Self { shape, x, margin, core: Core::Shape, vertindex: -1, meshindex: -1 }
+    }
+
+    fn discrete(&self) -> bool {
+        matches!(self.shape, ConvexShape::Cuboid(_) | ConvexShape::Hull(_))
+    }
+
+    /// The support point along unit world direction `dir` (no margin).
+    fn support(&mut self, dir: &Vec3) -> Vec3 {
+        let (rot, pos) = (&self.x.rot, &self.x.pos);
+        match self.core {
+            Core::Point => return *pos,
+            Core::Line => {
+                let z = rot.column(2);
+                let len = match self.shape {
+                    ConvexShape::Capsule(c) => c.segment.b.z,
+                    _ => 0.0,
+                };
+                let scl = if z.dot(dir) >= 0.0 { len } else { -len };
+                return z * scl + pos;
+            }
+            Core::Shape => {}
+        }
+        let local = rot.tr_mul(dir);
+        let supp = match self.shape {
+            ConvexShape::Ball(b) => return dir * b.radius + pos,
+            ConvexShape::Capsule(c) => {
+                let mut s = local * c.radius;
+                s.z += if local.z >= 0.0 { c.segment.b.z } else { -c.segment.b.z };
+                s
+            }
+            ConvexShape::Ellipsoid(e) => {
+                let size = Vec3::new(e.radii.x, e.radii.y, e.radii.z);
+                let s = local.component_mul(&size);
+                let norm2 = s.dot(&s);
+                if norm2 < MINVAL * MINVAL {
+                    return rot.column(0) * size.x + pos;
+                }
+                (s * (1.0 / norm2.sqrt())).component_mul(&size)
+            }
+            ConvexShape::Cylinder(c) => {
+                let n2 = local.x * local.x + local.y * local.y;
+                let scl = if n2 >= MINVAL * MINVAL { c.radius / n2.sqrt() } else { 0.0 };
+                Vec3::new(
+                    scl * local.x,
+                    scl * local.y,
+                    if local.z >= 0.0 { c.half_height } else { -c.half_height },
+                )
+            }
+            ConvexShape::Cuboid(b) => {
+                let h = b.half_extents;
+                let s = Vec3::new(
+                    if local.x >= 0.0 { h.x } else { -h.x },
+                    if local.y >= 0.0 { h.y } else { -h.y },
+                    if local.z >= 0.0 { h.z } else { -h.z },
+                );
+                self.vertindex = (s.x > 0.0) as i32 | ((s.y > 0.0) as i32) << 1 | ((s.z > 0.0) as i32) << 2;
+                s
+            }
+            ConvexShape::Hull(h) => {
+                let points = h.polyhedron().points();
+                let d = parry3d_f64::math::Vector::new(local.x, local.y, local.z);
+                let i = if points.len() < HILLCLIMB_MIN {
+                    // Exhaustive, from the cached vertex (ties keep the earlier best).
+                    let (mut imax, mut max) = (0usize, f32::MIN as f64);
+                    if self.vertindex >= 0 {
+                        imax = self.vertindex as usize;
+                        max = d.dot(points[imax]);
+                    }
+                    for (i, p) in points.iter().enumerate() {
+                        let v = d.dot(*p);
+                        if v > max {
+                            (max, imax) = (v, i);
+                        }
+                    }
+                    imax
+                } else {
+                    let i = h.support_index_warm(d, self.meshindex);
+                    self.meshindex = i as i32;
+                    i
+                };
+                self.vertindex = i as i32;
+                let p = points[i];
+                Vec3::new(p.x, p.y, p.z)
+            }
+        };
+        rot * supp + pos
+    }
+}
+
+/// A polytope vertex: the support point of the difference and its two parts.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Vertex {
+    vert: Vec3,
+    vert1: Vec3,
+    vert2: Vec3,
+    /// The geoms' vertex indices of the parts (see [`CcdObj::vertindex`]).
+    pub(crate) index1: i32,
+    pub(crate) index2: i32,
+}
+
+const ZERO_VERTEX: Vertex = Vertex {
+    vert: Vec3::new(0.0, 0.0, 0.0),
+    vert1: Vec3::new(0.0, 0.0, 0.0),
+    vert2: Vec3::new(0.0, 0.0, 0.0),
+    index1: -1,
+    index2: -1,
+};
+
+/// The support vertex of the difference along `dir` (geom 2 along `dir_neg`), margins added.
+fn support(o1: &mut CcdObj, o2: &mut CcdObj, dir: &Vec3, dir_neg: &Vec3) -> Vertex {
+    let mut vert1 = o1.support(dir);
+    if o1.margin > 0.0 && o1.core == Core::Shape {
+        vert1 += dir * (0.5 * o1.margin);
+    }
+    let mut vert2 = o2.support(dir_neg);
+    if o2.margin > 0.0 && o2.core == Core::Shape {
+        vert2 += dir_neg * (0.5 * o2.margin);
+    }
+    Vertex { vert: vert1 - vert2, vert1, vert2, index1: o1.vertindex, index2: o2.vertindex }
+}
+
+fn gjk_support(o1: &mut CcdObj, o2: &mut CcdObj, x_k: &Vec3, x_norm: f64) -> Vertex {
+    let dir_neg = x_k * (1.0 / x_norm);
+    let dir = dir_neg * -1.0;
+    support(o1, o2, &dir, &dir_neg)
+}
+
+fn det3(a: &Vec3, b: &Vec3, c: &Vec3) -> f64 {
+    a.x * (b.y * c.z - b.z * c.y) + a.y * (b.z * c.x - b.x * c.z) + a.z * (b.x * c.y - b.y * c.x)
+}
+
+fn lincomb(coef: &[f64], v: [&Vec3; 4]) -> Vec3 {
+    let mut r = Vec3::zeros();
+    for k in 0..3 {
+        r[k] = match coef.len() {
+            1 => coef[0] * v[0][k],
+            2 => coef[0] * v[0][k] + coef[1] * v[1][k],
+            3 => coef[0] * v[0][k] + coef[1] * v[1][k] + coef[2] * v[2][k],
+            4 => coef[0] * v[0][k] + coef[1] * v[1][k] + coef[2] * v[2][k] + coef[3] * v[3][k],
+            _ => 0.0,
+        };
+    }
+    r
+}
+
+/// MuJoCo's `mju_normalize3`: (1, 0, 0) for a vector shorter than `mjMINVAL`.
+fn normalize3(v: &Vec3) -> Vec3 {
+    let n = v.norm();
+    if n < MINVAL {
+        Vec3::x()
+    } else {
+        v * (1.0 / n)
+    }
+}
+
+/// The solver's state (MuJoCo's `mjCCDStatus`, one witness pair).
+struct Status {
+    separated: bool,
+    dist: f64,
+    x1: Vec3,
+    x2: Vec3,
+    max_iterations: usize,
+    tolerance: f64,
+    dist_cutoff: f64,
+    gjk_iterations: usize,
+    simplex: [Vertex; 4],
+    nsimplex: usize,
+}
+
+fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
+    let get_dist = st.dist_cutoff > 0.0;
+    let mut backup = !get_dist;
+    let (mut n, mut k) = (0usize, 0usize);
+    let kmax = st.max_iterations;
+    let mut lambda = [0.0f64; 4];
+    let tol2 = st.tolerance * st.tolerance;
+    st.separated = false;
+    let discrete = o1.discrete() && o2.discrete() && o1.margin == 0.0 && o2.margin == 0.0;
+    let epsilon = if discrete { 0.0 } else { 0.5 * tol2 };
+    let min_norm = if discrete { MINVAL } else { st.tolerance };
+    let mut x_k = st.x1 - st.x2;
+    let (mut x_norm, mut x_norm_prev) = (x_k.norm(), 0.0);
+    let separated = |st: &mut Status, k| {
+        st.separated = true;
+        st.gjk_iterations = k;
+        st.nsimplex = 0;
+        st.dist = MAX_LIMIT;
+    };
+    while k < kmax {
+        if x_norm < min_norm || (x_norm_prev - x_norm).abs() < MINVAL {
+            break;
+        }
+        st.simplex[n] = gjk_support(o1, o2, &x_k, x_norm);
+        let s_k = st.simplex[n].vert;
+        if x_k.dot(&(x_k - s_k)) < epsilon {
+            break;
+        }
+        let lower = x_k.dot(&s_k);
+        if !get_dist {
+            if lower > 0.0 {
+                return separated(st, k);
+            }
+        } else if st.dist_cutoff < MAX_LIMIT && lower > 0.0 && lower >= st.dist_cutoff * x_norm {
+            return separated(st, k);
+        }
+        if n == 3 && backup {
+            st.gjk_iterations = k;
+            let ret = gjk_intersect(st, o1, o2);
+            if ret != -1 {
+                st.separated = ret == 0;
+                st.dist = if ret > 0 { 0.0 } else { MAX_LIMIT };
+                return;
+            }
+            k = st.gjk_iterations;
+            backup = false;
+        }
+        subdistance(&mut lambda, n + 1, &st.simplex);
+        n = 0;
+        for i in 0..4 {
+            if lambda[i] == 0.0 {
+                continue;
+            }
+            st.simplex[n] = st.simplex[i];
+            lambda[n] = lambda[i];
+            n += 1;
+        }
+        if n < 1 {
+            return separated(st, k);
+        }
+        let s = &st.simplex;
+        x_k = lincomb(&lambda[..n], [&s[0].vert, &s[1].vert, &s[2].vert, &s[3].vert]);
+        x_norm_prev = x_norm;
+        x_norm = x_k.norm();
+        if n == 4 {
+            break;
+        }
+        k += 1;
+    }
+    if n > 0 {
+        let s = &st.simplex;
+        st.x1 = lincomb(&lambda[..n], [&s[0].vert1, &s[1].vert1, &s[2].vert1, &s[3].vert1]);
+        st.x2 = lincomb(&lambda[..n], [&s[0].vert2, &s[1].vert2, &s[2].vert2, &s[3].vert2]);
+    }
+    let tmp = gjk_support(o1, o2, &x_k, x_norm);
+    if x_k.dot(&tmp.vert) > 0.0 {
+        st.separated = true;
+    }
+    st.gjk_iterations = k;
+    st.nsimplex = n;
+    st.dist = if n == 4 && !st.separated { 0.0 } else { x_norm };
+}
+
+/// The unit normal of face (v1, v2, v3) and the origin's signed distance along it (MAX when
+/// the face is degenerate).
+fn signed_distance(v1: &Vertex, v2: &Vertex, v3: &Vertex) -> (Vec3, f64) {
+    let normal = (v3.vert - v1.vert).cross(&(v2.vert - v1.vert));
+    let norm2 = normal.dot(&normal);
+    if norm2 > MINVAL * MINVAL && norm2 < MAXVAL * MAXVAL {
+        let n = normal * (1.0 / norm2.sqrt());
+        return (n, n.dot(&v1.vert));
+    }
+    (normal, MAX_LIMIT)
+}
+
+/// 1 if the tetrahedron in `st.simplex` can be grown to contain the origin, 0 if the origin is
+/// outside the difference, −1 if inconclusive (MuJoCo's `gjkIntersect`).
+fn gjk_intersect(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) -> i32 {
+    let mut simplex = st.simplex;
+    let mut s = [0usize, 1, 2, 3];
+    let mut k = st.gjk_iterations;
+    while k < st.max_iterations {
+        let f = [
+            signed_distance(&simplex[s[2]], &simplex[s[1]], &simplex[s[3]]),
+            signed_distance(&simplex[s[0]], &simplex[s[2]], &simplex[s[3]]),
+            signed_distance(&simplex[s[1]], &simplex[s[0]], &simplex[s[3]]),
+            signed_distance(&simplex[s[0]], &simplex[s[1]], &simplex[s[2]]),
+        ];
+        if f.iter().any(|(_, d)| *d == 0.0) {
+            st.gjk_iterations = k;
+            return -1;
+        }
+        let i = if f[0].1 < f[1].1 { 0 } else { 1 };
+        let j = if f[2].1 < f[3].1 { 2 } else { 3 };
+        let index = if f[i].1 < f[j].1 { i } else { j };
+        if f[index].1 > 0.0 {
+            st.nsimplex = 4;
+            st.simplex = [simplex[s[0]], simplex[s[1]], simplex[s[2]], simplex[s[3]]];
+            st.gjk_iterations = k;
+            return 1;
+        }
+        let dir = f[index].0;
+        simplex[s[index]] = support(o1, o2, &dir, &-dir);
+        if dir.dot(&simplex[s[index]].vert) < 0.0 {
+            st.nsimplex = 0;
+            st.gjk_iterations = k;
+            return 0;
+        }
+        s.swap((index + 1) & 3, (index + 2) & 3);
+        k += 1;
+    }
+    st.gjk_iterations = k;
+    -1
+}
+
+/// The origin projected on the plane through v1, v2, v3 (None: degenerate).
+fn project_origin_plane(v1: &Vec3, v2: &Vec3, v3: &Vec3) -> Option<Vec3> {
+    let (d21, d31, d32) = (v2 - v1, v3 - v1, v3 - v2);
+    let n = d32.cross(&d21);
+    let (nv, nn) = (n.dot(v2), n.dot(&n));
+    if nn == 0.0 {
+        return None;
+    }
+    if nv != 0.0 && nn > MINVAL {
+        return Some(n * (nv / nn));
+    }
+    let n = d21.cross(&d31);
+    let (nv, nn) = (n.dot(v1), n.dot(&n));
+    if nn == 0.0 {
+        return None;
+    }
+    if nv != 0.0 && nn > MINVAL {
+        return Some(n * (nv / nn));
+    }
+    let n = d31.cross(&d32);
+    let (nv, nn) = (n.dot(v3), n.dot(&n));
+    Some(n * (nv / nn))
+}
+
+fn same_sign(a: f64, b: f64) -> bool {
+    (a > 0.0 && b > 0.0) || (a < 0.0 && b < 0.0)
+}
+
+fn subdistance(lambda: &mut [f64; 4], n: usize, s: &[Vertex; 4]) {
+    *lambda = [0.0; 4];
+    match n {
+        4 => s3d(lambda, &s[0].vert, &s[1].vert, &s[2].vert, &s[3].vert),
+        3 => {
+            let mut l = [0.0; 3];
+            s2d(&mut l, &s[0].vert, &s[1].vert, &s[2].vert);
+            lambda[..3].copy_from_slice(&l);
+        }
+        2 => {
+            let l = s1d(&s[0].vert, &s[1].vert);
+            lambda[..2].copy_from_slice(&l);
+        }
+        _ => lambda[0] = 1.0,
+    }
+}
+
+fn s3d(lambda: &mut [f64; 4], s1: &Vec3, s2: &Vec3, s3: &Vec3, s4: &Vec3) {
+    let c41 = -det3(s2, s3, s4);
+    let c42 = det3(s1, s3, s4);
+    let c43 = -det3(s1, s2, s4);
+    let c44 = det3(s1, s2, s3);
+    let m_det = c41 + c42 + c43 + c44;
+    let comp = [same_sign(m_det, c41), same_sign(m_det, c42), same_sign(m_det, c43), same_sign(m_det, c44)];
+    if comp.iter().all(|&c| c) {
+        *lambda = [c41 / m_det, c42 / m_det, c43 / m_det, c44 / m_det];
+        return;
+    }
+    let mut dmin = MAX_LIMIT;
+    // Faces opposite each vertex whose sign differs, in MuJoCo's order (the first candidate
+    // unconditionally, later ones when strictly closer).
+    let faces: [([&Vec3; 3], [usize; 3]); 4] = [
+        ([s2, s3, s4], [1, 2, 3]),
+        ([s1, s3, s4], [0, 2, 3]),
+        ([s1, s2, s4], [0, 1, 3]),
+        ([s1, s2, s3], [0, 1, 2]),
+    ];
+    for (f, (v, idx)) in faces.iter().enumerate() {
+        if comp[f] {
+            continue;
+        }
+        let mut l = [0.0; 3];
+        s2d(&mut l, v[0], v[1], v[2]);
+        let x = lincomb(&l, [v[0], v[1], v[2], v[2]]);
+        let d = x.dot(&x);
+        if f == 0 || d < dmin {
+            *lambda = [0.0; 4];
+            for (k, &i) in idx.iter().enumerate() {
+                lambda[i] = l[k];
+            }
+            dmin = d;
+        }
+    }
+}
+
+fn s2d(lambda: &mut [f64; 3], s1: &Vec3, s2: &Vec3, s3: &Vec3) {
+    let Some(p_o) = project_origin_plane(s1, s2, s3) else {
+        let l = s1d(s1, s2);
+        *lambda = [l[0], l[1], 0.0];
+        return;
+    };
+    let m14 = s2[1] * s3[2] - s2[2] * s3[1] - s1[1] * s3[2] + s1[2] * s3[1] + s1[1] * s2[2] - s1[2] * s2[1];
+    let m24 = s2[0] * s3[2] - s2[2] * s3[0] - s1[0] * s3[2] + s1[2] * s3[0] + s1[0] * s2[2] - s1[2] * s2[0];
+    let m34 = s2[0] * s3[1] - s2[1] * s3[0] - s1[0] * s3[1] + s1[1] * s3[0] + s1[0] * s2[1] - s1[1] * s2[0];
+    let (mu1, mu2, mu3) = (m14.abs(), m24.abs(), m34.abs());
+    let (m_max, x, y) = if mu1 >= mu2 && mu1 >= mu3 {
+        (m14, 1, 2)
+    } else if mu2 >= mu3 {
+        (m24, 0, 2)
+    } else {
+        (m34, 0, 1)
+    };
+    let (s1x, s1y, s2x, s2y, s3x, s3y, px, py) = (s1[x], s1[y], s2[x], s2[y], s3[x], s3[y], p_o[x], p_o[y]);
+    let c31 = px * s2y + py * s3x + s2x * s3y - px * s3y - py * s2x - s3x * s2y;
+    let c32 = px * s3y + py * s1x + s3x * s1y - px * s1y - py * s3x - s1x * s3y;
+    let c33 = px * s1y + py * s2x + s1x * s2y - px * s2y - py * s1x - s2x * s1y;
+    let comp = [same_sign(m_max, c31), same_sign(m_max, c32), same_sign(m_max, c33)];
+    if comp.iter().all(|&c| c) {
+        *lambda = [c31 / m_max, c32 / m_max, c33 / m_max];
+        return;
+    }
+    let mut dmin = MAX_LIMIT;
+    let edges: [([&Vec3; 2], [usize; 2]); 3] = [([s2, s3], [1, 2]), ([s1, s3], [0, 2]), ([s1, s2], [0, 1])];
+    for (e, (v, idx)) in edges.iter().enumerate() {
+        if comp[e] {
+            continue;
+        }
+        let l = s1d(v[0], v[1]);
+        let p = lincomb(&l, [v[0], v[1], v[1], v[1]]);
+        let d = p.dot(&p);
+        // MuJoCo takes the first edge's candidate unconditionally, later ones when strictly closer.
+        if e == 0 || d < dmin {
+            *lambda = [0.0; 3];
+            lambda[idx[0]] = l[0];
+            lambda[idx[1]] = l[1];
+            dmin = d;
+        }
+    }
+}
+
+fn s1d(s1: &Vec3, s2: &Vec3) -> [f64; 2] {
+    // The origin projected on the line.
+    let diff = s2 - s1;
+    let scl = -(s2.dot(&diff) / diff.dot(&diff));
+    let p_o = s2 + diff * scl;
+    let mut mu_max = s1[0] - s2[0];
+    let mut index = 0;
+    for i in 1..3 {
+        let mu = s1[i] - s2[i];
+        if mu.abs() >= mu_max.abs() {
+            mu_max = mu;
+            index = i;
+        }
+    }
+    let c1 = p_o[index] - s2[index];
+    let c2 = s1[index] - p_o[index];
+    if same_sign(mu_max, c1) && same_sign(mu_max, c2) {
+        [c1 / mu_max, c2 / mu_max]
+    } else {
+        [0.0, 1.0]
+    }
+}
+
+// ------------------------------------------------------------------------------------------
+// EPA
+
+/// A face of the polytope.
+#[derive(Clone, Copy, Debug)]
+struct Face {
+    verts: [usize; 3],
+    /// Adjacent faces across edges (v1, v2), (v2, v3), (v3, v1).
+    adj: [usize; 3],
+    /// The origin's projection on the face (its outward normal scaled by its distance).
+    v: Vec3,
+    dist2: f64,
+    /// Index in the map; −1 not in it, −2 deleted.
+    index: i64,
+}
+
+/// The expanding polytope and its scratch (MuJoCo's `Polytope`), reused per thread.
+#[derive(Default)]
+struct Polytope {
+    verts: Vec<Vertex>,
+    faces: Vec<Face>,
+    maxfaces: usize,
+    center: Vec3,
+    map: Vec<usize>,
+    h_indices: Vec<usize>,
+    h_edges: Vec<usize>,
+    h_w: Vec3,
+}
+
+thread_local! {
+    static POLYTOPE: RefCell<Polytope> = RefCell::new(Polytope::default());
+}
+
+/// EPA failures before the expansion (MuJoCo's `mjEPAStatus`); any of them means no contact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PolytopeError {
+    NonConvex,
+    BadNormal,
+    InvalidV4,
+    InvalidV5,
+    MissingOrigin,
+    OriginOnFace,
+}
+
+impl Polytope {
+    fn reset(&mut self) {
+        self.verts.clear();
+        self.faces.clear();
+        self.map.clear();
+        self.h_indices.clear();
+        self.h_edges.clear();
+    }
+
+    fn insert(&mut self, v: Vertex) -> usize {
+        self.verts.push(v);
+        self.verts.len() - 1
+    }
+
+    fn epa_support(&mut self, o1: &mut CcdObj, o2: &mut CcdObj, d: &Vec3, dnorm: f64) -> usize {
+        let (mut dir, mut dir_neg) = (Vec3::x(), -Vec3::x());
+        if dnorm > MINVAL {
+            dir = Vec3::new(d.x / dnorm, d.y / dnorm, d.z / dnorm);
+            dir_neg = dir * -1.0;
+        }
+        let v = support(o1, o2, &dir, &dir_neg);
+        self.insert(v)
+    }
+
+    /// Appends face (v1, v2, v3) with its adjacency; returns its squared distance (0: degenerate).
+    fn attach(&mut self, v1: usize, v2: usize, v3: usize, a1: usize, a2: usize, a3: usize) -> f64 {
+        let mut face =
+            Face { verts: [v1, v2, v3], adj: [a1, a2, a3], v: Vec3::zeros(), dist2: 0.0, index: -1 };
+        let ret = project_origin_plane(&self.verts[v3].vert, &self.verts[v2].vert, &self.verts[v1].vert);
+        let Some(mut v) = ret else {
+            self.faces.push(face);
+            return 0.0;
+        };
+        let outward = self.verts[v1].vert - self.center;
+        if v.dot(&outward) < 0.0 {
+            v *= -1.0;
+        }
+        face.v = v;
+        face.dist2 = v.dot(&v);
+        self.faces.push(face);
+        face.dist2
+    }
+
+    fn populate_map(&mut self) {
+        self.map.clear();
+        for i in 0..self.faces.len() {
+            self.map.push(i);
+            self.faces[i].index = i as i64;
+        }
+    }
+
+    fn delete_face(&mut self, f: usize) {
+        let idx = self.faces[f].index;
+        if idx >= 0 {
+            let last = self.map.pop().expect("a face in the map");
+            if (idx as usize) < self.map.len() {
+                self.map[idx as usize] = last;
+                self.faces[last].index = idx;
+            }
+        }
+        self.faces[f].index = -2;
+    }
+
+    fn get_edge(&self, f: usize, vertex: usize) -> usize {
+        let v = self.faces[f].verts;
+        if v[0] == vertex {
+            0
+        } else if v[1] == vertex {
+            1
+        } else {
+            2
+        }
+    }
+
+    fn horizon_rec(&mut self, f: usize, e: usize) -> bool {
+        let face = self.faces[f];
+        if face.v.dot(&self.h_w) - face.dist2 > MINVAL {
+            self.delete_face(f);
+            for k in 1..3 {
+                let i = (e + k) % 3;
+                let adj = face.adj[i];
+                if self.faces[adj].index > -2 {
+                    let adj_edge = self.get_edge(adj, face.verts[(i + 1) % 3]);
+                    if !self.horizon_rec(adj, adj_edge) {
+                        self.h_indices.push(adj);
+                        self.h_edges.push(adj_edge);
+                    }
+                }
+            }
+            return true;
+        }
+        false
+    }
+
+    fn horizon(&mut self, f: usize) {
+        self.delete_face(f);
+        let face = self.faces[f];
+        for (a, vert) in [(0, 1), (1, 2), (2, 0)] {
+            let adj = face.adj[a];
+            let adj_edge = self.get_edge(adj, face.verts[vert]);
+            if (a == 0 || self.faces[adj].index > -2) && !self.horizon_rec(adj, adj_edge) {
+                self.h_indices.push(adj);
+                self.h_edges.push(adj_edge);
+            }
+        }
+    }
+
+    fn replace_simplex3(&mut self, st: &mut Status, v1: usize, v2: usize, v3: usize) {
+        st.nsimplex = 3;
+        st.simplex[0] = self.verts[v1];
+        st.simplex[1] = self.verts[v2];
+        st.simplex[2] = self.verts[v3];
+        self.reset();
+    }
+
+    fn polytope2(&mut self, st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) -> Result<(), PolytopeError> {
+        let (v1, v2) = (st.simplex[0].vert, st.simplex[1].vert);
+        self.center = (v1 + v2) * 0.5;
+        let diff = v2 - v1;
+        let (mut value, mut index) = (MAX_LIMIT, 0);
+        for i in 0..3 {
+            if diff[i].abs() < value {
+                value = diff[i].abs();
+                index = i;
+            }
+        }
+        let mut e = Vec3::zeros();
+        e[index] = 1.0;
+        let d1 = e.cross(&diff);
+        let r = rotmat(&diff);
+        let d2 = r * d1;
+        let d3 = r * d2;
+        let v1i = self.insert(st.simplex[0]);
+        let v2i = self.insert(st.simplex[1]);
+        let v3i = self.epa_support(o1, o2, &d1, d1.norm());
+        let v4i = self.epa_support(o1, o2, &d2, d2.norm());
+        let v5i = self.epa_support(o1, o2, &d3, d3.norm());
+        let faces = [
+            (v1i, v3i, v4i, 1, 3, 2),
+            (v1i, v5i, v3i, 2, 4, 0),
+            (v1i, v4i, v5i, 0, 5, 1),
+            (v2i, v4i, v3i, 5, 0, 4),
+            (v2i, v3i, v5i, 3, 1, 5),
+            (v2i, v5i, v4i, 4, 2, 3),
+        ];
+        for (a, b, c, x, y, z) in faces {
+            if self.attach(a, b, c, x, y, z) < MINVAL * MINVAL {
+                self.replace_simplex3(st, a, b, c);
+                return self.polytope3(st, o1, o2);
+            }
+        }
+        let (p3, p4, p5) = (self.verts[v3i].vert, self.verts[v4i].vert, self.verts[v5i].vert);
+        if ray_triangle(&v1, &v2, &p3, &p4, &p5) == 0 {
+            return Err(PolytopeError::NonConvex);
+        }
+        self.populate_map();
+        Ok(())
+    }
+
+    fn polytope3(&mut self, st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) -> Result<(), PolytopeError> {
+        let (v1, v2, v3) = (st.simplex[0].vert, st.simplex[1].vert, st.simplex[2].vert);
+        self.center = (v1 + v2 + v3) * (1.0 / 3.0);
+        let n = (v2 - v1).cross(&(v3 - v1));
+        let n_norm = n.norm();
+        if n_norm < MINVAL {
+            return Err(PolytopeError::BadNormal);
+        }
+        let n_neg = n * -1.0;
+        let v1i = self.insert(st.simplex[0]);
+        let v2i = self.insert(st.simplex[1]);
+        let v3i = self.insert(st.simplex[2]);
+        let v5i = self.epa_support(o1, o2, &n_neg, n_norm);
+        let v4i = self.epa_support(o1, o2, &n, n_norm);
+        let (v4, v5) = (self.verts[v4i].vert, self.verts[v5i].vert);
+        if tri_point_intersect(&v1, &v2, &v3, &v4) {
+            return Err(PolytopeError::InvalidV4);
+        }
+        if tri_point_intersect(&v1, &v2, &v3, &v5) {
+            return Err(PolytopeError::InvalidV5);
+        }
+        if st.dist > 10.0 * MINVAL && !test_tetra(&v1, &v2, &v3, &v4) && !test_tetra(&v1, &v2, &v3, &v5) {
+            return Err(PolytopeError::MissingOrigin);
+        }
+        let faces = [
+            (v4i, v1i, v2i, 1, 3, 2),
+            (v4i, v3i, v1i, 2, 4, 0),
+            (v4i, v2i, v3i, 0, 5, 1),
+            (v5i, v2i, v1i, 5, 0, 4),
+            (v5i, v1i, v3i, 3, 1, 5),
+            (v5i, v3i, v2i, 4, 2, 3),
+        ];
+        for (a, b, c, x, y, z) in faces {
+            if self.attach(a, b, c, x, y, z) < MINVAL * MINVAL {
+                return Err(PolytopeError::OriginOnFace);
+            }
+        }
+        self.populate_map();
+        Ok(())
+    }
+
+    fn polytope4(&mut self, st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) -> Result<(), PolytopeError> {
+        let v1 = self.insert(st.simplex[0]);
+        let v2 = self.insert(st.simplex[1]);
+        let v3 = self.insert(st.simplex[2]);
+        let v4 = self.insert(st.simplex[3]);
+        let p = |i: usize| self.verts[i].vert;
+        self.center = (p(v1) + p(v2) + p(v3) + p(v4)) * 0.25;
+        let faces =
+            [(v1, v2, v3, 1, 3, 2), (v1, v4, v2, 2, 3, 0), (v1, v3, v4, 0, 3, 1), (v4, v3, v2, 2, 0, 1)];
+        for (a, b, c, x, y, z) in faces {
+            if self.attach(a, b, c, x, y, z) < MINVAL * MINVAL {
+                self.replace_simplex3(st, a, b, c);
+                return self.polytope3(st, o1, o2);
+            }
+        }
+        let p = |i: usize| self.verts[i].vert;
+        if !test_tetra(&p(v1), &p(v2), &p(v3), &p(v4)) {
+            return Err(PolytopeError::MissingOrigin);
+        }
+        self.populate_map();
+        Ok(())
+    }
+
+    /// The expansion: the face that approximates the penetration (None: no contact).
+    fn epa(&mut self, st: &Status, o1: &mut CcdObj, o2: &mut CcdObj) -> Option<usize> {
+        let (mut upper, mut upper2) = (MAX_LIMIT, MAX_LIMIT);
+        let mut face: Option<usize> = None;
+        let discrete = o1.discrete() && o2.discrete() && o1.margin == 0.0 && o2.margin == 0.0;
+        let tolerance = if discrete { MINVAL } else { st.tolerance };
+        let kmax = st.max_iterations.min(1000);
+        self.maxfaces = 6 * st.max_iterations;
+        for k in 0..kmax {
+            let pface = face;
+            let mut lower2 = MAX_LIMIT;
+            for &f in &self.map {
+                if self.faces[f].dist2 < lower2 {
+                    face = Some(f);
+                    lower2 = self.faces[f].dist2;
+                }
+            }
+            let Some(f) = face.filter(|_| lower2 <= upper2) else {
+                face = pface;
+                break;
+            };
+            if lower2 <= 0.0 {
+                break;
+            }
+            let lower = lower2.sqrt();
+            let fv = self.faces[f].v;
+            let wi = self.epa_support(o1, o2, &fv, lower);
+            let w = self.verts[wi];
+            let upper_k = fv.dot(&w.vert) / lower;
+            if upper_k < upper {
+                upper = upper_k;
+                upper2 = upper * upper;
+            }
+            if upper - lower < tolerance {
+                if k == 0 && upper < lower - 1e-10 {
+                    face = None;
+                }
+                break;
+            }
+            if discrete && self.verts[..wi].iter().any(|v| v.index1 == w.index1 && v.index2 == w.index2) {
+                break;
+            }
+            self.h_w = w.vert;
+            self.h_indices.clear();
+            self.h_edges.clear();
+            self.horizon(f);
+            let nedges = self.h_indices.len();
+            if nedges < 3 {
+                face = None;
+                break;
+            }
+            let nfaces = self.faces.len();
+            if nedges > self.maxfaces.saturating_sub(nfaces) {
+                break;
+            }
+            for i in 0..nedges {
+                let cur = nfaces + i;
+                let (hi, he) = (self.h_indices[i], self.h_edges[i]);
+                let hv = self.faces[hi].verts;
+                let (v1, v2) = (hv[he], hv[(he + 1) % 3]);
+                self.faces[hi].adj[he] = cur;
+                let prev = if i == 0 { nfaces + nedges - 1 } else { cur - 1 };
+                let next = nfaces + (i + 1) % nedges;
+                let dist2 = self.attach(wi, v2, v1, prev, hi, next);
+                if dist2 == 0.0 {
+                    face = None;
+                    break;
+                }
+                if dist2 >= lower2 && dist2 <= upper2 {
+                    self.faces[cur].index = self.map.len() as i64;
+                    self.map.push(cur);
+                }
+            }
+            if self.map.is_empty() || face.is_none() {
+                break;
+            }
+        }
+        face
+    }
+
+    /// The witness points of face `f` and its signed distance (MuJoCo's `epaWitness`).
+    fn witness(&self, f: usize) -> (Vec3, Vec3, f64) {
+        let face = &self.faces[f];
+        let [a, b, c] = face.verts.map(|i| &self.verts[i]);
+        let l = tri_affine_coord(&a.vert, &b.vert, &c.vert, &face.v);
+        let x1 = lincomb(&l, [&a.vert1, &b.vert1, &c.vert1, &c.vert1]);
+        let x2 = lincomb(&l, [&a.vert2, &b.vert2, &c.vert2, &c.vert2]);
+        (x1, x2, -face.dist2.sqrt())
+    }
+}
+
+/// The rotation by 120° about `axis` (row-major as MuJoCo's `rotmat`).
+fn rotmat(axis: &Vec3) -> crate::spatial::Mat3 {
+    let n = axis.norm();
+    let (u1, u2, u3) = (axis.x / n, axis.y / n, axis.z / n);
+    let sin = 0.86602540378;
+    let cos = -0.5;
+    crate::spatial::Mat3::new(
+        cos + u1 * u1 * (1.0 - cos),
+        u1 * u2 * (1.0 - cos) - u3 * sin,
+        u1 * u3 * (1.0 - cos) + u2 * sin,
+        u2 * u1 * (1.0 - cos) + u3 * sin,
+        cos + u2 * u2 * (1.0 - cos),
+        u2 * u3 * (1.0 - cos) - u1 * sin,
+        u1 * u3 * (1.0 - cos) - u2 * sin,
+        u2 * u3 * (1.0 - cos) + u1 * sin,
+        cos + u3 * u3 * (1.0 - cos),
+    )
+}
+
+fn same_side(p0: &Vec3, p1: &Vec3, p2: &Vec3, p3: &Vec3) -> bool {
+    let n = (p1 - p0).cross(&(p2 - p0));
+    let dot1 = n.dot(&(p3 - p0));
+    let dot2 = n.dot(&(p0 * -1.0));
+    (dot1 > 0.0 && dot2 > 0.0) || (dot1 < 0.0 && dot2 < 0.0)
+}
+
+fn test_tetra(p0: &Vec3, p1: &Vec3, p2: &Vec3, p3: &Vec3) -> bool {
+    same_side(p0, p1, p2, p3)
+        && same_side(p1, p2, p3, p0)
+        && same_side(p2, p3, p0, p1)
+        && same_side(p3, p0, p1, p2)
+}
+
+fn ray_triangle(v1: &Vec3, v2: &Vec3, v3: &Vec3, v4: &Vec3, v5: &Vec3) -> i32 {
+    let (d12, d13, d14, d15) = (v2 - v1, v3 - v1, v4 - v1, v5 - v1);
+    let vol1 = det3(&d13, &d14, &d12);
+    let vol2 = det3(&d14, &d15, &d12);
+    let vol3 = det3(&d15, &d13, &d12);
+    if vol1 >= 0.0 && vol2 >= 0.0 && vol3 >= 0.0 {
+        return 1;
+    }
+    if vol1 <= 0.0 && vol2 <= 0.0 && vol3 <= 0.0 {
+        return -1;
+    }
+    0
+}
+
+fn tri_affine_coord(v1: &Vec3, v2: &Vec3, v3: &Vec3, p: &Vec3) -> [f64; 3] {
+    let m14 = v2[1] * v3[2] - v2[2] * v3[1] - v1[1] * v3[2] + v1[2] * v3[1] + v1[1] * v2[2] - v1[2] * v2[1];
+    let m24 = v2[0] * v3[2] - v2[2] * v3[0] - v1[0] * v3[2] + v1[2] * v3[0] + v1[0] * v2[2] - v1[2] * v2[0];
+    let m34 = v2[0] * v3[1] - v2[1] * v3[0] - v1[0] * v3[1] + v1[1] * v3[0] + v1[0] * v2[1] - v1[1] * v2[0];
+    let (mu1, mu2, mu3) = (m14.abs(), m24.abs(), m34.abs());
+    let (m_max, x, y) = if mu1 >= mu2 && mu1 >= mu3 {
+        (m14, 1, 2)
+    } else if mu2 >= mu3 {
+        (m24, 0, 2)
+    } else {
+        (m34, 0, 1)
+    };
+    let c31 = p[x] * v2[y] + p[y] * v3[x] + v2[x] * v3[y] - p[x] * v3[y] - p[y] * v2[x] - v3[x] * v2[y];
+    let c32 = p[x] * v3[y] + p[y] * v1[x] + v3[x] * v1[y] - p[x] * v1[y] - p[y] * v3[x] - v1[x] * v3[y];
+    let c33 = p[x] * v1[y] + p[y] * v2[x] + v1[x] * v2[y] - p[x] * v2[y] - p[y] * v1[x] - v2[x] * v1[y];
+    [c31 / m_max, c32 / m_max, c33 / m_max]
+}
+
+fn tri_point_intersect(v1: &Vec3, v2: &Vec3, v3: &Vec3, p: &Vec3) -> bool {
+    let l = tri_affine_coord(v1, v2, v3, p);
+    if l[0] < 0.0 || l[1] < 0.0 || l[2] < 0.0 {
+        return false;
+    }
+    let pr = v1 * l[0] + v2 * l[1] + v3 * l[2];
+    (pr - p).norm() < MINVAL
+}
+
+/// A contact from the solver: the witness points (of the geoms inflated by half the margin
+/// each; their midpoint is the contact position), the unit normal from geom 1 to geom 2, the
+/// contact distance (the margin plus the inflated geoms' signed distance) and, when EPA found
+/// it, the geom vertex indices of its final face's three polytope vertices (geom 1's, geom 2's).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CcdContact {
+    /// Witness point on geom 1 (world).
+    pub x1: Vec3,
+    /// Witness point on geom 2 (world).
+    pub x2: Vec3,
+    /// Unit normal from geom 1 to geom 2.
+    pub normal: Vec3,
+    /// Contact distance (m).
+    pub dist: f64,
+    /// The final EPA face's vertices: geom 1's and geom 2's vertex indices and points.
+    pub face: Option<FaceFeatures>,
+}
+
+/// MuJoCo's `mjc_penetration` with one contact: the penetration of the two geoms inflated by
+/// half of `margin` each (a contact when the inflated geoms overlap), by GJK/EPA to
+/// `tolerance` within `iterations`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn penetration(
+    s1: &ConvexShape,
+    x1: &Transform,
+    s2: &ConvexShape,
+    x2: &Transform,
+    margin: f64,
+    tolerance: f64,
+    iterations: usize,
+) -> Option<CcdContact> {
+    let mut o1 = CcdObj::new(s1, x1, margin);
+    let mut o2 = CcdObj::new(s2, x2, margin);
+    let mut st = Status {
+        separated: false,
+        dist: 0.0,
+        x1: x1.pos,
+        x2: x2.pos,
+        max_iterations: iterations,
+        tolerance,
+        dist_cutoff: 0.0,
+        gjk_iterations: 0,
+        simplex: [ZERO_VERTEX; 4],
+        nsimplex: 0,
+    };
+    let core = |s: &ConvexShape| match s {
+        ConvexShape::Ball(b) => Some((Core::Point, b.radius)),
+        ConvexShape::Capsule(c) => Some((Core::Line, c.radius)),
+        _ => None,
+    };
+    let (c1, c2) = (core(s1), core(s2));
+    if c1.is_some() || c2.is_some() {
+        let mut full = [0.0; 2];
+        for (k, (o, c)) in [(&mut o1, c1), (&mut o2, c2)].into_iter().enumerate() {
+            if let Some((kind, radius)) = c {
+                full[k] = radius + 0.5 * margin;
+                o.core = kind;
+            }
+        }
+        st.dist_cutoff = full[0] + full[1];
+        gjk(&mut st, &mut o1, &mut o2);
+        st.dist_cutoff = 0.0;
+        o1.core = Core::Shape;
+        o2.core = Core::Shape;
+        if st.dist > st.tolerance {
+            // Shallow: the cores' witness points moved out by the radii.
+            let n = normalize3(&(st.x2 - st.x1));
+            if full[0] != 0.0 {
+                st.x1 += n * full[0];
+            }
+            if full[1] != 0.0 {
+                st.x2 -= n * full[1];
+            }
+            st.dist -= full[0] + full[1];
+            if st.dist > st.dist_cutoff || st.dist >= 0.0 {
+                return None;
+            }
+            return Some(contact(&st, margin, None));
+        }
+        st.gjk_iterations = 0;
+        st.x1 = x1.pos;
+        st.x2 = x2.pos;
+    }
+    gjk(&mut st, &mut o1, &mut o2);
+    if !(st.dist <= tolerance && st.nsimplex > 1 && !st.separated) {
+        return None;
+    }
+    st.dist = 0.0;
+    POLYTOPE.with(|pt| {
+        let pt = &mut *pt.borrow_mut();
+        pt.reset();
+        let built = match st.nsimplex {
+            2 => pt.polytope2(&mut st, &mut o1, &mut o2),
+            3 => pt.polytope3(&mut st, &mut o1, &mut o2),
+            _ => pt.polytope4(&mut st, &mut o1, &mut o2),
+        };
+        built.ok()?;
+        let f = pt.epa(&st, &mut o1, &mut o2)?;
+        let (w1, w2, d) = pt.witness(f);
+        (st.x1, st.x2, st.dist) = (w1, w2, d);
+        if st.dist >= 0.0 {
+            return None;
+        }
+        let v = pt.faces[f].verts.map(|i| pt.verts[i]);
+        let face = (v.map(|v| v.index1), v.map(|v| v.index2), v.map(|v| v.vert1), v.map(|v| v.vert2));
+        Some(contact(&st, margin, Some(face)))
+    })
+}
+
+/// A final EPA face's features: geom 1's and geom 2's vertex indices of its three polytope
+/// vertices, and their points on geom 1 and geom 2 (world).
+pub(crate) type FaceFeatures = ([i32; 3], [i32; 3], [Vec3; 3], [Vec3; 3]);
+
+fn contact(st: &Status, margin: f64, face: Option<FaceFeatures>) -> CcdContact {
+    CcdContact { x1: st.x1, x2: st.x2, normal: normalize3(&(st.x1 - st.x2)), dist: margin + st.dist, face }
+}
