@@ -378,7 +378,7 @@ pub fn transition_jacobians<'py>(
     let model = model_for(m, &d)?;
     check_state(d.data(), "transition_jacobians")?;
     let mut work = lagrange::derivatives::TransitionWork::new(&model);
-    let options = lagrange::derivatives::TransitionOptions { eps, centered };
+    let options = lagrange::derivatives::TransitionOptions { eps, centered, ..Default::default() };
     let data = d.data();
     py.detach(|| lagrange::derivatives::transition_jacobians(&model, data, &mut work, &options))
         .map_err(error::sim)?;
