@@ -78,6 +78,53 @@ fn mul_j(j: &DMatrix<f64>, s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut 
     }
 }
 
+/// H += J_Bᵀ S J_B for the rows B = i..i+dim of J and the block S (top-left dim × dim of
+/// `block`): a single row directly over its nonzero columns; a block (an elliptic contact on its
+/// cone) through W = S J_B over the union of its rows' columns (`cols`, `w` scratch), dim² + dim
+/// products per column pair fewer than entry by entry.
+fn add_block_hessian(
+    h: &mut DMatrix<f64>,
+    j: &DMatrix<f64>,
+    nz: &Sparsity,
+    (i, dim, block): (usize, usize, &[[f64; 6]; 6]),
+    cols: &mut Vec<usize>,
+    w: &mut DMatrix<f64>,
+) {
+    if dim == 1 {
+        let d = block[0][0];
+        for &p in nz.row(i) {
+            let x = d * j[(i, p)];
+            for &q in nz.row(i) {
+                h[(p, q)] += x * j[(i, q)];
+            }
+        }
+        return;
+    }
+    cols.clear();
+    for r in i..i + dim {
+        for &p in nz.row(r) {
+            if !cols.contains(&p) {
+                cols.push(p);
+            }
+        }
+    }
+    for (c, &q) in cols.iter().enumerate() {
+        for a in 0..dim {
+            w[(a, c)] = (0..dim).map(|b| block[a][b] * j[(i + b, q)]).sum();
+        }
+    }
+    for &p in cols.iter() {
+        for a in 0..dim {
+            let x = j[(i + a, p)];
+            if x != 0.0 {
+                for (c, &q) in cols.iter().enumerate() {
+                    h[(p, q)] += x * w[(a, c)];
+                }
+            }
+        }
+    }
+}
+
 /// r ← M x for the dense symmetric M.
 fn mul_m(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
     m.mul_to(x, r);
@@ -185,13 +232,9 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
             Primal::Newton => {
                 let h = &mut soft.hessian;
                 h.copy_from(mass_matrix);
-                rows.hessian(&soft.jar, efc_state, |a, b, w| {
-                    for &p in nz.row(a) {
-                        let x = w * efc_j[(a, p)];
-                        for &q in nz.row(b) {
-                            h[(p, q)] += x * efc_j[(b, q)];
-                        }
-                    }
+                let (cols, w) = (&mut soft.block_cols, &mut soft.block_w);
+                rows.hessian(&soft.jar, efc_state, |i, dim, block| {
+                    add_block_hessian(h, efc_j, &nz, (i, dim, block), cols, w);
                 });
                 soft.dir.copy_from(&soft.grad);
                 if cholesky(&soft.hessian, nv, &mut soft.factor, 0.0) {

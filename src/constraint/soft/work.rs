@@ -31,6 +31,10 @@ pub(crate) struct SoftWork {
     /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
     pub ar: DMatrix<f64>,
     pub minv_jt: DMatrix<f64>,
+    /// Newton's Hessian of an elliptic contact's cone block: the union of its rows' nonzero
+    /// columns, and S J over them (6 × nv).
+    pub block_cols: Vec<usize>,
+    pub block_w: DMatrix<f64>,
 }
 
 impl SoftWork {
@@ -52,6 +56,8 @@ impl SoftWork {
             nz_index: Vec::with_capacity(nefc * nv),
             ar: DMatrix::zeros(0, 0),
             minv_jt: DMatrix::zeros(0, 0),
+            block_cols: Vec::with_capacity(nv),
+            block_w: DMatrix::zeros(6, nv),
         }
     }
 }
