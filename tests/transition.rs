@@ -8,7 +8,7 @@
 mod common;
 
 use common::*;
-use lagrange::derivatives::{transition_jacobians, TransitionOptions, TransitionWork};
+use lagrange::derivatives::{transition_jacobians, TransitionMethod, TransitionOptions, TransitionWork};
 use lagrange::model::options::Integrator;
 use lagrange::Data;
 use serde::Deserialize;
@@ -70,7 +70,7 @@ fn check_skip_equals_plain(scene: &str, integrator: Option<Integrator>) {
     let mut data = Data::new(&model);
     let mut fast = TransitionWork::new(&model);
     let mut plain = TransitionWork::new(&model);
-    let options = TransitionOptions { eps: golden.eps, centered: golden.centered, skip: true };
+    let options = TransitionOptions { eps: golden.eps, centered: golden.centered, ..Default::default() };
     for s in 0..golden.states.len() {
         load_state(&golden, &mut data, s);
         transition_jacobians(&model, &mut data, &mut plain, &TransitionOptions { skip: false, ..options })
@@ -199,4 +199,102 @@ fn forward_differences_and_bad_eps() {
     let bad = TransitionOptions { eps: -1.0, ..Default::default() };
     assert!(transition_jacobians(&model, &mut data, &mut work, &bad).is_err());
     assert_eq!(data.qpos, q);
+}
+
+/// [A B] of the hybrid method (analytic velocity and control columns) and of the plain centred
+/// differences at the state in `data`, their relative difference asserted below `HYBRID_REL`;
+/// returns the number of analytic columns.
+fn check_hybrid(label: &str, model: &lagrange::Model, data: &mut Data) -> usize {
+    let mut plain = TransitionWork::new(model);
+    let mut hybrid = TransitionWork::new(model);
+    let fd = TransitionOptions { skip: false, ..Default::default() };
+    transition_jacobians(model, data, &mut plain, &fd).unwrap();
+    let options = TransitionOptions { method: TransitionMethod::Hybrid, ..Default::default() };
+    transition_jacobians(model, data, &mut hybrid, &options).unwrap();
+    let (ours, theirs) = (ab(&hybrid.a, &hybrid.b), ab(&plain.a, &plain.b));
+    let n = hybrid.analytic_columns();
+    println!(
+        "{label} ({:?}, {} rows): hybrid ({n} analytic columns) vs centred differences [A B] {:.2e}",
+        model.options.integrator,
+        data.nefc,
+        rel_err_mat(&ours, &theirs)
+    );
+    assert_close_mat(&format!("{label} hybrid [A B]"), &ours, &theirs, HYBRID_REL);
+    n
+}
+
+/// The model of `text` with the tight solver of `tight_model`.
+fn tight_text(text: &str) -> lagrange::Model {
+    let mut model = lagrange::Model::from_str(text).unwrap();
+    let o = &mut model.options;
+    o.solver = lagrange::model::options::Solver::Newton;
+    o.tolerance = 1e-15;
+    o.iterations = 1000;
+    o.ls_iterations = 100;
+    o.ls_tolerance = 1e-12;
+    model
+}
+
+#[test]
+fn hybrid_equals_differences_golden_scenes() {
+    for scene in ["go1_standing", "go1_walking", "humanoid_floor", "panda_free"] {
+        let golden = read_golden(scene);
+        let model = tight_model(repo_path(&golden.model).to_str().unwrap());
+        let mut data = Data::new(&model);
+        for s in 0..golden.states.len() {
+            load_state(&golden, &mut data, s);
+            if golden.states[s].contact_set_same {
+                let n = check_hybrid(&format!("{scene} state {s}"), &model, &mut data);
+                assert!(n >= model.nv, "{scene}: the velocity columns are analytic");
+            }
+        }
+    }
+}
+
+/// A box resting on a plane (four pyramidal contacts), Euler and implicitfast.
+#[test]
+fn hybrid_box_on_plane() {
+    for integrator in ["Euler", "implicitfast"] {
+        let model = tight_text(&format!(
+            r#"<mujoco><option timestep="0.002" integrator="{integrator}"/><worldbody>
+            <geom type="plane" size="5 5 .1"/>
+            <body pos="0 0 0.1"><freejoint/><geom type="box" size=".1 .08 .1" mass="1"/></body>
+            </worldbody></mujoco>"#
+        ));
+        let mut data = Data::new(&model);
+        for _ in 0..300 {
+            lagrange::integrate::step(&model, &mut data).unwrap();
+        }
+        data.qvel[0] = 0.01;
+        data.qvel[5] = 0.02;
+        check_hybrid(&format!("box on plane ({integrator})"), &model, &mut data);
+    }
+}
+
+/// A joint limit, a joint equality, damping, a motor, a position servo and a velocity servo.
+#[test]
+fn hybrid_limit_equality_actuators() {
+    for integrator in ["Euler", "implicitfast"] {
+        let model = tight_text(&format!(
+            r#"<mujoco><option timestep="0.002" integrator="{integrator}"/><worldbody>
+            <body><joint name="a" type="hinge" axis="0 1 0" range="-30 30" damping="0.1"/>
+              <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+              <body pos="0.3 0 0"><joint name="b" type="hinge" axis="0 1 0" damping="0.1"/>
+                <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/></body></body>
+            <body pos="0 1 0"><joint name="c" type="hinge" axis="0 1 0"/>
+              <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/></body>
+            </worldbody>
+            <equality><joint joint1="c" joint2="b" polycoef="0 0.5 0 0 0"/></equality>
+            <actuator><motor joint="a"/><position joint="b" kp="5"/><velocity joint="c" kv="0.3"/></actuator>
+            </mujoco>"#
+        ));
+        let mut data = Data::new(&model);
+        data.qpos.copy_from_slice(&[0.55, 0.2, 0.1]);
+        data.qvel.copy_from_slice(&[0.1, -0.2, 0.3]);
+        data.ctrl.copy_from_slice(&[0.1, 0.2, 0.3]);
+        lagrange::forward::forward(&model, &mut data);
+        assert!(data.nefc >= 2, "the limit and the equality are rows");
+        let n = check_hybrid(&format!("limit and equality ({integrator})"), &model, &mut data);
+        assert_eq!(n, model.nv + 3, "every column analytic but the positions");
+    }
 }

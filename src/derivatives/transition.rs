@@ -21,6 +21,7 @@
 //! (the RK4 stages and the exact mode's drift projection evaluate other configurations). The
 //! skipped and the plain differences agree to the solver's tolerance (tests/transition.rs).
 
+use super::transition_analytic::{self, AnalyticWork};
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix};
 use crate::error::InputError;
 use crate::forward::SkipStage;
@@ -30,6 +31,21 @@ use crate::model::{difference_configuration_unchecked, integrate_configuration_u
 use crate::sim::SimError;
 use crate::{Data, Model};
 use nalgebra::{DMatrix, DVector};
+
+/// How [`transition_jacobians`] computes the columns.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TransitionMethod {
+    /// Every column by finite differences (MuJoCo's `mjd_transitionFD`).
+    #[default]
+    FiniteDifference,
+    /// The velocity and control columns analytic — the smooth dynamics' derivatives and the soft
+    /// solve's by the implicit function theorem (docs/physics.md) — and the position and
+    /// activation columns by finite differences. Applies to the Euler and implicitfast
+    /// integrators with the Newton or CG solver and no activations; columns it cannot do
+    /// (module `transition_analytic`: a control at a clamp, connect or weld rows for the velocity
+    /// columns) and other models fall back to differences.
+    Hybrid,
+}
 
 /// How [`transition_jacobians`] differences.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,11 +59,13 @@ pub struct TransitionOptions {
     /// solve from the nominal solution (module doc); true by default. False: every nudge runs
     /// the whole step from the input's warm start (the plain differences, for checking).
     pub skip: bool,
+    /// Finite differences only (default) or analytic velocity and control columns.
+    pub method: TransitionMethod,
 }
 
 impl Default for TransitionOptions {
     fn default() -> Self {
-        Self { eps: 1e-6, centered: true, skip: true }
+        Self { eps: 1e-6, centered: true, skip: true, method: TransitionMethod::FiniteDifference }
     }
 }
 
@@ -66,6 +84,7 @@ pub struct TransitionWork {
     /// position stage (the implicit integrators overwrite the factor with that of M − h D).
     mass_matrix: DMatrix<f64>,
     mass_factor: DMatrix<f64>,
+    analytic: AnalyticWork,
 }
 
 /// The inputs every nudged step starts from.
@@ -127,7 +146,16 @@ impl TransitionWork {
             dq: DVector::zeros(nv),
             mass_matrix: DMatrix::zeros(nv, nv),
             mass_factor: DMatrix::zeros(nv, nv),
+            analytic: AnalyticWork::new(model),
         }
+    }
+
+    /// How many columns of [A B] the last [`transition_jacobians`] computed analytically
+    /// ([`TransitionMethod::Hybrid`]: nv velocity columns and one per control whose force is
+    /// affine in it away from its clamps; 0 with finite differences).
+    pub fn analytic_columns(&self) -> usize {
+        let v = if self.analytic.v_done { self.dq.len() } else { 0 };
+        v + self.analytic.ctrl_done.iter().filter(|&&d| d).count()
     }
 
     fn save(&mut self, data: &Data) {
@@ -315,10 +343,24 @@ fn differences(
     let (eps, centered) = (options.eps, options.centered);
     let mut a = std::mem::take(&mut work.a);
     let mut b = std::mem::take(&mut work.b);
+    // The analytic columns, at the nominal forward evaluation still in `data` (its stages'
+    // buffers; M is CRBA's again after the nominal step).
+    let hybrid = options.method == TransitionMethod::Hybrid && transition_analytic::supported(model);
+    let analytic = hybrid && {
+        let TransitionWork { analytic, next, .. } = &mut *work;
+        transition_analytic::columns(model, data, analytic, &next.qvel, &mut a, &mut b)
+    };
+    if !analytic {
+        work.analytic.v_done = false;
+        work.analytic.ctrl_done.fill(false);
+    }
     let result = (|| {
         // MuJoCo's order: ctrl and act (position and velocity stages reused), v (position stage
         // reused), q (nothing reused), so that each reuses what the nominal step left.
         for i in 0..model.actuators.len() {
+            if work.analytic.ctrl_done[i] {
+                continue;
+            }
             let ctrl = work.saved.ctrl[i];
             let within = |x0: f64, x1: f64| match model.actuators[i].ctrlrange {
                 Some([lo, hi]) => x0 >= lo && x1 <= hi,
@@ -344,6 +386,9 @@ fn differences(
             .chain((0..nv).map(|k| (nv + k, Input::V(k), SkipStage::Position)))
             .chain((0..nv).map(|k| (k, Input::Q(k), SkipStage::None)));
         for (col, input, s) in inputs {
+            if work.analytic.v_done && matches!(input, Input::V(_)) {
+                continue;
+            }
             nudged_step(model, data, work, input, eps, stage(s))?;
             if centered {
                 nudged_step(model, data, work, input, -eps, stage(s))?;

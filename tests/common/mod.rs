@@ -736,6 +736,12 @@ pub const TRANSITION_REL: f64 = 1e-6;
 /// [A B] measured: humanoid 1.3e-9, go1 ≤ 1.2e-11, panda 8e-11.
 pub const SKIP_REL: f64 = 1e-8;
 
+/// Relative tolerance of the hybrid transition Jacobians (analytic velocity and control columns
+/// through the soft solve's optimality conditions) against lagrange's own centred differences
+/// (tests/transition.rs), on scenes whose contact set and row zones stay the same under the
+/// nudges: the 1e-6; the differences' own error is O(ε²) truncation plus round-off / ε.
+pub const HYBRID_REL: f64 = 1e-6;
+
 /// Relative tolerance of the poses and joint values in the viewer's pages (`cli/tests/viewer.rs`):
 /// they are stored as f32, whose rounding is 2⁻²⁴ ≈ 6e-8 of a value; 1e-7 allows one rounding.
 pub const VIEW_F32_REL: f64 = 1e-7;
