@@ -146,7 +146,7 @@ fn check_scene(scene: &str) {
         if st.contact_set_same {
             assert_close_mat(&at("[A B]"), &ours, &theirs, TRANSITION_REL);
             println!(
-                "{}: A alone {:.2e}, B alone {:.2e}",
+                "{}: [A B] {e:.2e}, A alone {:.2e}, B alone {:.2e}",
                 at(""),
                 rel_err_mat(&work.a, &ga),
                 rel_err_mat(&work.b, &gb)
