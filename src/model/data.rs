@@ -335,11 +335,10 @@ pub struct Data {
     /// World pose of each geom that collides, from the last collision pass (MuJoCo's `geom_xpos`,
     /// `geom_xmat`).
     pub x_world_geom: Vec<Transform>,
-    /// Contacts of the last collision pass (MuJoCo's `contact`); capacity reserved for the model.
+    /// Contacts of the last collision pass (MuJoCo's `contact`). Room for
+    /// [`INITIAL_CONTACTS`](crate::model::INITIAL_CONTACTS) is reserved; a pass that finds more
+    /// grows it (once: the capacity is kept), so no contact is ever dropped.
     pub contacts: Vec<Contact>,
-    /// Contacts dropped because a collision pass found more than [`Model::max_contacts`]
-    /// (cumulative; MuJoCo's `mjWARN_CONTACTFULL`).
-    pub contacts_dropped: u64,
 
     // --- sensors ---
     /// The sensors' values from the last `forward` (MuJoCo's `sensordata`; each sensor's slice at
@@ -441,17 +440,16 @@ impl Data {
             efc_kbip: vec![[0.0; 4]; nefc],
             efc_aref: DVector::zeros(nefc),
             efc_state: vec![EfcState::Satisfied; nefc],
-            contact_mu: vec![0.0; model.max_contacts()],
+            contact_mu: vec![0.0; model.max_contacts().min(crate::model::INITIAL_CONTACTS)],
             qacc_warmstart: DVector::zeros(nv),
             solver_niter: 0,
             solver_improvement: 0.0,
             solver_gradient: 0.0,
             soft: SoftWork::new(nv, nefc),
             x_world_geom: vec![Transform::identity(); model.geoms.len()],
-            contacts: Vec::with_capacity(model.max_contacts()),
+            contacts: Vec::with_capacity(model.max_contacts().min(crate::model::INITIAL_CONTACTS)),
             sensordata: DVector::zeros(model.nsensordata),
             sensor_work: crate::sensor::SensorWork::new(model),
-            contacts_dropped: 0,
             forward_skip: Default::default(),
         }
     }
