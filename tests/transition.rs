@@ -1,7 +1,8 @@
 //! Transition Jacobians of a step (`lagrange::derivatives::transition_jacobians`) against MuJoCo
 //! 4.0's `mjd_transitionFD` (golden data in `tests/data/mujoco/transition/`, from
 //! `validation/mujoco_transition_golden.py`): the go1 standing and walking on its floor, the
-//! humanoid falling onto its floor, the contact-free panda arm (implicitfast), at
+//! humanoid falling onto its floor, the contact-free panda arm (implicitfast), a gripper holding
+//! a box (validation/scenes/gripper_box.xml), at
 //! `TRANSITION_REL` where every nudged step keeps the nominal contact set; plus the
 //! library's own checks (state restored, forward vs centred).
 
@@ -56,10 +57,11 @@ fn read_golden(scene: &str) -> Golden {
     serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap()
 }
 
-/// Stage skipping (MuJoCo's mj_stepSkip) and the nominal warm start change only the order of
-/// round-off and the soft solver's starting point: [A B] with skipping equals the plain
-/// differences (every nudge a whole step from the input's warm start) to `SKIP_REL`, and both
-/// leave the state and warm start as they were.
+/// Stage skipping (MuJoCo's mj_stepSkip) changes only the order of round-off: from the same
+/// (the input's) warm start, [A B] with skipping equals the plain differences (every nudge a
+/// whole step) to `SKIP_REL`. The nominal warm start (the default) moves the nudged solves'
+/// stopping points within the solver's tolerance: within `NOMINAL_WARMSTART_REL`. All leave the
+/// state and warm start as they were.
 fn check_skip_equals_plain(scene: &str, integrator: Option<Integrator>) {
     let golden = read_golden(scene);
     let mut model = tight_model(repo_path(&golden.model).to_str().unwrap());
@@ -68,20 +70,33 @@ fn check_skip_equals_plain(scene: &str, integrator: Option<Integrator>) {
     }
     let scene = format!("{scene} ({:?})", model.options.integrator);
     let mut data = Data::new(&model);
-    let mut fast = TransitionWork::new(&model);
-    let mut plain = TransitionWork::new(&model);
+    let (mut fast, mut plain, mut warm) =
+        (TransitionWork::new(&model), TransitionWork::new(&model), TransitionWork::new(&model));
     let options = TransitionOptions { eps: golden.eps, centered: golden.centered, ..Default::default() };
+    let skipped = TransitionOptions { nominal_warmstart: false, ..options };
+    let whole = TransitionOptions { skip: false, ..skipped };
     for s in 0..golden.states.len() {
         load_state(&golden, &mut data, s);
-        transition_jacobians(&model, &mut data, &mut plain, &TransitionOptions { skip: false, ..options })
-            .unwrap();
-        transition_jacobians(&model, &mut data, &mut fast, &options).unwrap();
+        transition_jacobians(&model, &mut data, &mut plain, &whole).unwrap();
+        transition_jacobians(&model, &mut data, &mut fast, &skipped).unwrap();
+        transition_jacobians(&model, &mut data, &mut warm, &options).unwrap();
         assert_eq!(data.qacc_warmstart.as_slice(), &golden.states[s].qacc_warmstart[..]);
         // [A B] norm-wise, as against MuJoCo: the panda's B is round-off (its forces at their
         // range bounds).
-        let (ours, theirs) = (ab(&fast.a, &fast.b), ab(&plain.a, &plain.b));
-        println!("{scene} state {s}: skipping vs plain [A B] {:.2e}", rel_err_mat(&ours, &theirs));
-        assert_close_mat(&format!("{scene} state {s} [A B]"), &ours, &theirs, SKIP_REL);
+        let theirs = ab(&plain.a, &plain.b);
+        let (ours, nominal) = (ab(&fast.a, &fast.b), ab(&warm.a, &warm.b));
+        println!(
+            "{scene} state {s}: [A B] skipping vs plain {:.2e}, nominal warm start vs plain {:.2e}",
+            rel_err_mat(&ours, &theirs),
+            rel_err_mat(&nominal, &theirs)
+        );
+        assert_close_mat(&format!("{scene} state {s} [A B] skipped"), &ours, &theirs, SKIP_REL);
+        assert_close_mat(
+            &format!("{scene} state {s} [A B] nominal warm start"),
+            &nominal,
+            &theirs,
+            NOMINAL_WARMSTART_REL,
+        );
     }
 }
 
@@ -98,7 +113,7 @@ fn ab(a: &nalgebra::DMatrix<f64>, b: &nalgebra::DMatrix<f64>) -> nalgebra::DMatr
 
 #[test]
 fn skipping_equals_plain_differences() {
-    for scene in ["go1_standing", "go1_walking", "humanoid_floor", "panda_free"] {
+    for scene in ["go1_standing", "go1_walking", "humanoid_floor", "panda_free", "gripper_box"] {
         check_skip_equals_plain(scene, None);
     }
     // The other integrators: implicit (its own LU, M recomputed), implicitfast (the factor of
@@ -115,7 +130,13 @@ fn check_scene(scene: &str) {
     let model = tight_model(repo_path(&golden.model).to_str().unwrap());
     let mut data = Data::new(&model);
     let mut work = TransitionWork::new(&model);
-    let options = TransitionOptions { eps: golden.eps, centered: golden.centered, ..Default::default() };
+    // MuJoCo's procedure: every nudge from the input's warm start (stages skipped).
+    let options = TransitionOptions {
+        eps: golden.eps,
+        centered: golden.centered,
+        nominal_warmstart: false,
+        ..Default::default()
+    };
     for (s, st) in golden.states.iter().enumerate() {
         data.qpos.copy_from_slice(&st.qpos);
         data.qvel.copy_from_slice(&st.qvel);
@@ -177,6 +198,11 @@ fn transition_panda_contact_free() {
     check_scene("panda_free");
 }
 
+#[test]
+fn transition_gripper_holding_a_box() {
+    check_scene("gripper_box");
+}
+
 /// Forward differences agree with centred ones to O(ε) on the contact-free arm, and a bad ε is
 /// an error that leaves the state alone.
 #[test]
@@ -207,9 +233,14 @@ fn forward_differences_and_bad_eps() {
 fn check_hybrid(label: &str, model: &lagrange::Model, data: &mut Data) -> usize {
     let mut plain = TransitionWork::new(model);
     let mut hybrid = TransitionWork::new(model);
-    let fd = TransitionOptions { skip: false, ..Default::default() };
+    let fd = TransitionOptions { skip: false, nominal_warmstart: false, ..Default::default() };
     transition_jacobians(model, data, &mut plain, &fd).unwrap();
-    let options = TransitionOptions { method: TransitionMethod::Hybrid, ..Default::default() };
+    // From the input's warm start as the differences, so that the position columns are theirs.
+    let options = TransitionOptions {
+        method: TransitionMethod::Hybrid,
+        nominal_warmstart: false,
+        ..Default::default()
+    };
     transition_jacobians(model, data, &mut hybrid, &options).unwrap();
     let (ours, theirs) = (ab(&hybrid.a, &hybrid.b), ab(&plain.a, &plain.b));
     let n = hybrid.analytic_columns();
@@ -237,7 +268,7 @@ fn tight_text(text: &str) -> lagrange::Model {
 
 #[test]
 fn hybrid_equals_differences_golden_scenes() {
-    for scene in ["go1_standing", "go1_walking", "humanoid_floor", "panda_free"] {
+    for scene in ["go1_standing", "go1_walking", "humanoid_floor", "panda_free", "gripper_box"] {
         let golden = read_golden(scene);
         let model = tight_model(repo_path(&golden.model).to_str().unwrap());
         let mut data = Data::new(&model);

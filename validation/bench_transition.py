@@ -25,7 +25,7 @@ import mujoco as mj
 import numpy as np
 
 REPO = pathlib.Path(__file__).resolve().parent.parent
-SCENES = ["go1_standing", "go1_walking", "humanoid_floor", "panda_free"]
+SCENES = ["go1_standing", "go1_walking", "humanoid_floor", "panda_free", "gripper_box"]
 
 
 def mujoco_us(scene: str, reps: int) -> tuple[int, list[float]]:
