@@ -5,7 +5,8 @@
 //! same answer to its tolerance.
 //!
 //! - **Newton**: the search direction −H⁻¹ g with H = M + Jᵀ (∂²s) J (D on quadratic rows, the
-//!   cone's block on elliptic contacts in their middle zone), factored by dense Cholesky;
+//!   cone's block on elliptic contacts in their middle zone), factored by a Cholesky that skips
+//!   H's structural zeros ([`super::sparse_cholesky`]);
 //! - **CG**: Polak–Ribière conjugate gradients preconditioned by M⁻¹ (the LᵀDL factor of M);
 //!
 //! both with an exact line search along the direction: Newton's method on the convex,
@@ -14,7 +15,6 @@
 //! `tolerance`, the scale being 1 / (meaninertia · max(1, nv)).
 
 use super::cost::Rows;
-use crate::constraint::dense::{cholesky, cholesky_solve};
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, Model};
 use nalgebra::{DMatrix, DVector};
@@ -60,15 +60,38 @@ impl Sparsity<'_> {
 }
 
 /// Fills the sparsity of rows 0..nefc of `j` into `start` and `index` (grown only when a problem is
-/// larger than any before it).
+/// larger than any before it): J is read by columns (contiguous in memory), counted per row, then
+/// each row's columns are placed in ascending order.
 fn sparsity(j: &DMatrix<f64>, nefc: usize, start: &mut Vec<usize>, index: &mut Vec<usize>) {
     start.clear();
-    index.clear();
-    start.push(0);
-    for i in 0..nefc {
-        index.extend((0..j.ncols()).filter(|&k| j[(i, k)] != 0.0));
-        start.push(index.len());
+    start.resize(nefc + 1, 0);
+    let rows = j.nrows();
+    let data = j.as_slice();
+    for k in 0..j.ncols() {
+        for (i, &v) in data[k * rows..k * rows + nefc].iter().enumerate() {
+            if v != 0.0 {
+                start[i + 1] += 1;
+            }
+        }
     }
+    for i in 0..nefc {
+        start[i + 1] += start[i];
+    }
+    index.clear();
+    index.resize(start[nefc], 0);
+    // start[i] is row i's next free slot while filling, then shifted back.
+    for k in 0..j.ncols() {
+        for (i, &v) in data[k * rows..k * rows + nefc].iter().enumerate() {
+            if v != 0.0 {
+                index[start[i]] = k;
+                start[i] += 1;
+            }
+        }
+    }
+    for i in (1..=nefc).rev() {
+        start[i] = start[i - 1];
+    }
+    start[0] = 0;
 }
 
 /// r ← J x (rows 0..nefc).
@@ -125,9 +148,22 @@ fn add_block_hessian(
     }
 }
 
-/// r ← M x for the dense symmetric M.
-fn mul_m(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
-    m.mul_to(x, r);
+/// r ← M x, reading only M's nonzeros: the diagonal and each dof's ancestor chain
+/// (`Model::dof_parent`; M[l][k] ≠ 0 only when l is an ancestor of k or k of l).
+fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
+    let nv = x.len();
+    for k in 0..nv {
+        r[k] = m[(k, k)] * x[k];
+    }
+    for k in 0..nv {
+        let mut l = dof_parent[k];
+        while l != crate::model::NO_DOF {
+            let m_lk = m[(l, k)];
+            r[l] += m_lk * x[k];
+            r[k] += m_lk * x[l];
+            l = dof_parent[l];
+        }
+    }
 }
 
 /// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
@@ -185,7 +221,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                  jar: &mut DVector<f64>,
                  force: &mut DVector<f64>,
                  state: &mut [_]| {
-        mul_m(mass_matrix, x, ma);
+        mul_m(&model.dof_parent, mass_matrix, x, ma);
         mul_j(efc_j, &nz, nefc, x, jar);
         for i in 0..nefc {
             jar[i] -= efc_aref[i];
@@ -237,8 +273,8 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                     add_block_hessian(h, efc_j, &nz, (i, dim, block), cols, w);
                 });
                 soft.dir.copy_from(&soft.grad);
-                if cholesky(&soft.hessian, nv, &mut soft.factor, 0.0) {
-                    cholesky_solve(&soft.factor, nv, soft.dir.as_mut_slice());
+                if soft.factor.factor(&soft.hessian, nv, 0.0) {
+                    soft.factor.solve(soft.dir.as_mut_slice());
                 } else {
                     solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
                 }
@@ -267,7 +303,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
             }
         }
         mul_j(efc_j, &nz, nefc, &soft.dir, &mut soft.jv);
-        mul_m(mass_matrix, &soft.dir, &mut soft.mdir);
+        mul_m(&model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
         let g0: f64 = (0..nv).map(|k| (soft.ma[k] - qfrc_smooth[k]) * soft.dir[k]).sum();
         let dmd = soft.dir.dot(&soft.mdir);
         let alpha = line_search(&rows, &soft.jar, &soft.jv, &mut soft.jar_trial, g0, dmd, s);
