@@ -101,53 +101,6 @@ fn mul_j(j: &DMatrix<f64>, s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut 
     }
 }
 
-/// H += J_Bᵀ S J_B for the rows B = i..i+dim of J and the block S (top-left dim × dim of
-/// `block`): a single row directly over its nonzero columns; a block (an elliptic contact on its
-/// cone) through W = S J_B over the union of its rows' columns (`cols`, `w` scratch), dim² + dim
-/// products per column pair fewer than entry by entry.
-fn add_block_hessian(
-    h: &mut DMatrix<f64>,
-    j: &DMatrix<f64>,
-    nz: &Sparsity,
-    (i, dim, block): (usize, usize, &[[f64; 6]; 6]),
-    cols: &mut Vec<usize>,
-    w: &mut DMatrix<f64>,
-) {
-    if dim == 1 {
-        let d = block[0][0];
-        for &p in nz.row(i) {
-            let x = d * j[(i, p)];
-            for &q in nz.row(i) {
-                h[(p, q)] += x * j[(i, q)];
-            }
-        }
-        return;
-    }
-    cols.clear();
-    for r in i..i + dim {
-        for &p in nz.row(r) {
-            if !cols.contains(&p) {
-                cols.push(p);
-            }
-        }
-    }
-    for (c, &q) in cols.iter().enumerate() {
-        for a in 0..dim {
-            w[(a, c)] = (0..dim).map(|b| block[a][b] * j[(i + b, q)]).sum();
-        }
-    }
-    for &p in cols.iter() {
-        for a in 0..dim {
-            let x = j[(i + a, p)];
-            if x != 0.0 {
-                for (c, &q) in cols.iter().enumerate() {
-                    h[(p, q)] += x * w[(a, c)];
-                }
-            }
-        }
-    }
-}
-
 /// r ← M x, reading only M's nonzeros: the diagonal and each dof's ancestor chain
 /// (`Model::dof_parent`; M[l][k] ≠ 0 only when l is an ancestor of k or k of l).
 fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
@@ -266,14 +219,52 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         iter += 1;
         match method {
             Primal::Newton => {
+                // H = M + Jᵀ (∂²s) J, lower triangle only, assembled over its nonzeros: the
+                // last pattern's entries cleared, M's tree entries written, the rows' added.
                 let h = &mut soft.hessian;
-                h.copy_from(mass_matrix);
-                let (cols, w) = (&mut soft.block_cols, &mut soft.block_w);
+                for k in 0..nv {
+                    for &j in soft.factor.pattern_row(k) {
+                        h[(k, j)] = 0.0;
+                    }
+                    h[(k, k)] = mass_matrix[(k, k)];
+                    let mut l = model.dof_parent[k];
+                    while l != crate::model::NO_DOF {
+                        h[(k, l)] = mass_matrix[(k, l)];
+                        l = model.dof_parent[l];
+                    }
+                }
+                // The row groups with a Hessian block: single quadratic rows, and an elliptic
+                // contact's rows in its cone zone (one dense block).
+                soft.active_rows.clear();
+                let active = &mut soft.active_rows;
                 rows.hessian(&soft.jar, efc_state, |i, dim, block| {
-                    add_block_hessian(h, efc_j, &nz, (i, dim, block), cols, w);
+                    // The block's entries (a, b) in row order, as one group.
+                    for (a, row) in (i..i + dim).zip(block) {
+                        for (b, &w) in (i..i + dim).zip(row) {
+                            match active.last_mut() {
+                                Some(g) if g.1 >= a.min(b) => g.1 = g.1.max(a.max(b)),
+                                _ => active.push((a, a.max(b))),
+                            }
+                            for &p in nz.row(a) {
+                                let x = w * efc_j[(a, p)];
+                                for &q in nz.row(b) {
+                                    if p >= q {
+                                        h[(p, q)] += x * efc_j[(b, q)];
+                                    }
+                                }
+                            }
+                        }
+                    }
                 });
                 soft.dir.copy_from(&soft.grad);
-                if soft.factor.factor(&soft.hessian, nv, 0.0) {
+                if soft.factor.factor_structured(
+                    &soft.hessian,
+                    nv,
+                    &model.dof_parent,
+                    &soft.active_rows,
+                    &nz_start,
+                    &nz_index,
+                ) {
                     soft.factor.solve(soft.dir.as_mut_slice());
                 } else {
                     solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());

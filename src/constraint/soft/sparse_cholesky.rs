@@ -42,6 +42,10 @@ pub(crate) struct SparseCholesky {
     c_vals: Vec<f64>,
     /// Dense scratch row of L.
     x: Vec<f64>,
+    /// The rows whose columns form the cliques of the pattern, and each dof's cliques.
+    cliques: Vec<usize>,
+    d_start: Vec<usize>,
+    d_cliques: Vec<usize>,
 }
 
 impl SparseCholesky {
@@ -63,11 +67,106 @@ impl SparseCholesky {
             c_rows: Vec::with_capacity(nnz),
             c_vals: Vec::with_capacity(nnz),
             x: Vec::with_capacity(n),
+            cliques: Vec::with_capacity(n),
+            d_start: Vec::with_capacity(n + 1),
+            d_cliques: Vec::with_capacity(nnz),
         }
+    }
+
+    /// The strictly lower nonzeros of H by rows, from the last factorization (its pattern): the
+    /// entries a caller that assembles H in place must clear before the next assembly.
+    pub fn pattern_row(&self, k: usize) -> &[usize] {
+        if k + 1 < self.h_start.len() {
+            &self.h_cols[self.h_start[k]..self.h_start[k + 1]]
+        } else {
+            &[]
+        }
+    }
+
+    /// Factors `h` (lower triangle read) whose strictly lower nonzeros lie in M's tree pattern
+    /// (each dof's ancestors, `dof_parent`) and in the cliques of the constraint row groups
+    /// `groups` (rows `first..=last` with one Hessian block: the union of their columns
+    /// `nz_index[nz_start[r]..nz_start[r + 1]]` couple pairwise), without reading the rest of
+    /// `h`: the work is that of the nonzeros. Returns false if a pivot is not positive.
+    pub fn factor_structured(
+        &mut self,
+        h: &DMatrix<f64>,
+        n: usize,
+        dof_parent: &[usize],
+        groups: &[(usize, usize)],
+        nz_start: &[usize],
+        nz_index: &[usize],
+    ) -> bool {
+        // A clique's columns: its group's rows' columns (repeats are harmless: marks dedupe).
+        let cols = |g: (usize, usize)| &nz_index[nz_start[g.0]..nz_start[g.1 + 1]];
+        // Cliques: the groups, consecutive single rows with equal columns (one contact's pyramid
+        // rows) taken once.
+        self.cliques.clear();
+        for (i, &g) in groups.iter().enumerate() {
+            let repeat = i > 0 && {
+                let last = groups[self.cliques[self.cliques.len() - 1]];
+                last.0 == last.1 && g.0 == g.1 && cols(last) == cols(g)
+            };
+            if !repeat {
+                self.cliques.push(i);
+            }
+        }
+        // Each dof's cliques (counting sort).
+        self.d_start.clear();
+        self.d_start.resize(n + 1, 0);
+        for &c in &self.cliques {
+            for &p in cols(groups[c]) {
+                self.d_start[p + 1] += 1;
+            }
+        }
+        for k in 0..n {
+            self.d_start[k + 1] += self.d_start[k];
+        }
+        self.h_count.clear();
+        self.h_count.extend_from_slice(&self.d_start[..n]);
+        self.d_cliques.clear();
+        self.d_cliques.resize(self.d_start[n], 0);
+        for &c in &self.cliques {
+            for &p in cols(groups[c]) {
+                self.d_cliques[self.h_count[p]] = c;
+                self.h_count[p] += 1;
+            }
+        }
+        // Row k of H's strict lower pattern: k's ancestors and the dofs below k of its cliques.
+        self.mark.clear();
+        self.mark.resize(n, NONE);
+        self.h_start.clear();
+        self.h_start.push(0);
+        self.h_cols.clear();
+        for k in 0..n {
+            self.mark[k] = k;
+            let begin = self.h_cols.len();
+            let mut l = dof_parent[k];
+            while l != NONE {
+                if self.mark[l] != k {
+                    self.mark[l] = k;
+                    self.h_cols.push(l);
+                }
+                l = dof_parent[l];
+            }
+            for &c in &self.d_cliques[self.d_start[k]..self.d_start[k + 1]] {
+                for &q in cols(groups[c]) {
+                    if q < k && self.mark[q] != k {
+                        self.mark[q] = k;
+                        self.h_cols.push(q);
+                    }
+                }
+            }
+            self.h_cols[begin..].sort_unstable();
+            self.h_start.push(self.h_cols.len());
+        }
+        self.elimination_tree(n);
+        self.numeric(h, n, 0.0)
     }
 
     /// Factors the symmetric `h` (its lower triangle is read; n × n at the top left) into L.
     /// Returns false if a pivot is not above `tol` (as the dense factorization).
+    #[cfg(test)]
     pub fn factor(&mut self, h: &DMatrix<f64>, n: usize, tol: f64) -> bool {
         self.pattern_of_h(h, n);
         self.elimination_tree(n);
@@ -76,6 +175,7 @@ impl SparseCholesky {
 
     /// Row lists of H's strictly lower nonzeros, from its lower triangle read by columns
     /// (contiguous in memory), transposed by counting.
+    #[cfg(test)]
     fn pattern_of_h(&mut self, h: &DMatrix<f64>, n: usize) {
         self.h_count.clear();
         self.h_count.resize(n + 1, 0);
@@ -267,6 +367,40 @@ mod tests {
         }
         // Fewer stored entries than the dense lower triangle: the structure was used.
         assert!(sparse.l_cols.len() < n * (n - 1) / 2);
+    }
+
+    #[test]
+    fn the_structured_factor_equals_the_scanning_one() {
+        // A tree 0 → 1 → 2 and a free chain 3 → 4 → 5, and dof 6 alone; two constraint rows
+        // coupling {2, 4} and {5, 6}.
+        let n = 7;
+        let dof_parent = [NONE, 0, 1, NONE, 3, 4, NONE];
+        let mut h = DMatrix::zeros(n, n);
+        for k in 0..n {
+            h[(k, k)] = 4.0 + k as f64;
+            let mut l = dof_parent[k];
+            while l != NONE {
+                h[(k, l)] = 0.3 + 0.1 * (k + l) as f64;
+                h[(l, k)] = h[(k, l)];
+                l = dof_parent[l];
+            }
+        }
+        for (a, b, v) in [(4, 2, 0.5), (6, 5, -0.4)] {
+            h[(a, b)] += v;
+            h[(b, a)] += v;
+        }
+        let (nz_start, nz_index) = ([0, 2, 4], [2, 4, 5, 6]);
+        let mut structured = SparseCholesky::default();
+        assert!(structured.factor_structured(&h, n, &dof_parent, &[(0, 0), (1, 1)], &nz_start, &nz_index));
+        let mut scanning = SparseCholesky::default();
+        assert!(scanning.factor(&h, n, 0.0));
+        let rhs: Vec<f64> = (0..n).map(|i| 1.0 + i as f64).collect();
+        let (mut x1, mut x2) = (rhs.clone(), rhs);
+        structured.solve(&mut x1);
+        scanning.solve(&mut x2);
+        assert_eq!(x1, x2);
+        // Dof 6 couples only to 5: no fill reaches the first tree.
+        assert_eq!(structured.pattern_row(6), &[5]);
     }
 
     #[test]

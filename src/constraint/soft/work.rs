@@ -22,19 +22,18 @@ pub(crate) struct SoftWork {
     pub mdir: DVector<f64>,
     pub grad_prev: DVector<f64>,
     pub mgrad_prev: DVector<f64>,
-    /// The cost's Hessian M + Jᵀ D J (+ cone blocks), nv × nv, and its sparse Cholesky factor.
+    /// The cost's Hessian M + Jᵀ D J (+ cone blocks), nv × nv (lower triangle, nonzero only on
+    /// its factor's pattern), and its sparse Cholesky factor.
     pub hessian: DMatrix<f64>,
     pub factor: super::sparse_cholesky::SparseCholesky,
+    /// The row groups (first, last) with a Hessian block in the current Newton iteration.
+    pub active_rows: Vec<(usize, usize)>,
     /// The nonzero columns of each row of J: row i's are `nz_index[nz_start[i]..nz_start[i + 1]]`.
     pub nz_start: Vec<usize>,
     pub nz_index: Vec<usize>,
     /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
     pub ar: DMatrix<f64>,
     pub minv_jt: DMatrix<f64>,
-    /// Newton's Hessian of an elliptic contact's cone block: the union of its rows' nonzero
-    /// columns, and S J over them (6 × nv).
-    pub block_cols: Vec<usize>,
-    pub block_w: DMatrix<f64>,
 }
 
 impl SoftWork {
@@ -52,12 +51,11 @@ impl SoftWork {
             mgrad_prev: DVector::zeros(nv),
             hessian: DMatrix::zeros(nv, nv),
             factor: super::sparse_cholesky::SparseCholesky::with_capacity(nv),
+            active_rows: Vec::with_capacity(nefc),
             nz_start: Vec::with_capacity(nefc + 1),
             nz_index: Vec::with_capacity(nefc * nv),
             ar: DMatrix::zeros(0, 0),
             minv_jt: DMatrix::zeros(0, 0),
-            block_cols: Vec::with_capacity(nv),
-            block_w: DMatrix::zeros(6, nv),
         }
     }
 }
