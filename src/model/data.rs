@@ -211,6 +211,9 @@ pub struct Data {
     pub qfrc_bias: DVector<f64>,
     /// Passive forces: joint damping and springs.
     pub qfrc_passive: DVector<f64>,
+    /// The fluid forces' part of `qfrc_passive` (MuJoCo's `qfrc_fluid`): zero unless
+    /// `<option density>` or `viscosity` is nonzero (`dynamics::fluid`).
+    pub qfrc_fluid: DVector<f64>,
     /// Actuator forces in joint space (the actuation stage).
     pub qfrc_actuator: DVector<f64>,
     /// Per actuator: transmission length, velocity, and scalar force (MuJoCo's names).
@@ -400,6 +403,7 @@ impl Data {
             mocap_quat: model.mocap_pose0.iter().map(|x| x.quat_wxyz()).collect(),
             qfrc_bias: DVector::zeros(nv),
             qfrc_passive: DVector::zeros(nv),
+            qfrc_fluid: DVector::zeros(nv),
             qfrc_actuator: DVector::zeros(nv),
             actuator_length: DVector::zeros(model.actuators.len()),
             actuator_velocity: DVector::zeros(model.actuators.len()),

@@ -194,6 +194,9 @@ pub struct Geom {
     /// use by ray casting and geom distances ([`crate::collision::GeomMesh`]); geoms using the
     /// same file and scale share one.
     pub mesh: Option<std::sync::Arc<crate::collision::GeomMesh>>,
+    /// `fluidshape="ellipsoid"` with its five `fluidcoef` (MuJoCo's `geom_fluid[1..6]`), if set:
+    /// the geom's body then feels the ellipsoid fluid model instead of the inertia-box one.
+    pub fluid: Option<[f64; 5]>,
 }
 
 /// The compiled, immutable model. Build it with a loader (e.g. [`crate::io::load`]) or by
