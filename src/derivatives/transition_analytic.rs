@@ -66,12 +66,13 @@ impl AnalyticWork {
 }
 
 /// Whether the analytic columns apply to `model`: the Euler or implicitfast integrator, the
-/// soft mode (or no rows) with a primal solver (Newton or CG), and no activations.
+/// soft mode (or no rows) with a primal solver (Newton or CG), no activations, and no fluid
+/// forces (their velocity derivative is not in `smooth_derivatives`).
 pub(super) fn supported(model: &Model) -> bool {
     let integrator = matches!(model.options.integrator, Integrator::Euler | Integrator::ImplicitFast);
     let plan = &model.plan;
     let soft = plan.constraints.is_empty() || plan.solver.soft_weights().is_some();
-    integrator && soft && model.options.solver != Solver::Pgs && model.na() == 0
+    integrator && soft && model.options.solver != Solver::Pgs && model.na() == 0 && plan.fluid.is_none()
 }
 
 /// The analytic columns at the nominal state of `data` (its buffers those of the nominal
