@@ -8,7 +8,7 @@ Run from the repository root with the validation venv (see validation/README.md)
 
 One file per pair type: the closed forms lagrange follows point for point (sphere-box,
 capsule-box, box-box, sphere-cylinder: MuJoCo's mjc_SphereBox, mjc_CapsuleBox, mjc_BoxBox,
-mjc_SphereCylinder), plane-mesh with one vertex below the plane (corpus meshes under
+mjc_SphereCylinder), plane-mesh with one and with several vertices below the plane (corpus meshes under
 tests/data/meshes/mujoco: MuJoCo's f32 vertices in the mesh's inertial frame) and, as regression,
 sphere-sphere, sphere-capsule, capsule-capsule and plane against sphere, capsule, box and
 cylinder. Each file holds a few scenes (an MJCF text: two free bodies with one geom each, or a
@@ -540,8 +540,8 @@ def world_vertices(s: Scene, mesh: int) -> np.ndarray:
 def plane_mesh() -> list:
     """Meshes at random orientations just touching the plane: one vertex alone below it (MuJoCo's
     mesh vertices are f32 in its inertial frame: the contact is that vertex), and lifted beyond
-    it. Poses with more than one vertex below the plane (where MuJoCo 4.0 adds vertices of a hull
-    polygon) are skipped here: lagrange does not select those yet."""
+    it; then deeper at random orientations, where MuJoCo 4.0 adds the other vertices of the hull
+    triangle facing the plane."""
     out = []
     for name, file in MESHES:
         s = mesh_scene("plane_mesh", name, file, NO_MARGIN)
@@ -557,6 +557,15 @@ def plane_mesh() -> list:
             below = {tuple(p) for p in world_vertices(s, 0) if p[2] <= 0.0}
             if len(case["contacts"]) <= 1 and len(below) <= 1:
                 cases.append(case)
+        # Several vertices below the plane (MuJoCo 4.0: the deepest vertex and its hull triangle
+        # facing the plane, at most 3 contacts; src/collision/plane_mesh.rs).
+        frng = np.random.default_rng([SEED, zlib.crc32((s.name + "/face").encode())])
+        while len(cases) < 28:
+            target = -frng.uniform(2e-4, 3e-3)
+            q2 = s.place(None, random_quat(frng), np.array([0.0, 0.0, 1.0]), target, start=(0.0, 0.0, -1.0))
+            if q2 is None:
+                continue
+            cases.append(s.record(f"face{len(cases)}", "penetrating", None, q2))
         out.append((s, cases, 0))
     return out
 

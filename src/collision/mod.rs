@@ -37,6 +37,7 @@ pub mod inside;
 pub mod mesh;
 pub mod multiccd;
 pub mod plane;
+pub mod plane_mesh;
 pub mod ray;
 pub mod sphere_cylinder;
 
@@ -54,6 +55,8 @@ use convex::PairPoint;
 use parry3d_f64::math::Vector;
 use parry3d_f64::shape::ConvexPolyhedron;
 use plane::PlanePoint;
+use plane_mesh::PlaneHull;
+use std::sync::Arc;
 
 /// How much farther than MuJoCo's margin the exact mode detects contacts (m).
 pub const EXACT_REACH: f64 = 1e-3;
@@ -71,6 +74,9 @@ pub struct CollisionModel {
     /// packed: the two geoms, the pair's margin + gap plus both bounding radii (geom 2's alone
     /// against a plane), and whether geom 1 is a plane.
     pub broad: Vec<BroadPair>,
+    /// Per geom, a colliding mesh's hull prepared for plane contacts ([`plane_mesh`]; geoms of one
+    /// hull share it).
+    pub plane_hulls: Vec<Option<Arc<PlaneHull>>>,
 }
 
 /// The bounding-sphere test of one candidate pair (see [`CollisionModel::broad`]).
@@ -90,6 +96,8 @@ impl CollisionModel {
     /// The shapes, bounding radii and broad-phase data of `model`'s geoms and candidate pairs.
     pub fn new(model: &Model) -> Self {
         let mut shapes = Vec::with_capacity(model.geoms.len());
+        let mut plane_hulls: Vec<Option<Arc<PlaneHull>>> = Vec::with_capacity(model.geoms.len());
+        let mut built: Vec<(*const Vec<Vec3>, Option<Arc<PlaneHull>>)> = Vec::new();
         let mut rbound = Vec::with_capacity(model.geoms.len());
         for g in &model.geoms {
             let (shape, r) = match &g.shape {
@@ -110,6 +118,15 @@ impl CollisionModel {
             };
             shapes.push(shape);
             rbound.push(r);
+            plane_hulls.push(g.hull.as_ref().and_then(|h| {
+                let key = Arc::as_ptr(h);
+                if let Some((_, p)) = built.iter().find(|(k, _)| *k == key) {
+                    return p.clone();
+                }
+                let p = PlaneHull::new(h).map(Arc::new);
+                built.push((key, p.clone()));
+                p
+            }));
         }
         let broad = model
             .collision_pairs
@@ -121,7 +138,7 @@ impl CollisionModel {
                 BroadPair { geom: [g1 as u32, g2 as u32], reach: p.margin + p.gap + radii, plane }
             })
             .collect();
-        Self { shapes, rbound, broad }
+        Self { shapes, rbound, broad, plane_hulls }
     }
 }
 
@@ -187,8 +204,8 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
                 }
                 Shape::Ellipsoid { radii } => plane::ellipsoid(&x1, &x2, radii, within, &mut out),
                 Shape::Mesh { .. } => {
-                    if let Some(h) = &geom2.hull {
-                        plane::hull(&x1, &x2, h, within, &mut out)
+                    if let Some(h) = &cm.plane_hulls[g2] {
+                        plane_mesh::plane_mesh(&x1, &x2, h, within, &mut out)
                     }
                 }
                 Shape::Plane { .. } | Shape::Hfield { .. } => {}

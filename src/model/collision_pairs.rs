@@ -60,7 +60,7 @@ pub fn type_rank(shape: &Shape) -> u8 {
 }
 
 /// The most contacts a pair of these shapes yields (MuJoCo's closed forms and `mj_maxContact`):
-/// box against box 8, plane against box, cylinder or mesh hull 4, plane or box against a capsule
+/// box against box 8, plane against box, cylinder or mesh hull 4 (MuJoCo 4.0 gives a mesh up to the 4 corners of a hull quadrilateral), plane or box against a capsule
 /// 2; the convex pairs (`mjc_Convex`, see `collision::multiccd`) 1 with a sphere or an ellipsoid
 /// or when `multiccd` is off, else 5 with a capsule or a cylinder, 4 for boxes and meshes
 /// without margin (face clipping pruned to a quadrilateral) and 5 with one; every other pair 1.
