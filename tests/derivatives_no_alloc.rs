@@ -4,7 +4,7 @@
 
 use lagrange::derivatives::{
     aba_derivatives, rnea_derivatives, smooth_derivatives, transition_jacobians, DerivativesWork,
-    TransitionOptions, TransitionWork,
+    TransitionMethod, TransitionOptions, TransitionWork,
 };
 use lagrange::io::{load, LoadOptions};
 use lagrange::Data;
@@ -39,5 +39,11 @@ fn derivative_kernels_do_not_allocate() {
             transition_jacobians(&model, &mut data, &mut tw, &TransitionOptions::default()).unwrap();
         });
         assert_eq!(n, 0, "{file}: transition_jacobians allocated {n} times");
+        let hybrid = TransitionOptions { method: TransitionMethod::Hybrid, ..Default::default() };
+        transition_jacobians(&model, &mut data, &mut tw, &hybrid).unwrap();
+        let n = allocations(|| {
+            transition_jacobians(&model, &mut data, &mut tw, &hybrid).unwrap();
+        });
+        assert_eq!(n, 0, "{file}: the hybrid transition_jacobians allocated {n} times");
     }
 }

@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
-"""Same-run timing of transition Jacobians: lagrange's transition_jacobians (examples/transition_cost.rs)
-against MuJoCo's mjd_transitionFD (centred, eps 1e-6, no sensors), at the states of
+"""Same-run timing of transition Jacobians: lagrange's transition_jacobians (examples/transition_cost.rs;
+finite differences with stage skipping, and the hybrid method with analytic velocity and control
+columns) against MuJoCo's mjd_transitionFD (centred, eps 1e-6, no sensors), at the states of
 tests/data/mujoco/transition/*.json with each model's own solver options. Report only.
 
     python validation/bench_transition.py [--lagrange-example PATH] [--rounds 5]
 
-Each round times MuJoCo (median of 20 calls per state) then lagrange (the same), per scene; the
-ratio of each round is lagrange / MuJoCo; prints a markdown table (median ratio and range).
+Each round times MuJoCo (median of 20 calls per state) then lagrange's two methods (the same), per
+scene; the ratio of each round is lagrange / MuJoCo; prints a markdown table (median ratio and
+range).
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ import mujoco as mj
 import numpy as np
 
 REPO = pathlib.Path(__file__).resolve().parent.parent
-SCENES = ["go1_standing", "go1_walking", "humanoid_floor", "panda_free"]
+SCENES = ["go1_standing", "go1_walking", "humanoid_floor", "panda_free", "gripper_box"]
 
 
 def mujoco_us(scene: str, reps: int) -> tuple[int, list[float]]:
@@ -56,19 +58,21 @@ def main() -> int:
     args = ap.parse_args()
     rows = []
     for scene in SCENES:
-        ratios, ours, theirs = [], [], []
+        ours, hyb, theirs, ratios, hratios = [], [], [], [], []
         for _ in range(args.rounds):
             nv, mu = mujoco_us(scene, args.reps)
-            res = subprocess.run([args.lagrange_example, scene, str(args.reps)], capture_output=True, text=True, check=True)
-            lg = json.loads(res.stdout)["us"]
-            ours.append(statistics.median(lg))
             theirs.append(statistics.median(mu))
-            ratios.append(ours[-1] / theirs[-1])
-        rows.append("| %s | %d | %.0f | %.0f | %.2f (%.2f–%.2f) |" % (
-            scene, nv, statistics.median(ours), statistics.median(theirs), statistics.median(ratios),
-            min(ratios), max(ratios)))
-    print("| scene | nv | lagrange µs | MuJoCo µs | lagrange / MuJoCo |")
-    print("| --- | ---: | ---: | ---: | ---: |")
+            for mode, times, rs in (("skip", ours, ratios), ("hybrid", hyb, hratios)):
+                res = subprocess.run([args.lagrange_example, scene, str(args.reps), mode],
+                                     capture_output=True, text=True, check=True)
+                times.append(statistics.median(json.loads(res.stdout)["us"]))
+                rs.append(times[-1] / theirs[-1])
+        rows.append("| %s | %d | %.0f | %.0f | %.0f | %.2f (%.2f–%.2f) | %.2f (%.2f–%.2f) |" % (
+            scene, nv, statistics.median(ours), statistics.median(hyb), statistics.median(theirs),
+            statistics.median(ratios), min(ratios), max(ratios),
+            statistics.median(hratios), min(hratios), max(hratios)))
+    print("| scene | nv | lagrange FD µs | lagrange hybrid µs | MuJoCo µs | FD / MuJoCo | hybrid / MuJoCo |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
     print("\n".join(rows))
     return 0
 

@@ -9,7 +9,8 @@ Run from the repository root with the validation venv (see validation/README.md)
 
 Scenes: the go1 on its floor standing (keyframe "home", its controls) and walking (random
 controls about home, 5% of their ranges, for 150 steps), the humanoid falling onto its floor, the panda arm without a
-floor (contact-free; implicitfast). Each model is the tight-solver copy of the soft-mode golden
+floor (contact-free; implicitfast), a parallel gripper holding a box in the air by friction
+(validation/scenes/gripper_box.xml: six sphere-box contacts, servos with random controls). Each model is the tight-solver copy of the soft-mode golden
 data (Newton, tolerance 1e-15, 1000 iterations, line search 100 iterations to 1e-12, dense
 Jacobians: lagrange's tests/common tight_model), so that the nudged steps' solutions are exact
 to round-off. Per state: qpos, qvel, act, ctrl, qacc_warmstart, the number of contacts, and
@@ -44,6 +45,7 @@ SCENES = {
     "go1_walking": ("models/mjcf/unitree_go1/scene.xml", "home", 150, 0.05),
     "humanoid_floor": ("models/mjcf/humanoid/humanoid.xml", None, 60, 0.3),
     "panda_free": ("models/mjcf/franka_emika_panda/panda.xml", "home", 30, 0.3),
+    "gripper_box": ("validation/scenes/gripper_box.xml", "hold", 200, 0.05),
 }
 N_STATES = 2
 

@@ -117,8 +117,9 @@ enum Command {
         #[arg(long, value_name = "N")]
         step: Option<u32>,
         /// Add `"derivatives"` to each state's result (docs/derivatives.md): `all` (RNEA, ABA,
-        /// smooth forward dynamics and the step's transition Jacobians A, B) or `smooth` (without
-        /// the transition).
+        /// smooth forward dynamics and the step's transition Jacobians A, B), `smooth` (without
+        /// the transition) or `hybrid` (as `all`, the transition's velocity and control columns
+        /// analytic).
         #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "all")]
         derivatives: Option<eval::Derivatives>,
     },

@@ -1,5 +1,6 @@
 //! `eval --derivatives`: the `"derivatives"` block of each state (shapes, the library's numbers),
-//! `--derivatives smooth` without the transition, and the refusal with `--kernels-only`.
+//! `--derivatives smooth` without the transition, `hybrid` as `all`, and the refusal with
+//! `--kernels-only`.
 
 mod run;
 
@@ -53,6 +54,19 @@ fn eval_adds_derivatives() {
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert!(v["results"][0]["derivatives"].get("transition").is_none());
     assert!(v["results"][0]["derivatives"].get("smooth").is_some());
+
+    // `hybrid`: the same Jacobians (this model has activations: every column is differenced).
+    let (ok, out, err) =
+        lagrange(&["eval", ACTIVATION, "--states", states.to_str().unwrap(), "--derivatives", "hybrid"]);
+    assert!(ok, "{err}");
+    let h: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (a, b) = (&d["transition"]["A"], &h["results"][0]["derivatives"]["transition"]["A"]);
+    for i in 0..2 * nv + na {
+        for j in 0..2 * nv + na {
+            let (x, y) = (a[i][j].as_f64().unwrap(), b[i][j].as_f64().unwrap());
+            assert!((x - y).abs() <= 1e-6 * (1.0 + x.abs()), "hybrid A ({i}, {j}): {y} vs {x}");
+        }
+    }
 
     let (ok, _, err) = lagrange(&[
         "eval",

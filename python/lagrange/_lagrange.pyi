@@ -190,8 +190,11 @@ def aba_derivatives(
     m: Model, d: Data, q: FloatArray, v: FloatArray, tau: FloatArray
 ) -> Tuple[FloatArray, FloatArray, FloatArray]:
     """(dqacc_dq, dqacc_dv, dqacc_dtau = M⁻¹) of unconstrained forward dynamics."""
-def transition_jacobians(m: Model, d: Data, eps: float = 1e-6, centered: bool = True) -> Tuple[FloatArray, FloatArray]:
-    """(A, B) of one step from d's state, as MuJoCo's mjd_transitionFD."""
+def transition_jacobians(
+    m: Model, d: Data, eps: float = 1e-6, centered: bool = True, method: str = "fd"
+) -> Tuple[FloatArray, FloatArray]:
+    """(A, B) of one step from d's state, as MuJoCo's mjd_transitionFD; method="hybrid": the
+    velocity and control columns analytic."""
 def rollout(
     model: Model,
     initial_states: FloatArray,

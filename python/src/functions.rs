@@ -364,21 +364,33 @@ pub fn aba_derivatives<'py>(
 /// Transition Jacobians of one step of the model's integrator from the state in `d`, with
 /// constraints and contacts (MuJoCo's `mjd_transitionFD`): `(A, B)`, A of size
 /// (2 nv + na) × (2 nv + na) for x = (q in the tangent space, v, act), B (2 nv + na) × nu for
-/// u = ctrl; finite differences with nudge `eps`, centred by default. `d`'s state is restored.
-/// The GIL is released while it runs.
+/// u = ctrl; finite differences with nudge `eps`, centred by default, with MuJoCo's stage
+/// skipping; `method="hybrid"` computes the velocity and control columns analytically
+/// (docs/derivatives.md). `d`'s state is restored. The GIL is released while it runs.
 #[pyfunction]
-#[pyo3(signature = (m, d, eps=1e-6, centered=true))]
+#[pyo3(signature = (m, d, eps=1e-6, centered=true, method="fd"))]
 pub fn transition_jacobians<'py>(
     py: Python<'py>,
     m: &Bound<'py, PyModel>,
     mut d: PyRefMut<'py, PyData>,
     eps: f64,
     centered: bool,
+    method: &str,
 ) -> PyResult<(Matrix<'py>, Matrix<'py>)> {
+    use lagrange::derivatives::TransitionMethod;
     let model = model_for(m, &d)?;
     check_state(d.data(), "transition_jacobians")?;
+    let method = match method {
+        "fd" => TransitionMethod::FiniteDifference,
+        "hybrid" => TransitionMethod::Hybrid,
+        other => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "transition_jacobians: method is {other:?}; use \"fd\" or \"hybrid\""
+            )))
+        }
+    };
     let mut work = lagrange::derivatives::TransitionWork::new(&model);
-    let options = lagrange::derivatives::TransitionOptions { eps, centered };
+    let options = lagrange::derivatives::TransitionOptions { eps, centered, method, ..Default::default() };
     let data = d.data();
     py.detach(|| lagrange::derivatives::transition_jacobians(&model, data, &mut work, &options))
         .map_err(error::sim)?;

@@ -52,6 +52,8 @@ def test_transition_jacobians_against_mujoco():
     mujoco.mjd_transitionFD(mm, md, 1e-6, True, Am, Bm, None, None)
     assert A.shape == Am.shape and B.shape == Bm.shape
     assert rel_err(A, Am) < 1e-6
+    Ah, Bh = lagrange.transition_jacobians(m, d, method="hybrid")
+    assert rel_err(Ah, Am) < 1e-6 and Bh.shape == B.shape
 
 
 def test_derivative_arguments_are_checked():
@@ -63,3 +65,5 @@ def test_derivative_arguments_are_checked():
         lagrange.aba_derivatives(m, d, np.zeros(6), np.full(6, np.nan), np.zeros(6))
     with pytest.raises(lagrange.LagrangeError):
         lagrange.transition_jacobians(m, d, eps=-1.0)
+    with pytest.raises(ValueError):
+        lagrange.transition_jacobians(m, d, method="analytic")

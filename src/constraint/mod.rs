@@ -28,6 +28,7 @@ mod solver;
 
 pub use contact::CONTACT_ACTIVE_DISTANCE;
 pub use coulomb::{Level, SolverSettings, SEPARATING_VELOCITY, SLIP_VELOCITY};
+pub(crate) use dense::{cholesky, cholesky_solve};
 pub(crate) use exact::{project_positions, project_velocities_unchecked, solve_exact};
 pub use exact::{project_velocities, row_violation};
 pub(crate) use exact_work::ExactWork;

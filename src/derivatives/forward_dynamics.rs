@@ -11,7 +11,9 @@
 
 use super::rnea::rnea_derivatives_unchecked;
 use super::DerivativesWork;
-use crate::dynamics::{aba_unchecked, crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
+use crate::dynamics::{
+    aba_unchecked, crba_unchecked, factorize_mass_matrix, solve_transposed_with_factor_unchecked,
+};
 use crate::error::{check, InputError};
 use crate::forward::{
     accumulate_xfrc, actuation_unchecked, add_actuator_length_derivative, add_actuator_velocity_derivative,
@@ -127,24 +129,23 @@ fn smooth_derivatives_at(model: &Model, data: &mut Data, work: &mut DerivativesW
     solve_columns(model, data, work, q);
 }
 
-/// M at q and its factor, then ∂q̈/∂q = −M⁻¹ ∂τ/∂q, ∂q̈/∂v = −M⁻¹ ∂τ/∂v, ∂q̈/∂τ = M⁻¹, column by
-/// column (contiguous in the column-major matrices).
+/// M at q and its factor, then ∂q̈/∂q = −M⁻¹ ∂τ/∂q, ∂q̈/∂v = −M⁻¹ ∂τ/∂v, ∂q̈/∂τ = M⁻¹: the
+/// tree-sparse solve on the transposes, every right-hand side at once (`work.scratch`).
 fn solve_columns(model: &Model, data: &mut Data, work: &mut DerivativesWork, q: &[f64]) {
     crba_unchecked(model, data, q);
     factorize_mass_matrix(model, data);
     let factor = &data.mass_factor;
-    let minus_solve = |from: &DMatrix<f64>, to: &mut DMatrix<f64>| {
-        for (x, &y) in to.iter_mut().zip(from.iter()) {
-            *x = -y;
-        }
-        for mut col in to.column_iter_mut() {
-            solve_with_factor_unchecked(model, factor, col.as_mut_slice());
-        }
+    let y = &mut work.scratch;
+    // X = −M⁻¹ B: Y = −Bᵀ in, Y = Xᵀ out.
+    let mut minus_solve = |from: &DMatrix<f64>, to: &mut DMatrix<f64>| {
+        y.tr_copy_from(from);
+        y.neg_mut();
+        solve_transposed_with_factor_unchecked(model, factor, y);
+        y.transpose_to(to);
     };
     minus_solve(&work.dtau_dq, &mut work.dqacc_dq);
     minus_solve(&work.dtau_dv, &mut work.dqacc_dv);
+    // M⁻¹ is symmetric: Yᵀ = Y.
     work.dqacc_dtau.fill_with_identity();
-    for mut col in work.dqacc_dtau.column_iter_mut() {
-        solve_with_factor_unchecked(model, factor, col.as_mut_slice());
-    }
+    solve_transposed_with_factor_unchecked(model, factor, &mut work.dqacc_dtau);
 }

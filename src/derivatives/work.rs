@@ -30,6 +30,8 @@ pub struct DerivativesWork {
     /// The generalized force the forward-dynamics derivatives were taken at (for
     /// [`smooth_derivatives`](super::smooth_derivatives): passive + actuator + applied).
     pub tau: DVector<f64>,
+    /// nv × nv scratch of the solves.
+    pub(crate) scratch: DMatrix<f64>,
 }
 
 impl DerivativesWork {
@@ -46,6 +48,7 @@ impl DerivativesWork {
             dqacc_dtau: DMatrix::zeros(nv, nv),
             qacc: DVector::zeros(nv),
             tau: DVector::zeros(nv),
+            scratch: DMatrix::zeros(nv, nv),
         }
     }
 

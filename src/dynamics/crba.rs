@@ -401,6 +401,68 @@ pub(crate) fn solve_with_factor_unchecked(model: &Model, factor: &DMatrix<f64>, 
     }
 }
 
+/// Solves M X = B for many right-hand sides at once, with the factor of
+/// [`factorize_mass_matrix`], on the transposes: `y` (n × nv, column-major) holds Bᵀ on entry and
+/// Xᵀ on return, so that each step of the tree-sparse solve is an update of whole contiguous
+/// columns (one per dof) across every right-hand side — the same arithmetic per right-hand side
+/// as [`solve_with_factor_unchecked`], vectorized across them.
+pub(crate) fn solve_transposed_with_factor_unchecked(
+    model: &Model,
+    factor: &DMatrix<f64>,
+    y: &mut DMatrix<f64>,
+) {
+    let lambda = &model.dof_parent[..model.nv];
+    let nv = model.nv;
+    let n = y.nrows();
+    let h = factor.as_slice();
+    let y = y.as_mut_slice();
+    // Lᵀ Z = B: column j of Y (row j of X) −= L[i][j] · column i, from the leaves up.
+    for i in (0..nv).rev() {
+        if lambda[i] == NO_DOF {
+            continue;
+        }
+        let col_l = &h[i * nv..(i + 1) * nv];
+        let (before, rest) = y.split_at_mut(i * n);
+        let y_i = &rest[..n];
+        for_each_run(model, lambda[i], |s, e| {
+            for j in s..=e {
+                let l = col_l[j];
+                if l != 0.0 {
+                    for (a, b) in before[j * n..(j + 1) * n].iter_mut().zip(y_i) {
+                        *a -= l * b;
+                    }
+                }
+            }
+        });
+    }
+    // D W = Z.
+    for i in 0..nv {
+        let d = 1.0 / h[i + i * nv];
+        for a in &mut y[i * n..(i + 1) * n] {
+            *a *= d;
+        }
+    }
+    // L X = W, from the root down: column i −= Σ L[i][j] · column j.
+    for i in 0..nv {
+        if lambda[i] == NO_DOF {
+            continue;
+        }
+        let col_l = &h[i * nv..(i + 1) * nv];
+        let (before, rest) = y.split_at_mut(i * n);
+        let y_i = &mut rest[..n];
+        for_each_run(model, lambda[i], |s, e| {
+            for j in s..=e {
+                let l = col_l[j];
+                if l != 0.0 {
+                    for (a, b) in y_i.iter_mut().zip(&before[j * n..(j + 1) * n]) {
+                        *a -= l * b;
+                    }
+                }
+            }
+        });
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -20,6 +20,7 @@
 mod activation;
 mod actuation;
 mod plan;
+mod skip;
 mod transmission;
 mod xfrc;
 
@@ -32,6 +33,7 @@ pub(crate) use actuation::{actuation_unchecked, add_actuator_length_derivative};
 
 pub use crate::constraint::DriftCorrection;
 pub use plan::{Plan, Stage, StageKind, Status};
+pub(crate) use skip::{ForwardSkip, SkipStage};
 pub(crate) use xfrc::accumulate_xfrc;
 
 use crate::dynamics::{
@@ -74,12 +76,23 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     // Collision and the rows at q: the M path only while a row exists (an equality, a joint at
     // a limit, a touching contact, or MuJoCo's activation rules in soft mode); ABA otherwise,
     // as for a model without constraints.
-    let m_path = plan.has_constraints() && solver.rows_exist(rows, model, data, q);
+    // A skip request (finite differences, `SkipStage`) reuses the last evaluation's leading
+    // stages, its collision and its M-path decision included.
+    let skip = std::mem::take(&mut data.forward_skip.stage);
+    let m_path = if skip == SkipStage::None {
+        plan.has_constraints() && solver.rows_exist(rows, model, data, q)
+    } else {
+        data.forward_skip.m_path
+    };
+    data.forward_skip.m_path = m_path;
     for stage in &plan.stages {
         if stage.status != Status::Runs {
             continue;
         }
         match stage.kind {
+            StageKind::Position | StageKind::Velocity | StageKind::Passive if skip == SkipStage::Velocity => {
+            }
+            StageKind::Position if skip == SkipStage::Position => {}
             StageKind::Position if m_path => {
                 crba_unchecked(model, data, q);
                 factorize_mass_matrix(model, data);

@@ -290,6 +290,8 @@ pub struct Data {
     /// MuJoCo's `cacc`, `cfrc_ext`, `cfrc_int` per MuJoCo body and their work buffers, filled by
     /// [`rne_post_constraint`](crate::dynamics::rne_post_constraint).
     pub(crate) rne_post: RnePost,
+    /// Stage skipping for finite differences (`forward::ForwardSkip`, MuJoCo's `mj_forwardSkip`).
+    pub(crate) forward_skip: crate::forward::ForwardSkip,
 
     // --- soft (MuJoCo-compatible) constraint model, MuJoCo's buffer names ---
     /// Rows of equality constraints and of friction loss in the soft solve (MuJoCo's `ne`, `nf`;
@@ -455,6 +457,7 @@ impl Data {
             contacts: Vec::with_capacity(model.max_contacts().min(crate::model::INITIAL_CONTACTS)),
             sensordata: DVector::zeros(model.nsensordata),
             sensor_work: crate::sensor::SensorWork::new(model),
+            forward_skip: Default::default(),
         }
     }
 }

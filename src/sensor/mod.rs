@@ -131,7 +131,7 @@ fn apply_cutoff(s: &Sensor, out: &mut [f64]) {
 /// `data.sensordata`. Nothing when the model has no computed sensor.
 pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], time: f64) {
     let needs = &model.plan.sensor_needs;
-    if !needs.any {
+    if !needs.any || data.forward_skip.sensors {
         return;
     }
     forward_kinematics_unchecked(model, data, q);

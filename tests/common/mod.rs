@@ -729,6 +729,24 @@ pub const DERIV_FD_REL: f64 = 1e-6;
 /// 1e-6 relative holds only where both engines' steps agree smoothly (the same contact set).
 pub const TRANSITION_REL: f64 = 1e-6;
 
+/// Relative tolerance between the stage-skipping transition Jacobians and the plain ones
+/// (tests/transition.rs), both from the input's warm start: the same arithmetic but for the
+/// stages' order of evaluation (measured: bitwise equal on every scene and integrator).
+pub const SKIP_REL: f64 = 1e-12;
+
+/// Relative tolerance between the transition Jacobians with the nominal warm start (the
+/// default) and the plain ones (tests/transition.rs): the nudged solves (tight solver, tolerance
+/// 1e-15 on the scaled improvement) start from other points and stop at others within the
+/// solver's tolerance, divided by 2ε. Measured: 2.9e-6 on the gripper holding a box (friction),
+/// 1.3e-9 on the humanoid, ≤ 2e-11 on the go1.
+pub const NOMINAL_WARMSTART_REL: f64 = 1e-5;
+
+/// Relative tolerance of the hybrid transition Jacobians (analytic velocity and control columns
+/// through the soft solve's optimality conditions) against lagrange's own centred differences
+/// (tests/transition.rs), on scenes whose contact set and row zones stay the same under the
+/// nudges: the 1e-6; the differences' own error is O(ε²) truncation plus round-off / ε.
+pub const HYBRID_REL: f64 = 1e-6;
+
 /// Relative tolerance of the poses and joint values in the viewer's pages (`cli/tests/viewer.rs`):
 /// they are stored as f32, whose rounding is 2⁻²⁴ ≈ 6e-8 of a value; 1e-7 allows one rounding.
 pub const VIEW_F32_REL: f64 = 1e-7;

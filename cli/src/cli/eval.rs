@@ -13,7 +13,7 @@ use lagrange::constraint::contact_force::contact_force;
 use lagrange::constraint::ConstraintMode;
 use lagrange::derivatives::{
     aba_derivatives, rnea_derivatives, smooth_derivatives, transition_jacobians, DerivativesWork,
-    TransitionOptions, TransitionWork,
+    TransitionMethod, TransitionOptions, TransitionWork,
 };
 use lagrange::dynamics::{aba, bias_forces, center_of_mass, crba, kinetic_energy, potential_energy};
 use lagrange::forward::forward;
@@ -59,6 +59,9 @@ pub enum Derivatives {
     All,
     /// Without the transition Jacobians.
     Smooth,
+    /// As `all`, the transition's velocity and control columns analytic (the library's
+    /// `TransitionMethod::Hybrid`; docs/derivatives.md).
+    Hybrid,
 }
 
 /// Buffers of the derivatives, made once per run.
@@ -78,7 +81,8 @@ impl DerivativeBuffers {
 /// `"derivatives"` of one state, after [`forward_json`] left the state in `data`: `rnea` at
 /// (q, v, forward's qacc), `aba` of the printed ABA `qacc` (τ = the state's tau), `smooth` of
 /// `forward.qacc_smooth` (passive, actuator and applied forces differentiated), `transition`
-/// (A, B of one step, as MuJoCo's `mjd_transitionFD`, centred, ε = 1e-6) unless `smooth`.
+/// (A, B of one step, as MuJoCo's `mjd_transitionFD`, centred, ε = 1e-6; `hybrid`: the velocity
+/// and control columns analytic) unless `smooth`.
 fn derivatives_json(
     model: &Model,
     data: &mut Data,
@@ -96,13 +100,18 @@ fn derivatives_json(
     smooth_derivatives(model, data, w)?;
     let smooth = json!({"dqacc_dq": rows(&w.dqacc_dq), "dqacc_dv": rows(&w.dqacc_dv), "dqacc_dtau": rows(&w.dqacc_dtau)});
     let mut out = json!({"rnea": rnea, "aba": aba, "smooth": smooth});
-    if d.which == Derivatives::All {
+    if d.which != Derivatives::Smooth {
         data.qacc_warmstart.copy_from(&qacc);
-        out["transition"] =
-            match transition_jacobians(model, data, &mut d.transition, &TransitionOptions::default()) {
-                Ok(()) => json!({"A": rows(&d.transition.a), "B": rows(&d.transition.b)}),
-                Err(e) => json!({"error": e.to_string()}),
-            };
+        let method = if d.which == Derivatives::Hybrid {
+            TransitionMethod::Hybrid
+        } else {
+            TransitionMethod::FiniteDifference
+        };
+        let options = TransitionOptions { method, ..Default::default() };
+        out["transition"] = match transition_jacobians(model, data, &mut d.transition, &options) {
+            Ok(()) => json!({"A": rows(&d.transition.a), "B": rows(&d.transition.b)}),
+            Err(e) => json!({"error": e.to_string()}),
+        };
     }
     Ok(out)
 }

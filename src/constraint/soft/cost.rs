@@ -178,15 +178,28 @@ impl Rows<'_> {
         (d1, d2)
     }
 
-    /// Calls `add(i, j, h)` for the Hessian of s in jar on the rows that have one: D_i on
-    /// quadratic rows (i = j), and the dense dim × dim block of an elliptic contact on its cone.
-    pub fn hessian(&self, jar: &DVector<f64>, state: &[EfcState], mut add: impl FnMut(usize, usize, f64)) {
+    /// Calls `add(i, dim, h)` for each block of the Hessian of s in jar on the rows that have
+    /// one, h in the top-left dim × dim of the array: D_i on a quadratic row (dim 1, also each
+    /// row of an elliptic contact in its bottom zone), and the dense block of an elliptic contact
+    /// on its cone (rows i..i+dim).
+    pub fn hessian(
+        &self,
+        jar: &DVector<f64>,
+        state: &[EfcState],
+        mut add: impl FnMut(usize, usize, &[[f64; 6]; 6]),
+    ) {
+        let mut block = [[0.0; 6]; 6];
         let mut i = 0;
         while i < self.nefc {
             if self.kind[i] == EfcType::ContactElliptic && i >= self.ne + self.nf {
                 let dim = self.block(i);
                 match state[i] {
-                    EfcState::Quadratic => (i..i + dim).for_each(|j| add(j, j, self.d[j])),
+                    EfcState::Quadratic => {
+                        for j in i..i + dim {
+                            block[0][0] = self.d[j];
+                            add(j, 1, &block);
+                        }
+                    }
                     EfcState::Cone => {
                         let c = &self.contacts[self.id[i]];
                         let mu = self.mu[self.id[i]];
@@ -205,9 +218,10 @@ impl Rows<'_> {
                                             + if a == b { mu * mu - mu * n / t } else { 0.0 }
                                     }
                                 };
-                                add(i + a, i + b, dm * scale(a) * scale(b) * h);
+                                block[a][b] = dm * scale(a) * scale(b) * h;
                             }
                         }
+                        add(i, dim, &block);
                     }
                     _ => {}
                 }
@@ -215,7 +229,8 @@ impl Rows<'_> {
                 continue;
             }
             if state[i] == EfcState::Quadratic {
-                add(i, i, self.d[i]);
+                block[0][0] = self.d[i];
+                add(i, 1, &block);
             }
             i += 1;
         }

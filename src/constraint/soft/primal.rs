@@ -237,16 +237,21 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                 // contact's rows in its cone zone (one dense block).
                 soft.active_rows.clear();
                 let active = &mut soft.active_rows;
-                rows.hessian(&soft.jar, efc_state, |a, b, w| {
-                    match active.last_mut() {
-                        Some(g) if g.1 >= a.min(b) => g.1 = g.1.max(a.max(b)),
-                        _ => active.push((a, a.max(b))),
-                    }
-                    for &p in nz.row(a) {
-                        let x = w * efc_j[(a, p)];
-                        for &q in nz.row(b) {
-                            if p >= q {
-                                h[(p, q)] += x * efc_j[(b, q)];
+                rows.hessian(&soft.jar, efc_state, |i, dim, block| {
+                    // The block's entries (a, b) in row order, as one group.
+                    for (a, row) in (i..i + dim).zip(block) {
+                        for (b, &w) in (i..i + dim).zip(row) {
+                            match active.last_mut() {
+                                Some(g) if g.1 >= a.min(b) => g.1 = g.1.max(a.max(b)),
+                                _ => active.push((a, a.max(b))),
+                            }
+                            for &p in nz.row(a) {
+                                let x = w * efc_j[(a, p)];
+                                for &q in nz.row(b) {
+                                    if p >= q {
+                                        h[(p, q)] += x * efc_j[(b, q)];
+                                    }
+                                }
                             }
                         }
                     }
