@@ -481,7 +481,7 @@ fn unsimulated_tendon_terms_are_warnings() {
     let about_u: Vec<&String> = m.warnings.iter().filter(|w| w.contains("'u'")).collect();
     assert_eq!(about_u.len(), 1, "{:?}", m.warnings);
     assert!(about_u[0].contains("inline.xml:") && about_u[0].contains("armature=\"0.1\" is not simulated"));
-    let u = &m.tendons[0];
+    let u = m.tendons.iter().find(|t| t.name == "u").unwrap();
     assert_eq!((u.stiffness, u.damping, u.frictionloss), (10.0, 0.0, 0.5));
 }
 
