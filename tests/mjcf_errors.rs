@@ -209,3 +209,20 @@ fn tendons_actuators_and_contacts_name_what_they_act_on() {
         &["exclude_unknown_body.xml:19", "<exclude>", "unknown body 'nope'"],
     );
 }
+
+#[test]
+fn composition_errors_name_the_element_line_and_what_mujoco_does() {
+    mentions("composite_grid.xml", &["composite_grid.xml:3", "<composite>", "MuJoCo 4.0 rejects it"]);
+    mentions(
+        "body_plugin.xml",
+        &["body_plugin.xml:7", "<plugin>", "MuJoCo would run plugin 'mujoco.elasticity.cable'"],
+    );
+    mentions(
+        "attach_unknown_model.xml",
+        &["attach_unknown_model.xml:6", "<attach>", "sub-model (<asset><model name>)", "'gripper'"],
+    );
+    mentions(
+        "mesh_builtin.xml",
+        &["mesh_builtin.xml:3", "<mesh>", "the built-in mesh 'sphere'", "MuJoCo 4.0 would generate"],
+    );
+}

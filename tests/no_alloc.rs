@@ -33,6 +33,8 @@ fn kernels_and_integrators_do_not_allocate() {
         // Actuators: activation dynamics (act in the state), site, ball and free transmissions.
         ("tests/data/mjcf/actuators/activation.xml", false),
         ("tests/data/mjcf/actuators/transmissions.xml", false),
+        // Fluid forces (the inertia-box model) in the passive stage.
+        ("tests/data/mjcf/fluid/inertia_box.xml", false),
     ] {
         let model = load(&root.join(file), &LoadOptions { floating, ..Default::default() }).unwrap();
         let mut data = Data::new(&model);

@@ -186,9 +186,10 @@ fn go1_stands_on_its_servos_as_in_mujoco() {
     assert!(sim.data.qvel.amax() < 1e-2, "standing still: |v| = {}", sim.data.qvel.amax());
 }
 
-/// Fluid forces (`<option density viscosity wind>`) are not simulated: the plan says so.
+/// Fluid forces (`<option density viscosity wind>`) run in the passive stage: the plan lists the
+/// medium (tests/fluid.rs compares the forces with MuJoCo's).
 #[test]
-fn fluid_options_are_listed_as_not_simulated() {
+fn fluid_options_are_listed_as_simulated() {
     let path = std::env::temp_dir().join(format!("lagrange-fluid-{}.xml", std::process::id()));
     std::fs::write(
         &path,
@@ -199,7 +200,7 @@ fn fluid_options_are_listed_as_not_simulated() {
     let _ = std::fs::remove_file(&path);
     let plan = Plan::new(&model, None);
     let fluid = plan.stages.iter().find(|s| s.name == "fluid forces").expect("a fluid stage");
-    assert_eq!(fluid.status, lagrange::forward::Status::NotSimulated);
+    assert_eq!(fluid.status, lagrange::forward::Status::Runs);
     assert!(
         fluid.reason.contains("viscosity=\"0.1\"") && fluid.reason.contains("wind=\"1 0 0\""),
         "{}",

@@ -236,9 +236,6 @@ class MjRef:
         for bit in ("mjDSBL_FRICTIONLOSS", "mjDSBL_LIMIT", "mjDSBL_CONTACT", "mjDSBL_ACTUATION"):
             m.opt.disableflags |= int(getattr(D, bit))
         m.opt.jacobian = mj.mjtJacobian.mjJAC_DENSE
-        self.fluid = bool(m.opt.density or m.opt.viscosity)
-        m.opt.density = 0.0
-        m.opt.viscosity = 0.0
         self.m = m
         self.d = mj.MjData(m)
         self.dfd = mj.MjData(m)
@@ -262,8 +259,6 @@ class MjRef:
             for mm in self.mimics:
                 if mm.joint not in by or mm.leader not in by:
                     raise ValueError("mimic joint '%s' or '%s' is not a MuJoCo joint" % (mm.joint, mm.leader))
-        if self.fluid:
-            self.notes.append("MuJoCo's fluid forces (density/viscosity) zeroed: not part of lagrange's qfrc_passive")
 
     # -- counts ---------------------------------------------------------------------------------
 

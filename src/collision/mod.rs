@@ -126,11 +126,10 @@ impl CollisionModel {
 }
 
 /// The contacts of every candidate pair at the current body poses (`x_world_body`), closer than
-/// the pair's margin + gap plus `reach`, into `data.contacts` (cleared first; no allocation: the capacity
-/// is `Model::max_contacts`).
+/// the pair's margin + gap plus `reach`, into `data.contacts` (cleared first; no allocation once the
+/// buffers have held as many contacts: a pass that finds more than every earlier one grows them).
 pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) {
     data.contacts.clear();
-    let budget = model.max_contacts();
     // World poses of the colliding geoms, once per pass (MuJoCo's geom_xpos, geom_xmat).
     for (g, geom) in model.geoms.iter().enumerate() {
         if cm.shapes[g].is_some() || geom.collision {
@@ -156,10 +155,6 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         let start = data.contacts.len();
         let mut push = |p1: Vec3, p2: Vec3, normal: Vec3, dist: f64, hint: Option<Vec3>, feature: u32| {
             if data.contacts.len() - start >= pair.max_contacts {
-                return;
-            }
-            if data.contacts.len() >= budget {
-                data.contacts_dropped += 1;
                 return;
             }
             data.contacts.push(Contact {
@@ -273,5 +268,10 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
             }
             push(p.p1, p.p2, p.normal, p.dist, None, 0);
         }
+    }
+    // One regularized-cone μ per contact (`contact_mu`): grown with the contact buffer when this
+    // pass found more contacts than any before.
+    if data.contact_mu.len() < data.contacts.len() {
+        data.contact_mu.resize(data.contacts.len(), 0.0);
     }
 }

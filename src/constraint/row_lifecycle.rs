@@ -46,8 +46,8 @@ impl RowLifecycle {
         Self {
             frozen: false,
             limits: Vec::with_capacity(model.joints.len()),
-            contacts: Vec::with_capacity(model.max_contacts()),
-            sticking: Vec::with_capacity(model.max_contacts()),
+            contacts: Vec::with_capacity(model.max_contacts().min(crate::model::INITIAL_CONTACTS)),
+            sticking: Vec::with_capacity(model.max_contacts().min(crate::model::INITIAL_CONTACTS)),
             sticking_dofs: Vec::with_capacity(model.nv),
         }
     }

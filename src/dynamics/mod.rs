@@ -2,12 +2,13 @@
 //! matrix (CRBA) and its tree-sparse factorization, forward dynamics (ABA), energy, centre of mass
 //! and momentum, MuJoCo's per-body accelerations and wrenches after a solve (`rne_post`), and the
 //! forward-mode derivative passes of RNEA along each dof (`rnea_velocity`, `rnea_configuration`),
-//! which `derivatives` and the implicit stepper use.
+//! which `derivatives` and the implicit stepper use; MuJoCo's fluid forces (`fluid`).
 //! Every function writes into [`Data`](crate::Data) and allocates nothing.
 
 mod aba;
 mod crba;
 mod energy;
+pub mod fluid;
 pub(crate) mod rne_post;
 mod rnea;
 mod rnea_configuration;

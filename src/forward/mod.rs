@@ -6,7 +6,7 @@
 //! |---|---|
 //! | position | body poses, `mass_matrix` and its factor, constraint rows `efc_j`, `efc_pos` |
 //! | velocity | `qfrc_bias` = RNEA(q, v, 0), `efc_vel` = J v, `efc_jdotv` = J̇ v |
-//! | passive | `qfrc_passive` = −damping ⊙ v − k ⊙ (q − q_spring) |
+//! | passive | `qfrc_passive` = −damping ⊙ v − k ⊙ (q − q_spring) + `qfrc_fluid` |
 //! | actuation | `actuator_length`, `actuator_velocity`, `actuator_force`, `act_dot`, `qfrc_actuator` from `ctrl` and `act` |
 //! | acceleration | `qacc_smooth` (ABA, or M⁻¹`qfrc_smooth` on the M path), `qfrc_smooth` on the M path |
 //! | constraint | `efc_force` (λ), `qfrc_constraint` = Jᵀλ, `qacc` |
@@ -112,13 +112,16 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
 }
 
 /// Passive forces: joint damping −d ⊙ v and the springs of hinge and slide joints
-/// −k (q − q_spring) (MuJoCo's `mj_passive` for these elements).
+/// −k (q − q_spring), then the fluid forces (MuJoCo's `mj_passive` for these elements).
 pub(crate) fn passive(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     for k in 0..model.nv {
         data.qfrc_passive[k] = -model.dof_damping[k] * v[k];
     }
     for s in &model.springs {
         data.qfrc_passive[s.dof_adr] -= s.stiffness * (q[s.qpos_adr] - s.rest);
+    }
+    if let Some(fluid) = &model.plan.fluid {
+        crate::dynamics::fluid::fluid_forces(model, fluid, data, q, v);
     }
     crate::tendon::passive::add_tendon_passive(model, data);
 }

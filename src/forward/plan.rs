@@ -39,6 +39,9 @@ pub enum StageKind {
     /// Other passive forces MuJoCo computes (fluid forces, gravity compensation, spring-dampers, …;
     /// not simulated).
     PassiveOther,
+    /// MuJoCo's fluid forces (`<option density viscosity wind>`, geom `fluidshape`), part of the
+    /// passive stage (`dynamics::fluid`).
+    Fluid,
 }
 
 /// Whether a stage runs.
@@ -95,6 +98,8 @@ pub struct Plan {
     pub actuator_bias_velocity: Vec<f64>,
     /// What the sensor stage computes beside the sensors (body velocities, subtree momenta, …).
     pub sensor_needs: crate::sensor::SensorNeeds,
+    /// The fluid forces' bodies and coefficients (None without `<option density>` or `viscosity`).
+    pub fluid: Option<crate::dynamics::fluid::FluidModel>,
 }
 
 impl Plan {
@@ -119,6 +124,7 @@ impl Plan {
             solver,
             actuator_bias_velocity: super::resolved_bias_velocity(model),
             sensor_needs: crate::sensor::SensorNeeds::of(model),
+            fluid: crate::dynamics::fluid::FluidModel::new(model),
         }
     }
 
@@ -212,8 +218,9 @@ fn stages(
     });
     let damped = model.dof_damping.iter().filter(|&&d| d != 0.0).count();
     let springs = model.springs.len();
+    let fluid = crate::dynamics::fluid::FluidModel::new(model);
     let tendon_passive = crate::tendon::passive::count_tendon_passive(model);
-    out.push(if damped + springs + tendon_passive > 0 {
+    out.push(if damped + springs + tendon_passive > 0 || fluid.is_some() {
         let tendons = if tendon_passive > 0 {
             format!(", {tendon_passive} tendon spring-dampers (ten_Jᵀ f)")
         } else {
@@ -223,7 +230,10 @@ fn stages(
             Passive,
             "passive",
             Runs,
-            format!("joint damping on {damped} degrees of freedom, {springs} joint springs{tendons}"),
+            format!(
+                "joint damping on {damped} degrees of freedom, {springs} joint springs{tendons}{}",
+                if fluid.is_some() { ", fluid forces" } else { "" }
+            ),
         )
     } else {
         stage(Passive, "passive", Skipped, "no joint damping or springs")
@@ -425,15 +435,14 @@ fn stages(
     let other = model.elements.iter().filter(|e| matches!(e.category.as_str(), "body" | "joint")).count()
         + multi_dof_springs;
     let o = &model.options;
-    if o.density > 0.0 || o.viscosity > 0.0 {
+    if let Some(f) = &fluid {
+        out.push(fluid_stage(model, f));
+    } else if o.density != 0.0 || o.viscosity != 0.0 {
         out.push(stage(
-            PassiveOther,
+            Fluid,
             "fluid forces",
-            NotSimulated,
-            format!(
-                "<option density=\"{}\" viscosity=\"{}\" wind=\"{} {} {}\">: MuJoCo's fluid drag and viscous forces are not simulated",
-                o.density, o.viscosity, o.wind[0], o.wind[1], o.wind[2]
-            ),
+            Skipped,
+            "switched off with every passive force by <flag spring=\"disable\" damper=\"disable\">",
         ));
     }
     if other > 0 {
@@ -445,6 +454,23 @@ fn stages(
         ));
     }
     out
+}
+
+/// The fluid-forces stage: the medium, how many bodies feel each model, and what is left out.
+fn fluid_stage(model: &Model, f: &crate::dynamics::fluid::FluidModel) -> Stage {
+    let o = &model.options;
+    let (boxes, geoms) = f.counts();
+    let mut reason = format!(
+        "<option density=\"{}\" viscosity=\"{}\" wind=\"{} {} {}\">: inertia-box model on {boxes} bodies, ellipsoid model on {geoms} geoms, into qfrc_fluid and qfrc_passive; not in the implicit integrators' velocity derivative (MuJoCo's is)",
+        o.density, o.viscosity, o.wind[0], o.wind[1], o.wind[2]
+    );
+    if !f.unsupported.is_empty() {
+        reason.push_str(&format!(
+            "; {} fluidshape=\"ellipsoid\" geoms without semi-axes here (mesh, plane, height field) feel nothing",
+            f.unsupported.len()
+        ));
+    }
+    stage(StageKind::Fluid, "fluid forces", Status::Runs, reason)
 }
 
 /// The sensor stage: how many sensors of each stage are computed, what they add to a `forward`,

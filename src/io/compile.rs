@@ -210,6 +210,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 group: g.group,
                 rgba: g.rgba,
                 material_rgba: g.material_rgba,
+                fluid: g.fluid,
                 mesh: match &g.shape {
                     Shape::Mesh { path, scale } => Some(
                         geom_meshes

@@ -215,6 +215,9 @@ pub struct Data {
     pub qfrc_bias: DVector<f64>,
     /// Passive forces: joint damping and springs.
     pub qfrc_passive: DVector<f64>,
+    /// The fluid forces' part of `qfrc_passive` (MuJoCo's `qfrc_fluid`): zero unless
+    /// `<option density>` or `viscosity` is nonzero (`dynamics::fluid`).
+    pub qfrc_fluid: DVector<f64>,
     /// Actuator forces in joint space (the actuation stage).
     pub qfrc_actuator: DVector<f64>,
     /// Per actuator: transmission length, velocity, and scalar force (MuJoCo's names).
@@ -337,11 +340,10 @@ pub struct Data {
     /// World pose of each geom that collides, from the last collision pass (MuJoCo's `geom_xpos`,
     /// `geom_xmat`).
     pub x_world_geom: Vec<Transform>,
-    /// Contacts of the last collision pass (MuJoCo's `contact`); capacity reserved for the model.
+    /// Contacts of the last collision pass (MuJoCo's `contact`). Room for
+    /// [`INITIAL_CONTACTS`](crate::model::INITIAL_CONTACTS) is reserved; a pass that finds more
+    /// grows it (once: the capacity is kept), so no contact is ever dropped.
     pub contacts: Vec<Contact>,
-    /// Contacts dropped because a collision pass found more than [`Model::max_contacts`]
-    /// (cumulative; MuJoCo's `mjWARN_CONTACTFULL`).
-    pub contacts_dropped: u64,
 
     // --- sensors ---
     /// The sensors' values from the last `forward` (MuJoCo's `sensordata`; each sensor's slice at
@@ -422,6 +424,7 @@ impl Data {
             mocap_quat: model.mocap_pose0.iter().map(|x| x.quat_wxyz()).collect(),
             qfrc_bias: DVector::zeros(nv),
             qfrc_passive: DVector::zeros(nv),
+            qfrc_fluid: DVector::zeros(nv),
             qfrc_actuator: DVector::zeros(nv),
             actuator_length: DVector::zeros(model.actuators.len()),
             actuator_velocity: DVector::zeros(model.actuators.len()),
@@ -462,17 +465,16 @@ impl Data {
             efc_kbip: vec![[0.0; 4]; nefc],
             efc_aref: DVector::zeros(nefc),
             efc_state: vec![EfcState::Satisfied; nefc],
-            contact_mu: vec![0.0; model.max_contacts()],
+            contact_mu: vec![0.0; model.max_contacts().min(crate::model::INITIAL_CONTACTS)],
             qacc_warmstart: DVector::zeros(nv),
             solver_niter: 0,
             solver_improvement: 0.0,
             solver_gradient: 0.0,
             soft: SoftWork::new(nv, nefc),
             x_world_geom: vec![Transform::identity(); model.geoms.len()],
-            contacts: Vec::with_capacity(model.max_contacts()),
+            contacts: Vec::with_capacity(model.max_contacts().min(crate::model::INITIAL_CONTACTS)),
             sensordata: DVector::zeros(model.nsensordata),
             sensor_work: crate::sensor::SensorWork::new(model),
-            contacts_dropped: 0,
             ten_length: DVector::zeros(model.tendons.len()),
             ten_velocity: DVector::zeros(model.tendons.len()),
             ten_j: DMatrix::zeros(model.tendons.len(), nv),

@@ -194,6 +194,9 @@ pub struct Geom {
     /// use by ray casting and geom distances ([`crate::collision::GeomMesh`]); geoms using the
     /// same file and scale share one.
     pub mesh: Option<std::sync::Arc<crate::collision::GeomMesh>>,
+    /// `fluidshape="ellipsoid"` with its five `fluidcoef` (MuJoCo's `geom_fluid[1..6]`), if set:
+    /// the geom's body then feels the ellipsoid fluid model instead of the inertia-box one.
+    pub fluid: Option<[f64; 5]>,
 }
 
 /// The compiled, immutable model. Build it with a loader (e.g. [`crate::io::load`]) or by
@@ -378,12 +381,12 @@ impl Model {
         }
         q
     }
-    /// Upper bound on the number of contacts one collision pass can report (sizes
-    /// `Data::contacts` and the contact rows): the sum of each candidate pair's bound, capped at
-    /// [`MAX_CONTACTS`] (a resource limit, like MuJoCo's contact arena: contacts beyond it are
-    /// dropped and counted in [`Data::contacts_dropped`]).
+    /// Upper bound on the number of contacts one collision pass can report: the sum of each
+    /// candidate pair's bound (MuJoCo's per-pair limits). Nothing is dropped below it: `Data`
+    /// reserves room for up to [`INITIAL_CONTACTS`] contacts and its contact buffers grow when a
+    /// pass finds more than every earlier pass (as MuJoCo's arena, without its fixed size).
     pub fn max_contacts(&self) -> usize {
-        self.collision_pairs.iter().map(|p| p.max_contacts).sum::<usize>().min(MAX_CONTACTS)
+        self.collision_pairs.iter().map(|p| p.max_contacts).sum::<usize>()
     }
 
     /// Whether any degree of freedom has viscous damping (the passive stage's damping term).
@@ -426,8 +429,9 @@ pub fn dof_run_starts(dof_parent: &[usize]) -> Vec<usize> {
     start
 }
 
-/// The most contacts one collision pass keeps (see [`Model::max_contacts`]).
-pub const MAX_CONTACTS: usize = 500;
+/// How many contacts `Data` reserves room for before the first pass (fewer if the model's
+/// [`Model::max_contacts`] is smaller); more grow the buffers once, when first needed.
+pub const INITIAL_CONTACTS: usize = 500;
 
 /// `q ← q ⊕ v·dt` for the whole configuration (MuJoCo's `mj_integratePos`).
 ///

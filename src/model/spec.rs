@@ -348,6 +348,10 @@ pub struct GeomSpec {
     /// Contact parameters (MJCF `contype`, `conaffinity`, `condim`, `priority`, `friction`,
     /// `solmix`, `solref`, `solimp`, `margin`, `gap`; MuJoCo's defaults for URDF).
     pub contact: GeomContact,
+    /// MJCF `fluidshape="ellipsoid"` with its `fluidcoef` (blunt drag, slender drag, angular
+    /// drag, Kutta lift, Magnus lift; MuJoCo's defaults 0.5 0.25 1.5 1 1): the geom takes part
+    /// in MuJoCo's ellipsoid fluid model. None for `fluidshape="none"` (the default).
+    pub fluid: Option<[f64; 5]>,
 }
 
 /// A geom's contact parameters (MuJoCo documentation, "XML Reference → geom" and "Computation →
@@ -411,6 +415,7 @@ impl GeomSpec {
             rgba: DEFAULT_GEOM_RGBA,
             material_rgba: None,
             contact: GeomContact::default(),
+            fluid: None,
         }
     }
 }

@@ -103,7 +103,11 @@ impl SensorWork {
             subtree: Subtree::new(model),
             kinetic: 0.0,
             time: 0.0,
-            matches: Vec::with_capacity(if has_contact_sensor { model.max_contacts() } else { 0 }),
+            matches: Vec::with_capacity(if has_contact_sensor {
+                model.max_contacts().min(crate::model::INITIAL_CONTACTS)
+            } else {
+                0
+            }),
         }
     }
 }

@@ -16,6 +16,7 @@ pub mod impedance;
 pub mod pgs;
 pub mod primal;
 pub mod rows;
+mod sparse_cholesky;
 pub mod weights;
 mod work;
 

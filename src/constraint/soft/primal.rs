@@ -5,7 +5,8 @@
 //! same answer to its tolerance.
 //!
 //! - **Newton**: the search direction −H⁻¹ g with H = M + Jᵀ (∂²s) J (D on quadratic rows, the
-//!   cone's block on elliptic contacts in their middle zone), factored by dense Cholesky;
+//!   cone's block on elliptic contacts in their middle zone), factored by a Cholesky that skips
+//!   H's structural zeros ([`super::sparse_cholesky`]);
 //! - **CG**: Polak–Ribière conjugate gradients preconditioned by M⁻¹ (the LᵀDL factor of M);
 //!
 //! both with an exact line search along the direction: Newton's method on the convex,
@@ -14,7 +15,6 @@
 //! `tolerance`, the scale being 1 / (meaninertia · max(1, nv)).
 
 use super::cost::Rows;
-use crate::constraint::dense::{cholesky, cholesky_solve};
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, Model};
 use nalgebra::{DMatrix, DVector};
@@ -60,15 +60,38 @@ impl Sparsity<'_> {
 }
 
 /// Fills the sparsity of rows 0..nefc of `j` into `start` and `index` (grown only when a problem is
-/// larger than any before it).
+/// larger than any before it): J is read by columns (contiguous in memory), counted per row, then
+/// each row's columns are placed in ascending order.
 fn sparsity(j: &DMatrix<f64>, nefc: usize, start: &mut Vec<usize>, index: &mut Vec<usize>) {
     start.clear();
-    index.clear();
-    start.push(0);
-    for i in 0..nefc {
-        index.extend((0..j.ncols()).filter(|&k| j[(i, k)] != 0.0));
-        start.push(index.len());
+    start.resize(nefc + 1, 0);
+    let rows = j.nrows();
+    let data = j.as_slice();
+    for k in 0..j.ncols() {
+        for (i, &v) in data[k * rows..k * rows + nefc].iter().enumerate() {
+            if v != 0.0 {
+                start[i + 1] += 1;
+            }
+        }
     }
+    for i in 0..nefc {
+        start[i + 1] += start[i];
+    }
+    index.clear();
+    index.resize(start[nefc], 0);
+    // start[i] is row i's next free slot while filling, then shifted back.
+    for k in 0..j.ncols() {
+        for (i, &v) in data[k * rows..k * rows + nefc].iter().enumerate() {
+            if v != 0.0 {
+                index[start[i]] = k;
+                start[i] += 1;
+            }
+        }
+    }
+    for i in (1..=nefc).rev() {
+        start[i] = start[i - 1];
+    }
+    start[0] = 0;
 }
 
 /// r ← J x (rows 0..nefc).
@@ -78,9 +101,22 @@ fn mul_j(j: &DMatrix<f64>, s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut 
     }
 }
 
-/// r ← M x for the dense symmetric M.
-fn mul_m(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
-    m.mul_to(x, r);
+/// r ← M x, reading only M's nonzeros: the diagonal and each dof's ancestor chain
+/// (`Model::dof_parent`; M[l][k] ≠ 0 only when l is an ancestor of k or k of l).
+fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
+    let nv = x.len();
+    for k in 0..nv {
+        r[k] = m[(k, k)] * x[k];
+    }
+    for k in 0..nv {
+        let mut l = dof_parent[k];
+        while l != crate::model::NO_DOF {
+            let m_lk = m[(l, k)];
+            r[l] += m_lk * x[k];
+            r[k] += m_lk * x[l];
+            l = dof_parent[l];
+        }
+    }
 }
 
 /// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
@@ -138,7 +174,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                  jar: &mut DVector<f64>,
                  force: &mut DVector<f64>,
                  state: &mut [_]| {
-        mul_m(mass_matrix, x, ma);
+        mul_m(&model.dof_parent, mass_matrix, x, ma);
         mul_j(efc_j, &nz, nefc, x, jar);
         for i in 0..nefc {
             jar[i] -= efc_aref[i];
@@ -183,19 +219,48 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         iter += 1;
         match method {
             Primal::Newton => {
+                // H = M + Jᵀ (∂²s) J, lower triangle only, assembled over its nonzeros: the
+                // last pattern's entries cleared, M's tree entries written, the rows' added.
                 let h = &mut soft.hessian;
-                h.copy_from(mass_matrix);
+                for k in 0..nv {
+                    for &j in soft.factor.pattern_row(k) {
+                        h[(k, j)] = 0.0;
+                    }
+                    h[(k, k)] = mass_matrix[(k, k)];
+                    let mut l = model.dof_parent[k];
+                    while l != crate::model::NO_DOF {
+                        h[(k, l)] = mass_matrix[(k, l)];
+                        l = model.dof_parent[l];
+                    }
+                }
+                // The row groups with a Hessian block: single quadratic rows, and an elliptic
+                // contact's rows in its cone zone (one dense block).
+                soft.active_rows.clear();
+                let active = &mut soft.active_rows;
                 rows.hessian(&soft.jar, efc_state, |a, b, w| {
+                    match active.last_mut() {
+                        Some(g) if g.1 >= a.min(b) => g.1 = g.1.max(a.max(b)),
+                        _ => active.push((a, a.max(b))),
+                    }
                     for &p in nz.row(a) {
                         let x = w * efc_j[(a, p)];
                         for &q in nz.row(b) {
-                            h[(p, q)] += x * efc_j[(b, q)];
+                            if p >= q {
+                                h[(p, q)] += x * efc_j[(b, q)];
+                            }
                         }
                     }
                 });
                 soft.dir.copy_from(&soft.grad);
-                if cholesky(&soft.hessian, nv, &mut soft.factor, 0.0) {
-                    cholesky_solve(&soft.factor, nv, soft.dir.as_mut_slice());
+                if soft.factor.factor_structured(
+                    &soft.hessian,
+                    nv,
+                    &model.dof_parent,
+                    &soft.active_rows,
+                    &nz_start,
+                    &nz_index,
+                ) {
+                    soft.factor.solve(soft.dir.as_mut_slice());
                 } else {
                     solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
                 }
@@ -224,7 +289,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
             }
         }
         mul_j(efc_j, &nz, nefc, &soft.dir, &mut soft.jv);
-        mul_m(mass_matrix, &soft.dir, &mut soft.mdir);
+        mul_m(&model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
         let g0: f64 = (0..nv).map(|k| (soft.ma[k] - qfrc_smooth[k]) * soft.dir[k]).sum();
         let dmd = soft.dir.dot(&soft.mdir);
         let alpha = line_search(&rows, &soft.jar, &soft.jv, &mut soft.jar_trial, g0, dmd, s);

@@ -94,8 +94,17 @@ fn row_bound(cm: &ConstraintModel, model: &Model, data: &Data) -> usize {
 /// `Data::contacts` from a collision pass at q): `nefc`, `ne`, `nf`, `efc_type`, `efc_id`,
 /// `efc_j`, `efc_pos`, `efc_margin`, `efc_frictionloss`.
 pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f64], cone: Cone) {
-    data.reserve_rows(row_bound(cm, model, data));
+    let bound = row_bound(cm, model, data);
+    data.reserve_rows(bound);
     let ne = cm.equality_rows(model, data, q);
+    // Rows ne..bound start at zero: cleared column by column (contiguous in J's storage) rather
+    // than row by row (strided).
+    let stride = data.efc_j.nrows();
+    let nv = model.nv;
+    let j = data.efc_j.as_mut_slice();
+    for c in 0..nv {
+        j[c * stride + ne..c * stride + bound].fill(0.0);
+    }
     data.efc_margin.rows_mut(0, ne).fill(0.0);
     data.efc_frictionloss.rows_mut(0, ne).fill(0.0);
     // MuJoCo's weld rotation rows.
@@ -151,7 +160,6 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
         for (dist, dir) in joint_limit_sides(l, q, margin).into_iter().flatten() {
             data.efc_id[r] = l.joint;
             data.efc_type[r] = EfcType::LimitJoint;
-            data.efc_j.row_mut(r).fill(0.0);
             for k in 0..ndof {
                 data.efc_j[(r, l.dof_adr + k)] = dir[k];
             }
@@ -229,9 +237,6 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
         let dim = contact.condim.clamp(1, 6) as usize;
         // The contact-frame Jacobian rows (normal, tangents, torsion, rolling) in rows r..r+dim.
         let rows = if dim == 1 || cone == Cone::Elliptic { dim } else { 2 * (dim - 1) };
-        for i in r..r + rows.max(dim) {
-            data.efc_j.row_mut(i).fill(0.0);
-        }
         add_contact_jacobian(model, data, &contact, r, dim);
         let kind = if dim == 1 {
             EfcType::ContactFrictionless
@@ -267,9 +272,18 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
 /// `efc_vel` = J v of every row and `efc_jdotv` of connect and weld rows (0 elsewhere), at the
 /// state of [`soft_positions`]. Needs the body velocities (`v_body`).
 pub(crate) fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Data, v: &[f64]) {
-    for r in 0..data.nefc {
-        let row = data.efc_j.row(r);
-        data.efc_vel[r] = (0..model.nv).filter(|&k| row[k] != 0.0).map(|k| row[k] * v[k]).sum();
+    // Column by column (contiguous in J's storage), each row's sum in ascending dof order.
+    let nefc = data.nefc;
+    let stride = data.efc_j.nrows();
+    let j = data.efc_j.as_slice();
+    let vel = &mut data.efc_vel.as_mut_slice()[..nefc];
+    vel.fill(0.0);
+    for (k, &vk) in v.iter().enumerate().take(model.nv) {
+        for (r, &jrk) in j[k * stride..k * stride + nefc].iter().enumerate() {
+            if jrk != 0.0 {
+                vel[r] += jrk * vk;
+            }
+        }
     }
     data.efc_jdotv.rows_mut(0, data.nefc).fill(0.0);
     if data.ne == 0 {

@@ -22,9 +22,12 @@ pub(crate) struct SoftWork {
     pub mdir: DVector<f64>,
     pub grad_prev: DVector<f64>,
     pub mgrad_prev: DVector<f64>,
-    /// The cost's Hessian M + Jᵀ D J (+ cone blocks) and its Cholesky factor, nv × nv.
+    /// The cost's Hessian M + Jᵀ D J (+ cone blocks), nv × nv (lower triangle, nonzero only on
+    /// its factor's pattern), and its sparse Cholesky factor.
     pub hessian: DMatrix<f64>,
-    pub factor: DMatrix<f64>,
+    pub factor: super::sparse_cholesky::SparseCholesky,
+    /// The row groups (first, last) with a Hessian block in the current Newton iteration.
+    pub active_rows: Vec<(usize, usize)>,
     /// The nonzero columns of each row of J: row i's are `nz_index[nz_start[i]..nz_start[i + 1]]`.
     pub nz_start: Vec<usize>,
     pub nz_index: Vec<usize>,
@@ -47,7 +50,8 @@ impl SoftWork {
             grad_prev: DVector::zeros(nv),
             mgrad_prev: DVector::zeros(nv),
             hessian: DMatrix::zeros(nv, nv),
-            factor: DMatrix::zeros(nv, nv),
+            factor: super::sparse_cholesky::SparseCholesky::with_capacity(nv),
+            active_rows: Vec::with_capacity(nefc),
             nz_start: Vec::with_capacity(nefc + 1),
             nz_index: Vec::with_capacity(nefc * nv),
             ar: DMatrix::zeros(0, 0),

@@ -30,6 +30,14 @@ pub(crate) fn meshes(
     for section in root.children_named("asset") {
         for e in section.children_named("mesh") {
             let a = defaults.resolve(e, MAIN)?;
+            if let Some(shape) = a.text("builtin") {
+                return Err(LoadError::Unsupported {
+                    loc: e.loc.clone(),
+                    element: "mesh".into(),
+                    what: format!("the built-in mesh '{shape}'"),
+                    fix: "MuJoCo 4.0 would generate its vertices and faces from 'params'; save that mesh to an STL or OBJ file (e.g. from MuJoCo's compiled mesh_vert/mesh_face) and give it in 'file'".into(),
+                });
+            }
             let Some(file) = a.text("file") else {
                 return Err(LoadError::Unsupported {
                     loc: e.loc.clone(),

@@ -1,22 +1,31 @@
 //! Checks the element tree against MuJoCo's MJCF schema ([`super::schema`]): value counts and
 //! keywords of known attributes are errors when wrong (as in MuJoCo); unknown attributes and
 //! elements are warnings with file:line; known elements this engine does not build and that would
-//! change the dynamics (`replicate`, `attach`, `composite`, `flexcomp`, `<deformable>` flexes,
-//! sub-model assets) are errors that say so.
+//! change the dynamics (`composite`, `flexcomp`, `<deformable>` flexes, engine plugins on bodies,
+//! geoms and meshes) are errors
+//! that name the element, its line and what MuJoCo would do with it. (`replicate`, `attach` and
+//! sub-model assets are composed by [`super::attach`]; skins only draw.)
 
 use super::attrs::Attrs;
 use super::schema_types::ElementSchema;
 use super::xml::Element;
 use crate::io::LoadError;
 
-/// Elements MuJoCo knows that change the model's bodies or dynamics and are not built here.
-const UNSUPPORTED: [(&str, &str); 6] = [
-    ("replicate", "write the repeated bodies out"),
-    ("attach", "paste the attached model's bodies into this file"),
-    ("composite", "expand the composite into bodies and joints"),
-    ("flexcomp", "flexible bodies are not simulated; remove it"),
-    ("flex", "flexible bodies are not simulated; remove it"),
-    ("model", "paste the sub-model's bodies into this file"),
+/// Elements MuJoCo knows that change the model's bodies or dynamics and are not built here: what
+/// MuJoCo would do, and how to rewrite the model without them.
+const UNSUPPORTED: [(&str, &str); 3] = [
+    (
+        "composite",
+        "MuJoCo 4.0 rejects it too (\"unrecognized element\"; MuJoCo 3 generated a cable, rope or grid of bodies, joints and tendons from it); write those bodies out, or compile the model with MuJoCo 3 and save it (mj_saveLastXML)",
+    ),
+    (
+        "flexcomp",
+        "MuJoCo would generate a deformable flex with its vertex bodies; flexible bodies are not simulated here: remove it",
+    ),
+    (
+        "flex",
+        "MuJoCo would simulate a deformable flex between bodies; flexible bodies are not simulated here: remove it",
+    ),
 ];
 
 /// Checks the whole tree; returns the warnings.
@@ -50,6 +59,19 @@ fn check(e: &Element, decl: &ElementSchema, warnings: &mut Vec<String>) -> Resul
                     fix: fix.to_string(),
                 });
             }
+        }
+        if child.tag == "plugin" && matches!(e.tag.as_str(), "body" | "worldbody" | "frame" | "geom" | "mesh")
+        {
+            return Err(LoadError::Unsupported {
+                loc: child.loc.clone(),
+                element: child.tag.clone(),
+                what: format!("an engine plugin in <{}>", e.tag),
+                fix: format!(
+                    "MuJoCo would run plugin '{}' ({}); plugins are not run here: remove the <plugin> (and its <extension>)",
+                    child.attr("plugin").or(child.attr("instance")).unwrap_or("?"),
+                    if e.tag == "mesh" || e.tag == "geom" { "a signed-distance shape" } else { "forces on the body" }
+                ),
+            });
         }
         match child_decl {
             Some(d) => check(child, d, warnings)?,

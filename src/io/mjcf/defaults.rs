@@ -63,6 +63,18 @@ impl Defaults {
             let main = d.classes[MAIN].clone();
             d.read(section, MAIN, &main)?;
         }
+        // The classes of attached models (super::attach): each a root over MuJoCo's built-ins.
+        for section in root.children_named(super::attach::ATTACHED_DEFAULTS) {
+            let name = section.attr("class").unwrap_or(MAIN);
+            if d.classes.contains_key(name) {
+                return Err(LoadError::DuplicateName {
+                    loc: section.loc.clone(),
+                    element: "default class",
+                    name: name.to_string(),
+                });
+            }
+            d.read(section, name, &Class::default())?;
+        }
         Ok(d)
     }
 

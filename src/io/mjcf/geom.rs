@@ -221,6 +221,15 @@ pub(crate) fn geom(
             }
         },
     };
+    let fluid = match a.keyword("fluidshape", &["none", "ellipsoid"])?.as_deref() {
+        Some("ellipsoid") => {
+            // MuJoCo's defaults; a partial `fluidcoef` overrides the first entries.
+            let mut coef = [0.5, 0.25, 1.5, 1.0, 1.0];
+            a.fill("fluidcoef", &mut coef)?;
+            Some(coef)
+        }
+        _ => None,
+    };
     Ok(GeomSpec {
         name: a.text("name").unwrap_or("").to_string(),
         loc: a.loc.clone(),
@@ -234,6 +243,7 @@ pub(crate) fn geom(
         rgba,
         material_rgba,
         contact,
+        fluid,
     })
 }
 

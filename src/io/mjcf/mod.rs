@@ -3,15 +3,17 @@
 //!
 //! Passes: read the file into one element tree with `<include>`s spliced (`xml`); check every
 //! element and attribute against MuJoCo's schema (`check`: unknown ones are warnings, elements
-//! that would change the dynamics and are not supported are errors); read `<compiler>` and
-//! `<option>`; build the default classes (`defaults`); read the mesh assets (`assets`); walk
-//! `<worldbody>` depth-first in file order into links (`body`, `geom`); read keyframes and
+//! that would change the dynamics and are not supported are errors); read `<compiler>`; expand
+//! `<replicate>`s and merge `<attach>`ed sub-models (`replicate`, `attach`); read `<option>`;
+//! build the default classes (`defaults`); read the mesh assets (`assets`); walk `<worldbody>`
+//! depth-first in file order into links (`body`, `geom`); read keyframes and
 //! sensors (`sections`), equality constraints (`equality`), tendons (`tendon`), actuators
 //! (`actuator`) and contact pairs and exclusions (`contact`), whose names the compile step
 //! resolves.
 
 mod actuator;
 mod assets;
+mod attach;
 mod attrs;
 mod body;
 mod check;
@@ -20,6 +22,7 @@ mod defaults;
 mod equality;
 mod geom;
 mod orientation;
+mod replicate;
 mod schema;
 mod schema_types;
 mod sections;
@@ -114,6 +117,14 @@ fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<Mo
     }
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let compiler = sections::compiler(root, &dir)?;
+    // Composition (`<replicate>`, `<attach>`): expanded into plain elements first.
+    let composed;
+    let root = if attach::needed(root) {
+        composed = attach::expand(root, &compiler, &dir, &mut warnings)?;
+        &composed
+    } else {
+        root
+    };
     let (options, gravity) = sections::options(root)?;
     let defaults = defaults::Defaults::build(root)?;
     let meshes = assets::meshes(root, &defaults, &compiler, &root.loc.file)?;

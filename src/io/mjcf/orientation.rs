@@ -112,7 +112,8 @@ pub fn z_to_matrix(v: &Vec3) -> Mat3 {
     axis_angle_matrix(&axis, angle)
 }
 
-fn euler_matrix(e: &[f64; 3], angles: &AngleConvention) -> Mat3 {
+/// The rotation of Euler angles `e` (in the convention's unit and sequence).
+pub(crate) fn euler_matrix(e: &[f64; 3], angles: &AngleConvention) -> Mat3 {
     let mut q = UnitQuaternion::identity();
     for (i, &c) in angles.eulerseq.iter().enumerate() {
         let half = e[i] * angles.to_radians / 2.0;

@@ -1,0 +1,206 @@
+"""Contact-rich scenes beside `mj_step` (issue 26, item 5): per-step time of lagrange's soft and
+exact modes against MuJoCo 4.0 in the same run, and the growth of the step time with the number
+of objects in a bin (time ∝ Nᵏ, fitted for both engines). Report only: writes the section
+"## Contact-rich scenes: soft and exact step beside mj_step" of validation/bench.md. Not part of
+.ci/run (the large bins take minutes in lagrange's dense solver); run it by hand:
+
+    validation/.venv/bin/python validation/bench_contact_rich.py [--quick] [--binary target/release/lagrange]
+
+Scenes (generated here, deterministic): box stacks of 5/10/20 on a floor, a heavy box on a light
+one at mass ratios 10/100/1000, bins of N = 10/50/100/200/400 mixed primitives (spheres, capsules,
+boxes) dropped into a walled bin, a 30-link capsule chain falling onto the floor; and the shipped
+go1 and dm_control humanoid scenes. Every scene: Euler, 2 ms, Newton (MuJoCo's defaults), pyramidal
+cones, from rest. MuJoCo: `mjTIMER_STEP` per step (a C clock as `mjcb_time`), the best of 3 runs.
+lagrange: `eval --step S` from the same start, `step_us` (the best of 3 in one process), in soft
+and in exact mode (`--constraints exact`); a run that fails (divergence, NaN) is reported with its
+message. `--quick` keeps the small scenes only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import platform
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+sys.path.insert(0, str(HERE))
+from crossval_common import lagrange_eval_json  # noqa: E402
+from crossval_scenes import commit, replace_section  # noqa: E402
+
+SECTION = "## Contact-rich scenes: soft and exact step beside mj_step"
+OPTION = '<option timestep="0.002" integrator="Euler" solver="Newton" cone="pyramidal"/>'
+FLOOR = '<geom name="floor" type="plane" size="0 0 1"/>'
+
+
+def stack(n: int) -> str:
+    bodies = "".join(
+        f'<body pos="0 0 {0.05 + 0.1 * k + 1e-4 * k:.6f}"><freejoint/>'
+        f'<geom type="box" size="0.05 0.05 0.05" mass="1"/></body>' for k in range(n))
+    return f"<mujoco>{OPTION}<worldbody>{FLOOR}{bodies}</worldbody></mujoco>"
+
+
+def mass_ratio(r: float) -> str:
+    return (f"<mujoco>{OPTION}<worldbody>{FLOOR}"
+            '<body pos="0 0 0.05"><freejoint/><geom type="box" size="0.05 0.05 0.05" mass="1"/></body>'
+            f'<body pos="0 0 0.1501"><freejoint/><geom type="box" size="0.1 0.1 0.05" mass="{r}"/></body>'
+            "</worldbody></mujoco>")
+
+
+def bin_scene(n: int) -> str:
+    """N primitives on a grid above a walled bin whose floor area grows with N (a pile ~3 deep)."""
+    rng = np.random.default_rng(26 + n)
+    side = max(2, math.ceil(math.sqrt(n / 3)))
+    half = 0.06 * side
+    walls = "".join(
+        f'<geom type="box" pos="{x} {y} 0.3" size="{sx} {sy} 0.3"/>'
+        for x, y, sx, sy in ((half + 0.01, 0, 0.01, half), (-half - 0.01, 0, 0.01, half),
+                             (0, half + 0.01, half, 0.01), (0, -half - 0.01, half, 0.01)))
+    bodies = []
+    for k in range(n):
+        i, j, layer = k % side, (k // side) % side, k // (side * side)
+        x = -half + 0.06 + 0.12 * i + rng.uniform(-0.01, 0.01)
+        y = -half + 0.06 + 0.12 * j + rng.uniform(-0.01, 0.01)
+        z = 0.06 + 0.12 * layer
+        kind = k % 3
+        geom = ('<geom type="sphere" size="0.04"/>', '<geom type="capsule" size="0.025 0.03"/>',
+                '<geom type="box" size="0.035 0.035 0.035"/>')[kind]
+        bodies.append(f'<body pos="{x:.6f} {y:.6f} {z:.6f}" euler="{rng.uniform(0, 90):.3f} 0 0">'
+                      f"<freejoint/>{geom}</body>")
+    return f"<mujoco>{OPTION}<worldbody>{FLOOR}{walls}{''.join(bodies)}</worldbody></mujoco>"
+
+
+def chain(n: int = 30) -> str:
+    """A capsule chain of n links on ball joints, its free root 0.3 m above the floor, lying
+    horizontally: it falls and drapes."""
+    inner = ""
+    for _ in range(n - 1):
+        inner = f'<body pos="0.1 0 0"><joint type="ball"/><geom type="capsule" fromto="0 0 0 0.1 0 0" size="0.02"/>{inner}</body>'
+    return (f"<mujoco>{OPTION}<worldbody>{FLOOR}<body pos=\"0 0 0.3\"><freejoint/>"
+            f'<geom type="capsule" fromto="0 0 0 0.1 0 0" size="0.02"/>{inner}</body></worldbody></mujoco>')
+
+
+def scenes(quick: bool) -> list[tuple[str, str, object, int]]:
+    """(name, group, MJCF text or a path, steps)."""
+    out: list[tuple[str, str, object, int]] = []
+    for n in (5, 10) if quick else (5, 10, 20):
+        out.append((f"stack_{n}", "stack", stack(n), 200))
+    for r in (10, 100) if quick else (10, 100, 1000):
+        out.append((f"ratio_{r}", "ratio", mass_ratio(r), 200))
+    for n in (10, 50) if quick else (10, 50, 100, 200, 400):
+        out.append((f"bin_{n}", "bin", bin_scene(n), 200 if n <= 50 else 40 if n <= 100 else 10))
+    out.append(("chain_30", "chain", chain(30), 200))
+    out.append(("humanoid", "robot", REPO / "models/mjcf/humanoid/humanoid.xml", 200))
+    out.append(("go1", "robot", REPO / "models/mjcf/unitree_go1/scene.xml", 200))
+    return out
+
+
+def mujoco_step_us(mj, path: Path, steps: int) -> float:
+    m = mj.MjModel.from_xml_path(str(path))
+    d = mj.MjData(m)
+    best = math.inf
+    for _ in range(3):
+        mj.mj_resetData(m, d)
+        mj.mj_step(m, d, nstep=steps)
+        t = d.timer[int(mj.mjtTimer.mjTIMER_STEP)]
+        best = min(best, t.duration / t.number)
+    return best
+
+
+def lagrange_step_us(binary: Path, path: Path, q0: list[float], steps: int, mode: str) -> tuple[float, str]:
+    """The best of 3 runs of `steps` steps in `mode` (µs per step), or NaN and the failure."""
+    try:
+        out = lagrange_eval_json(binary, path, [{"q": q0}] * 3,
+                                 ["--step", str(steps), "--constraints", mode], timeout=3600, state_errors=True)
+    except (RuntimeError, Exception) as e:  # a timeout or a refusal: reported, never hidden
+        return math.nan, str(e).splitlines()[0][:120]
+    good = [r for r in out["results"] if "step_us" in r]
+    if not good:
+        return math.nan, str(out["results"][0].get("error", "failed"))[:120]
+    finite = all(all(math.isfinite(x) for x in r["qpos"]) for r in good)
+    return min(r["step_us"] for r in good), "" if finite else "non-finite state"
+
+
+def fit_exponent(ns: list[int], ts: list[float]) -> float:
+    pts = [(math.log(n), math.log(t)) for n, t in zip(ns, ts) if math.isfinite(t) and t > 0]
+    if len(pts) < 2:
+        return math.nan
+    x, y = np.array(pts).T
+    return float(np.polyfit(x, y, 1)[0])
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--binary", type=Path, default=REPO / "target/release/lagrange")
+    ap.add_argument("--quick", action="store_true", help="the small scenes only")
+    ap.add_argument("--no-write", action="store_true", help="print, do not write validation/bench.md")
+    args = ap.parse_args()
+    import mujoco as mj
+
+    clock = time.perf_counter
+    mj.set_mjcb_time(lambda: clock() * 1e6)  # µs: the timers' unit below
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, group, scene, steps in scenes(args.quick):
+            path = scene if isinstance(scene, Path) else Path(tmp) / f"{name}.xml"
+            if not isinstance(scene, Path):
+                path.write_text(scene)
+            m = mj.MjModel.from_xml_path(str(path))
+            q0 = [float(x) for x in m.qpos0]
+            mj_us = mujoco_step_us(mj, path, steps)
+            soft, soft_err = lagrange_step_us(args.binary, path, q0, steps, "soft")
+            exact, exact_err = lagrange_step_us(args.binary, path, q0, steps, "exact")
+            rows.append(dict(name=name, group=group, nv=m.nv, ngeom=m.ngeom, steps=steps, mj=mj_us, soft=soft,
+                             exact=exact, soft_err=soft_err, exact_err=exact_err))
+            r = rows[-1]
+            print(f"{name:10s} nv {m.nv:5d}  mj_step {mj_us:10.1f} µs  soft {soft:12.1f} µs ({soft / mj_us:7.2f}×) "
+                  f"exact {exact:12.1f} µs ({exact / mj_us:7.2f}×) {soft_err} {exact_err}", flush=True)
+    text = report(rows)
+    print(text)
+    if not args.no_write:
+        replace_section(HERE / "bench.md", SECTION, text)
+    return 0
+
+
+def ratio(a: float, b: float) -> str:
+    return f"{a / b:.2f}" if math.isfinite(a) and math.isfinite(b) and b > 0 else "—"
+
+
+def report(rows) -> str:
+    import mujoco as mj
+
+    bins = [r for r in rows if r["group"] == "bin"]
+    ns = [int(r["name"].split("_")[1]) for r in bins]
+    k = {key: fit_exponent(ns, [r[key] for r in bins]) for key in ("mj", "soft", "exact")}
+    med = {key: float(np.nanmedian([r[key] / r["mj"] for r in rows if r["group"] != "robot"])) for key in ("soft", "exact")}
+    lines = [
+        SECTION, "",
+        f"Written by `validation/bench_contact_rich.py` on {time.strftime('%Y-%m-%d', time.gmtime())} (UTC), lagrange "
+        f"{commit()}, MuJoCo {mj.__version__}, {platform.machine()}, load average "
+        f"{' '.join(f'{x:.2f}' for x in __import__('os').getloadavg())} on {__import__('os').cpu_count()} CPUs "
+        "(not pinned: with more runnable processes than CPUs figures move by 2×). Report only (issue 26). Each scene "
+        "from rest, Euler 2 ms, Newton, pyramidal cones; per-step µs over the steps shown, the best of 3 runs, "
+        "MuJoCo's `mjTIMER_STEP` against lagrange's `eval --step` in soft and exact mode. Ratios: lagrange / MuJoCo.",
+        "",
+        f"Median ratio of the contact-rich scenes (robots excluded): soft {med['soft']:.2f}, exact {med['exact']:.2f}. "
+        f"Bins, time ∝ Nᵏ fitted over N = {', '.join(map(str, ns))}: MuJoCo k = {k['mj']:.2f}, lagrange soft "
+        f"k = {k['soft']:.2f}, exact k = {k['exact']:.2f} (issue 26 asks soft ≤ MuJoCo's + 0.1).",
+        "",
+        "| scene | nv | geoms | steps | mj_step µs | soft µs | soft ratio | exact µs | exact ratio | failures |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        fail = "; ".join(f"{m}: {e}" for m, e in (("soft", r["soft_err"]), ("exact", r["exact_err"])) if e)
+        lines.append(f"| {r['name']} | {r['nv']} | {r['ngeom']} | {r['steps']} | {r['mj']:.1f} | {r['soft']:.1f} | "
+                     f"{ratio(r['soft'], r['mj'])} | {r['exact']:.1f} | {ratio(r['exact'], r['mj'])} | {fail} |")
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    sys.exit(main())
