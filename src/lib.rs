@@ -52,5 +52,6 @@ pub mod prelude;
 pub mod sensor;
 pub mod sim;
 pub mod spatial;
+pub mod tendon;
 
 pub use model::{Data, Model};

@@ -8,7 +8,7 @@
 use lagrange::io::{compile, load, mjcf, LoadOptions};
 use lagrange::model::actuator::{ActuatorShortcut, BiasType, DynType, GainType, Transmission};
 use lagrange::model::equality::{DEFAULT_SOLIMP, DEFAULT_SOLREF};
-use lagrange::model::{EqualityKind, FrameKind, Model, TendonKind};
+use lagrange::model::{EqualityKind, FrameKind, Model, PathElement, TendonKind};
 use lagrange::spatial::{Mat3, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -119,7 +119,14 @@ fn tendons_keep_mujoco_order_and_limits() {
     assert_eq!(m.tendons[0].kind, TendonKind::Fixed { joints: vec![(hinge, 2.0), (slide, -1.0)] });
     assert_eq!(m.tendons[0].range, Some([-0.5, 0.5]), "range with autolimits: limited");
     assert_eq!(m.tendons[1].range, None);
-    assert_eq!(m.tendons[2].kind, TendonKind::Spatial { path: vec!["sa".into(), "sc".into()] });
+    let (sa, sc) = (frame(&m, "sa", FrameKind::Site), frame(&m, "sc", FrameKind::Site));
+    assert_eq!(
+        m.tendons[2].kind,
+        TendonKind::Spatial {
+            path: vec!["sa".into(), "sc".into()],
+            wraps: vec![PathElement::Site(sa), PathElement::Site(sc)]
+        }
+    );
 }
 
 /// One actuator's expected values (MuJoCo 4.0.0).
@@ -465,15 +472,17 @@ fn equality_on_a_spatial_tendon_is_listed_with_a_warning() {
 /// warning naming file, line, tendon and attribute (never silently dropped); zeros say nothing.
 #[test]
 fn unsimulated_tendon_terms_are_warnings() {
+    // stiffness, damping and frictionloss are simulated (read into the tendon); armature is said.
     let m = compile_mjcf(&model_with(
         "",
-        r#"  <tendon><fixed name="u" stiffness="10" damping="0" frictionloss="0.5 "><joint joint="hinge" coef="1"/></fixed></tendon>"#,
+        r#"  <tendon><fixed name="u" stiffness="10" damping="0" frictionloss="0.5 " armature="0.1"><joint joint="hinge" coef="1"/></fixed></tendon>"#,
     ))
     .unwrap();
     let about_u: Vec<&String> = m.warnings.iter().filter(|w| w.contains("'u'")).collect();
-    assert_eq!(about_u.len(), 2, "{:?}", m.warnings);
-    assert!(about_u[0].contains("inline.xml:") && about_u[0].contains("stiffness=\"10\" is not simulated"));
-    assert!(about_u[1].contains("frictionloss=\"0.5\"") && about_u[1].contains("friction_tendon"));
+    assert_eq!(about_u.len(), 1, "{:?}", m.warnings);
+    assert!(about_u[0].contains("inline.xml:") && about_u[0].contains("armature=\"0.1\" is not simulated"));
+    let u = m.tendons.iter().find(|t| t.name == "u").unwrap();
+    assert_eq!((u.stiffness, u.damping, u.frictionloss), (10.0, 0.0, 0.5));
 }
 
 #[test]

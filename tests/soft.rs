@@ -259,7 +259,9 @@ fn a_tendon_limit_alone_constrains_the_model() {
     assert!(!exact.has_constraints());
     let listed = exact.stages.iter().find(|s| s.name == "joint limits").unwrap();
     assert!(
-        listed.reason.contains("1 fixed-tendon length limits kept, not simulated in exact mode"),
+        listed
+            .reason
+            .contains("1 tendon length limits and friction losses kept, not simulated in exact mode"),
         "{}",
         listed.reason
     );

@@ -306,7 +306,7 @@ fn info_lists_typed_elements_with_what_is_simulated() {
     assert_eq!(c["status"], "simulated (exact mode)");
     assert!(c["source"].as_str().unwrap().ends_with("elements.xml:47"), "{c}");
     assert_eq!(find("t1")["status"], "simulated (equality rows)", "coupled by the tendon equality");
-    assert_eq!(find("rope")["status"], "parsed, not simulated");
+    assert_eq!(find("rope")["status"], "simulated");
     assert_eq!(find("rope")["kind"], "spatial");
     let p = find("p_class");
     assert_eq!((p["kind"].as_str(), p["status"].as_str()), (Some("position"), Some("simulated")));

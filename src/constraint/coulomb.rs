@@ -128,7 +128,10 @@ pub(crate) fn solve_coulomb(
         while i < n {
             let len = data.efc_block_len(i);
             match data.efc_type[i] {
-                EfcType::Equality => scalar_update(data, i, f64::NEG_INFINITY, f64::INFINITY),
+                // Tendon friction rows are the soft mode's; the exact mode never makes them.
+                EfcType::Equality | EfcType::FrictionTendon => {
+                    scalar_update(data, i, f64::NEG_INFINITY, f64::INFINITY)
+                }
                 EfcType::FrictionDof => friction_dof(model, data, i, level),
                 // Pyramidal rows are the soft mode's; the exact mode never makes them.
                 EfcType::LimitJoint
@@ -512,7 +515,7 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     while i < n {
         let len = data.efc_block_len(i);
         match data.efc_type[i] {
-            EfcType::Equality => data.exact.active.push(i),
+            EfcType::Equality | EfcType::FrictionTendon => data.exact.active.push(i),
             EfcType::LimitJoint
             | EfcType::LimitTendon
             | EfcType::ContactFrictionless
@@ -637,7 +640,7 @@ fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         let len = data.efc_block_len(i);
         let l = data.exact.lambda_prev[i];
         let ok = match data.efc_type[i] {
-            EfcType::Equality => true,
+            EfcType::Equality | EfcType::FrictionTendon => true,
             EfcType::LimitJoint
             | EfcType::LimitTendon
             | EfcType::ContactFrictionless

@@ -160,10 +160,13 @@ pub struct ConstraintModel {
     pub friction: Vec<FrictionRow>,
     /// Limited joints, one entry each (rows when a bound is within the margin).
     pub limits: Vec<LimitRow>,
-    /// Fixed tendons with a length range: a row per bound within the tendon's margin, soft mode
-    /// only (the exact mode has no tendon rows: `Plan::new` empties this list there and lists the
-    /// limits as not simulated).
+    /// Tendons (fixed or spatial) with a length range: a row per bound within the tendon's
+    /// margin, soft mode only (the exact mode has no tendon rows: `Plan::new` empties this list
+    /// there and lists the limits as not simulated).
     pub tendon_limits: Vec<usize>,
+    /// Tendons with dry friction (`frictionloss` > 0): one row each, always present, soft mode
+    /// only (emptied by `Plan::new` in exact mode, like `tendon_limits`).
+    pub tendon_friction: Vec<usize>,
 }
 
 /// P(x) and P′(x), P″(x) of MuJoCo's quartic `polycoef`.
@@ -209,15 +212,25 @@ impl ConstraintModel {
             Vec::new()
         };
         let tendon_limits = if flags.limit {
-            let limited =
-                |t: &crate::model::Tendon| t.range.is_some() && matches!(t.kind, TendonKind::Fixed { .. });
-            (0..model.tendons.len()).filter(|&t| limited(&model.tendons[t])).collect()
+            (0..model.tendons.len()).filter(|&t| model.tendons[t].range.is_some()).collect()
         } else {
             Vec::new()
         };
         let friction = if flags.frictionloss { FrictionRow::of_model(model) } else { Vec::new() };
+        let tendon_friction = if flags.frictionloss {
+            (0..model.tendons.len()).filter(|&t| model.tendons[t].frictionloss > 0.0).collect()
+        } else {
+            Vec::new()
+        };
         if model.equalities.is_empty() || !flags.equality {
-            return Self { collision, equalities: Vec::new(), friction, limits, tendon_limits };
+            return Self {
+                collision,
+                equalities: Vec::new(),
+                friction,
+                limits,
+                tendon_limits,
+                tendon_friction,
+            };
         }
         let mut data = Data::new(model);
         forward_kinematics_unchecked(model, &mut data, &model.qpos0);
@@ -310,7 +323,7 @@ impl ConstraintModel {
             };
             equalities.push(EqualityRows { id, geometry, mocap });
         }
-        Self { collision, equalities, friction, limits, tendon_limits }
+        Self { collision, equalities, friction, limits, tendon_limits, tendon_friction }
     }
 
     /// Whether the model has no constraint rows at all (no equality, friction loss, joint or
@@ -320,6 +333,7 @@ impl ConstraintModel {
             && self.friction.is_empty()
             && self.limits.is_empty()
             && self.tendon_limits.is_empty()
+            && self.tendon_friction.is_empty()
             && !self.has_collision()
     }
 
@@ -509,7 +523,9 @@ impl ConstraintModel {
         while r < data.nefc {
             data.efc_vel[r] = (0..model.nv).map(|k| data.efc_j[(r, k)] * v[k]).sum();
             match data.efc_type[r] {
-                EfcType::Equality | EfcType::FrictionDof | EfcType::LimitTendon => data.efc_jdotv[r] = 0.0,
+                EfcType::Equality | EfcType::FrictionDof | EfcType::FrictionTendon | EfcType::LimitTendon => {
+                    data.efc_jdotv[r] = 0.0
+                }
                 EfcType::LimitJoint => {
                     let joint = data.efc_id[r];
                     let l = self.limits.iter().find(|l| l.joint == joint);

@@ -85,6 +85,7 @@ pub fn smooth_derivatives(
 /// [`smooth_derivatives`] at (q, v), `data.qpos` and `data.qvel` unused.
 fn smooth_derivatives_at(model: &Model, data: &mut Data, work: &mut DerivativesWork, q: &[f64], v: &[f64]) {
     let plan = &model.plan;
+    crate::tendon::compute(model, data, q, v);
     if plan.runs(StageKind::Passive) {
         passive(model, data, q, v);
     } else {

@@ -49,10 +49,11 @@ pub fn resolved_bias_velocity(model: &Model) -> Vec<f64> {
                 crate::dynamics::crba_unchecked(model, &mut data, q0);
                 crate::dynamics::factorize_mass_matrix(model, &mut data);
                 forward_kinematics_unchecked(model, &mut data, q0);
+                crate::tendon::lengths_and_jacobians(model, &mut data, q0);
                 data
             });
-            let Data { actuator_moment, x_world_body, s_body, x_world_frame, .. } = data;
-            let poses = Poses { x_world_body, s_body, x_world_frame };
+            let Data { actuator_moment, x_world_body, s_body, x_world_frame, ten_length, ten_j, .. } = data;
+            let poses = Poses { x_world_body, s_body, x_world_frame, ten_length, ten_j };
             actuator_moment.row_mut(i).fill(0.0);
             transmission(model, a, q0, poses, actuator_moment, i);
             let moment = actuator_moment.row(i).transpose();
@@ -100,6 +101,7 @@ pub fn actuation(
     check::q("actuation", model, q)?;
     check::v("actuation", "v", model, v)?;
     InputError::check_len("actuation", "bias_velocity", bias_velocity.len(), model.actuators.len(), "nu")?;
+    crate::tendon::compute(model, data, q, v);
     actuation_unchecked(model, data, q, v, bias_velocity);
     Ok(())
 }
@@ -137,8 +139,8 @@ pub(crate) fn actuation_unchecked(
             }
             continue;
         }
-        let Data { actuator_moment, x_world_body, s_body, x_world_frame, .. } = data;
-        let poses = Poses { x_world_body, s_body, x_world_frame };
+        let Data { actuator_moment, x_world_body, s_body, x_world_frame, ten_length, ten_j, .. } = data;
+        let poses = Poses { x_world_body, s_body, x_world_frame, ten_length, ten_j };
         let length = transmission(model, a, q, poses, actuator_moment, i);
         let velocity = actuator_moment.row(i).iter().zip(v).map(|(m, v)| m * v).sum::<f64>();
         let ctrl = if zeroed { 0.0 } else { clamped_ctrl(model, data, i) };

@@ -73,6 +73,9 @@ pub fn forward(model: &Model, data: &mut Data) {
 pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     let plan = &model.plan;
     let (rows, solver) = (&plan.constraints, &plan.solver);
+    // Tendon lengths, Jacobians and velocities first: limits, passive forces, actuators and
+    // sensors read them.
+    crate::tendon::compute(model, data, q, v);
     // Collision and the rows at q: the M path only while a row exists (an equality, a joint at
     // a limit, a touching contact, or MuJoCo's activation rules in soft mode); ABA otherwise,
     // as for a model without constraints.
@@ -133,6 +136,7 @@ pub(crate) fn passive(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     if let Some(fluid) = &model.plan.fluid {
         crate::dynamics::fluid::fluid_forces(model, fluid, data, q, v);
     }
+    crate::tendon::passive::add_tendon_passive(model, data);
 }
 
 /// The driving force on dof k: actuator plus applied, clamped to the dof's effort limit (URDF

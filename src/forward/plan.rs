@@ -32,7 +32,7 @@ pub enum StageKind {
     FrictionLoss,
     /// Collision detection and contact rows.
     Collision,
-    /// Spatial tendons (kept, not simulated).
+    /// Tendon lengths, Jacobians and wrap points (`mj_tendon`).
     Tendons,
     /// The sensor stage (`sensordata`), after the constraint stage.
     Sensors,
@@ -111,6 +111,7 @@ impl Plan {
         // The exact mode has no tendon rows: its fixed-tendon limits are listed as not simulated.
         let exact_tendon_limits = if mode == ConstraintMode::Exact {
             std::mem::take(&mut constraints.tendon_limits).len()
+                + std::mem::take(&mut constraints.tendon_friction).len()
         } else {
             0
         };
@@ -164,7 +165,7 @@ fn stage(kind: StageKind, name: &'static str, status: Status, reason: impl Into<
     Stage { kind, name, status, reason: reason.into() }
 }
 
-/// The stages of the plan; `exact_tendon_limits` fixed-tendon limits are kept but not simulated
+/// The stages of the plan; `exact_tendon_limits` tendon limits and friction losses are kept but not simulated
 /// (exact mode).
 fn stages(
     model: &Model,
@@ -177,7 +178,7 @@ fn stages(
     let nrow: usize = constraints.equalities.iter().map(|e| model.equalities[e.id].kind.nrow()).sum();
     let ntendon = constraints.tendon_limits.len();
     let nlimit = constraints.limits.len() + ntendon;
-    let nfriction = constraints.friction.len();
+    let nfriction = constraints.friction.len() + constraints.tendon_friction.len();
     let rows = match (nrow, nlimit) {
         (_, 0) => format!("{nrow} constraint rows"),
         (0, _) => {
@@ -218,13 +219,19 @@ fn stages(
     let damped = model.dof_damping.iter().filter(|&&d| d != 0.0).count();
     let springs = model.springs.len();
     let fluid = crate::dynamics::fluid::FluidModel::new(model);
-    out.push(if damped + springs > 0 || fluid.is_some() {
+    let tendon_passive = crate::tendon::passive::count_tendon_passive(model);
+    out.push(if damped + springs + tendon_passive > 0 || fluid.is_some() {
+        let tendons = if tendon_passive > 0 {
+            format!(", {tendon_passive} tendon spring-dampers (ten_Jᵀ f)")
+        } else {
+            String::new()
+        };
         stage(
             Passive,
             "passive",
             Runs,
             format!(
-                "joint damping on {damped} degrees of freedom, {springs} joint springs{}",
+                "joint damping on {damped} degrees of freedom, {springs} joint springs{tendons}{}",
                 if fluid.is_some() { ", fluid forces" } else { "" }
             ),
         )
@@ -318,7 +325,7 @@ fn stages(
         stage(Equality, "equality", Runs, format!("{} ({nrow} rows{inactive})", list.join(", ")))
     });
     let tendons_kept = if exact_tendon_limits > 0 {
-        format!("; {exact_tendon_limits} fixed-tendon length limits kept, not simulated in exact mode (soft mode has them)")
+        format!("; {exact_tendon_limits} tendon length limits and friction losses kept, not simulated in exact mode (soft mode has them)")
     } else {
         String::new()
     };
@@ -327,7 +334,7 @@ fn stages(
         let counts = [
             (nlimit - ntendon - ball, "limited hinge/slide joints"),
             (ball, "ball-joint cone limits"),
-            (ntendon, "fixed-tendon length limits"),
+            (ntendon, "tendon length limits"),
         ];
         let what: Vec<String> =
             counts.iter().filter(|(n, _)| *n > 0).map(|(n, w)| format!("{n} {w}")).collect();
@@ -353,12 +360,13 @@ fn stages(
         stage(JointLimits, "joint limits", Skipped, "no limited joints")
     });
     let nfriction = constraints.friction.len();
-    out.push(if nfriction > 0 {
+    let ntendon_friction = constraints.tendon_friction.len();
+    out.push(if nfriction + ntendon_friction > 0 {
         stage(
             FrictionLoss,
             "friction loss",
             Runs,
-            format!("{nfriction} dofs with dry friction: bounded rows |λ| ≤ frictionloss, always active"),
+            format!("{nfriction} dofs and {ntendon_friction} tendons with dry friction: bounded rows |λ| ≤ frictionloss, always active"),
         )
     } else if !flags.frictionloss && model.joints.iter().any(|j| j.friction > 0.0) {
         stage(
@@ -409,7 +417,19 @@ fn stages(
     });
     let spatial =
         model.tendons.iter().filter(|t| matches!(t.kind, crate::model::TendonKind::Spatial { .. })).count();
-    out.push(kept(Tendons, "spatial tendons", spatial, "spatial tendons", "kept, not simulated"));
+    out.push(if model.tendons.is_empty() {
+        stage(Tendons, "tendons", Skipped, "no tendons")
+    } else {
+        stage(
+            Tendons,
+            "tendons",
+            Runs,
+            format!(
+                "{} tendons ({spatial} spatial: forward kinematics, site paths wrapped around spheres and cylinders, pulleys): ten_length, ten_J, ten_velocity each evaluation",
+                model.tendons.len()
+            ),
+        )
+    });
     out.push(sensor_stage(model));
     let multi_dof_springs = model.joints.iter().filter(|j| j.stiffness != 0.0 && j.kind.nq() > 1).count();
     let other = model.elements.iter().filter(|e| matches!(e.category.as_str(), "body" | "joint")).count()
@@ -498,15 +518,6 @@ fn sensor_stage(model: &Model) -> Stage {
     stage(StageKind::Sensors, "sensors", status, reason)
 }
 
-/// A stage for `n` kept elements: not simulated with `why`, or skipped if there are none.
-fn kept(kind: StageKind, name: &'static str, n: usize, what: &str, why: &str) -> Stage {
-    if n > 0 {
-        stage(kind, name, Status::NotSimulated, format!("{n} {what}: {why}"))
-    } else {
-        stage(kind, name, Status::Skipped, format!("no {what}"))
-    }
-}
-
 /// The constraint stage in soft mode: solver, cone and the `<option>` settings honoured, and the
 /// MuJoCo features of the model the soft mode does not simulate yet.
 fn soft_description(model: &Model) -> String {
@@ -551,14 +562,6 @@ pub fn soft_unsupported(model: &Model) -> Vec<String> {
     }
     if o.flags.island {
         out.push("<flag island> (islands are solved as one problem: same solution)".to_string());
-    }
-    let spatial_limits = model
-        .tendons
-        .iter()
-        .filter(|t| t.range.is_some() && matches!(t.kind, crate::model::TendonKind::Spatial { .. }))
-        .count();
-    if spatial_limits > 0 {
-        out.push(format!("{spatial_limits} spatial-tendon limits"));
     }
     out
 }

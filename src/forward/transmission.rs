@@ -10,6 +10,7 @@
 //! | ball joint | r · g, with r the rotation vector of the (normalized) joint quaternion | g on the 3 dofs |
 //! | free joint | 0 | (gear₀₋₂, g) on the 6 dofs |
 //! | fixed tendon | gear₀ · Σ coef · q | gear₀ · coef |
+//! | spatial tendon | gear₀ · `ten_length` | gear₀ · `ten_J` (`crate::tendon`) |
 //! | site | 0 | J_siteᵀ (R_site gear) |
 //! | site with refsite | Rᵣᵀ(p_site − pᵣ) · gear₀₋₂ + log(Rᵣᵀ R_site) · gear₃₋₅ | (J_site − Jᵣ)ᵀ (Rᵣ gear), 0 on common ancestor dofs |
 //! | slider-crank | gear₀ (a·d − √((a·d)² + r² − d·d)) | gear₀ ∂length/∂q through d and a |
@@ -34,12 +35,15 @@ use crate::model::{JointKind, Model, TendonKind};
 use crate::spatial::{Mat3, Motion, Transform, Vec3};
 use nalgebra::DMatrix;
 
-/// The poses a site transmission needs (from forward kinematics at the same q).
+/// The poses a site transmission needs (from forward kinematics at the same q), and the
+/// tendons' lengths and Jacobians at q (`crate::tendon`) for spatial-tendon transmissions.
 #[derive(Clone, Copy)]
 pub(crate) struct Poses<'a> {
     pub x_world_body: &'a [Transform],
     pub s_body: &'a [Motion],
     pub x_world_frame: &'a [Transform],
+    pub ten_length: &'a nalgebra::DVector<f64>,
+    pub ten_j: &'a DMatrix<f64>,
 }
 
 /// Whether the transmission needs body and site poses (a site transmission).
@@ -116,8 +120,8 @@ fn add_projected_jacobian(
 }
 
 /// The length of actuator `i` at q; adds its moment arms to row `i` of `moment` (the caller
-/// zeroes it). `poses` must hold forward kinematics at q when [`needs_poses`]. Transmissions not
-/// simulated (spatial tendons, planar joints, body) give length 0 and no moment.
+/// zeroes it). `poses` must hold forward kinematics at q when [`needs_poses`], and the tendons
+/// at q. Transmissions not simulated (planar joints, body) give length 0 and no moment.
 pub(crate) fn transmission(
     model: &Model,
     a: &Actuator,
@@ -168,7 +172,12 @@ pub(crate) fn transmission(
                 }
                 length
             }
-            TendonKind::Spatial { .. } => 0.0,
+            TendonKind::Spatial { .. } => {
+                for k in 0..model.nv {
+                    moment[(i, k)] += gear[0] * poses.ten_j[(*t, k)];
+                }
+                gear[0] * poses.ten_length[*t]
+            }
         },
         Transmission::Site { site, refsite: None } => {
             let x = &poses.x_world_frame[*site];

@@ -372,6 +372,7 @@ impl Advance for Variational {
         // The drive, held over the step (with the activations at the step's start).
         if !model.actuators.is_empty() {
             data.act.copy_from(&state.act);
+            crate::tendon::compute(model, data, q0, state.v.as_slice());
             actuation_unchecked(model, data, q0, state.v.as_slice(), &model.plan.actuator_bias_velocity);
         }
         for k in 0..nv {
@@ -446,6 +447,7 @@ impl Advance for Variational {
                 self.terms0.pass(model, self.xi.as_slice(), false);
             }
             self.terms1.compute_unchecked(model, data, self.q1.as_slice(), self.xi.as_slice());
+            crate::tendon::compute(model, data, q0, self.xi.as_slice());
             passive(model, data, q0, self.xi.as_slice());
             for k in 0..nv {
                 self.mu_bar[k] = 0.5 * (self.terms0.momentum_gen[k] + self.terms1.momentum_gen[k]);
@@ -554,6 +556,7 @@ impl Advance for Variational {
         self.last_h = h;
         self.last_valid = true;
         // p_{k+1} = h/2 [∂_qL(q_{k+1}, ξ) + passive(q_{k+1}, ξ) + drive] + J_r⁻¹(−hξ) μ̄.
+        crate::tendon::compute(model, data, self.q1.as_slice(), self.xi.as_slice());
         passive(model, data, self.q1.as_slice(), self.xi.as_slice());
         self.theta.neg_mut();
         self.dexp_inv_mu_bar(model);

@@ -441,6 +441,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             ),
         });
     }
+    crate::tendon::resolve_spring_lengths(&mut model);
     model.plan = crate::forward::Plan::new(&model, None);
     Ok(model)
 }

@@ -19,13 +19,14 @@
 use crate::io::LoadError;
 use crate::model::actuator::ActuatorShortcut;
 use crate::model::equality::{DEFAULT_SOLIMP, DEFAULT_SOLREF};
+use crate::model::spec::Shape;
 use crate::model::spec::{
     ActuatorSpec, ContactPairSpec, EqualitySpec, EqualitySpecKind, JointType, ModelSpec, TendonSpec,
     TendonSpecKind, TransmissionSpec,
 };
 use crate::model::{
     Actuator, ContactExclude, ContactPair, Element, Equality, EqualityKind, FrameKind, JointKind, Model,
-    SourceLoc, Tendon, TendonKind,
+    PathElement, SourceLoc, Tendon, TendonKind, WrapShape,
 };
 use std::collections::HashMap;
 
@@ -531,29 +532,21 @@ fn tendon(t: &TendonSpec, n: &Names) -> Result<Tendon, LoadError> {
             }
             TendonKind::Fixed { joints: terms }
         }
-        TendonSpecKind::Spatial { path } => {
-            for (element, name) in path {
-                match element.as_str() {
-                    "site" => drop(n.site(name, &t.loc, "spatial")?),
-                    "geom" => drop(n.geom(name, &t.loc, "spatial")?),
-                    _ => {}
-                }
-            }
-            TendonKind::Spatial {
-                path: path
-                    .iter()
-                    .map(
-                        |(element, name)| {
-                            if element == "pulley" {
-                                format!("pulley {name}")
-                            } else {
-                                name.clone()
-                            }
-                        },
-                    )
-                    .collect(),
-            }
-        }
+        TendonSpecKind::Spatial { path } => TendonKind::Spatial {
+            path: path
+                .iter()
+                .map(
+                    |(element, name, _)| {
+                        if element == "pulley" {
+                            format!("pulley {name}")
+                        } else {
+                            name.clone()
+                        }
+                    },
+                )
+                .collect(),
+            wraps: spatial_path(t, path, n)?,
+        },
     };
     Ok(Tendon {
         name: t.name.clone(),
@@ -561,8 +554,73 @@ fn tendon(t: &TendonSpec, n: &Names) -> Result<Tendon, LoadError> {
         range: t.range,
         soft: t.soft,
         actuator_force_range: t.actuator_force_range,
+        stiffness: t.stiffness,
+        spring_length: t.spring_length,
+        damping: t.damping,
+        frictionloss: t.frictionloss,
         loc: t.loc.clone(),
     })
+}
+
+/// A spatial tendon's path resolved and checked as MuJoCo's compiler does: it starts and ends
+/// with a site, a geom (sphere or cylinder) sits between two sites, a pulley (divisor > 0)
+/// follows a site and is followed by one.
+fn spatial_path(
+    t: &TendonSpec,
+    path: &[(String, String, Option<String>)],
+    n: &Names,
+) -> Result<Vec<PathElement>, LoadError> {
+    let invalid =
+        |detail: String| LoadError::Invalid { loc: t.loc.clone(), element: "spatial".into(), detail };
+    let who = quoted(&t.name);
+    let is_site = |i: usize| path.get(i).is_some_and(|(e, _, _)| e == "site");
+    if path.len() < 2 || !is_site(0) || !is_site(path.len() - 1) {
+        return Err(invalid(format!(
+            "tendon {who}'s path must start and end with a <site> (MuJoCo's rule); it has {} elements",
+            path.len()
+        )));
+    }
+    let mut out = Vec::with_capacity(path.len());
+    for (i, (element, name, side)) in path.iter().enumerate() {
+        out.push(match element.as_str() {
+            "site" => PathElement::Site(n.site(name, &t.loc, "spatial")?),
+            "geom" => {
+                if !is_site(i - 1) || !is_site(i + 1) {
+                    return Err(invalid(format!(
+                        "geom '{name}' in tendon {who} must sit between two <site>s (MuJoCo's rule)"
+                    )));
+                }
+                let geom = n.geom(name, &t.loc, "spatial")?;
+                let (shape, radius) = match n.model.geoms[geom].shape {
+                    Shape::Sphere { radius } => (WrapShape::Sphere, radius),
+                    Shape::Cylinder { radius, .. } => (WrapShape::Cylinder, radius),
+                    _ => {
+                        return Err(invalid(format!(
+                            "geom '{name}' in tendon {who} is neither a sphere nor a cylinder; MuJoCo wraps tendons around those only"
+                        )))
+                    }
+                };
+                let sidesite = side.as_deref().map(|s| n.site(s, &t.loc, "spatial")).transpose()?;
+                PathElement::Geom { geom, shape, radius, sidesite }
+            }
+            "pulley" => {
+                let divisor: f64 = name.trim().parse().unwrap_or(f64::NAN);
+                if divisor.is_nan() || divisor <= 0.0 {
+                    return Err(invalid(format!(
+                        "a pulley in tendon {who} has divisor '{name}'; give a positive number"
+                    )));
+                }
+                if !is_site(i - 1) || !is_site(i + 1) {
+                    return Err(invalid(format!(
+                        "a pulley in tendon {who} must come between two <site>s (it starts a new branch)"
+                    )));
+                }
+                PathElement::Pulley { divisor }
+            }
+            other => return Err(invalid(format!("<{other}> is not a path element of a spatial tendon"))),
+        });
+    }
+    Ok(out)
 }
 
 /// One actuator: its transmission resolved, and `inheritrange` turned into a control (or, for

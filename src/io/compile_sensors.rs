@@ -11,7 +11,7 @@
 
 use crate::io::compile_elements::Names;
 use crate::io::LoadError;
-use crate::model::{Element, JointKind, Model, TendonKind};
+use crate::model::{Element, JointKind, Model};
 use crate::sensor::{
     ContactSensorSpec, Sensor, SensorDataType, SensorObject, SensorStage, SensorType, CONTACT_FIELDS,
     RAY_FIELDS,
@@ -172,9 +172,6 @@ fn sensor(e: &Element, names: &Names, model: &Model, id: usize) -> Result<Sensor
             let tendon = &model.tendons[t];
             if matches!(kind, TendonLimitPos | TendonLimitVel | TendonLimitFrc) && tendon.range.is_none() {
                 return Err(invalid(e, "tendon must be limited in sensor"));
-            }
-            if matches!(tendon.kind, TendonKind::Spatial { .. }) {
-                not_computed = Some("it reads a spatial tendon (spatial tendons are not simulated)".into());
             }
             object = SensorObject::Tendon(t);
         }

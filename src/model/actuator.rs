@@ -5,7 +5,7 @@
 //! except the kinds [`unsimulated_reason`] names, which `info` lists as not simulated, the loader
 //! warns about, and which exert no force.
 
-use super::{JointKind, Model, SourceLoc, TendonKind};
+use super::{JointKind, Model, SourceLoc};
 
 /// The MJCF element the actuator was written as.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -170,7 +170,7 @@ impl Actuator {
 }
 
 /// Why actuator `a` of `model` is not simulated, or None if it is: muscle and user dynamics, gains
-/// and biases; planar-joint, spatial-tendon and body (adhesion) transmissions.
+/// and biases; planar-joint and body (adhesion) transmissions.
 pub fn unsimulated_reason(model: &Model, a: &Actuator) -> Option<&'static str> {
     if matches!(a.dyntype, DynType::Muscle | DynType::User) {
         return Some("muscle or user activation dynamics");
@@ -185,9 +185,7 @@ pub fn unsimulated_reason(model: &Model, a: &Actuator) -> Option<&'static str> {
         Transmission::Joint(j) | Transmission::JointInParent(j) => {
             matches!(model.joints[*j].kind, JointKind::Planar { .. }).then_some("a planar joint transmission")
         }
-        Transmission::Tendon(t) => matches!(model.tendons[*t].kind, TendonKind::Spatial { .. })
-            .then_some("a spatial tendon transmission"),
-        Transmission::Site { .. } | Transmission::SliderCrank { .. } => None,
+        Transmission::Tendon(_) | Transmission::Site { .. } | Transmission::SliderCrank { .. } => None,
         Transmission::Body(_) => Some("a body (adhesion) transmission"),
     }
 }

@@ -33,13 +33,16 @@ pub enum EfcType {
     FrictionDof,
     /// A joint limit (unilateral): the row's acceleration w ≥ 0, λ ≥ 0, w λ = 0.
     LimitJoint,
+    /// Soft mode: dry friction along a tendon (`frictionloss`): |λ| ≤ the tendon's friction
+    /// loss, J = the tendon's Jacobian (MuJoCo's `mjCNSTR_FRICTION_TENDON`).
+    FrictionTendon,
     /// The normal row of a frictionless contact (condim 1), unilateral like a limit.
     ContactFrictionless,
     /// The rows of a frictional contact (condim 3, 4 or 6): the normal row first (unilateral),
     /// then the friction rows, whose forces lie in the elliptic Coulomb cone
     /// Σ (λ_i / μ_i)² ≤ λ_n² (MuJoCo's `mjCNSTR_CONTACT_ELLIPTIC`).
     ContactElliptic,
-    /// Soft mode: a fixed tendon's length limit (MuJoCo's `mjCNSTR_LIMIT_TENDON`), unilateral.
+    /// Soft mode: a tendon's length limit (MuJoCo's `mjCNSTR_LIMIT_TENDON`), unilateral.
     LimitTendon,
     /// Soft mode, pyramidal cone (MuJoCo's `mjCNSTR_CONTACT_PYRAMIDAL`): a contact of dimension
     /// d gives 2(d − 1) rows J_n ± μ_i J_i, each with a force ≥ 0 (MuJoCo documentation,
@@ -66,6 +69,7 @@ impl EfcType {
         match self {
             EfcType::Equality => "equality",
             EfcType::FrictionDof => "friction_dof",
+            EfcType::FrictionTendon => "friction_tendon",
             EfcType::LimitJoint => "limit_joint",
             EfcType::ContactFrictionless => "contact_frictionless",
             EfcType::ContactElliptic => "contact_elliptic",
@@ -351,6 +355,24 @@ pub struct Data {
     pub sensordata: DVector<f64>,
     /// The sensor stage's scratch.
     pub(crate) sensor_work: crate::sensor::SensorWork,
+
+    // --- tendons (crate::tendon, at the start of each evaluation) ---
+    /// Each tendon's length (MuJoCo's `ten_length`, m; a fixed tendon's Σ coef·q).
+    pub ten_length: DVector<f64>,
+    /// Each tendon's rate of length change `ten_J · v` (MuJoCo's `ten_velocity`).
+    pub ten_velocity: DVector<f64>,
+    /// The tendon Jacobian ∂ten_length/∂q, ntendon × nv (MuJoCo's `ten_J`, dense; its rows are
+    /// the tendons' moment arms).
+    pub ten_j: DMatrix<f64>,
+    /// Per tendon, its first wrap point in `wrap_obj`/`wrap_xpos` (MuJoCo's `ten_wrapadr`).
+    pub ten_wrapadr: Vec<usize>,
+    /// Per tendon, its number of wrap points (MuJoCo's `ten_wrapnum`; 0 for fixed tendons).
+    pub ten_wrapnum: Vec<usize>,
+    /// Per wrap point: −1 a site, −2 a pulley, else the index of the geom wrapped around
+    /// (MuJoCo's `wrap_obj`).
+    pub wrap_obj: Vec<i64>,
+    /// Per wrap point: its world position (MuJoCo's `wrap_xpos`; zero for a pulley).
+    pub wrap_xpos: Vec<crate::spatial::Vec3>,
 }
 
 impl Data {
@@ -359,6 +381,7 @@ impl Data {
     pub fn new(model: &Model) -> Self {
         let nb = model.nbody();
         let nv = model.nv;
+        let nwrap: usize = model.tendons.iter().map(|t| super::tendon::max_wrap_points(&t.kind)).sum();
         // Equality rows, and one row per limited hinge/slide joint (one side is active at a time).
         // Equality rows, one row per limited hinge/slide/ball joint (one side is active at a
         // time), one per dof with friction loss, and up to 6 per contact.
@@ -458,6 +481,13 @@ impl Data {
             sensordata: DVector::zeros(model.nsensordata),
             sensor_work: crate::sensor::SensorWork::new(model),
             forward_skip: Default::default(),
+            ten_length: DVector::zeros(model.tendons.len()),
+            ten_velocity: DVector::zeros(model.tendons.len()),
+            ten_j: DMatrix::zeros(model.tendons.len(), nv),
+            ten_wrapadr: vec![0; model.tendons.len()],
+            ten_wrapnum: vec![0; model.tendons.len()],
+            wrap_obj: vec![0; nwrap],
+            wrap_xpos: vec![crate::spatial::Vec3::zeros(); nwrap],
         }
     }
 }

@@ -29,7 +29,7 @@ pub use hfield::HeightField;
 pub use joint::{axis_angle, HingeAxis, JointKind};
 pub use links::Links;
 pub use options::{Flags, Options};
-pub use tendon::{Tendon, TendonKind};
+pub use tendon::{PathElement, Tendon, TendonKind, WrapShape};
 pub use warning::{WarningStat, Warnings};
 
 use crate::spatial::{Mat3, RigidInertia, Transform, Vec3};
@@ -273,7 +273,7 @@ pub struct Model {
     pub keyframes: Vec<Keyframe>,
     /// Equality constraints and URDF mimic couplings (simulated by the constraint layer).
     pub equalities: Vec<Equality>,
-    /// Tendons in MuJoCo's order (fixed tendons are simulated, spatial ones listed).
+    /// Tendons in MuJoCo's order (fixed and spatial, simulated by [`crate::tendon`]).
     pub tendons: Vec<Tendon>,
     /// Actuators in MuJoCo's order (`ctrl` layout).
     pub actuators: Vec<Actuator>,

@@ -517,6 +517,14 @@ pub struct TendonSpec {
     pub soft: SoftParams,
     /// Total actuator force range if limited (`actuatorfrclimited`/`actuatorfrcrange`).
     pub actuator_force_range: Option<[f64; 2]>,
+    /// `stiffness` of the tendon's spring.
+    pub stiffness: f64,
+    /// `springlength` (one value: both bounds; `[-1, -1]`: the length at `qpos_spring`).
+    pub spring_length: [f64; 2],
+    /// `damping` along the tendon.
+    pub damping: f64,
+    /// `frictionloss` along the tendon.
+    pub frictionloss: f64,
     /// Where it is written.
     pub loc: SourceLoc,
 }
@@ -529,11 +537,11 @@ pub enum TendonSpecKind {
         /// (joint name, coefficient, element) per `<joint>` child.
         joints: Vec<(String, f64, SourceLoc)>,
     },
-    /// `<spatial>`: its path as (element, name): `site` and `geom` with the object's name,
-    /// `pulley` with its divisor.
+    /// `<spatial>`: its path as (element, name, side site): `site` and `geom` with the object's
+    /// name (a geom with its `sidesite` if given), `pulley` with its divisor.
     Spatial {
-        /// (element tag, name or divisor) per path element, in file order.
-        path: Vec<(String, String)>,
+        /// (element tag, name or divisor, `sidesite`) per path element, in file order.
+        path: Vec<(String, String, Option<String>)>,
     },
 }
 

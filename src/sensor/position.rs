@@ -6,7 +6,6 @@
 use super::objects::{mul_quat, neg_quat, normalize_quat, object_pose, object_quat};
 use super::types::{Sensor, SensorObject, SensorType};
 use super::SensorWork;
-use crate::model::tendon::fixed_tendon;
 use crate::model::{Data, EfcType, Model};
 use crate::spatial::Vec3;
 
@@ -28,7 +27,7 @@ pub(crate) fn compute(model: &Model, data: &Data, work: &SensorWork, s: &Sensor,
             copy3(out, &x.rot.tr_mul(&Vec3::from(model.options.magnetic)));
         }
         (JointPos, SensorObject::Joint(j)) => out[0] = q[model.joints[j].qpos_adr],
-        (TendonPos, SensorObject::Tendon(t)) => out[0] = fixed_tendon(model, t, q, false),
+        (TendonPos, SensorObject::Tendon(t)) => out[0] = data.ten_length[t],
         (ActuatorPos, SensorObject::Actuator(a)) => out[0] = data.actuator_length[a],
         (BallQuat, SensorObject::Joint(j)) => {
             let a = model.joints[j].qpos_adr;

@@ -14,7 +14,6 @@ use super::objects::{object_pose, object_velocity};
 use super::position::limit_row;
 use super::types::{Sensor, SensorObject, SensorType};
 use super::SensorWork;
-use crate::model::tendon::fixed_tendon;
 use crate::model::{Data, EfcType, Model};
 use crate::spatial::Vec3;
 
@@ -29,7 +28,7 @@ pub(crate) fn compute(model: &Model, data: &Data, work: &SensorWork, s: &Sensor,
         (Velocimeter, obj) => copy3(out, &object_velocity(model, data, obj, true).1),
         (Gyro, obj) => copy3(out, &object_velocity(model, data, obj, true).0),
         (JointVel, SensorObject::Joint(j)) => out[0] = v[model.joints[j].dof_adr],
-        (TendonVel, SensorObject::Tendon(t)) => out[0] = fixed_tendon(model, t, v, true),
+        (TendonVel, SensorObject::Tendon(t)) => out[0] = data.ten_velocity[t],
         (ActuatorVel, SensorObject::Actuator(a)) => out[0] = data.actuator_velocity[a],
         (BallAngVel, SensorObject::Joint(j)) => {
             let d = model.joints[j].dof_adr;

@@ -90,6 +90,13 @@ pub const RK4_CONSERVATION_REL: f64 = 1e-9;
 /// impratio 100 of go1 are the worst conditioned); 1e-6 keeps a margin of 100.
 pub const SOFT_REL: f64 = 1e-6;
 
+/// The inside wrap of a spatial tendon (side site inside the geom) against MuJoCo 4.0: its contact
+/// point comes from a Newton solve that stops at MuJoCo's tolerance (1e-6 on the angle equation),
+/// and MuJoCo 4.0's iterates differ from lagrange's in the last steps: the point and the tendon's
+/// Jacobian agree to ~2e-7 relative (its length, stationary in the point, to 1e-14).
+#[allow(dead_code)]
+pub const INSIDE_WRAP_REL: f64 = 1e-6;
+
 /// CG against MuJoCo's Newton optimum (`tests/soft.rs`): CG stops when its cost stagnates at
 /// round-off, which on go1's elliptic cones with impratio 100 is still ~1e-6 of the force scale
 /// from the optimum — MuJoCo 4.0's own CG (same tight options, the golden states) stops 6.1e-7

@@ -239,6 +239,9 @@ fn forward_json(model: &Model, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f
             EfcType::LimitTendon => {
                 json!({"name": model.tendons[id].name, "kind": "tendon_limit", "source": model.tendons[id].loc.to_string()})
             }
+            EfcType::FrictionTendon => {
+                json!({"name": model.tendons[id].name, "kind": "tendon_friction", "source": model.tendons[id].loc.to_string()})
+            }
             EfcType::FrictionDof => {
                 let joint = model.joint_of(model.dof_body[id]);
                 json!({"name": joint.name, "kind": "friction", "source": file, "dof": id})

@@ -66,7 +66,7 @@ fn listing(model: &Model) -> Vec<Listed> {
                 joints.iter().map(|&(j, _)| joint(j)).collect(),
                 if coupled { "simulated (equality rows)" } else { "parsed" },
             ),
-            TendonKind::Spatial { path } => ("spatial", path.clone(), NOT_SIMULATED),
+            TendonKind::Spatial { path, .. } => ("spatial", path.clone(), "simulated"),
         };
         out.push(Listed {
             category: "tendon".into(),

@@ -118,7 +118,7 @@ fn diag_approx(model: &Model, w: &InverseWeights, data: &mut Data) {
             }
             EfcType::FrictionDof => data.efc_diag_a[i] = w.dof_invweight0[id],
             EfcType::LimitJoint => data.efc_diag_a[i] = w.dof_invweight0[model.joints[id].dof_adr],
-            EfcType::LimitTendon => data.efc_diag_a[i] = w.tendon_invweight0[id],
+            EfcType::LimitTendon | EfcType::FrictionTendon => data.efc_diag_a[i] = w.tendon_invweight0[id],
             kind => {
                 let c = &data.contacts[id];
                 let (mut tran, mut rot) = (0.0, 0.0);
@@ -166,6 +166,10 @@ fn parameters(model: &Model, data: &Data, i: usize) -> ([f64; 2], [f64; 2], [f64
             let s = &model.tendons[id].soft;
             (s.solref_limit, [0.0; 2], s.solimp_limit)
         }
+        EfcType::FrictionTendon => {
+            let s = &model.tendons[id].soft;
+            (s.solref_friction, [0.0; 2], s.solimp_friction)
+        }
         EfcType::FrictionDof => {
             let s = &model.joint_of(model.dof_body[id]).soft;
             (s.solref_friction, [0.0; 2], s.solimp_friction)
@@ -200,7 +204,7 @@ pub(crate) fn make_impedance(model: &Model, w: &InverseWeights, data: &mut Data)
     let mut i = 0;
     while i < data.nefc {
         let kind = data.efc_type[i];
-        let frictional_dof = kind == EfcType::FrictionDof;
+        let frictional_dof = matches!(kind, EfcType::FrictionDof | EfcType::FrictionTendon);
         let (solref, solreffriction, solimp) = parameters(model, data, i);
         let (solref, solimp) = sanitize(model, solref, solimp, false);
         let (solreffriction, _) = sanitize(model, solreffriction, solimp, true);

@@ -23,7 +23,7 @@ use crate::constraint::rows::EqualityRows;
 use crate::constraint::rows::{point_motion, RowGeometry};
 use crate::constraint::ConstraintModel;
 use crate::kinematics::bias_accelerations_unchecked;
-use crate::model::{options::Cone, Data, EfcType, Model, TendonKind};
+use crate::model::{options::Cone, Data, EfcType, Model};
 use crate::spatial::{Mat3, Transform, Vec3};
 
 /// A quaternion [w, x, y, z] and the Hamilton product.
@@ -83,7 +83,11 @@ fn row_bound(cm: &ConstraintModel, model: &Model, data: &Data) -> usize {
         .map(|e| model.equalities[e.id].kind.nrow())
         .sum();
     let contacts: usize = data.contacts.iter().map(|c| 2 * (c.condim.clamp(1, 6) as usize)).sum();
-    eq + cm.friction.len() + 2 * cm.limits.len() + 2 * cm.tendon_limits.len() + contacts
+    eq + cm.friction.len()
+        + cm.tendon_friction.len()
+        + 2 * cm.limits.len()
+        + 2 * cm.tendon_limits.len()
+        + contacts
 }
 
 /// Writes the soft rows at configuration `q` (body poses and motion subspaces at q, and
@@ -140,6 +144,15 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
         data.efc_frictionloss[r] = f.loss;
         r += 1;
     }
+    for &t in &cm.tendon_friction {
+        data.efc_id[r] = t;
+        data.efc_type[r] = EfcType::FrictionTendon;
+        data.efc_j.row_mut(r).copy_from(&data.ten_j.row(t));
+        data.efc_pos[r] = 0.0;
+        data.efc_margin[r] = 0.0;
+        data.efc_frictionloss[r] = model.tendons[t].frictionloss;
+        r += 1;
+    }
     let nf = r - ne;
     for l in &cm.limits {
         let margin = model.joints[l.joint].soft.margin;
@@ -156,24 +169,23 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
             r += 1;
         }
     }
-    r = tendon_limit_rows(model, &cm.tendon_limits, data, q, r);
+    r = tendon_limit_rows(model, &cm.tendon_limits, data, r);
     data.nefc = contact_rows(model, data, r, cone);
     data.ne = ne;
     data.nf = nf;
 }
 
-/// The limit rows of the limited fixed tendons `tendons` (`ConstraintModel::tendon_limits`) from
+/// The limit rows of the limited tendons `tendons` (`ConstraintModel::tendon_limits`) from
 /// row `r` on (MuJoCo's `mj_instantiateLimit`: a row per bound closer than the tendon's margin,
-/// J = ±∂L/∂q); returns the next free row.
-fn tendon_limit_rows(model: &Model, tendons: &[usize], data: &mut Data, q: &[f64], mut r: usize) -> usize {
+/// J = ±∂L/∂q = ±`ten_J`); returns the next free row.
+fn tendon_limit_rows(model: &Model, tendons: &[usize], data: &mut Data, mut r: usize) -> usize {
     for &t in tendons {
         let tendon = &model.tendons[t];
-        let TendonKind::Fixed { joints } = &tendon.kind else { continue };
-        for (dist, sign) in tendon_limit_sides(model, t, q).into_iter().flatten() {
+        for (dist, sign) in tendon_limit_sides(model, data, t).into_iter().flatten() {
             data.efc_id[r] = t;
             data.efc_type[r] = EfcType::LimitTendon;
-            for &(j, c) in joints {
-                data.efc_j[(r, model.joints[j].dof_adr)] += sign * c;
+            for c in 0..model.nv {
+                data.efc_j[(r, c)] = sign * data.ten_j[(t, c)];
             }
             data.efc_pos[r] = dist;
             data.efc_margin[r] = tendon.soft.margin;
@@ -203,14 +215,14 @@ fn joint_limit_sides(l: &LimitRow, q: &[f64], margin: f64) -> [Option<(f64, Vec3
     }
 }
 
-/// The bounds of fixed tendon `t`'s length limit closer than its margin at `q`, each as
-/// (distance, sign of J = ±∂L/∂q); none for an unlimited or spatial tendon.
-fn tendon_limit_sides(model: &Model, t: usize, q: &[f64]) -> [Option<(f64, f64)>; 2] {
+/// The bounds of tendon `t`'s length limit closer than its margin at the evaluation's
+/// `ten_length`, each as (distance, sign of J = ±∂L/∂q); none for an unlimited tendon.
+fn tendon_limit_sides(model: &Model, data: &Data, t: usize) -> [Option<(f64, f64)>; 2] {
     let tendon = &model.tendons[t];
-    let (Some(range), TendonKind::Fixed { .. }) = (tendon.range, &tendon.kind) else {
+    let Some(range) = tendon.range else {
         return [None, None];
     };
-    let length = crate::model::tendon::fixed_tendon(model, t, q, false);
+    let length = data.ten_length[t];
     let within = |dist: f64, sign: f64| (dist < tendon.soft.margin).then_some((dist, sign));
     [within(length - range[0], 1.0), within(range[1] - length, -1.0)]
 }
@@ -328,14 +340,16 @@ pub(crate) fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Da
 /// bound, or a contact closer than its `includemargin`. `forward` takes the ABA path when none
 /// does.
 pub(crate) fn soft_active(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f64]) -> bool {
-    let mut active = !cm.friction.is_empty() || cm.equalities.iter().any(|e| data.eq_active[e.id]);
+    let mut active = !cm.friction.is_empty()
+        || !cm.tendon_friction.is_empty()
+        || cm.equalities.iter().any(|e| data.eq_active[e.id]);
     if cm.has_collision() {
         crate::kinematics::body_poses(model, data, q);
         crate::collision::collide(model, &cm.collision, data, 0.0);
         active |= data.contacts.iter().any(|c| c.dist < c.includemargin);
     }
     let tendon_limit =
-        cm.tendon_limits.iter().any(|&t| tendon_limit_sides(model, t, q).iter().any(Option::is_some));
+        cm.tendon_limits.iter().any(|&t| tendon_limit_sides(model, data, t).iter().any(Option::is_some));
     active
         || tendon_limit
         || cm

@@ -8,12 +8,12 @@
 //!   rotational one the mean of the last three; zero for bodies welded to the world;
 //! - `dof_invweight0`: (M⁻¹)_dd for a hinge or slide, the mean of the three diagonal entries of
 //!   its block for a ball, and of the translational and rotational blocks for a free joint;
-//! - `tendon_invweight0`: J_t M⁻¹ J_tᵀ of a fixed tendon;
+//! - `tendon_invweight0`: J_t M⁻¹ J_tᵀ of a tendon (J_t its `ten_J` row at `qpos0`);
 //! - `meaninertia`: the mean of M's diagonal at `qpos0`, which scales the solvers' tolerance.
 
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
 use crate::kinematics::{for_each_ancestor_dof, forward_kinematics_unchecked};
-use crate::model::{Data, FrameKind, JointKind, Model, TendonKind};
+use crate::model::{Data, FrameKind, JointKind, Model};
 use crate::spatial::Vec3;
 
 /// The soft model's constants of one model.
@@ -26,7 +26,7 @@ pub struct InverseWeights {
     pub geom_frame: Vec<usize>,
     /// Per dof: its inverse weight at `qpos0` (MuJoCo's `dof_invweight0`).
     pub dof_invweight0: Vec<f64>,
-    /// Per tendon: J_t M⁻¹ J_tᵀ at `qpos0` for a fixed tendon (MuJoCo's `tendon_invweight0`).
+    /// Per tendon: J_t M⁻¹ J_tᵀ at `qpos0` (MuJoCo's `tendon_invweight0`).
     pub tendon_invweight0: Vec<f64>,
     /// The mean of M's diagonal at `qpos0` (MuJoCo's `meaninertia`).
     pub meaninertia: f64,
@@ -40,6 +40,10 @@ impl InverseWeights {
         forward_kinematics_unchecked(model, &mut data, &model.qpos0);
         crba_unchecked(model, &mut data, &model.qpos0);
         factorize_mass_matrix(model, &mut data);
+        // The tendons' ten_J rows at qpos0 (forward kinematics above is at qpos0).
+        crate::tendon::lengths_and_jacobians(model, &mut data, &model.qpos0);
+        let tendon_rows: Vec<Vec<f64>> =
+            (0..model.tendons.len()).map(|t| data.ten_j.row(t).iter().copied().collect()).collect();
         let meaninertia =
             if nv > 0 { (0..nv).map(|k| data.mass_matrix[(k, k)]).sum::<f64>() / nv as f64 } else { 1.0 };
         // x ↦ M⁻¹ x with the factor at qpos0.
@@ -101,20 +105,7 @@ impl InverseWeights {
         for (d, w) in simple_dofs {
             dof_invweight0[d] = w;
         }
-        let tendon_invweight0 = model
-            .tendons
-            .iter()
-            .map(|t| match &t.kind {
-                TendonKind::Fixed { joints } => {
-                    let mut r = vec![0.0; nv];
-                    for &(j, c) in joints {
-                        r[model.joints[j].dof_adr] += c;
-                    }
-                    quadratic(&[r])[0]
-                }
-                TendonKind::Spatial { .. } => 0.0,
-            })
-            .collect();
+        let tendon_invweight0 = tendon_rows.iter().map(|r| quadratic(std::slice::from_ref(r))[0]).collect();
         let geom_frame = model.geoms.iter().map(|g| body_frame(model, g.body, Some(&g.link))).collect();
         Self { frame_invweight0, geom_frame, dof_invweight0, tendon_invweight0, meaninertia }
     }

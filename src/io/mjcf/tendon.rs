@@ -2,9 +2,10 @@
 //! "XML Reference → tendon"), with the defaults of `<default><tendon>`.
 //!
 //! A `<fixed>` tendon is the linear combination `L = Σ coef · q[joint]` of its `<joint joint coef>`
-//! children (`coef` is required, a joint may appear once); a `<spatial>` tendon keeps the names
-//! of its path (`site`, `geom`, `pulley`) for listing. `limited`/`range` follow `<compiler
-//! autolimits>`.
+//! children (`coef` is required, a joint may appear once); a `<spatial>` tendon keeps its path
+//! (`site`, `geom` with `sidesite`, `pulley divisor`), resolved and checked at compile time.
+//! `limited`/`range` follow `<compiler autolimits>`; `stiffness`, `springlength` (one or two
+//! values), `damping` and `frictionloss` are read; `armature` is not simulated (said).
 
 use super::defaults::{Defaults, MAIN};
 use super::xml::Element;
@@ -59,18 +60,17 @@ pub(crate) fn tendons(
                     .iter()
                     .map(|c| {
                         let attr = if c.tag == "pulley" { "divisor" } else { c.tag.as_str() };
-                        (c.tag.clone(), c.attr(attr).unwrap_or("").to_string())
+                        let side = (c.tag == "geom").then(|| c.attr("sidesite")).flatten();
+                        (c.tag.clone(), c.attr(attr).unwrap_or("").to_string(), side.map(str::to_string))
                     })
                     .collect();
                 TendonSpecKind::Spatial { path }
             };
-            // MuJoCo's passive tendon terms and tendon friction/armature: not simulated yet, so a
-            // nonzero value is said, never silently dropped.
+            // Tendon armature: not simulated yet, so a nonzero value is said, never silently dropped.
             for (attr, what) in [
-                ("stiffness", "a spring along the tendon (qfrc_passive)"),
-                ("damping", "a damper along the tendon (qfrc_passive)"),
-                ("frictionloss", "a dry-friction row on the tendon (friction_tendon)"),
                 ("armature", "an inertia added along the tendon to M"),
+                ("stiffnesspoly", "a polynomial spring along the tendon"),
+                ("dampingpoly", "a polynomial damper along the tendon"),
             ] {
                 if let Some(values) = a.numbers(attr)? {
                     if values.iter().any(|&x| x != 0.0) {
@@ -88,7 +88,33 @@ pub(crate) fn tendons(
             let soft = super::body::soft_params(&a)?;
             let actuator_force_range =
                 a.limited_range("actuatorfrclimited", "actuatorfrcrange", autolimits, warnings)?;
-            out.push(TendonSpec { name, kind, range, soft, actuator_force_range, loc: e.loc.clone() });
+            let scalar = |attr: &str| -> Result<f64, LoadError> { Ok(a.real(attr)?.unwrap_or(0.0)) };
+            let (stiffness, damping, frictionloss) =
+                (scalar("stiffness")?, scalar("damping")?, scalar("frictionloss")?);
+            let spring_length = match a.numbers("springlength")?.as_deref() {
+                None => [-1.0, -1.0],
+                Some([x]) => [*x, *x],
+                Some([lo, hi]) if lo <= hi => [*lo, *hi],
+                Some([_, _]) => {
+                    return Err(a.error(
+                        "springlength",
+                        "has its lower value above its upper one; give \"lower upper\"",
+                    ))
+                }
+                Some(_) => return Err(a.error("springlength", "takes one or two values")),
+            };
+            out.push(TendonSpec {
+                name,
+                kind,
+                range,
+                soft,
+                actuator_force_range,
+                stiffness,
+                spring_length,
+                damping,
+                frictionloss,
+                loc: e.loc.clone(),
+            });
         }
     }
     Ok(out)
