@@ -211,12 +211,20 @@ fn stages(
     });
     let damped = model.dof_damping.iter().filter(|&&d| d != 0.0).count();
     let springs = model.springs.len();
-    out.push(if damped + springs > 0 {
+    let gravcomp = if crate::dynamics::gravcomp::active(model) { model.gravcomp.len() } else { 0 };
+    out.push(if damped + springs + gravcomp > 0 {
         stage(
             Passive,
             "passive",
             Runs,
-            format!("joint damping on {damped} degrees of freedom, {springs} joint springs"),
+            format!(
+                "joint damping on {damped} degrees of freedom, {springs} joint springs{}",
+                if gravcomp > 0 {
+                    format!(", gravity compensation on {gravcomp} bodies")
+                } else {
+                    String::new()
+                }
+            ),
         )
     } else {
         stage(Passive, "passive", Skipped, "no joint damping or springs")
@@ -421,7 +429,9 @@ fn stages(
             PassiveOther,
             "passive (other)",
             NotSimulated,
-            format!("{other} elements (gravity compensation, spring-dampers, polynomial or ball/free springs); see `info` elements"),
+            format!(
+                "{other} elements (spring-dampers, polynomial or ball/free springs); see `info` elements"
+            ),
         ));
     }
     out
