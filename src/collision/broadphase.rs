@@ -20,7 +20,7 @@ use crate::model::Model;
 use crate::spatial::Transform;
 
 /// Below this many candidate pairs between bounded geoms, every pair is tested directly.
-const SWEEP_FROM_PAIRS: usize = 64;
+const SWEEP_FROM_PAIRS: usize = 1000;
 
 /// The model-constant part of the sweep: which geoms take part and how pairs are looked up.
 #[derive(Clone, Debug, Default)]

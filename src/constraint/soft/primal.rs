@@ -15,6 +15,7 @@
 //! `tolerance`, the scale being 1 / (meaninertia · max(1, nv)).
 
 use super::cost::Rows;
+use crate::constraint::dense::{cholesky, cholesky_solve};
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, Model};
 use nalgebra::{DMatrix, DVector};
@@ -105,6 +106,10 @@ fn mul_j(j: &DMatrix<f64>, s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut 
 /// (`Model::dof_parent`; M[l][k] ≠ 0 only when l is an ancestor of k or k of l).
 fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
     let nv = x.len();
+    if nv <= DENSE_NV {
+        m.mul_to(x, r);
+        return;
+    }
     for k in 0..nv {
         r[k] = m[(k, k)] * x[k];
     }
@@ -118,6 +123,10 @@ fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVect
         }
     }
 }
+
+/// Up to this many dofs the Newton Hessian is assembled and factored dense (and M x is a dense
+/// product): below it the sparse bookkeeping costs more than the zeros it skips.
+pub(crate) const DENSE_NV: usize = 40;
 
 /// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
 /// `qfrc_smooth`, `qacc_smooth`, the mass matrix and its factor: writes `qacc`, `efc_force`,
@@ -219,55 +228,79 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         iter += 1;
         match method {
             Primal::Newton => {
-                // H = M + Jᵀ (∂²s) J, lower triangle only, assembled over its nonzeros: the
-                // last pattern's entries cleared, M's tree entries written, the rows' added.
-                let h = &mut soft.hessian;
-                for k in 0..nv {
-                    for &j in soft.factor.pattern_row(k) {
-                        h[(k, j)] = 0.0;
-                    }
-                    h[(k, k)] = mass_matrix[(k, k)];
-                    let mut l = model.dof_parent[k];
-                    while l != crate::model::NO_DOF {
-                        h[(k, l)] = mass_matrix[(k, l)];
-                        l = model.dof_parent[l];
-                    }
-                }
-                // The row groups with a Hessian block: single quadratic rows, and an elliptic
-                // contact's rows in its cone zone (one dense block).
-                soft.active_rows.clear();
-                let active = &mut soft.active_rows;
-                rows.hessian(&soft.jar, efc_state, |i, dim, block| {
-                    // The block's entries (a, b) in row order, as one group.
-                    for (a, row) in (i..i + dim).zip(block) {
-                        for (b, &w) in (i..i + dim).zip(row) {
-                            match active.last_mut() {
-                                Some(g) if g.1 >= a.min(b) => g.1 = g.1.max(a.max(b)),
-                                _ => active.push((a, a.max(b))),
-                            }
-                            for &p in nz.row(a) {
-                                let x = w * efc_j[(a, p)];
-                                for &q in nz.row(b) {
-                                    if p >= q {
+                if nv <= DENSE_NV {
+                    // Small: H = M + Jᵀ (∂²s) J in full, by dense Cholesky.
+                    let h = &mut soft.hessian;
+                    h.copy_from(mass_matrix);
+                    rows.hessian(&soft.jar, efc_state, |i, dim, block| {
+                        for (a, row) in (i..i + dim).zip(block) {
+                            for (b, &w) in (i..i + dim).zip(row) {
+                                for &p in nz.row(a) {
+                                    let x = w * efc_j[(a, p)];
+                                    for &q in nz.row(b) {
                                         h[(p, q)] += x * efc_j[(b, q)];
                                     }
                                 }
                             }
                         }
+                    });
+                    soft.dir.copy_from(&soft.grad);
+                    if cholesky(&soft.hessian, nv, &mut soft.dense_factor, 0.0) {
+                        cholesky_solve(&soft.dense_factor, nv, soft.dir.as_mut_slice());
+                    } else {
+                        solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
                     }
-                });
-                soft.dir.copy_from(&soft.grad);
-                if soft.factor.factor_structured(
-                    &soft.hessian,
-                    nv,
-                    &model.dof_parent,
-                    &soft.active_rows,
-                    &nz_start,
-                    &nz_index,
-                ) {
-                    soft.factor.solve(soft.dir.as_mut_slice());
                 } else {
-                    solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
+                    // H = M + Jᵀ (∂²s) J, lower triangle only, assembled over its nonzeros: the
+                    // last pattern's entries cleared, M's tree entries written, the rows' added.
+                    let h = &mut soft.hessian;
+                    for k in 0..nv {
+                        for &j in soft.factor.pattern_row(k) {
+                            h[(k, j)] = 0.0;
+                        }
+                        h[(k, k)] = mass_matrix[(k, k)];
+                        let mut l = model.dof_parent[k];
+                        while l != crate::model::NO_DOF {
+                            h[(k, l)] = mass_matrix[(k, l)];
+                            l = model.dof_parent[l];
+                        }
+                    }
+                    // The row groups with a Hessian block: single quadratic rows, and an elliptic
+                    // contact's rows in its cone zone (one dense block).
+                    soft.active_rows.clear();
+                    let active = &mut soft.active_rows;
+                    rows.hessian(&soft.jar, efc_state, |i, dim, block| {
+                        // The block's entries (a, b) in row order, as one group.
+                        for (a, row) in (i..i + dim).zip(block) {
+                            for (b, &w) in (i..i + dim).zip(row) {
+                                match active.last_mut() {
+                                    Some(g) if g.1 >= a.min(b) => g.1 = g.1.max(a.max(b)),
+                                    _ => active.push((a, a.max(b))),
+                                }
+                                for &p in nz.row(a) {
+                                    let x = w * efc_j[(a, p)];
+                                    for &q in nz.row(b) {
+                                        if p >= q {
+                                            h[(p, q)] += x * efc_j[(b, q)];
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                    });
+                    soft.dir.copy_from(&soft.grad);
+                    if soft.factor.factor_structured(
+                        &soft.hessian,
+                        nv,
+                        &model.dof_parent,
+                        &soft.active_rows,
+                        &nz_start,
+                        &nz_index,
+                    ) {
+                        soft.factor.solve(soft.dir.as_mut_slice());
+                    } else {
+                        solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
+                    }
                 }
                 soft.dir.neg_mut();
             }

@@ -26,6 +26,8 @@ pub(crate) struct SoftWork {
     /// its factor's pattern), and its sparse Cholesky factor.
     pub hessian: DMatrix<f64>,
     pub factor: super::sparse_cholesky::SparseCholesky,
+    /// The dense Cholesky factor of small Hessians (nv × nv; empty above the dense size).
+    pub dense_factor: DMatrix<f64>,
     /// The row groups (first, last) with a Hessian block in the current Newton iteration.
     pub active_rows: Vec<(usize, usize)>,
     /// The nonzero columns of each row of J: row i's are `nz_index[nz_start[i]..nz_start[i + 1]]`.
@@ -51,6 +53,11 @@ impl SoftWork {
             mgrad_prev: DVector::zeros(nv),
             hessian: DMatrix::zeros(nv, nv),
             factor: super::sparse_cholesky::SparseCholesky::with_capacity(nv),
+            dense_factor: if nv <= super::primal::DENSE_NV {
+                DMatrix::zeros(nv, nv)
+            } else {
+                DMatrix::zeros(0, 0)
+            },
             active_rows: Vec::with_capacity(nefc),
             nz_start: Vec::with_capacity(nefc + 1),
             nz_index: Vec::with_capacity(nefc * nv),
