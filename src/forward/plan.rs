@@ -562,8 +562,11 @@ fn soft_description(model: &Model) -> String {
 pub fn soft_unsupported(model: &Model) -> Vec<String> {
     let o = &model.options;
     let mut out = Vec::new();
-    if o.noslip_iterations > 0 {
-        out.push(format!("noslip_iterations = {} (the no-slip post-process)", o.noslip_iterations));
+    if o.noslip_iterations > 0 && o.cone == crate::model::options::Cone::Elliptic {
+        out.push(format!(
+            "noslip_iterations = {} on elliptic cones (the no-slip post-process runs on friction loss only)",
+            o.noslip_iterations
+        ));
     }
     if o.flags.override_contacts {
         out.push("<flag override> (o_margin, o_solref, o_solimp, o_friction)".to_string());

@@ -247,6 +247,8 @@ pub struct Options {
     pub ls_tolerance: f64,
     /// Iterations of the no-slip post-processing solver (0: off).
     pub noslip_iterations: u32,
+    /// Tolerance of the no-slip solver's scaled improvement (1e-6).
+    pub noslip_tolerance: f64,
     /// Ratio of frictional to normal constraint impedance (1).
     pub impratio: f64,
     /// The medium's density (kg/m³; MuJoCo's fluid forces act when density or viscosity is
@@ -282,6 +284,7 @@ impl Default for Options {
             ls_iterations: 50,
             ls_tolerance: 0.01,
             noslip_iterations: 0,
+            noslip_tolerance: 1e-6,
             impratio: 1.0,
             density: 0.0,
             viscosity: 0.0,

@@ -13,6 +13,7 @@
 
 pub mod cost;
 pub mod impedance;
+pub mod noslip;
 pub mod pgs;
 pub mod primal;
 pub mod rows;
@@ -52,6 +53,9 @@ pub(crate) fn solve_soft(model: &Model, weights: &InverseWeights, data: &mut Dat
         Solver::Newton => solve_primal(model, data, Primal::Newton, s),
         Solver::Cg => solve_primal(model, data, Primal::Cg, s),
         Solver::Pgs => pgs::solve_pgs(model, data, s),
+    }
+    if model.options.noslip_iterations > 0 {
+        noslip::solve_noslip(model, data, s.scale);
     }
     data.qacc_warmstart.copy_from(&data.qacc);
 }

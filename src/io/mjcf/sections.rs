@@ -137,6 +137,7 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
         for (attr, slot) in [
             ("tolerance", &mut o.tolerance),
             ("ls_tolerance", &mut o.ls_tolerance),
+            ("noslip_tolerance", &mut o.noslip_tolerance),
             ("impratio", &mut o.impratio),
             ("density", &mut o.density),
             ("viscosity", &mut o.viscosity),
