@@ -5,8 +5,10 @@
 //! distance, the pair's combined friction, condim, solref and solimp; MuJoCo documentation,
 //! "Computation → Collision detection").
 //!
-//! A bounding-sphere test rejects far pairs first (MuJoCo's `mj_filterSphere`); the narrow phase
-//! is closed form for planes ([`plane`]), spheres and capsules, spheres against cylinders
+//! On scenes with many candidate pairs a sweep and prune over the geoms' bounding cubes picks the
+//! pairs that may touch ([`broadphase`], MuJoCo's `mj_broadphase`); a bounding-sphere test then
+//! rejects far pairs (MuJoCo's `mj_filterSphere`); the narrow phase
+//! is closed form for planes ([`plane`], meshes on planes [`plane_mesh`]), spheres and capsules, spheres against cylinders
 //! ([`sphere_cylinder`]), and boxes against spheres,
 //! capsules ([`box_primitive`]) and boxes ([`box_box`]) with MuJoCo's multi-point manifolds, and
 //! GJK/EPA on support maps for the other convex pairs ([`convex`]). Meshes collide by their
