@@ -9,6 +9,7 @@ mod aba;
 mod crba;
 mod energy;
 pub mod fluid;
+pub mod gravcomp;
 pub(crate) mod rne_post;
 mod rnea;
 mod rnea_configuration;

@@ -184,6 +184,17 @@ pub(crate) fn actuation_unchecked(
             *f += m * force;
         }
     }
+    // `actuatorgravcomp` joints: their gravity compensation (the passive stage's
+    // `qfrc_gravcomp`) is an actuator force, inside the clamp below (MuJoCo's mj_fwdActuation).
+    if crate::dynamics::gravcomp::active(model) {
+        let Data { qfrc_gravcomp, qfrc_actuator, .. } = data;
+        crate::dynamics::gravcomp::add_gravcomp(
+            model,
+            qfrc_gravcomp.as_slice(),
+            qfrc_actuator.as_mut_slice(),
+            true,
+        );
+    }
     // Joints' `actuatorfrcrange`: the total actuator force on each of their dofs is clamped.
     for j in &model.joints {
         if let Some([lo, hi]) = j.actuator_force_range {

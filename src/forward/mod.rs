@@ -125,7 +125,9 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
 }
 
 /// Passive forces: joint damping −d ⊙ v and the springs of hinge and slide joints
-/// −k (q − q_spring), then the fluid forces (MuJoCo's `mj_passive` for these elements).
+/// −k (q − q_spring), the fluid forces, the tendons' springs and dampers, and gravity
+/// compensation `qfrc_gravcomp` on the joints without `actuatorgravcomp` (MuJoCo's `mj_passive`
+/// for these elements).
 pub(crate) fn passive(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     for k in 0..model.nv {
         data.qfrc_passive[k] = -model.dof_damping[k] * v[k];
@@ -137,6 +139,16 @@ pub(crate) fn passive(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         crate::dynamics::fluid::fluid_forces(model, fluid, data, q, v);
     }
     crate::tendon::passive::add_tendon_passive(model, data);
+    // Gravity compensation (body `gravcomp`), except on `actuatorgravcomp` joints.
+    if crate::dynamics::gravcomp::gravity_compensation(model, data, q) {
+        let Data { qfrc_gravcomp, qfrc_passive, .. } = data;
+        crate::dynamics::gravcomp::add_gravcomp(
+            model,
+            qfrc_gravcomp.as_slice(),
+            qfrc_passive.as_mut_slice(),
+            false,
+        );
+    }
 }
 
 /// The driving force on dof k: actuator plus applied, clamped to the dof's effort limit (URDF

@@ -220,7 +220,8 @@ fn stages(
     let springs = model.springs.len();
     let fluid = crate::dynamics::fluid::FluidModel::new(model);
     let tendon_passive = crate::tendon::passive::count_tendon_passive(model);
-    out.push(if damped + springs + tendon_passive > 0 || fluid.is_some() {
+    let gravcomp = if crate::dynamics::gravcomp::active(model) { model.gravcomp.len() } else { 0 };
+    out.push(if damped + springs + tendon_passive + gravcomp > 0 || fluid.is_some() {
         let tendons = if tendon_passive > 0 {
             format!(", {tendon_passive} tendon spring-dampers (ten_Jᵀ f)")
         } else {
@@ -231,8 +232,13 @@ fn stages(
             "passive",
             Runs,
             format!(
-                "joint damping on {damped} degrees of freedom, {springs} joint springs{tendons}{}",
-                if fluid.is_some() { ", fluid forces" } else { "" }
+                "joint damping on {damped} degrees of freedom, {springs} joint springs{tendons}{}{}",
+                if fluid.is_some() { ", fluid forces" } else { "" },
+                if gravcomp > 0 {
+                    format!(", gravity compensation on {gravcomp} bodies")
+                } else {
+                    String::new()
+                }
             ),
         )
     } else {
@@ -453,7 +459,9 @@ fn stages(
             PassiveOther,
             "passive (other)",
             NotSimulated,
-            format!("{other} elements (gravity compensation, spring-dampers, polynomial or ball/free springs); see `info` elements"),
+            format!(
+                "{other} elements (spring-dampers, polynomial or ball/free springs); see `info` elements"
+            ),
         ));
     }
     out

@@ -140,6 +140,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                     stiffness: j.stiffness,
                     spring_ref: j.spring_ref,
                     soft: j.soft,
+                    actuator_gravcomp: j.actuator_gravcomp,
                 });
                 nq += jnq;
                 nv += jnv;
@@ -225,6 +226,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             });
         }
     }
+
+    let gravcomp = body_gravcomp(spec, &link_body, &link_inertias);
 
     if spec.mass_rules.require_moving_mass {
         check_moving_mass(spec, &bodies, &link_body, &mut warnings);
@@ -350,6 +353,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         })
         .collect();
     let mut model = Model {
+        gravcomp,
         name: spec.name.clone(),
         source: spec.source.clone(),
         gravity: spec.gravity,
@@ -596,6 +600,33 @@ fn check_moving_mass(
             ));
         }
     }
+}
+
+/// The gravity compensation of each compiled body from its links' `gravcomp` (links welded to
+/// the world or a mocap body never move and are left out).
+fn body_gravcomp(
+    spec: &ModelSpec,
+    link_body: &[(usize, Transform)],
+    link_inertias: &[RigidInertia],
+) -> Vec<crate::model::GravComp> {
+    let mut out: Vec<crate::model::GravComp> = Vec::new();
+    for &(li, fraction) in &spec.gravcomp {
+        let (body, x_body_link) = link_body[li];
+        let mass = fraction * link_inertias[li].mass;
+        if body == 0 || mass == 0.0 {
+            continue;
+        }
+        let com = x_body_link.pos + x_body_link.rot * link_inertias[li].com();
+        match out.iter_mut().find(|g| g.body == body) {
+            Some(g) => {
+                let total = g.mass + mass;
+                g.com = (g.com * g.mass + com * mass) / total;
+                g.mass = total;
+            }
+            None => out.push(crate::model::GravComp { body, mass, com }),
+        }
+    }
+    out
 }
 
 /// A link's own mass properties in link coordinates and the mass each of its geoms contributed:

@@ -220,6 +220,9 @@ pub struct Data {
     pub qfrc_fluid: DVector<f64>,
     /// Actuator forces in joint space (the actuation stage).
     pub qfrc_actuator: DVector<f64>,
+    /// Gravity compensation (body `gravcomp`) as generalized forces, MuJoCo's `qfrc_gravcomp`:
+    /// added to `qfrc_passive`, or to `qfrc_actuator` on joints with `actuatorgravcomp`.
+    pub qfrc_gravcomp: DVector<f64>,
     /// Per actuator: transmission length, velocity, and scalar force (MuJoCo's names).
     pub actuator_length: DVector<f64>,
     /// Per actuator: the transmission's velocity (MuJoCo's `actuator_velocity`).
@@ -430,6 +433,7 @@ impl Data {
             qfrc_passive: DVector::zeros(nv),
             qfrc_fluid: DVector::zeros(nv),
             qfrc_actuator: DVector::zeros(nv),
+            qfrc_gravcomp: DVector::zeros(nv),
             actuator_length: DVector::zeros(model.actuators.len()),
             actuator_velocity: DVector::zeros(model.actuators.len()),
             actuator_moment: DMatrix::zeros(model.actuators.len(), model.nv),

@@ -95,6 +95,9 @@ pub struct Joint {
     pub spring_ref: f64,
     /// Soft-constraint parameters of the limit and friction-loss rows (soft mode only).
     pub soft: spec::SoftParams,
+    /// MJCF `actuatorgravcomp`: gravity compensation on this joint's dofs goes to
+    /// `qfrc_actuator` instead of `qfrc_passive` (MuJoCo's `jnt_actgravcomp`).
+    pub actuator_gravcomp: bool,
 }
 
 /// A rigid body of the compiled tree (the fused links included).
@@ -299,6 +302,22 @@ pub struct Model {
     /// actuators' resolved bias terms. Code that edits the elements or options afterwards calls
     /// [`rebuild_plan`](Self::rebuild_plan).
     pub plan: crate::forward::Plan,
+    /// Gravity compensation (MJCF body `gravcomp`), one entry per compiled body that has any
+    /// ([`crate::dynamics::gravcomp`]).
+    pub gravcomp: Vec<GravComp>,
+}
+
+/// The gravity compensation of one compiled body: the links fused into it that have a `gravcomp`
+/// add up to one force −`mass` · g at `com` (their weights are parallel, so their sum acts at the
+/// compensated-mass-weighted centroid).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GravComp {
+    /// The compiled body (index in `Model::bodies`).
+    pub body: usize,
+    /// Σ gravcomp · mass over the fused links (kg).
+    pub mass: f64,
+    /// The centroid of the compensated masses in the body frame.
+    pub com: Vec3,
 }
 
 /// A linear spring on a one-dof joint: generalized force `−stiffness·(q[qpos_adr] − rest)` on

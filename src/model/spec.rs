@@ -42,6 +42,9 @@ pub struct ModelSpec {
     pub elements: Vec<Element>,
     /// Loader warnings (unknown attributes, ignored elements), each with file:line.
     pub warnings: Vec<String>,
+    /// Gravity compensation (MJCF body `gravcomp`): (index in [`links`](Self::links), fraction of
+    /// the link's weight cancelled), for the links where it is nonzero.
+    pub gravcomp: Vec<(usize, f64)>,
 }
 
 /// MuJoCo's `<compiler>` rules for mass properties, applied per link in this order: inertia from
@@ -182,6 +185,9 @@ pub struct JointSpec {
     /// Soft-constraint parameters of its limit and friction-loss rows (MJCF `solreflimit`,
     /// `solimplimit`, `solreffriction`, `solimpfriction`, `margin`).
     pub soft: SoftParams,
+    /// MJCF `actuatorgravcomp`: the gravity compensation of the joint's dofs is added to
+    /// `qfrc_actuator` (subject to `actuatorfrcrange`) instead of `qfrc_passive`.
+    pub actuator_gravcomp: bool,
 }
 
 /// The soft-constraint parameters of a joint's or a tendon's limit and friction-loss rows
@@ -247,6 +253,7 @@ impl JointSpec {
             qpos0: Vec::new(),
             mimic: None,
             soft: SoftParams::default(),
+            actuator_gravcomp: false,
         }
     }
 }

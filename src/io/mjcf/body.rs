@@ -43,6 +43,8 @@ pub(crate) struct TreeBuilder<'a> {
     pub warnings: Vec<String>,
     /// Passive elements of bodies and joints that are parsed, not simulated.
     pub kept: Vec<crate::model::Element>,
+    /// Body `gravcomp` where nonzero: (link index, fraction).
+    pub gravcomp: Vec<(usize, f64)>,
     /// MuJoCo's body and joint ids so far (world = body 0), for naming unnamed ones.
     next_body: usize,
     next_joint: usize,
@@ -63,6 +65,7 @@ impl<'a> TreeBuilder<'a> {
             links: Vec::new(),
             warnings: Vec::new(),
             kept: Vec::new(),
+            gravcomp: Vec::new(),
             next_body: 1,
             next_joint: 0,
         }
@@ -202,9 +205,7 @@ impl<'a> TreeBuilder<'a> {
         if mocap && (!joints.is_empty() || parent != 0) {
             return Err(a.error("mocap", "is only allowed on a top-level body without joints"));
         }
-        if a.real("gravcomp")?.is_some_and(|g| g != 0.0) {
-            self.keep("body", "gravcomp", &name, &a);
-        }
+        let gravcomp = a.real("gravcomp")?.unwrap_or(0.0);
 
         // The link chain: the body link hangs from `parent` directly or from its joint links.
         let mut chain_parent = parent;
@@ -284,6 +285,9 @@ impl<'a> TreeBuilder<'a> {
             mocap,
         });
         let link = self.links.len() - 1;
+        if gravcomp != 0.0 {
+            self.gravcomp.push((link, gravcomp));
+        }
         self.attach_geoms_and_sites(link, &content, Transform::identity(), from_geoms)?;
         for (b, x, bclass) in &content.bodies {
             self.body(b, link, *x, bclass)?;
@@ -415,6 +419,7 @@ impl<'a> TreeBuilder<'a> {
         j.armature = a.real("armature")?.unwrap_or(0.0);
         j.friction = a.real("frictionloss")?.unwrap_or(0.0);
         j.soft = soft_params(&a)?;
+        j.actuator_gravcomp = a.bool("actuatorgravcomp")?.unwrap_or(false);
         if a.has("springdamper") {
             self.keep("joint", "springdamper", &name, &a);
         }

@@ -161,5 +161,6 @@ fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<Mo
         contact_excludes,
         elements,
         warnings,
+        gravcomp: builder.gravcomp,
     })
 }

@@ -1,0 +1,72 @@
+//! Actuation features of issue 30 against MuJoCo 4.0 (reference data from
+//! validation/mujoco_actuation_golden.py, checked against the live MuJoCo in `.ci/run`): for each
+//! scene of tests/data/mjcf/actuation, `mj_forward` quantities at random states (gravity
+//! compensation `qfrc_gravcomp`, `qfrc_passive`, `qfrc_actuator`, the actuators' length,
+//! velocity, force and `act_dot`, `qacc`) to 1e-9 relative, and a 200-step `mj_step` trajectory at
+//! fixed controls (qpos, qvel, act) to 1e-9.
+
+mod common;
+
+use common::{rel_err_vec, state_rel_err, REF_REL};
+use lagrange::prelude::*;
+use serde_json::Value;
+
+fn floats(v: &Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+fn golden() -> Value {
+    serde_json::from_str(&std::fs::read_to_string("tests/data/mujoco/actuation.json").unwrap()).unwrap()
+}
+
+/// Compares every forward quantity of every state of `scene` and its trajectory; returns the
+/// worst forward and trajectory errors.
+fn check_scene(name: &str, scene: &Value) -> (f64, f64) {
+    let model = Model::from_file(scene["model"].as_str().unwrap()).unwrap();
+    assert!(model.warnings.is_empty(), "{name}: {:?}", model.warnings);
+    let mut data = Data::new(&model);
+    let mut worst_forward = 0.0f64;
+    for (s, state) in scene["states"].as_array().unwrap().iter().enumerate() {
+        data.qpos.copy_from_slice(&floats(&state["qpos"]));
+        data.qvel.copy_from_slice(&floats(&state["qvel"]));
+        data.act.copy_from_slice(&floats(&state["act"]));
+        data.ctrl.copy_from_slice(&floats(&state["ctrl"]));
+        forward(&model, &mut data);
+        let ours: [(&str, &[f64]); 8] = [
+            ("qfrc_gravcomp", data.qfrc_gravcomp.as_slice()),
+            ("qfrc_passive", data.qfrc_passive.as_slice()),
+            ("qfrc_actuator", data.qfrc_actuator.as_slice()),
+            ("actuator_length", data.actuator_length.as_slice()),
+            ("actuator_velocity", data.actuator_velocity.as_slice()),
+            ("actuator_force", data.actuator_force.as_slice()),
+            ("act_dot", data.act_dot.as_slice()),
+            ("qacc", data.qacc.as_slice()),
+        ];
+        for (key, ours) in ours {
+            let err = rel_err_vec(ours, &floats(&state[key]));
+            assert!(err <= REF_REL, "{name} state {s}: {key} rel err {err:e}: {ours:?} vs {}", state[key]);
+            worst_forward = worst_forward.max(err);
+        }
+    }
+    reset(&model, &mut data).unwrap();
+    data.ctrl.copy_from_slice(&floats(&scene["ctrl"]));
+    let mut worst_run = 0.0f64;
+    let mut k = 0;
+    for sample in scene["run"].as_array().unwrap() {
+        while k < sample["step"].as_u64().unwrap() {
+            step(&model, &mut data).unwrap();
+            k += 1;
+        }
+        let err = state_rel_err(sample, &data).max(rel_err_vec(data.act.as_slice(), &floats(&sample["act"])));
+        assert!(err <= REF_REL, "{name} step {k}: rel err {err:e}");
+        worst_run = worst_run.max(err);
+    }
+    println!("{name}: forward worst rel err {worst_forward:.1e}, 200 steps worst rel err {worst_run:.1e}");
+    (worst_forward, worst_run)
+}
+
+#[test]
+fn gravity_compensation_follows_mujoco() {
+    let golden = golden();
+    check_scene("gravcomp.xml", &golden["scenes"]["gravcomp.xml"]);
+}

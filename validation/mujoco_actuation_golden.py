@@ -1,0 +1,110 @@
+"""Reference data for the actuation features of issue 30 (gravity compensation with and without
+`actuatorgravcomp`, muscles, adhesion, `<flag override>`): for each scene of tests/data/mjcf/actuation,
+MuJoCo's mj_forward at random states (qpos from qpos0 moved by a random velocity through
+mj_integratePos, random qvel, act and ctrl) — qfrc_gravcomp, qfrc_passive, qfrc_actuator,
+actuator_length, actuator_velocity, actuator_force, act_dot, qacc — the model's
+actuator_lengthrange, and a 200-step mj_step trajectory from qpos0 at fixed controls (qpos, qvel,
+act after 1, 50, 100 and 200 steps). Writes tests/data/mujoco/actuation.json (generated: do not
+edit); with --check, recomputes and exits 1 when the committed file differs beyond 1e-12 (another
+MuJoCo would give other numbers). Read by tests/actuation_mujoco.rs.
+
+  python validation/mujoco_actuation_golden.py [--check]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ROOT / "tests/data/mjcf/actuation"
+OUT = ROOT / "tests/data/mujoco/actuation.json"
+#: Per scene: the fixed controls of the trajectory (one per actuator).
+CONTROLS = {
+    "gravcomp.xml": [0.3, 0.1],
+}
+NSTATES = 4
+SAMPLES = [1, 50, 100, 200]
+FORWARD_KEYS = ["qfrc_gravcomp", "qfrc_passive", "qfrc_actuator", "actuator_length", "actuator_velocity",
+                "actuator_force", "act_dot", "qacc"]
+
+
+def lists(d, keys):
+    return {k: np.asarray(getattr(d, k)).ravel().tolist() for k in keys}
+
+
+def scene(name: str) -> dict:
+    path = SCENES / name
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(30)
+    states = []
+    for _ in range(NSTATES):
+        qpos = m.qpos0.copy()
+        mujoco.mj_integratePos(m, qpos, rng.uniform(-0.6, 0.6, m.nv), 1.0)
+        d.qpos[:] = qpos
+        d.qvel[:] = rng.uniform(-1.0, 1.0, m.nv)
+        d.act[:] = rng.uniform(0.0, 1.0, m.na)
+        lo = np.where(m.actuator_ctrllimited, m.actuator_ctrlrange[:, 0], -1.0)
+        hi = np.where(m.actuator_ctrllimited, m.actuator_ctrlrange[:, 1], 1.0)
+        d.ctrl[:] = rng.uniform(lo, hi)
+        mujoco.mj_forward(m, d)
+        states.append({**lists(d, ["qpos", "qvel", "act", "ctrl"]), **lists(d, FORWARD_KEYS)})
+    mujoco.mj_resetData(m, d)
+    d.ctrl[:] = CONTROLS[name]
+    run = []
+    for k in range(1, max(SAMPLES) + 1):
+        mujoco.mj_step(m, d)
+        if k in SAMPLES:
+            run.append({"step": k, **lists(d, ["qpos", "qvel", "act"])})
+    return {
+        "model": str(path.relative_to(ROOT)),
+        "actuator_lengthrange": m.actuator_lengthrange.ravel().tolist(),
+        "states": states,
+        "ctrl": CONTROLS[name],
+        "run": run,
+    }
+
+
+def worst_difference(a, b) -> float:
+    """The largest absolute difference between two JSON trees of numbers (inf on a shape change)."""
+    if isinstance(a, dict):
+        if not isinstance(b, dict) or a.keys() != b.keys():
+            return float("inf")
+        return max((worst_difference(a[k], b[k]) for k in a), default=0.0)
+    if isinstance(a, list):
+        if not isinstance(b, list) or len(a) != len(b):
+            return float("inf")
+        return max((worst_difference(x, y) for x, y in zip(a, b)), default=0.0)
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        return abs(a - b)
+    return 0.0 if a == b else float("inf")
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--check", action="store_true")
+    args = ap.parse_args()
+    doc = {
+        "generated_by": "validation/mujoco_actuation_golden.py (do not edit)",
+        "mujoco": mujoco.__version__,
+        "scenes": {name: scene(name) for name in CONTROLS},
+    }
+    if args.check:
+        old = json.loads(OUT.read_text())
+        worst = worst_difference(doc["scenes"], old["scenes"])
+        ok = worst <= 1e-12
+        print(f"actuation reference data: live MuJoCo {mujoco.__version__} differs by {worst:.1e} ({'ok' if ok else 'CHANGED'})")
+        return 0 if ok else 1
+    OUT.write_text(json.dumps(doc, indent=1) + "\n")
+    print(f"wrote {OUT.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
