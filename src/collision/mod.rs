@@ -5,14 +5,16 @@
 //! distance, the pair's combined friction, condim, solref and solimp; MuJoCo documentation,
 //! "Computation → Collision detection").
 //!
-//! A bounding-sphere test rejects far pairs first (MuJoCo's `mj_filterSphere`); the narrow phase
-//! is closed form for planes ([`plane`]), spheres and capsules, spheres against cylinders
+//! On scenes with many candidate pairs a sweep and prune over the geoms' bounding cubes picks the
+//! pairs that may touch ([`broadphase`], MuJoCo's `mj_broadphase`); a bounding-sphere test then
+//! rejects far pairs (MuJoCo's `mj_filterSphere`); the narrow phase
+//! is closed form for planes ([`plane`], meshes on planes [`plane_mesh`]), spheres and capsules, spheres against cylinders
 //! ([`sphere_cylinder`]), and boxes against spheres,
 //! capsules ([`box_primitive`]) and boxes ([`box_box`]) with MuJoCo's multi-point manifolds, and
 //! GJK/EPA on support maps for the other convex pairs ([`convex`]). Meshes collide by their
 //! convex hulls, whose support points are found by hill climbing on the hull's edges
-//! ([`hull_support`], as MuJoCo's mesh graph); height fields are not collided yet (`info` lists
-//! them).
+//! ([`hull_support`], as MuJoCo's mesh graph); height fields collide with spheres ([`hfield`], MuJoCo's
+//! prisms); their other pairs are not collided yet (`info` lists them).
 //!
 //! `collide` reports the contacts closer than the pair's margin + gap plus `reach`: MuJoCo's rule
 //! with `reach` = 0 (contacts in the gap are reported without rows: rows exist below the margin,
@@ -34,6 +36,7 @@ pub mod convex;
 mod frame;
 pub mod geom_distance;
 mod gjk;
+pub mod hfield;
 pub mod hull_support;
 pub mod inside;
 pub mod mesh;
@@ -215,6 +218,12 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
                 feature,
             });
         };
+        // Height fields against spheres: MuJoCo's prisms ([`hfield`]).
+        if let (Shape::Hfield { field, .. }, Shape::Sphere { radius }) = (&geom1.shape, &geom2.shape) {
+            let mut out = |p: hfield::HfieldPoint| push(p.p1, p.p2, p.normal, p.dist, None, 0);
+            hfield::sphere(&x1, field, &x2.pos, *radius, pair.margin, &mut out);
+            continue;
+        }
         if let Shape::Plane { .. } = geom1.shape {
             let n = x1.rot.column(2).into_owned();
             let mut out =

@@ -56,11 +56,13 @@ pub fn aba_derivatives(
 /// The derivatives of `qacc_smooth` (forward dynamics without constraints) at the state in
 /// `data` (`qpos`, `qvel`, `ctrl`, `act`, `qfrc_applied`, `xfrc_applied`), with the forces that
 /// depend on the state differentiated too: joint damping (∂/∂v = −d), hinge and slide springs
-/// (∂/∂q = −k) and the actuators' affine gains and biases through their moment arms
+/// (∂/∂q = −k), the tendons' springs and dampers (along J = ∂L/∂q; a spatial tendon's path
+/// curvature left out) and the actuators' affine gains and biases through their moment arms
 /// (∂force/∂velocity = b₂ + g₂ x, ∂force/∂length = b₁ + g₁ x; see
 /// `forward::actuation::add_actuator_length_derivative` for what the configuration part leaves out). Not
-/// differentiated: the q-dependence of `xfrc_applied`'s Jacobian, and the effort-limit and
-/// `actuatorfrcrange` clamps (a clamped force's derivative is reported as if unclamped).
+/// differentiated: the q-dependence of `xfrc_applied`'s Jacobian and of gravity compensation,
+/// fluid forces, and the effort-limit and `actuatorfrcrange` clamps (a clamped force's
+/// derivative is reported as if unclamped).
 /// Results as [`aba_derivatives`], with `work.tau` the total generalized force; runs the passive
 /// and actuation stages (their buffers in `data` are left at this state).
 ///
@@ -116,6 +118,7 @@ fn smooth_derivatives_at(model: &Model, data: &mut Data, work: &mut DerivativesW
         for s in &model.springs {
             work.dtau_dq[(s.dof_adr, s.dof_adr)] += s.stiffness;
         }
+        add_tendon_passive_derivative(model, data, work);
     }
     if actuated {
         add_actuator_velocity_derivative(
@@ -128,6 +131,34 @@ fn smooth_derivatives_at(model: &Model, data: &mut Data, work: &mut DerivativesW
         add_actuator_length_derivative(model, data, work.dtau_dq.as_mut_slice(), 1.0);
     }
     solve_columns(model, data, work, q);
+}
+
+/// The tendons' springs and dampers, f = −k (L − L_spring) − b L̇ along J = ∂L/∂q (outside the
+/// spring's dead band): −∂f/∂v = b JᵀJ and −∂f/∂q = k JᵀJ (a spatial tendon's path curvature,
+/// f ∂²L/∂q², is left out: exact for fixed tendons, whose J is constant).
+fn add_tendon_passive_derivative(model: &Model, data: &Data, work: &mut DerivativesWork) {
+    let flags = &model.options.flags;
+    for (t, tendon) in model.tendons.iter().enumerate() {
+        let b = if flags.damper { tendon.damping } else { 0.0 };
+        let [lower, upper] = tendon.spring_length;
+        let length = data.ten_length[t];
+        let stretched = length > upper || length < lower;
+        let k = if flags.spring && stretched { tendon.stiffness } else { 0.0 };
+        if b == 0.0 && k == 0.0 {
+            continue;
+        }
+        for r in 0..model.nv {
+            let j_r = data.ten_j[(t, r)];
+            if j_r == 0.0 {
+                continue;
+            }
+            for c in 0..model.nv {
+                let jj = j_r * data.ten_j[(t, c)];
+                work.dtau_dv[(r, c)] += b * jj;
+                work.dtau_dq[(r, c)] += k * jj;
+            }
+        }
+    }
 }
 
 /// M at q and its factor, then ∂q̈/∂q = −M⁻¹ ∂τ/∂q, ∂q̈/∂v = −M⁻¹ ∂τ/∂v, ∂q̈/∂τ = M⁻¹: the

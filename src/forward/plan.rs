@@ -391,8 +391,11 @@ fn stages(
         .iter()
         .filter(|g| g.collision && matches!(g.shape, crate::model::spec::Shape::Hfield { .. }))
         .count();
-    let hfield_note =
-        if hfields > 0 { format!("; {hfields} height fields are not collided yet") } else { String::new() };
+    let hfield_note = if hfields > 0 {
+        format!("; {hfields} height fields collide with spheres only (other pairs not collided yet)")
+    } else {
+        String::new()
+    };
     out.push(if npairs > 0 {
         let bound = model.max_contacts();
         stage(

@@ -60,7 +60,7 @@ pub fn type_rank(shape: &Shape) -> u8 {
 }
 
 /// The most contacts a pair of these shapes yields (MuJoCo's closed forms and `mj_maxContact`):
-/// box against box 8, plane against box, cylinder or mesh hull 4 (MuJoCo 4.0 gives a mesh up to the 4 corners of a hull quadrilateral), plane or box against a capsule
+/// a height field 50 (`mjMAXCONPAIR`), box against box 8, plane against box, cylinder or mesh hull 4 (MuJoCo 4.0 gives a mesh up to the 4 corners of a hull quadrilateral), plane or box against a capsule
 /// 2; the convex pairs (`mjc_Convex`, see `collision::multiccd`) 1 with a sphere or an ellipsoid
 /// or when `multiccd` is off, else 5 with a capsule or a cylinder, 4 for boxes and meshes
 /// without margin (face clipping pruned to a quadrilateral) and 5 with one; every other pair 1.
@@ -70,7 +70,8 @@ fn max_contacts(a: &Shape, b: &Shape, multiccd: bool, has_margin: bool) -> usize
         (Box { .. }, Box { .. }) => 8,
         (Plane { .. }, Box { .. } | Cylinder { .. } | Mesh { .. }) => 4,
         (Plane { .. }, Capsule { .. }) | (Capsule { .. }, Box { .. }) | (Box { .. }, Capsule { .. }) => 2,
-        (Plane { .. } | Hfield { .. }, _) | (_, Plane { .. } | Hfield { .. }) => 1,
+        (Hfield { .. }, _) | (_, Hfield { .. }) => crate::collision::hfield::MAX_CONTACTS,
+        (Plane { .. }, _) | (_, Plane { .. }) => 1,
         // Closed forms of one contact.
         (Sphere { .. } | Capsule { .. }, Sphere { .. } | Capsule { .. })
         | (Sphere { .. }, Box { .. })
@@ -85,9 +86,12 @@ fn max_contacts(a: &Shape, b: &Shape, multiccd: bool, has_margin: bool) -> usize
 }
 
 /// Whether a collision function exists for the pair (planes and height fields never collide with
-/// each other; height fields are not collided yet).
+/// each other; a height field collides only with spheres so far, see `collision::hfield`).
 fn collidable(a: &Shape, b: &Shape) -> bool {
-    let hfield = matches!(a, Shape::Hfield { .. }) || matches!(b, Shape::Hfield { .. });
+    let hfield = match (a, b) {
+        (Shape::Hfield { .. }, Shape::Sphere { .. }) | (Shape::Sphere { .. }, Shape::Hfield { .. }) => false,
+        _ => matches!(a, Shape::Hfield { .. }) || matches!(b, Shape::Hfield { .. }),
+    };
     let planes = matches!(a, Shape::Plane { .. }) && matches!(b, Shape::Plane { .. });
     !(hfield || planes)
 }
