@@ -21,19 +21,24 @@ fn vec(v: &Value) -> Vec<f64> {
 }
 
 /// The cases this engine post-processes like MuJoCo: every pyramidal scene, elliptic ones with
-/// no-slip off.
-fn cases(golden: &Value) -> Vec<(String, u32, Value)> {
+/// no-slip off (`elliptic`: instead the elliptic scenes with no-slip on, not post-processed yet:
+/// [`elliptic_noslip_matches_mujoco`] is ignored and says why).
+fn cases_of(golden: &Value, elliptic: bool) -> Vec<(String, u32, Value)> {
     let mut out = Vec::new();
     for (scene, by_n) in golden["scenes"].as_object().unwrap() {
         for (n, case) in by_n.as_object().unwrap() {
             let n: u32 = n.parse().unwrap();
-            if n > 0 && scene.contains("elliptic") {
+            if (n > 0 && scene.contains("elliptic")) != elliptic {
                 continue;
             }
             out.push((scene.clone(), n, case.clone()));
         }
     }
     out
+}
+
+fn cases(golden: &Value) -> Vec<(String, u32, Value)> {
+    cases_of(golden, false)
 }
 
 fn load(scene: &str, n: u32, ctrl: f64) -> (Model, Data) {
@@ -83,5 +88,21 @@ fn noslip_trajectories_match_mujoco() {
         }
         println!("{scene} noslip {n}: 200 steps, worst rel err {worst:.1e}");
         assert!(worst <= SOFT_REL, "{scene} noslip {n}: {worst:e}");
+    }
+}
+
+#[test]
+#[ignore = "issue 30: no-slip on elliptic cones (MuJoCo's QCQP on the cone of the fixed normal force) is not written; src/constraint/soft/noslip.rs leaves elliptic contact rows as the main solver set them"]
+fn elliptic_noslip_matches_mujoco() {
+    let golden = golden();
+    let ctrl = golden["ctrl"].as_f64().unwrap();
+    for (scene, n, case) in cases_of(&golden, true) {
+        let (model, mut data) = load(&scene, n, ctrl);
+        let sample = &case["forward"];
+        data.qpos.copy_from_slice(&vec(&sample["qpos"]));
+        data.qvel.copy_from_slice(&vec(&sample["qvel"]));
+        forward(&model, &mut data);
+        let err = rel_err_vec(&data.efc_force.as_slice()[..data.nefc], &vec(&sample["efc_force"]));
+        assert!(err <= REF_REL, "{scene} noslip {n} efc_force: {err:e}");
     }
 }
