@@ -155,6 +155,7 @@ impl CollisionModel {
 /// buffers have held as many contacts: a pass that finds more than every earlier one grows them).
 pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) {
     data.contacts.clear();
+    let budget = model.contact_budget();
     // World poses of the colliding geoms, once per pass (MuJoCo's geom_xpos, geom_xmat).
     for (g, geom) in model.geoms.iter().enumerate() {
         if cm.shapes[g].is_some() || geom.collision {
@@ -201,6 +202,10 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         let start = data.contacts.len();
         let mut push = |p1: Vec3, p2: Vec3, normal: Vec3, dist: f64, hint: Option<Vec3>, feature: u32| {
             if data.contacts.len() - start >= pair.max_contacts {
+                return;
+            }
+            if data.contacts.len() >= budget {
+                data.contacts_dropped += 1;
                 return;
             }
             data.contacts.push(Contact {

@@ -64,12 +64,20 @@ impl ExactWork {
         }
     }
 
-    /// Grows every buffer to `nefc` rows, keeping the warm start.
-    pub fn grow(&mut self, nv: usize, nefc: usize) {
+    /// The dense matrices (M⁻¹Jᵀ, the Delassus matrix and its factors) for `nefc` rows, if
+    /// smaller: only the exact mode needs them (nefc² numbers each).
+    pub fn grow_matrices(&mut self, nv: usize, nefc: usize) {
+        if self.delassus.nrows() >= nefc && self.minv_jt.nrows() == nv {
+            return;
+        }
         self.minv_jt = DMatrix::zeros(nv, nefc);
         for m in [&mut self.delassus, &mut self.factor, &mut self.sub] {
             *m = DMatrix::zeros(nefc, nefc);
         }
+    }
+
+    /// The per-row vectors for `nefc` rows.
+    pub fn grow_vectors(&mut self, nefc: usize) {
         for v in [&mut self.rhs, &mut self.eig, &mut self.sub_rhs, &mut self.lambda_prev] {
             *v = DVector::zeros(nefc);
         }

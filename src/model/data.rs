@@ -349,8 +349,11 @@ pub struct Data {
     pub(crate) broadphase: crate::collision::broadphase::BroadphaseWork,
     /// Contacts of the last collision pass (MuJoCo's `contact`). Room for
     /// [`INITIAL_CONTACTS`](crate::model::INITIAL_CONTACTS) is reserved; a pass that finds more
-    /// grows it (once: the capacity is kept), so no contact is ever dropped.
+    /// grows it (once: the capacity is kept), up to [`Model::contact_budget`].
     pub contacts: Vec<Contact>,
+    /// Contacts dropped because a collision pass found more than [`Model::contact_budget`]
+    /// (cumulative; MuJoCo's `mjWARN_CONTACTFULL`).
+    pub contacts_dropped: u64,
 
     // --- sensors ---
     /// The sensors' values from the last `forward` (MuJoCo's `sensordata`; each sensor's slice at
@@ -482,6 +485,7 @@ impl Data {
             x_world_geom: vec![Transform::identity(); model.geoms.len()],
             broadphase: crate::collision::broadphase::BroadphaseWork::new(model),
             contacts: Vec::with_capacity(model.max_contacts().min(crate::model::INITIAL_CONTACTS)),
+            contacts_dropped: 0,
             sensordata: DVector::zeros(model.nsensordata),
             sensor_work: crate::sensor::SensorWork::new(model),
             forward_skip: Default::default(),
@@ -565,6 +569,15 @@ impl Data {
     /// Makes room for `n` rows (at least doubling), keeping the warm start; allocates only when a
     /// problem is larger than any before it.
     pub fn reserve_rows(&mut self, n: usize) {
+        self.reserve_soft_rows(n);
+        // The exact mode's dense matrices (nefc² each), for the whole row capacity.
+        let (nv, cap) = (self.efc_j.ncols(), self.efc_capacity());
+        self.exact.grow_matrices(nv, cap);
+    }
+
+    /// [`reserve_rows`](Self::reserve_rows) without the exact mode's dense matrices: what the soft
+    /// mode needs (rows × nv for J, vectors per row).
+    pub(crate) fn reserve_soft_rows(&mut self, n: usize) {
         let cap = self.efc_capacity();
         if n <= cap {
             return;
@@ -572,7 +585,7 @@ impl Data {
         let new = n.max(2 * cap);
         let nv = self.efc_j.ncols();
         self.efc_j = DMatrix::zeros(new, nv);
-        self.exact.grow(nv, new);
+        self.exact.grow_vectors(new);
         for v in [
             &mut self.efc_pos,
             &mut self.efc_vel,

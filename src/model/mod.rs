@@ -410,6 +410,23 @@ impl Model {
         self.collision_pairs.iter().map(|p| p.max_contacts).sum::<usize>()
     }
 
+    /// The most contacts one collision pass keeps: a memory limit on the constraint rows they
+    /// make (up to 6 each), whose dense Jacobian and per-row buffers take rows × (nv + 20) numbers and, in exact mode, whose
+    /// Delassus matrix takes rows²: [`CONTACT_MEMORY`] bytes for either, and never fewer than
+    /// [`INITIAL_CONTACTS`]. Contacts beyond it are dropped and counted in
+    /// [`Data::contacts_dropped`] (`simulate` warns with the count).
+    pub fn contact_budget(&self) -> usize {
+        let numbers = (CONTACT_MEMORY / 8) as f64;
+        // Each row: its J row (nv numbers) and about 20 per-row numbers (efc_* vectors).
+        let by_jacobian = numbers / (6.0 * (self.nv + 20) as f64);
+        let by_delassus = if self.plan.mode() == crate::constraint::ConstraintMode::Exact {
+            numbers.sqrt() / 6.0
+        } else {
+            f64::INFINITY
+        };
+        (by_jacobian.min(by_delassus) as usize).max(INITIAL_CONTACTS)
+    }
+
     /// Whether any degree of freedom has viscous damping (the passive stage's damping term).
     pub fn has_damping(&self) -> bool {
         self.dof_damping.iter().any(|&d| d != 0.0)
@@ -453,6 +470,10 @@ pub fn dof_run_starts(dof_parent: &[usize]) -> Vec<usize> {
 /// How many contacts `Data` reserves room for before the first pass (fewer if the model's
 /// [`Model::max_contacts`] is smaller); more grow the buffers once, when first needed.
 pub const INITIAL_CONTACTS: usize = 500;
+
+/// The memory the rows of one collision pass's contacts may take (bytes; see
+/// [`Model::contact_budget`]).
+pub const CONTACT_MEMORY: usize = 1 << 30;
 
 /// `q ← q ⊕ v·dt` for the whole configuration (MuJoCo's `mj_integratePos`).
 ///

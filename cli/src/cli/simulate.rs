@@ -130,6 +130,8 @@ pub struct Summary {
     /// Nothing adds or removes energy (no damping, friction loss, actuators, joint limits or
     /// contacts): the energy drift measures the integration error alone.
     pub passive: bool,
+    /// Contacts dropped because a collision pass found more than the model's contact budget.
+    pub contacts_dropped: u64,
     /// Whether the model has constraint rows (equalities, mimics, joint limits).
     pub constrained: bool,
     pub dt: f64,
@@ -480,6 +482,7 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         sensors,
         warnings: sim.data.warnings.messages(model),
         passive,
+        contacts_dropped: sim.data.contacts_dropped,
         constrained: sim.model.plan.has_constraints(),
         integrator: sim.integrator(),
         dt,
@@ -661,6 +664,7 @@ pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
         "max_constraint_violation": {"position": s.max_violation[0], "velocity": s.max_violation[1]},
         "max_penetration": s.max_penetration,
         "max_contacts": s.max_contacts,
+        "contacts_dropped": s.contacts_dropped,
         "solver": {"max_iterations": s.max_solver_iterations, "unconverged": s.unconverged.0,
                    "worst_unconverged_residual": s.unconverged.1},
         "q": s.final_state.q.as_slice(),
@@ -765,6 +769,14 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
             out,
             "contacts: up to {} touching, deepest penetration after a step {:.3e} m",
             s.max_contacts, s.max_penetration
+        );
+    }
+    if s.contacts_dropped > 0 {
+        let _ = writeln!(
+            out,
+            "warning: {} contacts were dropped: collision passes found more than the budget of {} contacts (the memory their constraint rows may take, lagrange::model::CONTACT_MEMORY); exclude pairs that need not touch (<contact><exclude>, contype/conaffinity)",
+            s.contacts_dropped,
+            model.contact_budget()
         );
     }
     if s.unconverged.0 > 0 {

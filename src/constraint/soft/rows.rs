@@ -95,7 +95,7 @@ fn row_bound(cm: &ConstraintModel, model: &Model, data: &Data) -> usize {
 /// `efc_j`, `efc_pos`, `efc_margin`, `efc_frictionloss`.
 pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f64], cone: Cone) {
     let bound = row_bound(cm, model, data);
-    data.reserve_rows(bound);
+    data.reserve_soft_rows(bound);
     let ne = cm.equality_rows(model, data, q);
     // Rows ne..bound start at zero: cleared column by column (contiguous in J's storage) rather
     // than row by row (strided).
