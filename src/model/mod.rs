@@ -412,8 +412,8 @@ impl Model {
 
     /// The most contacts one collision pass keeps: a memory limit on the constraint rows they
     /// make (up to 6 each), whose dense Jacobian and per-row buffers take rows × (nv + 20) numbers and, in exact mode, whose
-    /// Delassus matrix takes rows²: [`CONTACT_MEMORY`] bytes for either, and never fewer than
-    /// [`INITIAL_CONTACTS`]. Contacts beyond it are dropped and counted in
+    /// Delassus matrix takes rows²: [`CONTACT_MEMORY`] bytes for either, at most [`MAX_CONTACTS`] and
+    /// never fewer than [`INITIAL_CONTACTS`]. Contacts beyond it are dropped and counted in
     /// [`Data::contacts_dropped`] (`simulate` warns with the count).
     pub fn contact_budget(&self) -> usize {
         let numbers = (CONTACT_MEMORY / 8) as f64;
@@ -424,7 +424,7 @@ impl Model {
         } else {
             f64::INFINITY
         };
-        (by_jacobian.min(by_delassus) as usize).max(INITIAL_CONTACTS)
+        (by_jacobian.min(by_delassus) as usize).clamp(INITIAL_CONTACTS, MAX_CONTACTS)
     }
 
     /// Whether any degree of freedom has viscous damping (the passive stage's damping term).
@@ -470,6 +470,12 @@ pub fn dof_run_starts(dof_parent: &[usize]) -> Vec<usize> {
 /// How many contacts `Data` reserves room for before the first pass (fewer if the model's
 /// [`Model::max_contacts`] is smaller); more grow the buffers once, when first needed.
 pub const INITIAL_CONTACTS: usize = 500;
+
+/// The most contacts one collision pass keeps whatever the memory allows: the solvers' dense
+/// parts (PGS's and no-slip's J M⁻¹ Jᵀ, the exact Delassus matrix) grow with the square of the
+/// rows, so more contacts cost seconds per step (the fuzzer found 2000 too many for no-slip;
+/// issue 26's sparse solvers will raise it).
+pub const MAX_CONTACTS: usize = 500;
 
 /// The memory the rows of one collision pass's contacts may take (bytes; see
 /// [`Model::contact_budget`]).

@@ -249,6 +249,12 @@ fn expand(tag: &str, a: &Attrs, mut p: Params) -> Result<Params, LoadError> {
                 _ if inherit => old.biasprm[2],
                 _ => 0.0,
             };
+            if kp < 0.0 && p.biasprm[2] > 0.0 {
+                return Err(a.error(
+                    "kp",
+                    format!("is {kp} with a 'dampratio': the damping 2·dampratio·√(kp·m) needs kp ≥ 0 (MuJoCo computes NaN); give a non-negative kp, or 'kv' instead of 'dampratio'"),
+                ));
+            }
             p.gainprm[0] = kp;
             p.biasprm[1] = -kp;
             match real("timeconst")? {
