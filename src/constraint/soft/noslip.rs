@@ -8,9 +8,7 @@
 //! `noslip_tolerance`. Elliptic cones' friction rows are left as the main solver set them (not
 //! done yet: MuJoCo's QCQP on the cone of the fixed normal force).
 
-use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, EfcType, Model};
-use nalgebra::DMatrix;
 
 /// MuJoCo's guard against a vanishing diagonal (mjMINVAL).
 const MIN_VAL: f64 = 1e-15;
@@ -41,23 +39,8 @@ fn cost_change(data: &mut Data, rows: &[usize], old: &[f64], res: &[f64]) -> f64
 pub fn solve_noslip(model: &Model, data: &mut Data, scale: f64) {
     let nv = model.nv;
     let n = data.nefc;
-    if data.soft.ar.nrows() < n {
-        data.soft.ar = DMatrix::zeros(n, n);
-        data.soft.minv_jt = DMatrix::zeros(nv, n);
-    }
+    super::pgs::dual_matrix(model, data);
     for i in 0..n {
-        let mut col = data.soft.minv_jt.column_mut(i);
-        for k in 0..nv {
-            col[k] = data.efc_j[(i, k)];
-        }
-        solve_with_factor_unchecked(model, &data.mass_factor, data.soft.minv_jt.column_mut(i).as_mut_slice());
-    }
-    for i in 0..n {
-        for j in 0..=i {
-            let a: f64 = (0..nv).map(|k| data.efc_j[(i, k)] * data.soft.minv_jt[(k, j)]).sum();
-            data.soft.ar[(i, j)] = a;
-            data.soft.ar[(j, i)] = a;
-        }
         // b = J a₀ − aref
         let ja: f64 = (0..nv).map(|k| data.efc_j[(i, k)] * data.qacc_smooth[k]).sum();
         data.soft.jar[i] = ja - data.efc_aref[i];

@@ -171,12 +171,11 @@ fn surface_fista(b: &[[f64; 6]; 6], g: &[f64; 6], dim: usize, start: [f64; 6]) -
     x
 }
 
-/// Solves the soft problem by PGS; writes the same outputs as
-/// `solve_primal` (the unconverged count included).
-pub fn solve_pgs(model: &Model, data: &mut Data, s: Settings) {
+/// M⁻¹ Jᵀ into `soft.minv_jt` and the dual matrix J M⁻¹ Jᵀ of the rows into `soft.ar` (both
+/// grown once for larger problems): what PGS (with R added) and the no-slip sweeps work on.
+pub(crate) fn dual_matrix(model: &Model, data: &mut Data) {
     let nv = model.nv;
     let n = data.nefc;
-    // M⁻¹ Jᵀ and AR = J M⁻¹ Jᵀ + diag(R) (grown once for larger problems).
     if data.soft.ar.nrows() < n {
         data.soft.ar = DMatrix::zeros(n, n);
         data.soft.minv_jt = DMatrix::zeros(nv, n);
@@ -194,6 +193,17 @@ pub fn solve_pgs(model: &Model, data: &mut Data, s: Settings) {
             data.soft.ar[(i, j)] = a;
             data.soft.ar[(j, i)] = a;
         }
+    }
+}
+
+/// Solves the soft problem by PGS; writes the same outputs as
+/// `solve_primal` (the unconverged count included).
+pub fn solve_pgs(model: &Model, data: &mut Data, s: Settings) {
+    let nv = model.nv;
+    let n = data.nefc;
+    // AR = J M⁻¹ Jᵀ + diag(R).
+    dual_matrix(model, data);
+    for i in 0..n {
         data.soft.ar[(i, i)] += data.efc_r[i];
     }
     // b = J a₀ − aref in `jar`; forces from the warm start's rows are not kept: start at 0.
