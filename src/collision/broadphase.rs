@@ -1,4 +1,4 @@
-//! Sweep and prune over the geoms' world boxes (issue 25; MuJoCo's broad phase, `mj_broadphase`
+//! Sweep and prune over the geoms' world boxes (MuJoCo's broad phase, `mj_broadphase`
 //! in engine_collision_driver.c, sweeps boxes along the principal axis of the geoms' positions):
 //! which candidate pairs ([`Model::collision_pairs`]) can touch at the current poses, found in
 //! time that grows with the geoms and the overlapping boxes instead of with all candidate pairs.

@@ -177,7 +177,7 @@ thread_local! {
 }
 
 /// The first contact of a convex pair as MuJoCo 4.0's native solver finds it
-/// ([`super::ccd::penetration`]: GJK/EPA on the geoms inflated by half of `margin` each, to the
+/// (`ccd::penetration`: GJK/EPA on the geoms inflated by half of `margin` each, to the
 /// model's `ccd_tolerance` within `ccd_iterations`): witness points whose midpoint is MuJoCo's
 /// contact position, its normal and the contact distance; None when the inflated geoms do not
 /// overlap.

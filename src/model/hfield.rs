@@ -4,8 +4,8 @@
 //! spread over the rectangle [−`size[0]`, `size[0]`] × [−`size[1]`, `size[1]`] of the geom frame,
 //! elevation `data · size[2]` above z = 0, the solid reaching down to z = −`size[3]`.
 //!
-//! Row `r` lies at y = −size[1] + r·2·size[1]/(nrow − 1), column `c` at
-//! x = −size[0] + c·2·size[0]/(ncol − 1) (MuJoCo's `hfield_data[r·ncol + c]`): row 0 is the
+//! Row `r` lies at y = −size₁ + r·2·size₁/(nrow − 1), column `c` at
+//! x = −size₀ + c·2·size₀/(ncol − 1) (MuJoCo's `hfield_data[r·ncol + c]`): row 0 is the
 //! lowest y, which is the *last* line of a PNG image or of the `elevation` attribute (MuJoCo
 //! reverses both so that the text and the picture read top to bottom as seen from above).
 
@@ -58,7 +58,7 @@ impl HeightField {
     }
 
     /// The half-extents of the box MuJoCo gives a height field geom for its mass and inertia
-    /// (`geom_size`: size[0], size[1], size[2]/4 + size[3]/2).
+    /// (`geom_size`: size₀, size₁, size₂/4 + size₃/2).
     pub fn mass_box(&self) -> [f64; 3] {
         let s = &self.size;
         [s[0], s[1], 0.25 * s[2] + 0.5 * s[3]]

@@ -474,7 +474,7 @@ pub const INITIAL_CONTACTS: usize = 500;
 /// The most contacts one collision pass keeps whatever the memory allows: the solvers' dense
 /// parts (PGS's and no-slip's J M⁻¹ Jᵀ, the exact Delassus matrix) grow with the square of the
 /// rows, so more contacts cost seconds per step (the fuzzer found 2000 too many for no-slip;
-/// issue 26's sparse solvers will raise it).
+/// sparse dual solvers would raise it; see docs/constraints.md).
 pub const MAX_CONTACTS: usize = 500;
 
 /// The memory the rows of one collision pass's contacts may take (bytes; see

@@ -6,7 +6,7 @@
 //!
 //! - **Newton**: the search direction −H⁻¹ g with H = M + Jᵀ (∂²s) J (D on quadratic rows, the
 //!   cone's block on elliptic contacts in their middle zone), factored by a Cholesky that skips
-//!   H's structural zeros ([`super::sparse_cholesky`]);
+//!   H's structural zeros (`sparse_cholesky.rs`);
 //! - **CG**: Polak–Ribière conjugate gradients preconditioned by M⁻¹ (the LᵀDL factor of M);
 //!
 //! both with an exact line search along the direction: Newton's method on the convex,

@@ -1,5 +1,5 @@
 //! Cholesky factorization of the Newton Hessian H = M + Jᵀ D J that does only the work its
-//! nonzeros need (issue 26): the tree sparsity of M (a dof couples only to its ancestors) plus the
+//! nonzeros need (docs/constraints.md, "Soft constraints"): the tree sparsity of M (a dof couples only to its ancestors) plus the
 //! couplings of the active rows (a row touches only its bodies' ancestor dofs). Independent
 //! groups of dofs — bodies that touch nothing, separate piles, MuJoCo's constraint islands — stay
 //! uncoupled in the factor, so their cost adds instead of multiplying.
