@@ -66,7 +66,36 @@ fn binary_and_png_files_as_mujoco() {
         w.write_image_data(&pixels).unwrap();
     }
     std::fs::write(dir.join("h.png"), &png_bytes).unwrap();
-    for file in ["h.bin", "h.png"] {
+    // Colour images: MuJoCo's decoder (lodepng asked for grey) keeps the red channel and
+    // ignores green, blue and alpha; a palette image keeps its palette entry's red.
+    let heights: Vec<u8> = ROWS.iter().rev().flatten().map(|&v| (v * 60.0) as u8).collect();
+    for (name, color, channels) in
+        [("rgb.png", png::ColorType::Rgb, 3), ("rgba.png", png::ColorType::Rgba, 4)]
+    {
+        let mut bytes = Vec::new();
+        let mut enc = png::Encoder::new(&mut bytes, 4, 3);
+        enc.set_color(color);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().unwrap();
+        let pixels: Vec<u8> =
+            heights.iter().flat_map(|&h| [h, 255 - h, 7, 100].into_iter().take(channels)).collect();
+        w.write_image_data(&pixels).unwrap();
+        drop(w);
+        std::fs::write(dir.join(name), &bytes).unwrap();
+    }
+    {
+        let mut bytes = Vec::new();
+        let mut enc = png::Encoder::new(&mut bytes, 4, 3);
+        enc.set_color(png::ColorType::Indexed);
+        enc.set_depth(png::BitDepth::Eight);
+        let palette: Vec<u8> = (0..=255u8).flat_map(|i| [i, 0, 255 - i]).collect();
+        enc.set_palette(palette);
+        let mut w = enc.write_header().unwrap();
+        w.write_image_data(&heights).unwrap();
+        drop(w);
+        std::fs::write(dir.join("palette.png"), &bytes).unwrap();
+    }
+    for file in ["h.bin", "h.png", "rgb.png", "rgba.png", "palette.png"] {
         let xml = format!(
             r#"<mujoco><asset><hfield name="h" file="{}" size="1 0.8 0.3 0.1"/></asset><worldbody><geom type="hfield" hfield="h"/></worldbody></mujoco>"#,
             dir.join(file).display()

@@ -130,8 +130,10 @@ fn hfield(a: &Attrs, e: &Element, compiler: &Compiler, main_file: &str) -> Resul
     Ok(HeightField::new(nrow, ncol, size, data))
 }
 
-/// A grayscale PNG (8- or 16-bit; 16-bit samples keep their high byte as MuJoCo's 8-bit
-/// conversion does), rows reversed.
+/// A PNG as MuJoCo reads it for a height field: decoded to 8-bit grey the way its PNG decoder
+/// (lodepng, asked for `LCT_GREY`) converts — a grey image keeps its value, a colour or palette
+/// image keeps its **red** channel, 16-bit samples keep their high byte, alpha is ignored — rows
+/// reversed.
 fn read_png(bytes: &[u8]) -> Result<(usize, usize, Vec<f32>), String> {
     let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
@@ -142,7 +144,10 @@ fn read_png(bytes: &[u8]) -> Result<(usize, usize, Vec<f32>), String> {
     let channels = match info.color_type {
         png::ColorType::Grayscale => 1,
         png::ColorType::GrayscaleAlpha => 2,
-        other => return Err(format!("a {other:?} PNG: height fields are read from grayscale images")),
+        png::ColorType::Rgb => 3,
+        png::ColorType::Rgba => 4,
+        // EXPAND turns palette images into Rgb/Rgba before this point.
+        png::ColorType::Indexed => return Err("a palette PNG the decoder did not expand".into()),
     };
     let (ncol, nrow) = (info.width as usize, info.height as usize);
     if nrow == 0 || ncol == 0 {
