@@ -13,7 +13,8 @@ const GO1: &str = "models/mjcf/unitree_go1/scene.xml";
 #[test]
 fn from_file_and_from_str_tell_the_format_by_content() {
     let urdf = std::fs::read_to_string("models/ur5/ur5.urdf").unwrap();
-    let dir = std::env::temp_dir().join(format!("lagrange-api-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-api-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // A URDF under a name without the extension still loads as URDF (exact mode, its default).
     let path = dir.join("robot.description");

@@ -17,8 +17,8 @@ use std::path::PathBuf;
 /// path, so `file=` can name `tests/data/meshes/...` absolutely).
 fn mjcf(name: &str, body: &str) -> Result<Model, String> {
     let text = format!("<mujoco model=\"{name}\"><compiler angle=\"radian\"/>{body}</mujoco>");
-    let path: PathBuf =
-        std::env::temp_dir().join(format!("lagrange-collision-{}-{name}.xml", std::process::id()));
+    let path: PathBuf = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-collision-{}-{name}.xml", std::process::id()));
     std::fs::write(&path, text).unwrap();
     let model = load(&path, &LoadOptions::default()).map_err(|e| e.to_string());
     let _ = std::fs::remove_file(&path);

@@ -20,7 +20,8 @@ const G: f64 = 9.81;
 fn with_friction(file: &str, mu: f64) -> Model {
     let text = std::fs::read_to_string(Path::new("models/textbook").join(file)).unwrap();
     let text = text.replace(r#"friction="0.5 0 0""#, &format!(r#"friction="{mu} 0 0""#));
-    let path: PathBuf = std::env::temp_dir().join(format!("lagrange-{}-{mu}-{file}", std::process::id()));
+    let path: PathBuf = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-{}-{mu}-{file}", std::process::id()));
     std::fs::write(&path, text).unwrap();
     let model = load(&path, &LoadOptions::default()).unwrap();
     let _ = std::fs::remove_file(&path);

@@ -122,8 +122,11 @@ fn read_scene(name: &str) -> Scene {
 fn load_scene(scene: &Scene) -> Model {
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let path =
-        std::env::temp_dir().join(format!("lagrange-geomq-{}-{call}-{}.xml", std::process::id(), scene.name));
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "lagrange-geomq-{}-{call}-{}.xml",
+        std::process::id(),
+        scene.name
+    ));
     let meshdir = data_dir().join("meshes");
     std::fs::write(&path, scene.mjcf.replace("@MESHDIR@", meshdir.to_str().unwrap())).unwrap();
     let model = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", scene.name));

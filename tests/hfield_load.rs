@@ -45,7 +45,8 @@ const ROWS: [[f32; 4]; 3] = [[3.0, 2.0, 0.0, 1.0], [1.0, 1.0, 1.0, 1.0], [0.0, 1
 
 #[test]
 fn binary_and_png_files_as_mujoco() {
-    let dir = std::env::temp_dir().join(format!("lagrange-hfield-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-hfield-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // Binary: int32 nrow, int32 ncol, float32 data, row 0 first.
     let mut bin = Vec::new();
@@ -114,7 +115,8 @@ fn bad_hfields_are_typed_errors() {
         (ELEVATION.replace("0 1 2 3  1 1 1 1", "0 1 2 3"), "elevation"),
         (ELEVATION.replace(r#"size="1 0.8 0.3 0.1""#, r#"size="1 0.8 0.3 0""#), "positive"),
     ] {
-        let path = std::env::temp_dir().join(format!("lagrange-hfield-bad-{}.xml", std::process::id()));
+        let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!("lagrange-hfield-bad-{}.xml", std::process::id()));
         std::fs::write(&path, xml).unwrap();
         let err = lagrange::io::load(&path, &Default::default()).unwrap_err().to_string();
         assert!(err.contains(says), "{err}");

@@ -10,7 +10,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 fn write_urdf(tag: &str, text: &str) -> PathBuf {
     static COUNTER: AtomicUsize = AtomicUsize::new(0);
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let dir = std::env::temp_dir().join(format!("lagrange-load-errors-{}-{n}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-load-errors-{}-{n}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(format!("{tag}.urdf"));
     std::fs::write(&path, text).unwrap();
@@ -344,7 +345,8 @@ fn mesh_that_resolves_but_does_not_exist() {
 
 #[test]
 fn mesh_inside_a_found_package_that_does_not_exist() {
-    let root = std::env::temp_dir().join(format!("lagrange-load-errors-{}-pkg", std::process::id()));
+    let root = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-load-errors-{}-pkg", std::process::id()));
     std::fs::create_dir_all(root.join("lagrange_err_pkg/meshes")).unwrap();
     let mesh = r#"    <collision><geometry><mesh filename="package://lagrange_err_pkg/meshes/nope.stl"/></geometry></collision>"#;
     let text = two_links("fixed", "", mesh);
@@ -394,7 +396,8 @@ fn duplicate_joint_name() {
 
 #[test]
 fn file_that_does_not_exist() {
-    let path = std::env::temp_dir().join("lagrange-load-errors-no-such-dir/robot.urdf");
+    let path =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("lagrange-load-errors-no-such-dir/robot.urdf");
     let e = load(&path, &LoadOptions::default()).unwrap_err();
     assert!(matches!(e, LoadError::Io { .. }), "{e:?}");
     assert_mentions(&e.to_string(), &[&path.display().to_string(), "cannot read the file", "check the path"]);

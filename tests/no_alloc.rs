@@ -172,7 +172,8 @@ fn geometric_queries_do_not_allocate() {
     let doc: serde_json::Value = serde_json::from_str(&scene).unwrap();
     let meshdir = root.join("tests/data/mujoco_geomq/meshes");
     let mjcf = doc["mjcf"].as_str().unwrap().replace("@MESHDIR@", meshdir.to_str().unwrap());
-    let path = std::env::temp_dir().join(format!("lagrange-no-alloc-geomq-{}.xml", std::process::id()));
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-no-alloc-geomq-{}.xml", std::process::id()));
     std::fs::write(
         &path,
         mjcf.replace("</worldbody>", r#"<site name="zone" type="box" size="0.1 0.2 0.3"/></worldbody>"#),

@@ -190,7 +190,8 @@ fn go1_stands_on_its_servos_as_in_mujoco() {
 /// medium (tests/fluid.rs compares the forces with MuJoCo's).
 #[test]
 fn fluid_options_are_listed_as_simulated() {
-    let path = std::env::temp_dir().join(format!("lagrange-fluid-{}.xml", std::process::id()));
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-fluid-{}.xml", std::process::id()));
     std::fs::write(
         &path,
         r#"<mujoco><option viscosity="0.1" wind="1 0 0"/><worldbody><body><freejoint/><geom size="0.1"/></body></worldbody></mujoco>"#,

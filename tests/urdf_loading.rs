@@ -51,7 +51,8 @@ fn xyz_rpy(x: [f64; 3], r: [f64; 3]) -> Transform {
 
 /// Unique scratch folder under the system temp dir.
 fn scratch(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("lagrange-urdf-loading-{}-{tag}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-urdf-loading-{}-{tag}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir

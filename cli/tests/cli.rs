@@ -12,7 +12,8 @@ use serde_json::Value;
 use std::path::PathBuf;
 
 fn temp_file(name: &str, text: &str) -> PathBuf {
-    let path = std::env::temp_dir().join(format!("lagrange-cli-{}-{name}", std::process::id()));
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-cli-{}-{name}", std::process::id()));
     std::fs::write(&path, text).unwrap();
     path
 }
@@ -139,7 +140,8 @@ fn eval_rejects_a_state_of_the_wrong_size() {
 
 #[test]
 fn simulate_prints_a_summary_and_writes_the_csv() {
-    let csv = std::env::temp_dir().join(format!("lagrange-cli-{}-traj.csv", std::process::id()));
+    let csv = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-cli-{}-traj.csv", std::process::id()));
     let (ok, out, err) = lagrange(&[
         "simulate",
         "models/textbook/double_pendulum.urdf",
@@ -414,7 +416,8 @@ fn simulate_and_eval_report_mujocos_run_time_warnings() {
     let summary: Value = serde_json::from_str(&out).unwrap();
     let warnings = summary["warnings"].as_array().unwrap();
     assert!(warnings.iter().any(|w| w.as_str().unwrap().contains("'m_free'")), "{warnings:?}");
-    let states = std::env::temp_dir().join(format!("lagrange-cli-{}-warnings.json", std::process::id()));
+    let states = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-cli-{}-warnings.json", std::process::id()));
     std::fs::write(&states, r#"{"states": [{"q": [0.1, 0.2, 0.3, 0.1, 0.2]}]}"#).unwrap();
     let (ok, out, err) =
         lagrange(&["eval", "tests/data/mjcf/warnings/dup_hinges.xml", "--states", states.to_str().unwrap()]);

@@ -38,7 +38,8 @@ fn unsimulated_transmissions_are_warned_and_listed() {
 /// final act from the keyframe's.
 #[test]
 fn eval_and_simulate_carry_act() {
-    let states = std::env::temp_dir().join(format!("lagrange-act-{}.json", std::process::id()));
+    let states = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-act-{}.json", std::process::id()));
     std::fs::write(
         &states,
         r#"{"states": [{"q": [0.1, -0.2, 0.05, 0.3], "ctrl": [1.5, 1, -1, 2, 0.5, 0.3, 0.2, 1, 30],
@@ -57,7 +58,8 @@ fn eval_and_simulate_carry_act() {
     assert!(!ok && err.contains("states[0]: 'act' has 2 values, the model needs 9"), "{err}");
     let _ = std::fs::remove_file(&states);
 
-    let csv = std::env::temp_dir().join(format!("lagrange-act-{}.csv", std::process::id()));
+    let csv = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-act-{}.csv", std::process::id()));
     let (ok, out, err) = lagrange(&[
         "simulate",
         ACTIVATION,

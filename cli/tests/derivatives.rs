@@ -20,7 +20,8 @@ fn shape(m: &serde_json::Value) -> (usize, usize) {
 fn eval_adds_derivatives() {
     let model = load(&run::root().join(ACTIVATION), &LoadOptions::default()).unwrap();
     let (nv, na, nu) = (model.nv, model.na(), model.actuators.len());
-    let states = std::env::temp_dir().join(format!("lagrange-deriv-{}.json", std::process::id()));
+    let states = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-deriv-{}.json", std::process::id()));
     std::fs::write(
         &states,
         r#"{"states": [{"q": [0.1, -0.2, 0.05, 0.3], "v": [0.3, -0.1, 0.2, 0.05], "tau": [0.1, 0, 0, -0.2],

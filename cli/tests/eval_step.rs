@@ -16,7 +16,8 @@ const BOX: &str = "tests/data/mjcf/edges/box_iterations0.xml";
 const DROP: &str = "models/textbook/drop.xml";
 
 fn states_file(name: &str, states: &Value) -> std::path::PathBuf {
-    let path = std::env::temp_dir().join(format!("lagrange-eval-step-{}-{name}.json", std::process::id()));
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-eval-step-{}-{name}.json", std::process::id()));
     std::fs::write(&path, json!({ "states": states }).to_string()).unwrap();
     path
 }

@@ -11,7 +11,8 @@ use run::lagrange;
 use std::path::PathBuf;
 
 fn temp_file(name: &str, text: &str) -> PathBuf {
-    let path = std::env::temp_dir().join(format!("lagrange-inputs-{}-{name}", std::process::id()));
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-inputs-{}-{name}", std::process::id()));
     std::fs::write(&path, text).unwrap();
     path
 }

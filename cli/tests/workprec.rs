@@ -16,7 +16,8 @@ use std::path::PathBuf;
 const MODEL: &str = "models/textbook/double_pendulum.xml";
 
 fn temp_path(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("lagrange-workprec-{}-{name}", std::process::id()))
+    std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-workprec-{}-{name}", std::process::id()))
 }
 
 fn keys(v: &Value) -> Vec<String> {

@@ -519,8 +519,8 @@ pub fn repo_path(rel: &str) -> PathBuf {
 pub fn load_mjcf_text(label: &str, scene: &str, mjcf: &str) -> Model {
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let path =
-        std::env::temp_dir().join(format!("lagrange-{label}-{}-{call}-{scene}.xml", std::process::id()));
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-{label}-{}-{call}-{scene}.xml", std::process::id()));
     std::fs::write(&path, mjcf).unwrap();
     let model = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{scene}: {e}"));
     let _ = std::fs::remove_file(&path);
