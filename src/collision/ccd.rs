@@ -1049,6 +1049,37 @@ pub(crate) fn penetration(
     })
 }
 
+/// Whether GJK proves the two geoms, inflated by half of `margin` each, apart: a support plane
+/// separating them found within `iterations` (MuJoCo's early exit in `gjk` with no distance
+/// wanted: the first support point with x_k·s_k > 0). Exact when true — a separating plane is a
+/// certificate — so a caller may skip its own narrow phase; false leaves the pair undecided.
+pub(crate) fn separated(
+    s1: &ConvexShape,
+    x1: &Transform,
+    s2: &ConvexShape,
+    x2: &Transform,
+    margin: f64,
+    tolerance: f64,
+    iterations: usize,
+) -> bool {
+    let mut o1 = CcdObj::new(s1, x1, margin);
+    let mut o2 = CcdObj::new(s2, x2, margin);
+    let mut st = Status {
+        separated: false,
+        dist: 0.0,
+        x1: x1.pos,
+        x2: x2.pos,
+        max_iterations: iterations,
+        tolerance,
+        dist_cutoff: 0.0,
+        gjk_iterations: 0,
+        simplex: [ZERO_VERTEX; 4],
+        nsimplex: 0,
+    };
+    gjk(&mut st, &mut o1, &mut o2);
+    st.separated
+}
+
 /// A final EPA face's features: geom 1's and geom 2's vertex indices of its three polytope
 /// vertices, and their points on geom 1 and geom 2 (world).
 pub(crate) type FaceFeatures = ([i32; 3], [i32; 3], [Vec3; 3], [Vec3; 3]);

@@ -195,6 +195,19 @@ pub fn mujoco_pair(
         // search: with MuJoCo's solver 3 fewer box–mesh cases matched (its EPA face on coplanar
         // facets depends on the hull's vertex order, which is parry's here, not MuJoCo's).
         LAST_FACE.with(|f| f.set(None));
+        // MuJoCo's GJK dismisses most candidate pairs after a few support points; the exact EPA
+        // runs only for the pairs GJK cannot prove apart.
+        if super::ccd::separated(
+            s1,
+            x1,
+            s2,
+            x2,
+            margin,
+            options.ccd_tolerance,
+            options.ccd_iterations as usize,
+        ) {
+            return None;
+        }
         return support_pair(x1, s1, x2, s2, margin);
     }
     let c = super::ccd::penetration(

@@ -7,7 +7,8 @@
 //!
 //! On scenes with many candidate pairs a sweep and prune over the geoms' bounding cubes picks the
 //! pairs that may touch ([`broadphase`], MuJoCo's `mj_broadphase`); a bounding-sphere test then
-//! rejects far pairs (MuJoCo's `mj_filterSphere`); the narrow phase
+//! rejects far pairs (MuJoCo's `mj_filterSphere`), and an oriented-bounding-box test the pairs of
+//! convex geoms whose boxes are apart ([`obb`], MuJoCo's `mj_collideOBB`); the narrow phase
 //! is closed form for planes ([`plane`], meshes on planes [`plane_mesh`]), spheres and capsules, spheres against cylinders
 //! ([`sphere_cylinder`]), and boxes against spheres,
 //! capsules ([`box_primitive`]) and boxes ([`box_box`]) with MuJoCo's multi-point manifolds, and
@@ -41,6 +42,7 @@ pub mod hull_support;
 pub mod inside;
 pub mod mesh;
 pub mod multiccd;
+pub mod obb;
 pub mod plane;
 pub mod plane_mesh;
 pub mod ray;
@@ -84,6 +86,9 @@ pub struct CollisionModel {
     pub plane_hulls: Vec<Option<Arc<PlaneHull>>>,
     /// The sweep and prune over the geoms' boxes ([`broadphase`]).
     pub sweep: broadphase::Broadphase,
+    /// Per geom, its bounding box in its own frame for the [`obb`] test (None for planes, height
+    /// fields and meshes without a hull).
+    pub local_box: Vec<Option<obb::LocalBox>>,
 }
 
 /// The bounding-sphere test of one candidate pair (see [`CollisionModel::broad`]).
@@ -146,7 +151,12 @@ impl CollisionModel {
             })
             .collect();
         let sweep = broadphase::Broadphase::new(model, &rbound);
-        Self { shapes, rbound, broad, plane_hulls, sweep }
+        let local_box = model
+            .geoms
+            .iter()
+            .map(|g| obb::LocalBox::of(&g.shape, g.hull.as_deref().map(|h| &h[..])))
+            .collect();
+        Self { shapes, rbound, broad, plane_hulls, sweep, local_box }
     }
 }
 
@@ -199,6 +209,11 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         let (geom1, geom2) = (&model.geoms[g1], &model.geoms[g2]);
         let (x1, x2) = (data.x_world_geom[g1], data.x_world_geom[g2]);
         let within = pair.margin + pair.gap + reach;
+        if let (Some(b1), Some(b2)) = (&cm.local_box[g1], &cm.local_box[g2]) {
+            if obb::apart(b1, &x1, b2, &x2, within) {
+                continue;
+            }
+        }
         let start = data.contacts.len();
         let mut push = |p1: Vec3, p2: Vec3, normal: Vec3, dist: f64, hint: Option<Vec3>, feature: u32| {
             if data.contacts.len() - start >= pair.max_contacts {
