@@ -57,6 +57,11 @@ impl HullSupport {
         &self.polyhedron
     }
 
+    /// The neighbours of vertex `v` along the hull's edges.
+    pub fn neighbours(&self, v: usize) -> &[u32] {
+        &self.adj[self.adj_start[v] as usize..self.adj_start[v + 1] as usize]
+    }
+
     /// The index (in `polyhedron().points()`) of the vertex farthest along `dir`, by hill climbing.
     pub fn support_index(&self, dir: Vector) -> usize {
         self.support_index_warm(dir, -1)

@@ -63,6 +63,7 @@ struct Scratch {
     feature1: Vec<u32>,
     feature2: Vec<u32>,
     tmp: Vec<u32>,
+    faces: Vec<u32>,
 }
 
 thread_local! {
@@ -72,7 +73,7 @@ thread_local! {
 /// A polytope geom: a box (half-extents) or a mesh's hull.
 enum Poly<'a> {
     Cuboid(Vec3),
-    Hull(&'a parry3d_f64::shape::ConvexPolyhedron),
+    Hull(&'a parry3d_f64::shape::ConvexPolyhedron, &'a super::hull_support::HullSupport),
 }
 
 impl<'a> Poly<'a> {
@@ -82,7 +83,7 @@ impl<'a> Poly<'a> {
                 let h = c.half_extents;
                 Some(Poly::Cuboid(Vec3::new(h.x, h.y, h.z)))
             }
-            ConvexShape::Hull(s) => Some(Poly::Hull(s.polyhedron())),
+            ConvexShape::Hull(s) => Some(Poly::Hull(s.polyhedron(), s)),
             _ => None,
         }
     }
@@ -90,7 +91,7 @@ impl<'a> Poly<'a> {
     fn nvert(&self) -> usize {
         match self {
             Poly::Cuboid(_) => 8,
-            Poly::Hull(p) => p.points().len(),
+            Poly::Hull(p, _) => p.points().len(),
         }
     }
 
@@ -102,17 +103,10 @@ impl<'a> Poly<'a> {
                 if i & 2 != 0 { h.y } else { -h.y },
                 if i & 4 != 0 { h.z } else { -h.z },
             ),
-            Poly::Hull(p) => {
+            Poly::Hull(p, _) => {
                 let v: Vector = p.points()[i as usize];
                 Vec3::new(v.x, v.y, v.z)
             }
-        }
-    }
-
-    fn nface(&self) -> usize {
-        match self {
-            Poly::Cuboid(_) => 6,
-            Poly::Hull(p) => p.faces().len(),
         }
     }
 
@@ -124,7 +118,7 @@ impl<'a> Poly<'a> {
                 n[(f / 2) as usize] = if f.is_multiple_of(2) { 1.0 } else { -1.0 };
                 n
             }
-            Poly::Hull(p) => {
+            Poly::Hull(p, _) => {
                 let n = p.faces()[f as usize].normal;
                 Vec3::new(n.x, n.y, n.z)
             }
@@ -141,7 +135,7 @@ impl<'a> Poly<'a> {
                     [[7, 3, 1, 5], [2, 6, 4, 0], [2, 3, 7, 6], [4, 5, 1, 0], [6, 7, 5, 4], [3, 2, 0, 1]];
                 out.extend_from_slice(&BOX_FACES[f as usize]);
             }
-            Poly::Hull(p) => {
+            Poly::Hull(p, _) => {
                 let face = p.faces()[f as usize];
                 let start = face.first_vertex_or_edge as usize;
                 let n = face.num_vertices_or_edges as usize;
@@ -157,10 +151,31 @@ impl<'a> Poly<'a> {
     }
 }
 
-/// The vertices of `poly` (at pose `x`) within `tol` of its support plane along world `dir`.
+/// The vertices of `poly` (at pose `x`) within `tol` of its support plane along world `dir`, in
+/// ascending order. A hull's are found from its support vertex (hill climbing) by walking its
+/// edges through the vertices within `tol`: the vertices of a convex polytope on one side of a
+/// plane are connected along its edges (from any of them a neighbour farther along `dir` leads to
+/// the support vertex), so the walk finds all of them without visiting the others.
 fn support_feature(poly: &Poly, x: &Transform, dir: &Vec3, tol: f64, out: &mut Vec<u32>) {
     out.clear();
     let local = x.rot.transpose() * dir;
+    if let Poly::Hull(_, support) = poly {
+        let top = support.support_index(Vector::new(local.x, local.y, local.z)) as u32;
+        let threshold = poly.vertex(top).dot(&local) - tol;
+        out.push(top);
+        let mut k = 0;
+        while k < out.len() {
+            let v = out[k] as usize;
+            k += 1;
+            for &j in support.neighbours(v) {
+                if poly.vertex(j).dot(&local) >= threshold && !out.contains(&j) {
+                    out.push(j);
+                }
+            }
+        }
+        out.sort_unstable();
+        return;
+    }
     let mut best = f64::NEG_INFINITY;
     for i in 0..poly.nvert() as u32 {
         best = best.max(poly.vertex(i).dot(&local));
@@ -168,6 +183,27 @@ fn support_feature(poly: &Poly, x: &Transform, dir: &Vec3, tol: f64, out: &mut V
     for i in 0..poly.nvert() as u32 {
         if poly.vertex(i).dot(&local) >= best - tol {
             out.push(i);
+        }
+    }
+}
+
+/// The faces around vertex `v`, in ascending order, into `out` (a box's three by scanning its six).
+fn vertex_faces(poly: &Poly, v: u32, tmp: &mut Vec<u32>, out: &mut Vec<u32>) {
+    out.clear();
+    match poly {
+        Poly::Hull(p, _) => {
+            let vertex = p.vertices()[v as usize];
+            let start = vertex.first_adj_face_or_edge as usize;
+            let n = vertex.num_adj_faces_or_edge as usize;
+            out.extend_from_slice(&p.faces_adj_to_vertex()[start..start + n]);
+            out.sort_unstable();
+        }
+        Poly::Cuboid(_) => {
+            for f in 0..6 {
+                if poly.face_has(f, v, tmp) {
+                    out.push(f);
+                }
+            }
         }
     }
 }
@@ -180,11 +216,14 @@ fn feature_faces(
     feature: &[u32],
     dir: &Vec3,
     tmp: &mut Vec<u32>,
+    faces: &mut Vec<u32>,
     out: &mut Vec<(Vec3, u32)>,
 ) {
     out.clear();
-    for f in 0..poly.nface() as u32 {
-        if feature.iter().take(3).all(|&v| poly.face_has(f, v, tmp)) {
+    let Some(&v0) = feature.first() else { return };
+    vertex_faces(poly, v0, tmp, faces);
+    for &f in faces.iter() {
+        if feature.iter().skip(1).take(2).all(|&v| poly.face_has(f, v, tmp)) {
             out.push((x.rot * poly.face_normal(f), f));
         }
     }
@@ -204,7 +243,14 @@ fn face_polygon(poly: &Poly, x: &Transform, f: u32, tmp: &mut Vec<u32>, out: &mu
 
 /// The edges of a feature of one or two vertices as (start, end) world points: the edge itself,
 /// or every edge from the vertex (along the faces around it).
-fn feature_edges(poly: &Poly, x: &Transform, feature: &[u32], tmp: &mut Vec<u32>, out: &mut Vec<Vec3>) {
+fn feature_edges(
+    poly: &Poly,
+    x: &Transform,
+    feature: &[u32],
+    tmp: &mut Vec<u32>,
+    faces: &mut Vec<u32>,
+    out: &mut Vec<Vec3>,
+) {
     out.clear();
     let v0 = feature[0];
     let p0 = x.act_point(&poly.vertex(v0));
@@ -213,7 +259,8 @@ fn feature_edges(poly: &Poly, x: &Transform, feature: &[u32], tmp: &mut Vec<u32>
         out.push(x.act_point(&poly.vertex(feature[1])));
         return;
     }
-    for f in 0..poly.nface() as u32 {
+    vertex_faces(poly, v0, tmp, faces);
+    for &f in faces.iter() {
         poly.face_vertices(f, tmp);
         if let Some(k) = tmp.iter().position(|&v| v == v0) {
             // MuJoCo's: the polygon's previous vertex in its own (counter-clockwise) order.
@@ -248,8 +295,8 @@ pub fn polytope_contacts(
         let mut tmp = std::mem::take(&mut s.tmp);
         support_feature(&p1, x1, &n, tol, &mut s.feature1);
         support_feature(&p2, x2, &-n, tol, &mut s.feature2);
-        feature_faces(&p1, x1, &s.feature1, &n, &mut tmp, &mut s.normals1);
-        feature_faces(&p2, x2, &s.feature2, &-n, &mut tmp, &mut s.normals2);
+        feature_faces(&p1, x1, &s.feature1, &n, &mut tmp, &mut s.faces, &mut s.normals1);
+        feature_faces(&p2, x2, &s.feature2, &-n, &mut tmp, &mut s.faces, &mut s.normals2);
         let (dim1, dim2) = (s.feature1.len().min(3), s.feature2.len().min(3));
         // The most nearly opposite face pair within the tolerance.
         let mut aligned: Option<(f64, usize, usize)> = None;
@@ -280,7 +327,7 @@ pub fn polytope_contacts(
             });
         } else if dim1 < 3 && dim1 <= dim2 {
             // An edge of geom 1 against a face of geom 2.
-            feature_edges(&p1, x1, &s.feature1, &mut tmp, &mut s.face1);
+            feature_edges(&p1, x1, &s.feature1, &mut tmp, &mut s.faces, &mut s.face1);
             if let Some((e, j)) = edge_face(&s.face1, &s.normals2) {
                 let (n2, f2) = s.normals2[j];
                 face_polygon(&p2, x2, f2, &mut tmp, &mut s.face2);
@@ -293,7 +340,7 @@ pub fn polytope_contacts(
             }
         } else if dim2 < 3 {
             // An edge of geom 2 against a face of geom 1.
-            feature_edges(&p2, x2, &s.feature2, &mut tmp, &mut s.face2);
+            feature_edges(&p2, x2, &s.feature2, &mut tmp, &mut s.faces, &mut s.face2);
             if let Some((e, i)) = edge_face(&s.face2, &s.normals1) {
                 let (n1, f1) = s.normals1[i];
                 face_polygon(&p1, x1, f1, &mut tmp, &mut s.face1);
@@ -563,7 +610,7 @@ fn cap_polytope(
         let mut tmp = std::mem::take(&mut s.tmp);
         let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
         support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
-        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.normals2);
+        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.faces, &mut s.normals2);
         let opposite = s
             .normals2
             .iter()
@@ -616,7 +663,7 @@ fn segment_polytope(
         let mut tmp = std::mem::take(&mut s.tmp);
         let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
         support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
-        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.normals2);
+        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.faces, &mut s.normals2);
         s.face1.clear();
         s.face1.extend_from_slice(&seg);
         let mut count = 0;
