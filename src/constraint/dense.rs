@@ -33,43 +33,68 @@ pub(crate) fn solve_psd(
     min_norm_solve(a, n, b, work, vec)
 }
 
-/// Lower Cholesky factor of A into `l`; false if a pivot is not above `tol`.
+/// Lower Cholesky factor of A into `l`; false if a pivot is not above `tol`. Only A's lower
+/// triangle is read.
+///
+/// Column by column (left-looking), each column's entries updated by the earlier columns in
+/// ascending order — per entry the same operations in the same order as the textbook row form
+/// `l_ij = (a_ij − Σ_k l_ik l_jk) / l_jj`, so the factor is the same to the bit, but every inner
+/// loop runs down a column (contiguous in nalgebra's column-major storage), and columns whose
+/// entry in row j is zero are skipped (they subtract exact zeros).
 pub(crate) fn cholesky(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f64) -> bool {
+    let stride = l.nrows();
+    let ls = l.as_mut_slice();
     for j in 0..n {
-        let mut d = a[(j, j)];
-        for k in 0..j {
-            d -= l[(j, k)] * l[(j, k)];
+        let cj = j * stride;
+        for i in j..n {
+            ls[cj + i] = a[(i, j)];
         }
+        for k in 0..j {
+            let ck = k * stride;
+            let ljk = ls[ck + j];
+            if ljk == 0.0 {
+                continue;
+            }
+            for i in j..n {
+                ls[cj + i] -= ls[ck + i] * ljk;
+            }
+        }
+        let d = ls[cj + j];
         if d <= tol {
             return false;
         }
         let d = d.sqrt();
-        l[(j, j)] = d;
+        ls[cj + j] = d;
         for i in j + 1..n {
-            let mut s = a[(i, j)];
-            for k in 0..j {
-                s -= l[(i, k)] * l[(j, k)];
-            }
-            l[(i, j)] = s / d;
+            ls[cj + i] /= d;
         }
     }
     true
 }
 
+/// Solves L Lᵀ x = b in place with the factor of [`cholesky`] (forward substitution column by
+/// column, per entry in the same order as the row form; back substitution by rows of Lᵀ, which
+/// are L's columns).
 pub(crate) fn cholesky_solve(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
-    for i in 0..n {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= l[(i, k)] * b[k];
+    let stride = l.nrows();
+    let ls = l.as_slice();
+    for k in 0..n {
+        let ck = k * stride;
+        b[k] /= ls[ck + k];
+        let bk = b[k];
+        if bk != 0.0 {
+            for i in k + 1..n {
+                b[i] -= ls[ck + i] * bk;
+            }
         }
-        b[i] = s / l[(i, i)];
     }
     for i in (0..n).rev() {
+        let ci = i * stride;
         let mut s = b[i];
         for k in i + 1..n {
-            s -= l[(k, i)] * b[k];
+            s -= ls[ci + k] * b[k];
         }
-        b[i] = s / l[(i, i)];
+        b[i] = s / ls[ci + i];
     }
 }
 

@@ -229,7 +229,8 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         match method {
             Primal::Newton => {
                 if nv <= DENSE_NV {
-                    // Small: H = M + Jᵀ (∂²s) J in full, by dense Cholesky.
+                    // Small: H = M + Jᵀ (∂²s) J, its lower triangle (all the dense Cholesky
+                    // reads), by dense Cholesky.
                     let h = &mut soft.hessian;
                     h.copy_from(mass_matrix);
                     rows.hessian(&soft.jar, efc_state, |i, dim, block| {
@@ -238,7 +239,9 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                                 for &p in nz.row(a) {
                                     let x = w * efc_j[(a, p)];
                                     for &q in nz.row(b) {
-                                        h[(p, q)] += x * efc_j[(b, q)];
+                                        if p >= q {
+                                            h[(p, q)] += x * efc_j[(b, q)];
+                                        }
                                     }
                                 }
                             }
