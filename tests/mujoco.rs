@@ -216,7 +216,11 @@ fn check_model(name: &str) {
     // Mass properties per body (each MJCF body's own, in its frame).
     let mut e_mass = MaxErr::new(&format!("{name}: body masses"), REF_REL);
     let mut e_com = MaxErr::new(&format!("{name}: body centres of mass (stacked)"), REF_REL);
-    let mut e_inertia = MaxErr::new(&format!("{name}: body inertias about the COM"), REF_REL);
+    // Inline-mesh tensors (mesh_inline.xml) agree with MuJoCo's to ~2e-8 only, as mesh files do
+    // (tests/mujoco_meshes.rs): masses and centres of mass agree to 1e-16, the principal-axis
+    // fit differs; the mesh tolerance, not the f64 one, applies there.
+    let inertia_tol = if name.starts_with("mesh_") { common::MESH_MUJOCO_REL } else { REF_REL };
+    let mut e_inertia = MaxErr::new(&format!("{name}: body inertias about the COM"), inertia_tol);
     let mut e_total = MaxErr::new(&format!("{name}: total mass of all bodies (welded included)"), REF_REL);
     let (mut com, mut com_ref, mut com_names) = (vec![], vec![], vec![]);
     let mut total = 0.0;
@@ -429,6 +433,7 @@ mujoco_tests! {
     inertial_forms => "inertial_forms",
     joint_anchor_ref => "joint_anchor_ref",
     keyframes => "keyframes",
+    mesh_inline => "mesh_inline",
     multijoint => "multijoint",
     orient_body => "orient_body",
     orient_geom => "orient_geom",

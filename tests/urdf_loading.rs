@@ -315,8 +315,8 @@ fn geoms_are_kept_in_file_order_with_origins() {
     assert!(base[1].collision);
     assert_transform(&base[1].x_body_geom, &xyz_rpy([0.0, 0.0, 0.1], [FRAC_PI_2, 0.0, 0.0]), "cylinder");
     match &base[2].shape {
-        Shape::Mesh { path, scale } => {
-            assert_eq!(path, &data("meshes/tetra.stl"));
+        Shape::Mesh { source, scale } => {
+            assert_eq!(source.path(), Some(data("meshes/tetra.stl").as_path()));
             assert_eq!(*scale, Vec3::new(0.1, 0.2, 0.3));
         }
         s => panic!("expected the mesh, got {s:?}"),
@@ -350,9 +350,9 @@ fn package_fixture(root: &Path, package: &str) -> PathBuf {
 
 fn mesh_path(m: &Model) -> PathBuf {
     match &m.geoms[0].shape {
-        Shape::Mesh { path, scale } => {
+        Shape::Mesh { source, scale } => {
             assert_eq!(*scale, Vec3::new(1.0, 1.0, 1.0));
-            path.clone()
+            source.path().expect("a URDF mesh is a file").to_path_buf()
         }
         s => panic!("expected a mesh, got {s:?}"),
     }
@@ -400,7 +400,13 @@ fn file_uris_and_absolute_paths_resolve() {
             <mesh filename="{filename}" scale="2 2 2"/></geometry></collision></link></robot>"#
         );
         let m = load_urdf_str(&text, &root.join("elsewhere/f.urdf"), &LoadOptions::default()).unwrap();
-        assert_eq!(m.geoms[0].shape, Shape::Mesh { path: mesh.clone(), scale: Vec3::new(2.0, 2.0, 2.0) });
+        assert_eq!(
+            m.geoms[0].shape,
+            Shape::Mesh {
+                source: lagrange::mass::MeshSource::File(mesh.clone()),
+                scale: Vec3::new(2.0, 2.0, 2.0)
+            }
+        );
         assert!(m.geoms[0].collision);
     }
     let _ = std::fs::remove_dir_all(&root);

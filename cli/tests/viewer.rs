@@ -88,7 +88,7 @@ fn view_writes_a_self_contained_page_of_the_model_at_a_keyframe() {
     let geoms = scene["geoms"].as_array().unwrap();
     assert_eq!(geoms.len(), model.geoms.len());
     let mesh_files: std::collections::BTreeSet<_> =
-        model.geoms.iter().filter_map(|g| g.mesh.as_ref().map(|m| m.path().to_path_buf())).collect();
+        model.geoms.iter().filter_map(|g| g.mesh.as_ref().map(|m| m.source().to_string())).collect();
     assert_eq!(scene["meshes"].as_array().unwrap().len(), mesh_files.len());
     // The one frame's poses are the keyframe's forward kinematics.
     assert_eq!(frames["n"], 1);

@@ -18,23 +18,23 @@ use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use parry3d_f64::shape::ConvexPolyhedron;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::OnceLock;
 
 /// A mesh geom's file, with its triangles and hull read on first use (see the module
 /// documentation).
 #[derive(Debug)]
 pub struct GeomMesh {
-    path: PathBuf,
+    source: mass::MeshSource,
     scale: Vec3,
     triangles: OnceLock<Result<MeshTriangles, String>>,
     hull: OnceLock<Result<MeshHull, String>>,
 }
 
-/// Two mesh geoms are equal when they read the same file at the same scale.
+/// Two mesh geoms are equal when they read the same file (or inline asset) at the same scale.
 impl PartialEq for GeomMesh {
     fn eq(&self, other: &Self) -> bool {
-        self.path == other.path && self.scale == other.scale
+        self.source == other.source && self.scale == other.scale
     }
 }
 
@@ -62,14 +62,19 @@ pub struct MeshHull {
 }
 
 impl GeomMesh {
-    /// The mesh in `path`, scaled by `scale` (nothing is read yet).
-    pub fn new(path: PathBuf, scale: Vec3) -> Self {
-        Self { path, scale, triangles: OnceLock::new(), hull: OnceLock::new() }
+    /// The mesh from `source`, scaled by `scale` (nothing is read yet).
+    pub fn new(source: mass::MeshSource, scale: Vec3) -> Self {
+        Self { source, scale, triangles: OnceLock::new(), hull: OnceLock::new() }
     }
 
-    /// The mesh file.
-    pub fn path(&self) -> &Path {
-        &self.path
+    /// The mesh file (None for an inline mesh).
+    pub fn path(&self) -> Option<&Path> {
+        self.source.path()
+    }
+
+    /// Where the mesh's triangles come from.
+    pub fn source(&self) -> &mass::MeshSource {
+        &self.source
     }
 
     /// The scale applied to the file's vertices.
@@ -85,7 +90,7 @@ impl GeomMesh {
     pub fn triangles(&self) -> Result<&MeshTriangles, &str> {
         self.triangles
             .get_or_init(|| {
-                let mesh = mass::read_mesh(&self.path, &self.scale).map_err(|e| e.to_string())?;
+                let mesh = self.source.read(&self.scale).map_err(|e| e.to_string())?;
                 Ok(MeshTriangles::new(mesh))
             })
             .as_ref()

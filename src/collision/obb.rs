@@ -155,8 +155,11 @@ mod tests {
         let b = LocalBox::of(&Shape::Capsule { radius: 0.25, length: 1.0 }, None).unwrap();
         assert_eq!(b.half, Vec3::new(0.25, 0.25, 0.75));
         let hull = [Vec3::new(1.0, 2.0, 3.0), Vec3::new(-1.0, 0.0, 5.0)];
-        let b = LocalBox::of(&Shape::Mesh { path: "m.stl".into(), scale: Vec3::repeat(1.0) }, Some(&hull))
-            .unwrap();
+        let b = LocalBox::of(
+            &Shape::Mesh { source: crate::mass::MeshSource::File("m.stl".into()), scale: Vec3::repeat(1.0) },
+            Some(&hull),
+        )
+        .unwrap();
         assert_eq!((b.centre, b.half), (Vec3::new(0.0, 1.0, 4.0), Vec3::new(1.0, 1.0, 1.0)));
         assert!(LocalBox::of(&Shape::Plane { size: Vec3::repeat(1.0) }, None).is_none());
     }

@@ -30,8 +30,10 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let mut meshes = crate::io::geom_mass::MeshCache::default();
     let mut hulls = crate::io::geom_hull::HullCache::default();
     // The lazily read triangles and hulls of mesh geoms, one per file and scale.
-    let mut geom_meshes: HashMap<(std::path::PathBuf, [u64; 3]), std::sync::Arc<crate::collision::GeomMesh>> =
-        HashMap::new();
+    let mut geom_meshes: HashMap<
+        (crate::mass::MeshSource, [u64; 3]),
+        std::sync::Arc<crate::collision::GeomMesh>,
+    > = HashMap::new();
     let mut warnings = spec.warnings.clone();
     // Pass 0: every link's own mass properties (explicit or from its geoms), with the compiler's
     // bounds; then `settotalmass` scales the moving links.
@@ -213,11 +215,14 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 material_rgba: g.material_rgba,
                 fluid: g.fluid,
                 mesh: match &g.shape {
-                    Shape::Mesh { path, scale } => Some(
+                    Shape::Mesh { source, scale } => Some(
                         geom_meshes
-                            .entry((path.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()]))
+                            .entry((
+                                source.clone(),
+                                [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()],
+                            ))
                             .or_insert_with(|| {
-                                std::sync::Arc::new(crate::collision::GeomMesh::new(path.clone(), *scale))
+                                std::sync::Arc::new(crate::collision::GeomMesh::new(source.clone(), *scale))
                             })
                             .clone(),
                     ),

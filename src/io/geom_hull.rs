@@ -22,13 +22,12 @@ use crate::mass;
 use crate::model::spec::{GeomSpec, Shape};
 use crate::spatial::{quat_to_matrix, Mat3, Vec3};
 use std::collections::HashMap;
-use std::path::PathBuf;
 use std::sync::Arc;
 
 /// Hull vertices by (file, scale, inertia mode).
 #[derive(Default)]
 pub struct HullCache {
-    entries: HashMap<(PathBuf, [u64; 3], mass::MeshInertia), Arc<Vec<Vec3>>>,
+    entries: HashMap<(mass::MeshSource, [u64; 3], mass::MeshInertia), Arc<Vec<Vec3>>>,
 }
 
 /// The hull vertices of `g` if it is a colliding mesh geom (None for primitives and for meshes
@@ -44,11 +43,11 @@ pub fn geom_hull(
     cache: &mut HullCache,
     warnings: &mut Vec<String>,
 ) -> Result<Option<Arc<Vec<Vec3>>>, LoadError> {
-    let Shape::Mesh { path, scale } = &g.shape else { return Ok(None) };
+    let Shape::Mesh { source, scale } = &g.shape else { return Ok(None) };
     if !g.collision {
         return Ok(None);
     }
-    let key = (path.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()], g.mesh_inertia);
+    let key = (source.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()], g.mesh_inertia);
     if let Some(h) = cache.entries.get(&key) {
         return Ok(Some(h.clone()));
     }
@@ -56,16 +55,15 @@ pub fn geom_hull(
         loc: g.loc.clone(),
         what,
         link: link.to_string(),
-        path: path.display().to_string(),
+        path: source.to_string(),
         reason,
     };
-    let mesh = match mass::read_mesh(path, scale) {
+    let mesh = match source.read(scale) {
         Ok(m) => m,
         Err(e) => {
             warnings.push(format!(
                 "{}: {what} '{link}': collision mesh '{}' cannot be read ({e}): the geom does not collide",
-                g.loc,
-                path.display()
+                g.loc, source
             ));
             return Ok(None);
         }

@@ -6,13 +6,12 @@ use crate::mass::{self, GeomMass, MeshInertia, Primitive};
 use crate::model::spec::{GeomSpec, Shape};
 use crate::spatial::{RigidInertia, Vec3};
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
 
 /// Unit-density mesh mass properties by (file, scale, mode), so that a mesh used by several geoms
 /// is read and integrated once.
 #[derive(Default)]
 pub struct MeshCache {
-    entries: HashMap<(PathBuf, [u64; 3], MeshInertia), (f64, RigidInertia)>,
+    entries: HashMap<(mass::MeshSource, [u64; 3], MeshInertia), (f64, RigidInertia)>,
 }
 
 /// The mass properties a geom contributes to its link, in the geom's frame.
@@ -43,8 +42,8 @@ pub fn geom_inertia(
         // size[0], size[1], size[2]/4 + size[3]/2 (its `geom_size`, mjCGeom::SetInertia).
         Shape::Plane { .. } => return Ok(RigidInertia::zero()),
         Shape::Hfield { field, .. } => Primitive::Box { half_extents: Vec3::from(field.mass_box()) },
-        Shape::Mesh { path, scale } => {
-            return mesh_geom_inertia(g, what, link, path, scale, meshes, warnings)
+        Shape::Mesh { source, scale } => {
+            return mesh_geom_inertia(g, what, link, source, scale, meshes, warnings)
         }
     };
     let measure = mass::primitive_measure(&primitive, g.distribution);
@@ -56,12 +55,12 @@ fn mesh_geom_inertia(
     g: &GeomSpec,
     what: LinkWord,
     link: &str,
-    path: &Path,
+    source: &mass::MeshSource,
     scale: &Vec3,
     meshes: &mut MeshCache,
     warnings: &mut Vec<String>,
 ) -> Result<RigidInertia, LoadError> {
-    let key = (path.to_path_buf(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()], g.mesh_inertia);
+    let key = (source.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()], g.mesh_inertia);
     let (measure, unit) = match meshes.entries.get(&key) {
         Some(e) => *e,
         None => {
@@ -69,17 +68,17 @@ fn mesh_geom_inertia(
                 loc: g.loc.clone(),
                 what,
                 link: link.to_string(),
-                path: path.display().to_string(),
+                path: source.to_string(),
                 reason: e.to_string(),
             };
-            let mesh = mass::read_mesh(path, scale).map_err(err)?;
+            let mesh = source.read(scale).map_err(err)?;
             let (e, open) = mass::mesh_inertia_as_mujoco(&mesh, g.mesh_inertia).map_err(err)?;
             if let Some(open) = open {
                 // MuJoCo 4.0 integrates an open surface in these modes too: so do we, and say so.
                 warnings.push(format!(
                     "{}: {what} '{link}': mesh '{}': {open}; its mass properties are MuJoCo's volume integrals over the open surface (inertia=\"{}\"), which depend on where the holes are",
                     g.loc,
-                    path.display(),
+                    source,
                     match g.mesh_inertia {
                         MeshInertia::Exact => "exact",
                         _ => "legacy",

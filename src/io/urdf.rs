@@ -682,7 +682,10 @@ fn geom_specs(
                     }
                     other => other?,
                 };
-                Shape::Mesh { path, scale: Vec3::new(scale[0], scale[1], scale[2]) }
+                Shape::Mesh {
+                    source: crate::mass::MeshSource::File(path),
+                    scale: Vec3::new(scale[0], scale[1], scale[2]),
+                }
             }
             other => return Err(bad(format!("unknown geometry <{other}>"))),
         };

@@ -25,6 +25,7 @@ mod error;
 mod fast_hash;
 mod mesh;
 mod mesh_io;
+mod mesh_source;
 mod primitive;
 mod principal;
 mod topology;
@@ -32,6 +33,7 @@ mod topology;
 pub use error::MeshError;
 pub use mesh::{convex_hull, mesh_inertia, mesh_inertia_as_mujoco, TriangleMesh};
 pub use mesh_io::{read_mesh, read_mesh_with, ObjObjects, ReadOptions};
+pub use mesh_source::MeshSource;
 pub use primitive::{primitive_inertia, primitive_measure, Primitive};
 pub use principal::{
     compose, parallel_axis, principal, principal_angle_xy, principal_axes, rotate_tensor, Principal,

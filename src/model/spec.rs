@@ -317,10 +317,10 @@ pub enum Shape {
         /// The grid and sizes (shared by the geoms naming the asset).
         field: std::sync::Arc<super::hfield::HeightField>,
     },
-    /// A mesh file, resolved to a path on disk, with its scale.
+    /// A mesh (a file resolved to a path on disk, or an inline asset), with its scale.
     Mesh {
-        /// The mesh file.
-        path: PathBuf,
+        /// Where the mesh's triangles come from.
+        source: crate::mass::MeshSource,
         /// Scale factors along the mesh's x, y, z, applied to its vertices.
         scale: Vec3,
     },

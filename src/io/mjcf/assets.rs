@@ -1,4 +1,5 @@
-//! `<asset>`: mesh files (with their default class, scale and inertia mode) and material colours
+//! `<asset>`: meshes (files, or inline `vertex`/`face` lists: [`super::mesh_inline`]; with their
+//! default class, scale and inertia mode) and material colours
 //! (`rgba`, which ray casting filters on) by name. Textures, the other material attributes and
 //! height fields are accepted; they do not affect the dynamics.
 
@@ -6,15 +7,15 @@ use super::defaults::{Defaults, MAIN};
 use super::xml::Element;
 use super::Compiler;
 use crate::io::LoadError;
-use crate::mass::MeshInertia;
+use crate::mass::{MeshInertia, MeshSource};
 use crate::spatial::Vec3;
 use std::collections::HashMap;
-use std::path::PathBuf;
 
-/// A mesh asset: the file on disk, its scale and how MuJoCo computes its inertia.
+/// A mesh asset: its file on disk or inline triangles, its scale and how MuJoCo computes its
+/// inertia.
 #[derive(Clone, Debug)]
 pub struct MeshAsset {
-    pub path: PathBuf,
+    pub source: MeshSource,
     pub scale: Vec3,
     pub inertia: MeshInertia,
 }
@@ -38,13 +39,20 @@ pub(crate) fn meshes(
                     fix: "MuJoCo 4.0 would generate its vertices and faces from 'params'; save that mesh to an STL or OBJ file (e.g. from MuJoCo's compiled mesh_vert/mesh_face) and give it in 'file'".into(),
                 });
             }
+            let inertia = match a.keyword("inertia", &["convex", "exact", "legacy", "shell"])?.as_deref() {
+                Some("convex") => MeshInertia::Convex,
+                Some("exact") => MeshInertia::Exact,
+                Some("shell") => MeshInertia::Shell,
+                _ => MeshInertia::Legacy,
+            };
             let Some(file) = a.text("file") else {
-                return Err(LoadError::Unsupported {
-                    loc: e.loc.clone(),
-                    element: "mesh".into(),
-                    what: "a mesh without a file (inline vertices, builtin shapes)".into(),
-                    fix: "save the mesh to an STL or OBJ file and give its name in 'file'".into(),
-                });
+                let (name, mesh) = super::mesh_inline::inline_mesh(e, &a)?;
+                let scale = a.vec3("scale")?.unwrap_or(Vec3::repeat(1.0));
+                out.insert(
+                    name.clone(),
+                    MeshAsset { source: MeshSource::Inline { name, mesh }, scale, inertia },
+                );
+                continue;
             };
             // MuJoCo looks in the mesh folder first, then (for a file pulled in by <include>)
             // next to the including file.
@@ -71,12 +79,6 @@ pub(crate) fn meshes(
                     stem.to_string()
                 }
             };
-            let inertia = match a.keyword("inertia", &["convex", "exact", "legacy", "shell"])?.as_deref() {
-                Some("convex") => MeshInertia::Convex,
-                Some("exact") => MeshInertia::Exact,
-                Some("shell") => MeshInertia::Shell,
-                _ => MeshInertia::Legacy,
-            };
             for moved in ["refpos", "refquat"] {
                 if a.has(moved) {
                     return Err(LoadError::Unsupported {
@@ -88,7 +90,7 @@ pub(crate) fn meshes(
                 }
             }
             let scale = a.vec3("scale")?.unwrap_or(Vec3::repeat(1.0));
-            out.insert(name, MeshAsset { path, scale, inertia });
+            out.insert(name, MeshAsset { source: MeshSource::File(path), scale, inertia });
         }
     }
     Ok(out)

@@ -166,7 +166,7 @@ pub(crate) fn geom(
                 });
             };
             mesh_inertia = m.inertia;
-            Shape::Mesh { path: m.path.clone(), scale: m.scale }
+            Shape::Mesh { source: m.source.clone(), scale: m.scale }
         }
         other => {
             return Err(LoadError::Unsupported {

@@ -191,7 +191,7 @@ pub fn scene_json(model: &Model) -> (Value, Vec<String>) {
                         mesh = json!(meshes.len() - 1);
                     }
                     Err(e) => {
-                        warnings.push(format!("mesh {}: {e}; not drawn", m.path().display()));
+                        warnings.push(format!("mesh {}: {e}; not drawn", m.source()));
                         continue;
                     }
                 }
