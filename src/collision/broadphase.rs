@@ -58,6 +58,10 @@ pub struct BroadphaseWork {
     ends: Vec<(f64, u32)>,
     /// The candidate pairs that passed, ascending.
     pub(crate) pairs: Vec<u32>,
+    /// Per candidate pair, whether the last collision pass found it touching: such a pair skips
+    /// the GJK test that proves most pairs apart (it would not), straight to its narrow phase.
+    /// The contacts do not depend on it.
+    pub(crate) touching: Vec<bool>,
 }
 
 impl BroadphaseWork {
@@ -66,6 +70,7 @@ impl BroadphaseWork {
         Self {
             ends: Vec::with_capacity(model.geoms.len()),
             pairs: Vec::with_capacity(model.collision_pairs.len()),
+            touching: vec![false; model.collision_pairs.len()],
         }
     }
 }
