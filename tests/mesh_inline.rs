@@ -1,6 +1,7 @@
 //! Inline meshes (`<mesh vertex=… face=…>`, no file: src/io/mjcf/mesh_inline.rs) against MuJoCo
 //! 4.0 (tests/data/mujoco/mesh_inline_rest.json, validation/mujoco_meshsrc_golden.py): an inline
-//! box and an inline point cloud without faces (its convex hull) dropped onto a plane follow
+//! box, an inline point cloud without faces (its convex hull) and a built-in icosphere
+//! (src/io/mjcf/mesh_builtin.rs) dropped onto a plane follow
 //! `mj_step` for 200 steps at the soft tolerance; their masses agree to f64 round-off and their
 //! collision hulls are MuJoCo's compiled vertices (same distances from the centre of mass). Masses,
 //! inertias, M and qfrc_bias of inline meshes are in tests/mujoco.rs (`mesh_inline`). Bad inline
@@ -90,7 +91,10 @@ fn bad_inline_meshes_are_typed_errors_naming_the_line() {
         (format!(r#"<mesh name="m" vertex="{tet}" face="0 1 -1"/>"#), "vertex index -1 does not exist"),
         (format!(r#"<mesh vertex="{tet}"/>"#), "needs a 'name'"),
         (r#"<mesh name="m" vertex="0 0 0  1 0 0  2 0 0  3 0 0"/>"#.to_string(), "convex hull"),
-        (r#"<mesh name="m" builtin="sphere" params="3"/>"#.to_string(), "built-in mesh 'sphere'"),
+        (r#"<mesh name="m" builtin="wedge" params="1 1 30 30 0.5"/>"#.to_string(), "built-in mesh 'wedge'"),
+        (r#"<mesh name="m" builtin="sphere" params="5"/>"#.to_string(), "subdivision must be in 0..=4"),
+        (r#"<mesh name="m" builtin="cone" params="8"/>"#.to_string(), "requires 2"),
+        (r#"<mesh name="m" builtin="cube" params="8"/>"#.to_string(), "'builtin' is 'cube'"),
     ] {
         let err = load_err(&mesh);
         assert!(err.contains(expect), "{mesh}: {err}");

@@ -1,6 +1,6 @@
 """Reference data for inline meshes (`<mesh vertex=... face=...>`, no file): MuJoCo's mj_step on
-tests/data/mjcf/applied/mesh_inline_rest.xml (an inline box and an inline point cloud without
-faces dropped onto a plane) for 200 steps, qpos and qvel after 1, 50, 100 and 200 steps and the
+tests/data/mjcf/applied/mesh_inline_rest.xml (an inline box, an inline point cloud without
+faces and a built-in icosphere dropped onto a plane) for 200 steps, qpos and qvel after 1, 50, 100 and 200 steps and the
 contacts' count; and each mesh's compiled vertices (mesh_vert, MuJoCo's inertial frame, f32) with
 the body's mass. Writes tests/data/mujoco/mesh_inline_rest.json (generated: do not edit); with
 --check, recomputes and exits 1 when the committed file differs beyond 1e-12. Masses, inertias,

@@ -31,14 +31,6 @@ pub(crate) fn meshes(
     for section in root.children_named("asset") {
         for e in section.children_named("mesh") {
             let a = defaults.resolve(e, MAIN)?;
-            if let Some(shape) = a.text("builtin") {
-                return Err(LoadError::Unsupported {
-                    loc: e.loc.clone(),
-                    element: "mesh".into(),
-                    what: format!("the built-in mesh '{shape}'"),
-                    fix: "MuJoCo 4.0 would generate its vertices and faces from 'params'; save that mesh to an STL or OBJ file (e.g. from MuJoCo's compiled mesh_vert/mesh_face) and give it in 'file'".into(),
-                });
-            }
             let inertia = match a.keyword("inertia", &["convex", "exact", "legacy", "shell"])?.as_deref() {
                 Some("convex") => MeshInertia::Convex,
                 Some("exact") => MeshInertia::Exact,
@@ -46,7 +38,10 @@ pub(crate) fn meshes(
                 _ => MeshInertia::Legacy,
             };
             let Some(file) = a.text("file") else {
-                let (name, mesh) = super::mesh_inline::inline_mesh(e, &a)?;
+                let (name, mesh) = match a.text("builtin") {
+                    Some(shape) => super::mesh_builtin::builtin_mesh(e, &a, shape)?,
+                    None => super::mesh_inline::inline_mesh(e, &a)?,
+                };
                 let scale = a.vec3("scale")?.unwrap_or(Vec3::repeat(1.0));
                 out.insert(
                     name.clone(),

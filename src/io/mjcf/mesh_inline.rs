@@ -19,7 +19,7 @@ pub(crate) fn inline_mesh(e: &Element, a: &Attrs) -> Result<(String, Arc<Triangl
     let invalid = |detail: String| LoadError::Invalid { loc: e.loc.clone(), element: "mesh".into(), detail };
     let Some(coords) = a.numbers("vertex")? else {
         return Err(invalid(
-            "a mesh without 'file' needs 'vertex' (lagrange does not generate 'builtin' meshes); give 'file', or 'vertex' (and 'face')".into(),
+            "a mesh without 'file' or 'builtin' needs 'vertex'; give 'file', 'builtin', or 'vertex' (and 'face')".into(),
         ));
     };
     let Some(name) = a.text("name") else {

@@ -22,6 +22,7 @@ mod defaults;
 mod equality;
 mod geom;
 mod hfield;
+mod mesh_builtin;
 mod mesh_inline;
 mod orientation;
 mod replicate;

@@ -1,0 +1,155 @@
+//! Built-in meshes (`<mesh builtin="…" params="…">`) that lagrange generates as MuJoCo 4.0 does
+//! (`mjs_makeMesh`, user_api.cc; `mjCMesh::MakeSphere`, `MakeCone`, user_mesh.cc), in the same
+//! `f32` arithmetic so that the vertices are MuJoCo's bit for bit:
+//! - `sphere` (params: subdivisions 0–4): an icosahedron on the unit sphere, each subdivision
+//!   splitting every triangle in four at its edges' midpoints pushed onto the sphere;
+//! - `cone` (params: edges, top radius): a unit circle of `edges` points at z = −1 and a circle of
+//!   the top radius at z = +1 (a single apex when it is 0); no faces, so its convex hull.
+//!
+//! The other built-ins (`hemisphere`, `supersphere`, `supertorus`, `wedge`, `plate`) are refused
+//! with a typed error saying so.
+
+use super::attrs::Attrs;
+use super::xml::Element;
+use crate::io::LoadError;
+use crate::mass::{self, TriangleMesh};
+use crate::spatial::Vec3;
+use std::collections::HashMap;
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+/// The name and triangles (mesh frame, before scale) of a built-in mesh element `e`.
+pub(crate) fn builtin_mesh(
+    e: &Element,
+    a: &Attrs,
+    shape: &str,
+) -> Result<(String, Arc<TriangleMesh>), LoadError> {
+    let invalid = |detail: String| LoadError::Invalid { loc: e.loc.clone(), element: "mesh".into(), detail };
+    let Some(name) = a.text("name") else {
+        return Err(invalid(format!("the built-in mesh '{shape}' needs a 'name' for geoms to refer to it")));
+    };
+    let params = a.numbers("params")?.unwrap_or_default();
+    let count = |n: usize, what: &str| -> Result<(), LoadError> {
+        if params.len() == n {
+            Ok(())
+        } else {
+            Err(a.error(
+                "params",
+                format!("has {} numbers: the {shape} mesh type requires {n} ({what})", params.len()),
+            ))
+        }
+    };
+    let mesh = match shape {
+        "sphere" => {
+            count(1, "subdivisions")?;
+            let subdiv = params[0] as i64;
+            if !(0..=4).contains(&subdiv) {
+                return Err(a.error("params", format!("gives {subdiv} subdivisions: sphere subdivision must be in 0..=4")));
+            }
+            sphere(subdiv as usize)
+        }
+        "cone" => {
+            count(2, "edges, top radius")?;
+            let nedge = params[0] as i64;
+            if !(3..=100_000).contains(&nedge) {
+                return Err(a.error("params", format!("gives {nedge} edges: a cone needs 3 to 100000")));
+            }
+            let vertices = cone(nedge as usize, params[1]);
+            mass::convex_hull(&vertices)
+                .map_err(|err| invalid(format!("the built-in cone '{name}' has no volume: {err}")))?
+        }
+        "hemisphere" | "supersphere" | "supertorus" | "wedge" | "plate" => {
+            return Err(LoadError::Unsupported {
+                loc: e.loc.clone(),
+                element: "mesh".into(),
+                what: format!("the built-in mesh '{shape}' (lagrange generates 'sphere' and 'cone')"),
+                fix: "save that mesh to an STL or OBJ file (e.g. from MuJoCo's compiled mesh_vert/mesh_face) and give it in 'file', or give it as inline 'vertex'/'face'".into(),
+            })
+        }
+        other => {
+            return Err(a.error(
+                "builtin",
+                format!("is '{other}': MuJoCo's built-in meshes are sphere, hemisphere, cone, supersphere, supertorus, wedge, plate"),
+            ))
+        }
+    };
+    Ok((name.to_string(), Arc::new(mesh)))
+}
+
+/// MuJoCo's `MakeSphere` (make_faces): an icosahedron subdivided `subdiv` times, in `f32`.
+fn sphere(subdiv: usize) -> TriangleMesh {
+    let phi: f32 = ((1.0 + 5f64.sqrt()) / 2.0) as f32;
+    #[rustfmt::skip]
+    let mut vert: Vec<f32> = vec![
+        -1.0, phi, 0.0, 1.0, phi, 0.0, -1.0, -phi, 0.0, 1.0, -phi, 0.0,
+        0.0, -1.0, phi, 0.0, 1.0, phi, 0.0, -1.0, -phi, 0.0, 1.0, -phi,
+        phi, 0.0, -1.0, phi, 0.0, 1.0, -phi, 0.0, -1.0, -phi, 0.0, 1.0,
+    ];
+    // MuJoCo divides each f32 by a double norm (the quotient in f64, stored as f32).
+    let norm = (1.0 + f64::from(phi) * f64::from(phi)).sqrt();
+    for v in &mut vert {
+        *v = (f64::from(*v) / norm) as f32;
+    }
+    #[rustfmt::skip]
+    let mut face: Vec<u32> = vec![
+        0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8,
+        3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1,
+    ];
+    for _ in 0..subdiv {
+        let mut cache: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut midpoint = |a: u32, b: u32, vert: &mut Vec<f32>| -> u32 {
+            let key = (a.min(b), a.max(b));
+            if let Some(&i) = cache.get(&key) {
+                return i;
+            }
+            let (a, b) = (a as usize * 3, b as usize * 3);
+            let mut m = [
+                (vert[a] + vert[b]) / 2.0,
+                (vert[a + 1] + vert[b + 1]) / 2.0,
+                (vert[a + 2] + vert[b + 2]) / 2.0,
+            ];
+            let n = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
+            for x in &mut m {
+                *x /= n;
+            }
+            let i = (vert.len() / 3) as u32;
+            vert.extend_from_slice(&m);
+            cache.insert(key, i);
+            i
+        };
+        let mut next = Vec::with_capacity(face.len() * 4);
+        for t in face.chunks_exact(3) {
+            let (v1, v2, v3) = (t[0], t[1], t[2]);
+            let m12 = midpoint(v1, v2, &mut vert);
+            let m23 = midpoint(v2, v3, &mut vert);
+            let m31 = midpoint(v3, v1, &mut vert);
+            next.extend_from_slice(&[v1, m12, m31, v2, m23, m12, v3, m31, m23, m12, m23, m31]);
+        }
+        face = next;
+    }
+    TriangleMesh {
+        vertices: vert.chunks_exact(3).map(|c| Vec3::new(c[0].into(), c[1].into(), c[2].into())).collect(),
+        triangles: face.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+    }
+}
+
+/// MuJoCo's `MakeCone`: its vertices (f64 angles, stored as `f32`).
+fn cone(nedge: usize, radius: f64) -> Vec<Vec3> {
+    let f = |x: f64| f64::from(x as f32);
+    let n = nedge as f64;
+    let mut out: Vec<Vec3> = (0..nedge)
+        .map(|i| Vec3::new(f((2.0 * i as f64 * PI / n).cos()), f((2.0 * i as f64 * PI / n).sin()), -1.0))
+        .collect();
+    if radius > 0.0 {
+        out.extend((nedge..2 * nedge).map(|i| {
+            Vec3::new(
+                f(radius * (2.0 * i as f64 * PI / n).cos()),
+                f(radius * (2.0 * i as f64 * PI / n).sin()),
+                1.0,
+            )
+        }));
+    } else {
+        out.push(Vec3::new(0.0, 0.0, 1.0));
+    }
+    out
+}
