@@ -223,6 +223,11 @@ fn composition_errors_name_the_element_line_and_what_mujoco_does() {
     );
     mentions(
         "mesh_builtin.xml",
-        &["mesh_builtin.xml:3", "<mesh>", "the built-in mesh 'sphere'", "MuJoCo 4.0 would generate"],
+        &[
+            "mesh_builtin.xml:3",
+            "<mesh>",
+            "the built-in mesh 'supertorus'",
+            "lagrange generates 'sphere' and 'cone'",
+        ],
     );
 }
