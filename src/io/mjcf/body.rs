@@ -423,7 +423,7 @@ impl<'a> TreeBuilder<'a> {
         if let Some(sd) = a.array::<2>("springdamper")? {
             // MuJoCo: "when defined, springdamper values must be positive"; 0 0 is undefined.
             if sd != [0.0, 0.0] {
-                if !(sd[0] > 0.0 && sd[1] > 0.0) || !sd.iter().all(|x| x.is_finite()) {
+                if !(sd[0] > 0.0 && sd[1] > 0.0 && sd.iter().all(|x| x.is_finite())) {
                     return Err(a.error(
                         "springdamper",
                         "when defined, both values (timeconst, dampratio) must be positive and finite, as MuJoCo requires",
