@@ -8,7 +8,8 @@
 //! within their pair's margin + gap + reach have overlapping cubes along every axis, so the sweep
 //! never loses a pair the exact bounding-sphere test that follows ([`super::collide`]) would keep.
 //! The cubes are sorted along the world axis of largest spread and swept; each overlapping pair
-//! of geoms is looked up among the candidate pairs (a sorted key table, built once). Pairs with a
+//! of geoms is looked up among the candidate pairs (a dense geom-by-geom table for up to 512
+//! geoms, else a sorted key table; built once). Pairs with a
 //! plane or a height field (unbounded) are always passed on. The result is the candidate pairs'
 //! indices in ascending order — `collision_pairs`' order — so contacts come out in the same order
 //! as from the all-pairs loop, and the simulation is the same to the last bit.
@@ -21,6 +22,11 @@ use crate::spatial::Transform;
 
 /// Below this many candidate pairs between bounded geoms, every pair is tested directly.
 const SWEEP_FROM_PAIRS: usize = 1000;
+/// Up to this many geoms in the sweep, overlapping geoms find their pair in a dense table
+/// (at most 1 MiB); above it, by binary search among the keys.
+const DENSE_TABLE_GEOMS: usize = 512;
+/// A table entry without a candidate pair.
+const NO_PAIR: u32 = u32::MAX;
 
 /// The model-constant part of the sweep: which geoms take part and how pairs are looked up.
 #[derive(Clone, Debug, Default)]
@@ -37,6 +43,11 @@ pub struct Broadphase {
     keys: Vec<(u64, u32)>,
     /// The pairs with an unbounded geom (plane, height field), ascending.
     unbounded: Vec<u32>,
+    /// With few geoms: each geom's position in `geoms` (`NO_PAIR` for the others) and the pair
+    /// index of every two of them (`table[a · geoms.len() + b]`, `NO_PAIR` where they are no
+    /// candidate pair); empty otherwise.
+    local: Vec<u32>,
+    table: Vec<u32>,
 }
 
 /// Per-step scratch of the sweep, in [`Data`](crate::Data): room for every participating geom and pair,
@@ -47,6 +58,10 @@ pub struct BroadphaseWork {
     ends: Vec<(f64, u32)>,
     /// The candidate pairs that passed, ascending.
     pub(crate) pairs: Vec<u32>,
+    /// Per candidate pair, whether the last collision pass found it touching: such a pair skips
+    /// the GJK test that proves most pairs apart (it would not), straight to its narrow phase.
+    /// The contacts do not depend on it.
+    pub(crate) touching: Vec<bool>,
 }
 
 impl BroadphaseWork {
@@ -55,6 +70,7 @@ impl BroadphaseWork {
         Self {
             ends: Vec::with_capacity(model.geoms.len()),
             pairs: Vec::with_capacity(model.collision_pairs.len()),
+            touching: vec![false; model.collision_pairs.len()],
         }
     }
 }
@@ -84,14 +100,31 @@ impl Broadphase {
             }
         }
         keys.sort_unstable();
-        let geoms = (0..model.geoms.len()).filter(|&g| in_sweep[g]).map(|g| g as u32).collect();
+        let geoms: Vec<u32> = (0..model.geoms.len()).filter(|&g| in_sweep[g]).map(|g| g as u32).collect();
+        let sweep = keys.len() >= SWEEP_FROM_PAIRS;
+        let (mut local, mut table) = (Vec::new(), Vec::new());
+        if sweep && geoms.len() <= DENSE_TABLE_GEOMS {
+            let n = geoms.len();
+            local = vec![NO_PAIR; model.geoms.len()];
+            for (l, &g) in geoms.iter().enumerate() {
+                local[g as usize] = l as u32;
+            }
+            table = vec![NO_PAIR; n * n];
+            for &(k, i) in &keys {
+                let (a, b) = (local[(k >> 32) as usize] as usize, local[(k & 0xffff_ffff) as usize] as usize);
+                table[a * n + b] = i;
+                table[b * n + a] = i;
+            }
+        }
         Self {
-            sweep: keys.len() >= SWEEP_FROM_PAIRS,
+            sweep,
             geoms,
             rbound: rbound.to_vec(),
             half_margin: 0.5 * margin,
             keys,
             unbounded,
+            local,
+            table,
         }
     }
 
@@ -131,8 +164,19 @@ impl Broadphase {
                 if apart {
                     continue;
                 }
-                if let Ok(at) = self.keys.binary_search_by_key(&key(gi as usize, gj as usize), |&(k, _)| k) {
-                    work.pairs.push(self.keys[at].1);
+                if self.table.is_empty() {
+                    if let Ok(at) =
+                        self.keys.binary_search_by_key(&key(gi as usize, gj as usize), |&(k, _)| k)
+                    {
+                        work.pairs.push(self.keys[at].1);
+                    }
+                } else {
+                    let n = self.geoms.len();
+                    let pair =
+                        self.table[self.local[gi as usize] as usize * n + self.local[gj as usize] as usize];
+                    if pair != NO_PAIR {
+                        work.pairs.push(pair);
+                    }
                 }
             }
         }

@@ -180,7 +180,8 @@ thread_local! {
 /// (`ccd::penetration`: GJK/EPA on the geoms inflated by half of `margin` each, to the
 /// model's `ccd_tolerance` within `ccd_iterations`): witness points whose midpoint is MuJoCo's
 /// contact position, its normal and the contact distance; None when the inflated geoms do not
-/// overlap.
+/// overlap. `touching` (the pair touched at the last pass) skips the separation test of box and
+/// mesh pairs, which does not change the answer.
 pub fn mujoco_pair(
     x1: &Transform,
     s1: &ConvexShape,
@@ -188,6 +189,7 @@ pub fn mujoco_pair(
     s2: &ConvexShape,
     margin: f64,
     options: &crate::model::Options,
+    touching: bool,
 ) -> Option<PairPoint> {
     let polytope = |s: &ConvexShape| matches!(s, ConvexShape::Cuboid(_) | ConvexShape::Hull(_));
     if polytope(s1) && polytope(s2) {
@@ -196,16 +198,19 @@ pub fn mujoco_pair(
         // facets depends on the hull's vertex order, which is parry's here, not MuJoCo's).
         LAST_FACE.with(|f| f.set(None));
         // MuJoCo's GJK dismisses most candidate pairs after a few support points; the exact EPA
-        // runs only for the pairs GJK cannot prove apart.
-        if super::ccd::separated(
-            s1,
-            x1,
-            s2,
-            x2,
-            margin,
-            options.ccd_tolerance,
-            options.ccd_iterations as usize,
-        ) {
+        // runs only for the pairs GJK cannot prove apart (a pair touching at the last pass goes
+        // straight to it).
+        if !touching
+            && super::ccd::separated(
+                s1,
+                x1,
+                s2,
+                x2,
+                margin,
+                options.ccd_tolerance,
+                options.ccd_iterations as usize,
+            )
+        {
             return None;
         }
         return support_pair(x1, s1, x2, s2, margin);

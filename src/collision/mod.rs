@@ -179,9 +179,16 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
     }
     // Taken out while contacts are written, put back after (no allocation).
     let swept = std::mem::take(&mut data.broadphase.pairs);
+    let mut touching = std::mem::take(&mut data.broadphase.touching);
     let all = 0..model.collision_pairs.len();
     let mut next = 0;
+    // The pair being collided and the contact count before it: whether it touched is known at
+    // the next pair.
+    let mut open: Option<(usize, usize)> = None;
     loop {
+        if let Some((i, before)) = open.take() {
+            touching[i] = data.contacts.len() > before;
+        }
         let idx = if cm.sweep.sweep {
             match swept.get(next) {
                 Some(&i) => i as usize,
@@ -193,6 +200,7 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
             break;
         };
         next += 1;
+        open = Some((idx, data.contacts.len()));
         let (pair, b) = (&model.collision_pairs[idx], &cm.broad[idx]);
         // Bounding spheres (a plane: the other geom's sphere against the plane).
         let (x1, x2) = (&data.x_world_geom[b.geom[0] as usize], &data.x_world_geom[b.geom[1] as usize]);
@@ -323,7 +331,9 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         let point = match (segment(&x1, &geom1.shape), segment(&x2, &geom2.shape)) {
             (Some((s1, r1)), Some((s2, r2))) => convex::swept_spheres(s1, r1, s2, r2, within),
             _ => match (&cm.shapes[g1], &cm.shapes[g2]) {
-                (Some(s1), Some(s2)) => convex::mujoco_pair(&x1, s1, &x2, s2, within, &model.options),
+                (Some(s1), Some(s2)) => {
+                    convex::mujoco_pair(&x1, s1, &x2, s2, within, &model.options, touching[idx])
+                }
                 _ => None,
             },
         };
@@ -342,6 +352,7 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         }
     }
     data.broadphase.pairs = swept;
+    data.broadphase.touching = touching;
     // One regularized-cone μ per contact (`contact_mu`): grown with the contact buffer when this
     // pass found more contacts than any before.
     if data.contact_mu.len() < data.contacts.len() {

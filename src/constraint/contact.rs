@@ -95,6 +95,24 @@ pub(crate) fn add_contact_jacobian(model: &Model, data: &mut Data, contact: &Con
     }
 }
 
+/// Calls `column(k)` once for every dof `k` that moves one of `bodies` but not the other: the
+/// dofs of both paths to the root below their lowest common ancestor, where a contact Jacobian
+/// can be nonzero (bodies are numbered parents first, so the path with the larger body index
+/// steps up until the two meet).
+pub(crate) fn for_each_relative_dof(model: &Model, bodies: [usize; 2], mut column: impl FnMut(usize)) {
+    let [mut a, mut b] = bodies;
+    while a != b {
+        let step = if a > b { &mut a } else { &mut b };
+        let j = model.joint_of(*step);
+        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+            column(k);
+        }
+        let parent = model.bodies[*step].parent;
+        debug_assert!(parent < *step, "bodies are numbered parents first");
+        *step = parent;
+    }
+}
+
 /// `efc_jdotv` of the contact rows r..r+dim of contact `c` (needs `bias_accelerations` at the
 /// state): the bias accelerations of the curvature-centre points of the two surfaces (module doc).
 pub(crate) fn contact_jdotv(model: &Model, data: &mut Data, r: usize, dim: usize, c: usize) {

@@ -21,7 +21,7 @@
 //! simulated, and contributes no force ([`unsimulated_reason`]).
 
 use super::activation::{activation_rate, next_activation};
-use super::transmission::{needs_poses, transmission, Poses};
+use super::transmission::{moment_span, needs_poses, transmission, Poses};
 use crate::error::{check, InputError};
 use crate::kinematics::forward_kinematics_unchecked;
 pub use crate::model::actuator::unsimulated_reason;
@@ -142,7 +142,7 @@ pub(crate) fn actuation_unchecked(
         let Data { actuator_moment, x_world_body, s_body, x_world_frame, ten_length, ten_j, .. } = data;
         let poses = Poses { x_world_body, s_body, x_world_frame, ten_length, ten_j };
         let length = transmission(model, a, q, poses, actuator_moment, i);
-        let velocity = actuator_moment.row(i).iter().zip(v).map(|(m, v)| m * v).sum::<f64>();
+        let velocity = moment_span(model, a).map(|k| actuator_moment[(i, k)] * v[k]).sum::<f64>();
         let ctrl = if zeroed { 0.0 } else { clamped_ctrl(model, data, i) };
         // The input of the gain: the control, or the activation (the next one with actearly).
         let input = match act_index {
@@ -180,8 +180,8 @@ pub(crate) fn actuation_unchecked(
             continue;
         }
         let Data { qfrc_actuator, actuator_moment, .. } = data;
-        for (f, m) in qfrc_actuator.iter_mut().zip(actuator_moment.row(i).iter()) {
-            *f += m * force;
+        for k in moment_span(model, a) {
+            qfrc_actuator[k] += actuator_moment[(i, k)] * force;
         }
     }
     // `actuatorgravcomp` joints: their gravity compensation (the passive stage's

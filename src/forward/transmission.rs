@@ -122,6 +122,18 @@ fn add_projected_jacobian(
 /// The length of actuator `i` at q; adds its moment arms to row `i` of `moment` (the caller
 /// zeroes it). `poses` must hold forward kinematics at q when [`needs_poses`], and the tendons
 /// at q. Transmissions not simulated (planar joints, body) give length 0 and no moment.
+/// The dofs where actuator `a`'s moment row can be nonzero: its joint's for a joint
+/// transmission (the rest of the row stays zero), every dof otherwise.
+pub(crate) fn moment_span(model: &Model, a: &Actuator) -> std::ops::Range<usize> {
+    match &a.transmission {
+        Transmission::Joint(j) | Transmission::JointInParent(j) => {
+            let joint = &model.joints[*j];
+            joint.dof_adr..joint.dof_adr + joint.kind.nv()
+        }
+        _ => 0..model.nv,
+    }
+}
+
 pub(crate) fn transmission(
     model: &Model,
     a: &Actuator,

@@ -60,18 +60,27 @@ impl Sparsity<'_> {
     }
 }
 
-/// Fills the sparsity of rows 0..nefc of `j` into `start` and `index` (grown only when a problem is
-/// larger than any before it): J is read by columns (contiguous in memory), counted per row, then
-/// each row's columns are placed in ascending order.
-fn sparsity(j: &DMatrix<f64>, nefc: usize, start: &mut Vec<usize>, index: &mut Vec<usize>) {
+/// The nonzero columns of J's rows 0..nefc, ascending, into `start`/`index` (row i's are
+/// `index[start[i]..start[i + 1]]`), from one pass over J's columns (contiguous in its storage):
+/// each column's nonzero rows are appended to `index` column after column (`start` counting
+/// them per row), then regrouped by row in place through `scratch`.
+fn sparsity(
+    j: &DMatrix<f64>,
+    nefc: usize,
+    start: &mut Vec<usize>,
+    index: &mut Vec<usize>,
+    scratch: &mut Vec<(usize, usize)>,
+) {
     start.clear();
     start.resize(nefc + 1, 0);
+    scratch.clear();
     let rows = j.nrows();
     let data = j.as_slice();
     for k in 0..j.ncols() {
         for (i, &v) in data[k * rows..k * rows + nefc].iter().enumerate() {
             if v != 0.0 {
                 start[i + 1] += 1;
+                scratch.push((i, k));
             }
         }
     }
@@ -80,14 +89,11 @@ fn sparsity(j: &DMatrix<f64>, nefc: usize, start: &mut Vec<usize>, index: &mut V
     }
     index.clear();
     index.resize(start[nefc], 0);
-    // start[i] is row i's next free slot while filling, then shifted back.
-    for k in 0..j.ncols() {
-        for (i, &v) in data[k * rows..k * rows + nefc].iter().enumerate() {
-            if v != 0.0 {
-                index[start[i]] = k;
-                start[i] += 1;
-            }
-        }
+    // start[i] is row i's next free slot while filling (columns arrive in ascending order), then
+    // shifted back.
+    for &(i, k) in scratch.iter() {
+        index[start[i]] = k;
+        start[i] += 1;
     }
     for i in (1..=nefc).rev() {
         start[i] = start[i - 1];
@@ -137,7 +143,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     let nefc = data.nefc;
     {
         let Data { efc_j, soft, .. } = &mut *data;
-        sparsity(efc_j, nefc, &mut soft.nz_start, &mut soft.nz_index);
+        sparsity(efc_j, nefc, &mut soft.nz_start, &mut soft.nz_index, &mut soft.nz_scratch);
     }
     let Data {
         efc_j,

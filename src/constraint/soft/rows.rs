@@ -246,13 +246,16 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
             // Pyramid edges J_n ± μ_i J_i, in place from the last pair down (row r + 2k − 2 and
             // r + 2k − 1 for friction direction k; direction k ≥ 1 sits in row r + k, which the
             // pairs below it have not overwritten yet).
+            // Only the columns of the dofs that move one body and not the other can be nonzero
+            // (a common ancestor's columns cancel to exact zeros, which the edges keep).
+            let bodies = contact.geom.map(|g| model.geoms[g].body);
             for k in (1..dim).rev() {
                 let mu = contact.friction[k - 1];
-                for col in 0..model.nv {
+                crate::constraint::contact::for_each_relative_dof(model, bodies, |col| {
                     let (n, t) = (data.efc_j[(r, col)], data.efc_j[(r + k, col)]);
                     data.efc_j[(r + 2 * k - 2, col)] = n + mu * t;
                     data.efc_j[(r + 2 * k - 1, col)] = n - mu * t;
-                }
+                });
             }
             EfcType::ContactPyramidal
         };

@@ -33,6 +33,8 @@ pub(crate) struct SoftWork {
     /// The nonzero columns of each row of J: row i's are `nz_index[nz_start[i]..nz_start[i + 1]]`.
     pub nz_start: Vec<usize>,
     pub nz_index: Vec<usize>,
+    /// (row, column) of J's nonzeros in column order, while `nz_start`/`nz_index` are built.
+    pub nz_scratch: Vec<(usize, usize)>,
     /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
     pub ar: DMatrix<f64>,
     pub minv_jt: DMatrix<f64>,
@@ -61,6 +63,7 @@ impl SoftWork {
             active_rows: Vec::with_capacity(nefc),
             nz_start: Vec::with_capacity(nefc + 1),
             nz_index: Vec::with_capacity(nefc * nv),
+            nz_scratch: Vec::new(),
             ar: DMatrix::zeros(0, 0),
             minv_jt: DMatrix::zeros(0, 0),
         }
