@@ -43,7 +43,7 @@ fn springdamper_matches_mujoco() {
         assert!(err <= REF_REL, "state {i}: {err:e}");
     }
     let s = &golden["states"][0];
-    reset(&model, &mut data);
+    reset(&model, &mut data).unwrap();
     data.qpos.copy_from_slice(&vec(&s["q"]));
     data.qvel.copy_from_slice(&vec(&s["v"]));
     data.ctrl.copy_from_slice(&vec(&s["ctrl"]));
