@@ -4,7 +4,8 @@ hand-made poses (above, touching, penetrating, over cell edges, diagonals and co
 beyond the border) and seeded random ones, with and without a margin; per pose mj_collision's
 contacts (geom pair, pos, frame, dist, includemargin). Writes tests/data/mujoco/hfield_collision.json
 (generated: do not edit); with --check, recomputes with the live MuJoCo and exits 1 when the
-committed file differs beyond 1e-12.
+committed file differs beyond 1e-12. The same for a capsule, box, cylinder and ellipsoid at
+random poses and orientations (tests/data/mujoco/hfield_convex_collision.json).
 
   python validation/mujoco_hfield_golden.py [--check]
 """
@@ -21,6 +22,15 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "tests/data/mujoco/hfield_collision.json"
+OUT_CONVEX = ROOT / "tests/data/mujoco/hfield_convex_collision.json"
+
+# The other geoms MuJoCo collides with a height field (by mjc_ConvexHField's prisms).
+CONVEX_GEOMS = [
+    ("capsule", 'type="capsule" size="0.1 0.15"'),
+    ("box", 'type="box" size="0.15 0.1 0.08"'),
+    ("cylinder", 'type="cylinder" size="0.12 0.1"'),
+    ("ellipsoid", 'type="ellipsoid" size="0.15 0.1 0.08"'),
+]
 
 TERRAIN = (
     '<hfield name="t" nrow="4" ncol="5" size="1 0.8 0.3 0.1" '
@@ -38,6 +48,23 @@ def scene(name: str, margin: float) -> dict:
     <body name="ball">
       <freejoint/>
       <geom name="ball" type="sphere" size="0.15" margin="{margin}"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+    return {"name": name, "mjcf": mjcf}
+
+
+def convex_scene(name: str, geom: str, margin: float) -> dict:
+    mjcf = f"""<mujoco model="{name}">
+  <asset>{TERRAIN}</asset>
+  <worldbody>
+    <body name="ground" pos="0.1 -0.2 0.05" euler="4 -3 20">
+      <geom name="terrain" type="hfield" hfield="t"/>
+    </body>
+    <body name="thing">
+      <freejoint/>
+      <geom name="thing" {geom} margin="{margin}"/>
     </body>
   </worldbody>
 </mujoco>
@@ -67,20 +94,25 @@ def world_pos(m: mujoco.MjModel, d: mujoco.MjData, local: list[float]) -> list[f
     return (d.geom_xpos[g] + d.geom_xmat[g].reshape(3, 3) @ np.array(local)).tolist()
 
 
-def cases(sc: dict) -> list[dict]:
+def cases(sc: dict, nrandom: int = 200, turn: bool = False) -> list[dict]:
     m = mujoco.MjModel.from_xml_string(sc["mjcf"])
     d = mujoco.MjData(m)
     mujoco.mj_kinematics(m, d)
     poses = [(n, world_pos(m, d, p)) for n, p in hand_made()]
     rng = np.random.default_rng(25)
-    for k in range(200):
+    for k in range(nrandom):
         local = [rng.uniform(-1.15, 1.15), rng.uniform(-0.95, 0.95), rng.uniform(-0.2, 0.45)]
         poses.append((f"random-{k}", world_pos(m, d, local)))
+    quats = [[np.cos(0.3), np.sin(0.3) * 0.6, np.sin(0.3) * 0.8, 0.0]]
+    if turn:
+        for _ in poses:
+            q = rng.normal(size=4)
+            quats.append((q / np.linalg.norm(q)).tolist())
     out = []
-    for name, p in poses:
+    for k, (name, p) in enumerate(poses):
         d.qpos[:] = 0
         d.qpos[:3] = p
-        d.qpos[3:7] = [np.cos(0.3), np.sin(0.3) * 0.6, np.sin(0.3) * 0.8, 0.0]
+        d.qpos[3:7] = quats[k + 1] if turn else quats[0]
         mujoco.mj_kinematics(m, d)
         mujoco.mj_collision(m, d)
         out.append(
@@ -112,6 +144,14 @@ def flat(doc: dict) -> list[float]:
     return vals
 
 
+def convex_doc() -> dict:
+    scenes = [convex_scene(n, g, 0.0) for n, g in CONVEX_GEOMS]
+    scenes += [convex_scene(n + "-margin", g, 0.02) for n, g in CONVEX_GEOMS]
+    for sc in scenes:
+        sc["cases"] = cases(sc, nrandom=60, turn=True)
+    return {"generator": "validation/mujoco_hfield_golden.py (do not edit)", "mujoco": mujoco.__version__, "scenes": scenes}
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--check", action="store_true")
@@ -120,13 +160,20 @@ def main() -> int:
     for sc in scenes:
         sc["cases"] = cases(sc)
     doc = {"generator": "validation/mujoco_hfield_golden.py (do not edit)", "mujoco": mujoco.__version__, "scenes": scenes}
+    cdoc = convex_doc()
     if args.check:
-        old, new = flat(json.loads(OUT.read_text())), flat(doc)
-        worst = float("inf") if len(old) != len(new) else max((abs(a - b) for a, b in zip(old, new)), default=0.0)
-        ok = worst <= 1e-12
-        print(f"hfield collision reference: live MuJoCo {mujoco.__version__} differs by {worst:.1e} ({'ok' if ok else 'CHANGED'})")
-        return 0 if ok else 1
+        bad = 0
+        for path, d in ((OUT, doc), (OUT_CONVEX, cdoc)):
+            old, new = flat(json.loads(path.read_text())), flat(d)
+            worst = float("inf") if len(old) != len(new) else max((abs(a - b) for a, b in zip(old, new)), default=0.0)
+            ok = worst <= 1e-12
+            bad += not ok
+            print(f"{path.name}: live MuJoCo {mujoco.__version__} differs by {worst:.1e} ({'ok' if ok else 'CHANGED'})")
+        return 0 if bad == 0 else 1
     OUT.write_text(json.dumps(doc, indent=1) + "\n")
+    OUT_CONVEX.write_text(json.dumps(cdoc, indent=1) + "\n")
+    ccounts = [len(c["contacts"]) for sc in cdoc["scenes"] for c in sc["cases"]]
+    print(f"wrote {OUT_CONVEX.relative_to(ROOT)}: {len(ccounts)} cases, {sum(ccounts)} contacts, max {max(ccounts)} per case")
     counts = [len(c["contacts"]) for sc in scenes for c in sc["cases"]]
     print(f"wrote {OUT.relative_to(ROOT)}: {len(counts)} cases, {sum(counts)} contacts, max {max(counts)} per case")
     return 0

@@ -47,16 +47,19 @@ pub(crate) struct CcdObj<'a> {
     vertindex: i32,
     /// The hill climb's warm start (−1: none yet).
     meshindex: i32,
+    /// A height-field prism standing in for `shape` (its frame's three base then three top
+    /// vertices, MuJoCo's `data.hfield.prism`), or None.
+    prism: Option<&'a [Vec3; 6]>,
 }
 
 impl<'a> CcdObj<'a> {
     /// Geom `shape` at pose `x`, inflated by half of `margin`.
     pub(crate) fn new(shape: &'a ConvexShape, x: &'a Transform, margin: f64) -> Self {
-        Self { shape, x, margin, core: Core::Shape, vertindex: -1, meshindex: -1 }
+        Self { shape, x, margin, core: Core::Shape, vertindex: -1, meshindex: -1, prism: None }
     }
 
     fn discrete(&self) -> bool {
-        matches!(self.shape, ConvexShape::Cuboid(_) | ConvexShape::Hull(_))
+        self.prism.is_some() || matches!(self.shape, ConvexShape::Cuboid(_) | ConvexShape::Hull(_))
     }
 
     /// The support point along unit world direction `dir` (no margin).
@@ -76,6 +79,19 @@ impl<'a> CcdObj<'a> {
             Core::Shape => {}
         }
         let local = rot.tr_mul(dir);
+        if let Some(prism) = self.prism {
+            // MuJoCo's `mjc_prism_support`: the best of the base or the top by dir.z.
+            let start = if local.z < 0.0 { 0 } else { 3 };
+            let (mut ibest, mut best) = (start, prism[start].dot(&local));
+            for (i, v) in prism.iter().enumerate().skip(start + 1).take(2) {
+                let d = v.dot(&local);
+                if d > best {
+                    (ibest, best) = (i, d);
+                }
+            }
+            self.vertindex = ibest as i32;
+            return rot * prism[ibest] + pos;
+        }
         let supp = match self.shape {
             ConvexShape::Ball(b) => return dir * b.radius + pos,
             ConvexShape::Capsule(c) => {
@@ -971,7 +987,40 @@ pub(crate) fn penetration(
     tolerance: f64,
     iterations: usize,
 ) -> Option<CcdContact> {
+    penetration_with(s1, None, x1, s2, x2, margin, tolerance, iterations)
+}
+
+/// [`penetration`] of a height-field prism (`prism`: base then top vertices in the frame `x1`)
+/// and geom `s2`: MuJoCo's `mjc_penetration` call in `mjc_ConvexHField`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn penetration_prism(
+    prism: &[Vec3; 6],
+    x1: &Transform,
+    s2: &ConvexShape,
+    x2: &Transform,
+    margin: f64,
+    tolerance: f64,
+    iterations: usize,
+) -> Option<CcdContact> {
+    // The shape is unused when a prism stands in for it (any non-core shape will do).
+    let stand_in =
+        ConvexShape::Cuboid(parry3d_f64::shape::Cuboid::new(parry3d_f64::math::Vector::new(0.0, 0.0, 0.0)));
+    penetration_with(&stand_in, Some(prism), x1, s2, x2, margin, tolerance, iterations)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn penetration_with(
+    s1: &ConvexShape,
+    prism1: Option<&[Vec3; 6]>,
+    x1: &Transform,
+    s2: &ConvexShape,
+    x2: &Transform,
+    margin: f64,
+    tolerance: f64,
+    iterations: usize,
+) -> Option<CcdContact> {
     let mut o1 = CcdObj::new(s1, x1, margin);
+    o1.prism = prism1;
     let mut o2 = CcdObj::new(s2, x2, margin);
     let mut st = Status {
         separated: false,

@@ -14,8 +14,8 @@
 //! capsules ([`box_primitive`]) and boxes ([`box_box`]) with MuJoCo's multi-point manifolds, and
 //! GJK/EPA on support maps for the other convex pairs ([`convex`]). Meshes collide by their
 //! convex hulls, whose support points are found by hill climbing on the hull's edges
-//! ([`hull_support`], as MuJoCo's mesh graph); height fields collide with spheres ([`hfield`], MuJoCo's
-//! prisms); their other pairs are not collided yet (`info` lists them).
+//! ([`hull_support`], as MuJoCo's mesh graph); height fields collide with spheres exactly ([`hfield`], MuJoCo's
+//! prisms) and with the other geoms by GJK/EPA on the prisms ([`hfield_convex`]).
 //!
 //! `collide` reports the contacts closer than the pair's margin + gap plus `reach`: MuJoCo's rule
 //! with `reach` = 0 (contacts in the gap are reported without rows: rows exist below the margin,
@@ -38,6 +38,7 @@ mod frame;
 pub mod geom_distance;
 mod gjk;
 pub mod hfield;
+pub mod hfield_convex;
 pub mod hull_support;
 pub mod inside;
 pub mod mesh;
@@ -250,6 +251,14 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         if let (Shape::Hfield { field, .. }, Shape::Sphere { radius }) = (&geom1.shape, &geom2.shape) {
             let mut out = |p: hfield::HfieldPoint| push(p.p1, p.p2, p.normal, p.dist, None, 0);
             hfield::sphere(&x1, field, &x2.pos, *radius, pair.margin, &mut out);
+            continue;
+        }
+        // Height fields against the other convex geoms: MuJoCo's prisms by GJK/EPA ([`hfield_convex`]).
+        if let Shape::Hfield { field, .. } = &geom1.shape {
+            if let Some(s2) = &cm.shapes[g2] {
+                let mut out = |p: hfield::HfieldPoint| push(p.p1, p.p2, p.normal, p.dist, None, 0);
+                hfield_convex::convex(&x1, field, s2, &x2, pair.margin, &model.options, &mut out);
+            }
             continue;
         }
         if let Shape::Plane { .. } = geom1.shape {

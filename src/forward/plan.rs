@@ -392,7 +392,7 @@ fn stages(
         .filter(|g| g.collision && matches!(g.shape, crate::model::spec::Shape::Hfield { .. }))
         .count();
     let hfield_note = if hfields > 0 {
-        format!("; {hfields} height fields collide with spheres only (other pairs not collided yet)")
+        format!("; {hfields} height fields (MuJoCo's prisms: exact for spheres, GJK/EPA for the other geoms)")
     } else {
         String::new()
     };

@@ -86,14 +86,10 @@ fn max_contacts(a: &Shape, b: &Shape, multiccd: bool, has_margin: bool) -> usize
 }
 
 /// Whether a collision function exists for the pair (planes and height fields never collide with
-/// each other; a height field collides only with spheres so far, see `collision::hfield`).
+/// each other; a height field collides with every other geom, see `collision::hfield_convex`).
 fn collidable(a: &Shape, b: &Shape) -> bool {
-    let hfield = match (a, b) {
-        (Shape::Hfield { .. }, Shape::Sphere { .. }) | (Shape::Sphere { .. }, Shape::Hfield { .. }) => false,
-        _ => matches!(a, Shape::Hfield { .. }) || matches!(b, Shape::Hfield { .. }),
-    };
-    let planes = matches!(a, Shape::Plane { .. }) && matches!(b, Shape::Plane { .. });
-    !(hfield || planes)
+    let flat = |s: &Shape| matches!(s, Shape::Plane { .. } | Shape::Hfield { .. });
+    !(flat(a) && flat(b))
 }
 
 /// MuJoCo's `mj_contactParam` for a dynamic pair.
