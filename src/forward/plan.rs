@@ -571,9 +571,6 @@ pub fn soft_unsupported(model: &Model) -> Vec<String> {
             o.noslip_iterations
         ));
     }
-    if o.flags.override_contacts {
-        out.push("<flag override> (o_margin, o_solref, o_solimp, o_friction)".to_string());
-    }
     if o.flags.island {
         out.push("<flag island> (islands are solved as one problem: same solution)".to_string());
     }

@@ -8,7 +8,9 @@
 //!   (`<flag filterparent>`), never a body pair listed in `<exclude>`;
 //! - explicit `<pair>`s, with their own parameters and no filter (a geom pair that is both
 //!   explicit and dynamic is taken once, explicitly);
-//! - none when `<flag contact="disable">` (or `constraint`).
+//! - none when `<flag contact="disable">` (or `constraint`);
+//! - under `<flag override>`, every pair takes `<option>`'s `o_margin`, `o_solref`, `o_solimp`
+//!   and `o_friction` (MuJoCo's `mj_assign*` in engine_core_constraint.c).
 //!
 //! Each pair carries its combined contact parameters: the geom of higher `priority` gives all of
 //! them; at equal priority condim and friction are the larger, solref and solimp the `solmix`
@@ -230,5 +232,27 @@ pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
             });
         }
     }
+    if flags.override_contacts {
+        override_params(model, &mut out);
+    }
     out
+}
+
+/// `<flag override>` (MuJoCo's `mj_assignMargin`, `mj_assignRef`, `mj_assignImp`,
+/// `mj_assignFriction`): every pair takes `o_margin`, `o_solref` (for its friction rows too),
+/// `o_solimp` and `o_friction` (each entry at least `mjMINMU`); gap and condim stay the pair's
+/// (checked against MuJoCo 4.0: contacts are reported within `o_margin` + gap, with rows within
+/// `o_margin`).
+fn override_params(model: &Model, pairs: &mut [CollisionPair]) {
+    const MINMU: f64 = 1e-5;
+    let o = &model.options;
+    for p in pairs {
+        p.margin = o.o_margin;
+        p.solref = o.o_solref;
+        p.solreffriction = o.o_solref;
+        p.solimp = o.o_solimp;
+        p.friction = o.o_friction.map(|mu| mu.max(MINMU));
+        let (s1, s2) = (&model.geoms[p.geom[0]].shape, &model.geoms[p.geom[1]].shape);
+        p.max_contacts = max_contacts(s1, s2, o.flags.multiccd, p.margin + p.gap > 0.0);
+    }
 }

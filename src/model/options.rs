@@ -104,8 +104,9 @@ pub struct Flags {
     pub eulerdamp: bool,
     /// Automatic reset on numerical instability (`mjDSBL_AUTORESET`); lagrange does not read it.
     pub autoreset: bool,
-    /// Overriding contact parameters with `o_margin`, `o_solref`, … (`mjENBL_OVERRIDE`, MJCF
-    /// `override`); not simulated, listed by `info`.
+    /// Overriding every contact's margin, solref (also solreffriction), solimp and friction with
+    /// [`Options::o_margin`], [`Options::o_solref`], [`Options::o_solimp`], [`Options::o_friction`]
+    /// (`mjENBL_OVERRIDE`, MJCF `override`); the gap and condim stay the pair's.
     pub override_contacts: bool,
     /// Energy computation (`mjENBL_ENERGY`); lagrange does not read it.
     pub energy: bool,
@@ -269,6 +270,15 @@ pub struct Options {
     pub ccd_iterations: u32,
     /// The `<flag>` switches.
     pub flags: Flags,
+    /// Contact margin under `<flag override>` (m; MuJoCo's `o_margin`, default 0).
+    pub o_margin: f64,
+    /// Contact solref under `<flag override>` (`o_solref`, default `0.02 1`).
+    pub o_solref: [f64; 2],
+    /// Contact solimp under `<flag override>` (`o_solimp`, default `0.9 0.95 0.001 0.5 2`).
+    pub o_solimp: [f64; 5],
+    /// Contact friction under `<flag override>` (`o_friction`, default `1 1 0.005 0.0001 0.0001`;
+    /// each entry at least MuJoCo's `mjMINMU` = 1e-5).
+    pub o_friction: [f64; 5],
 }
 
 impl Default for Options {
@@ -293,6 +303,10 @@ impl Default for Options {
             ccd_tolerance: 1e-6,
             ccd_iterations: 35,
             flags: Flags::default(),
+            o_margin: 0.0,
+            o_solref: [0.02, 1.0],
+            o_solimp: [0.9, 0.95, 0.001, 0.5, 2.0],
+            o_friction: [1.0, 1.0, 0.005, 0.0001, 0.0001],
         }
     }
 }

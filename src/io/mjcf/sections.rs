@@ -150,6 +150,12 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
                 *slot = v;
             }
         }
+        if let Some(v) = a.real("o_margin")? {
+            o.o_margin = v;
+        }
+        a.fill("o_solref", &mut o.o_solref)?;
+        a.fill("o_solimp", &mut o.o_solimp)?;
+        a.fill("o_friction", &mut o.o_friction)?;
         for f in e.children_named("flag") {
             for (name, value) in &f.attrs {
                 let on = match value.as_str() {
