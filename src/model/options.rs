@@ -253,11 +253,11 @@ pub struct Options {
     /// Ratio of frictional to normal constraint impedance (1).
     pub impratio: f64,
     /// The medium's density (kg/m³; MuJoCo's fluid forces act when density or viscosity is
-    /// positive; not simulated, listed by `info`).
+    /// positive: `dynamics::fluid`, docs/fluid.md).
     pub density: f64,
-    /// The medium's viscosity (Pa·s; not simulated, listed by `info`).
+    /// The medium's viscosity (Pa·s; fluid forces, `dynamics::fluid`).
     pub viscosity: f64,
-    /// The medium's velocity in the world frame (m/s; not simulated, listed by `info`).
+    /// The medium's velocity in the world frame (m/s; fluid forces, `dynamics::fluid`).
     pub wind: [f64; 3],
     /// The global magnetic flux in the world frame, read by magnetometer sensors (MuJoCo's
     /// `magnetic`, default (0, −0.5, 0)).
