@@ -43,6 +43,6 @@ pub(crate) fn rnea_derivatives_unchecked(
 ) {
     rnea_unchecked(model, data, q, v, a);
     work.config.compute(model, data, v, a, &mut work.dtau_dq);
-    work.bias.compute(model, data, q, v);
+    work.bias.compute_after_rnea(model, data, v);
     work.dtau_dv.copy_from(&work.bias.dbias_dv);
 }

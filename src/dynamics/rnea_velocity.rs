@@ -71,6 +71,26 @@ impl BiasDerivative {
             self.v_body[b] = data.x_parent_body[b].inv_act_motion(&self.v_body[p]) + self.v_joint[b];
             self.momentum[b] = model.bodies[b].inertia.mul_motion(&self.v_body[b]);
         }
+        self.columns(model, data);
+    }
+
+    /// [`compute`](Self::compute) when `data` already holds RNEA's pass at (q, v) (joint
+    /// transforms, motion subspaces and `v_body`, as [`rnea_unchecked`](crate::dynamics) leaves
+    /// them): the joint updates and the velocity pass are not redone.
+    pub fn compute_after_rnea(&mut self, model: &Model, data: &Data, v: &[f64]) {
+        let nb = model.nbody();
+        self.v_body[0] = Motion::zero();
+        for b in 1..nb {
+            self.v_joint[b] = joint_velocity(model, data, b, v);
+            self.v_body[b] = data.v_body[b];
+            self.momentum[b] = model.bodies[b].inertia.mul_motion(&self.v_body[b]);
+        }
+        self.columns(model, data);
+    }
+
+    /// The nv columns of ∂c/∂v from the prepared `v_joint`, `v_body` and `momentum`.
+    fn columns(&mut self, model: &Model, data: &Data) {
+        let nb = model.nbody();
         self.dbias_dv.fill(0.0);
         for k in 0..model.nv {
             let c = model.dof_body[k];
