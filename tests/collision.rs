@@ -405,3 +405,39 @@ fn bad_collision_geometry_is_a_typed_error() {
     println!("{err}");
     assert!(err.contains("condim") && err.contains("1, 3, 4 or 6"), "{err}");
 }
+
+/// `<exclude>` names file bodies: a jointless body fused into its parent (one compiled body)
+/// keeps its own identity, so excluding the parent against a third body leaves the fused child's
+/// geoms colliding with it — as in MuJoCo 4.0, which gives the palm–finger box pair 4 contacts
+/// here (found on Menagerie's Aero hand, whose palm hangs jointless under its mount).
+#[test]
+fn excluding_a_parent_does_not_exclude_its_fused_child() {
+    let model = mjcf(
+        "exclude_fused",
+        r#"<worldbody>
+             <body name="mount"><geom name="mount_box" type="box" size="0.1 0.1 0.02" pos="0 0 -0.5"/>
+               <body name="palm"><geom name="palm_box" type="box" size="0.1 0.1 0.02"/></body>
+             </body>
+             <body name="finger" pos="0 0 0.03"><freejoint/><geom name="finger_box" type="box" size="0.02 0.02 0.02"/></body>
+           </worldbody>
+           <contact><exclude body1="mount" body2="finger"/></contact>"#,
+    )
+    .unwrap();
+    let found = contacts(&model);
+    assert_eq!(found.len(), 4, "{found:?}");
+    let names: Vec<&str> = found[0].geom.iter().map(|&g| model.geoms[g].name.as_str()).collect();
+    assert_eq!(names, ["palm_box", "finger_box"]);
+    // The excluded pair itself stays out: mount against finger (moved down onto the mount's box).
+    let model = mjcf(
+        "exclude_fused_mount",
+        r#"<worldbody>
+             <body name="mount"><geom name="mount_box" type="box" size="0.1 0.1 0.02"/>
+               <body name="palm"><geom name="palm_box" type="box" size="0.1 0.1 0.02" pos="0 0 0.5"/></body>
+             </body>
+             <body name="finger" pos="0 0 0.03"><freejoint/><geom name="finger_box" type="box" size="0.02 0.02 0.02"/></body>
+           </worldbody>
+           <contact><exclude body1="mount" body2="finger"/></contact>"#,
+    )
+    .unwrap();
+    assert!(contacts(&model).is_empty());
+}

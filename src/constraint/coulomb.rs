@@ -37,11 +37,14 @@ pub struct SolverSettings {
     /// Relative tolerance on the change one sweep makes to the motion, max |M⁻¹Jᵀ Δλ|, against the
     /// constraint forces' whole correction max |M⁻¹Jᵀ λ|.
     pub tolerance: f64,
+    /// The algorithm for rows with dry friction at the acceleration level (Gauss–Seidel or
+    /// ADMM); the velocity projection always uses Gauss–Seidel.
+    pub solver: super::ExactContactSolver,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        Self { max_iterations: 1000, tolerance: 1e-13 }
+        Self { max_iterations: 1000, tolerance: 1e-13, solver: super::ExactContactSolver::Pgs }
     }
 }
 
@@ -504,7 +507,7 @@ fn shifted_solve(
 /// (λ_n ≥ 0, w ≥ 0 off contact, friction inside its cone or box, w opposing a friction at its
 /// bound). A contact whose friction is on its cone's boundary makes the system unsymmetric: then
 /// there is no polish and the iteration goes on.
-fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
+pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     let n = data.nefc;
     const TOL: f64 = 1e-9;
     let mut i = 0;

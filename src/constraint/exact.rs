@@ -9,6 +9,7 @@
 //! of v onto J v = 0).
 
 use super::active_set::{solve_delassus, solve_mixed};
+use super::admm::{solve_admm, ExactContactSolver};
 use super::coulomb::{has_friction, solve_coulomb, Level, SolverSettings, SEPARATING_VELOCITY};
 use super::ConstraintModel;
 use super::ExactWork;
@@ -79,8 +80,12 @@ pub(crate) fn solve_exact(
         data.exact.rhs[i] = -(j_qacc + data.efc_jdotv[i]) - alpha * data.efc_vel[i] - beta * data.efc_pos[i];
     }
     if has_friction(data) {
-        let scale = data.qacc_smooth.amax();
-        solve_coulomb(model, data, Level::Acceleration, settings, scale);
+        if settings.solver == ExactContactSolver::Admm {
+            solve_admm(model, data, settings);
+        } else {
+            let scale = data.qacc_smooth.amax();
+            solve_coulomb(model, data, Level::Acceleration, settings, scale);
+        }
         // No rank to report: the iterative solve gives one of the equivalent force distributions.
         data.exact.active.clear();
     } else {

@@ -41,6 +41,8 @@ pub(crate) struct ExactWork {
     /// Per row, the Coulomb solve's polish: a contact (at its normal row) whose friction is on
     /// its cone, slipping or starting to.
     pub slipping: Vec<bool>,
+    /// The ADMM solve's per-row buffers ([`super::admm`]).
+    pub admm: super::admm::AdmmWork,
 }
 
 impl ExactWork {
@@ -61,6 +63,7 @@ impl ExactWork {
             lambda_prev: DVector::zeros(nefc),
             pressing: vec![false; nefc],
             slipping: vec![false; nefc],
+            admm: Default::default(),
         }
     }
 
@@ -84,6 +87,7 @@ impl ExactWork {
         self.warm.resize_vertically_mut(nefc, 0.0);
         self.pressing.resize(nefc, false);
         self.slipping.resize(nefc, false);
+        self.admm.grow(nefc);
         self.active.reserve(nefc.saturating_sub(self.active.len()));
         self.warm_rows.reserve(nefc.saturating_sub(self.warm_rows.len()));
     }

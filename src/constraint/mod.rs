@@ -13,6 +13,7 @@
 //! MuJoCo's rows, regularization and solvers.
 
 mod active_set;
+mod admm;
 mod contact;
 pub mod contact_force;
 mod coulomb;
@@ -26,6 +27,7 @@ mod rows;
 pub mod soft;
 mod solver;
 
+pub use admm::{ExactContactSolver, ADMM_TOLERANCE};
 pub use contact::CONTACT_ACTIVE_DISTANCE;
 pub use coulomb::{Level, SolverSettings, SEPARATING_VELOCITY, SLIP_VELOCITY};
 pub(crate) use dense::{cholesky, cholesky_solve};

@@ -445,10 +445,55 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             ),
         });
     }
+    auto_spring_damper(spec, &mut model);
     crate::tendon::resolve_spring_lengths(&mut model);
     crate::model::lengthrange::set_acc0(&mut model);
     model.plan = crate::forward::Plan::new(&model, None);
     Ok(model)
+}
+
+/// MJCF `springdamper` (MuJoCo's `mjCModel::AutoSpringDamper`, user_model.cc): a joint given a
+/// time constant τ and damping ratio ζ gets, from its inertia at `qpos0` m = ndof / Σ
+/// `dof_invweight0` over its dofs, the stiffness m / (τ² ζ²) and the damping 2 m / τ (as a
+/// soft constraint's `solref` maps to stiffness and damping), replacing the file's `stiffness`
+/// and `damping`. Checked against MuJoCo 4.0.0's `jnt_stiffness` and `dof_damping`
+/// (tests/mjcf_features.rs) and on dm_control's dog (validation/crossval_features.py).
+fn auto_spring_damper(spec: &ModelSpec, model: &mut Model) {
+    let params: Vec<(usize, [f64; 2])> = spec
+        .links
+        .iter()
+        .filter(|l| l.joint.jtype != JointType::Fixed)
+        .enumerate()
+        .filter_map(|(j, l)| l.joint.springdamper.map(|p| (j, p)))
+        .collect();
+    if params.is_empty() {
+        return;
+    }
+    const MINVAL: f64 = 1e-15;
+    let weights = crate::constraint::soft::weights::InverseWeights::new(model);
+    for (ji, [timeconst, dampratio]) in params {
+        let (d, n) = (model.joints[ji].dof_adr, model.joints[ji].kind.nv());
+        let inertia = n as f64 / weights.dof_invweight0[d..d + n].iter().sum::<f64>().max(MINVAL);
+        let stiffness = inertia / (timeconst * timeconst * dampratio * dampratio).max(MINVAL);
+        let damping = 2.0 * inertia / timeconst.max(MINVAL);
+        if spec.options.flags.damper {
+            // dof_damping holds the file's damping plus what actuators reflect onto the dof.
+            let file_damping = model.joints[ji].damping;
+            for k in d..d + n {
+                model.dof_damping[k] += damping - file_damping;
+            }
+        }
+        let joint = &mut model.joints[ji];
+        joint.stiffness = stiffness;
+        joint.damping = damping;
+        if spec.options.flags.spring && joint.kind.nq() == 1 {
+            let spring = Spring { qpos_adr: joint.qpos_adr, dof_adr: d, stiffness, rest: joint.spring_ref };
+            match model.springs.binary_search_by_key(&d, |s| s.dof_adr) {
+                Ok(i) => model.springs[i] = spring,
+                Err(i) => model.springs.insert(i, spring),
+            }
+        }
+    }
 }
 
 /// Actuator `damping` and `armature` (MuJoCo 4's `actuator_damping`, `actuator_armature`): on a

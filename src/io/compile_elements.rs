@@ -108,11 +108,13 @@ pub(crate) fn compile_elements(spec: &ModelSpec, model: &Model) -> Result<Elemen
             name: x.name.clone(),
             body1: model.frames[f1].body,
             body2: model.frames[f2].body,
+            mujoco_body: [b1, b2],
             loc: x.loc.clone(),
         };
         if b1 > b2 {
             std::mem::swap(&mut x.body1, &mut x.body2);
             std::mem::swap(&mut b1, &mut b2);
+            x.mujoco_body = [b1, b2];
         }
         excludes.push(((b1, b2), x));
     }

@@ -160,11 +160,22 @@ pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
     }
     let explicit = out.len();
     let has_dofs = |b: usize| b != 0;
-    // <exclude> names file bodies: compare their roots (a multi-joint body's chain is one body).
-    let excluded = |b1: usize, b2: usize| {
-        model.contact_excludes.iter().any(|e| {
-            let (e1, e2) = (model.body_root[e.body1], model.body_root[e.body2]);
-            (e1, e2) == (b1, b2) || (e1, e2) == (b2, b1)
+    // <exclude> names file bodies: compared with the geoms' own file bodies (MuJoCo's
+    // geom_bodyid; a multi-joint body's chain is one body, and a jointless body fused into its
+    // parent stays itself — excluding the parent does not exclude it), or, for a model without
+    // that table, with their compiled bodies' roots.
+    let excluded = |i: usize, j: usize, b1: usize, b2: usize| {
+        let file_bodies = (model.links.of_geom.len() == model.geoms.len())
+            .then(|| (model.links.of_geom[i], model.links.of_geom[j]));
+        model.contact_excludes.iter().any(|e| match file_bodies {
+            Some((g1, g2)) => {
+                let [e1, e2] = e.mujoco_body;
+                (e1, e2) == (g1, g2) || (e1, e2) == (g2, g1)
+            }
+            None => {
+                let (e1, e2) = (model.body_root[e.body1], model.body_root[e.body2]);
+                (e1, e2) == (b1, b2) || (e1, e2) == (b2, b1)
+            }
         })
     };
     let n = model.geoms.len();
@@ -189,7 +200,7 @@ pub fn candidate_pairs(model: &Model) -> Vec<CollisionPair> {
                 || !(has_dofs(b1) || has_dofs(b2))
                 || !compatible
                 || parent_child
-                || excluded(b1, b2)
+                || excluded(i, j, b1, b2)
                 || !collidable(&gi.shape, &gj.shape)
             {
                 continue;

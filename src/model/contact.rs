@@ -40,6 +40,10 @@ pub struct ContactExclude {
     pub body1: usize,
     /// The second body (index in `Model::bodies`).
     pub body2: usize,
+    /// The two bodies as MuJoCo numbers them (`Model::links`; the file's bodies, a body fused
+    /// into its parent keeping its own id), in `body1`, `body2` order: what the exclusion compares
+    /// with each geom's body (MuJoCo's `geom_bodyid`).
+    pub mujoco_body: [usize; 2],
     /// Where it is written.
     pub loc: SourceLoc,
 }

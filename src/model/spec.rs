@@ -178,6 +178,10 @@ pub struct JointSpec {
     pub stiffness: f64,
     /// The spring's rest position, in q (MuJoCo `springref`).
     pub spring_ref: f64,
+    /// MJCF `springdamper` (timeconst, dampratio), both positive: stiffness and damping computed
+    /// at compile time from the joint's inertia at `qpos0`, replacing `stiffness` and `damping`
+    /// (MuJoCo's `mjCModel::AutoSpringDamper`).
+    pub springdamper: Option<[f64; 2]>,
     /// The joint's reference configuration (MuJoCo `qpos0`); empty means neutral.
     pub qpos0: Vec<f64>,
     /// URDF `<mimic>`: this joint follows another one.
@@ -250,6 +254,7 @@ impl JointSpec {
             armature: 0.0,
             stiffness: 0.0,
             spring_ref: 0.0,
+            springdamper: None,
             qpos0: Vec::new(),
             mimic: None,
             soft: SoftParams::default(),

@@ -420,8 +420,17 @@ impl<'a> TreeBuilder<'a> {
         j.friction = a.real("frictionloss")?.unwrap_or(0.0);
         j.soft = soft_params(&a)?;
         j.actuator_gravcomp = a.bool("actuatorgravcomp")?.unwrap_or(false);
-        if a.has("springdamper") {
-            self.keep("joint", "springdamper", &name, &a);
+        if let Some(sd) = a.array::<2>("springdamper")? {
+            // MuJoCo: "when defined, springdamper values must be positive"; 0 0 is undefined.
+            if sd != [0.0, 0.0] {
+                if !(sd[0] > 0.0 && sd[1] > 0.0 && sd.iter().all(|x| x.is_finite())) {
+                    return Err(a.error(
+                        "springdamper",
+                        "when defined, both values (timeconst, dampratio) must be positive and finite, as MuJoCo requires",
+                    ));
+                }
+                j.springdamper = Some(sd);
+            }
         }
         for poly in ["stiffness", "damping"] {
             if a.some_numbers(poly, 1, 3)?.is_some_and(|v| v[1..].iter().any(|&c| c != 0.0)) {
