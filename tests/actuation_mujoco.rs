@@ -8,6 +8,7 @@
 mod common;
 
 use common::{rel_err_vec, state_rel_err, REF_REL};
+use lagrange::forward::unsimulated_reason;
 use lagrange::prelude::*;
 use serde_json::Value;
 
@@ -69,4 +70,45 @@ fn check_scene(name: &str, scene: &Value) -> (f64, f64) {
 fn gravity_compensation_follows_mujoco() {
     let golden = golden();
     check_scene("gravcomp.xml", &golden["scenes"]["gravcomp.xml"]);
+}
+
+/// The compile-time muscle constants of `scene`: `actuator_lengthrange` (exact: copied from the
+/// file or a joint's or tendon's range) and `actuator_acc0` (to 1e-9 relative).
+fn check_muscle_constants(name: &str, scene: &Value) {
+    let model = Model::from_file(scene["model"].as_str().unwrap()).unwrap();
+    let lengthrange: Vec<f64> = model.actuators.iter().flat_map(|a| a.lengthrange).collect();
+    assert_eq!(lengthrange, floats(&scene["actuator_lengthrange"]), "{name}: actuator_lengthrange");
+    let acc0: Vec<f64> = model.actuators.iter().map(|a| a.acc0).collect();
+    let err = rel_err_vec(&acc0, &floats(&scene["actuator_acc0"]));
+    assert!(err <= REF_REL, "{name}: actuator_acc0 rel err {err:e}: {acc0:?}");
+    for a in &model.actuators {
+        assert_eq!(unsimulated_reason(&model, a), None, "{name}: {}", a.name);
+    }
+}
+
+#[test]
+fn muscles_with_lengthrange_from_limits_follow_mujoco() {
+    let golden = golden();
+    let scene = &golden["scenes"]["muscle_limits.xml"];
+    check_muscle_constants("muscle_limits.xml", scene);
+    check_scene("muscle_limits.xml", scene);
+}
+
+#[test]
+fn muscles_with_written_lengthrange_and_smooth_switching_follow_mujoco() {
+    let golden = golden();
+    let scene = &golden["scenes"]["muscle_written.xml"];
+    check_muscle_constants("muscle_written.xml", scene);
+    check_scene("muscle_written.xml", scene);
+}
+
+#[test]
+fn a_muscle_without_lengthrange_is_listed_as_not_simulated() {
+    let model = Model::from_str(
+        r#"<mujoco><worldbody><body><joint name="j" range="-1 1"/><geom size="0.1"/></body></worldbody>
+           <actuator><muscle joint="j"/></actuator></mujoco>"#,
+    )
+    .unwrap();
+    assert_eq!(model.actuators[0].lengthrange, [0.0, 0.0]);
+    assert!(unsimulated_reason(&model, &model.actuators[0]).unwrap().contains("lengthrange"));
 }

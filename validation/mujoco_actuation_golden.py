@@ -3,7 +3,7 @@
 MuJoCo's mj_forward at random states (qpos from qpos0 moved by a random velocity through
 mj_integratePos, random qvel, act and ctrl) — qfrc_gravcomp, qfrc_passive, qfrc_actuator,
 actuator_length, actuator_velocity, actuator_force, act_dot, qacc — the model's
-actuator_lengthrange, and a 200-step mj_step trajectory from qpos0 at fixed controls (qpos, qvel,
+actuator_lengthrange and actuator_acc0, and a 200-step mj_step trajectory from qpos0 at fixed controls (qpos, qvel,
 act after 1, 50, 100 and 200 steps). Writes tests/data/mujoco/actuation.json (generated: do not
 edit); with --check, recomputes and exits 1 when the committed file differs beyond 1e-12 (another
 MuJoCo would give other numbers). Read by tests/actuation_mujoco.rs.
@@ -27,6 +27,8 @@ OUT = ROOT / "tests/data/mujoco/actuation.json"
 #: Per scene: the fixed controls of the trajectory (one per actuator).
 CONTROLS = {
     "gravcomp.xml": [0.3, 0.1],
+    "muscle_limits.xml": [0.8, 0.2, 1.3, 0.5],
+    "muscle_written.xml": [0.6, 1.0, 0.05, 0.9],
 }
 NSTATES = 4
 SAMPLES = [1, 50, 100, 200]
@@ -65,6 +67,7 @@ def scene(name: str) -> dict:
     return {
         "model": str(path.relative_to(ROOT)),
         "actuator_lengthrange": m.actuator_lengthrange.ravel().tolist(),
+        "actuator_acc0": m.actuator_acc0.ravel().tolist(),
         "states": states,
         "ctrl": CONTROLS[name],
         "run": run,

@@ -15,8 +15,10 @@
 //! `actearly` the force uses that next activation instead of the current one, which removes the
 //! one-step delay between a control and its force.
 //!
-//! `muscle` and `user` dynamics own an activation too (so `act` has MuJoCo's layout) but are not
-//! simulated: their ẇ is 0.
+//! | muscle | MuJoCo's muscle activation ([`muscle`](super::muscle)) |
+//!
+//! `user` dynamics own an activation too (so `act` has MuJoCo's layout) but are not simulated:
+//! their ẇ is 0.
 
 use crate::model::actuator::{Actuator, DynType};
 use crate::model::Model;
@@ -34,7 +36,8 @@ pub fn activation_rate(a: &Actuator, ctrl: f64, act: f64) -> f64 {
     match a.dyntype {
         DynType::Integrator => ctrl,
         DynType::Filter | DynType::FilterExact => (ctrl - act) / time_constant(a),
-        DynType::None | DynType::Muscle | DynType::User => 0.0,
+        DynType::Muscle => super::muscle::muscle_activation_rate(ctrl, act, &a.dynprm),
+        DynType::None | DynType::User => 0.0,
     }
 }
 

@@ -14,13 +14,14 @@
 //! order, checked against it), and the generalized force `qfrc_actuator` = Σ momentᵀ force,
 //! clamped on each joint with an `actuatorfrcrange`.
 //!
-//! Simulated: dyntype none, integrator, filter, filterexact; fixed or affine gain; none or affine
-//! bias; joint (hinge, slide, ball, free), jointinparent, fixed-tendon, slider-crank and site
+//! Simulated: dyntype none, integrator, filter, filterexact, muscle; fixed, affine or muscle gain;
+//! none, affine or muscle bias ([`muscle`](super::muscle), with `actuator_lengthrange` resolved); joint (hinge, slide, ball, free), jointinparent, fixed-tendon, slider-crank and site
 //! (with or without refsite) transmissions — MuJoCo's `motor`, `position`, `velocity`, `intvelocity`, `damper`,
-//! `cylinder` and such `general` ones. Every other kind is kept, listed by `info` as not
+//! `cylinder`, `muscle` and such `general` ones. Every other kind is kept, listed by `info` as not
 //! simulated, and contributes no force ([`unsimulated_reason`]).
 
 use super::activation::{activation_rate, next_activation};
+use super::muscle::{muscle_bias, muscle_gain};
 use super::transmission::{moment_span, needs_poses, transmission, Poses};
 use crate::error::{check, InputError};
 use crate::kinematics::forward_kinematics_unchecked;
@@ -159,10 +160,12 @@ pub(crate) fn actuation_unchecked(
         };
         let gain = match a.gaintype {
             GainType::Affine => a.gainprm[0] + a.gainprm[1] * length + a.gainprm[2] * velocity,
+            GainType::Muscle => muscle_gain(length, velocity, a.lengthrange, a.acc0, &a.gainprm),
             _ => a.gainprm[0],
         };
         let bias = match a.biastype {
             BiasType::Affine => a.biasprm[0] + a.biasprm[1] * length + bias_velocity[i] * velocity,
+            BiasType::Muscle => muscle_bias(length, a.lengthrange, a.acc0, &a.biasprm),
             _ => 0.0,
         };
         data.actuator_length[i] = length;

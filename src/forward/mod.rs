@@ -19,9 +19,10 @@
 
 mod activation;
 mod actuation;
+pub mod muscle;
 mod plan;
 mod skip;
-mod transmission;
+pub(crate) mod transmission;
 mod xfrc;
 
 pub use activation::{activation_rate, next_activation};

@@ -452,6 +452,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     }
     auto_spring_damper(spec, &mut model);
     crate::tendon::resolve_spring_lengths(&mut model);
+    crate::model::lengthrange::set_acc0(&mut model);
     model.plan = crate::forward::Plan::new(&model, None);
     Ok(model)
 }

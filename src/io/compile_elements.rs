@@ -686,6 +686,7 @@ fn actuator(
             ctrlrange = range;
         }
     }
+    let lengthrange = crate::model::lengthrange::resolve(a, &transmission, &n.model.joints, tendons);
     Ok(Actuator {
         name: a.name.clone(),
         shortcut: a.shortcut,
@@ -701,6 +702,8 @@ fn actuator(
         forcerange: a.forcerange,
         actrange,
         actearly: a.actearly,
+        lengthrange,
+        acc0: 0.0,
         loc: a.loc.clone(),
     })
 }

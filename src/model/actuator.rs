@@ -24,9 +24,9 @@ pub enum ActuatorShortcut {
     Damper,
     /// `<cylinder>`: a pneumatic or hydraulic cylinder (first-order filter on the pressure).
     Cylinder,
-    /// `<muscle>`: MuJoCo's muscle model (not simulated).
+    /// `<muscle>`: MuJoCo's muscle model.
     Muscle,
-    /// `<adhesion>`: an adhesive body force (not simulated).
+    /// `<adhesion>`: an adhesive body force .
     Adhesion,
     /// `<plugin>`: an engine plugin (the MJCF loader keeps plugin actuators as untyped elements,
     /// so none has this shortcut).
@@ -92,9 +92,9 @@ pub enum DynType {
     Filter,
     /// The same filter integrated exactly over a step (`filterexact`).
     FilterExact,
-    /// MuJoCo's muscle activation (`muscle`; not simulated).
+    /// MuJoCo's muscle activation (`muscle`).
     Muscle,
-    /// A user callback (`user`; not simulated).
+    /// A user callback (`user`).
     User,
 }
 
@@ -106,9 +106,9 @@ pub enum GainType {
     Fixed,
     /// gain = `gainprm[0]` + `gainprm[1]` · length + `gainprm[2]` · velocity (`affine`).
     Affine,
-    /// MuJoCo's muscle gain (`muscle`; not simulated).
+    /// MuJoCo's muscle gain (`muscle`).
     Muscle,
-    /// A user callback (`user`; not simulated).
+    /// A user callback (`user`).
     User,
 }
 
@@ -121,9 +121,9 @@ pub enum BiasType {
     /// bias = `biasprm[0]` + `biasprm[1]` · length + `biasprm[2]` · velocity (`affine`; a
     /// positive `biasprm[2]` of a position servo is a damping ratio, resolved in the model's plan).
     Affine,
-    /// MuJoCo's muscle bias (`muscle`; not simulated).
+    /// MuJoCo's muscle bias (`muscle`).
     Muscle,
-    /// A user callback (`user`; not simulated).
+    /// A user callback (`user`).
     User,
 }
 
@@ -158,6 +158,14 @@ pub struct Actuator {
     pub actrange: Option<[f64; 2]>,
     /// `actearly`: use the next activation in the force (MuJoCo ≥ 3).
     pub actearly: bool,
+    /// The range of its length a muscle's gain and bias are normalized by (MuJoCo's
+    /// `actuator_lengthrange`): the `lengthrange` written, else (with
+    /// `<compiler><lengthrange uselimit="true">`) its joint's or tendon's range; [0, 0] when
+    /// neither is given ([`crate::model::lengthrange`]).
+    pub lengthrange: [f64; 2],
+    /// |M₀⁻¹ momentᵀ| at `qpos0` (MuJoCo's `actuator_acc0`): the acceleration a unit force gives,
+    /// which scales a muscle's `force` when that is negative ([`crate::model::lengthrange`]).
+    pub acc0: f64,
     /// Where it is written.
     pub loc: SourceLoc,
 }
@@ -169,17 +177,22 @@ impl Actuator {
     }
 }
 
-/// Why actuator `a` of `model` is not simulated, or None if it is: muscle and user dynamics, gains
-/// and biases; planar-joint and body (adhesion) transmissions.
+/// Why actuator `a` of `model` is not simulated, or None if it is: user dynamics, gains and biases;
+/// a muscle without `lengthrange`;
+/// planar-joint and body (adhesion) transmissions.
 pub fn unsimulated_reason(model: &Model, a: &Actuator) -> Option<&'static str> {
-    if matches!(a.dyntype, DynType::Muscle | DynType::User) {
-        return Some("muscle or user activation dynamics");
+    if a.dyntype == DynType::User {
+        return Some("user activation dynamics");
     }
-    if !matches!(a.gaintype, GainType::Fixed | GainType::Affine) {
-        return Some("muscle or user gain");
+    if a.gaintype == GainType::User {
+        return Some("user gain");
     }
-    if !matches!(a.biastype, BiasType::None | BiasType::Affine) {
-        return Some("muscle or user bias");
+    if a.biastype == BiasType::User {
+        return Some("user bias");
+    }
+    let muscle = a.gaintype == GainType::Muscle || a.biastype == BiasType::Muscle;
+    if muscle && a.lengthrange[0] >= a.lengthrange[1] {
+        return Some("a muscle without lengthrange (the compiler's lengthrange simulation is not implemented: give lengthrange, or <compiler><lengthrange uselimit=\"true\"/>)");
     }
     match &a.transmission {
         Transmission::Joint(j) | Transmission::JointInParent(j) => {

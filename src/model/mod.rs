@@ -12,6 +12,7 @@ mod elements;
 pub mod equality;
 pub mod hfield;
 mod joint;
+pub mod lengthrange;
 mod links;
 pub mod options;
 pub mod reset;

@@ -629,6 +629,11 @@ pub struct ActuatorSpec {
     /// Actuator-level armature (MuJoCo's `actuator_armature`): reflected through the transmission
     /// onto its dofs.
     pub armature: f64,
+    /// `lengthrange` as written ([0, 0] when absent: the compiler computes it).
+    pub lengthrange: [f64; 2],
+    /// `<compiler><lengthrange uselimit>`: a muscle without a `lengthrange` takes its joint's or
+    /// tendon's range when that is limited.
+    pub lengthrange_uselimit: bool,
     /// Where it is written.
     pub loc: SourceLoc,
 }

@@ -500,6 +500,8 @@ fn finish(
         inheritrange: p.inheritrange,
         damping: damping(a, warnings)?,
         armature: nonnegative_attr(a, "armature")?,
+        lengthrange: a.array::<2>("lengthrange")?.unwrap_or([0.0; 2]),
+        lengthrange_uselimit: false,
         loc: e.loc.clone(),
     })
 }
@@ -583,4 +585,17 @@ fn transmission(a: &Attrs, warnings: &mut Vec<String>) -> Result<TransmissionSpe
             }
         }
     })
+}
+
+/// `<compiler><lengthrange uselimit>` (MuJoCo's `mjLROpt.uselimit`, default false) onto every
+/// actuator (the compile step resolves `actuator_lengthrange` with it).
+pub(crate) fn lengthrange_options(root: &Element, actuators: &mut [ActuatorSpec]) -> Result<(), LoadError> {
+    for c in root.children_named("compiler") {
+        for e in c.children_named("lengthrange") {
+            if let Some(v) = Attrs::plain(e).bool("uselimit")? {
+                actuators.iter_mut().for_each(|a| a.lengthrange_uselimit = v);
+            }
+        }
+    }
+    Ok(())
 }
