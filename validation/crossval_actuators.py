@@ -7,8 +7,9 @@ large enough to reach `forcerange` — and random activations `act` (within `act
 limited, with some outside it).
 
 Compared: the actuators lagrange simulates (dyntype none, integrator, filter or filterexact,
-`actearly` included; fixed or affine gain; none or affine bias; joint — hinge, slide, ball, free —,
-jointinparent, fixed-tendon, slider-crank or site transmission, with or without refsite);
+`actearly` included; fixed or affine gain; none or affine bias; muscles with a lengthrange;
+joint — hinge, slide, ball, free —, jointinparent, fixed- or spatial-tendon, slider-crank or site
+transmission, with or without refsite);
 qfrc_actuator when every actuator of the model is simulated. Others are counted as skipped with
 the reason. Tolerance 1e-9 relative (max|Δ| / max(1, max|ref|)). Contacts are off on both sides
 (forces only). Then activations (and q, v) are stepped against mj_step on the test models
@@ -42,21 +43,27 @@ def simulated(m, i) -> str | None:
     import mujoco as mj
 
     I = int  # MuJoCo's enums compare with Python ints, not with numpy integers
+    muscle = (I(m.actuator_dyntype[i]) == I(mj.mjtDyn.mjDYN_MUSCLE)
+              or I(m.actuator_gaintype[i]) == I(mj.mjtGain.mjGAIN_MUSCLE)
+              or I(m.actuator_biastype[i]) == I(mj.mjtBias.mjBIAS_MUSCLE))
+    if muscle and not m.actuator_lengthrange[i][0] < m.actuator_lengthrange[i][1]:
+        return "muscle without a lengthrange"
     if I(m.actuator_dyntype[i]) not in (I(mj.mjtDyn.mjDYN_NONE), I(mj.mjtDyn.mjDYN_INTEGRATOR),
-                                        I(mj.mjtDyn.mjDYN_FILTER), I(mj.mjtDyn.mjDYN_FILTEREXACT)):
-        return "muscle or user dynamics"
-    if I(m.actuator_gaintype[i]) not in (I(mj.mjtGain.mjGAIN_FIXED), I(mj.mjtGain.mjGAIN_AFFINE)):
-        return "muscle or user gain"
-    if I(m.actuator_biastype[i]) not in (I(mj.mjtBias.mjBIAS_NONE), I(mj.mjtBias.mjBIAS_AFFINE)):
-        return "muscle or user bias"
+                                        I(mj.mjtDyn.mjDYN_FILTER), I(mj.mjtDyn.mjDYN_FILTEREXACT),
+                                        I(mj.mjtDyn.mjDYN_MUSCLE)):
+        return "user dynamics"
+    if I(m.actuator_gaintype[i]) not in (I(mj.mjtGain.mjGAIN_FIXED), I(mj.mjtGain.mjGAIN_AFFINE),
+                                         I(mj.mjtGain.mjGAIN_MUSCLE)):
+        return "user gain"
+    if I(m.actuator_biastype[i]) not in (I(mj.mjtBias.mjBIAS_NONE), I(mj.mjtBias.mjBIAS_AFFINE),
+                                         I(mj.mjtBias.mjBIAS_MUSCLE)):
+        return "user bias"
     t, obj = I(m.actuator_trntype[i]), I(m.actuator_trnid[i][0])
     if t in (I(mj.mjtTrn.mjTRN_JOINT), I(mj.mjtTrn.mjTRN_JOINTINPARENT), I(mj.mjtTrn.mjTRN_SITE),
              I(mj.mjtTrn.mjTRN_SLIDERCRANK)):
         return None
     if t == I(mj.mjtTrn.mjTRN_TENDON):
-        adr, num = I(m.tendon_adr[obj]), I(m.tendon_num[obj])
-        fixed = all(I(m.wrap_type[adr + k]) == I(mj.mjtWrap.mjWRAP_JOINT) for k in range(num))
-        return None if fixed else "spatial tendon"
+        return None
     return "body (adhesion) transmission"
 
 
@@ -156,7 +163,7 @@ def step_checks(binary: Path) -> int:
 def main() -> int:
     import mujoco as mj
 
-    binary = REPO / "target" / "release" / "lagrange"
+    binary = Path(os.environ.get("LAGRANGE_BIN", REPO / "target" / "release" / "lagrange"))
     entries = [e for e in corpus() if e.fmt == "mjcf"]
     entries += [type(entries[0])(str(p.relative_to(REPO)), str(p.relative_to(REPO)), "tests", p, "mjcf")
                 for p in sorted((REPO / "tests" / "data" / "mjcf" / "actuators").glob("*.xml"))]
