@@ -4,9 +4,9 @@
 //! cell is cut into two triangular prisms (diagonal from column c−1, row r+1 to column c, row r;
 //! base at z = −`size[3]`), visited row by row, then column, then the cell's two prisms. A prism
 //! whose three tops plus the margin lie below the geom's lowest point is skipped; every other is a
-//! convex solid collided with the geom by MuJoCo's native GJK/EPA ([`super::ccd`], the prism's
+//! convex solid collided with the geom by MuJoCo's native GJK/EPA (`collision::ccd`, the prism's
 //! support as MuJoCo's `mjc_prism_support`), one contact per prism closer than the margin, at most
-//! [`MAX_CONTACTS`](super::hfield::MAX_CONTACTS). Spheres keep their exact closed form
+//! [`super::hfield::MAX_CONTACTS`]. Spheres keep their exact closed form
 //! ([`super::hfield::sphere`]).
 
 use super::ccd::penetration_prism;

@@ -30,7 +30,7 @@ use crate::model::{Data, EfcType, Model};
 /// Which algorithm the exact mode uses for rows with dry friction.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ExactContactSolver {
-    /// Projected block Gauss–Seidel with polish ([`super::coulomb`]).
+    /// Projected block Gauss–Seidel with polish (`constraint::coulomb`).
     #[default]
     Pgs,
     /// The proximal ADMM of Carpentier, Montaut & Le Lidec (this module); the velocity-level
