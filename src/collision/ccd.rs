@@ -238,6 +238,25 @@ struct Status {
     nsimplex: usize,
 }
 
+impl Status {
+    /// A solver run between geoms at `x1` and `x2` (GJK starts from their origins), to
+    /// `tolerance` within `iterations`, no distance wanted.
+    fn start(x1: &Transform, x2: &Transform, tolerance: f64, iterations: usize) -> Self {
+        Status {
+            separated: false,
+            dist: 0.0,
+            x1: x1.pos,
+            x2: x2.pos,
+            max_iterations: iterations,
+            tolerance,
+            dist_cutoff: 0.0,
+            gjk_iterations: 0,
+            simplex: [ZERO_VERTEX; 4],
+            nsimplex: 0,
+        }
+    }
+}
+
 fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
     let get_dist = st.dist_cutoff > 0.0;
     let mut backup = !get_dist;
@@ -1022,18 +1041,7 @@ fn penetration_with(
     let mut o1 = CcdObj::new(s1, x1, margin);
     o1.prism = prism1;
     let mut o2 = CcdObj::new(s2, x2, margin);
-    let mut st = Status {
-        separated: false,
-        dist: 0.0,
-        x1: x1.pos,
-        x2: x2.pos,
-        max_iterations: iterations,
-        tolerance,
-        dist_cutoff: 0.0,
-        gjk_iterations: 0,
-        simplex: [ZERO_VERTEX; 4],
-        nsimplex: 0,
-    };
+    let mut st = Status::start(x1, x2, tolerance, iterations);
     let core = |s: &ConvexShape| match s {
         ConvexShape::Ball(b) => Some((Core::Point, b.radius)),
         ConvexShape::Capsule(c) => Some((Core::Line, c.radius)),
@@ -1113,18 +1121,7 @@ pub(crate) fn separated(
 ) -> bool {
     let mut o1 = CcdObj::new(s1, x1, margin);
     let mut o2 = CcdObj::new(s2, x2, margin);
-    let mut st = Status {
-        separated: false,
-        dist: 0.0,
-        x1: x1.pos,
-        x2: x2.pos,
-        max_iterations: iterations,
-        tolerance,
-        dist_cutoff: 0.0,
-        gjk_iterations: 0,
-        simplex: [ZERO_VERTEX; 4],
-        nsimplex: 0,
-    };
+    let mut st = Status::start(x1, x2, tolerance, iterations);
     gjk(&mut st, &mut o1, &mut o2);
     st.separated
 }
