@@ -551,3 +551,29 @@ fn mesh_files_are_bounded() {
     assert!(msg.contains("629145600 bytes") && msg.contains("limit of 536870912"), "{msg}");
     let _ = std::fs::remove_file(&path);
 }
+
+#[test]
+fn absurd_tendon_springs_and_fluid_options_are_refused() {
+    // Found by fuzzing: a spatial tendon's damping of 1e308 and a wind of -1e200 loaded and gave
+    // non-finite accelerations.
+    let dir = temp_dir("absurd_options");
+    let path = dir.join("tendon_damping.xml");
+    std::fs::write(
+        &path,
+        r#"<mujoco><worldbody><site name="a"/><body pos="0 0 -0.3"><joint name="j"/><geom size=".1"/><site name="b"/></body></worldbody>
+<tendon><spatial name="t" damping="1e308"><site site="a"/><site site="b"/></spatial></tendon></mujoco>"#,
+    )
+    .unwrap();
+    refused(
+        &path,
+        &LoadOptions::default(),
+        &["tendon_damping.xml:2", "tendon 't'", "1e308", "absurdly large"],
+    );
+    let path = dir.join("wind.xml");
+    std::fs::write(
+        &path,
+        r#"<mujoco><option density="1.2" wind="2 0 -1e200"/><worldbody><body><freejoint/><geom size=".1"/></body></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    refused(&path, &LoadOptions::default(), &["option", "wind", "1e200", "absurdly large"]);
+}

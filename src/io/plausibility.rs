@@ -140,6 +140,24 @@ pub fn check_spec(spec: &ModelSpec) -> Result<(), LoadError> {
         || "timestep, tolerance, ls_tolerance or impratio".into(),
         &[o.timestep, o.tolerance, o.ls_tolerance, o.impratio],
     )?;
+    check(
+        &top,
+        "option",
+        || "density, viscosity or a wind component".into(),
+        &[o.density, o.viscosity, o.wind[0], o.wind[1], o.wind[2]],
+    )?;
+    check(
+        &top,
+        "option",
+        || "o_margin, o_solref, o_solimp or o_friction".into(),
+        &[o.o_margin]
+            .iter()
+            .chain(&o.o_solref)
+            .chain(&o.o_solimp)
+            .chain(&o.o_friction)
+            .copied()
+            .collect::<Vec<_>>(),
+    )?;
     if o.timestep <= 0.0 {
         return Err(invalid(
             &top,
@@ -194,6 +212,13 @@ fn check_elements(spec: &ModelSpec) -> Result<(), LoadError> {
                 format!("tendon '{}': actuatorfrcrange {range:?} is not finite; fix the value", t.name),
             ));
         }
+        check(
+            &t.loc,
+            "tendon",
+            || format!("tendon '{}': stiffness, damping or frictionloss", t.name),
+            &[t.stiffness, t.damping, t.frictionloss],
+        )?;
+        check_length(&t.loc, "tendon", || format!("tendon '{}': springlength", t.name), &t.spring_length)?;
         if let TendonSpecKind::Fixed { joints } = &t.kind {
             for (joint, coef, loc) in joints {
                 check(
