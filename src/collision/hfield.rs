@@ -66,38 +66,12 @@ pub fn sphere(
     }
     // The sphere's box in the height-field frame (support points along ±x, ±y, ±z).
     let (lo, hi) = (p - Vec3::repeat(radius), p + Vec3::repeat(radius));
-    if lo.x - margin > s[0]
-        || hi.x + margin < -s[0]
-        || lo.y - margin > s[1]
-        || hi.y + margin < -s[1]
-        || lo.z - margin > s[2]
-        || hi.z + margin < -s[3]
-    {
-        return;
-    }
-    // The sub-grid under the geom's box grown by the margin (MuJoCo 4.0.0 measured).
-    let (glo, ghi) = (lo - Vec3::repeat(margin), hi + Vec3::repeat(margin));
-    let cols = (ncol - 1) as f64;
-    let rows = (nrow - 1) as f64;
-    let cmin = (((glo.x + s[0]) / (2.0 * s[0]) * cols).floor().max(0.0)) as usize;
-    let cmax = (((ghi.x + s[0]) / (2.0 * s[0]) * cols).ceil() as i64).clamp(0, ncol as i64 - 1) as usize;
-    let rmin = (((glo.y + s[1]) / (2.0 * s[1]) * rows).floor().max(0.0)) as usize;
-    let rmax = (((ghi.y + s[1]) / (2.0 * s[1]) * rows).ceil() as i64).clamp(0, nrow as i64 - 1) as usize;
-    let dx = 2.0 * s[0] / cols;
-    let dy = 2.0 * s[1] / rows;
-    // A grid point of the prism's top (x, y, lifted height).
-    let vert = |r: usize, c: usize| {
-        Vec3::new(dx * c as f64 - s[0], dy * r as f64 - s[1], f64::from(field.data[r * ncol + c]) * s[2])
-    };
+    let Some(cells) = Cells::under(field, &lo, &hi, margin) else { return };
     let grown = radius;
     let mut n = 0;
-    for r in rmin..rmax {
-        for c in cmin + 1..=cmax {
-            let cell = [
-                [vert(r + 1, c - 1), vert(r, c - 1), vert(r + 1, c)],
-                [vert(r, c - 1), vert(r + 1, c), vert(r, c)],
-            ];
-            for top in &cell {
+    for r in cells.rows.clone() {
+        for c in cells.cols.clone() {
+            for top in &cells.tops(field, r, c) {
                 if top.iter().all(|v| v.z + margin < lo.z) {
                     continue;
                 }
@@ -179,4 +153,55 @@ fn point_prism(p: &Vec3, top: &[Vec3; 3], bottom: f64) -> Option<(Vec3, Vec3, f6
     }
     let d = d2.sqrt();
     Some((q, (p - q) / d, d))
+}
+
+/// The grid cells of a height field under a geom's box `[lo, hi]` (height-field frame) grown by
+/// `margin` — MuJoCo 4.0's sub-grid, measured on its contacts — with the grid spacing; shared
+/// by the sphere's closed form and the convex geoms' prisms ([`super::hfield_convex`]).
+pub(crate) struct Cells {
+    /// Rows r of the cells (r, r + 1).
+    pub rows: std::ops::Range<usize>,
+    /// Columns c of the cells (c − 1, c).
+    pub cols: std::ops::RangeInclusive<usize>,
+    dx: f64,
+    dy: f64,
+}
+
+impl Cells {
+    /// The cells under `[lo, hi]`, or None when the box grown by `margin` misses the field's
+    /// volume (its base at −size[3] to its top at size[2]).
+    pub fn under(field: &HeightField, lo: &Vec3, hi: &Vec3, margin: f64) -> Option<Self> {
+        let s = field.size;
+        let (nrow, ncol) = (field.nrow, field.ncol);
+        if lo.x - margin > s[0]
+            || hi.x + margin < -s[0]
+            || lo.y - margin > s[1]
+            || hi.y + margin < -s[1]
+            || lo.z - margin > s[2]
+            || hi.z + margin < -s[3]
+        {
+            return None;
+        }
+        let (glo, ghi) = (lo - Vec3::repeat(margin), hi + Vec3::repeat(margin));
+        let cols = (ncol - 1) as f64;
+        let rows = (nrow - 1) as f64;
+        let cmin = (((glo.x + s[0]) / (2.0 * s[0]) * cols).floor().max(0.0)) as usize;
+        let cmax = (((ghi.x + s[0]) / (2.0 * s[0]) * cols).ceil() as i64).clamp(0, ncol as i64 - 1) as usize;
+        let rmin = (((glo.y + s[1]) / (2.0 * s[1]) * rows).floor().max(0.0)) as usize;
+        let rmax = (((ghi.y + s[1]) / (2.0 * s[1]) * rows).ceil() as i64).clamp(0, nrow as i64 - 1) as usize;
+        Some(Self { rows: rmin..rmax, cols: cmin + 1..=cmax, dx: 2.0 * s[0] / cols, dy: 2.0 * s[1] / rows })
+    }
+
+    /// A grid point (x, y, its height scaled by size[2]) of row `r`, column `c`.
+    fn vertex(&self, field: &HeightField, r: usize, c: usize) -> Vec3 {
+        let s = field.size;
+        let z = f64::from(field.data[r * field.ncol + c]) * s[2];
+        Vec3::new(self.dx * c as f64 - s[0], self.dy * r as f64 - s[1], z)
+    }
+
+    /// The tops of the cell's two triangular prisms, in MuJoCo's order.
+    pub fn tops(&self, field: &HeightField, r: usize, c: usize) -> [[Vec3; 3]; 2] {
+        let v = |r, c| self.vertex(field, r, c);
+        [[v(r + 1, c - 1), v(r, c - 1), v(r + 1, c)], [v(r, c - 1), v(r + 1, c), v(r, c)]]
+    }
 }

@@ -11,7 +11,7 @@
 
 use super::ccd::penetration_prism;
 use super::convex::ConvexShape;
-use super::hfield::{HfieldPoint, MAX_CONTACTS};
+use super::hfield::{Cells, HfieldPoint, MAX_CONTACTS};
 use crate::model::{HeightField, Options};
 use crate::spatial::{Transform, Vec3};
 
@@ -41,36 +41,11 @@ pub fn convex(
         hi[k] = local(shape.world_support(x_geom, &axis));
         lo[k] = local(shape.world_support(x_geom, &-axis));
     }
-    if lo.x - margin > s[0]
-        || hi.x + margin < -s[0]
-        || lo.y - margin > s[1]
-        || hi.y + margin < -s[1]
-        || lo.z - margin > s[2]
-        || hi.z + margin < -s[3]
-    {
-        return;
-    }
-    // The sub-grid under the geom's box grown by the margin (as the sphere's, MuJoCo 4.0.0).
-    let (glo, ghi) = (lo - Vec3::repeat(margin), hi + Vec3::repeat(margin));
-    let cols = (ncol - 1) as f64;
-    let rows = (nrow - 1) as f64;
-    let cmin = (((glo.x + s[0]) / (2.0 * s[0]) * cols).floor().max(0.0)) as usize;
-    let cmax = (((ghi.x + s[0]) / (2.0 * s[0]) * cols).ceil() as i64).clamp(0, ncol as i64 - 1) as usize;
-    let rmin = (((glo.y + s[1]) / (2.0 * s[1]) * rows).floor().max(0.0)) as usize;
-    let rmax = (((ghi.y + s[1]) / (2.0 * s[1]) * rows).ceil() as i64).clamp(0, nrow as i64 - 1) as usize;
-    let dx = 2.0 * s[0] / cols;
-    let dy = 2.0 * s[1] / rows;
-    let vert = |r: usize, c: usize| {
-        Vec3::new(dx * c as f64 - s[0], dy * r as f64 - s[1], f64::from(field.data[r * ncol + c]) * s[2])
-    };
+    let Some(cells) = Cells::under(field, &lo, &hi, margin) else { return };
     let mut n = 0;
-    for r in rmin..rmax {
-        for c in cmin + 1..=cmax {
-            let cell = [
-                [vert(r + 1, c - 1), vert(r, c - 1), vert(r + 1, c)],
-                [vert(r, c - 1), vert(r + 1, c), vert(r, c)],
-            ];
-            for top in &cell {
+    for r in cells.rows.clone() {
+        for c in cells.cols.clone() {
+            for top in &cells.tops(field, r, c) {
                 if top.iter().all(|v| v.z + margin < lo.z) {
                     continue;
                 }
