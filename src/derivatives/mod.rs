@@ -12,6 +12,7 @@
 
 mod forward_dynamics;
 mod rnea;
+mod rnea_sweep;
 mod transition;
 mod transition_analytic;
 mod work;

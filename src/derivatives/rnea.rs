@@ -1,16 +1,14 @@
 //! [`rnea_derivatives`]: ∂τ/∂q and ∂τ/∂v of inverse dynamics τ = RNEA(q, v, a) (the quantities
 //! of Pinocchio's `computeRNEADerivatives`, in lagrange's coordinates; ∂τ/∂a is the mass
-//! matrix M). Forward-mode differentiation of the recursion, one direction per dof
-//! (`dynamics::rnea_configuration`, `dynamics::rnea_velocity`).
+//! matrix M). One sweep root to leaves and one back, in world axes (`rnea_sweep`).
 
 use super::DerivativesWork;
-use crate::dynamics::rnea_unchecked;
 use crate::error::{check, InputError};
 use crate::{Data, Model};
 
 /// ∂τ/∂q and ∂τ/∂v of τ = RNEA(q, v, a) into `work.dtau_dq` and `work.dtau_dv` (τ itself is left
-/// in `data.tau`). Cost: one RNEA, then two forward-mode passes per dof over the dof's subtree
-/// and ancestor chain, O(nv · nbody); no allocation.
+/// in `data.tau`). Cost: about three RNEAs plus a few 6-vector products per (dof, ancestor dof)
+/// pair, O(nv · depth); no allocation.
 ///
 /// # Errors
 /// [`InputError::Length`] when q is not nq long, v or a not nv long, or `data` or `work` was made
@@ -41,8 +39,5 @@ pub(crate) fn rnea_derivatives_unchecked(
     v: &[f64],
     a: &[f64],
 ) {
-    rnea_unchecked(model, data, q, v, a);
-    work.config.compute(model, data, v, a, &mut work.dtau_dq);
-    work.bias.compute_after_rnea(model, data, v);
-    work.dtau_dv.copy_from(&work.bias.dbias_dv);
+    work.sweep.compute(model, data, q, v, a, (&mut work.dtau_dq, &mut work.dtau_dv));
 }

@@ -3,7 +3,7 @@
 //! [`smooth_derivatives`](super::smooth_derivatives)), made once per model so that the kernels
 //! allocate nothing.
 
-use crate::dynamics::{BiasDerivative, ConfigurationDerivative};
+use super::rnea_sweep::RneaSweep;
 use crate::error::InputError;
 use crate::Model;
 use nalgebra::{DMatrix, DVector};
@@ -13,8 +13,7 @@ use nalgebra::{DMatrix, DVector};
 /// space (MuJoCo's `mj_integratePos` layout), velocities, accelerations and forces in lagrange's
 /// (MuJoCo's) coordinates. See docs/derivatives.md.
 pub struct DerivativesWork {
-    pub(crate) bias: BiasDerivative,
-    pub(crate) config: ConfigurationDerivative,
+    pub(crate) sweep: RneaSweep,
     /// ∂τ/∂q of inverse dynamics (tangent columns).
     pub dtau_dq: DMatrix<f64>,
     /// ∂τ/∂v of inverse dynamics (= ∂c/∂v, independent of the acceleration).
@@ -39,8 +38,7 @@ impl DerivativesWork {
     pub fn new(model: &Model) -> Self {
         let nv = model.nv;
         Self {
-            bias: BiasDerivative::new(model),
-            config: ConfigurationDerivative::new(model),
+            sweep: RneaSweep::new(model),
             dtau_dq: DMatrix::zeros(nv, nv),
             dtau_dv: DMatrix::zeros(nv, nv),
             dqacc_dq: DMatrix::zeros(nv, nv),
@@ -55,6 +53,6 @@ impl DerivativesWork {
     /// [`InputError::Length`] when the buffers were made for a model of another size.
     pub(crate) fn check(&self, function: &'static str, model: &Model) -> Result<(), InputError> {
         InputError::check_len(function, "work (dofs)", self.qacc.len(), model.nv, "nv")?;
-        InputError::check_len(function, "work (bodies)", self.bias.nbody(), model.nbody(), "nbody")
+        InputError::check_len(function, "work (bodies)", self.sweep.nbody(), model.nbody(), "nbody")
     }
 }

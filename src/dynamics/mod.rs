@@ -1,8 +1,8 @@
 //! Rigid-body dynamics (docs/architecture.md, "Layers"): inverse dynamics (RNEA), the joint-space inertia
 //! matrix (CRBA) and its tree-sparse factorization, forward dynamics (ABA), energy, centre of mass
 //! and momentum, MuJoCo's per-body accelerations and wrenches after a solve (`rne_post`), and the
-//! forward-mode derivative passes of RNEA along each dof (`rnea_velocity`, `rnea_configuration`),
-//! which `derivatives` and the implicit stepper use; MuJoCo's fluid forces (`fluid`).
+//! forward-mode velocity derivative of the bias forces along each dof (`rnea_velocity`), which the
+//! implicit stepper uses; MuJoCo's fluid forces (`fluid`).
 //! Every function writes into [`Data`](crate::Data) and allocates nothing.
 
 mod aba;
@@ -12,7 +12,6 @@ pub mod fluid;
 pub mod gravcomp;
 pub(crate) mod rne_post;
 mod rnea;
-mod rnea_configuration;
 mod rnea_velocity;
 
 pub use aba::aba;
@@ -25,7 +24,6 @@ pub(crate) use rne_post::RnePost;
 pub use rne_post::{
     body_acceleration, external_wrench, interaction_wrench, object_acceleration, rne_post_constraint,
 };
+pub(crate) use rnea::bias_forces_unchecked;
 pub use rnea::{bias_forces, gravity_forces, rnea};
-pub(crate) use rnea::{bias_forces_unchecked, rnea_unchecked};
-pub(crate) use rnea_configuration::ConfigurationDerivative;
 pub(crate) use rnea_velocity::BiasDerivative;

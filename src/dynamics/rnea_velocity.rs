@@ -50,11 +50,6 @@ impl BiasDerivative {
         }
     }
 
-    /// Bodies the buffers were made for.
-    pub fn nbody(&self) -> usize {
-        self.v_body.len()
-    }
-
     /// Fills [`dbias_dv`](Self::dbias_dv) at (q, v); updates the joint transforms and motion
     /// subspaces of `data` at q.
     ///
@@ -69,20 +64,6 @@ impl BiasDerivative {
             let p = model.bodies[b].parent;
             self.v_joint[b] = joint_velocity(model, data, b, v);
             self.v_body[b] = data.x_parent_body[b].inv_act_motion(&self.v_body[p]) + self.v_joint[b];
-            self.momentum[b] = model.bodies[b].inertia.mul_motion(&self.v_body[b]);
-        }
-        self.columns(model, data);
-    }
-
-    /// [`compute`](Self::compute) when `data` already holds RNEA's pass at (q, v) (joint
-    /// transforms, motion subspaces and `v_body`, as [`rnea_unchecked`](crate::dynamics) leaves
-    /// them): the joint updates and the velocity pass are not redone.
-    pub fn compute_after_rnea(&mut self, model: &Model, data: &Data, v: &[f64]) {
-        let nb = model.nbody();
-        self.v_body[0] = Motion::zero();
-        for b in 1..nb {
-            self.v_joint[b] = joint_velocity(model, data, b, v);
-            self.v_body[b] = data.v_body[b];
             self.momentum[b] = model.bodies[b].inertia.mul_motion(&self.v_body[b]);
         }
         self.columns(model, data);
