@@ -4,15 +4,16 @@
 //!
 //! Differentiating the identity RNEA(q, v, q̈(q, v, τ)) = τ gives
 //! ∂q̈/∂q = −M⁻¹ ∂τ/∂q|ₐ₌q̈, ∂q̈/∂v = −M⁻¹ ∂τ/∂v, ∂q̈/∂τ = M⁻¹ (Carpentier & Mansard, RSS 2018,
-//! §IV): one ABA, the RNEA derivatives at a = q̈ ([`rnea_derivatives`](super::rnea_derivatives)),
-//! and M's tree-sparse LᵀDL factor applied to 3 nv columns. When τ depends on the state through
+//! §IV): q̈ from M's tree-sparse LᵀDL factor and the bias forces, the RNEA derivatives at a = q̈
+//! ([`rnea_derivatives`](super::rnea_derivatives)), and the factor applied to 3 nv columns. When τ depends on the state through
 //! forces f(q, v) (springs, damping, actuator gains and biases), ∂τ/∂q and ∂τ/∂v above become
 //! ∂τ/∂q − ∂f/∂q and ∂τ/∂v − ∂f/∂v.
 
 use super::rnea::rnea_derivatives_unchecked;
 use super::DerivativesWork;
 use crate::dynamics::{
-    aba_unchecked, crba_unchecked, factorize_mass_matrix, solve_transposed_with_factor_unchecked,
+    bias_forces_unchecked, crba_unchecked, factorize_mass_matrix, solve_transposed_with_factor_unchecked,
+    solve_with_factor_unchecked,
 };
 use crate::error::{check, InputError};
 use crate::forward::{
@@ -20,12 +21,12 @@ use crate::forward::{
     drive, passive, StageKind,
 };
 use crate::{Data, Model};
-use nalgebra::DMatrix;
 
 /// ∂q̈/∂q, ∂q̈/∂v and ∂q̈/∂τ of q̈ = ABA(q, v, τ) into `work.dqacc_dq`, `work.dqacc_dv` and
 /// `work.dqacc_dtau`, q̈ into `work.qacc`; on the way `work.dtau_dq` and `work.dtau_dv` hold the
-/// RNEA derivatives at a = q̈, and `data.mass_matrix` and its factor M at q. Cost: one ABA, the
-/// RNEA derivatives, one CRBA and 3 nv sparse triangular solves; no allocation.
+/// RNEA derivatives at a = q̈, and `data.mass_matrix` and its factor M at q. Cost: one CRBA, its
+/// factor, the bias forces, the RNEA derivatives and 3 nv + 1 sparse triangular solves; no
+/// allocation.
 ///
 /// # Errors
 /// [`InputError::Length`] when q is not nq long, v or tau not nv long, or `data` or `work` was
@@ -44,12 +45,11 @@ pub fn aba_derivatives(
     check::v("aba_derivatives", "v", model, v)?;
     check::v("aba_derivatives", "tau", model, tau)?;
     work.tau.copy_from_slice(tau);
-    aba_unchecked(model, data, q, v, tau);
-    work.qacc.copy_from(&data.aba_qacc);
+    forward_with_factor(model, data, work, q, v);
     let qacc = std::mem::take(&mut work.qacc);
     rnea_derivatives_unchecked(model, data, work, q, v, qacc.as_slice());
     work.qacc = qacc;
-    solve_columns(model, data, work, q);
+    solve_columns(model, data, work);
     Ok(())
 }
 
@@ -103,10 +103,7 @@ fn smooth_derivatives_at(model: &Model, data: &mut Data, work: &mut DerivativesW
     for k in 0..model.nv {
         work.tau[k] = data.qfrc_passive[k] + drive(model, data, k) + data.qfrc_xfrc[k];
     }
-    let tau = std::mem::take(&mut work.tau);
-    aba_unchecked(model, data, q, v, tau.as_slice());
-    work.tau = tau;
-    work.qacc.copy_from(&data.aba_qacc);
+    forward_with_factor(model, data, work, q, v);
     let qacc = std::mem::take(&mut work.qacc);
     rnea_derivatives_unchecked(model, data, work, q, v, qacc.as_slice());
     work.qacc = qacc;
@@ -130,7 +127,7 @@ fn smooth_derivatives_at(model: &Model, data: &mut Data, work: &mut DerivativesW
         );
         add_actuator_length_derivative(model, data, work.dtau_dq.as_mut_slice(), 1.0);
     }
-    solve_columns(model, data, work, q);
+    solve_columns(model, data, work);
 }
 
 /// The tendons' springs and dampers, f = −k (L − L_spring) − b L̇ along J = ∂L/∂q (outside the
@@ -161,23 +158,51 @@ fn add_tendon_passive_derivative(model: &Model, data: &Data, work: &mut Derivati
     }
 }
 
-/// M at q and its factor, then ∂q̈/∂q = −M⁻¹ ∂τ/∂q, ∂q̈/∂v = −M⁻¹ ∂τ/∂v, ∂q̈/∂τ = M⁻¹: the
-/// tree-sparse solve on the transposes, every right-hand side at once (`work.scratch`).
-fn solve_columns(model: &Model, data: &mut Data, work: &mut DerivativesWork, q: &[f64]) {
+/// M at q, its factor, and q̈ = M⁻¹ (τ − c(q, v)) into `work.qacc` (τ from `work.tau`): the factor
+/// is needed for the derivatives anyway, and CRBA, the factor and RNEA's bias forces cost less
+/// than ABA.
+fn forward_with_factor(model: &Model, data: &mut Data, work: &mut DerivativesWork, q: &[f64], v: &[f64]) {
     crba_unchecked(model, data, q);
     factorize_mass_matrix(model, data);
-    let factor = &data.mass_factor;
-    let y = &mut work.scratch;
-    // X = −M⁻¹ B: Y = −Bᵀ in, Y = Xᵀ out.
-    let mut minus_solve = |from: &DMatrix<f64>, to: &mut DMatrix<f64>| {
-        y.tr_copy_from(from);
-        y.neg_mut();
-        solve_transposed_with_factor_unchecked(model, factor, y);
-        y.transpose_to(to);
-    };
-    minus_solve(&work.dtau_dq, &mut work.dqacc_dq);
-    minus_solve(&work.dtau_dv, &mut work.dqacc_dv);
-    // M⁻¹ is symmetric: Yᵀ = Y.
-    work.dqacc_dtau.fill_with_identity();
-    solve_transposed_with_factor_unchecked(model, factor, &mut work.dqacc_dtau);
+    bias_forces_unchecked(model, data, q, v);
+    for k in 0..model.nv {
+        work.qacc[k] = work.tau[k] - data.tau[k];
+    }
+    solve_with_factor_unchecked(model, &data.mass_factor, work.qacc.as_mut_slice());
+}
+
+/// With M's factor at q, ∂q̈/∂q = −M⁻¹ ∂τ/∂q, ∂q̈/∂v = −M⁻¹ ∂τ/∂v, ∂q̈/∂τ = M⁻¹: one
+/// tree-sparse solve on the transposes of all three, stacked (`work.scratch`, 3 nv × nv: rows
+/// −(∂τ/∂q)ᵀ, −(∂τ/∂v)ᵀ, 1 in; the results' transposes out), so that each step of the solve
+/// updates 3 nv right-hand sides at once.
+fn solve_columns(model: &Model, data: &mut Data, work: &mut DerivativesWork) {
+    let nv = model.nv;
+    let n = 3 * nv;
+    let y = work.scratch.as_mut_slice();
+    let (dq, dv) = (work.dtau_dq.as_slice(), work.dtau_dv.as_slice());
+    // Column c of Y: (−row c of ∂τ/∂q, −row c of ∂τ/∂v, e_c).
+    for c in 0..nv {
+        let col = &mut y[c * n..(c + 1) * n];
+        for r in 0..nv {
+            col[r] = -dq[c + r * nv];
+            col[nv + r] = -dv[c + r * nv];
+        }
+        col[2 * nv..].fill(0.0);
+        col[2 * nv + c] = 1.0;
+    }
+    solve_transposed_with_factor_unchecked(model, &data.mass_factor, &mut work.scratch);
+    let y = work.scratch.as_slice();
+    let outputs = [work.dqacc_dq.as_mut_slice(), work.dqacc_dv.as_mut_slice()];
+    for (block, out) in outputs.into_iter().enumerate() {
+        for j in 0..nv {
+            for i in 0..nv {
+                out[i + j * nv] = y[block * nv + j + i * n];
+            }
+        }
+    }
+    // M⁻¹ is symmetric: its block is its own transpose.
+    let inverse = work.dqacc_dtau.as_mut_slice();
+    for i in 0..nv {
+        inverse[i * nv..(i + 1) * nv].copy_from_slice(&y[i * n + 2 * nv..(i + 1) * n]);
+    }
 }

@@ -72,8 +72,8 @@ impl RneaSweep {
         self.x_tree.len()
     }
 
-    /// τ = RNEA(q, v, qacc) into `data.tau` (armature included), ∂τ/∂q (tangent columns) into
-    /// `dtau_dq` and ∂τ/∂v into `dtau_dv`; updates `data`'s joint transforms and subspaces at q.
+    /// τ = RNEA(q, v, qacc) into `data.tau` (armature included), ∂τ/∂q (tangent columns) and
+    /// ∂τ/∂v into `out` (in that order); updates `data`'s joint transforms and subspaces at q.
     pub fn compute(
         &mut self,
         model: &Model,
@@ -81,7 +81,41 @@ impl RneaSweep {
         q: &[f64],
         v: &[f64],
         qacc: &[f64],
-        (dtau_dq, dtau_dv): (&mut DMatrix<f64>, &mut DMatrix<f64>),
+        out: (&mut DMatrix<f64>, &mut DMatrix<f64>),
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above), all `compute_avx2` requires.
+            unsafe { self.compute_avx2(model, data, q, v, qacc, out) };
+            return;
+        }
+        self.compute_kernel(model, data, q, v, qacc, out);
+    }
+
+    /// [`compute_kernel`](Self::compute_kernel) compiled for AVX2 (same operations, same bits).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn compute_avx2(
+        &mut self,
+        model: &Model,
+        data: &mut Data,
+        q: &[f64],
+        v: &[f64],
+        qacc: &[f64],
+        out: (&mut DMatrix<f64>, &mut DMatrix<f64>),
+    ) {
+        self.compute_kernel(model, data, q, v, qacc, out);
+    }
+
+    #[inline(always)]
+    fn compute_kernel(
+        &mut self,
+        model: &Model,
+        data: &mut Data,
+        q: &[f64],
+        v: &[f64],
+        qacc: &[f64],
+        out: (&mut DMatrix<f64>, &mut DMatrix<f64>),
     ) {
         let nb = model.nbody();
         let gravity = Motion::new(Vec3::zeros(), -model.gravity);
@@ -142,8 +176,11 @@ impl RneaSweep {
             self.v[b] = v_b;
             self.a[b] = a_b;
         }
+        let nv = model.nv;
+        let (dtau_dq, dtau_dv) = out;
         dtau_dq.fill(0.0);
         dtau_dv.fill(0.0);
+        let (dq, dv) = (dtau_dq.as_mut_slice(), dtau_dv.as_mut_slice());
         // Backward: subtree sums, then the rows and columns of each joint's dofs.
         for b in (1..nb).rev() {
             let j = model.joint_of(b);
@@ -171,12 +208,12 @@ impl RneaSweep {
             for (i, m) in (da..da + nv_j).enumerate() {
                 for k in da..da + nv_j {
                     let s_k = &self.s[k];
-                    dtau_dv[(k, m)] = s_k.dot(&df_dv[i]);
-                    let mut dq = s_k.dot(&df_dq[i]);
+                    dv[k + m * nv] = s_k.dot(&df_dv[i]);
+                    let mut x = s_k.dot(&df_dq[i]);
                     if self.child_attached[k] {
-                        dq += self.s[m].cross_motion(s_k).dot(&f_c);
+                        x += self.s[m].cross_motion(s_k).dot(&f_c);
                     }
-                    dtau_dq[(k, m)] = dq;
+                    dq[k + m * nv] = x;
                 }
             }
             // The ancestors' rows of this joint's columns, and this joint's rows of theirs.
@@ -184,10 +221,10 @@ impl RneaSweep {
             while k != usize::MAX {
                 let (s_k, a_k, phi_k, psi_k) = (&self.s[k], &self.a_col[k], &self.phi[k], &self.psi[k]);
                 for (i, m) in (da..da + nv_j).enumerate() {
-                    dtau_dv[(k, m)] = s_k.dot(&df_dv[i]);
-                    dtau_dq[(k, m)] = s_k.dot(&df_dq[i]);
-                    dtau_dv[(m, k)] = a_k.dot(&p_col[i]) + s_k.dot(&q_col[i]);
-                    dtau_dq[(m, k)] = phi_k.dot(&p_col[i]) + psi_k.dot(&q_col[i]);
+                    dv[k + m * nv] = s_k.dot(&df_dv[i]);
+                    dq[k + m * nv] = s_k.dot(&df_dq[i]);
+                    dv[m + k * nv] = a_k.dot(&p_col[i]) + s_k.dot(&q_col[i]);
+                    dq[m + k * nv] = phi_k.dot(&p_col[i]) + psi_k.dot(&q_col[i]);
                 }
                 k = model.dof_parent[k];
             }
@@ -218,4 +255,35 @@ fn inertia_rate(i: &RigidInertia, v: &Motion) -> RigidInertia {
     i_dot[(1, 1)] += d;
     i_dot[(2, 2)] += d;
     RigidInertia { mass: 0.0, h: w.cross(h) + vl * i.mass, i_origin: i_dot }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AVX2 build of the sweep gives the same bits as the portable one (no fused
+    /// multiply–add, no reordering).
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    #[ignore = "compares the CPU-specific (AVX2) build of the sweep with the portable one; needs such a CPU: cargo test --release -p lagrange --lib -- --ignored (as .ci/run does)"]
+    fn avx2_sweep_is_bit_for_bit() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            eprintln!("skipped: this CPU has no AVX2, the AVX2 sweep is never used here");
+            return;
+        }
+        for (file, model, q) in crate::kernel_test_states::robots() {
+            let mut data = Data::new(&model);
+            let mut sweep = RneaSweep::new(&model);
+            let nv = model.nv;
+            let v: Vec<f64> = (0..nv).map(|k| 0.5 * (k as f64).cos()).collect();
+            let a: Vec<f64> = (0..nv).map(|k| 0.3 - 0.1 * k as f64).collect();
+            let (mut dq0, mut dv0) = (DMatrix::zeros(nv, nv), DMatrix::zeros(nv, nv));
+            let (mut dq1, mut dv1) = (DMatrix::zeros(nv, nv), DMatrix::zeros(nv, nv));
+            sweep.compute_kernel(&model, &mut data, &q, &v, &a, (&mut dq0, &mut dv0));
+            // SAFETY: AVX2 is present (checked above).
+            unsafe { sweep.compute_avx2(&model, &mut data, &q, &v, &a, (&mut dq1, &mut dv1)) };
+            assert_eq!(dq0.as_slice(), dq1.as_slice(), "{file}");
+            assert_eq!(dv0.as_slice(), dv1.as_slice(), "{file}");
+        }
+    }
 }

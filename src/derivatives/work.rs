@@ -29,7 +29,7 @@ pub struct DerivativesWork {
     /// The generalized force the forward-dynamics derivatives were taken at (for
     /// [`smooth_derivatives`](super::smooth_derivatives): passive + actuator + applied).
     pub tau: DVector<f64>,
-    /// nv × nv scratch of the solves.
+    /// 3 nv × nv scratch of the solves (the three right-hand sides stacked).
     pub(crate) scratch: DMatrix<f64>,
 }
 
@@ -46,7 +46,7 @@ impl DerivativesWork {
             dqacc_dtau: DMatrix::zeros(nv, nv),
             qacc: DVector::zeros(nv),
             tau: DVector::zeros(nv),
-            scratch: DMatrix::zeros(nv, nv),
+            scratch: DMatrix::zeros(3 * nv, nv),
         }
     }
 
