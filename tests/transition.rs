@@ -329,3 +329,37 @@ fn hybrid_limit_equality_actuators() {
         assert_eq!(n, model.nv + 3, "every column analytic but the positions");
     }
 }
+
+/// Without constraint rows every column is analytic: a floating body with a ball-jointed arm
+/// (rotations' exponential map), hinge springs and damping, a fixed tendon with a spring, a motor,
+/// a position servo and a tendon actuator, Euler and implicitfast.
+#[test]
+fn hybrid_contact_free_all_analytic() {
+    for integrator in ["Euler", "implicitfast"] {
+        let model = tight_text(&format!(
+            r#"<mujoco><option timestep="0.002" integrator="{integrator}"><flag contact="disable"/></option>
+            <worldbody><body pos="0 0 1"><freejoint/><geom type="box" size=".1 .08 .06" mass="2"/>
+              <body pos="0.1 0 0"><joint name="s" type="ball" damping="0.05"/>
+                <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+                <body pos="0.3 0 0"><joint name="a" type="hinge" axis="0 1 0" stiffness="3" springref="0.2" damping="0.1"/>
+                  <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+                  <body pos="0.3 0 0"><joint name="b" type="slide" axis="1 0 0" damping="0.2"/>
+                    <geom type="sphere" size="0.04"/></body></body></body></body>
+            </worldbody>
+            <tendon><fixed name="t" stiffness="2" damping="0.1"><joint joint="a" coef="1"/><joint joint="b" coef="-0.5"/></fixed></tendon>
+            <actuator><motor joint="a"/><position joint="b" kp="5" kv="0.5"/><motor tendon="t" gear="2"/></actuator>
+            </mujoco>"#
+        ));
+        let mut data = Data::new(&model);
+        let (nq, nv) = (model.nq, model.nv);
+        let dq: Vec<f64> = (0..nv).map(|i| 0.3 * (i as f64 + 1.0).sin()).collect();
+        lagrange::model::integrate_configuration(&model, data.qpos.as_mut_slice(), &dq, 1.0).unwrap();
+        assert_eq!(data.qpos.len(), nq);
+        for i in 0..nv {
+            data.qvel[i] = 0.4 * (1.7 * i as f64).cos();
+        }
+        data.ctrl.copy_from_slice(&[0.3, 0.1, -0.2]);
+        let n = check_hybrid(&format!("contact-free ({integrator})"), &model, &mut data);
+        assert_eq!(n, 2 * nv + 3, "every column analytic");
+    }
+}

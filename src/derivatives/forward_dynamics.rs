@@ -105,9 +105,24 @@ fn smooth_derivatives_at(model: &Model, data: &mut Data, work: &mut DerivativesW
     }
     forward_with_factor(model, data, work, q, v);
     let qacc = std::mem::take(&mut work.qacc);
-    rnea_derivatives_unchecked(model, data, work, q, v, qacc.as_slice());
+    dtau_minus_dforce(model, data, work, q, v, qacc.as_slice());
     work.qacc = qacc;
-    // ∂τ/∂x − ∂f/∂x: the passive and actuator forces' own derivatives.
+    solve_columns(model, data, work);
+}
+
+/// ∂τ/∂q − ∂f/∂q and ∂τ/∂v − ∂f/∂v into `work.dtau_dq` and `work.dtau_dv`: the RNEA derivatives
+/// at (q, v, a) less the derivatives of the passive and actuator forces f, whose stages' buffers
+/// in `data` must be at (q, v) ([`smooth_derivatives`]' list of what is differentiated).
+pub(super) fn dtau_minus_dforce(
+    model: &Model,
+    data: &mut Data,
+    work: &mut DerivativesWork,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+) {
+    let plan = &model.plan;
+    rnea_derivatives_unchecked(model, data, work, q, v, a);
     if plan.runs(StageKind::Passive) {
         for k in 0..model.nv {
             work.dtau_dv[(k, k)] += model.dof_damping[k];
@@ -117,7 +132,7 @@ fn smooth_derivatives_at(model: &Model, data: &mut Data, work: &mut DerivativesW
         }
         add_tendon_passive_derivative(model, data, work);
     }
-    if actuated {
+    if plan.runs(StageKind::Actuation) {
         add_actuator_velocity_derivative(
             model,
             data,
@@ -127,7 +142,6 @@ fn smooth_derivatives_at(model: &Model, data: &mut Data, work: &mut DerivativesW
         );
         add_actuator_length_derivative(model, data, work.dtau_dq.as_mut_slice(), 1.0);
     }
-    solve_columns(model, data, work);
 }
 
 /// The tendons' springs and dampers, f = −k (L − L_spring) − b L̇ along J = ∂L/∂q (outside the

@@ -41,7 +41,8 @@ pub enum TransitionMethod {
     FiniteDifference,
     /// The velocity and control columns analytic — the smooth dynamics' derivatives and the soft
     /// solve's by the implicit function theorem (docs/physics.md) — and the position and
-    /// activation columns by finite differences. Applies to the Euler and implicitfast
+    /// activation columns by finite differences (the position columns analytic too when no
+    /// constraint row is active and every force's q-derivative is known: docs/derivatives.md). Applies to the Euler and implicitfast
     /// integrators with the Newton or CG solver and no activations; columns it cannot do
     /// (module `transition_analytic`: a control at a clamp, connect or weld rows for the velocity
     /// columns) and other models fall back to differences.
@@ -163,11 +164,13 @@ impl TransitionWork {
     }
 
     /// How many columns of [A B] the last [`transition_jacobians`] computed analytically
-    /// ([`TransitionMethod::Hybrid`]: nv velocity columns and one per control whose force is
-    /// affine in it away from its clamps; 0 with finite differences).
+    /// ([`TransitionMethod::Hybrid`]: nv velocity columns, nv position columns when no
+    /// constraint row is active and every force's q-derivative is known, and one per control
+    /// whose force is affine in it away from its clamps; 0 with finite differences).
     pub fn analytic_columns(&self) -> usize {
         let v = if self.analytic.v_done { self.dq.len() } else { 0 };
-        v + self.analytic.ctrl_done.iter().filter(|&&d| d).count()
+        let q = if self.analytic.q_done { self.dq.len() } else { 0 };
+        v + q + self.analytic.ctrl_done.iter().filter(|&&d| d).count()
     }
 
     fn save(&mut self, data: &Data) {
@@ -364,6 +367,7 @@ fn differences(
     };
     if !analytic {
         work.analytic.v_done = false;
+        work.analytic.q_done = false;
         work.analytic.ctrl_done.fill(false);
     }
     let result = (|| {
@@ -398,7 +402,9 @@ fn differences(
             .chain((0..nv).map(|k| (nv + k, Input::V(k), SkipStage::Position)))
             .chain((0..nv).map(|k| (k, Input::Q(k), SkipStage::None)));
         for (col, input, s) in inputs {
-            if work.analytic.v_done && matches!(input, Input::V(_)) {
+            if (work.analytic.v_done && matches!(input, Input::V(_)))
+                || (work.analytic.q_done && matches!(input, Input::Q(_)))
+            {
                 continue;
             }
             nudged_step(model, data, work, input, eps, stage(s))?;

@@ -15,12 +15,14 @@
 //! q′ = q ⊕ h v′, whose tangent moves by J_r(h v′) h dv′ on ball and free rotations (the right
 //! Jacobian of SO(3)) and by h dv′ elsewhere.
 
+use super::forward_dynamics::dtau_minus_dforce;
 use super::{smooth_derivatives, DerivativesWork};
 use crate::constraint::soft::cost::Rows;
 use crate::constraint::{cholesky, cholesky_solve};
 use crate::forward::add_actuator_velocity_derivative;
-use crate::model::actuator::GainType;
+use crate::model::actuator::{BiasType, GainType, Transmission};
 use crate::model::options::{Integrator, Solver};
+use crate::model::tendon::TendonKind;
 use crate::model::{Data, EfcType, EqualityKind, JointKind, Model};
 use nalgebra::{DMatrix, DVector};
 
@@ -43,6 +45,10 @@ pub(super) struct AnalyticWork {
     pub ctrl_done: Vec<bool>,
     /// Whether the velocity columns are analytic.
     pub v_done: bool,
+    /// Whether the position columns are analytic ([`position_supported`]).
+    pub q_done: bool,
+    /// The step's effective acceleration (v′ − v)/h = K⁻¹ M q̈.
+    a_step: DVector<f64>,
 }
 
 impl AnalyticWork {
@@ -61,6 +67,8 @@ impl AnalyticWork {
             y: DVector::zeros(nv),
             ctrl_done: vec![false; model.actuators.len()],
             v_done: false,
+            q_done: false,
+            a_step: DVector::zeros(nv),
         }
     }
 }
@@ -90,6 +98,7 @@ pub(super) fn columns(
 ) -> bool {
     let nv = model.nv;
     work.v_done = false;
+    work.q_done = false;
     work.ctrl_done.fill(false);
     // The smooth part: ∂τ/∂v with damping and actuator terms; M at q (CRBA's, which the
     // implicit step perturbed by round-off) and the actuation stage's buffers are left at the
@@ -129,7 +138,95 @@ pub(super) fn columns(
         column(model, data, work, v_next, None, b, i);
         work.ctrl_done[i] = true;
     }
+    if position_supported(model, data) {
+        position_columns(model, data, work, v_next, a);
+        work.q_done = true;
+    }
     true
+}
+
+/// Whether the position columns can be analytic at the nominal state in `data`: no constraint
+/// rows (the contact set, its points and frames, move with q: those columns are differenced), and
+/// no force whose q-dependence [`dtau_minus_dforce`](super::forward_dynamics::dtau_minus_dforce)
+/// leaves out — gravity compensation, `xfrc_applied`, effort and `actuatorfrcrange` clamps,
+/// springs and dampers on spatial tendons, actuators other than affine ones on hinge or slide
+/// joints and fixed tendons (fluid forces and activations are excluded by [`supported`]).
+fn position_supported(model: &Model, data: &Data) -> bool {
+    if data.nefc != 0 || !model.gravcomp.is_empty() {
+        return false;
+    }
+    if data.xfrc_applied.iter().any(|w| w.iter().any(|&x| x != 0.0)) {
+        return false;
+    }
+    let clamps = model.joints.iter().any(|j| j.actuator_force_range.is_some())
+        || model.tendons.iter().any(|t| t.actuator_force_range.is_some())
+        || model.dof_effort_limit.iter().any(|l| l.is_finite());
+    let fixed = |t: usize| matches!(model.tendons[t].kind, TendonKind::Fixed { .. });
+    let tendons = (0..model.tendons.len())
+        .all(|t| fixed(t) || (model.tendons[t].stiffness == 0.0 && model.tendons[t].damping == 0.0));
+    let actuators = model.actuators.iter().all(|a| {
+        let transmission = match &a.transmission {
+            Transmission::Joint(j) | Transmission::JointInParent(j) => {
+                matches!(model.joints[*j].kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. })
+            }
+            Transmission::Tendon(t) => fixed(*t),
+            _ => false,
+        };
+        transmission
+            && crate::forward::unsimulated_reason(model, a).is_none()
+            && matches!(a.gaintype, GainType::Fixed | GainType::Affine)
+            && matches!(a.biastype, BiasType::None | BiasType::Affine)
+    });
+    !clamps && tendons && actuators
+}
+
+/// The position columns without rows: v′ = v + h K⁻¹ τ(q, v) with τ the smooth force less the
+/// bias, so dv′ = h K⁻¹ (∂τ/∂q − ∂(K ã)/∂q) with ã = K⁻¹ M q̈ the step's acceleration; K's
+/// q-dependence is M's, so the bracket is −(∂RNEA/∂q at a = ã − ∂f/∂q), one RNEA sweep. Then
+/// dq′ = e_k + h dv′, on ball and free rotations R(h ω′)ᵀ e_k + J_r(h ω′) h dω′
+/// (q′ = q ⊗ exp(h ω′)).
+fn position_columns(
+    model: &Model,
+    data: &mut Data,
+    work: &mut AnalyticWork,
+    v_next: &DVector<f64>,
+    a: &mut DMatrix<f64>,
+) {
+    let (nv, h) = (model.nv, model.options.timestep);
+    data.mass_matrix.mul_to(&data.qacc, &mut work.a_step);
+    cholesky_solve(&work.k_factor, nv, work.a_step.as_mut_slice());
+    let q = std::mem::take(&mut data.qpos);
+    let v = std::mem::take(&mut data.qvel);
+    dtau_minus_dforce(model, data, &mut work.deriv, q.as_slice(), v.as_slice(), work.a_step.as_slice());
+    data.qpos = q;
+    data.qvel = v;
+    for k in 0..nv {
+        for i in 0..nv {
+            work.y[i] = -work.deriv.dtau_dq[(i, k)];
+        }
+        cholesky_solve(&work.k_factor, nv, work.y.as_mut_slice());
+        for i in 0..nv {
+            let dv = h * work.y[i];
+            a[(nv + i, k)] = dv;
+            a[(i, k)] = h * dv + if i == k { 1.0 } else { 0.0 };
+        }
+        for joint in &model.joints {
+            let adr = match joint.kind {
+                JointKind::Free => joint.dof_adr + 3,
+                JointKind::Ball => joint.dof_adr,
+                _ => continue,
+            };
+            let phi = nalgebra::Vector3::new(v_next[adr], v_next[adr + 1], v_next[adr + 2]) * h;
+            let w = nalgebra::Vector3::new(a[(nv + adr, k)], a[(nv + adr + 1, k)], a[(nv + adr + 2, k)]) * h;
+            let mut t = right_jacobian(&phi, &w);
+            if (adr..adr + 3).contains(&k) {
+                t += nalgebra::Rotation3::new(-phi) * nalgebra::Vector3::ith(k - adr, 1.0);
+            }
+            for r in 0..3 {
+                a[(adr + r, k)] = t[r];
+            }
+        }
+    }
 }
 
 /// H = M + Jᵀ S J and G = Jᵀ S B J at the solution in `data` (S from the rows' zones in
