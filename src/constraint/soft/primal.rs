@@ -138,6 +138,38 @@ pub(crate) const DENSE_NV: usize = 40;
 /// `qfrc_smooth`, `qacc_smooth`, the mass matrix and its factor: writes `qacc`, `efc_force`,
 /// `efc_state`, `qfrc_constraint`, `solver_niter`, `solver_improvement`, `solver_gradient`,
 /// `efc_converged`, and counts a solve that stopped at the iteration limit in `efc_unconverged`.
+/// H[p][q] += (w J[a][p]) J[b][q] over the nonzero columns p ≥ q of rows a and b: the lower
+/// triangle of one Hessian term. Row a's weighted entries are gathered first (`weighted`, nv
+/// long, indexed like row a's nonzeros) so that J's column-major storage is read once per row,
+/// and the sums are written column by column; each entry gets the same products in the same
+/// order as a direct double loop, so the same bits.
+#[inline]
+fn add_weighted_outer(
+    h: &mut DMatrix<f64>,
+    efc_j: &DMatrix<f64>,
+    nz: &Sparsity,
+    a: usize,
+    b: usize,
+    w: f64,
+    weighted: &mut [f64],
+) {
+    let (row_a, row_b) = (nz.row(a), nz.row(b));
+    for (x, &p) in weighted.iter_mut().zip(row_a) {
+        *x = w * efc_j[(a, p)];
+    }
+    let nv = h.nrows();
+    let h = h.as_mut_slice();
+    for &q in row_b {
+        let j_bq = efc_j[(b, q)];
+        let column = &mut h[q * nv..(q + 1) * nv];
+        for (x, &p) in weighted.iter().zip(row_a) {
+            if p >= q {
+                column[p] += x * j_bq;
+            }
+        }
+    }
+}
+
 pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings) {
     let nv = model.nv;
     let nefc = data.nefc;
@@ -237,19 +269,12 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                 if nv <= DENSE_NV {
                     // Small: H = M + Jᵀ (∂²s) J, its lower triangle (all the dense Cholesky
                     // reads), by dense Cholesky.
-                    let h = &mut soft.hessian;
+                    let (h, weighted) = (&mut soft.hessian, &mut soft.weighted_row);
                     h.copy_from(mass_matrix);
                     rows.hessian(&soft.jar, efc_state, |i, dim, block| {
                         for (a, row) in (i..i + dim).zip(block) {
                             for (b, &w) in (i..i + dim).zip(row) {
-                                for &p in nz.row(a) {
-                                    let x = w * efc_j[(a, p)];
-                                    for &q in nz.row(b) {
-                                        if p >= q {
-                                            h[(p, q)] += x * efc_j[(b, q)];
-                                        }
-                                    }
-                                }
+                                add_weighted_outer(h, efc_j, &nz, a, b, w, weighted);
                             }
                         }
                     });
@@ -277,7 +302,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                     // The row groups with a Hessian block: single quadratic rows, and an elliptic
                     // contact's rows in its cone zone (one dense block).
                     soft.active_rows.clear();
-                    let active = &mut soft.active_rows;
+                    let (active, weighted) = (&mut soft.active_rows, &mut soft.weighted_row);
                     rows.hessian(&soft.jar, efc_state, |i, dim, block| {
                         // The block's entries (a, b) in row order, as one group.
                         for (a, row) in (i..i + dim).zip(block) {
@@ -286,14 +311,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                                     Some(g) if g.1 >= a.min(b) => g.1 = g.1.max(a.max(b)),
                                     _ => active.push((a, a.max(b))),
                                 }
-                                for &p in nz.row(a) {
-                                    let x = w * efc_j[(a, p)];
-                                    for &q in nz.row(b) {
-                                        if p >= q {
-                                            h[(p, q)] += x * efc_j[(b, q)];
-                                        }
-                                    }
-                                }
+                                add_weighted_outer(h, efc_j, &nz, a, b, w, weighted);
                             }
                         }
                     });

@@ -35,6 +35,8 @@ pub(crate) struct SoftWork {
     pub nz_index: Vec<usize>,
     /// (row, column) of J's nonzeros in column order, while `nz_start`/`nz_index` are built.
     pub nz_scratch: Vec<(usize, usize)>,
+    /// One row of J at its nonzero columns times a Hessian weight, while H is assembled (nv).
+    pub weighted_row: Vec<f64>,
     /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
     pub ar: DMatrix<f64>,
     pub minv_jt: DMatrix<f64>,
@@ -64,6 +66,7 @@ impl SoftWork {
             nz_start: Vec::with_capacity(nefc + 1),
             nz_index: Vec::with_capacity(nefc * nv),
             nz_scratch: Vec::new(),
+            weighted_row: vec![0.0; nv],
             ar: DMatrix::zeros(0, 0),
             minv_jt: DMatrix::zeros(0, 0),
         }
