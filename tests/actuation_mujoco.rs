@@ -103,12 +103,24 @@ fn muscles_with_written_lengthrange_and_smooth_switching_follow_mujoco() {
 }
 
 #[test]
-fn a_muscle_without_lengthrange_is_listed_as_not_simulated() {
-    let model = Model::from_str(
-        r#"<mujoco><worldbody><body><joint name="j" range="-1 1"/><geom size="0.1"/></body></worldbody>
-           <actuator><muscle joint="j"/></actuator></mujoco>"#,
-    )
-    .unwrap();
+fn a_muscle_without_lengthrange_is_simulated_for_one_and_listed_with_mode_none() {
+    let text = |compiler: &str| {
+        format!(
+            r#"<mujoco>{compiler}<worldbody><body><joint name="j" range="-1 1"/><geom size="0.1"/></body></worldbody>
+               <actuator><muscle joint="j"/></actuator></mujoco>"#
+        )
+    };
+    // The compiler's simulation pushes the hinge to its limits, ±1° (MuJoCo 4.0.0: ±0.0180232309
+    // rad, the soft limit's overshoot included; tests/lengthrange_mujoco.rs checks other scenes).
+    let model = Model::from_str(&text("")).unwrap();
+    let [lo, hi] = model.actuators[0].lengthrange;
+    assert!(
+        (lo + 0.018023230873313652).abs() < 1e-12 && (hi - 0.018023230873313652).abs() < 1e-12,
+        "{lo} {hi}"
+    );
+    assert!(unsimulated_reason(&model, &model.actuators[0]).is_none());
+    // mode="none": no range, and the muscle is listed as not simulated.
+    let model = Model::from_str(&text(r#"<compiler><lengthrange mode="none"/></compiler>"#)).unwrap();
     assert_eq!(model.actuators[0].lengthrange, [0.0, 0.0]);
     assert!(unsimulated_reason(&model, &model.actuators[0]).unwrap().contains("lengthrange"));
 }

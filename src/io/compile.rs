@@ -404,6 +404,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     model.elements.append(&mut e.kept);
     model.warnings.append(&mut e.warnings);
     reflect_actuator_damping_armature(spec, &mut model);
+    lengthrange_simulation(spec, &mut model)?;
     // Actuators of kinds the actuation stage does not simulate: listed by `info`, no force.
     for a in &model.actuators {
         if let Some(why) = crate::model::actuator::unsimulated_reason(&model, a) {
@@ -455,6 +456,30 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     crate::model::lengthrange::set_acc0(&mut model);
     model.plan = crate::forward::Plan::new(&model, None);
     Ok(model)
+}
+
+/// The actuators whose `actuator_lengthrange` neither the file nor a limit settles
+/// (`model::lengthrange::resolve`) get it from the compiler's simulation
+/// (`model::lengthrange_sim`), as MuJoCo's `mjCModel::LengthRange` after `mj_setConst`.
+fn lengthrange_simulation(spec: &ModelSpec, model: &mut Model) -> Result<(), LoadError> {
+    let which: Vec<usize> = spec
+        .actuators
+        .iter()
+        .zip(&model.actuators)
+        .enumerate()
+        .filter(|(_, (s, a))| {
+            crate::model::lengthrange::resolve(
+                s,
+                &a.transmission,
+                &model.joints,
+                &model.tendons,
+                &spec.lengthrange,
+            )
+            .is_none()
+        })
+        .map(|(i, _)| i)
+        .collect();
+    crate::model::lengthrange_sim::simulate_ranges(model, &which, &spec.lengthrange)
 }
 
 /// MJCF `springdamper` (MuJoCo's `mjCModel::AutoSpringDamper`, user_model.cc): a joint given a

@@ -686,7 +686,10 @@ fn actuator(
             ctrlrange = range;
         }
     }
-    let lengthrange = crate::model::lengthrange::resolve(a, &transmission, &n.model.joints, tendons);
+    // A range the simulation finds keeps the written one until compile runs it.
+    let lengthrange =
+        crate::model::lengthrange::resolve(a, &transmission, &n.model.joints, tendons, &spec.lengthrange)
+            .unwrap_or(a.lengthrange);
     Ok(Actuator {
         name: a.name.clone(),
         shortcut: a.shortcut,

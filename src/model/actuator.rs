@@ -192,7 +192,7 @@ pub fn unsimulated_reason(model: &Model, a: &Actuator) -> Option<&'static str> {
     }
     let muscle = a.gaintype == GainType::Muscle || a.biastype == BiasType::Muscle;
     if muscle && a.lengthrange[0] >= a.lengthrange[1] {
-        return Some("a muscle without lengthrange (the compiler's lengthrange simulation is not implemented: give lengthrange, or <compiler><lengthrange uselimit=\"true\"/>)");
+        return Some("a muscle without lengthrange (<compiler><lengthrange mode=\"none\"> leaves it [0, 0]: give lengthrange, or drop mode=\"none\")");
     }
     match &a.transmission {
         Transmission::Joint(j) | Transmission::JointInParent(j) => {

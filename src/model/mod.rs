@@ -13,6 +13,7 @@ pub mod equality;
 pub mod hfield;
 mod joint;
 pub mod lengthrange;
+pub(crate) mod lengthrange_sim;
 mod links;
 pub mod options;
 pub mod reset;

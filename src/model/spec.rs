@@ -34,6 +34,8 @@ pub struct ModelSpec {
     pub tendons: Vec<TendonSpec>,
     /// Actuators (MJCF `<actuator>`) in file order, shortcuts expanded.
     pub actuators: Vec<ActuatorSpec>,
+    /// `<compiler><lengthrange>`: how `actuator_lengthrange` is found.
+    pub lengthrange: crate::model::lengthrange::LengthRangeOptions,
     /// Explicit contact pairs (`<contact><pair>`).
     pub contact_pairs: Vec<ContactPairSpec>,
     /// Body pairs excluded from contact (`<contact><exclude>`).
@@ -631,9 +633,6 @@ pub struct ActuatorSpec {
     pub armature: f64,
     /// `lengthrange` as written ([0, 0] when absent: the compiler computes it).
     pub lengthrange: [f64; 2],
-    /// `<compiler><lengthrange uselimit>`: a muscle without a `lengthrange` takes its joint's or
-    /// tendon's range when that is limited.
-    pub lengthrange_uselimit: bool,
     /// Where it is written.
     pub loc: SourceLoc,
 }

@@ -233,6 +233,15 @@ pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
             json!({"name": f.name, "kind": format!("{:?}", f.kind).to_lowercase(), "body": model.bodies[f.body].name})
         })
         .collect();
+    // MuJoCo's actuator_* compile-time constants, by actuator.
+    let actuators: Vec<Value> = model
+        .actuators
+        .iter()
+        .map(|a| {
+            json!({"name": a.name, "kind": a.shortcut.name(), "lengthrange": a.lengthrange, "acc0": a.acc0,
+                   "gear": a.gear, "ctrlrange": a.ctrlrange, "forcerange": a.forcerange})
+        })
+        .collect();
     json!({
         "nq": model.nq,
         "nv": model.nv,
@@ -241,6 +250,7 @@ pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
         "total_mass": model.total_mass(),
         "bodies": bodies,
         "joints": joints,
+        "actuators": actuators,
         "frames": frames,
         "qpos0": model.qpos0,
         "options": {"timestep": model.options.timestep, "integrator": model.options.integrator.mjcf_name(),

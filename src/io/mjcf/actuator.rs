@@ -33,6 +33,7 @@ use super::defaults::{Defaults, MAIN};
 use super::xml::Element;
 use crate::io::LoadError;
 use crate::model::actuator::{ActuatorShortcut, BiasType, DynType, GainType};
+use crate::model::lengthrange::{LengthRangeMode, LengthRangeOptions};
 use crate::model::spec::{ActuatorSpec, TransmissionSpec};
 use crate::model::Element as KeptElement;
 
@@ -501,7 +502,6 @@ fn finish(
         damping: damping(a, warnings)?,
         armature: nonnegative_attr(a, "armature")?,
         lengthrange: a.array::<2>("lengthrange")?.unwrap_or([0.0; 2]),
-        lengthrange_uselimit: false,
         loc: e.loc.clone(),
     })
 }
@@ -587,15 +587,39 @@ fn transmission(a: &Attrs, warnings: &mut Vec<String>) -> Result<TransmissionSpe
     })
 }
 
-/// `<compiler><lengthrange uselimit>` (MuJoCo's `mjLROpt.uselimit`, default false) onto every
-/// actuator (the compile step resolves `actuator_lengthrange` with it).
-pub(crate) fn lengthrange_options(root: &Element, actuators: &mut [ActuatorSpec]) -> Result<(), LoadError> {
+/// `<compiler><lengthrange>` (MuJoCo's `mjLROpt`; every attribute, MuJoCo's defaults where absent).
+pub(crate) fn lengthrange_options(root: &Element) -> Result<LengthRangeOptions, LoadError> {
+    let mut o = LengthRangeOptions::default();
     for c in root.children_named("compiler") {
         for e in c.children_named("lengthrange") {
-            if let Some(v) = Attrs::plain(e).bool("uselimit")? {
-                actuators.iter_mut().for_each(|a| a.lengthrange_uselimit = v);
+            let at = Attrs::plain(e);
+            if let Some(m) = at.keyword("mode", &["none", "muscle", "muscleuser", "all"])? {
+                o.mode = match m.as_str() {
+                    "none" => LengthRangeMode::None,
+                    "muscleuser" => LengthRangeMode::MuscleUser,
+                    "all" => LengthRangeMode::All,
+                    _ => LengthRangeMode::Muscle,
+                };
+            }
+            o.useexisting = at.bool("useexisting")?.unwrap_or(o.useexisting);
+            o.uselimit = at.bool("uselimit")?.unwrap_or(o.uselimit);
+            for (name, field) in [
+                ("accel", &mut o.accel),
+                ("maxforce", &mut o.maxforce),
+                ("timeconst", &mut o.timeconst),
+                ("timestep", &mut o.timestep),
+                ("inttotal", &mut o.inttotal),
+                ("interval", &mut o.interval),
+                ("tolrange", &mut o.tolrange),
+            ] {
+                if let Some(x) = at.real(name)? {
+                    if !x.is_finite() || x < 0.0 {
+                        return Err(at.error(name, format!("{x} is not a finite non-negative number")));
+                    }
+                    *field = x;
+                }
             }
         }
     }
-    Ok(())
+    Ok(o)
 }

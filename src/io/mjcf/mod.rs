@@ -140,9 +140,8 @@ fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<Mo
     let mut elements = sections::sensors(root)?;
     let equalities = equality::equalities(root, &defaults, &mut elements, &mut warnings)?;
     let tendons = tendon::tendons(root, &defaults, compiler.autolimits, &mut warnings)?;
-    let mut actuators =
-        actuator::actuators(root, &defaults, compiler.autolimits, &mut elements, &mut warnings)?;
-    actuator::lengthrange_options(root, &mut actuators)?;
+    let actuators = actuator::actuators(root, &defaults, compiler.autolimits, &mut elements, &mut warnings)?;
+    let lengthrange = actuator::lengthrange_options(root)?;
     let (contact_pairs, contact_excludes) = contact::contacts(root, &defaults)?;
     check_targets(&elements, &builder.links, &tendons)?;
     elements.append(&mut builder.kept);
@@ -157,6 +156,7 @@ fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<Mo
             ..compiler.mass_rules.clone()
         },
         options,
+        lengthrange,
         keyframes,
         equalities,
         tendons,
