@@ -74,7 +74,9 @@ fn lengthranges_match_mujoco() {
         );
     }
     println!("lengthranges: {compared} compared, {refused} refused as MuJoCo does, {skipped} skipped");
-    assert!(compared >= 9 && refused >= 1);
+    // The 8 ranges of the hand-made scenes always; MyoSuite's 6 more when the venv is there
+    // (each skipped model printed above with its reason, and counted).
+    assert!(compared >= 8 + 6 - 3 * skipped && refused >= 1, "{compared} compared, {skipped} skipped");
 }
 
 /// Hostile options: a simulation too long to run and a negative option are refused with the fix.
