@@ -192,3 +192,53 @@ fn wraps_match_mujoco() {
         &spring, &length, &jac, &vel, &wraps, &inside, &act, &passive, &frc, &efc, &qacc, &sensors, &traj,
     ]);
 }
+
+/// A cylinder wrap whose straight segment misses the circle on the side away from the side site
+/// (the Aero hand's index and ring tendons): MuJoCo 4.0 wraps only when the side site is behind
+/// the circle. Lengths, Jacobians, wrap points and the trajectory against MuJoCo.
+#[test]
+fn side_site_behind_or_beside_matches_mujoco() {
+    let g = golden("side_behind");
+    let model = Model::from_file(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(&g.scene)).unwrap();
+    let mut data = Data::new(&model);
+    let mut length = MaxErr::new("ten_length", REF_REL);
+    let mut jac = MaxErr::new("ten_J", REF_REL);
+    let mut wraps = MaxErr::new("wrap_xpos (wrap_obj, ten_wrapnum exact)", REF_REL);
+    let (mut wrapped, mut straight) = (0, 0);
+    for (k, s) in g.states.iter().enumerate() {
+        set_state(&mut data, &s.qpos, &s.qvel, &s.ctrl);
+        forward(&model, &mut data);
+        for t in 0..model.tendons.len() {
+            let at = || format!("state {k} tendon {}", model.tendons[t].name);
+            length.add(rel_err_vec(&[data.ten_length[t]], &[s.ten_length[t]]), at);
+            jac.add(rel_err_vec(&row(&data.ten_j, t), &s.ten_j[t]), at);
+            let (adr, n) = (s.ten_wrapadr[t], s.ten_wrapnum[t]);
+            if n == 4 {
+                wrapped += 1;
+            } else {
+                straight += 1;
+            }
+            if data.ten_wrapnum[t] != n || data.wrap_obj[adr..adr + n] != s.wrap_obj[adr..adr + n] {
+                wraps.add(f64::NAN, || {
+                    format!("{}: wrap_obj differs from MuJoCo's {:?}", at(), &s.wrap_obj[adr..adr + n])
+                });
+                continue;
+            }
+            for w in adr..adr + n {
+                wraps.add(rel_err_vec(data.wrap_xpos[w].as_slice(), &s.wrap_xpos[w]), || {
+                    format!("{} point {w}", at())
+                });
+            }
+        }
+    }
+    // Both cases occur: "front" never wraps, "back" wraps round the back.
+    assert!(wrapped > 0 && straight > 0, "wrapped {wrapped}, straight {straight}");
+    let mut traj = MaxErr::new("200-step mj_step trajectory (qpos, qvel)", SOFT_REL);
+    set_state(&mut data, &g.trajectory.qpos0, &g.trajectory.qvel0, &g.trajectory.ctrl);
+    for (i, s) in g.trajectory.steps.iter().enumerate() {
+        step(&model, &mut data).unwrap();
+        traj.add(rel_err_vec(data.qpos.as_slice(), &s.qpos), || format!("step {i} qpos"));
+        traj.add(rel_err_vec(data.qvel.as_slice(), &s.qvel), || format!("step {i} qvel"));
+    }
+    report_and_assert(&[&length, &jac, &wraps, &traj]);
+}

@@ -44,12 +44,7 @@ N_STATES = 4
 SEED = 20261126
 SECTION = "## MuJoCo features on corpus models"
 # Differences understood but not fixed yet: reported as known, they do not fail the run.
-KNOWN = {
-    "tetheria_aero_hand_open/left_hand.xml": "(b): the index and ring tendons (spatial, wrapping cylinders with side "
-    "sites) are 8 mm longer than MuJoCo's once the fingers move at step 4, and their position actuators push 80 N "
-    "harder (lagrange's spatial-tendon wrapping, issue 30)",
-    "tetheria_aero_hand_open/right_hand.xml": "(b): as left_hand.xml",
-}
+KNOWN: dict[str, str] = {}
 
 
 def features(mj, m) -> list[str]:

@@ -9,7 +9,8 @@
 //! afterwards. In that plane the problem is a circle of radius r and two points d₀, d₁:
 //!
 //! - **outside** (no side site, or a side site outside the circle): if the segment d₀d₁ misses
-//!   the circle (or passes on the side site's side), there is no wrap. Otherwise each point has
+//!   the circle (or passes on the side site's side, or the side site is not behind the circle:
+//!   outside the cone spanned by −d₀ and −d₁, MuJoCo 4.0's rule), there is no wrap. Otherwise each point has
 //!   two tangent points t = (d r² ± r d⊥ √(|d|² − r²)) / |d|²; of the two consistent pairs the
 //!   one nearer the side site (its normalized mid-direction) or, without side site, the pair
 //!   with the shorter chord is taken, a pair whose tangent lines cross being rejected. The wrap
@@ -96,6 +97,22 @@ fn arc_length(t0: V2, t1: V2, long_way: bool, radius: f64) -> f64 {
     radius * angle
 }
 
+/// Whether the side direction `s` points into the cone spanned by −d₀ and −d₁ (the circle's
+/// centre inside the triangle d₀, d₁, s): the side site is behind the circle as seen from the
+/// segment. MuJoCo 4.0 wraps a segment that misses the circle only then (measured against the
+/// live MuJoCo 4.0.0 on 12 000 random planar cases; its 2026-08 source wraps whenever the
+/// segment passes on the side away from the side site).
+fn behind(s: V2, d0: V2, d1: V2) -> bool {
+    let cross = |a: V2, b: V2| a[0] * b[1] - a[1] * b[0];
+    let c = cross(d0, d1);
+    if c.abs() < MINVAL {
+        return false;
+    }
+    let alpha = -cross(s, d1) / c;
+    let beta = cross(s, d0) / c;
+    alpha >= 0.0 && beta >= 0.0
+}
+
 /// The outside wrap of the circle of radius `radius` at the origin between `d0` and `d1`, with
 /// the side direction `side` (scaled to the radius) if any: (tangent points, arc length) or None.
 fn wrap_outside(d0: V2, d1: V2, side: Option<V2>, radius: f64) -> Option<(V2, V2, f64)> {
@@ -112,7 +129,7 @@ fn wrap_outside(d0: V2, d1: V2, side: Option<V2>, radius: f64) -> Option<(V2, V2
     // the side site's side).
     let a = (-dot2(dif, d0) / dd).clamp(0.0, 1.0);
     let near = [d0[0] + a * dif[0], d0[1] + a * dif[1]];
-    if dot2(near, near) > sqr && side.is_none_or(|s| dot2(s, near) >= 0.0) {
+    if dot2(near, near) > sqr && side.is_none_or(|s| dot2(s, near) >= 0.0 || !behind(s, d0, d1)) {
         return None;
     }
     let (r0, r1) = ((sq0 - sqr).sqrt(), (sq1 - sqr).sqrt());
