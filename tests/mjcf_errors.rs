@@ -226,8 +226,8 @@ fn composition_errors_name_the_element_line_and_what_mujoco_does() {
         &[
             "mesh_builtin.xml:3",
             "<mesh>",
-            "the built-in mesh 'supertorus'",
-            "lagrange generates 'sphere' and 'cone'",
+            "the built-in mesh 'wedge'",
+            "lagrange generates 'sphere', 'cone', 'hemisphere', 'supersphere' and 'supertorus'",
         ],
     );
 }

@@ -113,6 +113,13 @@ pub const SOFT_CG_REL: f64 = 5e-6;
 /// 1e-7. 1e-6 bounds that with a margin; a wrong formula or mode errs by ≥ 1e-3.
 pub const MESH_MUJOCO_REL: f64 = 1e-6;
 
+/// Absolute tolerance (m) of a built-in mesh's hull-vertex distances from its centre of mass
+/// against MuJoCo's compiled `mesh_vert` (`tests/mesh_builtin_mujoco.rs`). Both sides generate the
+/// same f32 vertices; MuJoCo then stores the recentred, rotated vertices as f32 again, a rounding
+/// of ≤ 6e-8 relative on coordinates of ≤ 0.1 m, so ~1e-8 m; 1e-7 m bounds it with margin, where
+/// a wrong generator errs by ≥ 1e-4 m.
+pub const BUILTIN_HULL_ABS: f64 = 1e-7;
+
 /// Relative tolerance of mass properties that are exact in f64 (`tests/mass.rs`): a polyhedron
 /// (box, L-shape, plate, T-junction box) against its closed form, a primitive formula against the
 /// notes (eq. 51–53), identities such as the perpendicular-axis theorem (eq. 54). The only error is

@@ -4,10 +4,13 @@
 //! - `sphere` (params: subdivisions 0–4): an icosahedron on the unit sphere, each subdivision
 //!   splitting every triangle in four at its edges' midpoints pushed onto the sphere;
 //! - `cone` (params: edges, top radius): a unit circle of `edges` points at z = −1 and a circle of
-//!   the top radius at z = +1 (a single apex when it is 0); no faces, so its convex hull.
+//!   the top radius at z = +1 (a single apex when it is 0); no faces, so its convex hull;
+//! - `hemisphere` (params: resolution 0–10), `supersphere` (resolution ≥ 3, e, n) and
+//!   `supertorus` (resolution ≥ 3, radius in (0, 1], s, t): their generators in
+//!   src/io/mjcf/mesh_builtin_super.rs (`MakeHemisphere`, `MakeSupersphere`, `MakeSupertorus`).
 //!
-//! The other built-ins (`hemisphere`, `supersphere`, `supertorus`, `wedge`, `plate`) are refused
-//! with a typed error saying so.
+//! The other built-ins (`wedge`, `plate`, `grid`, `box`, `cylinder`, `ellipsoid`, `square`,
+//! `disc`) are refused with a typed error saying so.
 
 use super::attrs::Attrs;
 use super::xml::Element;
@@ -58,18 +61,51 @@ pub(crate) fn builtin_mesh(
             mass::convex_hull(&vertices)
                 .map_err(|err| invalid(format!("the built-in cone '{name}' has no volume: {err}")))?
         }
-        "hemisphere" | "supersphere" | "supertorus" | "wedge" | "plate" => {
+        "hemisphere" => {
+            count(1, "resolution")?;
+            let res = params[0] as i64;
+            if !(0..=10).contains(&res) {
+                return Err(a.error("params", format!("gives resolution {res}: hemisphere resolution must be in 0..=10")));
+            }
+            super::mesh_builtin_super::hemisphere(res as usize)
+        }
+        "supersphere" => {
+            count(3, "resolution, e, n")?;
+            let res = params[0] as i64;
+            if res < 3 {
+                return Err(a.error("params", format!("gives resolution {res}: supersphere resolution must be greater than 2")));
+            }
+            if params[1] < 0.0 || params[2] < 0.0 {
+                return Err(a.error("params", "gives a negative exponent: supersphere 'e' and 'n' cannot be negative"));
+            }
+            super::mesh_builtin_super::supersphere(res as usize, params[1], params[2])
+        }
+        "supertorus" => {
+            count(4, "resolution, radius, s, t")?;
+            let res = params[0] as i64;
+            if res < 3 {
+                return Err(a.error("params", format!("gives resolution {res}: supertorus resolution must be at least 3")));
+            }
+            if !(params[1] > 0.0 && params[1] <= 1.0) {
+                return Err(a.error("params", format!("gives radius {}: supertorus radius must be in (0, 1]", params[1])));
+            }
+            if !(params[2] > 0.0 && params[3] > 0.0) {
+                return Err(a.error("params", "gives an exponent <= 0: supertorus 's' and 't' must be greater than 0"));
+            }
+            super::mesh_builtin_super::supertorus(res as usize, params[1], params[2], params[3])
+        }
+        "wedge" | "plate" | "grid" | "box" | "cylinder" | "ellipsoid" | "square" | "disc" => {
             return Err(LoadError::Unsupported {
                 loc: e.loc.clone(),
                 element: "mesh".into(),
-                what: format!("the built-in mesh '{shape}' (lagrange generates 'sphere' and 'cone')"),
+                what: format!("the built-in mesh '{shape}' (lagrange generates 'sphere', 'cone', 'hemisphere', 'supersphere' and 'supertorus')"),
                 fix: "save that mesh to an STL or OBJ file (e.g. from MuJoCo's compiled mesh_vert/mesh_face) and give it in 'file', or give it as inline 'vertex'/'face'".into(),
             })
         }
         other => {
             return Err(a.error(
                 "builtin",
-                format!("is '{other}': MuJoCo's built-in meshes are sphere, hemisphere, cone, supersphere, supertorus, wedge, plate"),
+                format!("is '{other}': MuJoCo's built-in meshes are sphere, hemisphere, cone, supersphere, supertorus, wedge, plate, grid, box, cylinder, ellipsoid, square, disc"),
             ))
         }
     };

@@ -1,0 +1,148 @@
+//! MuJoCo 4.0's built-in meshes (`<mesh builtin=… params=…>`, src/io/mjcf/mesh_builtin.rs and
+//! mesh_builtin_super.rs) against MuJoCo (tests/data/mujoco/mesh_builtin.json,
+//! validation/mujoco_builtin_golden.py): sphere, cone, hemisphere, supersphere and supertorus at
+//! 1–3 parameter sets each, as one scaled free body over a plane. Its mass, centre of mass and
+//! principal inertia are MuJoCo's; its collision hull's vertices are MuJoCo's compiled vertices
+//! (same distances from the centre of mass); and it falls onto the plane as MuJoCo's does
+//! (qpos/qvel after 1, 40 and 120 `mj_step`s) up to the sample where MuJoCo rests it on two or more
+//! contacts (a face or an edge: MuJoCo's plane–convex contact subset is not followed yet). Built-ins MuJoCo refuses as a geom are refused.
+
+mod common;
+
+use common::{state_rel_err, BUILTIN_HULL_ABS, MESH_MUJOCO_REL, SOFT_REL};
+use lagrange::prelude::*;
+use serde_json::Value;
+
+fn golden() -> Value {
+    serde_json::from_str(&std::fs::read_to_string("tests/data/mujoco/mesh_builtin.json").unwrap()).unwrap()
+}
+
+fn numbers(v: &Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+#[test]
+fn builtin_mass_com_inertia_and_hull_are_mujocos() {
+    let golden = golden();
+    let (mut worst_mass, mut worst_hull) = (0.0f64, 0.0f64);
+    for case in golden["cases"].as_array().unwrap() {
+        let label = format!("{} {}", case["builtin"].as_str().unwrap(), case["params"].as_str().unwrap());
+        let model = Model::from_str(case["xml"].as_str().unwrap()).unwrap_or_else(|e| panic!("{label}: {e}"));
+        let body = &model.bodies[1];
+        let mass = case["body_mass"].as_f64().unwrap();
+        let rel = |a: f64, b: f64, scale: f64| (a - b).abs() / scale;
+        let mut err = rel(body.mass(), mass, mass);
+        let ipos = numbers(&case["body_ipos"]);
+        for (k, x) in ipos.iter().enumerate() {
+            err = err.max(rel(body.com()[k], *x, 0.1));
+        }
+        // Principal moments, sorted (MuJoCo's body_inertia is in its principal frame).
+        let mut theirs = numbers(&case["body_inertia"]);
+        let mut ours: Vec<f64> = body.inertia_com().symmetric_eigenvalues().iter().copied().collect();
+        theirs.sort_by(f64::total_cmp);
+        ours.sort_by(f64::total_cmp);
+        for (a, b) in ours.iter().zip(&theirs) {
+            err = err.max(rel(*a, *b, theirs[2]));
+        }
+        // Hull vertices: MuJoCo's mesh_vert are in the mesh's inertial frame (origin at the com).
+        let g = model.geoms.iter().find(|g| g.body == 1).unwrap();
+        let hull = g.hull.as_ref().expect("a built-in mesh collides by its hull");
+        let mut ours: Vec<f64> =
+            hull.iter().map(|v| (g.x_body_geom.act_point(v) - body.com()).norm()).collect();
+        let mut theirs: Vec<f64> = case["vert"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| numbers(v).iter().map(|x| x * x).sum::<f64>().sqrt())
+            .collect();
+        ours.sort_by(f64::total_cmp);
+        theirs.sort_by(f64::total_cmp);
+        // Interior vertices (the hemisphere's cap centre, a torus's inner ring) are not on the hull:
+        // every hull vertex is one of MuJoCo's, and the farthest vertices agree.
+        let hull_err = ours
+            .iter()
+            .map(|a| theirs.iter().map(|b| (a - b).abs()).fold(f64::INFINITY, f64::min))
+            .fold(0.0, f64::max)
+            .max((ours[ours.len() - 1] - theirs[theirs.len() - 1]).abs());
+        println!(
+            "{label}: mass {:.6} (MuJoCo {mass:.6}), mass/com/inertia rel err {err:.1e}, {} hull vertices of {}, distance err {hull_err:.1e} m",
+            body.mass(),
+            ours.len(),
+            theirs.len()
+        );
+        worst_mass = worst_mass.max(err);
+        worst_hull = worst_hull.max(hull_err);
+    }
+    assert!(worst_mass <= MESH_MUJOCO_REL, "mass properties: {worst_mass:e}");
+    assert!(worst_hull <= BUILTIN_HULL_ABS, "hull: {worst_hull:e}");
+}
+
+#[test]
+fn builtin_meshes_fall_onto_a_plane_as_in_mujoco() {
+    let golden = golden();
+    let mut worst = 0.0f64;
+    let mut compared = 0;
+    for case in golden["cases"].as_array().unwrap() {
+        let label = format!("{} {}", case["builtin"].as_str().unwrap(), case["params"].as_str().unwrap());
+        let model = Model::from_str(case["xml"].as_str().unwrap()).unwrap();
+        let mut data = Data::new(&model);
+        let mut k = 0;
+        let mut err = 0.0f64;
+        for sample in case["samples"].as_array().unwrap() {
+            while k < sample["step"].as_u64().unwrap() {
+                step(&model, &mut data).unwrap();
+                k += 1;
+            }
+            let e = state_rel_err(sample, &data);
+            let ncon = sample["ncon"].as_u64().unwrap();
+            println!("  step {k}: ncon {} (MuJoCo {ncon}), rel err {e:.1e}", data.contacts.len());
+            if ncon >= 2 {
+                // Resting on a face or an edge: MuJoCo's plane–convex contact picks its own subset
+                // of the hull's vertices, which lagrange's plane–mesh contacts do not follow yet
+                // (the cone, supported before, shows it too): from here on only printed.
+                break;
+            }
+            err = err.max(e);
+            compared += 1;
+        }
+        println!("{label}: {k} steps, rel err {err:.1e}, z {:.5}", data.qpos[2]);
+        worst = worst.max(err);
+    }
+    println!("{compared} samples compared, worst rel err {worst:.1e}");
+    assert!(compared >= 23, "{compared} samples compared");
+    assert!(worst <= SOFT_REL, "{worst:e}");
+}
+
+#[test]
+fn builtins_mujoco_refuses_are_refused() {
+    let golden = golden();
+    for case in golden["refused"].as_array().unwrap() {
+        let xml = format!(
+            "<mujoco><asset><mesh name=\"m\" builtin=\"{}\" params=\"{}\"/></asset><worldbody><body><freejoint/><geom type=\"mesh\" mesh=\"m\"/></body></worldbody></mujoco>",
+            case["builtin"].as_str().unwrap(),
+            case["params"].as_str().unwrap()
+        );
+        assert!(case["error"].is_string(), "MuJoCo refuses {xml}");
+        let err = Model::from_str(&xml).unwrap_err().to_string();
+        println!("{}: MuJoCo: {} / lagrange: {err}", case["builtin"], case["error"]);
+    }
+}
+
+#[test]
+fn bad_builtin_params_are_typed_errors() {
+    for (mesh, expect) in [
+        (r#"builtin="hemisphere" params="11""#, "must be in 0..=10"),
+        (r#"builtin="hemisphere" params="1 2""#, "requires 1"),
+        (r#"builtin="supersphere" params="2 1 1""#, "greater than 2"),
+        (r#"builtin="supersphere" params="8 -1 1""#, "cannot be negative"),
+        (r#"builtin="supertorus" params="8 1.5 1 1""#, "(0, 1]"),
+        (r#"builtin="supertorus" params="8 0.5 0 1""#, "greater than 0"),
+        (r#"builtin="supertorus" params="8 0.5 1""#, "requires 4"),
+    ] {
+        let xml = format!(
+            "<mujoco><asset>\n<mesh name=\"m\" {mesh}/></asset><worldbody><body><freejoint/><geom type=\"mesh\" mesh=\"m\"/></body></worldbody></mujoco>"
+        );
+        let err = Model::from_str(&xml).unwrap_err().to_string();
+        assert!(err.contains(expect) && err.contains(":2:"), "{mesh}: {err}");
+    }
+}

@@ -1,0 +1,96 @@
+"""Reference data for MuJoCo 4.0's built-in meshes (`<mesh builtin=... params=...>`), each at 2-3
+parameter sets: one free body with one mesh geom (scaled, density 800) over a plane. Per case: the
+compiled vertices (mesh_vert, MuJoCo's inertial frame, f32), the body's mass, com (body_ipos) and
+principal inertia (body_inertia), and qpos/qvel after 1, 40 and 120 steps of mj_step as the body falls
+onto the plane on its collision hull. Built-ins MuJoCo refuses as such a geom are listed with its
+error. Writes tests/data/mujoco/mesh_builtin.json (generated: do not edit); with --check,
+recomputes and exits 1 when the committed file differs beyond 1e-12.
+
+  python validation/mujoco_builtin_golden.py [--check]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import mujoco
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "tests/data/mujoco/mesh_builtin.json"
+SAMPLES = [1, 40, 120]
+CASES = [
+    ("sphere", "1"), ("cone", "6 0.5"),
+    ("hemisphere", "0"), ("hemisphere", "2"), ("hemisphere", "5"),
+    ("supersphere", "8 1 1"), ("supersphere", "12 0.5 2"), ("supersphere", "6 2 0.3"),
+    ("supertorus", "8 0.5 1 1"), ("supertorus", "12 0.3 0.5 2"), ("supertorus", "10 1 2 0.5"),
+]
+REFUSED = [("plate", "3 3")]
+
+
+def xml(builtin: str, params: str) -> str:
+    return (f'<mujoco><option timestep="0.002"/><asset><mesh name="m" builtin="{builtin}" params="{params}" '
+            f'scale="0.1 0.08 0.06"/></asset><worldbody><geom type="plane" size="2 2 0.1"/>'
+            f'<body pos="0.01 -0.02 0.12" euler="20 30 10"><freejoint/>'
+            f'<geom type="mesh" mesh="m" density="800"/></body></worldbody></mujoco>')
+
+
+def case(builtin: str, params: str) -> dict:
+    m = mujoco.MjModel.from_xml_string(xml(builtin, params))
+    d = mujoco.MjData(m)
+    out = {"builtin": builtin, "params": params, "xml": xml(builtin, params),
+           "vert": m.mesh_vert.tolist(), "nface": int(m.mesh_facenum[0]),
+           "body_mass": float(m.body_mass[1]), "body_ipos": m.body_ipos[1].tolist(),
+           "body_inertia": m.body_inertia[1].tolist(), "samples": []}
+    for k in range(1, max(SAMPLES) + 1):
+        mujoco.mj_step(m, d)
+        if k in SAMPLES:
+            out["samples"].append({"step": k, "qpos": d.qpos.tolist(), "qvel": d.qvel.tolist(),
+                                   "ncon": int(d.ncon)})
+    return out
+
+
+def refused(builtin: str, params: str) -> dict:
+    try:
+        mujoco.MjModel.from_xml_string(xml(builtin, params))
+        return {"builtin": builtin, "params": params, "error": None}
+    except ValueError as e:
+        return {"builtin": builtin, "params": params, "error": str(e).splitlines()[0]}
+
+
+def flat(x):
+    return [y for v in x for y in (flat(v) if isinstance(v, list) else [v])]
+
+
+def diff(a: dict, b: dict) -> float:
+    keys = ["vert", "body_mass", "body_ipos", "body_inertia"]
+    xs = [flat([a[k]]) for k in keys] + [flat([s["qpos"], s["qvel"], s["ncon"]]) for s in a["samples"]]
+    ys = [flat([b[k]]) for k in keys] + [flat([s["qpos"], s["qvel"], s["ncon"]]) for s in b["samples"]]
+    if any(len(x) != len(y) for x, y in zip(xs, ys)):
+        return float("inf")
+    return max(abs(p - q) for x, y in zip(xs, ys) for p, q in zip(x, y))
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--check", action="store_true")
+    args = ap.parse_args()
+    doc = {"generated_by": "validation/mujoco_builtin_golden.py (do not edit)", "mujoco": mujoco.__version__,
+           "cases": [case(b, p) for b, p in CASES], "refused": [refused(b, p) for b, p in REFUSED]}
+    if args.check:
+        old = json.loads(OUT.read_text())
+        worst = max(diff(a, b) for a, b in zip(doc["cases"], old["cases"]))
+        ok = (worst <= 1e-12 and len(doc["cases"]) == len(old["cases"])
+              and doc["refused"] == old["refused"])
+        print(f"built-in mesh reference data: live MuJoCo {mujoco.__version__} differs by {worst:.1e} "
+              f"({'ok' if ok else 'CHANGED'})")
+        return 0 if ok else 1
+    OUT.write_text(json.dumps(doc, indent=1) + "\n")
+    print(f"wrote {OUT.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
