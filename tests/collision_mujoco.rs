@@ -186,26 +186,11 @@ fn compare(model: &Model, data: &mut Data, case: &Case, worst: &mut Worst) -> Re
     Ok(())
 }
 
-/// Cases of the regression pairs where lagrange's existing sphere/capsule code (src/collision/
-/// convex.rs, outside the box closed forms) differs from MuJoCo 4.0 — (scene, case, why). The
-/// test asserts they still differ, so that a fix shows up here.
+/// Cases of the regression pairs where lagrange differs from MuJoCo 4.0 — (scene, case, why). The
+/// test asserts they still differ, so that a fix shows up here. (Spheres and capsules follow
+/// MuJoCo's closed forms since src/collision/capsule.rs: its coincident-centre normals and the
+/// two contacts of parallel capsules match.)
 const KNOWN_DIFFERENCES: &[(&str, &str, &str)] = &[
-    (
-        "sphere_sphere",
-        "coincident_centres",
-        "MuJoCo's normal for coincident centres is z₁ × z₂ (the geoms' z axes), lagrange's is x",
-    ),
-    (
-        "capsule_capsule",
-        "coincident_centres",
-        "coincident closest points: MuJoCo's normal is z₁ × z₂, lagrange's is x",
-    ),
-    (
-        "capsule_capsule",
-        "parallel_overlapping",
-        "MuJoCo's mjc_CapsuleCapsule gives two contacts for parallel overlapping segments, lagrange one \
-         (and the model limits the pair to one contact)",
-    ),
     ("plane_mesh_femoris", "face20", "the facing triangle and a neighbour within 1e-6 of coplanar form a quadrilateral here, whose fourth corner lies within the margin; MuJoCo 4.0 reports the deepest vertex alone (its qhull faces are not merged there; src/collision/plane_mesh.rs COPLANAR)"),
 ];
 

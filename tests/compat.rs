@@ -577,3 +577,15 @@ fn absurd_tendon_springs_and_fluid_options_are_refused() {
     .unwrap();
     refused(&path, &LoadOptions::default(), &["option", "wind", "1e200", "absurdly large"]);
 }
+
+/// A geom's partial `solref` (one value) keeps the default's second entry, as MuJoCo 4.0 reads it
+/// (MyoSuite's myoarm_tabletennis_native.xml writes solref="0.01"; MuJoCo: geom_solref [0.05, 1]
+/// for solref="0.05").
+#[test]
+fn partial_geom_solref_keeps_the_default_damping_ratio() {
+    let model = lagrange::Model::from_str(
+        r#"<mujoco><worldbody><geom name="g" size="0.1" solref="0.05"/></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    assert_eq!(model.geoms[0].contact.solref, [0.05, 1.0]);
+}

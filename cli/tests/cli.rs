@@ -32,6 +32,7 @@ fn info_json_has_exactly_the_documented_keys() {
     assert_eq!(
         keys(&v),
         [
+            "actuators",
             "bodies",
             "constraints",
             "elements",

@@ -1,5 +1,6 @@
-//! Convex geom pairs other than planes: spheres and capsules in closed form (closest points of
-//! segments), every other pair by GJK and EPA on support maps (parry3d-f64's
+//! Convex geom pairs other than planes and MuJoCo's closed forms: the closest points of two
+//! segments (`swept_spheres`, for geom distances; contacts of spheres and capsules are
+//! [`super::capsule`]'s), every other pair by GJK and EPA on support maps (parry3d-f64's
 //! `contact_support_map_support_map`) — including the ellipsoid, whose exact support map is
 //! written here (a support-map shape, not a polyhedral approximation), and meshes by their hulls.
 //! One contact per pair, at the midpoint of the two witness points.

@@ -32,6 +32,7 @@
 pub mod box_box;
 pub mod box_primitive;
 pub mod broadphase;
+pub mod capsule;
 mod ccd;
 pub mod convex;
 mod frame;
@@ -58,7 +59,7 @@ pub use ray::{ray, ray_site, RayFilter, RayHit};
 
 use crate::model::spec::Shape;
 use crate::model::{Contact, Data, Model};
-use crate::spatial::{Transform, Vec3};
+use crate::spatial::Vec3;
 use convex::PairPoint;
 use parry3d_f64::math::Vector;
 use parry3d_f64::shape::ConvexPolyhedron;
@@ -325,27 +326,40 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
                 box_box::box_box(&x1, &(s1 / 2.0), &x2, &(s2 / 2.0), within, &mut |p, f| emit(p, f, false));
                 true
             }
+            // Spheres and capsules: MuJoCo's sphere–sphere tests of segment points ([`capsule`]).
+            (Shape::Sphere { radius: r1 }, Shape::Sphere { radius: r2 }) => {
+                if let Some(p) = capsule::sphere_sphere_pair(&x1, *r1, &x2, *r2, within) {
+                    emit(p, 0, false);
+                }
+                true
+            }
+            (Shape::Sphere { radius }, Shape::Capsule { radius: rc, length })
+            | (Shape::Capsule { radius: rc, length }, Shape::Sphere { radius }) => {
+                let (xs, xc, swap) =
+                    if let Shape::Capsule { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
+                if let Some(p) = capsule::sphere_capsule(&xs, *radius, &xc, *rc, 0.5 * length, within) {
+                    emit(p, 0, swap);
+                }
+                true
+            }
+            (Shape::Capsule { radius: r1, length: l1 }, Shape::Capsule { radius: r2, length: l2 }) => {
+                let mut k = 0;
+                capsule::capsule_capsule(&x1, *r1, 0.5 * l1, &x2, *r2, 0.5 * l2, within, &mut |p| {
+                    emit(p, k, false);
+                    k += 1;
+                });
+                true
+            }
             _ => false,
         };
         if boxed {
             continue;
         }
-        let segment = |x: &Transform, shape: &Shape| match shape {
-            Shape::Sphere { radius } => Some(([x.pos, x.pos], *radius)),
-            Shape::Capsule { radius, length } => {
-                let a = x.rot.column(2) * (0.5 * length);
-                Some(([x.pos - a, x.pos + a], *radius))
+        let point = match (&cm.shapes[g1], &cm.shapes[g2]) {
+            (Some(s1), Some(s2)) => {
+                convex::mujoco_pair(&x1, s1, &x2, s2, within, &model.options, touching[idx])
             }
             _ => None,
-        };
-        let point = match (segment(&x1, &geom1.shape), segment(&x2, &geom2.shape)) {
-            (Some((s1, r1)), Some((s2, r2))) => convex::swept_spheres(s1, r1, s2, r2, within),
-            _ => match (&cm.shapes[g1], &cm.shapes[g2]) {
-                (Some(s1), Some(s2)) => {
-                    convex::mujoco_pair(&x1, s1, &x2, s2, within, &model.options, touching[idx])
-                }
-                _ => None,
-            },
         };
         if let Some(p) = point {
             if let (true, Some(s1), Some(s2)) = (pair.max_contacts > 1, &cm.shapes[g1], &cm.shapes[g2]) {

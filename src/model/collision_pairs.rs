@@ -63,7 +63,7 @@ pub fn type_rank(shape: &Shape) -> u8 {
 
 /// The most contacts a pair of these shapes yields (MuJoCo's closed forms and `mj_maxContact`):
 /// a height field 50 (`mjMAXCONPAIR`), box against box 8, plane against box, cylinder or mesh hull 4 (MuJoCo 4.0 gives a mesh up to the 4 corners of a hull quadrilateral), plane or box against a capsule
-/// 2; the convex pairs (`mjc_Convex`, see `collision::multiccd`) 1 with a sphere or an ellipsoid
+/// and capsule against capsule (parallel axes) 2; the convex pairs (`mjc_Convex`, see `collision::multiccd`) 1 with a sphere or an ellipsoid
 /// or when `multiccd` is off, else 5 with a capsule or a cylinder, 4 for boxes and meshes
 /// without margin (face clipping pruned to a quadrilateral) and 5 with one; every other pair 1.
 fn max_contacts(a: &Shape, b: &Shape, multiccd: bool, has_margin: bool) -> usize {
@@ -71,7 +71,10 @@ fn max_contacts(a: &Shape, b: &Shape, multiccd: bool, has_margin: bool) -> usize
     match (a, b) {
         (Box { .. }, Box { .. }) => 8,
         (Plane { .. }, Box { .. } | Cylinder { .. } | Mesh { .. }) => 4,
-        (Plane { .. }, Capsule { .. }) | (Capsule { .. }, Box { .. }) | (Box { .. }, Capsule { .. }) => 2,
+        (Plane { .. }, Capsule { .. })
+        | (Capsule { .. }, Box { .. })
+        | (Box { .. }, Capsule { .. })
+        | (Capsule { .. }, Capsule { .. }) => 2,
         (Hfield { .. }, _) | (_, Hfield { .. }) => crate::collision::hfield::MAX_CONTACTS,
         (Plane { .. }, _) | (_, Plane { .. }) => 1,
         // Closed forms of one contact.

@@ -287,8 +287,9 @@ pub(crate) fn contact_parameters(a: &Attrs) -> Result<GeomContact, LoadError> {
         }
         c.solmix = m;
     }
-    if let Some(r) = a.some_numbers("solref", 2, 2)? {
-        c.solref = [r[0], r[1]];
+    // A partial solref (one value) keeps the default's second, as MuJoCo reads it.
+    if let Some(r) = a.some_numbers("solref", 1, 2)? {
+        c.solref[..r.len()].copy_from_slice(&r);
     }
     if let Some(i) = a.some_numbers("solimp", 1, 5)? {
         c.solimp[..i.len()].copy_from_slice(&i);
