@@ -239,6 +239,7 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
                 frame: contact_frame(&normal, hint.as_ref()),
                 dist,
                 includemargin: pair.margin,
+                gap: pair.gap,
                 condim: pair.condim,
                 friction: pair.friction,
                 solref: pair.solref,

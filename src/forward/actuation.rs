@@ -16,11 +16,12 @@
 //!
 //! Simulated: dyntype none, integrator, filter, filterexact, muscle; fixed, affine or muscle gain;
 //! none, affine or muscle bias ([`muscle`](super::muscle), with `actuator_lengthrange` resolved); joint (hinge, slide, ball, free), jointinparent, fixed-tendon, slider-crank and site
-//! (with or without refsite) transmissions — MuJoCo's `motor`, `position`, `velocity`, `intvelocity`, `damper`,
+//! (with or without refsite), body (adhesion, [`adhesion`](super::adhesion)) transmissions — MuJoCo's `motor`, `position`, `velocity`, `intvelocity`, `damper`,
 //! `cylinder`, `muscle` and such `general` ones. Every other kind is kept, listed by `info` as not
 //! simulated, and contributes no force ([`unsimulated_reason`]).
 
 use super::activation::{activation_rate, next_activation};
+use super::adhesion::body_moment;
 use super::muscle::{muscle_bias, muscle_gain};
 use super::transmission::{moment_span, needs_poses, transmission, Poses};
 use crate::error::{check, InputError};
@@ -143,6 +144,11 @@ pub(crate) fn actuation_unchecked(
         let Data { actuator_moment, x_world_body, s_body, x_world_frame, ten_length, ten_j, .. } = data;
         let poses = Poses { x_world_body, s_body, x_world_frame, ten_length, ten_j };
         let length = transmission(model, a, q, poses, actuator_moment, i);
+        if let Transmission::Body(b) = a.transmission {
+            let Data { actuator_moment, x_world_body, s_body, contacts, .. } = data;
+            body_moment(model, contacts, x_world_body, s_body, b, actuator_moment, i);
+        }
+        let actuator_moment = &data.actuator_moment;
         let velocity = moment_span(model, a).map(|k| actuator_moment[(i, k)] * v[k]).sum::<f64>();
         let ctrl = if zeroed { 0.0 } else { clamped_ctrl(model, data, i) };
         // The input of the gain: the control, or the activation (the next one with actearly).

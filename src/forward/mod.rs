@@ -19,6 +19,7 @@
 
 mod activation;
 mod actuation;
+pub(crate) mod adhesion;
 pub mod muscle;
 mod plan;
 mod skip;

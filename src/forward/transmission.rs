@@ -46,9 +46,13 @@ pub(crate) struct Poses<'a> {
     pub ten_j: &'a DMatrix<f64>,
 }
 
-/// Whether the transmission needs body and site poses (a site transmission).
+/// Whether the transmission needs body and site poses (a site, slider-crank or body
+/// transmission).
 pub(crate) fn needs_poses(a: &Actuator) -> bool {
-    matches!(a.transmission, Transmission::Site { .. } | Transmission::SliderCrank { .. })
+    matches!(
+        a.transmission,
+        Transmission::Site { .. } | Transmission::SliderCrank { .. } | Transmission::Body(_)
+    )
 }
 
 /// The rotation vector (axis · angle, angle in (−π, π]) of the unit quaternion (w, x, y, z):

@@ -26,7 +26,7 @@ pub enum ActuatorShortcut {
     Cylinder,
     /// `<muscle>`: MuJoCo's muscle model.
     Muscle,
-    /// `<adhesion>`: an adhesive body force .
+    /// `<adhesion>`: an adhesive body force (a body transmission).
     Adhesion,
     /// `<plugin>`: an engine plugin (the MJCF loader keeps plugin actuators as untyped elements,
     /// so none has this shortcut).
@@ -179,7 +179,8 @@ impl Actuator {
 
 /// Why actuator `a` of `model` is not simulated, or None if it is: user dynamics, gains and biases;
 /// a muscle without `lengthrange`;
-/// planar-joint and body (adhesion) transmissions.
+/// planar-joint transmissions; body (adhesion) transmissions on a body merged with bodies welded
+/// to it (MuJoCo tells their contacts apart).
 pub fn unsimulated_reason(model: &Model, a: &Actuator) -> Option<&'static str> {
     if a.dyntype == DynType::User {
         return Some("user activation dynamics");
@@ -199,6 +200,6 @@ pub fn unsimulated_reason(model: &Model, a: &Actuator) -> Option<&'static str> {
             matches!(model.joints[*j].kind, JointKind::Planar { .. }).then_some("a planar joint transmission")
         }
         Transmission::Tendon(_) | Transmission::Site { .. } | Transmission::SliderCrank { .. } => None,
-        Transmission::Body(_) => Some("a body (adhesion) transmission"),
+        Transmission::Body(b) => crate::forward::adhesion::unsupported_reason(model, *b),
     }
 }

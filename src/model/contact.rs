@@ -64,6 +64,9 @@ pub struct Contact {
     /// the geoms' margins add up, and contacts are detected up to margin + gap, the gap's
     /// contacts being kept without rows).
     pub includemargin: f64,
+    /// The pair's gap: the contact is reported while `dist` < `includemargin` + `gap` (the
+    /// exact mode's collision looks a little further; adhesion counts only these).
+    pub gap: f64,
     /// 1 (frictionless), 3 (sliding), 4 (+ torsional), 6 (+ rolling).
     pub condim: u32,
     /// tangent1, tangent2, torsional, rolling1, rolling2.
