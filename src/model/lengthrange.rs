@@ -8,7 +8,7 @@
 //! written with lower < upper (`useexisting`); else, with `uselimit`, one on a limited joint takes
 //! the joint's range (not scaled by the gear, as MuJoCo) and one on a limited tendon the tendon's
 //! range; else the range comes from simulating the actuator pushed both ways
-//! ([`super::lengthrange_sim`]).
+//! (`model::lengthrange_sim`, the compiler's).
 
 use super::actuator::{BiasType, GainType, Transmission};
 use super::spec::ActuatorSpec;
