@@ -13,13 +13,14 @@ MuJoCo would give other numbers). Read by tests/actuation_mujoco.rs.
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from pathlib import Path
 
 import mujoco
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from golden_common import golden_main  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "tests/data/mjcf/actuation"
@@ -74,39 +75,9 @@ def scene(name: str) -> dict:
     }
 
 
-def worst_difference(a, b) -> float:
-    """The largest absolute difference between two JSON trees of numbers (inf on a shape change)."""
-    if isinstance(a, dict):
-        if not isinstance(b, dict) or a.keys() != b.keys():
-            return float("inf")
-        return max((worst_difference(a[k], b[k]) for k in a), default=0.0)
-    if isinstance(a, list):
-        if not isinstance(b, list) or len(a) != len(b):
-            return float("inf")
-        return max((worst_difference(x, y) for x, y in zip(a, b)), default=0.0)
-    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
-        return abs(a - b)
-    return 0.0 if a == b else float("inf")
-
-
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--check", action="store_true")
-    args = ap.parse_args()
-    doc = {
-        "generated_by": "validation/mujoco_actuation_golden.py (do not edit)",
-        "mujoco": mujoco.__version__,
-        "scenes": {name: scene(name) for name in CONTROLS},
-    }
-    if args.check:
-        old = json.loads(OUT.read_text())
-        worst = worst_difference(doc["scenes"], old["scenes"])
-        ok = worst <= 1e-12
-        print(f"actuation reference data: live MuJoCo {mujoco.__version__} differs by {worst:.1e} ({'ok' if ok else 'CHANGED'})")
-        return 0 if ok else 1
-    OUT.write_text(json.dumps(doc, indent=1) + "\n")
-    print(f"wrote {OUT.relative_to(ROOT)}")
-    return 0
+    return golden_main(__doc__, "validation/mujoco_actuation_golden.py", "actuation", OUT, ROOT,
+                       lambda: {name: scene(name) for name in CONTROLS})
 
 
 if __name__ == "__main__":
