@@ -576,6 +576,15 @@ fn absurd_tendon_springs_and_fluid_options_are_refused() {
     )
     .unwrap();
     refused(&path, &LoadOptions::default(), &["option", "wind", "1e200", "absurdly large"]);
+    // Found by fuzzing too: a geom's fluidcoef entry of 1e308 (ellipsoid fluid model).
+    let path = dir.join("fluidcoef.xml");
+    std::fs::write(
+        &path,
+        r#"<mujoco><option density="1.2"/><worldbody><body><freejoint/>
+<geom name="c" type="capsule" size="0.03 0.2" fluidshape="ellipsoid" fluidcoef="0.4 0.2 1.2 1e308 0.8"/></body></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    refused(&path, &LoadOptions::default(), &["fluidcoef.xml:2", "fluidcoef", "1e308", "absurdly large"]);
 }
 
 /// A geom's partial `solref` (one value) keeps the default's second entry, as MuJoCo 4.0 reads it

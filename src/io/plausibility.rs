@@ -339,6 +339,9 @@ fn check_link(link: &LinkSpec, word: LinkWord) -> Result<(), LoadError> {
             || format!("{name}: a contact parameter (friction, solref, solimp, solmix, margin, gap)"),
             &contact,
         )?;
+        if let Some(coef) = &g.fluid {
+            check(&g.loc, element, || format!("{name}: a fluidcoef entry"), coef)?;
+        }
         match g.mass {
             GeomMass::Mass(m) => check(&g.loc, element, || format!("{name}: the mass"), &[m])?,
             GeomMass::Density(d) => check(&g.loc, element, || format!("{name}: the density"), &[d])?,
