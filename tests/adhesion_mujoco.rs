@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{rel_err_vec, state_rel_err, REF_REL, SOFT_REL};
+use common::{follow_samples, rel_err_vec, state_rel_err, REF_REL, SOFT_REL};
 use lagrange::forward::unsimulated_reason;
 use lagrange::prelude::*;
 use serde_json::Value;
@@ -59,17 +59,11 @@ fn check_scene(name: &str) {
     }
     reset(&model, &mut data).unwrap();
     data.ctrl.copy_from_slice(&floats(&scene["ctrl"]));
-    let mut worst_run = 0.0f64;
-    let mut k = 0;
-    for sample in scene["run"].as_array().unwrap() {
-        while k < sample["step"].as_u64().unwrap() {
-            step(&model, &mut data).unwrap();
-            k += 1;
-        }
-        let err = state_rel_err(sample, &data);
+    let worst_run = follow_samples(&model, &mut data, &scene["run"], |sample, data, k| {
+        let err = state_rel_err(sample, data);
         assert!(err <= SOFT_REL, "{name} step {k}: rel err {err:e}");
-        worst_run = worst_run.max(err);
-    }
+        err
+    });
     println!(
         "{name}: moment/force worst rel err {worst_forward:.1e}, qacc {worst_qacc:.1e}, 200 steps {worst_run:.1e}"
     );

@@ -10,7 +10,7 @@
 
 mod common;
 
-use common::{rel_err_vec, state_rel_err, REF_REL};
+use common::{follow_samples, rel_err_vec, state_rel_err, REF_REL};
 use lagrange::model::options::Integrator;
 use lagrange::prelude::*;
 use serde_json::Value;
@@ -55,14 +55,9 @@ fn fluid_trajectories_match_mujoco() {
             model.options.integrator = integrator;
             let mut data = Data::new(&model);
             reset_keyframe(&model, &mut data, "moving").unwrap();
-            let (mut worst, mut k) = (0.0f64, 0);
-            for sample in reference["runs"][name].as_array().unwrap() {
-                while k < sample["step"].as_u64().unwrap() {
-                    step(&model, &mut data).unwrap();
-                    k += 1;
-                }
-                worst = worst.max(state_rel_err(sample, &data));
-            }
+            let worst = follow_samples(&model, &mut data, &reference["runs"][name], |sample, data, _| {
+                state_rel_err(sample, data)
+            });
             println!("{scene} {name}: 200 steps, worst rel err {worst:.1e}");
             assert!(worst <= REF_REL, "{scene} {name}: {worst:e}");
         }

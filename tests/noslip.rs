@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{rel_err_vec, state_rel_err, REF_REL, SOFT_REL};
+use common::{follow_samples, rel_err_vec, state_rel_err, REF_REL, SOFT_REL};
 use lagrange::prelude::*;
 use serde_json::Value;
 
@@ -78,14 +78,8 @@ fn noslip_trajectories_match_mujoco() {
     let ctrl = golden["ctrl"].as_f64().unwrap();
     for (scene, n, case) in cases(&golden) {
         let (model, mut data) = load(&scene, n, ctrl);
-        let (mut worst, mut k) = (0.0f64, 0);
-        for sample in case["run"].as_array().unwrap() {
-            while k < sample["step"].as_u64().unwrap() {
-                step(&model, &mut data).unwrap();
-                k += 1;
-            }
-            worst = worst.max(state_rel_err(sample, &data));
-        }
+        let worst =
+            follow_samples(&model, &mut data, &case["run"], |sample, data, _| state_rel_err(sample, data));
         println!("{scene} noslip {n}: 200 steps, worst rel err {worst:.1e}");
         assert!(worst <= SOFT_REL, "{scene} noslip {n}: {worst:e}");
     }

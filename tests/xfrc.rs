@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{state_rel_err, REF_REL};
+use common::{follow_samples, state_rel_err, REF_REL};
 use lagrange::model::FrameKind;
 use lagrange::prelude::*;
 use serde_json::Value;
@@ -52,15 +52,9 @@ fn wrenches_on_bodies_follow_mujoco() {
             let w: Vec<f64> = w.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
             data.xfrc_applied[body_index(&model, body)].copy_from_slice(&w);
         }
-        let mut worst = 0.0f64;
-        let mut k = 0;
-        for sample in golden["runs"][name].as_array().unwrap() {
-            while k < sample["step"].as_u64().unwrap() {
-                step(&model, &mut data).unwrap();
-                k += 1;
-            }
-            worst = worst.max(state_rel_err(sample, &data));
-        }
+        let worst = follow_samples(&model, &mut data, &golden["runs"][name], |sample, data, _| {
+            state_rel_err(sample, data)
+        });
         println!(
             "{name}: 200 steps with wrenches on box, forearm and welded hand, worst rel err {worst:.1e}"
         );

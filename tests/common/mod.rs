@@ -597,6 +597,26 @@ pub fn state_rel_err(sample: &serde_json::Value, data: &Data) -> f64 {
     worst
 }
 
+/// Steps `data` from its state to each golden sample's `"step"` count in turn (samples in
+/// increasing order) and returns the worst of `err(sample, data, step)` over them (the caller
+/// asserts inside `err` where a sample must pass).
+pub fn follow_samples(
+    model: &lagrange::Model,
+    data: &mut Data,
+    samples: &serde_json::Value,
+    mut err: impl FnMut(&serde_json::Value, &Data, u64) -> f64,
+) -> f64 {
+    let (mut worst, mut k) = (0.0f64, 0u64);
+    for sample in samples.as_array().unwrap() {
+        while k < sample["step"].as_u64().unwrap() {
+            lagrange::integrate::step(model, data).unwrap();
+            k += 1;
+        }
+        worst = worst.max(err(sample, data, k));
+    }
+    worst
+}
+
 /// The model at `path` with the golden data's tight solver options (Newton, tolerance 1e-15,
 /// 1000 iterations; line search 100 iterations to 1e-12), as validation/crossval_soft.py's
 /// tight copies.
