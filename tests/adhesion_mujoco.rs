@@ -1,4 +1,4 @@
-//! Adhesion (body transmissions, issue 30) against MuJoCo 4.0 (reference data from
+//! Adhesion (body transmissions, docs/physics.md) against MuJoCo 4.0 (reference data from
 //! validation/mujoco_adhesion_golden.py, checked against the live MuJoCo in `.ci/run`): for each
 //! scene of tests/data/mjcf/adhesion (adhesive spheres on a plane, one with rows and one in the
 //! gap; a suction cup (sphere) on a box resting on a table, with a `<general body=...>` on the box; a box

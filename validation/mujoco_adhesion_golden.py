@@ -1,4 +1,4 @@
-"""Reference data for adhesion (issue 30): body transmissions (`<adhesion>`, `<general body=...>`) on
+"""Reference data for adhesion: body transmissions (`<adhesion>`, `<general body=...>`) on
 the scenes of tests/data/mjcf/adhesion. MuJoCo's mj_forward at states (qpos0 moved by a small random
 velocity through mj_integratePos, so that contacts stay within margin and gap, random qvel and ctrl)
 — the dense actuator_moment, actuator_length, actuator_velocity, actuator_force, qfrc_actuator,

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 30's count: `lagrange info` on every MJCF model of the corpus (validation/crossval_corpus.py,
+"""The count of what lagrange parses but does not simulate: `lagrange info` on every MJCF model of the corpus (validation/crossval_corpus.py,
 `--extra` adds MyoSuite's), listing each element it reports as "parsed, not simulated" other than
 flexes, skins, plugins and user sensors (which stay outside the engine). Prints the count and the
 elements; exits 1 when a model has one, or when lagrange cannot load a model MuJoCo loads.
