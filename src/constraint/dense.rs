@@ -43,30 +43,34 @@ pub(crate) fn solve_psd(
 /// entry in row j is zero are skipped (they subtract exact zeros).
 pub(crate) fn cholesky(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f64) -> bool {
     let stride = l.nrows();
-    let ls = l.as_mut_slice();
+    let a_stride = a.nrows();
+    let (a_s, ls) = (a.as_slice(), l.as_mut_slice());
     for j in 0..n {
         let cj = j * stride;
-        for i in j..n {
-            ls[cj + i] = a[(i, j)];
-        }
+        // The earlier columns (read) and column j (written) as disjoint slices, so that the
+        // inner loops run without bounds checks or aliasing and vectorize (a separate multiply
+        // and subtract per entry, as the scalar form: the same bits).
+        let (done, rest) = ls.split_at_mut(cj);
+        let col_j = &mut rest[j..n];
+        col_j.copy_from_slice(&a_s[j * a_stride + j..j * a_stride + n]);
         for k in 0..j {
-            let ck = k * stride;
-            let ljk = ls[ck + j];
+            let col_k = &done[k * stride + j..k * stride + n];
+            let ljk = col_k[0];
             if ljk == 0.0 {
                 continue;
             }
-            for i in j..n {
-                ls[cj + i] -= ls[ck + i] * ljk;
+            for (x, &y) in col_j.iter_mut().zip(col_k) {
+                *x -= y * ljk;
             }
         }
-        let d = ls[cj + j];
+        let d = col_j[0];
         if d <= tol {
             return false;
         }
         let d = d.sqrt();
-        ls[cj + j] = d;
-        for i in j + 1..n {
-            ls[cj + i] /= d;
+        col_j[0] = d;
+        for x in &mut col_j[1..] {
+            *x /= d;
         }
     }
     true
@@ -78,23 +82,26 @@ pub(crate) fn cholesky(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f6
 pub(crate) fn cholesky_solve(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
     let stride = l.nrows();
     let ls = l.as_slice();
+    let b = &mut b[..n];
     for k in 0..n {
-        let ck = k * stride;
-        b[k] /= ls[ck + k];
-        let bk = b[k];
+        let col_k = &ls[k * stride + k..k * stride + n];
+        let (head, tail) = b[k..].split_at_mut(1);
+        head[0] /= col_k[0];
+        let bk = head[0];
         if bk != 0.0 {
-            for i in k + 1..n {
-                b[i] -= ls[ck + i] * bk;
+            for (x, &y) in tail.iter_mut().zip(&col_k[1..]) {
+                *x -= y * bk;
             }
         }
     }
     for i in (0..n).rev() {
-        let ci = i * stride;
-        let mut s = b[i];
-        for k in i + 1..n {
-            s -= ls[ci + k] * b[k];
+        let col_i = &ls[i * stride + i..i * stride + n];
+        let (head, tail) = b[i..].split_at_mut(1);
+        let mut s = head[0];
+        for (&y, &x) in col_i[1..].iter().zip(tail.iter()) {
+            s -= y * x;
         }
-        b[i] = s / ls[ci + i];
+        head[0] = s / col_i[0];
     }
 }
 

@@ -159,6 +159,18 @@ fn add_weighted_outer(
     }
     let nv = h.nrows();
     let h = h.as_mut_slice();
+    if a == b {
+        // One row's own term (a row's columns ascend): the entries p ≥ q of column q are the
+        // row's columns from q's position on, with no test per entry.
+        for (t, &q) in row_a.iter().enumerate() {
+            let j_bq = efc_j[(b, q)];
+            let column = &mut h[q * nv..(q + 1) * nv];
+            for (x, &p) in weighted[t..row_a.len()].iter().zip(&row_a[t..]) {
+                column[p] += x * j_bq;
+            }
+        }
+        return;
+    }
     for &q in row_b {
         let j_bq = efc_j[(b, q)];
         let column = &mut h[q * nv..(q + 1) * nv];
@@ -235,10 +247,16 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     if s.warmstart {
         let c = total(qacc_warmstart, &mut soft.mdir, &mut soft.jv, &mut soft.jar_trial, efc_state);
         if c < cost {
+            // The warm start's M a, jar, forces and states (in the scratch buffers) become the
+            // current ones: what evaluating the cost again at it would write.
             qacc.copy_from(qacc_warmstart);
-            cost = total(qacc, &mut soft.ma, &mut soft.jar, efc_force, efc_state);
+            std::mem::swap(&mut soft.ma, &mut soft.mdir);
+            std::mem::swap(&mut soft.jar, &mut soft.jv);
+            std::mem::swap(efc_force, &mut soft.jar_trial);
+            cost = c;
         } else {
-            cost = total(qacc, &mut soft.ma, &mut soft.jar, efc_force, efc_state);
+            // Back to qacc_smooth's states (the trial wrote its own): its M a and jar are kept.
+            rows.update(&soft.jar, efc_force, efc_state);
         }
     }
     let mut improvement = f64::INFINITY;
