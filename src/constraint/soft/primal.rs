@@ -52,23 +52,29 @@ pub struct Settings {
 struct Sparsity<'a> {
     start: &'a [usize],
     index: &'a [usize],
+    /// J's value at each of `index`'s entries (row i's are `value[start[i]..start[i + 1]]`).
+    value: &'a [f64],
 }
 
 impl Sparsity<'_> {
-    fn row(&self, i: usize) -> &[usize] {
-        &self.index[self.start[i]..self.start[i + 1]]
+    /// Row i's nonzero columns and J's values there.
+    fn row_values(&self, i: usize) -> (&[usize], &[f64]) {
+        let (s, e) = (self.start[i], self.start[i + 1]);
+        (&self.index[s..e], &self.value[s..e])
     }
 }
 
 /// The nonzero columns of J's rows 0..nefc, ascending, into `start`/`index` (row i's are
-/// `index[start[i]..start[i + 1]]`), from one pass over J's columns (contiguous in its storage):
-/// each column's nonzero rows are appended to `index` column after column (`start` counting
-/// them per row), then regrouped by row in place through `scratch`.
+/// `index[start[i]..start[i + 1]]`) and J's values there into `value`, from one pass over J's
+/// columns (contiguous in its storage): each column's nonzero rows are appended to `index`
+/// column after column (`start` counting them per row), then regrouped by row in place through
+/// `scratch`. The solver's products then read each row's values contiguously.
 fn sparsity(
     j: &DMatrix<f64>,
     nefc: usize,
     start: &mut Vec<usize>,
     index: &mut Vec<usize>,
+    value: &mut Vec<f64>,
     scratch: &mut Vec<(usize, usize)>,
 ) {
     start.clear();
@@ -89,10 +95,13 @@ fn sparsity(
     }
     index.clear();
     index.resize(start[nefc], 0);
+    value.clear();
+    value.resize(start[nefc], 0.0);
     // start[i] is row i's next free slot while filling (columns arrive in ascending order), then
     // shifted back.
     for &(i, k) in scratch.iter() {
         index[start[i]] = k;
+        value[start[i]] = data[k * rows + i];
         start[i] += 1;
     }
     for i in (1..=nefc).rev() {
@@ -102,9 +111,10 @@ fn sparsity(
 }
 
 /// r ← J x (rows 0..nefc).
-fn mul_j(j: &DMatrix<f64>, s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
+fn mul_j(s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
     for i in 0..nefc {
-        r[i] = s.row(i).iter().map(|&k| j[(i, k)] * x[k]).sum();
+        let (cols, vals) = s.row_values(i);
+        r[i] = cols.iter().zip(vals).map(|(&k, &j_ik)| j_ik * x[k]).sum();
     }
 }
 
@@ -140,30 +150,21 @@ pub(crate) const DENSE_NV: usize = 40;
 /// `efc_converged`, and counts a solve that stopped at the iteration limit in `efc_unconverged`.
 /// H[p][q] += (w J[a][p]) J[b][q] over the nonzero columns p ≥ q of rows a and b: the lower
 /// triangle of one Hessian term. Row a's weighted entries are gathered first (`weighted`, nv
-/// long, indexed like row a's nonzeros) so that J's column-major storage is read once per row,
-/// and the sums are written column by column; each entry gets the same products in the same
+/// long, indexed like row a's nonzeros, from the rows' compact values `Sparsity::value`), and
+/// the sums are written column by column; each entry gets the same products in the same
 /// order as a direct double loop, so the same bits.
 #[inline]
-fn add_weighted_outer(
-    h: &mut DMatrix<f64>,
-    efc_j: &DMatrix<f64>,
-    nz: &Sparsity,
-    a: usize,
-    b: usize,
-    w: f64,
-    weighted: &mut [f64],
-) {
-    let (row_a, row_b) = (nz.row(a), nz.row(b));
-    for (x, &p) in weighted.iter_mut().zip(row_a) {
-        *x = w * efc_j[(a, p)];
+fn add_weighted_outer(h: &mut DMatrix<f64>, nz: &Sparsity, a: usize, b: usize, w: f64, weighted: &mut [f64]) {
+    let ((row_a, j_a), (row_b, j_b)) = (nz.row_values(a), nz.row_values(b));
+    for (x, &j_ap) in weighted.iter_mut().zip(j_a) {
+        *x = w * j_ap;
     }
     let nv = h.nrows();
     let h = h.as_mut_slice();
     if a == b {
         // One row's own term (a row's columns ascend): the entries p ≥ q of column q are the
         // row's columns from q's position on, with no test per entry.
-        for (t, &q) in row_a.iter().enumerate() {
-            let j_bq = efc_j[(b, q)];
+        for (t, (&q, &j_bq)) in row_a.iter().zip(j_b).enumerate() {
             let column = &mut h[q * nv..(q + 1) * nv];
             for (x, &p) in weighted[t..row_a.len()].iter().zip(&row_a[t..]) {
                 column[p] += x * j_bq;
@@ -171,8 +172,7 @@ fn add_weighted_outer(
         }
         return;
     }
-    for &q in row_b {
-        let j_bq = efc_j[(b, q)];
+    for (&q, &j_bq) in row_b.iter().zip(j_b) {
         let column = &mut h[q * nv..(q + 1) * nv];
         for (x, &p) in weighted.iter().zip(row_a) {
             if p >= q {
@@ -187,10 +187,16 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     let nefc = data.nefc;
     {
         let Data { efc_j, soft, .. } = &mut *data;
-        sparsity(efc_j, nefc, &mut soft.nz_start, &mut soft.nz_index, &mut soft.nz_scratch);
+        sparsity(
+            efc_j,
+            nefc,
+            &mut soft.nz_start,
+            &mut soft.nz_index,
+            &mut soft.nz_value,
+            &mut soft.nz_scratch,
+        );
     }
     let Data {
-        efc_j,
         efc_type,
         efc_id,
         efc_d,
@@ -214,7 +220,8 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         ..
     } = data;
     let (nz_start, nz_index) = (std::mem::take(&mut soft.nz_start), std::mem::take(&mut soft.nz_index));
-    let nz = Sparsity { start: &nz_start, index: &nz_index };
+    let nz_value = std::mem::take(&mut soft.nz_value);
+    let nz = Sparsity { start: &nz_start, index: &nz_index, value: &nz_value };
     let rows = Rows {
         ne: *ne,
         nf: *nf,
@@ -234,7 +241,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                  force: &mut DVector<f64>,
                  state: &mut [_]| {
         mul_m(&model.dof_parent, mass_matrix, x, ma);
-        mul_j(efc_j, &nz, nefc, x, jar);
+        mul_j(&nz, nefc, x, jar);
         for i in 0..nefc {
             jar[i] -= efc_aref[i];
         }
@@ -272,8 +279,9 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         for i in 0..nefc {
             let f = efc_force[i];
             if f != 0.0 {
-                for &k in nz.row(i) {
-                    soft.grad[k] -= efc_j[(i, k)] * f;
+                let (cols, vals) = nz.row_values(i);
+                for (&k, &j_ik) in cols.iter().zip(vals) {
+                    soft.grad[k] -= j_ik * f;
                 }
             }
         }
@@ -292,7 +300,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                     rows.hessian(&soft.jar, efc_state, |i, dim, block| {
                         for (a, row) in (i..i + dim).zip(block) {
                             for (b, &w) in (i..i + dim).zip(row) {
-                                add_weighted_outer(h, efc_j, &nz, a, b, w, weighted);
+                                add_weighted_outer(h, &nz, a, b, w, weighted);
                             }
                         }
                     });
@@ -329,7 +337,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                                     Some(g) if g.1 >= a.min(b) => g.1 = g.1.max(a.max(b)),
                                     _ => active.push((a, a.max(b))),
                                 }
-                                add_weighted_outer(h, efc_j, &nz, a, b, w, weighted);
+                                add_weighted_outer(h, &nz, a, b, w, weighted);
                             }
                         }
                     });
@@ -371,7 +379,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                 have_dir = true;
             }
         }
-        mul_j(efc_j, &nz, nefc, &soft.dir, &mut soft.jv);
+        mul_j(&nz, nefc, &soft.dir, &mut soft.jv);
         mul_m(&model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
         let g0: f64 = (0..nv).map(|k| (soft.ma[k] - qfrc_smooth[k]) * soft.dir[k]).sum();
         let dmd = soft.dir.dot(&soft.mdir);
@@ -391,13 +399,15 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     for i in 0..nefc {
         let f = efc_force[i];
         if f != 0.0 {
-            for &k in nz.row(i) {
-                qfrc_constraint[k] += f * efc_j[(i, k)];
+            let (cols, vals) = nz.row_values(i);
+            for (&k, &j_ik) in cols.iter().zip(vals) {
+                qfrc_constraint[k] += f * j_ik;
             }
         }
     }
     data.soft.nz_start = nz_start;
     data.soft.nz_index = nz_index;
+    data.soft.nz_value = nz_value;
     data.solver_niter = iter;
     data.solver_improvement = if improvement.is_finite() { improvement } else { 0.0 };
     data.solver_gradient = gradient;

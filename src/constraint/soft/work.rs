@@ -33,6 +33,8 @@ pub(crate) struct SoftWork {
     /// The nonzero columns of each row of J: row i's are `nz_index[nz_start[i]..nz_start[i + 1]]`.
     pub nz_start: Vec<usize>,
     pub nz_index: Vec<usize>,
+    /// J's values at those entries, in the same order.
+    pub nz_value: Vec<f64>,
     /// (row, column) of J's nonzeros in column order, while `nz_start`/`nz_index` are built.
     pub nz_scratch: Vec<(usize, usize)>,
     /// One row of J at its nonzero columns times a Hessian weight, while H is assembled (nv).
@@ -65,6 +67,7 @@ impl SoftWork {
             active_rows: Vec::with_capacity(nefc),
             nz_start: Vec::with_capacity(nefc + 1),
             nz_index: Vec::with_capacity(nefc * nv),
+            nz_value: Vec::with_capacity(nefc * nv),
             nz_scratch: Vec::new(),
             weighted_row: vec![0.0; nv],
             ar: DMatrix::zeros(0, 0),
