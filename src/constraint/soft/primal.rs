@@ -112,9 +112,10 @@ fn sparsity(
 
 /// r ← J x (rows 0..nefc).
 fn mul_j(s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
-    for i in 0..nefc {
+    let x = x.as_slice();
+    for (i, r_i) in r.as_mut_slice()[..nefc].iter_mut().enumerate() {
         let (cols, vals) = s.row_values(i);
-        r[i] = cols.iter().zip(vals).map(|(&k, &j_ik)| j_ik * x[k]).sum();
+        *r_i = cols.iter().zip(vals).map(|(&k, &j_ik)| j_ik * x[k]).sum();
     }
 }
 
@@ -242,10 +243,17 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                  state: &mut [_]| {
         mul_m(&model.dof_parent, mass_matrix, x, ma);
         mul_j(&nz, nefc, x, jar);
-        for i in 0..nefc {
-            jar[i] -= efc_aref[i];
+        for (j, &r) in jar.as_mut_slice()[..nefc].iter_mut().zip(&efc_aref.as_slice()[..nefc]) {
+            *j -= r;
         }
-        let gauss: f64 = (0..nv).map(|k| 0.5 * (x[k] - qacc_smooth[k]) * (ma[k] - qfrc_smooth[k])).sum();
+        let (x, a0) = (&x.as_slice()[..nv], &qacc_smooth.as_slice()[..nv]);
+        let (ma, f0) = (&ma.as_slice()[..nv], &qfrc_smooth.as_slice()[..nv]);
+        let gauss: f64 = x
+            .iter()
+            .zip(a0)
+            .zip(ma.iter().zip(f0))
+            .map(|((&x, &a0), (&ma, &f0))| 0.5 * (x - a0) * (ma - f0))
+            .sum();
         gauss + rows.update(jar, force, state)
     };
     // Start: the warm start (the previous solution) if it costs less than qacc_smooth.
@@ -273,8 +281,10 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     let mut stalled = false;
     loop {
         // g = M a − qfrc_smooth − Jᵀ f.
-        for k in 0..nv {
-            soft.grad[k] = soft.ma[k] - qfrc_smooth[k];
+        for ((g, &ma), &f0) in
+            soft.grad.as_mut_slice().iter_mut().zip(soft.ma.as_slice()).zip(qfrc_smooth.as_slice())
+        {
+            *g = ma - f0;
         }
         for i in 0..nefc {
             let f = efc_force[i];
@@ -296,7 +306,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                     // Small: H = M + Jᵀ (∂²s) J, its lower triangle (all the dense Cholesky
                     // reads), by dense Cholesky.
                     let (h, weighted) = (&mut soft.hessian, &mut soft.weighted_row);
-                    h.copy_from(mass_matrix);
+                    h.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
                     rows.hessian(&soft.jar, efc_state, |i, dim, block| {
                         for (a, row) in (i..i + dim).zip(block) {
                             for (b, &w) in (i..i + dim).zip(row) {
@@ -381,7 +391,9 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         }
         mul_j(&nz, nefc, &soft.dir, &mut soft.jv);
         mul_m(&model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
-        let g0: f64 = (0..nv).map(|k| (soft.ma[k] - qfrc_smooth[k]) * soft.dir[k]).sum();
+        let g0: f64 = (soft.ma.iter().zip(qfrc_smooth.iter()).zip(soft.dir.iter()))
+            .map(|((&ma, &f0), &d)| (ma - f0) * d)
+            .sum();
         let dmd = soft.dir.dot(&soft.mdir);
         let alpha = line_search(&rows, &soft.jar, &soft.jv, &mut soft.jar_trial, g0, dmd, s);
         if alpha == 0.0 {
@@ -436,8 +448,8 @@ fn line_search(
 ) -> f64 {
     let n = rows.nefc;
     let mut deriv = |alpha: f64| {
-        for i in 0..n {
-            trial[i] = jar[i] + alpha * jv[i];
+        for ((t, &j), &v) in trial.as_mut_slice()[..n].iter_mut().zip(jar.as_slice()).zip(jv.as_slice()) {
+            *t = j + alpha * v;
         }
         let (d1, d2) = rows.directional(trial, jv);
         (g0 + alpha * dmd + d1, dmd + d2)
