@@ -165,10 +165,14 @@ fn add_weighted_outer(h: &mut DMatrix<f64>, nz: &Sparsity, a: usize, b: usize, w
     if a == b {
         // One row's own term (a row's columns ascend): the entries p ≥ q of column q are the
         // row's columns from q's position on, with no test per entry.
-        for (t, (&q, &j_bq)) in row_a.iter().zip(j_b).enumerate() {
+        let len = row_a.len();
+        let (weighted, j_b) = (&weighted[..len], &j_b[..len]);
+        for t in 0..len {
+            let (q, j_bq) = (row_a[t], j_b[t]);
             let column = &mut h[q * nv..(q + 1) * nv];
-            for (x, &p) in weighted[t..row_a.len()].iter().zip(&row_a[t..]) {
-                column[p] += x * j_bq;
+            let (x_t, p_t) = (&weighted[t..], &row_a[t..]);
+            for u in 0..p_t.len() {
+                column[p_t[u]] += x_t[u] * j_bq;
             }
         }
         return;
