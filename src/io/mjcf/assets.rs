@@ -41,11 +41,9 @@ pub(crate) fn meshes(
             let Some(file) = a.text("file") else {
                 let (name, mesh) = match a.text("builtin") {
                     Some(shape) => {
-                        let (name, mesh, shell) = super::mesh_builtin::builtin_mesh(e, &a, shape)?;
-                        // MuJoCo: a built-in surface without volume turns `legacy` into `shell`.
-                        if shell && inertia == MeshInertia::Legacy {
-                            inertia = MeshInertia::Shell;
-                        }
+                        // MuJoCo makes a built-in surface without volume `shell`.
+                        let (name, mesh, mode) = super::mesh_builtin::builtin_mesh(e, &a, shape, inertia)?;
+                        inertia = mode;
                         (name, mesh)
                     }
                     None => super::mesh_inline::inline_mesh(e, &a)?,

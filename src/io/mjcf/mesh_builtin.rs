@@ -15,21 +15,24 @@
 //! stores as surfaces without volume turn a `legacy` inertia into `shell`.
 
 use super::attrs::Attrs;
+use super::mesh_builtin_solid::Shell;
 use super::xml::Element;
 use crate::io::LoadError;
-use crate::mass::{self, TriangleMesh};
+use crate::mass::{self, MeshInertia, TriangleMesh};
 use crate::spatial::Vec3;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-/// The name and triangles (mesh frame, before scale) of a built-in mesh element `e`, and whether
-/// MuJoCo makes its `legacy` inertia `shell` (the surfaces without volume).
+/// The name and triangles (mesh frame, before scale) of a built-in mesh element `e`, and its
+/// inertia mode: the element's `inertia`, or `shell` where MuJoCo makes it so (the surfaces
+/// without volume).
 pub(crate) fn builtin_mesh(
     e: &Element,
     a: &Attrs,
     shape: &str,
-) -> Result<(String, Arc<TriangleMesh>, bool), LoadError> {
+    inertia: MeshInertia,
+) -> Result<(String, Arc<TriangleMesh>, MeshInertia), LoadError> {
     let invalid = |detail: String| LoadError::Invalid { loc: e.loc.clone(), element: "mesh".into(), detail };
     let Some(name) = a.text("name") else {
         return Err(invalid(format!("the built-in mesh '{shape}' needs a 'name' for geoms to refer to it")));
@@ -45,8 +48,8 @@ pub(crate) fn builtin_mesh(
             ))
         }
     };
-    // MuJoCo switches a `legacy` inertia to `shell` for the built-ins without volume.
-    let mut shell = false;
+    // MuJoCo switches the inertia to `shell` for the built-ins without volume.
+    let mut inertia = inertia;
     let mesh = match shape {
         "sphere" => {
             count(1, "subdivisions")?;
@@ -109,7 +112,11 @@ pub(crate) fn builtin_mesh(
             let g = super::mesh_builtin_solid::generate(shape, &params).map_err(|r| {
                 a.error("params", format!("of the built-in {shape} mesh '{name}' is refused as MuJoCo 4.0 refuses it: \"{}\"; {}", r.reason, r.fix))
             })?;
-            shell = g.shell;
+            match g.shell {
+                Shell::Always => inertia = MeshInertia::Shell,
+                Shell::FromLegacy if inertia == MeshInertia::Legacy => inertia = MeshInertia::Shell,
+                _ => {}
+            }
             let vertices: Vec<Vec3> =
                 g.vert.chunks_exact(3).map(|c| Vec3::new(c[0].into(), c[1].into(), c[2].into())).collect();
             if g.face.is_empty() {
@@ -129,7 +136,7 @@ pub(crate) fn builtin_mesh(
             ))
         }
     };
-    Ok((name.to_string(), Arc::new(mesh), shell))
+    Ok((name.to_string(), Arc::new(mesh), inertia))
 }
 
 /// MuJoCo's `MakeSphere` (make_faces): an icosahedron subdivided `subdiv` times, in `f32`.

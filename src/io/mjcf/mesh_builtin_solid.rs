@@ -11,8 +11,9 @@
 //!   hull;
 //! - a `dim` 2 `box`, `cylinder` or `ellipsoid`: an open-top surface (the `+z` side omitted) whose
 //!   `legacy` inertia becomes `shell`;
-//! - `plate`, `square`, `disc` and a `dim` 2 `grid`: flat triangulated surfaces (inertia `shell`),
-//!   which MuJoCo refuses as a geom ("has coplanar vertices, cannot compute convex hull").
+//! - `plate`, `square`, `disc` and a `dim` 2 `grid`: flat triangulated surfaces (inertia `shell`:
+//!   always for `plate`, over `legacy` for the others), which MuJoCo refuses as a colliding geom
+//!   ("has coplanar vertices, cannot compute convex hull") and accepts as a visual one.
 //!
 //! The checks are MuJoCo's, in MuJoCo's order; the messages quote MuJoCo's reason.
 
@@ -22,14 +23,26 @@ use std::f64::consts::PI;
 const EPS: f64 = 1e-14;
 
 /// A generated built-in mesh: MuJoCo's `uservert` (flat `f32` triples), its `userface` (empty
-/// when MuJoCo stores only points) and whether MuJoCo switches a `legacy` inertia to `shell`.
+/// when MuJoCo stores only points) and how MuJoCo changes its inertia mode.
 pub(crate) struct Generated {
     /// Vertices, three `f32` per vertex.
     pub vert: Vec<f32>,
     /// Triangles, three vertex indices per face; empty for a point cloud (hull).
     pub face: Vec<u32>,
-    /// MuJoCo sets `inertia="shell"` over a `legacy` one (a surface without volume).
-    pub shell: bool,
+    /// How MuJoCo sets `inertia` for this surface.
+    pub shell: Shell,
+}
+
+/// How MuJoCo 4.0 changes a built-in's inertia mode.
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub(crate) enum Shell {
+    /// The mesh's `inertia` stands.
+    Keep,
+    /// A `legacy` inertia (the default, or given) becomes `shell`: the surfaces without volume
+    /// (documented under `<mesh params>`).
+    FromLegacy,
+    /// `shell` whatever the file says (`MakeRect` sets it for `plate`).
+    Always,
 }
 
 /// A refused parameter set: MuJoCo's reason and how to fix it.
@@ -228,7 +241,7 @@ fn wedge(res: [usize; 2], fov: [f64; 2], gamma: f64) -> Generated {
             vert.extend([e.cos() * a.sin(), e.sin(), -e.cos() * a.cos()].map(|x| x as f32));
         }
     }
-    Generated { vert, face: Vec::new(), shell: false }
+    Generated { vert, face: Vec::new(), shell: Shell::Keep }
 }
 
 /// `MakeRect(resolution)`: cell centres of a `[−1, 1]²` grid at z = −1, two triangles between
@@ -253,7 +266,7 @@ fn plate(res: [usize; 2]) -> Generated {
             }
         }
     }
-    Generated { vert, face, shell: true }
+    Generated { vert, face, shell: Shell::Always }
 }
 
 /// `MakeGrid` in 3D (`volume`: the points of a `count` grid centred on the origin; the
@@ -274,7 +287,7 @@ fn grid(count: [usize; 3], spacing: [f64; 3], volume: bool, disc: bool) -> Optio
                 }
             }
         }
-        return Some(Generated { vert, face: Vec::new(), shell: false });
+        return Some(Generated { vert, face: Vec::new(), shell: Shell::Keep });
     }
     if count[0] < 2 || count[1] < 2 {
         return None;
@@ -305,7 +318,7 @@ fn grid(count: [usize; 3], spacing: [f64; 3], volume: bool, disc: bool) -> Optio
             vert.extend([pos[0] as f32, pos[1] as f32, 0.0]);
         }
     }
-    Some(Generated { vert, face, shell: true })
+    Some(Generated { vert, face, shell: Shell::FromLegacy })
 }
 
 /// Which surface `BoxProject` maps the box's grid onto.
@@ -385,7 +398,7 @@ fn solid(kind: Projection, count: [usize; 3], spacing: [f64; 3], volume: bool) -
         }
     }
     if volume {
-        return Generated { vert, face: Vec::new(), shell: false };
+        return Generated { vert, face: Vec::new(), shell: Shell::Keep };
     }
     let at = |ix: usize, iy: usize, iz: usize| idx[lin(ix, iy, iz)];
     let mut face = Vec::new();
@@ -414,5 +427,5 @@ fn solid(kind: Projection, count: [usize; 3], spacing: [f64; 3], volume: bool) -
             }
         }
     }
-    Generated { vert, face, shell: true }
+    Generated { vert, face, shell: Shell::FromLegacy }
 }
