@@ -227,6 +227,10 @@ fn bad_builtin_params_are_typed_errors() {
         (r#"builtin="supertorus" params="8 1.5 1 1""#, "(0, 1]"),
         (r#"builtin="supertorus" params="8 0.5 0 1""#, "greater than 0"),
         (r#"builtin="supertorus" params="8 0.5 1""#, "requires 4"),
+        (r#"builtin="grid" params="0 3 3 1 1 1""#, "Grid count must be positive"),
+        (r#"builtin="box" params="3 3 3 1 1 1 4""#, "Mesh dim must be 2 or 3"),
+        (r#"builtin="wedge" params="1 1 60 30 0""#, "at least 4 vertices required"),
+        (r#"builtin="ellipsoid" params="3 3 3 0 1 1""#, "has coplanar vertices"),
     ] {
         let xml = format!(
             "<mujoco><asset>\n<mesh name=\"m\" {mesh}/></asset><worldbody><body><freejoint/><geom type=\"mesh\" mesh=\"m\"/></body></worldbody></mujoco>"
