@@ -202,7 +202,7 @@ fn builtins_mujoco_refuses_are_refused_for_its_reason() {
 }
 
 #[test]
-fn flat_builtins_load_when_no_geom_uses_them() {
+fn flat_surfaces_load_when_no_geom_uses_them_flat_point_sets_do_not() {
     // MuJoCo only needs a hull for a mesh geom: the flat built-ins are accepted as assets.
     for mesh in [
         r#"builtin="plate" params="3 3""#,
@@ -214,6 +214,18 @@ fn flat_builtins_load_when_no_geom_uses_them() {
             "<mujoco><asset><mesh name=\"m\" {mesh}/></asset><worldbody><body><freejoint/><geom size=\"0.1\"/></body></worldbody></mujoco>"
         );
         Model::from_str(&xml).unwrap_or_else(|e| panic!("{mesh}: {e}"));
+    }
+    // A point set (no faces) needs its hull as faces, used or not: MuJoCo refuses a flat one.
+    for (mesh, reason) in [
+        (r#"builtin="wedge" params="2 2 60 30 0""#, "has coplanar vertices"),
+        (r#"builtin="wedge" params="2 1 60 30 0""#, "at least 4 vertices required"),
+        (r#"builtin="grid" params="3 3 3 0 0.1 0.1""#, "has coplanar vertices"),
+    ] {
+        let xml = format!(
+            "<mujoco><asset><mesh name=\"m\" {mesh}/></asset><worldbody><body><freejoint/><geom size=\"0.1\"/></body></worldbody></mujoco>"
+        );
+        let err = Model::from_str(&xml).unwrap_err().to_string();
+        assert!(err.contains(reason), "{mesh}: {err}");
     }
 }
 
