@@ -399,6 +399,13 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     model.equalities = e.equalities;
     model.tendons = e.tendons;
     model.actuators = e.actuators;
+    // Each control history's place in `Data::history`, in actuator order (MuJoCo's
+    // `actuator_historyadr`).
+    let mut history_adr = 0;
+    for h in model.actuators.iter_mut().filter_map(|a| a.history.as_mut()) {
+        h.adr = history_adr;
+        history_adr += 2 + 2 * h.nsample;
+    }
     model.contact_pairs = e.contact_pairs;
     model.contact_excludes = e.contact_excludes;
     model.elements.append(&mut e.kept);

@@ -21,7 +21,7 @@ pub mod spec;
 pub mod tendon;
 pub mod warning;
 
-pub use actuator::Actuator;
+pub use actuator::{Actuator, ActuatorHistory, Interp};
 pub use collision_pairs::CollisionPair;
 pub use contact::{Contact, ContactExclude, ContactPair};
 pub use data::{Data, EfcState, EfcType, SLIP_VELOCITY};
@@ -344,6 +344,11 @@ impl Model {
     /// dynamics, in actuator order.
     pub fn na(&self) -> usize {
         self.actuators.iter().map(|a| a.actnum()).sum()
+    }
+    /// Length of `Data::history` (MuJoCo's `nhistory`): 2 + 2·nsample per actuator with a
+    /// control history.
+    pub fn nhistory(&self) -> usize {
+        self.actuators.iter().filter_map(|a| a.history.as_ref()).map(|h| 2 + 2 * h.nsample).sum()
     }
     /// Number of bodies including the world.
     pub fn nbody(&self) -> usize {
