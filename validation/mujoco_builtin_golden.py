@@ -36,7 +36,8 @@ CASES = [
     ("cylinder", "3 3 3 1 1 1"), ("cylinder", "6 4 2 1 1 1"), ("cylinder", "6 5 3 0.6 0.5 1 2"),
     ("ellipsoid", "3 3 3 1 1 1"), ("ellipsoid", "5 4 4 0.5 0.6 0.5"), ("ellipsoid", "4 4 3 1 1 1 2"),
     # MuJoCo's inertia switches: a dim-2 surface keeps a non-legacy mode; the plate is always shell.
-    ("box", "3 3 3 1 1 1 2", 'inertia="convex"'), ("ellipsoid", "3 3 3 1 1 1", 'inertia="shell"'),
+    ("box", "3 3 3 1 1 1 2", 'inertia="convex"'), ("box", "3 4 2 1 1 1 2", 'inertia="exact"'),
+    ("ellipsoid", "3 3 3 1 1 1", 'inertia="shell"'),
     # The flat built-ins as visual geoms (contype/conaffinity 0: no hull needed), shell mass, on a
     # body with a sphere.
     ("plate", "3 3", "", VISUAL), ("plate", "4 2", 'inertia="exact"', VISUAL),
