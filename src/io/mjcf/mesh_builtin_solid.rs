@@ -184,7 +184,7 @@ pub(crate) fn generate(shape: &str, params: &[f64]) -> Result<Generated, Refusal
             };
             Ok(solid(kind, count.map(|c| c as usize), [params[3], params[4], params[5]], dim == 3))
         }
-        _ => unreachable!("generate is called for the sampled built-ins only"),
+        _ => refuse("Unsupported mesh type", "give one of MuJoCo's built-in mesh types"),
     }
 }
 
