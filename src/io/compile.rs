@@ -417,7 +417,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 detail: format!(
                     "the actuators' control histories (nsample) take more than {MAX_HISTORY} numbers \
                      ({} MB) by actuator '{}': keep fewer samples",
-                    MAX_HISTORY * 8 >> 20,
+                    (MAX_HISTORY * 8) >> 20,
                     a.name
                 ),
             });
