@@ -118,3 +118,15 @@ fn transition_jacobians_refuse_a_control_history() {
         lagrange::derivatives::transition_jacobians(&model, &mut data, &mut work, &options).unwrap_err();
     assert!(err.to_string().contains("control history"), "{err}");
 }
+
+#[test]
+fn histories_that_would_exhaust_memory_are_refused() {
+    let motors: String =
+        (0..20).map(|k| format!(r#"<motor name="m{k}" joint="j" nsample="1000000"/>"#)).collect();
+    let xml = format!(
+        r#"<mujoco><worldbody><body><joint name="j" type="slide"/><geom size=".1"/></body>
+        </worldbody><actuator>{motors}</actuator></mujoco>"#
+    );
+    let err = Model::from_str(&xml).unwrap_err().to_string();
+    assert!(err.contains("control histories") && err.contains("'m8'"), "{err}");
+}
