@@ -137,6 +137,15 @@ def box_mesh():
                     assets=f'<mesh name="prism9" vertex="{base.prism(9, rng)}"/>')
     out.append((s, [placed(s, f"flat{k}", ORIGIN, yaw_tilt(rng, 0.02), (0.02 * k, -0.01 * k, 1), -0.004)
                     for k in range(6)], 0))
+    # A box edge across a cube face narrower than it, tilted along the edge: the edge clipped by
+    # both sides of the face, the points above the face dropped; where one end rises above the
+    # face MuJoCo 4.0 reports the remaining clipped point twice (the two coincident points the
+    # clipping of a two-point polygon makes), as lagrange does.
+    s = ConvexScene("box_cube_edge", BOX, CUBE_MESH, NO_MARGIN)
+    edge_up = ((0.0, 0.0, 0.0), axis_angle((1, 0, 0), math.pi / 4))
+    out.append((s, [placed(s, f"edge_across_tilted{k}", edge_up, axis_angle((0, 1, 0), tilt),
+                           (dx, -0.125, 0.18), -0.002)
+                    for k, (tilt, dx) in enumerate([(0.0, -0.1), (0.01, -0.2), (-0.02, -0.1), (0.02, 0.05)])], 0))
     s = ConvexScene("box_cube_single", BOX, CUBE_MESH, NO_MARGIN, flags=' multiccd="disable"')
     rng = np.random.default_rng([SEED, zlib.crc32(b"box_cube_single resting")])
     out.append((s, resting(s, rng, 6), 8))
