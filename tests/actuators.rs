@@ -404,16 +404,14 @@ fn activation_input_errors_name_the_fix() {
     .unwrap_err()
     .to_string();
     assert!(err.contains("keyframe 'k': an activation (act) 1e300 is absurdly large"), "{err}");
-    // A control delay is not simulated, and the loader says so.
+    // A control delay is simulated (tests/delay_mujoco.rs): no warning, a history buffer.
     let model = load_mjcf_str(
         r#"<mujoco><worldbody><body><joint name="j"/><geom size=".1"/></body></worldbody>
         <actuator><motor joint="j" nsample="3" delay="0.004"/></actuator></mujoco>"#,
     )
     .unwrap();
-    assert!(model
-        .warnings
-        .iter()
-        .any(|w| w.contains("'delay' (MuJoCo's control history buffer) is not simulated")));
+    assert!(model.warnings.iter().all(|w| !w.contains("delay")), "{:?}", model.warnings);
+    assert_eq!(model.nhistory(), 8);
     // The API refuses an act of the wrong length.
     let model = load(Path::new(ACTIVATION), &LoadOptions::default()).unwrap();
     let mut sim = Simulation::new(Arc::new(model), &SimOptions::default());

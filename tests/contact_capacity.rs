@@ -1,6 +1,9 @@
-//! Contacts beyond the budget are dropped visibly (issue 26, "no silent caps"): a pass that
-//! finds more contacts than `Model::contact_budget` keeps the budget's worth, counts the rest in
-//! `Data::contacts_dropped` (which `simulate` reports), and the next pass allocates nothing.
+//! No silent caps on contacts (docs/constraints.md): the soft mode's Newton solver keeps every
+//! contact of a scene with more than the initial buffers hold (they grow once; the next pass
+//! allocates nothing); with a solver that forms rows × rows matrices (PGS), a pass that finds more
+//! contacts than `Model::contact_budget` keeps the budget's worth, counts the rest in
+//! `Data::contacts_dropped` (which `simulate` reports) and raises the `contact_full` warning with
+//! the count and the time, and the next pass allocates nothing.
 
 use lagrange::forward::forward;
 use lagrange::integrate::step;
@@ -13,7 +16,8 @@ use alloc_counter::allocations;
 
 /// A plane and `n` free boxes in a grid, each pressed 1 mm into the plane: four corner contacts
 /// per box (MuJoCo's box–plane points).
-fn boxes_on_plane(n: usize) -> String {
+/// `condim`: the rows per contact (1 keeps PGS's dense rows × rows matrix small).
+fn boxes_on_plane(n: usize, solver: &str, condim: u32) -> String {
     let side = (n as f64).sqrt().ceil() as usize;
     let mut bodies = String::new();
     for k in 0..n {
@@ -23,14 +27,30 @@ fn boxes_on_plane(n: usize) -> String {
         );
     }
     format!(
-        "<mujoco><option timestep='0.002'/><worldbody><geom type='plane' size='0 0 1'/>\n{bodies}</worldbody></mujoco>"
+        "<mujoco><option timestep='0.002' solver='{solver}'/><default><geom condim='{condim}'/></default><worldbody><geom type='plane' size='0 0 1'/>\n{bodies}</worldbody></mujoco>"
     )
+}
+
+#[test]
+fn newton_keeps_every_contact_beyond_the_initial_buffers() {
+    let n = 140;
+    let model = common::load_mjcf_text("contact_capacity", "boxes_newton", &boxes_on_plane(n, "Newton", 3));
+    assert!(model.contact_budget() >= 4 * n, "budget {}", model.contact_budget());
+    assert!(INITIAL_CONTACTS < 4 * n, "the scene must exceed the initial buffers");
+    let mut data = Data::new(&model);
+    forward(&model, &mut data);
+    assert_eq!(data.contacts.len(), 4 * n, "every contact is kept");
+    assert_eq!(data.contacts_dropped, 0);
+    assert!(!data.warnings.any(), "{:?}", data.warnings.messages(&model));
+    assert!(data.qacc.iter().all(|a| a.is_finite()));
+    let again = allocations(|| forward(&model, &mut data));
+    assert_eq!(again, 0, "a pass at the same size allocated {again} times");
 }
 
 #[test]
 fn a_pass_with_more_contacts_than_the_budget_counts_what_it_drops() {
     let n = 140;
-    let model = common::load_mjcf_text("contact_capacity", "boxes", &boxes_on_plane(n));
+    let model = common::load_mjcf_text("contact_capacity", "boxes_pgs", &boxes_on_plane(n, "PGS", 1));
     assert!(
         model.max_contacts() >= 4 * n,
         "the pairs' bound {} is below the scene's contacts",
@@ -39,9 +59,14 @@ fn a_pass_with_more_contacts_than_the_budget_counts_what_it_drops() {
     let budget = model.contact_budget();
     assert!(budget >= INITIAL_CONTACTS && budget < 4 * n, "the scene must exceed the budget {budget}");
     let mut data = Data::new(&model);
+    data.time = 0.25;
     forward(&model, &mut data);
     assert_eq!(data.contacts.len(), budget, "the budget's worth is kept");
     assert_eq!(data.contacts_dropped, (4 * n - budget) as u64, "the rest is counted");
+    let w = &data.warnings;
+    assert_eq!((w.contact_full.number, w.contact_full.last_info, w.contact_full_time), (1, 4 * n, 0.25));
+    let message = w.messages(&model).join("\n");
+    assert!(message.contains(&format!("{} found", 4 * n)) && message.contains("t = 0.25 s"), "{message}");
     for c in &data.contacts {
         assert!((c.dist + 1e-3).abs() < 1e-12, "depth 1 mm");
     }
@@ -51,4 +76,5 @@ fn a_pass_with_more_contacts_than_the_budget_counts_what_it_drops() {
     assert_eq!(again, 0, "a pass at the same size allocated {again} times");
     step(&model, &mut data).unwrap();
     assert_eq!(data.contacts.len(), budget);
+    assert_eq!(data.warnings.contact_full.number, 3);
 }

@@ -1,15 +1,20 @@
-//! MuJoCo 4.0's built-in meshes (`<mesh builtin=… params=…>`, src/io/mjcf/mesh_builtin.rs and
-//! mesh_builtin_super.rs) against MuJoCo (tests/data/mujoco/mesh_builtin.json,
-//! validation/mujoco_builtin_golden.py): sphere, cone, hemisphere, supersphere and supertorus at
-//! 1–3 parameter sets each, as one scaled free body over a plane. Its mass, centre of mass and
-//! principal inertia are MuJoCo's; its collision hull's vertices are MuJoCo's compiled vertices
-//! (same distances from the centre of mass); and it falls onto the plane as MuJoCo's does
-//! (qpos/qvel after 1, 40 and 120 `mj_step`s) up to the sample where MuJoCo rests it on two or more
-//! contacts (a face or an edge: MuJoCo's plane–convex contact subset is not followed yet). Built-ins MuJoCo refuses as a geom are refused.
+//! MuJoCo 4.0's built-in meshes (`<mesh builtin=… params=…>`, src/io/mjcf/mesh_builtin.rs,
+//! mesh_builtin_super.rs and mesh_builtin_solid.rs) against MuJoCo (tests/data/mujoco/mesh_builtin.json,
+//! validation/mujoco_builtin_golden.py): sphere, cone, hemisphere, supersphere, supertorus, wedge,
+//! grid, box, cylinder and ellipsoid at 1–3 parameter sets each, as one scaled free body over a
+//! plane. The generated vertices and faces are MuJoCo's `uservert`/`userface` bit for bit (for the
+//! built-ins MuJoCo keeps as points, every hull vertex is one of its points); its mass, centre of
+//! mass and principal inertia are MuJoCo's (the `dim` 2 surfaces with MuJoCo's switch to `shell`);
+//! its collision hull's vertices are MuJoCo's compiled vertices (same distances from the centre of
+//! mass); and it falls onto the plane as MuJoCo's does (qpos/qvel after 1, 40 and 120 `mj_step`s)
+//! up to the sample where MuJoCo rests it on two or more contacts (a face or an edge: MuJoCo's
+//! plane–convex contact subset is not followed yet). What MuJoCo refuses (flat built-ins as a
+//! geom, bad parameters) is refused for MuJoCo's reason.
 
 mod common;
 
 use common::{state_rel_err, BUILTIN_HULL_ABS, MESH_MUJOCO_REL, SOFT_REL};
+use lagrange::mass::MeshSource;
 use lagrange::prelude::*;
 use serde_json::Value;
 
@@ -45,7 +50,17 @@ fn builtin_mass_com_inertia_and_hull_are_mujocos() {
             err = err.max(rel(*a, *b, theirs[2]));
         }
         // Hull vertices: MuJoCo's mesh_vert are in the mesh's inertial frame (origin at the com).
-        let g = model.geoms.iter().find(|g| g.body == 1).unwrap();
+        let g = model.geoms.iter().find(|g| g.body == 1 && g.mesh.is_some()).unwrap();
+        if !case["collides"].as_bool().unwrap() {
+            // A flat built-in as a visual geom beside a sphere: no hull, mass checked above.
+            assert!(g.hull.is_none() && !g.collision, "{label}: a visual geom");
+            println!(
+                "{label}: mass {:.6} (MuJoCo {mass:.6}), mass/com/inertia rel err {err:.1e}, visual",
+                body.mass()
+            );
+            worst_mass = worst_mass.max(err);
+            continue;
+        }
         let hull = g.hull.as_ref().expect("a built-in mesh collides by its hull");
         let mut ours: Vec<f64> =
             hull.iter().map(|v| (g.x_body_geom.act_point(v) - body.com()).norm()).collect();
@@ -75,6 +90,52 @@ fn builtin_mass_com_inertia_and_hull_are_mujocos() {
     }
     assert!(worst_mass <= MESH_MUJOCO_REL, "mass properties: {worst_mass:e}");
     assert!(worst_hull <= BUILTIN_HULL_ABS, "hull: {worst_hull:e}");
+}
+
+#[test]
+fn builtin_vertices_and_faces_are_mujocos_bit_for_bit() {
+    let golden = golden();
+    let (mut surfaces, mut clouds) = (0, 0);
+    for case in golden["cases"].as_array().unwrap() {
+        let label = format!("{} {}", case["builtin"].as_str().unwrap(), case["params"].as_str().unwrap());
+        let model = Model::from_str(case["xml"].as_str().unwrap()).unwrap();
+        let g = model.geoms.iter().find(|g| g.body == 1 && g.mesh.is_some()).unwrap();
+        let MeshSource::Inline { mesh, .. } = g.mesh.as_deref().unwrap().source() else {
+            panic!("{label}: a built-in mesh is inline")
+        };
+        // MuJoCo's uservert are f32: compared as f32 (the JSON's decimal may not round-trip to
+        // the same f64 bit for bit, it does to the same f32).
+        let theirs: Vec<[f32; 3]> = numbers(&case["uservert"])
+            .chunks_exact(3)
+            .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32])
+            .collect();
+        let ours: Vec<[f32; 3]> =
+            mesh.vertices.iter().map(|v| [v.x as f32, v.y as f32, v.z as f32]).collect();
+        assert!(
+            mesh.vertices.iter().all(|v| v.iter().all(|&x| f64::from(x as f32) == x)),
+            "{label}: not f32"
+        );
+        let faces: Vec<u32> = numbers(&case["userface"]).iter().map(|&i| i as u32).collect();
+        if faces.is_empty() {
+            // MuJoCo keeps points only; ours are their hull's: each is one of MuJoCo's, exactly.
+            for v in &ours {
+                assert!(theirs.contains(v), "{label}: hull vertex {v:?} is not one of MuJoCo's points");
+            }
+            clouds += 1;
+        } else {
+            assert_eq!(ours, theirs, "{label}: vertices");
+            let tris: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+            assert_eq!(tris, faces, "{label}: faces");
+            surfaces += 1;
+        }
+        println!(
+            "{label}: {} of MuJoCo's {} points, {} faces, exact",
+            ours.len(),
+            theirs.len(),
+            faces.len() / 3
+        );
+    }
+    assert!(surfaces >= 19 && clouds >= 11, "{surfaces} surfaces, {clouds} point sets");
 }
 
 #[test]
@@ -109,22 +170,62 @@ fn builtin_meshes_fall_onto_a_plane_as_in_mujoco() {
         worst = worst.max(err);
     }
     println!("{compared} samples compared, worst rel err {worst:.1e}");
-    assert!(compared >= 23, "{compared} samples compared");
+    assert!(compared >= 50, "{compared} samples compared");
     assert!(worst <= SOFT_REL, "{worst:e}");
 }
 
 #[test]
-fn builtins_mujoco_refuses_are_refused() {
+fn builtins_mujoco_refuses_are_refused_for_its_reason() {
     let golden = golden();
+    let mut n = 0;
     for case in golden["refused"].as_array().unwrap() {
         let xml = format!(
             "<mujoco><asset><mesh name=\"m\" builtin=\"{}\" params=\"{}\"/></asset><worldbody><body><freejoint/><geom type=\"mesh\" mesh=\"m\"/></body></worldbody></mujoco>",
             case["builtin"].as_str().unwrap(),
             case["params"].as_str().unwrap()
         );
-        assert!(case["error"].is_string(), "MuJoCo refuses {xml}");
+        let theirs = case["error"].as_str().unwrap_or_else(|| panic!("MuJoCo refuses {xml}"));
+        // MuJoCo's reason without its prefixes and the mesh's name: ours quotes it.
+        let reason = theirs.trim_start_matches("XML Error: ").trim_start_matches("Error: ");
+        let reason = reason.trim_start_matches("mesh 'm' ");
+        let reason = reason.split(". Consider").next().unwrap();
+        let ours = Model::from_str(&xml).unwrap_err().to_string();
+        println!("{} {}: MuJoCo: {theirs}\n  lagrange: {ours}", case["builtin"], case["params"]);
+        // A flat surface mesh reaches the geom's hull check, which says the same in its words.
+        let same = ours.contains(reason)
+            || (reason.starts_with("has coplanar vertices")
+                && ours.contains("all vertices are in one plane"));
+        assert!(same, "{xml}: MuJoCo says '{reason}', lagrange: {ours}");
+        n += 1;
+    }
+    assert!(n >= 29, "{n} refusals");
+}
+
+#[test]
+fn flat_surfaces_load_when_no_geom_uses_them_flat_point_sets_do_not() {
+    // MuJoCo only needs a hull for a mesh geom: the flat built-ins are accepted as assets.
+    for mesh in [
+        r#"builtin="plate" params="3 3""#,
+        r#"builtin="square" params="3 3 1 0.1 0.1 0.1""#,
+        r#"builtin="disc" params="4 4 1 0.1 0.1 0.1""#,
+        r#"builtin="grid" params="3 3 1 0.1 0.1 0.1 2""#,
+    ] {
+        let xml = format!(
+            "<mujoco><asset><mesh name=\"m\" {mesh}/></asset><worldbody><body><freejoint/><geom size=\"0.1\"/></body></worldbody></mujoco>"
+        );
+        Model::from_str(&xml).unwrap_or_else(|e| panic!("{mesh}: {e}"));
+    }
+    // A point set (no faces) needs its hull as faces, used or not: MuJoCo refuses a flat one.
+    for (mesh, reason) in [
+        (r#"builtin="wedge" params="2 2 60 30 0""#, "has coplanar vertices"),
+        (r#"builtin="wedge" params="2 1 60 30 0""#, "at least 4 vertices required"),
+        (r#"builtin="grid" params="3 3 3 0 0.1 0.1""#, "has coplanar vertices"),
+    ] {
+        let xml = format!(
+            "<mujoco><asset><mesh name=\"m\" {mesh}/></asset><worldbody><body><freejoint/><geom size=\"0.1\"/></body></worldbody></mujoco>"
+        );
         let err = Model::from_str(&xml).unwrap_err().to_string();
-        println!("{}: MuJoCo: {} / lagrange: {err}", case["builtin"], case["error"]);
+        assert!(err.contains(reason), "{mesh}: {err}");
     }
 }
 
@@ -138,6 +239,10 @@ fn bad_builtin_params_are_typed_errors() {
         (r#"builtin="supertorus" params="8 1.5 1 1""#, "(0, 1]"),
         (r#"builtin="supertorus" params="8 0.5 0 1""#, "greater than 0"),
         (r#"builtin="supertorus" params="8 0.5 1""#, "requires 4"),
+        (r#"builtin="grid" params="0 3 3 1 1 1""#, "Grid count must be positive"),
+        (r#"builtin="box" params="3 3 3 1 1 1 4""#, "Mesh dim must be 2 or 3"),
+        (r#"builtin="wedge" params="1 1 60 30 0""#, "at least 4 vertices required"),
+        (r#"builtin="ellipsoid" params="3 3 3 0 1 1""#, "has coplanar vertices"),
     ] {
         let xml = format!(
             "<mujoco><asset>\n<mesh name=\"m\" {mesh}/></asset><worldbody><body><freejoint/><geom type=\"mesh\" mesh=\"m\"/></body></worldbody></mujoco>"

@@ -91,7 +91,10 @@ fn bad_inline_meshes_are_typed_errors_naming_the_line() {
         (format!(r#"<mesh name="m" vertex="{tet}" face="0 1 -1"/>"#), "vertex index -1 does not exist"),
         (format!(r#"<mesh vertex="{tet}"/>"#), "needs a 'name'"),
         (r#"<mesh name="m" vertex="0 0 0  1 0 0  2 0 0  3 0 0"/>"#.to_string(), "convex hull"),
-        (r#"<mesh name="m" builtin="wedge" params="1 1 30 30 0.5"/>"#.to_string(), "built-in mesh 'wedge'"),
+        (
+            r#"<mesh name="m" builtin="wedge" params="1 1 30 30 0.5"/>"#.to_string(),
+            "at least 4 vertices required",
+        ),
         (r#"<mesh name="m" builtin="sphere" params="5"/>"#.to_string(), "subdivision must be in 0..=4"),
         (r#"<mesh name="m" builtin="cone" params="8"/>"#.to_string(), "requires 2"),
         (r#"<mesh name="m" builtin="cube" params="8"/>"#.to_string(), "'builtin' is 'cube'"),

@@ -224,10 +224,11 @@ fn composition_errors_name_the_element_line_and_what_mujoco_does() {
     mentions(
         "mesh_builtin.xml",
         &[
-            "mesh_builtin.xml:3",
-            "<mesh>",
-            "the built-in mesh 'wedge'",
-            "lagrange generates 'sphere', 'cone', 'hemisphere', 'supersphere' and 'supertorus'",
+            "mesh_builtin.xml:6",
+            "body 'b'",
+            "mesh 'ball'",
+            "all vertices are in one plane",
+            "contype=\"0\" conaffinity=\"0\"",
         ],
     );
 }

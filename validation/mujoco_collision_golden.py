@@ -540,8 +540,8 @@ def world_vertices(s: Scene, mesh: int) -> np.ndarray:
 def plane_mesh() -> list:
     """Meshes at random orientations just touching the plane: one vertex alone below it (MuJoCo's
     mesh vertices are f32 in its inertial frame: the contact is that vertex), and lifted beyond
-    it; then deeper at random orientations, where MuJoCo 4.0 adds the other vertices of the hull
-    triangle facing the plane."""
+    it; then deeper at random orientations, where MuJoCo 4.0 adds other vertices of the hull face
+    polygon facing the plane; then prisms with a many-sided face resting on it."""
     out = []
     for name, file in MESHES:
         s = mesh_scene("plane_mesh", name, file, NO_MARGIN)
@@ -557,8 +557,8 @@ def plane_mesh() -> list:
             below = {tuple(p) for p in world_vertices(s, 0) if p[2] <= 0.0}
             if len(case["contacts"]) <= 1 and len(below) <= 1:
                 cases.append(case)
-        # Several vertices below the plane (MuJoCo 4.0: the deepest vertex and its hull triangle
-        # facing the plane, at most 3 contacts; src/collision/plane_mesh.rs).
+        # Several vertices below the plane (MuJoCo 4.0: the deepest vertex and the vertices of its
+        # hull face polygon facing the plane, at most 4 contacts; src/collision/plane_mesh.rs).
         frng = np.random.default_rng([SEED, zlib.crc32((s.name + "/face").encode())])
         while len(cases) < 28:
             target = -frng.uniform(2e-4, 3e-3)
@@ -566,6 +566,38 @@ def plane_mesh() -> list:
             if q2 is None:
                 continue
             cases.append(s.record(f"face{len(cases)}", "penetrating", None, q2))
+        out.append((s, cases, 0))
+    out += prism_faces()
+    return out
+
+
+def prism(n: int, rng) -> str:
+    """A prism 0.1 m in radius and height whose bottom face is a convex n-gon (vertices at seeded
+    random angles on a circle) and whose top is a hexagon, as an inline MJCF mesh."""
+    angles = np.sort(rng.uniform(0.0, 2 * math.pi, n))
+    pts = [(0.1 * math.cos(a), 0.1 * math.sin(a), -0.05) for a in angles]
+    pts += [(0.1 * math.cos(a), 0.1 * math.sin(a), 0.05) for a in np.arange(6) * math.pi / 3]
+    return " ".join(repr(round(float(x), 9)) for p in pts for x in p)
+
+
+def prism_faces() -> list:
+    """Prisms resting tilted on the plane with their n-gon bottom face below it (n = 6, 9, 10,
+    11): MuJoCo 4.0 keeps four vertices of that face polygon, the deepest first and three chosen
+    by its quadrilateral search from it (src/collision/plane_mesh.rs). A 7-gon follows the same rule
+    but its f32 vertices lie 3e-9 m from the ones lagrange rounds (the mesh rounding of
+    src/io/geom_hull.rs), so it is not among them."""
+    out = []
+    for n in (6, 9, 10, 11):
+        rng = np.random.default_rng([SEED, zlib.crc32(f"prism{n}".encode())])
+        assets = f'<mesh name="prism{n}" vertex="{prism(n, rng)}"/>'
+        s = Scene(f"plane_mesh_prism{n}", None, f'type="mesh" mesh="prism{n}"', NO_MARGIN, assets=assets)
+        cases = []
+        while len(cases) < 8:
+            axis = (math.cos(rng.uniform(0, 2 * math.pi)), math.sin(rng.uniform(0, 2 * math.pi)), 0.0)
+            q = axis_angle(axis, rng.uniform(0.002, 0.03))
+            q2 = s.place(None, q, np.array([0.0, 0.0, 1.0]), -0.004, start=(0.0, 0.0, -1.0))
+            if q2 is not None:
+                cases.append(s.record(f"tilted{len(cases)}", "penetrating", None, q2))
         out.append((s, cases, 0))
     return out
 

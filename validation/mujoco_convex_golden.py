@@ -58,22 +58,23 @@ NO_MARGIN = (0.0, 0.0)
 MARGIN = (0.015625, 0.0)
 
 
-def mjcf(name, geom1, geom2, margins, flags="") -> str:
+def mjcf(name, geom1, geom2, margins, flags="", assets="") -> str:
     margin, gap = margins
     extra = f' margin="{margin!r}" gap="{gap!r}"' if margin or gap else ""
     return "\n".join([
         f'<mujoco model="{name}">', '<compiler angle="radian" meshdir="MESHDIR"/>',
-        f'<option><flag contact="enable"{flags}/></option>', ASSETS, "<worldbody>",
+        f'<option><flag contact="enable"{flags}/></option>', ASSETS.replace("</asset>", assets + "</asset>"),
+        "<worldbody>",
         f'<body name="b1"><freejoint/><geom name="g1" {geom1}{extra}/></body>',
         f'<body name="b2"><freejoint/><geom name="g2" {geom2}{extra}/></body>',
         "</worldbody>", "</mujoco>"]) + "\n"
 
 
 class ConvexScene(Scene):
-    def __init__(self, name, geom1, geom2, margins, flags=""):
+    def __init__(self, name, geom1, geom2, margins, flags="", assets=""):
         self.name = name
         self.plane = False
-        self.xml = mjcf(name, geom1, geom2, margins, flags)
+        self.xml = mjcf(name, geom1, geom2, margins, flags, assets)
         live = self.xml.replace("MESHDIR", str(MESHDIR))
         self.m = mujoco.MjModel.from_xml_string(live)
         self.d = mujoco.MjData(self.m)
@@ -129,6 +130,22 @@ def box_mesh():
     s = ConvexScene("box_cube_margin", BOX, CUBE_MESH, MARGIN)
     rng = np.random.default_rng([SEED, zlib.crc32(b"box_cube_margin resting")])
     out.append((s, resting(s, rng, 6), 8))
+    # A prism with a 9-gon face resting on the box (the clipped polygon is that face, more than
+    # four points: MuJoCo 4.0's quadrilateral, its first point fixed; src/collision/multiccd.rs).
+    rng = np.random.default_rng([SEED, zlib.crc32(b"box_prism9")])
+    s = ConvexScene("box_prism9", BOX, 'type="mesh" mesh="prism9"', NO_MARGIN,
+                    assets=f'<mesh name="prism9" vertex="{base.prism(9, rng)}"/>')
+    out.append((s, [placed(s, f"flat{k}", ORIGIN, yaw_tilt(rng, 0.02), (0.02 * k, -0.01 * k, 1), -0.004)
+                    for k in range(6)], 0))
+    # A box edge across a cube face narrower than it, tilted along the edge: the edge clipped by
+    # both sides of the face, the points above the face dropped; where one end rises above the
+    # face MuJoCo 4.0 reports the remaining clipped point twice (the two coincident points the
+    # clipping of a two-point polygon makes), as lagrange does.
+    s = ConvexScene("box_cube_edge", BOX, CUBE_MESH, NO_MARGIN)
+    edge_up = ((0.0, 0.0, 0.0), axis_angle((1, 0, 0), math.pi / 4))
+    out.append((s, [placed(s, f"edge_across_tilted{k}", edge_up, axis_angle((0, 1, 0), tilt),
+                           (dx, -0.125, 0.18), -0.002)
+                    for k, (tilt, dx) in enumerate([(0.0, -0.1), (0.01, -0.2), (-0.02, -0.1), (0.02, 0.05)])], 0))
     s = ConvexScene("box_cube_single", BOX, CUBE_MESH, NO_MARGIN, flags=' multiccd="disable"')
     rng = np.random.default_rng([SEED, zlib.crc32(b"box_cube_single resting")])
     out.append((s, resting(s, rng, 6), 8))

@@ -193,6 +193,17 @@ impl PyData {
     fn set_act(slf: Bound<'_, Self>, value: &Bound<'_, PyAny>) -> PyResult<()> {
         buffer_set(slf, value, "act", |d| (d.act.as_mut_ptr().cast::<f64>(), vec![d.act.len()]))
     }
+    /// The actuators' control histories (MuJoCo's `history`, nhistory values in its layout):
+    /// part of the state with delayed actuators (`delay`, `nsample`).
+    #[getter]
+    fn history<'py>(slf: Bound<'py, Self>) -> Bound<'py, PyArrayDyn<f64>> {
+        buffer_view(slf, |d| (d.history.as_mut_ptr().cast::<f64>(), vec![d.history.len()]))
+    }
+
+    #[setter]
+    fn set_history(slf: Bound<'_, Self>, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        buffer_set(slf, value, "history", |d| (d.history.as_mut_ptr().cast::<f64>(), vec![d.history.len()]))
+    }
     /// Controls (nu).
     #[getter]
     fn ctrl<'py>(slf: Bound<'py, Self>) -> Bound<'py, PyArrayDyn<f64>> {

@@ -265,6 +265,11 @@ impl PyModel {
     fn na(&self) -> usize {
         self.inner.na()
     }
+    /// Length of `Data.history` (MuJoCo's `nhistory`): the delayed actuators' control buffers.
+    #[getter]
+    fn nhistory(&self) -> usize {
+        self.inner.nhistory()
+    }
     /// Number of bodies in MuJoCo's numbering (for MJCF the world is body 0).
     #[getter]
     fn nbody(&self) -> usize {

@@ -92,3 +92,33 @@ def test_body_poses_against_mujoco(tight_copy):
     assert rel_err(d.xquat, md.xquat) < 1e-14
     assert rel_err(d.xmat, md.xmat) < 1e-14
     assert rel_err(lagrange.center_of_mass(m, d), md.subtree_com[0]) < 1e-14
+
+
+def test_delayed_controls_against_mujoco():
+    """Delayed actuators (delay, nsample, interp) stepped from the reset state with changing
+    controls: the history buffers (a writable state array, MuJoCo's layout), the forces and the
+    state after every step; a history set from MuJoCo's mid-run state continues as MuJoCo's."""
+    from conftest import ROOT
+
+    path = ROOT / "tests/data/mjcf/delay/arm_rk4.xml"
+    mm = mj.MjModel.from_xml_path(str(path))
+    md = mj.MjData(mm)
+    m = lagrange.Model.from_file(path)
+    d = lagrange.Data(m)
+    assert m.nhistory == mm.nhistory
+    assert np.array_equal(d.history, md.history)
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        md.ctrl[:] = d.ctrl[:] = rng.uniform(-1, 1, mm.nu)
+        mj.mj_step(mm, md)
+        lagrange.step(m, d)
+        assert rel_err(d.history, md.history) < 1e-14
+        assert rel_err(d.actuator_force, md.actuator_force) < 1e-9
+        assert rel_err(d.qvel, md.qvel) < 1e-9
+    # Continue from MuJoCo's state, history included.
+    d.qpos[:], d.qvel[:], d.act[:], d.history[:], d.time = md.qpos, md.qvel, md.act, md.history, md.time
+    md.ctrl[:] = d.ctrl[:] = 0.7
+    mj.mj_step(mm, md)
+    lagrange.step(m, d)
+    assert rel_err(d.qvel, md.qvel) < 1e-9
+    assert rel_err(d.history, md.history) < 1e-14

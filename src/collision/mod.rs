@@ -168,6 +168,7 @@ impl CollisionModel {
 pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) {
     data.contacts.clear();
     let budget = model.contact_budget();
+    let dropped_before = data.contacts_dropped;
     // World poses of the colliding geoms, once per pass (MuJoCo's geom_xpos, geom_xmat).
     for (g, geom) in model.geoms.iter().enumerate() {
         if cm.shapes[g].is_some() || geom.collision {
@@ -377,6 +378,10 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
     }
     data.broadphase.pairs = swept;
     data.broadphase.touching = touching;
+    if data.contacts_dropped > dropped_before {
+        let found = data.contacts.len() + (data.contacts_dropped - dropped_before) as usize;
+        data.warnings.contacts_full(found, data.time);
+    }
     // One regularized-cone μ per contact (`contact_mu`): grown with the contact buffer when this
     // pass found more contacts than any before.
     if data.contact_mu.len() < data.contacts.len() {

@@ -322,9 +322,17 @@ pub fn polytope_contacts(
             let (n2, f2) = s.normals2[j];
             face_polygon(&p1, x1, f1, &mut tmp, &mut s.face1);
             face_polygon(&p2, x2, f2, &mut tmp, &mut s.face2);
-            clip(&s.face1, &s.face2, &n1, &n2, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
-                out(w1, w2, d, false, -n2)
-            });
+            clip(
+                &s.face1,
+                &s.face2,
+                &n1,
+                &n2,
+                margin,
+                false,
+                &mut s.poly,
+                &mut s.clipped,
+                &mut |w1, w2, d| out(w1, w2, d, false, -n2),
+            );
         } else if dim1 < 3 && dim1 <= dim2 {
             // An edge of geom 1 against a face of geom 2.
             feature_edges(&p1, x1, &s.feature1, &mut tmp, &mut s.faces, &mut s.face1);
@@ -334,9 +342,17 @@ pub fn polytope_contacts(
                 let edge = [s.face1[2 * e], s.face1[2 * e + 1]];
                 s.face1.clear();
                 s.face1.extend_from_slice(&edge);
-                clip(&s.face2, &s.face1, &n2, &-n2, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
-                    out(w1, w2, d, true, -n2)
-                });
+                clip(
+                    &s.face2,
+                    &s.face1,
+                    &n2,
+                    &-n2,
+                    margin,
+                    false,
+                    &mut s.poly,
+                    &mut s.clipped,
+                    &mut |w1, w2, d| out(w1, w2, d, true, -n2),
+                );
             }
         } else if dim2 < 3 {
             // An edge of geom 2 against a face of geom 1.
@@ -347,9 +363,17 @@ pub fn polytope_contacts(
                 let edge = [s.face2[2 * e], s.face2[2 * e + 1]];
                 s.face2.clear();
                 s.face2.extend_from_slice(&edge);
-                clip(&s.face1, &s.face2, &n1, &-n1, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
-                    out(w1, w2, d, false, n1)
-                });
+                clip(
+                    &s.face1,
+                    &s.face2,
+                    &n1,
+                    &-n1,
+                    margin,
+                    false,
+                    &mut s.poly,
+                    &mut s.clipped,
+                    &mut |w1, w2, d| out(w1, w2, d, false, n1),
+                );
             }
         }
         s.tmp = tmp;
@@ -380,8 +404,12 @@ fn edge_face(edges: &[Vec3], faces: &[(Vec3, u32)]) -> Option<(usize, usize)> {
 /// Clips polygon (or edge) `clipped_in` by face polygon `face` (outward normal `n`, vertices
 /// clockwise about it), keeps the points not above the face's plane and reports each as
 /// witness points (on `face`'s plane along `wit_dir`, on `clipped_in`) and signed distance below
-/// the face: MuJoCo's `polygonClip`, with its pruning to the largest quadrilateral (more than 4
-/// points) and to the two farthest points (an edge).
+/// the face: MuJoCo's `polygonClip`, with its pruning of more than 4 points to a quadrilateral
+/// and of an edge to its two farthest points. The quadrilateral is MuJoCo 4.0's (the clipped
+/// polygon's first point fixed, [`super::plane_mesh::quad_from_first`]: measured black-box on 40
+/// box–prism faces, 38 the same points in the same order, the 2 others misread by the
+/// measurement); with `octagon` (a cylinder's cap, itself an octagon fitted to MuJoCo's cap
+/// contacts with this pruning) its 2026-08 source snapshot's `polygonQuad`, which that fit used.
 #[allow(clippy::too_many_arguments)]
 fn clip(
     face: &[Vec3],
@@ -389,6 +417,7 @@ fn clip(
     n: &Vec3,
     wit_dir: &Vec3,
     margin: f64,
+    octagon: bool,
     poly: &mut Vec<Vec3>,
     next: &mut Vec<Vec3>,
     out: &mut dyn FnMut(Vec3, Vec3, f64),
@@ -451,7 +480,11 @@ fn clip(
         out(w1, w2, d);
     };
     if poly.len() > 4 {
-        let q = largest_quad(poly);
+        let q = if octagon {
+            largest_quad(poly)
+        } else {
+            super::plane_mesh::quad_from_first(poly.len(), &|i| poly[i])
+        };
         for i in q {
             report(&poly[i]);
         }
@@ -482,8 +515,9 @@ fn area4(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> f64 {
 }
 
 /// Four vertices of a convex polygon (more than four vertices) spanning a quadrilateral of
-/// large area: MuJoCo's `polygonQuad` search (each corner advanced while the area grows), which
-/// depends on where the polygon starts (not always the largest).
+/// large area: the `polygonQuad` search of MuJoCo's 2026-08 source snapshot (each corner advanced
+/// while its area formula grows, every vertex tried as the first), which depends on where the
+/// polygon starts (not always the largest). MuJoCo 4.0.0 fixes the first vertex instead.
 fn largest_quad(p: &[Vec3]) -> [usize; 4] {
     let n = p.len();
     let next = |i: usize| (i + 1) % n;
@@ -626,10 +660,20 @@ fn cap_polytope(
                 s.face1.push(centre + (e1 * t.cos() + e2 * t.sin()) * r);
             }
             face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
-            clip(&s.face1, &s.face2, &n1, &n2, margin, &mut s.poly, &mut s.clipped, &mut |w1, w2, d| {
-                emit(PairPoint { p1: w1, p2: w2, normal: -n2, dist: d });
-                count += 1;
-            });
+            clip(
+                &s.face1,
+                &s.face2,
+                &n1,
+                &n2,
+                margin,
+                true,
+                &mut s.poly,
+                &mut s.clipped,
+                &mut |w1, w2, d| {
+                    emit(PairPoint { p1: w1, p2: w2, normal: -n2, dist: d });
+                    count += 1;
+                },
+            );
         }
         s.tmp = tmp;
         count
@@ -670,11 +714,21 @@ fn segment_polytope(
         if let Some((_, j)) = edge_face(&s.face1, &s.normals2) {
             let (n2, f2) = s.normals2[j];
             face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
-            clip(&s.face2, &s.face1, &n2, &-n2, margin + r, &mut s.poly, &mut s.clipped, &mut |_, v, _| {
-                let d = (v - s.face2[0]).dot(&n2);
-                emit(PairPoint { p1: v - n2 * r, p2: v - n2 * d, normal: -n2, dist: d - r });
-                count += 1;
-            });
+            clip(
+                &s.face2,
+                &s.face1,
+                &n2,
+                &-n2,
+                margin + r,
+                false,
+                &mut s.poly,
+                &mut s.clipped,
+                &mut |_, v, _| {
+                    let d = (v - s.face2[0]).dot(&n2);
+                    emit(PairPoint { p1: v - n2 * r, p2: v - n2 * d, normal: -n2, dist: d - r });
+                    count += 1;
+                },
+            );
         }
         s.tmp = tmp;
         count

@@ -9,7 +9,7 @@
 //! | box | every corner within the distance, at most 4 |
 //! | cylinder | the deepest rim point of the lower cap, the same rim point of the other cap, and, when the lower cap lies on the plane, two more points of that cap's rim at ±120° (a triangle) |
 //! | ellipsoid | its support point along −normal |
-//! | mesh | the collision pass: [`super::plane_mesh`] (MuJoCo 4.0's deepest vertex and its triangle facing the plane, at most 3); [`hull`] here (the deepest vertex and up to 3 more, spread out) serves geom distances |
+//! | mesh | the collision pass: [`super::plane_mesh`] (MuJoCo 4.0's deepest vertex and vertices of its face polygon facing the plane, at most 4); [`hull`] here (the deepest vertex and up to 3 more, spread out) serves geom distances |
 //!
 //! Each contact is (position on the plane side's midpoint, signed distance, tangent hint); the
 //! normal is the plane's.

@@ -1,30 +1,39 @@
 //! Plane against a mesh's convex hull as MuJoCo 4.0 does it (`mjc_PlaneConvex`, the plane row of
-//! its collision table): at most four contacts, hull vertices of the face resting on the plane.
+//! its collision table): at most four contacts, vertices of the hull face resting on the plane.
 //!
 //! 1. The hull vertex deepest below the plane (its support point along the plane's −normal,
 //!    found by hill climbing on the hull's edges from the vertex farthest along the nearest of 27
 //!    grid directions, as [`super::hull_support`]); none when it is farther than the margin.
-//! 2. Of the hull triangles around that vertex, the one whose outward normal points most nearly
-//!    along −normal (the face resting on the plane).
-//! 3. That triangle's other two vertices, in its outward (counter-clockwise) order starting after
-//!    the deepest vertex, each when it is closer than the margin.
+//! 2. Of the hull's face polygons around that vertex (coplanar triangles merged, as MuJoCo's
+//!    compiler merges its qhull facets into `mesh_polyvert` polygons), the one whose outward
+//!    normal points most nearly along −normal (the face resting on the plane).
+//! 3. That polygon's vertices in its outward (counter-clockwise) order starting at the deepest
+//!    vertex; with more than four, a quadrilateral of them: the deepest vertex fixed as the first
+//!    corner, the other three advanced along the polygon while the quadrilateral's area grows
+//!    (the last corner first, then the third, then the second, repeated while the last one
+//!    moves: [`quad_from_first`]). Each vertex after the deepest is kept when closer than the
+//!    margin.
 //!
-//! This is what the live MuJoCo 4.0.0 returns (checked on the Spot, Spot-arm and Barkour feet at
-//! every step of 300: the same vertices in the same order; its 2026-08 source snapshot took up to
-//! two edge neighbours of the deepest vertex farther than 0.3 of the bounding radius from it
-//! instead). Each contact lies midway between the vertex and the plane, with the plane's normal
-//! and distance `n·(v − p_plane)`.
+//! This is what the live MuJoCo 4.0.0 returns, measured black-box (its 2026-08 source snapshot
+//! took up to two edge neighbours of the deepest vertex farther than 0.3 of the bounding radius
+//! from it instead): prisms with random 5- to 11-gon faces resting tilted on a plane (60 poses:
+//! the same four vertices in the same order at every one, whatever the yaw and the tilt, the set
+//! a function of the deepest vertex alone); the Spot, Spot-arm and Barkour feet at every step of
+//! 300. The same quadrilateral rule, with the polygon's first vertex fixed, is the one MuJoCo
+//! 4.0's multi-point clipping prunes with (40 box–prism faces, see [`super::multiccd`]). Each
+//! contact lies midway between the vertex and the plane, with the plane's normal and distance
+//! `n·(v − p_plane)`.
 //!
-//! Where the facing triangle and one coplanar neighbour form a flat quadrilateral of the hull (a
-//! box-like mesh resting on a face), MuJoCo 4.0 takes the quadrilateral's four corners, and so
-//! does lagrange (the neighbour's far vertex between the shared edge's ends). Larger flat
-//! polygons keep the triangle's three (not yet compared with MuJoCo; MuJoCo triangulates with
-//! qhull, lagrange with parry3d's quickhull, so at exact ties the triangle may differ too).
+//! MuJoCo groups its facets by their normal's azimuth and polar angle rounded to 0.01 rad in the
+//! mesh's inertial frame; lagrange merges connected triangles whose normals agree to
+//! `COPLANAR`. Flat faces (boxes, prisms, CAD soles) merge alike; facets a few 1e-3 rad apart
+//! that share MuJoCo's rounded angles are one polygon there and separate triangles here. Where a
+//! polygon's quadrilateral areas tie exactly (a regular polygon), the choice is round-off's.
 
 use super::plane::PlanePoint;
 
-/// Two hull triangles whose unit normals' dot product exceeds 1 − this lie in one flat face
-/// (the mesh's single-precision vertices tilt coplanar triangles by up to ~1e-7).
+/// Two adjacent hull triangles whose unit normals' dot product exceeds 1 − this lie in one flat
+/// face polygon (the mesh's single-precision vertices tilt coplanar triangles by up to ~1e-7).
 const COPLANAR: f64 = 1e-6;
 use crate::spatial::{Transform, Vec3};
 
@@ -42,6 +51,15 @@ pub struct PlaneHull {
     triangles: Vec<[u32; 3]>,
     normals: Vec<Vec3>,
     extrema: [u32; 27],
+    /// Face polygon p's vertices, counter-clockwise about its outward normal, are
+    /// `poly[poly_start[p]..poly_start[p + 1]]`.
+    poly_start: Vec<u32>,
+    poly: Vec<u32>,
+    /// Face polygon p's outward unit normal (its triangles' area-weighted mean).
+    poly_normal: Vec<Vec3>,
+    /// Vertex i's polygons are `vpolys[vpoly_start[i]..vpoly_start[i + 1]]`.
+    vpoly_start: Vec<u32>,
+    vpolys: Vec<u32>,
 }
 
 impl PlaneHull {
@@ -94,7 +112,131 @@ impl PlaneHull {
             }
             *slot = best.0 as u32;
         }
-        Some(Self { vertices, adj_start, adj, tri_start, tris, triangles, normals, extrema })
+        let mut hull = Self {
+            vertices,
+            adj_start,
+            adj,
+            tri_start,
+            tris,
+            triangles,
+            normals,
+            extrema,
+            poly_start: vec![0],
+            poly: Vec::new(),
+            poly_normal: Vec::new(),
+            vpoly_start: Vec::new(),
+            vpolys: Vec::new(),
+        };
+        hull.build_polygons();
+        Some(hull)
+    }
+
+    /// Merges connected coplanar triangles into face polygons and traces each one's boundary
+    /// (counter-clockwise about the outward normal, following the triangles' own edge order); a
+    /// group whose boundary is not one simple loop stays as its separate triangles.
+    fn build_polygons(&mut self) {
+        let nt = self.triangles.len();
+        let mut group = vec![u32::MAX; nt];
+        let mut members: Vec<Vec<usize>> = Vec::new();
+        for t in 0..nt {
+            if group[t] != u32::MAX {
+                continue;
+            }
+            let g = members.len() as u32;
+            let mut stack = vec![t];
+            let mut list = Vec::new();
+            group[t] = g;
+            while let Some(u) = stack.pop() {
+                list.push(u);
+                for j in 0..3 {
+                    if let Some(w) = self.across(u, j) {
+                        if group[w] == u32::MAX && self.coplanar(u, w) {
+                            group[w] = g;
+                            stack.push(w);
+                        }
+                    }
+                }
+            }
+            list.sort_unstable();
+            members.push(list);
+        }
+        let n = self.vertices.len();
+        let mut per_vertex: Vec<Vec<u32>> = vec![Vec::new(); n];
+        let mut next = vec![u32::MAX; n];
+        for list in &members {
+            let loops = self.boundary(list, &mut next);
+            let singles: Vec<Vec<u32>> = match loops {
+                Some(l) => vec![l],
+                None => list.iter().map(|&t| self.triangles[t].to_vec()).collect(),
+            };
+            for vs in singles {
+                let mut normal = Vec3::zeros();
+                if vs.len() == 3 {
+                    let [a, b, c] = [vs[0], vs[1], vs[2]].map(|i| self.vertices[i as usize]);
+                    normal = (b - a).cross(&(c - a));
+                } else {
+                    for &t in list {
+                        let [a, b, c] = self.triangles[t].map(|i| self.vertices[i as usize]);
+                        normal += (b - a).cross(&(c - a));
+                    }
+                }
+                let len = normal.norm();
+                let p = self.poly_normal.len() as u32;
+                self.poly_normal.push(if len > 0.0 { normal / len } else { normal });
+                for &v in &vs {
+                    per_vertex[v as usize].push(p);
+                }
+                self.poly.extend_from_slice(&vs);
+                self.poly_start.push(self.poly.len() as u32);
+            }
+        }
+        self.vpoly_start.push(0);
+        for l in per_vertex {
+            self.vpolys.extend_from_slice(&l);
+            self.vpoly_start.push(self.vpolys.len() as u32);
+        }
+    }
+
+    /// The boundary loop of the triangles `list` (one coplanar group), or None when it is not a
+    /// single simple loop. `next` is scratch (all `u32::MAX` on entry and on return).
+    fn boundary(&self, list: &[usize], next: &mut [u32]) -> Option<Vec<u32>> {
+        if list.len() == 1 {
+            return Some(self.triangles[list[0]].to_vec());
+        }
+        let mut edges = Vec::new();
+        for &t in list {
+            for j in 0..3 {
+                let inner = self.across(t, j).is_some_and(|w| list.binary_search(&w).is_ok());
+                if !inner {
+                    let tri = self.triangles[t];
+                    edges.push((tri[j], tri[(j + 1) % 3]));
+                }
+            }
+        }
+        let mut simple = true;
+        for &(a, b) in &edges {
+            if next[a as usize] != u32::MAX {
+                simple = false;
+            }
+            next[a as usize] = b;
+        }
+        let mut out = Vec::with_capacity(edges.len());
+        if simple {
+            let start = edges[0].0;
+            let mut v = start;
+            loop {
+                out.push(v);
+                v = next[v as usize];
+                if v == u32::MAX || v == start || out.len() > edges.len() {
+                    break;
+                }
+            }
+            simple = v == start && out.len() == edges.len();
+        }
+        for &(a, _) in &edges {
+            next[a as usize] = u32::MAX;
+        }
+        simple.then_some(out)
     }
 
     /// The triangle across edge (v_j, v_{j+1}) of triangle `t` (another incident triangle of both).
@@ -108,37 +250,6 @@ impl PlaneHull {
     /// Whether triangles `t` and `u` lie in one plane (normals equal to round-off).
     fn coplanar(&self, t: usize, u: usize) -> bool {
         self.normals[t].dot(&self.normals[u]) > 1.0 - COPLANAR
-    }
-
-    /// When triangle `t` and exactly one neighbour form a flat quadrilateral of the hull (no
-    /// further coplanar triangle): the shared edge's index j in `t` (edge v_j → v_{j+1}) and the
-    /// neighbour's far vertex.
-    fn coplanar_quad(&self, t: usize) -> Option<(usize, u32)> {
-        let mut found = None;
-        for j in 0..3 {
-            let Some(u) = self.across(t, j) else { continue };
-            if !self.coplanar(t, u) {
-                continue;
-            }
-            if found.is_some() {
-                return None;
-            }
-            found = Some((j, u));
-        }
-        let (j, u) = found?;
-        // The neighbour's two other edges must not continue the polygon.
-        let shared = [self.triangles[t][j], self.triangles[t][(j + 1) % 3]];
-        for i in 0..3 {
-            let edge = [self.triangles[u][i], self.triangles[u][(i + 1) % 3]];
-            if shared.contains(&edge[0]) && shared.contains(&edge[1]) {
-                continue;
-            }
-            if self.across(u, i).is_some_and(|w| w != t && self.coplanar(u, w)) {
-                return None;
-            }
-        }
-        let far = *self.triangles[u].iter().find(|v| !shared.contains(v))?;
-        Some((j, far))
     }
 
     /// The hull's vertices (geom frame).
@@ -169,7 +280,7 @@ impl PlaneHull {
 }
 
 /// The contacts of `hull` (pose `x`) with the plane (pose `plane`, normal its z axis) closer than
-/// `reach` (the pair's margin), at most three (see the module documentation). `feature` is the
+/// `reach` (the pair's margin), the deepest vertex and at most three more (see the module documentation). `feature` is the
 /// hull vertex index.
 pub fn plane_mesh(
     plane: &Transform,
@@ -192,49 +303,65 @@ pub fn plane_mesh(
         return;
     }
     out(PlanePoint { surface: p, dist, hint: None, feature: first as u32 });
-    // The triangle around it facing the plane most (its normal nearest −normal).
-    let (s, e) = (hull.tri_start[first] as usize, hull.tri_start[first + 1] as usize);
+    // The face polygon around it facing the plane most (its normal nearest −normal).
+    let (s, e) = (hull.vpoly_start[first] as usize, hull.vpoly_start[first + 1] as usize);
     let mut face = None;
     let mut facing = f64::INFINITY;
-    for &t in &hull.tris[s..e] {
-        let along = hull.normals[t as usize].dot(&(-down));
+    for &p in &hull.vpolys[s..e] {
+        let along = hull.poly_normal[p as usize].dot(&(-down));
         if along < facing {
             facing = along;
-            face = Some(t as usize);
+            face = Some(p as usize);
         }
     }
     let Some(face) = face else { return };
-    let tri = hull.triangles[face];
-    // The face's polygon: the triangle, or the quadrilateral it forms with one coplanar
-    // neighbour (its far vertex inserted between the shared edge's ends, keeping the outward
-    // counter-clockwise order).
-    let mut polygon = [0u32; 4];
-    let len = match hull.coplanar_quad(face) {
-        Some((edge, w)) => {
-            for (slot, v) in polygon.iter_mut().zip(
-                tri.iter()
-                    .take(edge + 1)
-                    .copied()
-                    .chain(std::iter::once(w))
-                    .chain(tri.iter().skip(edge + 1).copied()),
-            ) {
-                *slot = v;
-            }
-            4
-        }
-        None => {
-            polygon[..3].copy_from_slice(&tri);
-            3
-        }
-    };
-    let k = polygon[..len].iter().position(|&v| v as usize == first).unwrap_or(0);
+    let polygon = &hull.poly[hull.poly_start[face] as usize..hull.poly_start[face + 1] as usize];
+    let len = polygon.len();
+    let k = polygon.iter().position(|&v| v as usize == first).unwrap_or(0);
+    let at = |i: usize| hull.vertices[polygon[(k + i) % len] as usize];
+    let corners = if len > 4 { quad_from_first(len, &at) } else { [0, 1, 2, 3] };
     // MuJoCo's inclusion test: along −normal beyond the geom centre's height less the margin.
     let threshold = n.dot(&(x.pos - plane.pos)) - reach;
-    for step in 1..len {
-        let i = polygon[(k + step) % len] as usize;
+    for &c in corners.iter().skip(1).take(len.min(4) - 1) {
+        let i = polygon[(k + c) % len] as usize;
         if down.dot(&hull.vertices[i]) > threshold {
             let q = point(i);
             out(PlanePoint { surface: q, dist: n.dot(&(q - plane.pos)), hint: None, feature: i as u32 });
         }
     }
+}
+
+/// Four corners (indices into a convex polygon of `len` > 4 vertices, `at(i)` its i-th vertex,
+/// increasing) of a large quadrilateral with its first vertex fixed: MuJoCo 4.0's pruning (the
+/// last corner advanced while the area grows, after each advance the third and then the second;
+/// not always the largest quadrilateral).
+pub fn quad_from_first(len: usize, at: &dyn Fn(usize) -> Vec3) -> [usize; 4] {
+    let area = |q: [usize; 4]| 0.5 * (at(q[2]) - at(q[0])).cross(&(at(q[3]) - at(q[1]))).norm();
+    let mut q = [0, 1, 2, 3];
+    let mut m = area(q);
+    while q[3] + 1 < len {
+        let next = area([q[0], q[1], q[2], q[3] + 1]);
+        if next <= m {
+            break;
+        }
+        m = next;
+        q[3] += 1;
+        while q[2] + 1 < q[3] {
+            let next = area([q[0], q[1], q[2] + 1, q[3]]);
+            if next <= m {
+                break;
+            }
+            m = next;
+            q[2] += 1;
+        }
+        while q[1] + 1 < q[2] {
+            let next = area([q[0], q[1] + 1, q[2], q[3]]);
+            if next <= m {
+                break;
+            }
+            m = next;
+            q[1] += 1;
+        }
+    }
+    q
 }

@@ -60,5 +60,6 @@ impl ConstraintMode {
     }
 }
 
-/// Relative size below which an eigenvalue of J M⁻¹ Jᵀ counts as zero (a redundant row).
+/// Relative size (to the largest diagonal entry) below which a pivot of J M⁻¹ Jᵀ's pivoted
+/// Cholesky factor counts as zero (a redundant row).
 pub const RANK_TOLERANCE: f64 = 1e-10;

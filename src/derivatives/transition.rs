@@ -291,8 +291,8 @@ fn skippable(model: &Model) -> bool {
 /// forward, twice that centred, most of them skipping stages ([`TransitionOptions::skip`]).
 ///
 /// # Errors
-/// [`SimError::Input`] when `data` or `work` was made for another model or ε is not finite and
-/// positive; the error of a step that fails (diverges) at the nominal or a nudged state.
+/// [`SimError::Input`] when `data` or `work` was made for another model, ε is not finite and
+/// positive, or an actuator keeps a control history (`nsample`; as MuJoCo's); the error of a step that fails (diverges) at the nominal or a nudged state.
 pub fn transition_jacobians(
     model: &Model,
     data: &mut Data,
@@ -320,6 +320,19 @@ pub fn transition_jacobians(
     }
     if let Some(f) = &data.stepper.failed {
         return Err(f.refusal());
+    }
+    if let Some(a) = model.actuators.iter().find(|a| a.history.is_some()) {
+        // A step records the controls into the history, which x does not hold.
+        return Err(InputError::Value {
+            function: "transition_jacobians",
+            argument: "model",
+            detail: format!(
+                "actuator '{}' keeps a control history (nsample, delay), which is part of the state but not of x = (q, v, act); \
+                 MuJoCo's mjd_transitionFD refuses delays too. Differentiate a copy of the model without nsample/delay",
+                a.name
+            ),
+        }
+        .into());
     }
     work.save(data);
     data.forward_skip.sensors = true;

@@ -72,10 +72,21 @@ pub fn resolved_bias_velocity(model: &Model) -> Vec<f64> {
 
 /// Actuator i's control, clamped to its `ctrlrange` unless `clampctrl` is disabled.
 fn clamped_ctrl(model: &Model, data: &Data, i: usize) -> f64 {
+    clamp_ctrl(model, i, data.ctrl[i])
+}
+
+/// `ctrl` of actuator i clamped to its `ctrlrange` unless `clampctrl` is disabled.
+fn clamp_ctrl(model: &Model, i: usize, ctrl: f64) -> f64 {
     match (model.options.flags.clampctrl, model.actuators[i].ctrlrange) {
-        (true, Some([lo, hi])) => data.ctrl[i].clamp(lo, hi),
-        _ => data.ctrl[i],
+        (true, Some([lo, hi])) => ctrl.clamp(lo, hi),
+        _ => ctrl,
     }
+}
+
+/// The control the actuation stage uses: actuator i's control, or with a `delay` its recorded
+/// control at `data.time` − delay (`forward::history`), clamped as [`clamped_ctrl`].
+fn stage_ctrl(model: &Model, data: &Data, i: usize) -> f64 {
+    clamp_ctrl(model, i, super::history::delayed_ctrl(model, data, i))
 }
 
 /// MuJoCo's `mju_isBad`: NaN or beyond ±mjMAXVAL.
@@ -122,7 +133,7 @@ pub(crate) fn actuation_unchecked(
     }
     // MuJoCo's mjWARN_BADCTRL (mj_fwdActuation): a control NaN, infinite or beyond ±MAX_CTRL
     // after its range clamp zeroes every control of this evaluation, with a warning.
-    let bad = (0..model.actuators.len()).find(|&i| is_bad(clamped_ctrl(model, data, i)));
+    let bad = (0..model.actuators.len()).find(|&i| is_bad(stage_ctrl(model, data, i)));
     if let Some(i) = bad {
         data.warnings.bad_control(i);
     }
@@ -150,7 +161,7 @@ pub(crate) fn actuation_unchecked(
         }
         let actuator_moment = &data.actuator_moment;
         let velocity = moment_span(model, a).map(|k| actuator_moment[(i, k)] * v[k]).sum::<f64>();
-        let ctrl = if zeroed { 0.0 } else { clamped_ctrl(model, data, i) };
+        let ctrl = if zeroed { 0.0 } else { stage_ctrl(model, data, i) };
         // The input of the gain: the control, or the activation (the next one with actearly).
         let input = match act_index {
             None => ctrl,

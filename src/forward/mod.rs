@@ -20,6 +20,7 @@
 mod activation;
 mod actuation;
 pub(crate) mod adhesion;
+pub mod history;
 pub mod muscle;
 mod plan;
 mod skip;
@@ -32,6 +33,7 @@ pub use actuation::{
     actuation, add_actuator_velocity_derivative, resolved_bias_velocity, unsimulated_reason,
 };
 pub(crate) use actuation::{actuation_unchecked, add_actuator_length_derivative};
+pub(crate) use history::{record_controls, reset_actuator_buffers};
 
 pub use crate::constraint::DriftCorrection;
 pub use plan::{Plan, Stage, StageKind, Status};

@@ -277,7 +277,13 @@ fn stages(
             Actuation,
             "actuation",
             Runs,
-            format!("{simulated} actuators (force = gain·(ctrl or act) + bias on joints, fixed tendons, sites and slider-cranks){missing}"),
+            format!(
+                "{simulated} actuators (force = gain·(ctrl or act) + bias on joints, fixed tendons, sites and slider-cranks){}{missing}",
+                match model.actuators.iter().filter(|a| a.history.is_some_and(|h| h.delay != 0.0)).count() {
+                    0 => String::new(),
+                    n => format!("; {n} with delayed controls (history buffers)"),
+                }
+            ),
         )
     });
     out.push(if constrained {

@@ -88,7 +88,12 @@ pub(crate) trait Advance {
     fn step_moved(&mut self, model: &Model, data: &mut Data, h: f64) -> StepReport {
         let mut stage_act = std::mem::take(self.stage_act());
         let mut state = State::take(data, &mut stage_act);
+        let start = state.time;
         let report = self.advance(model, data, &mut state, h);
+        if state.time != start && model.nhistory() > 0 {
+            // MuJoCo's mj_advance: the controls of the step just taken, at its start time.
+            crate::forward::record_controls(model, data, start);
+        }
         state.put(data, &mut stage_act);
         *self.stage_act() = stage_act;
         report

@@ -78,6 +78,8 @@ impl Advance for RungeKutta4 {
             if i > 0 {
                 data.act.axpy(C[i] * h, &self.act_rate[i - 1], 1.0);
             }
+            // The stage's time, which delayed controls are read at (MuJoCo's mj_RungeKutta).
+            data.time = state.time + C[i] * h;
             evaluate_stage(
                 model,
                 data,

@@ -179,13 +179,14 @@ impl Data {
         Ok(())
     }
 
-    /// `Ok` when this data's state and inputs have `model`'s sizes (nq, nv, na, nu), else
+    /// `Ok` when this data's state and inputs have `model`'s sizes (nq, nv, na, nu, nhistory), else
     /// [`InputError::Length`] naming the first that differs and the function `function`.
     pub fn check_sizes(&self, model: &Model, function: &'static str) -> Result<(), InputError> {
         InputError::check_len(function, "data.qpos", self.qpos.len(), model.nq, "nq")?;
         InputError::check_len(function, "data.qvel", self.qvel.len(), model.nv, "nv")?;
         InputError::check_len(function, "data.act", self.act.len(), model.na(), "na")?;
         InputError::check_len(function, "data.ctrl", self.ctrl.len(), model.actuators.len(), "nu")?;
+        InputError::check_len(function, "data.history", self.history.len(), model.nhistory(), "nhistory")?;
         InputError::check_len(function, "data.qfrc_applied", self.qfrc_applied.len(), model.nv, "nv")
     }
 }

@@ -17,6 +17,10 @@ const INERTIA_TOL: f64 = 1e-9;
 /// Inertia (kg·m²) below which a principal moment is round-off: MuJoCo's `mjMINVAL`.
 const ROUNDOFF_MINVAL: f64 = 1e-15;
 
+/// The most numbers the actuators' control histories may take together (`Data::history`,
+/// 128 MiB): a bound on a file's `nsample` that would exhaust memory.
+const MAX_HISTORY: usize = 1 << 24;
+
 /// Compiles a spec into a model.
 pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let file = spec.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
@@ -399,6 +403,26 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     model.equalities = e.equalities;
     model.tendons = e.tendons;
     model.actuators = e.actuators;
+    // Each control history's place in `Data::history`, in actuator order (MuJoCo's
+    // `actuator_historyadr`).
+    let mut history_adr = 0;
+    for a in model.actuators.iter_mut() {
+        let Some(h) = a.history.as_mut() else { continue };
+        h.adr = history_adr;
+        history_adr += 2 + 2 * h.nsample;
+        if history_adr > MAX_HISTORY {
+            return Err(LoadError::Invalid {
+                loc: a.loc.clone(),
+                element: "actuator".into(),
+                detail: format!(
+                    "the actuators' control histories (nsample) take more than {MAX_HISTORY} numbers \
+                     ({} MB) by actuator '{}': keep fewer samples",
+                    (MAX_HISTORY * 8) >> 20,
+                    a.name
+                ),
+            });
+        }
+    }
     model.contact_pairs = e.contact_pairs;
     model.contact_excludes = e.contact_excludes;
     model.elements.append(&mut e.kept);

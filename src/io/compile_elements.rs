@@ -707,6 +707,7 @@ fn actuator(
         actearly: a.actearly,
         lengthrange,
         acc0: 0.0,
+        history: a.history,
         loc: a.loc.clone(),
     })
 }

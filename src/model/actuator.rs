@@ -166,8 +166,51 @@ pub struct Actuator {
     /// |M₀⁻¹ momentᵀ| at `qpos0` (MuJoCo's `actuator_acc0`): the acceleration a unit force gives,
     /// which scales a muscle's `force` when that is negative ([`crate::model::lengthrange`]).
     pub acc0: f64,
+    /// Its control history (`nsample` > 0), MuJoCo's `actuator_history`, `actuator_historyadr`
+    /// and `actuator_delay`: None without one.
+    pub history: Option<ActuatorHistory>,
     /// Where it is written.
     pub loc: SourceLoc,
+}
+
+/// How a history buffer is read between two samples (MJCF `interp`, MuJoCo's
+/// `actuator_history[2i+1]`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Interp {
+    /// `zoh`: the older sample (MuJoCo's default).
+    #[default]
+    ZeroOrderHold,
+    /// `linear`: linear interpolation.
+    Linear,
+    /// `cubic`: a cubic Hermite spline with Catmull–Rom slopes.
+    Cubic,
+}
+
+impl Interp {
+    /// The MJCF keyword.
+    pub fn name(self) -> &'static str {
+        match self {
+            Interp::ZeroOrderHold => "zoh",
+            Interp::Linear => "linear",
+            Interp::Cubic => "cubic",
+        }
+    }
+}
+
+/// An actuator's control history (MJCF `nsample`, `delay`, `interp`; `forward::history`): the
+/// last `nsample` controls with their times, kept in `Data::history` from `adr` on
+/// (2 + 2·nsample entries), and the delay with which the actuation stage reads them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ActuatorHistory {
+    /// Number of samples kept (MuJoCo's `actuator_history[2i]`, > 0).
+    pub nsample: usize,
+    /// How it is read between samples.
+    pub interp: Interp,
+    /// The delay (s) with which the force sees the control (MuJoCo's `actuator_delay`); 0 keeps
+    /// the history without delaying the control.
+    pub delay: f64,
+    /// Its first entry in `Data::history` (MuJoCo's `actuator_historyadr`), set by the compiler.
+    pub adr: usize,
 }
 
 impl Actuator {

@@ -193,6 +193,11 @@ pub struct Data {
     pub act: DVector<f64>,
     /// Time derivative of `act` (MuJoCo's `act_dot`), written by the actuation stage.
     pub act_dot: DVector<f64>,
+    /// The actuators' control histories (MuJoCo's `history`, `nhistory` values in MuJoCo's
+    /// layout; `forward::history`): part of the state, like `act`. Each step records the
+    /// controls at the time it starts; actuators with a `delay` read their control from here.
+    /// Set by `Data::new` and `reset` to MuJoCo's initial buffers (zero controls at −n·h … −h).
+    pub history: DVector<f64>,
     /// Generalized forces applied by the user (MuJoCo's `qfrc_applied`).
     pub qfrc_applied: DVector<f64>,
     /// Cartesian wrenches applied by the user to bodies (MuJoCo's `xfrc_applied`): one per
@@ -427,6 +432,11 @@ impl Data {
             ctrl: DVector::zeros(model.actuators.len()),
             act: DVector::zeros(model.na()),
             act_dot: DVector::zeros(model.na()),
+            history: {
+                let mut history = DVector::zeros(model.nhistory());
+                crate::forward::reset_actuator_buffers(model, history.as_mut_slice());
+                history
+            },
             qfrc_applied: DVector::zeros(nv),
             xfrc_applied: vec![[0.0; 6]; model.frames.iter().filter(|f| f.kind == FrameKind::Link).count()],
             qfrc_xfrc: DVector::zeros(nv),

@@ -21,7 +21,7 @@ pub mod spec;
 pub mod tendon;
 pub mod warning;
 
-pub use actuator::Actuator;
+pub use actuator::{Actuator, ActuatorHistory, Interp};
 pub use collision_pairs::CollisionPair;
 pub use contact::{Contact, ContactExclude, ContactPair};
 pub use data::{Data, EfcState, EfcType, SLIP_VELOCITY};
@@ -345,6 +345,11 @@ impl Model {
     pub fn na(&self) -> usize {
         self.actuators.iter().map(|a| a.actnum()).sum()
     }
+    /// Length of `Data::history` (MuJoCo's `nhistory`): 2 + 2·nsample per actuator with a
+    /// control history.
+    pub fn nhistory(&self) -> usize {
+        self.actuators.iter().filter_map(|a| a.history.as_ref()).map(|h| 2 + 2 * h.nsample).sum()
+    }
     /// Number of bodies including the world.
     pub fn nbody(&self) -> usize {
         self.bodies.len()
@@ -413,20 +418,27 @@ impl Model {
     }
 
     /// The most contacts one collision pass keeps: a memory limit on the constraint rows they
-    /// make (up to 6 each), whose dense Jacobian and per-row buffers take rows × (nv + 20) numbers and, in exact mode, whose
-    /// Delassus matrix takes rows²: [`CONTACT_MEMORY`] bytes for either, at most [`MAX_CONTACTS`] and
-    /// never fewer than [`INITIAL_CONTACTS`]. Contacts beyond it are dropped and counted in
-    /// [`Data::contacts_dropped`] (`simulate` warns with the count).
+    /// make (up to 6 each), whose dense Jacobian and per-row buffers take rows × (nv + 20)
+    /// numbers, at most [`CONTACT_MEMORY`] bytes, as MuJoCo's arena bounds its contacts. Where a
+    /// solver forms a matrix of rows × rows (the exact mode's Delassus matrix, PGS's and the
+    /// no-slip pass's J M⁻¹ Jᵀ), that matrix must fit too, and at most [`MAX_CONTACTS`] are
+    /// kept; the soft mode's Newton and CG work on J and M only and keep up to
+    /// [`MAX_SOFT_CONTACTS`]. Never fewer than [`INITIAL_CONTACTS`]. Contacts beyond it are
+    /// dropped, counted in [`Data::contacts_dropped`] and raise the `contact_full` warning
+    /// (`Data::warnings`, with the count and the time of the pass).
     pub fn contact_budget(&self) -> usize {
         let numbers = (CONTACT_MEMORY / 8) as f64;
         // Each row: its J row (nv numbers) and about 20 per-row numbers (efc_* vectors).
         let by_jacobian = numbers / (6.0 * (self.nv + 20) as f64);
-        let by_delassus = if self.plan.mode() == crate::constraint::ConstraintMode::Exact {
-            numbers.sqrt() / 6.0
+        let dense_rows = self.plan.mode() == crate::constraint::ConstraintMode::Exact
+            || self.options.solver == options::Solver::Pgs
+            || self.options.noslip_iterations > 0;
+        let (by_delassus, most) = if dense_rows {
+            (numbers.sqrt() / 6.0, MAX_CONTACTS)
         } else {
-            f64::INFINITY
+            (f64::INFINITY, MAX_SOFT_CONTACTS)
         };
-        (by_jacobian.min(by_delassus) as usize).clamp(INITIAL_CONTACTS, MAX_CONTACTS)
+        (by_jacobian.min(by_delassus) as usize).clamp(INITIAL_CONTACTS, most)
     }
 
     /// Whether any degree of freedom has viscous damping (the passive stage's damping term).
@@ -473,11 +485,16 @@ pub fn dof_run_starts(dof_parent: &[usize]) -> Vec<usize> {
 /// [`Model::max_contacts`] is smaller); more grow the buffers once, when first needed.
 pub const INITIAL_CONTACTS: usize = 500;
 
-/// The most contacts one collision pass keeps whatever the memory allows: the solvers' dense
-/// parts (PGS's and no-slip's J M⁻¹ Jᵀ, the exact Delassus matrix) grow with the square of the
-/// rows, so more contacts cost seconds per step (the fuzzer found 2000 too many for no-slip;
-/// sparse dual solvers would raise it; see docs/constraints.md).
+/// The most contacts one collision pass keeps, whatever the memory allows, for the solvers with
+/// dense parts (PGS's and no-slip's J M⁻¹ Jᵀ, the exact Delassus matrix), which grow with the
+/// square of the rows, so more contacts cost seconds per step (the fuzzer found 2000 too many for
+/// no-slip; sparse dual solvers would raise it; see docs/constraints.md).
 pub const MAX_CONTACTS: usize = 500;
+
+/// The most contacts one collision pass keeps for the soft mode's Newton and CG solvers (linear
+/// in the rows): a bound on a runaway scene; [`Model::contact_budget`]'s memory limit is usually
+/// lower.
+pub const MAX_SOFT_CONTACTS: usize = 100_000;
 
 /// The memory the rows of one collision pass's contacts may take (bytes; see
 /// [`Model::contact_budget`]).

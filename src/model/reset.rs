@@ -6,7 +6,8 @@ use super::{Data, Model};
 use crate::error::InputError;
 
 /// Resets `data` to `model`'s reference state: time 0, `qpos` = `qpos0`, and zero velocities,
-/// activations, controls and applied forces (`qfrc_applied`, `xfrc_applied`); the solvers' warm starts are cleared, so the next
+/// activations, controls and applied forces (`qfrc_applied`, `xfrc_applied`), the control histories
+/// as MuJoCo initialises them; the solvers' warm starts are cleared, so the next
 /// step is the first of a new run, and the run-time warnings (`data.warnings`) are cleared
 /// (MuJoCo's `mj_resetData`). Allocates nothing. The output
 /// buffers keep their values until the next `forward`.
@@ -36,6 +37,7 @@ pub fn reset(model: &Model, data: &mut Data) -> Result<(), InputError> {
         buffer.fill(0.0);
     }
     data.xfrc_applied.fill([0.0; 6]);
+    crate::forward::reset_actuator_buffers(model, data.history.as_mut_slice());
     for (m, x) in model.mocap_pose0.iter().enumerate() {
         data.mocap_pos[m] = x.pos;
         data.mocap_quat[m] = x.quat_wxyz();

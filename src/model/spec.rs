@@ -633,6 +633,8 @@ pub struct ActuatorSpec {
     pub armature: f64,
     /// `lengthrange` as written ([0, 0] when absent: the compiler computes it).
     pub lengthrange: [f64; 2],
+    /// Its control history (`nsample` > 0, with `delay` and `interp`); the compiler sets `adr`.
+    pub history: Option<super::ActuatorHistory>,
     /// Where it is written.
     pub loc: SourceLoc,
 }

@@ -52,6 +52,12 @@ pub struct Warnings {
     /// `forward` or the start of a `step`: it reads as the identity, as MuJoCo's `mju_normalize4`
     /// makes it (MuJoCo itself does not warn). `last_info`: the joint (index in `Model::joints`).
     pub zero_quat: WarningStat,
+    /// MuJoCo's `mjWARN_CONTACTFULL`: a collision pass found more contacts than
+    /// [`Model::contact_budget`] keeps and dropped the rest (MuJoCo drops them when its arena is
+    /// full). `last_info`: the contacts that pass found, kept and dropped.
+    pub contact_full: WarningStat,
+    /// The simulation time of the last pass that raised [`Self::contact_full`].
+    pub contact_full_time: f64,
 }
 
 impl Warnings {
@@ -62,7 +68,10 @@ impl Warnings {
 
     /// Whether any warning was raised.
     pub fn any(&self) -> bool {
-        self.inertia.number > 0 || self.bad_ctrl.number > 0 || self.zero_quat.number > 0
+        self.inertia.number > 0
+            || self.bad_ctrl.number > 0
+            || self.zero_quat.number > 0
+            || self.contact_full.number > 0
     }
 
     /// Resets every counter (MuJoCo's `mj_resetData` does).
@@ -70,6 +79,8 @@ impl Warnings {
         self.inertia = WarningStat::default();
         self.bad_ctrl = WarningStat::default();
         self.zero_quat = WarningStat::default();
+        self.contact_full = WarningStat::default();
+        self.contact_full_time = 0.0;
         self.inertia_dofs.fill(false);
     }
 
@@ -97,6 +108,12 @@ impl Warnings {
     /// Records a bad control at actuator `i`.
     pub(crate) fn bad_control(&mut self, i: usize) {
         self.bad_ctrl.raise(i);
+    }
+
+    /// Counts a collision pass at `time` that found `found` contacts, more than it keeps.
+    pub(crate) fn contacts_full(&mut self, found: usize, time: f64) {
+        self.contact_full.raise(found);
+        self.contact_full_time = time;
     }
 
     /// Counts one singular factorization (after its pivots were recorded); `first`: the first
@@ -144,6 +161,23 @@ impl Warnings {
                  identity, as MuJoCo's mju_normalize4 does; set a unit quaternion [1, 0, 0, 0] for \
                  the joint's orientation",
                 self.zero_quat.number
+            ));
+        }
+        if self.contact_full.number > 0 {
+            out.push(format!(
+                "{} collision pass(es) found more contacts than the {} kept (last at t = {} s: {} \
+                 found), as MuJoCo's mjWARN_CONTACTFULL: the rest were dropped, so bodies may sink \
+                 into each other; exclude pairs that need not touch (<contact><exclude>, \
+                 contype/conaffinity){}",
+                self.contact_full.number,
+                model.contact_budget(),
+                self.contact_full_time,
+                self.contact_full.last_info,
+                if model.contact_budget() <= super::MAX_CONTACTS {
+                    ", or use the soft mode's Newton or CG solver without no-slip, which keeps more"
+                } else {
+                    ""
+                }
             ));
         }
         out

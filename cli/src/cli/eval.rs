@@ -46,6 +46,10 @@ pub struct StateIn {
     /// The simulation time (s) the clock sensor reads (default zero).
     #[serde(default)]
     pub time: Option<f64>,
+    /// The actuators' control histories (MuJoCo's `history`, `nhistory` values in its layout;
+    /// default: the buffers as a reset leaves them).
+    #[serde(default)]
+    pub history: Option<Vec<f64>>,
     /// The soft solver's warm start (MuJoCo's `qacc_warmstart`, nv values; default zero): read
     /// by `--step` only.
     #[serde(default)]
@@ -221,6 +225,7 @@ fn forward_json(model: &Model, data: &mut Data, s: &StateIn, v: &[f64], tau: &[f
     data.qpos.copy_from_slice(&s.q);
     data.qvel.copy_from_slice(v);
     data.time = s.time.unwrap_or(0.0);
+    set_history(model, data, s);
     data.warnings.clear();
     forward(model, data);
     let mut constraints = Vec::new();
@@ -342,6 +347,14 @@ pub fn geom_name(model: &Model, g: usize) -> String {
     }
 }
 
+/// The state's control histories, or the reset buffers when it gives none.
+pub fn set_history(model: &Model, data: &mut Data, s: &StateIn) {
+    match &s.history {
+        Some(h) => data.history.copy_from_slice(h),
+        None => lagrange::forward::history::reset_buffers(model, data),
+    }
+}
+
 /// Checks one input state's sizes and values.
 fn check_state(model: &Model, file: &str, i: usize, s: &StateIn) -> Result<(), CliError> {
     let err =
@@ -356,6 +369,7 @@ fn check_state(model: &Model, file: &str, i: usize, s: &StateIn) -> Result<(), C
     check("tau", &s.tau, model.nv)?;
     check("ctrl", &s.ctrl, model.actuators.len())?;
     check("act", &s.act, model.na())?;
+    check("history", &s.history, model.nhistory())?;
     check("qacc_warmstart", &s.qacc_warmstart, model.nv)?;
     match s.time {
         Some(t) if !t.is_finite() => Err(err("'time' is not finite".to_string())),

@@ -54,6 +54,7 @@ pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, n: u32) -> Result<V
     copy(data.ctrl.as_mut_slice(), &s.ctrl);
     copy(data.act.as_mut_slice(), &s.act);
     copy(data.qacc_warmstart.as_mut_slice(), &s.qacc_warmstart);
+    super::eval::set_history(model, data, s);
     let collide_us = collide_time(model, data, &s.q)?;
     let t0 = Instant::now();
     for _ in 0..n {
@@ -73,10 +74,14 @@ pub fn evaluate(model: &Model, data: &mut Data, s: &StateIn, n: u32) -> Result<V
         })
         .collect();
     let vec = |x: &nalgebra::DVector<f64>| x.as_slice().to_vec();
-    Ok(json!({
+    let mut result = json!({
         "qpos": vec(&data.qpos), "qvel": vec(&data.qvel), "act": vec(&data.act), "time": data.time,
         "contacts": contacts, "nefc": data.nefc, "step_us": step_us, "collide_us": collide_us,
-    }))
+    });
+    if model.nhistory() > 0 {
+        result["history"] = json!(vec(&data.history));
+    }
+    Ok(result)
 }
 
 /// Mean µs of one collision pass at `q` (body poses first, untimed), with the reach of the

@@ -238,8 +238,10 @@ pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
         .actuators
         .iter()
         .map(|a| {
+            let history =
+                a.history.map(|h| json!({"nsample": h.nsample, "delay": h.delay, "interp": h.interp.name()}));
             json!({"name": a.name, "kind": a.shortcut.name(), "lengthrange": a.lengthrange, "acc0": a.acc0,
-                   "gear": a.gear, "ctrlrange": a.ctrlrange, "forcerange": a.forcerange})
+                   "gear": a.gear, "ctrlrange": a.ctrlrange, "forcerange": a.forcerange, "history": history})
         })
         .collect();
     json!({

@@ -32,7 +32,7 @@ use super::attrs::Attrs;
 use super::defaults::{Defaults, MAIN};
 use super::xml::Element;
 use crate::io::LoadError;
-use crate::model::actuator::{ActuatorShortcut, BiasType, DynType, GainType};
+use crate::model::actuator::{ActuatorHistory, ActuatorShortcut, BiasType, DynType, GainType, Interp};
 use crate::model::lengthrange::{LengthRangeMode, LengthRangeOptions};
 use crate::model::spec::{ActuatorSpec, TransmissionSpec};
 use crate::model::Element as KeptElement;
@@ -427,12 +427,6 @@ fn finish(
     {
         return Err(a.error("ctrlrange", format!("cannot be negative for <{}>: the control scales a dissipative or adhesive force; use a range in [0, ∞)", e.tag)));
     }
-    if a.real("delay")?.is_some_and(|d| d > 0.0) {
-        warnings.push(format!(
-            "{}: <{}>: 'delay' (MuJoCo's control history buffer) is not simulated: the control acts without delay",
-            e.loc, e.tag
-        ));
-    }
     let forcerange = a.limited_range("forcelimited", "forcerange", autolimits, warnings)?;
     let actrange = a.limited_range("actlimited", "actrange", autolimits, warnings)?;
     if actrange.is_some() && p.dyntype == DynType::None {
@@ -502,8 +496,37 @@ fn finish(
         damping: damping(a, warnings)?,
         armature: nonnegative_attr(a, "armature")?,
         lengthrange: a.array::<2>("lengthrange")?.unwrap_or([0.0; 2]),
+        history: history(a)?,
         loc: e.loc.clone(),
     })
+}
+
+/// The control history (`nsample`, `delay`, `interp`; MuJoCo 4.0, `forward::history`): None
+/// without samples. As MuJoCo's compiler: a positive `delay` needs `nsample` > 0; a zero or
+/// negative `nsample` keeps no history; a negative `delay` reads the newest sample.
+fn history(a: &Attrs) -> Result<Option<ActuatorHistory>, LoadError> {
+    let nsample = a.int("nsample")?.unwrap_or(0);
+    let delay = a.real("delay")?.unwrap_or(0.0);
+    if nsample <= 0 {
+        if delay > 0.0 {
+            return Err(a.error(
+                "delay",
+                format!("is {delay} without a history buffer (MuJoCo: \"setting delay > 0 without a history buffer\"); give nsample > 0 samples to keep"),
+            ));
+        }
+        return Ok(None);
+    }
+    // MuJoCo allocates the buffer for any count; a bound keeps a typo from allocating gigabytes.
+    const MAX_SAMPLES: i64 = 1 << 20;
+    if nsample > MAX_SAMPLES {
+        return Err(a.error("nsample", format!("is {nsample}; at most {MAX_SAMPLES} samples are kept")));
+    }
+    let interp = match a.keyword("interp", &["zoh", "linear", "cubic"])?.as_deref() {
+        Some("linear") => Interp::Linear,
+        Some("cubic") => Interp::Cubic,
+        _ => Interp::ZeroOrderHold,
+    };
+    Ok(Some(ActuatorHistory { nsample: nsample as usize, interp, delay, adr: 0 }))
 }
 
 /// An attribute that cannot be negative (0 if absent).

@@ -31,7 +31,8 @@ pub(crate) fn meshes(
     for section in root.children_named("asset") {
         for e in section.children_named("mesh") {
             let a = defaults.resolve(e, MAIN)?;
-            let inertia = match a.keyword("inertia", &["convex", "exact", "legacy", "shell"])?.as_deref() {
+            let mut inertia = match a.keyword("inertia", &["convex", "exact", "legacy", "shell"])?.as_deref()
+            {
                 Some("convex") => MeshInertia::Convex,
                 Some("exact") => MeshInertia::Exact,
                 Some("shell") => MeshInertia::Shell,
@@ -39,7 +40,12 @@ pub(crate) fn meshes(
             };
             let Some(file) = a.text("file") else {
                 let (name, mesh) = match a.text("builtin") {
-                    Some(shape) => super::mesh_builtin::builtin_mesh(e, &a, shape)?,
+                    Some(shape) => {
+                        // MuJoCo makes a built-in surface without volume `shell`.
+                        let (name, mesh, mode) = super::mesh_builtin::builtin_mesh(e, &a, shape, inertia)?;
+                        inertia = mode;
+                        (name, mesh)
+                    }
                     None => super::mesh_inline::inline_mesh(e, &a)?,
                 };
                 let scale = a.vec3("scale")?.unwrap_or(Vec3::repeat(1.0));

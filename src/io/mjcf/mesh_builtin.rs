@@ -9,24 +9,30 @@
 //!   `supertorus` (resolution ≥ 3, radius in (0, 1], s, t): their generators in
 //!   src/io/mjcf/mesh_builtin_super.rs (`MakeHemisphere`, `MakeSupersphere`, `MakeSupertorus`).
 //!
-//! The other built-ins (`wedge`, `plate`, `grid`, `box`, `cylinder`, `ellipsoid`, `square`,
-//! `disc`) are refused with a typed error saying so.
+//! The sampled built-ins (`wedge`, `plate`, `grid`, `box`, `cylinder`, `ellipsoid`, `square`,
+//! `disc`) are generated in src/io/mjcf/mesh_builtin_solid.rs; those MuJoCo stores as points only
+//! become their convex hull here (MuJoCo's refusal when the points span no volume), those it
+//! stores as surfaces without volume turn a `legacy` inertia into `shell`.
 
 use super::attrs::Attrs;
+use super::mesh_builtin_solid::Shell;
 use super::xml::Element;
 use crate::io::LoadError;
-use crate::mass::{self, TriangleMesh};
+use crate::mass::{self, MeshInertia, TriangleMesh};
 use crate::spatial::Vec3;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-/// The name and triangles (mesh frame, before scale) of a built-in mesh element `e`.
+/// The name and triangles (mesh frame, before scale) of a built-in mesh element `e`, and its
+/// inertia mode: the element's `inertia`, or `shell` where MuJoCo makes it so (the surfaces
+/// without volume).
 pub(crate) fn builtin_mesh(
     e: &Element,
     a: &Attrs,
     shape: &str,
-) -> Result<(String, Arc<TriangleMesh>), LoadError> {
+    inertia: MeshInertia,
+) -> Result<(String, Arc<TriangleMesh>, MeshInertia), LoadError> {
     let invalid = |detail: String| LoadError::Invalid { loc: e.loc.clone(), element: "mesh".into(), detail };
     let Some(name) = a.text("name") else {
         return Err(invalid(format!("the built-in mesh '{shape}' needs a 'name' for geoms to refer to it")));
@@ -42,6 +48,8 @@ pub(crate) fn builtin_mesh(
             ))
         }
     };
+    // MuJoCo switches the inertia to `shell` for the built-ins without volume.
+    let mut inertia = inertia;
     let mesh = match shape {
         "sphere" => {
             count(1, "subdivisions")?;
@@ -54,8 +62,14 @@ pub(crate) fn builtin_mesh(
         "cone" => {
             count(2, "edges, top radius")?;
             let nedge = params[0] as i64;
-            if !(3..=100_000).contains(&nedge) {
-                return Err(a.error("params", format!("gives {nedge} edges: a cone needs 3 to 100000")));
+            if nedge < 3 {
+                return Err(a.error("params", format!("gives {nedge} edges: \"Cone nvert must be at least 3\" (MuJoCo 4.0)")));
+            }
+            if nedge > 100_000 {
+                return Err(a.error("params", format!("gives {nedge} edges: lagrange generates cones of at most 100000")));
+            }
+            if !(0.0..=1.0).contains(&params[1]) {
+                return Err(a.error("params", format!("gives top radius {}: \"Cone radius must be in [0, 1]\" (MuJoCo 4.0)", params[1])));
             }
             let vertices = cone(nedge as usize, params[1]);
             mass::convex_hull(&vertices)
@@ -95,12 +109,25 @@ pub(crate) fn builtin_mesh(
             super::mesh_builtin_super::supertorus(res as usize, params[1], params[2], params[3])
         }
         "wedge" | "plate" | "grid" | "box" | "cylinder" | "ellipsoid" | "square" | "disc" => {
-            return Err(LoadError::Unsupported {
-                loc: e.loc.clone(),
-                element: "mesh".into(),
-                what: format!("the built-in mesh '{shape}' (lagrange generates 'sphere', 'cone', 'hemisphere', 'supersphere' and 'supertorus')"),
-                fix: "save that mesh to an STL or OBJ file (e.g. from MuJoCo's compiled mesh_vert/mesh_face) and give it in 'file', or give it as inline 'vertex'/'face'".into(),
-            })
+            let g = super::mesh_builtin_solid::generate(shape, &params).map_err(|r| {
+                a.error("params", format!("of the built-in {shape} mesh '{name}' is refused as MuJoCo 4.0 refuses it: \"{}\"; {}", r.reason, r.fix))
+            })?;
+            match g.shell {
+                Shell::Always => inertia = MeshInertia::Shell,
+                Shell::FromLegacy if inertia == MeshInertia::Legacy => inertia = MeshInertia::Shell,
+                _ => {}
+            }
+            let vertices: Vec<Vec3> =
+                g.vert.chunks_exact(3).map(|c| Vec3::new(c[0].into(), c[1].into(), c[2].into())).collect();
+            if g.face.is_empty() {
+                // Points only: MuJoCo's faces are their convex hull.
+                if vertices.len() < 4 {
+                    return Err(invalid(format!("the built-in {shape} mesh '{name}' has {} vertices: MuJoCo refuses it (\"at least 4 vertices required\"); raise its resolution or counts", vertices.len())));
+                }
+                mass::convex_hull(&vertices).map_err(|err| invalid(format!("the built-in {shape} mesh '{name}' spans no volume ({err}): MuJoCo refuses it (\"has coplanar vertices, cannot compute convex hull\"); give other params or a primitive geom")))?
+            } else {
+                TriangleMesh { vertices, triangles: g.face.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect() }
+            }
         }
         other => {
             return Err(a.error(
@@ -109,7 +136,7 @@ pub(crate) fn builtin_mesh(
             ))
         }
     };
-    Ok((name.to_string(), Arc::new(mesh)))
+    Ok((name.to_string(), Arc::new(mesh), inertia))
 }
 
 /// MuJoCo's `MakeSphere` (make_faces): an icosahedron subdivided `subdiv` times, in `f32`.

@@ -23,6 +23,7 @@ mod equality;
 mod geom;
 mod hfield;
 mod mesh_builtin;
+mod mesh_builtin_solid;
 mod mesh_builtin_super;
 mod mesh_inline;
 mod orientation;
