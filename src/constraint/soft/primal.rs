@@ -290,12 +290,12 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         {
             *g = ma - f0;
         }
-        for i in 0..nefc {
-            let f = efc_force[i];
+        let grad = soft.grad.as_mut_slice();
+        for (i, &f) in efc_force.as_slice()[..nefc].iter().enumerate() {
             if f != 0.0 {
                 let (cols, vals) = nz.row_values(i);
                 for (&k, &j_ik) in cols.iter().zip(vals) {
-                    soft.grad[k] -= j_ik * f;
+                    grad[k] -= j_ik * f;
                 }
             }
         }
@@ -412,12 +412,12 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     }
     // qfrc_constraint = Jᵀ f.
     qfrc_constraint.fill(0.0);
-    for i in 0..nefc {
-        let f = efc_force[i];
+    let qfrc = qfrc_constraint.as_mut_slice();
+    for (i, &f) in efc_force.as_slice()[..nefc].iter().enumerate() {
         if f != 0.0 {
             let (cols, vals) = nz.row_values(i);
             for (&k, &j_ik) in cols.iter().zip(vals) {
-                qfrc_constraint[k] += f * j_ik;
+                qfrc[k] += f * j_ik;
             }
         }
     }
