@@ -52,16 +52,19 @@ impl Rows<'_> {
 
     /// Forces and states at `jar` into `force` and `state`; returns the cost s(jar).
     pub fn update(&self, jar: &DVector<f64>, force: &mut DVector<f64>, state: &mut [EfcState]) -> f64 {
+        // Slices: the per-row loops index them without nalgebra's shape checks.
+        let (jar, force) = (jar.as_slice(), force.as_mut_slice());
+        let (d_all, r_all, floss) = (self.d.as_slice(), self.r.as_slice(), self.floss.as_slice());
         let mut cost = 0.0;
         let mut i = 0;
         while i < self.nefc {
-            let (x, d) = (jar[i], self.d[i]);
+            let (x, d) = (jar[i], d_all[i]);
             if i < self.ne || self.kind[i] != EfcType::ContactElliptic {
                 // One scalar row: its state, force and cost.
                 let (st, f, c) = if i < self.ne {
                     (EfcState::Quadratic, -d * x, 0.5 * d * x * x)
                 } else if i < self.ne + self.nf {
-                    let (f, r) = (self.floss[i], self.r[i]);
+                    let (f, r) = (floss[i], r_all[i]);
                     if x <= -r * f {
                         (EfcState::LinearNeg, f, -0.5 * r * f * f - f * x)
                     } else if x >= r * f {
@@ -92,11 +95,11 @@ impl Rows<'_> {
                 EfcState::Cone
             };
             match zone {
-                EfcState::Satisfied => force.rows_mut(i, dim).fill(0.0),
+                EfcState::Satisfied => force[i..i + dim].fill(0.0),
                 EfcState::Quadratic => {
                     for j in i..i + dim {
-                        force[j] = -self.d[j] * jar[j];
-                        cost += 0.5 * self.d[j] * jar[j] * jar[j];
+                        force[j] = -d_all[j] * jar[j];
+                        cost += 0.5 * d_all[j] * jar[j] * jar[j];
                     }
                 }
                 _ => {
@@ -119,19 +122,21 @@ impl Rows<'_> {
     /// The first and second derivative of s(jar + α jv) in α, at α given by `jar` (already
     /// moved) along `jv`.
     pub fn directional(&self, jar: &DVector<f64>, jv: &DVector<f64>) -> (f64, f64) {
+        let (jar, jv) = (jar.as_slice(), jv.as_slice());
+        let (d_all, r_all, floss) = (self.d.as_slice(), self.r.as_slice(), self.floss.as_slice());
         let (mut d1, mut d2) = (0.0, 0.0);
         let mut i = 0;
         while i < self.nefc {
-            let (x, v, d) = (jar[i], jv[i], self.d[i]);
+            let (x, v, d) = (jar[i], jv[i], d_all[i]);
             let quadratic = if i < self.ne {
                 true
             } else if i < self.ne + self.nf {
-                let rf = self.r[i] * self.floss[i];
+                let rf = r_all[i] * floss[i];
                 if x <= -rf {
-                    d1 -= self.floss[i] * v;
+                    d1 -= floss[i] * v;
                     false
                 } else if x >= rf {
-                    d1 += self.floss[i] * v;
+                    d1 += floss[i] * v;
                     false
                 } else {
                     true
@@ -146,8 +151,8 @@ impl Rows<'_> {
                 if n >= mu * t || (t <= 0.0 && n >= 0.0) {
                 } else if mu * n + t <= 0.0 || (t <= 0.0 && n < 0.0) {
                     for j in i..i + dim {
-                        d1 += self.d[j] * jar[j] * jv[j];
-                        d2 += self.d[j] * jv[j] * jv[j];
+                        d1 += d_all[j] * jar[j] * jv[j];
+                        d2 += d_all[j] * jv[j] * jv[j];
                     }
                 } else {
                     let dm = d / (mu * mu * (1.0 + mu * mu));
@@ -188,6 +193,7 @@ impl Rows<'_> {
         state: &[EfcState],
         mut add: impl FnMut(usize, usize, &[[f64; 6]; 6]),
     ) {
+        let (jar, d_all) = (jar.as_slice(), self.d.as_slice());
         let mut block = [[0.0; 6]; 6];
         let mut i = 0;
         while i < self.nefc {
@@ -196,7 +202,7 @@ impl Rows<'_> {
                 match state[i] {
                     EfcState::Quadratic => {
                         for j in i..i + dim {
-                            block[0][0] = self.d[j];
+                            block[0][0] = d_all[j];
                             add(j, 1, &block);
                         }
                     }
@@ -204,7 +210,7 @@ impl Rows<'_> {
                         let c = &self.contacts[self.id[i]];
                         let mu = self.mu[self.id[i]];
                         let (n, t, u) = cone_coordinates(jar, i, dim, mu, &c.friction);
-                        let dm = self.d[i] / (mu * mu * (1.0 + mu * mu));
+                        let dm = d_all[i] / (mu * mu * (1.0 + mu * mu));
                         let scale = |k: usize| if k == 0 { mu } else { c.friction[k - 1] };
                         // In U: (1, −μ/T U_t) outer product plus μ N/T³ U_t U_tᵀ + (μ² − μN/T) I_t.
                         for a in 0..dim {
@@ -229,7 +235,7 @@ impl Rows<'_> {
                 continue;
             }
             if state[i] == EfcState::Quadratic {
-                block[0][0] = self.d[i];
+                block[0][0] = d_all[i];
                 add(i, 1, &block);
             }
             i += 1;
@@ -238,13 +244,7 @@ impl Rows<'_> {
 }
 
 /// N, T and U (U₀ = μ jar₀, U_j = μ_j jar_j) of the elliptic contact at row i.
-fn cone_coordinates(
-    jar: &DVector<f64>,
-    i: usize,
-    dim: usize,
-    mu: f64,
-    friction: &[f64; 5],
-) -> (f64, f64, [f64; 6]) {
+fn cone_coordinates(jar: &[f64], i: usize, dim: usize, mu: f64, friction: &[f64; 5]) -> (f64, f64, [f64; 6]) {
     let mut u = [0.0; 6];
     u[0] = jar[i] * mu;
     let mut t2 = 0.0;
