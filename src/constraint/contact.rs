@@ -66,7 +66,12 @@ pub(crate) fn contact_rows(model: &Model, data: &mut Data, mut r: usize, frictio
             data.efc_id[i] = c;
             data.efc_type[i] = kind;
             data.efc_pos[i] = 0.0;
-            data.efc_j.row_mut(i).fill(0.0);
+            // Row i of J cleared through its storage (every nrows-th entry): no index
+            // checks per entry.
+            let stride = data.efc_j.nrows();
+            for x in data.efc_j.as_mut_slice()[i..].iter_mut().step_by(stride) {
+                *x = 0.0;
+            }
         }
         data.efc_pos[r] = contact.dist;
         add_contact_jacobian(model, data, &contact, r, dim);

@@ -36,7 +36,12 @@ impl FrictionRow {
     pub(crate) fn write_row(&self, data: &mut Data, r: usize) {
         data.efc_id[r] = self.dof;
         data.efc_type[r] = EfcType::FrictionDof;
-        data.efc_j.row_mut(r).fill(0.0);
+        // Row r of J cleared through its storage (every nrows-th entry): no index
+        // checks per entry.
+        let stride = data.efc_j.nrows();
+        for x in data.efc_j.as_mut_slice()[r..].iter_mut().step_by(stride) {
+            *x = 0.0;
+        }
         data.efc_j[(r, self.dof)] = 1.0;
         data.efc_pos[r] = 0.0;
     }

@@ -168,7 +168,12 @@ impl LimitRow {
     pub(crate) fn write_row(&self, data: &mut Data, r: usize, dir: &Vec3, dist: f64) {
         data.efc_id[r] = self.joint;
         data.efc_type[r] = crate::model::EfcType::LimitJoint;
-        data.efc_j.row_mut(r).fill(0.0);
+        // Row r of J cleared through its storage (every nrows-th entry): no index
+        // checks per entry.
+        let stride = data.efc_j.nrows();
+        for x in data.efc_j.as_mut_slice()[r..].iter_mut().step_by(stride) {
+            *x = 0.0;
+        }
         for k in 0..self.ndof() {
             data.efc_j[(r, self.dof_adr + k)] = dir[k];
         }

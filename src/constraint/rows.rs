@@ -419,7 +419,12 @@ impl ConstraintModel {
             for i in r..r + n {
                 data.efc_id[i] = e.id;
                 data.efc_type[i] = EfcType::Equality;
-                data.efc_j.row_mut(i).fill(0.0);
+                // Row i of J cleared through its storage (every nrows-th entry): no index
+                // checks per entry.
+                let stride = data.efc_j.nrows();
+                for x in data.efc_j.as_mut_slice()[i..].iter_mut().step_by(stride) {
+                    *x = 0.0;
+                }
             }
             match &e.geometry {
                 RowGeometry::Points { a, r_a, b, r_b } => {
