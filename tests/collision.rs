@@ -441,3 +441,29 @@ fn excluding_a_parent_does_not_exclude_its_fused_child() {
     .unwrap();
     assert!(contacts(&model).is_empty());
 }
+
+/// A capsule standing upright on a floor: its tangent hint (the axis) is along the normal, and
+/// the frame is MuJoCo 4.0's (normal z, tangents x and y; its mju_normalize3 makes the vanished
+/// tangent x), with finite constraint rows and accelerations in both modes (the frame was NaN).
+#[test]
+fn an_upright_capsule_on_a_floor_has_mujocos_frame() {
+    let model = mjcf(
+        "upright_capsule",
+        r#"<worldbody><geom type="plane" size="0 0 1"/>
+           <body pos="0.5 0 0.3"><joint type="hinge" axis="0 1 0"/>
+             <geom type="capsule" fromto="0 0 0 0 0 -0.31" size="0.02"/></body></worldbody>"#,
+    )
+    .unwrap();
+    let c = contacts(&model);
+    assert_eq!(c.len(), 1);
+    assert_eq!(c[0].frame.row(1).transpose(), Vec3::x());
+    assert_eq!(c[0].frame.row(2).transpose(), Vec3::y());
+    for mode in [lagrange::constraint::ConstraintMode::Soft, lagrange::constraint::ConstraintMode::Exact] {
+        let mut model = model.clone();
+        model.set_constraint_mode(mode);
+        let mut data = Data::new(&model);
+        lagrange::forward::forward(&model, &mut data);
+        assert!(data.efc_j.rows(0, data.nefc).iter().all(|x| x.is_finite()), "{mode:?}");
+        assert!(data.qacc.iter().all(|x| x.is_finite()), "{mode:?}");
+    }
+}

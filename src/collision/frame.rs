@@ -13,6 +13,16 @@ pub fn contact_frame(n: &Vec3, hint: Option<&Vec3>) -> Mat3 {
         _ => Vec3::new(0.0, 0.0, 1.0),
     };
     t1 -= n * n.dot(&t1);
+    if t1.norm() < 1e-15 {
+        // A hint along the normal (a capsule standing on a plane): MuJoCo's mju_normalize3 makes
+        // the vanished tangent (1, 0, 0). Kept orthogonal to n here, and where x is along n too
+        // (MuJoCo's frame is then degenerate) the hint-free choice.
+        t1 = Vec3::x() - n * n.x;
+        if t1.norm() < 0.5 {
+            t1 = if n.y.abs() < 0.5 { Vec3::y() } else { Vec3::z() };
+            t1 -= n * n.dot(&t1);
+        }
+    }
     t1.normalize_mut();
     let t2 = n.cross(&t1);
     Mat3::from_rows(&[n.transpose(), t1.transpose(), t2.transpose()])
@@ -33,5 +43,11 @@ mod tests {
         assert!((f * f.transpose() - Mat3::identity()).amax() < 1e-15 && f.determinant() > 0.0);
         let f = contact_frame(&Vec3::z(), Some(&Vec3::new(1.0, 0.0, 0.3)));
         assert!((f.row(1).transpose() - Vec3::x()).norm() < 1e-15);
+        // A hint along the normal (a capsule standing on a floor): MuJoCo's frame (z, x, y).
+        let f = contact_frame(&Vec3::z(), Some(&Vec3::z()));
+        assert_eq!((f.row(1).transpose(), f.row(2).transpose()), (Vec3::x(), Vec3::y()));
+        // Along x too: still orthonormal, no NaN.
+        let f = contact_frame(&Vec3::x(), Some(&Vec3::x()));
+        assert!((f * f.transpose() - Mat3::identity()).amax() < 1e-15 && f.determinant() > 0.0);
     }
 }

@@ -43,6 +43,11 @@ pub(crate) struct ExactWork {
     pub slipping: Vec<bool>,
     /// The ADMM solve's per-row buffers ([`super::admm`]).
     pub admm: super::admm::AdmmWork,
+    /// Jᵀ, nv × nefc (columns 0..nefc used): each row of J contiguous, for the Delassus products.
+    pub jt: DMatrix<f64>,
+    /// Per row, the dofs [lo, hi) of the kinematic trees it touches (`dynamics::tree_span`):
+    /// M⁻¹ J_iᵀ is zero outside them, and A_ij = 0 when two rows' spans are disjoint.
+    pub spans: Vec<(usize, usize)>,
 }
 
 impl ExactWork {
@@ -64,6 +69,8 @@ impl ExactWork {
             pressing: vec![false; nefc],
             slipping: vec![false; nefc],
             admm: Default::default(),
+            jt: DMatrix::zeros(nv, nefc),
+            spans: vec![(0, 0); nefc],
         }
     }
 
@@ -74,6 +81,7 @@ impl ExactWork {
             return;
         }
         self.minv_jt = DMatrix::zeros(nv, nefc);
+        self.jt = DMatrix::zeros(nv, nefc);
         for m in [&mut self.delassus, &mut self.factor, &mut self.sub] {
             *m = DMatrix::zeros(nefc, nefc);
         }
@@ -87,6 +95,7 @@ impl ExactWork {
         self.warm.resize_vertically_mut(nefc, 0.0);
         self.pressing.resize(nefc, false);
         self.slipping.resize(nefc, false);
+        self.spans.resize(nefc, (0, 0));
         self.admm.grow(nefc);
         self.active.reserve(nefc.saturating_sub(self.active.len()));
         self.warm_rows.reserve(nefc.saturating_sub(self.warm_rows.len()));

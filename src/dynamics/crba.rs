@@ -401,6 +401,61 @@ pub(crate) fn solve_with_factor_unchecked(model: &Model, factor: &DMatrix<f64>, 
     }
 }
 
+/// The dofs [lo, hi) of the kinematic trees that dofs `first` ..= `last` belong to: M is
+/// block-diagonal over trees (M_ij ≠ 0 only on one ancestor chain) and each tree's dofs are
+/// contiguous in depth-first order, so M⁻¹ b for a b that is zero outside [first, last] is zero
+/// outside [lo, hi) ([`solve_with_factor_span_unchecked`]).
+pub(crate) fn tree_span(model: &Model, first: usize, last: usize) -> (usize, usize) {
+    let parent = &model.dof_parent[..model.nv];
+    let mut lo = first;
+    while parent[lo] != NO_DOF {
+        lo = parent[lo];
+    }
+    let mut hi = last + 1;
+    while hi < model.nv && parent[hi] != NO_DOF {
+        hi += 1;
+    }
+    (lo, hi)
+}
+
+/// [`solve_with_factor_unchecked`] for a right-hand side that is zero outside the trees' span
+/// [lo, hi) of [`tree_span`]: the same arithmetic on those dofs (the others stay zero), in
+/// time proportional to the span instead of nv.
+pub(crate) fn solve_with_factor_span_unchecked(
+    model: &Model,
+    factor: &DMatrix<f64>,
+    x: &mut [f64],
+    (lo, hi): (usize, usize),
+) {
+    let lambda = &model.dof_parent[..model.nv];
+    let nv = model.nv;
+    let h = factor.as_slice();
+    let x = &mut x[..nv];
+    for i in (lo..hi).rev() {
+        let (col_i, x_i) = (&h[i * nv..(i + 1) * nv], x[i]);
+        if lambda[i] != NO_DOF {
+            for_each_run(model, lambda[i], |s, e| {
+                for (xj, l) in x[s..=e].iter_mut().zip(&col_i[s..=e]) {
+                    *xj -= l * x_i;
+                }
+            });
+        }
+    }
+    for i in lo..hi {
+        x[i] /= h[i + i * nv];
+    }
+    for i in lo..hi {
+        let col_i = &h[i * nv..(i + 1) * nv];
+        let mut acc = 0.0;
+        if lambda[i] != NO_DOF {
+            for_each_run(model, lambda[i], |s, e| {
+                acc += x[s..=e].iter().zip(&col_i[s..=e]).map(|(xj, l)| xj * l).sum::<f64>();
+            });
+        }
+        x[i] -= acc;
+    }
+}
+
 /// Solves M X = B for many right-hand sides at once, with the factor of
 /// [`factorize_mass_matrix`], on the transposes: `y` (n × nv, column-major) holds Bᵀ on entry and
 /// Xᵀ on return, so that each step of the tree-sparse solve is an update of whole contiguous
