@@ -369,36 +369,7 @@ pub fn solve_with_factor(model: &Model, factor: &DMatrix<f64>, x: &mut [f64]) ->
 
 /// [`solve_with_factor`] without the argument checks.
 pub(crate) fn solve_with_factor_unchecked(model: &Model, factor: &DMatrix<f64>, x: &mut [f64]) {
-    let lambda = &model.dof_parent[..model.nv];
-    let nv = model.nv;
-    let h = factor.as_slice();
-    let x = &mut x[..nv];
-    // Lᵀ z = b, from the leaves up: x[chain of λ(i)] −= L[i][·] x[i].
-    for i in (0..nv).rev() {
-        let (col_i, x_i) = (&h[i * nv..(i + 1) * nv], x[i]);
-        if lambda[i] != NO_DOF {
-            for_each_run(model, lambda[i], |s, e| {
-                for (xj, l) in x[s..=e].iter_mut().zip(&col_i[s..=e]) {
-                    *xj -= l * x_i;
-                }
-            });
-        }
-    }
-    // D w = z.
-    for i in 0..nv {
-        x[i] /= h[i + i * nv];
-    }
-    // L x = w, from the root down: x[i] −= L[i][·] · x[chain of λ(i)].
-    for i in 0..nv {
-        let col_i = &h[i * nv..(i + 1) * nv];
-        let mut acc = 0.0;
-        if lambda[i] != NO_DOF {
-            for_each_run(model, lambda[i], |s, e| {
-                acc += x[s..=e].iter().zip(&col_i[s..=e]).map(|(xj, l)| xj * l).sum::<f64>();
-            });
-        }
-        x[i] -= acc;
-    }
+    solve_with_factor_span_unchecked(model, factor, x, (0, model.nv));
 }
 
 /// The dofs [lo, hi) of the kinematic trees that dofs `first` ..= `last` belong to: M is
@@ -420,7 +391,9 @@ pub(crate) fn tree_span(model: &Model, first: usize, last: usize) -> (usize, usi
 
 /// [`solve_with_factor_unchecked`] for a right-hand side that is zero outside the trees' span
 /// [lo, hi) of [`tree_span`]: the same arithmetic on those dofs (the others stay zero), in
-/// time proportional to the span instead of nv.
+/// time proportional to the span instead of nv. Lᵀ z = b from the leaves up (x[chain of λ(i)]
+/// −= L[i][·] x[i]), D w = z, then L x = w from the root down (x[i] −= L[i][·] · x[chain of
+/// λ(i)]).
 pub(crate) fn solve_with_factor_span_unchecked(
     model: &Model,
     factor: &DMatrix<f64>,
