@@ -145,10 +145,6 @@ fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVect
 /// product): below it the sparse bookkeeping costs more than the zeros it skips.
 pub(crate) const DENSE_NV: usize = 40;
 
-/// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
-/// `qfrc_smooth`, `qacc_smooth`, the mass matrix and its factor: writes `qacc`, `efc_force`,
-/// `efc_state`, `qfrc_constraint`, `solver_niter`, `solver_improvement`, `solver_gradient`,
-/// `efc_converged`, and counts a solve that stopped at the iteration limit in `efc_unconverged`.
 /// H[p][q] += (w J[a][p]) J[b][q] over the nonzero columns p ≥ q of rows a and b: the lower
 /// triangle of one Hessian term. Row a's weighted entries are gathered first (`weighted`, nv
 /// long, indexed like row a's nonzeros, from the rows' compact values `Sparsity::value`), and
@@ -187,6 +183,10 @@ fn add_weighted_outer(h: &mut DMatrix<f64>, nz: &Sparsity, a: usize, b: usize, w
     }
 }
 
+/// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
+/// `qfrc_smooth`, `qacc_smooth`, the mass matrix and its factor: writes `qacc`, `efc_force`,
+/// `efc_state`, `qfrc_constraint`, `solver_niter`, `solver_improvement`, `solver_gradient`,
+/// `efc_converged`, and counts a solve that stopped at the iteration limit in `efc_unconverged`.
 pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings) {
     let nv = model.nv;
     let nefc = data.nefc;
