@@ -598,3 +598,54 @@ fn partial_geom_solref_keeps_the_default_damping_ratio() {
     .unwrap();
     assert_eq!(model.geoms[0].contact.solref, [0.05, 1.0]);
 }
+
+/// Found by fuzzing (2026-11-27): sizes in a file that would exhaust memory are typed errors
+/// naming the element — a user sensor's `dim` and a contact sensor's `num` of 2³² − 1, a
+/// built-in plate or supersphere of ~10²⁰⁰ points — and a chain of 300 links stacked in one
+/// place (tens of thousands of candidate contacts) keeps the soft solver's work bounded: the
+/// contact budget follows the depth of the dof tree, and the overflow is a warning.
+#[test]
+fn fuzzed_sizes_are_refused_and_contact_work_is_bounded() {
+    let dir = temp_dir("fuzz_sizes");
+    let world = |body: &str, extra: &str| {
+        format!("<mujoco><worldbody><body><joint name=\"j\"/><geom size=\".1\"/><site name=\"s\"/></body>{body}</worldbody>{extra}</mujoco>")
+    };
+    let cases = [
+        ("user_dim", world("", "<sensor><user name=\"u\" dim=\"4294967295\"/></sensor>"), "sensordata"),
+        (
+            "contact_num",
+            world(
+                "",
+                "<sensor><contact name=\"c\" site=\"s\" num=\"4294967295\" data=\"found dist\"/></sensor>",
+            ),
+            "sensordata",
+        ),
+        (
+            "plate",
+            world("", "<asset><mesh name=\"p\" builtin=\"plate\" params=\"1e200 3\"/></asset>"),
+            "at most 10^6 points",
+        ),
+        (
+            "supersphere",
+            world("", "<asset><mesh name=\"p\" builtin=\"supersphere\" params=\"1e9 1 1\"/></asset>"),
+            "at most 10^6 points",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        let path = dir.join(format!("{name}.xml"));
+        std::fs::write(&path, text).unwrap();
+        refused(&path, &LoadOptions::default(), &[needle]);
+    }
+    let chain: String =
+        (0..300).map(|_| "<body><joint/><geom size=\".1\"/>").collect::<String>() + &"</body>".repeat(300);
+    let model = lagrange::Model::from_str(&format!(
+        "<mujoco><worldbody><geom type=\"plane\" size=\"0 0 1\"/><body>{chain}</body></worldbody></mujoco>"
+    ))
+    .unwrap();
+    assert_eq!(model.contact_budget(), lagrange::model::INITIAL_CONTACTS);
+    let mut data = lagrange::Data::new(&model);
+    lagrange::forward::forward(&model, &mut data);
+    assert!(data.qacc.iter().all(|x| x.is_finite()));
+    assert_eq!(data.contacts.len(), lagrange::model::INITIAL_CONTACTS);
+    assert_eq!(data.warnings.contact_full.number, 1);
+}

@@ -27,6 +27,10 @@ use crate::model::{integrate_configuration_unchecked, Data, EfcType, Model};
 fn delassus(model: &Model, data: &mut Data) {
     let n = data.nefc;
     let nv = model.nv;
+    // The dense matrices for the whole row capacity (grown once, when a problem is larger than
+    // any before it).
+    let cap = data.efc_capacity();
+    data.exact.grow_matrices(nv, cap);
     let Data {
         efc_j,
         mass_factor,

@@ -88,6 +88,10 @@ fn frame_object(
     }))
 }
 
+/// The most numbers `sensordata` may hold (128 MiB): a bound on a file's `dim` or `num` that
+/// would exhaust memory.
+const MAX_SENSORDATA: usize = 1 << 24;
+
 /// Compiles every sensor element of `elements` (category `sensor`, file order) against `model`;
 /// returns the sensors and the size of `sensordata`.
 pub(crate) fn compile_sensors(
@@ -100,7 +104,18 @@ pub(crate) fn compile_sensors(
     for e in elements.iter().filter(|e| e.category == "sensor") {
         let mut s = sensor(e, names, model, out.len())?;
         s.adr = adr;
-        adr += s.dim;
+        adr = adr.saturating_add(s.dim);
+        if adr > MAX_SENSORDATA {
+            return Err(invalid(
+                e,
+                format!(
+                    "the sensors take more than {MAX_SENSORDATA} numbers of sensordata ({} MiB) with this one \
+                     ({} values): give a smaller 'dim' or 'num'",
+                    (MAX_SENSORDATA * 8) >> 20,
+                    s.dim
+                ),
+            ));
+        }
         out.push(s);
     }
     Ok((out, adr))
@@ -270,7 +285,7 @@ fn sensor(e: &Element, names: &Names, model: &Model, id: usize) -> Result<Sensor
             if reduce == 3 && spec >> 7 != 0 {
                 return Err(invalid(e, "netforce reduction is incompatible with linvel or angvel"));
             }
-            dim = Some(slot_size(&CONTACT_FIELDS, spec) * num);
+            dim = Some(slot_size(&CONTACT_FIELDS, spec).saturating_mul(num));
             contact = Some(ContactSensorSpec { dataspec: spec, reduce, num });
         }
         EPotential | EKinetic | Clock => {}

@@ -579,10 +579,10 @@ impl Data {
     /// Makes room for `n` rows (at least doubling), keeping the warm start; allocates only when a
     /// problem is larger than any before it.
     pub fn reserve_rows(&mut self, n: usize) {
+        // The exact mode's dense matrices (nefc² each) grow where they are formed, with the
+        // Delassus matrix: rows written only to measure a violation (a soft-mode run's report)
+        // do not allocate them.
         self.reserve_soft_rows(n);
-        // The exact mode's dense matrices (nefc² each), for the whole row capacity.
-        let (nv, cap) = (self.efc_j.ncols(), self.efc_capacity());
-        self.exact.grow_matrices(nv, cap);
     }
 
     /// [`reserve_rows`](Self::reserve_rows) without the exact mode's dense matrices: what the soft

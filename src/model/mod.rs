@@ -423,22 +423,47 @@ impl Model {
     /// solver forms a matrix of rows × rows (the exact mode's Delassus matrix, PGS's and the
     /// no-slip pass's J M⁻¹ Jᵀ), that matrix must fit too, and at most [`MAX_CONTACTS`] are
     /// kept; the soft mode's Newton and CG work on J and M only and keep up to
-    /// [`MAX_SOFT_CONTACTS`]. Never fewer than [`INITIAL_CONTACTS`]. Contacts beyond it are
+    /// [`MAX_SOFT_CONTACTS`], as many as keep one Newton iteration's Hessian work bounded (rows ×
+    /// (2 · [`Model::max_dof_depth`])² below about 5·10⁸). Never fewer than [`INITIAL_CONTACTS`]. Contacts beyond it are
     /// dropped, counted in [`Data::contacts_dropped`] and raise the `contact_full` warning
     /// (`Data::warnings`, with the count and the time of the pass).
     pub fn contact_budget(&self) -> usize {
         let numbers = (CONTACT_MEMORY / 8) as f64;
         // Each row: its J row (nv numbers) and about 20 per-row numbers (efc_* vectors).
         let by_jacobian = numbers / (6.0 * (self.nv + 20) as f64);
-        let dense_rows = self.plan.mode() == crate::constraint::ConstraintMode::Exact
+        let dense_rows = self.dense_contact_rows();
+        // Newton's Hessian takes about (nonzeros per row)² per row and iteration; a row touches at
+        // most the ancestor dofs of its two bodies.
+        let depth = self.max_dof_depth().max(1) as f64;
+        let by_work = SOFT_WORK / (6.0 * (2.0 * depth).powi(2));
+        let (by_solver, most) =
+            if dense_rows { (numbers.sqrt() / 6.0, MAX_CONTACTS) } else { (by_work, MAX_SOFT_CONTACTS) };
+        (by_jacobian.min(by_solver) as usize).clamp(INITIAL_CONTACTS, most)
+    }
+
+    /// Whether a solver of this model forms a matrix of rows × rows (the exact mode's Delassus
+    /// matrix, PGS's and the no-slip pass's J M⁻¹ Jᵀ), which bounds the contacts it keeps.
+    pub fn dense_contact_rows(&self) -> bool {
+        self.plan.mode() == crate::constraint::ConstraintMode::Exact
             || self.options.solver == options::Solver::Pgs
-            || self.options.noslip_iterations > 0;
-        let (by_delassus, most) = if dense_rows {
-            (numbers.sqrt() / 6.0, MAX_CONTACTS)
-        } else {
-            (f64::INFINITY, MAX_SOFT_CONTACTS)
-        };
-        (by_jacobian.min(by_delassus) as usize).clamp(INITIAL_CONTACTS, most)
+            || self.options.noslip_iterations > 0
+    }
+
+    /// The most dofs on one chain from a root (the longest ancestor chain of a dof, itself
+    /// included; 0 without dofs).
+    /// Allocates nothing (each collision pass asks): O(nv · depth).
+    pub fn max_dof_depth(&self) -> usize {
+        (0..self.nv)
+            .map(|k| {
+                let (mut depth, mut d) = (1, k);
+                while self.dof_parent[d] != NO_DOF {
+                    d = self.dof_parent[d];
+                    depth += 1;
+                }
+                depth
+            })
+            .max()
+            .unwrap_or(0)
     }
 
     /// Whether any degree of freedom has viscous damping (the passive stage's damping term).
@@ -492,9 +517,15 @@ pub const INITIAL_CONTACTS: usize = 500;
 pub const MAX_CONTACTS: usize = 500;
 
 /// The most contacts one collision pass keeps for the soft mode's Newton and CG solvers (linear
-/// in the rows): a bound on a runaway scene; [`Model::contact_budget`]'s memory limit is usually
-/// lower.
+/// in the rows): a bound on a runaway scene; [`Model::contact_budget`]'s memory and work limits
+/// are usually lower.
 pub const MAX_SOFT_CONTACTS: usize = 100_000;
+
+/// The work one soft Newton iteration's Hessian may take from contact rows (multiply-adds,
+/// about 0.2 s): the contact budget keeps rows × (2 · max dof depth)² below it, so that a
+/// 400-sphere bin keeps every contact and a chain of hundreds of links stacked in one place
+/// keeps [`INITIAL_CONTACTS`].
+const SOFT_WORK: f64 = (1u64 << 29) as f64;
 
 /// The memory the rows of one collision pass's contacts may take (bytes; see
 /// [`Model::contact_budget`]).

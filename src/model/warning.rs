@@ -173,7 +173,7 @@ impl Warnings {
                 model.contact_budget(),
                 self.contact_full_time,
                 self.contact_full.last_info,
-                if model.contact_budget() <= super::MAX_CONTACTS {
+                if model.dense_contact_rows() {
                     ", or use the soft mode's Newton or CG solver without no-slip, which keeps more"
                 } else {
                     ""

@@ -92,6 +92,9 @@ pub(crate) fn builtin_mesh(
             if params[1] < 0.0 || params[2] < 0.0 {
                 return Err(a.error("params", "gives a negative exponent: supersphere 'e' and 'n' cannot be negative"));
             }
+            if (res as f64 + 1.0).powi(2) > super::mesh_builtin_solid::MAX_POINTS {
+                return Err(a.error("params", format!("gives resolution {res}: lagrange generates built-in meshes of at most 10^6 points")));
+            }
             super::mesh_builtin_super::supersphere(res as usize, params[1], params[2])
         }
         "supertorus" => {
@@ -106,11 +109,15 @@ pub(crate) fn builtin_mesh(
             if !(params[2] > 0.0 && params[3] > 0.0) {
                 return Err(a.error("params", "gives an exponent <= 0: supertorus 's' and 't' must be greater than 0"));
             }
+            if (res as f64 + 1.0).powi(2) > super::mesh_builtin_solid::MAX_POINTS {
+                return Err(a.error("params", format!("gives resolution {res}: lagrange generates built-in meshes of at most 10^6 points")));
+            }
             super::mesh_builtin_super::supertorus(res as usize, params[1], params[2], params[3])
         }
         "wedge" | "plate" | "grid" | "box" | "cylinder" | "ellipsoid" | "square" | "disc" => {
             let g = super::mesh_builtin_solid::generate(shape, &params).map_err(|r| {
-                a.error("params", format!("of the built-in {shape} mesh '{name}' is refused as MuJoCo 4.0 refuses it: \"{}\"; {}", r.reason, r.fix))
+                let by = if r.mujoco { "as MuJoCo 4.0 refuses it" } else { "by a limit of lagrange's" };
+                a.error("params", format!("of the built-in {shape} mesh '{name}' is refused {by}: \"{}\"; {}", r.reason, r.fix))
             })?;
             match g.shell {
                 Shell::Always => inertia = MeshInertia::Shell,

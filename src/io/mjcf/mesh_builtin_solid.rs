@@ -19,6 +19,9 @@
 
 use std::f64::consts::PI;
 
+/// The most points a built-in may generate here (about (count + 1) per direction, multiplied).
+pub(crate) const MAX_POINTS: f64 = 1e6;
+
 /// MuJoCo's `mjEPS` (user_util.h), the threshold of `mjuu_normvec`.
 const EPS: f64 = 1e-14;
 
@@ -47,14 +50,16 @@ pub(crate) enum Shell {
 
 /// A refused parameter set: MuJoCo's reason and how to fix it.
 pub(crate) struct Refusal {
-    /// MuJoCo 4.0's message.
+    /// MuJoCo 4.0's message (or lagrange's, when `mujoco` is false).
     pub reason: &'static str,
     /// What to change.
     pub fix: &'static str,
+    /// Whether MuJoCo 4.0 refuses the mesh too (false: a limit of lagrange's).
+    pub mujoco: bool,
 }
 
 fn refuse<T>(reason: &'static str, fix: &'static str) -> Result<T, Refusal> {
-    Err(Refusal { reason, fix })
+    Err(Refusal { reason, fix, mujoco: true })
 }
 
 /// Generates built-in `shape` (one of `wedge`, `plate`, `grid`, `box`, `cylinder`, `ellipsoid`,
@@ -62,6 +67,20 @@ fn refuse<T>(reason: &'static str, fix: &'static str) -> Result<T, Refusal> {
 pub(crate) fn generate(shape: &str, params: &[f64]) -> Result<Generated, Refusal> {
     // MuJoCo truncates integer parameters (`static_cast<int>`).
     let int = |x: f64| x as i64;
+    // lagrange's bound on the points a built-in generates (MuJoCo has none; a file asking for
+    // billions would exhaust memory).
+    let at_most = |counts: &[i64]| {
+        let points: f64 = counts.iter().map(|&c| c as f64 + 1.0).product();
+        if points > MAX_POINTS {
+            Err(Refusal {
+                reason: "lagrange generates built-in meshes of at most 10^6 points",
+                fix: "give smaller resolutions or counts",
+                mujoco: false,
+            })
+        } else {
+            Ok(())
+        }
+    };
     match shape {
         "wedge" => {
             if params.len() != 5 {
@@ -90,6 +109,7 @@ pub(crate) fn generate(shape: &str, params: &[f64]) -> Result<Generated, Refusal
             if !(0.0..=1.0).contains(&gamma) {
                 return refuse("`gamma` must be a nonnegative float between [0, 1]", "give gamma in [0, 1]");
             }
+            at_most(&res)?;
             Ok(wedge([res[0] as usize, res[1] as usize], fov, gamma))
         }
         "plate" => {
@@ -103,6 +123,7 @@ pub(crate) fn generate(shape: &str, params: &[f64]) -> Result<Generated, Refusal
                     "give resolutions of at least 1",
                 );
             }
+            at_most(&res)?;
             Ok(plate([res[0] as usize, res[1] as usize]))
         }
         "grid" => {
@@ -126,6 +147,7 @@ pub(crate) fn generate(shape: &str, params: &[f64]) -> Result<Generated, Refusal
                     "give count[2] = 1 for dim 2",
                 );
             }
+            at_most(&count)?;
             let count = count.map(|c| c as usize);
             let spacing = [params[3], params[4], params[5]];
             grid(count, spacing, dim == 3, false).map_or_else(
@@ -152,6 +174,7 @@ pub(crate) fn generate(shape: &str, params: &[f64]) -> Result<Generated, Refusal
             if count[2] != 1 {
                 return refuse("Square/disc count[2] must be 1", "give count[2] = 1");
             }
+            at_most(&count)?;
             let count = count.map(|c| c as usize);
             let spacing = [params[3], params[4], params[5]];
             grid(count, spacing, false, shape == "disc").map_or_else(
@@ -182,6 +205,7 @@ pub(crate) fn generate(shape: &str, params: &[f64]) -> Result<Generated, Refusal
                 "cylinder" => Projection::Cylinder,
                 _ => Projection::Ellipsoid,
             };
+            at_most(&count)?;
             Ok(solid(kind, count.map(|c| c as usize), [params[3], params[4], params[5]], dim == 3))
         }
         _ => refuse("Unsupported mesh type", "give one of MuJoCo's built-in mesh types"),
