@@ -12,10 +12,10 @@
 //! | 2 … 2 + n | the sample times, a ring ordered oldest to newest from cursor + 1 |
 //! | 2 + n … 2 + 2n | the sample values (the control) |
 //!
-//! [`reset_actuator_buffers`] sets the times to −n·h … −h (h the timestep) and the values to 0.
-//! Each step records the control at the step's start time ([`record_controls`], MuJoCo's
+//! [`reset_buffers`] sets the times to −n·h … −h (h the timestep) and the values to 0.
+//! Each step records the control at the step's start time (`record_controls`, MuJoCo's
 //! `mj_advance`) after the forces are computed; the actuation stage of an actuator with a
-//! nonzero `delay` reads its control at (stage time − delay) ([`delayed_ctrl`]): the oldest
+//! nonzero `delay` reads its control at (stage time − delay) (`delayed_ctrl`): the oldest
 //! value before the oldest sample, the newest after the newest, and between two samples the
 //! older one (`interp="zoh"`), the linear interpolation (`linear`) or a cubic Hermite spline
 //! with finite-difference (Catmull–Rom) slopes, zero at the ends (`cubic`). A time within
