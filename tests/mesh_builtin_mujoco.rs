@@ -6,9 +6,9 @@
 //! built-ins MuJoCo keeps as points, every hull vertex is one of its points); its mass, centre of
 //! mass and principal inertia are MuJoCo's (the `dim` 2 surfaces with MuJoCo's switch to `shell`);
 //! its collision hull's vertices are MuJoCo's compiled vertices (same distances from the centre of
-//! mass); and it falls onto the plane as MuJoCo's does (qpos/qvel after 1, 40 and 120 `mj_step`s)
-//! up to the sample where MuJoCo rests it on two or more contacts (a face or an edge: MuJoCo's
-//! plane–convex contact subset is not followed yet). What MuJoCo refuses (flat built-ins as a
+//! mass); and it falls onto the plane and rests as MuJoCo's does (qpos/qvel after 1, 40 and 120
+//! `mj_step`s; three cases' resting samples are known to differ, `RESTING_DIFFERS`). What MuJoCo
+//! refuses (flat built-ins as a
 //! geom, bad parameters) is refused for MuJoCo's reason.
 
 mod common;
@@ -138,6 +138,17 @@ fn builtin_vertices_and_faces_are_mujocos_bit_for_bit() {
     assert!(surfaces >= 19 && clouds >= 11, "{surfaces} surfaces, {clouds} point sets");
 }
 
+/// Cases whose resting state (on two or more contacts) differs from MuJoCo's although the
+/// contact count is the same: measured at step 120 (relative state error 0.64, 0.1 and 2.6e-4);
+/// not investigated — likely where MuJoCo's face polygon starts, which its qhull facet order
+/// decides (docs/multiccd.md). Every other case is compared while resting too (MuJoCo 4.0's
+/// plane–mesh face polygons and quadrilateral rule, src/collision/plane_mesh.rs).
+const RESTING_DIFFERS: [(&str, &str); 3] = [
+    ("hemisphere 2", "rel err 0.64 at step 120"),
+    ("supersphere 12 0.5 2", "rel err 0.1 at step 120"),
+    ("supertorus 12 0.3 0.5 2", "rel err 2.6e-4 at step 120"),
+];
+
 #[test]
 fn builtin_meshes_fall_onto_a_plane_as_in_mujoco() {
     let golden = golden();
@@ -157,11 +168,9 @@ fn builtin_meshes_fall_onto_a_plane_as_in_mujoco() {
             let e = state_rel_err(sample, &data);
             let ncon = sample["ncon"].as_u64().unwrap();
             println!("  step {k}: ncon {} (MuJoCo {ncon}), rel err {e:.1e}", data.contacts.len());
-            if ncon >= 2 {
-                // Resting on a face or an edge: MuJoCo's plane–convex contact picks its own subset
-                // of the hull's vertices, which lagrange's plane–mesh contacts do not follow yet
-                // (the cone, supported before, shows it too): from here on only printed.
-                break;
+            if ncon >= 2 && RESTING_DIFFERS.iter().any(|(l, _)| *l == label) {
+                // Known: see RESTING_DIFFERS; printed, not judged.
+                continue;
             }
             err = err.max(e);
             compared += 1;
@@ -169,8 +178,11 @@ fn builtin_meshes_fall_onto_a_plane_as_in_mujoco() {
         println!("{label}: {k} steps, rel err {err:.1e}, z {:.5}", data.qpos[2]);
         worst = worst.max(err);
     }
-    println!("{compared} samples compared, worst rel err {worst:.1e}");
-    assert!(compared >= 50, "{compared} samples compared");
+    println!(
+        "{compared} samples compared, worst rel err {worst:.1e}; {} cases' resting samples known to differ",
+        RESTING_DIFFERS.len()
+    );
+    assert!(compared >= 95, "{compared} samples compared");
     assert!(worst <= SOFT_REL, "{worst:e}");
 }
 
