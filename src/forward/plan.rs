@@ -100,6 +100,8 @@ pub struct Plan {
     pub sensor_needs: crate::sensor::SensorNeeds,
     /// The fluid forces' bodies and coefficients (None without `<option density>` or `viscosity`).
     pub fluid: Option<crate::dynamics::fluid::FluidModel>,
+    /// [`Model::max_dof_depth`], which the contact budget reads at every collision pass.
+    pub max_dof_depth: usize,
 }
 
 impl Plan {
@@ -125,6 +127,7 @@ impl Plan {
             actuator_bias_velocity: super::resolved_bias_velocity(model),
             sensor_needs: crate::sensor::SensorNeeds::of(model),
             fluid: crate::dynamics::fluid::FluidModel::new(model),
+            max_dof_depth: model.max_dof_depth(),
         }
     }
 

@@ -90,7 +90,7 @@ pub(crate) trait Advance {
         let mut state = State::take(data, &mut stage_act);
         let start = state.time;
         let report = self.advance(model, data, &mut state, h);
-        if state.time != start && model.nhistory() > 0 {
+        if state.time != start {
             // MuJoCo's mj_advance: the controls of the step just taken, at its start time.
             crate::forward::record_controls(model, data, start);
         }

@@ -434,7 +434,7 @@ impl Model {
         let dense_rows = self.dense_contact_rows();
         // Newton's Hessian takes about (nonzeros per row)² per row and iteration; a row touches at
         // most the ancestor dofs of its two bodies.
-        let depth = self.max_dof_depth().max(1) as f64;
+        let depth = self.plan.max_dof_depth.max(1) as f64;
         let by_work = SOFT_WORK / (6.0 * (2.0 * depth).powi(2));
         let (by_solver, most) =
             if dense_rows { (numbers.sqrt() / 6.0, MAX_CONTACTS) } else { (by_work, MAX_SOFT_CONTACTS) };
@@ -451,7 +451,7 @@ impl Model {
 
     /// The most dofs on one chain from a root (the longest ancestor chain of a dof, itself
     /// included; 0 without dofs).
-    /// Allocates nothing (each collision pass asks): O(nv · depth).
+    /// O(nv · depth); the plan keeps it (`Plan::max_dof_depth`) for the contact budget.
     pub fn max_dof_depth(&self) -> usize {
         (0..self.nv)
             .map(|k| {
