@@ -390,6 +390,8 @@ impl ConstraintModel {
 
     /// [`positions`](Self::positions) without the argument checks.
     pub(crate) fn positions_unchecked(&self, model: &Model, data: &mut Data, q: &[f64], full: bool) {
+        // The soft mode's record of J's nonzeros no longer describes efc_j (soft/jacobian.rs).
+        data.soft.j_recorded = false;
         let mut r = self.equality_rows(model, data, q);
         if full {
             for f in &self.friction {

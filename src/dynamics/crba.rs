@@ -330,8 +330,12 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
         while i != NO_DOF {
             let a = col_k[i] / d_k;
             let col_i = &mut before[i * nv..i * nv + i + 1];
-            for (x, y) in col_i.iter_mut().zip(&col_k[..=i]) {
-                *x -= a * y;
+            // Column k is nonzero only on k's chain, whose rows up to i are i's chain: the
+            // update skips the products with zeros (the same bits as the whole column).
+            let mut j = i;
+            while j != NO_DOF {
+                col_i[j] -= a * col_k[j];
+                j = lambda[j];
             }
             col_k[i] = a;
             i = lambda[i];

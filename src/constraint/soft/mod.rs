@@ -13,6 +13,7 @@
 
 pub mod cost;
 pub mod impedance;
+mod jacobian;
 pub mod noslip;
 pub mod pgs;
 pub mod primal;

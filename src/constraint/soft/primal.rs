@@ -64,52 +64,6 @@ impl Sparsity<'_> {
     }
 }
 
-/// The nonzero columns of J's rows 0..nefc, ascending, into `start`/`index` (row i's are
-/// `index[start[i]..start[i + 1]]`) and J's values there into `value`, from one pass over J's
-/// columns (contiguous in its storage): each column's nonzero rows are appended to `index`
-/// column after column (`start` counting them per row), then regrouped by row in place through
-/// `scratch`. The solver's products then read each row's values contiguously.
-fn sparsity(
-    j: &DMatrix<f64>,
-    nefc: usize,
-    start: &mut Vec<usize>,
-    index: &mut Vec<usize>,
-    value: &mut Vec<f64>,
-    scratch: &mut Vec<(usize, usize)>,
-) {
-    start.clear();
-    start.resize(nefc + 1, 0);
-    scratch.clear();
-    let rows = j.nrows();
-    let data = j.as_slice();
-    for k in 0..j.ncols() {
-        for (i, &v) in data[k * rows..k * rows + nefc].iter().enumerate() {
-            if v != 0.0 {
-                start[i + 1] += 1;
-                scratch.push((i, k));
-            }
-        }
-    }
-    for i in 0..nefc {
-        start[i + 1] += start[i];
-    }
-    index.clear();
-    index.resize(start[nefc], 0);
-    value.clear();
-    value.resize(start[nefc], 0.0);
-    // start[i] is row i's next free slot while filling (columns arrive in ascending order), then
-    // shifted back.
-    for &(i, k) in scratch.iter() {
-        index[start[i]] = k;
-        value[start[i]] = data[k * rows + i];
-        start[i] += 1;
-    }
-    for i in (1..=nefc).rev() {
-        start[i] = start[i - 1];
-    }
-    start[0] = 0;
-}
-
 /// r ← J x (rows 0..nefc).
 fn mul_j(s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
     let x = x.as_slice();
@@ -190,9 +144,10 @@ fn add_weighted_outer(h: &mut DMatrix<f64>, nz: &Sparsity, a: usize, b: usize, w
 pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Settings) {
     let nv = model.nv;
     let nefc = data.nefc;
-    {
+    if !data.soft.j_recorded {
+        // J was written by another writer since the soft position stage: its nonzeros again.
         let Data { efc_j, soft, .. } = &mut *data;
-        sparsity(
+        super::jacobian::record(
             efc_j,
             nefc,
             &mut soft.nz_start,
@@ -283,6 +238,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     let mut iter = 0;
     let mut have_dir = false;
     let mut stalled = false;
+    let mut analyzed = false;
     loop {
         // g = M a − qfrc_smooth − Jᵀ f.
         for ((g, &ma), &f0) in
@@ -339,31 +295,36 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                             l = model.dof_parent[l];
                         }
                     }
-                    // The row groups with a Hessian block: single quadratic rows, and an elliptic
-                    // contact's rows in its cone zone (one dense block).
-                    soft.active_rows.clear();
-                    let (active, weighted) = (&mut soft.active_rows, &mut soft.weighted_row);
+                    if !analyzed {
+                        // Once per solve (after the clear above, which needs the last pattern):
+                        // the pattern of every row that can have a Hessian block, whatever its
+                        // state — each row alone, a contact's rows as one group — so that it
+                        // holds for every iteration; kept from the last step when its cliques
+                        // are unchanged (`SparseCholesky::analyze`).
+                        soft.active_rows.clear();
+                        for i in 0..nefc {
+                            let same_contact = i > 0
+                                && efc_type[i].is_contact()
+                                && efc_type[i] == efc_type[i - 1]
+                                && efc_id[i] == efc_id[i - 1];
+                            match soft.active_rows.last_mut() {
+                                Some(g) if same_contact => g.1 = i,
+                                _ => soft.active_rows.push((i, i)),
+                            }
+                        }
+                        soft.factor.analyze(nv, &model.dof_parent, &soft.active_rows, &nz_start, &nz_index);
+                        analyzed = true;
+                    }
+                    let weighted = &mut soft.weighted_row;
                     rows.hessian(&soft.jar, efc_state, |i, dim, block| {
-                        // The block's entries (a, b) in row order, as one group.
                         for (a, row) in (i..i + dim).zip(block) {
                             for (b, &w) in (i..i + dim).zip(row) {
-                                match active.last_mut() {
-                                    Some(g) if g.1 >= a.min(b) => g.1 = g.1.max(a.max(b)),
-                                    _ => active.push((a, a.max(b))),
-                                }
                                 add_weighted_outer(h, &nz, a, b, w, weighted);
                             }
                         }
                     });
                     soft.dir.copy_from(&soft.grad);
-                    if soft.factor.factor_structured(
-                        &soft.hessian,
-                        nv,
-                        &model.dof_parent,
-                        &soft.active_rows,
-                        &nz_start,
-                        &nz_index,
-                    ) {
+                    if soft.factor.factor_analyzed(&soft.hessian) {
                         soft.factor.solve(soft.dir.as_mut_slice());
                     } else {
                         solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());

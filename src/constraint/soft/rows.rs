@@ -97,13 +97,19 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
     let bound = row_bound(cm, model, data);
     data.reserve_soft_rows(bound);
     let ne = cm.equality_rows(model, data, q);
-    // Rows ne..bound start at zero: cleared column by column (contiguous in J's storage) rather
-    // than row by row (strided).
-    let stride = data.efc_j.nrows();
-    let nv = model.nv;
-    let j = data.efc_j.as_mut_slice();
-    for c in 0..nv {
-        j[c * stride + ne..c * stride + bound].fill(0.0);
+    // Rows ne..bound start at zero: the last position stage's nonzeros cleared when they are
+    // recorded (`jacobian.rs`: every other entry is zero already), else every row from ne on,
+    // column by column (contiguous in J's storage) rather than row by row (strided).
+    if data.soft.j_recorded {
+        let Data { efc_j, soft, .. } = &mut *data;
+        super::jacobian::clear_recorded(efc_j, ne, &soft.nz_start, &soft.nz_index);
+    } else {
+        let stride = data.efc_j.nrows();
+        let nv = model.nv;
+        let j = data.efc_j.as_mut_slice();
+        for c in 0..nv {
+            j[c * stride + ne..(c + 1) * stride].fill(0.0);
+        }
     }
     data.efc_margin.rows_mut(0, ne).fill(0.0);
     data.efc_frictionloss.rows_mut(0, ne).fill(0.0);
@@ -170,9 +176,23 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
         }
     }
     r = tendon_limit_rows(model, &cm.tendon_limits, data, r);
+    // J's nonzeros, for the velocity stage, the solvers and the next clear (`jacobian.rs`): the
+    // rows so far by a scan of their columns, each contact's rows as they are written.
+    {
+        let Data { efc_j, soft, .. } = &mut *data;
+        super::jacobian::record(
+            efc_j,
+            r,
+            &mut soft.nz_start,
+            &mut soft.nz_index,
+            &mut soft.nz_value,
+            &mut soft.nz_scratch,
+        );
+    }
     data.nefc = contact_rows(model, data, r, cone);
     data.ne = ne;
     data.nf = nf;
+    data.soft.j_recorded = true;
 }
 
 /// The limit rows of the limited tendons `tendons` (`ConstraintModel::tendon_limits`) from
@@ -227,7 +247,8 @@ fn tendon_limit_sides(model: &Model, data: &Data, t: usize) -> [Option<(f64, f64
     [within(length - range[0], 1.0), within(range[1] - length, -1.0)]
 }
 
-/// The contact rows from row `r` on; returns the next free row.
+/// The contact rows from row `r` on, their nonzeros appended to the record of J's
+/// (`jacobian.rs`, rows 0..r recorded); returns the next free row.
 fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usize {
     for c in 0..data.contacts.len() {
         let contact = data.contacts[c];
@@ -259,6 +280,16 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
             }
             EfcType::ContactPyramidal
         };
+        let Data { efc_j, soft, .. } = &mut *data;
+        super::jacobian::chain_dofs(model, contact.geom.map(|g| model.geoms[g].body), &mut soft.columns);
+        super::jacobian::append_rows(
+            efc_j,
+            r..r + rows,
+            &soft.columns,
+            &mut soft.nz_start,
+            &mut soft.nz_index,
+            &mut soft.nz_value,
+        );
         for i in r..r + rows {
             data.efc_id[i] = c;
             data.efc_type[i] = kind;
@@ -275,16 +306,29 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
 /// `efc_vel` = J v of every row and `efc_jdotv` of connect and weld rows (0 elsewhere), at the
 /// state of [`soft_positions`]. Needs the body velocities (`v_body`).
 pub(crate) fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Data, v: &[f64]) {
-    // Column by column (contiguous in J's storage), each row's sum in ascending dof order.
+    // Each row's sum over its nonzeros in ascending dof order (`jacobian.rs`, recorded by the
+    // position stage), or over every column when the record is stale.
     let nefc = data.nefc;
-    let stride = data.efc_j.nrows();
-    let j = data.efc_j.as_slice();
-    let vel = &mut data.efc_vel.as_mut_slice()[..nefc];
-    vel.fill(0.0);
-    for (k, &vk) in v.iter().enumerate().take(model.nv) {
-        for (r, &jrk) in j[k * stride..k * stride + nefc].iter().enumerate() {
-            if jrk != 0.0 {
-                vel[r] += jrk * vk;
+    if data.soft.j_recorded {
+        let Data { efc_vel, soft, .. } = &mut *data;
+        let (start, index, value) = (&soft.nz_start, &soft.nz_index, &soft.nz_value);
+        for (i, vel) in efc_vel.as_mut_slice()[..nefc].iter_mut().enumerate() {
+            let mut s = 0.0;
+            for (&k, &j_ik) in index[start[i]..start[i + 1]].iter().zip(&value[start[i]..start[i + 1]]) {
+                s += j_ik * v[k];
+            }
+            *vel = s;
+        }
+    } else {
+        let stride = data.efc_j.nrows();
+        let j = data.efc_j.as_slice();
+        let vel = &mut data.efc_vel.as_mut_slice()[..nefc];
+        vel.fill(0.0);
+        for (k, &vk) in v.iter().enumerate().take(model.nv) {
+            for (r, &jrk) in j[k * stride..k * stride + nefc].iter().enumerate() {
+                if jrk != 0.0 {
+                    vel[r] += jrk * vk;
+                }
             }
         }
     }

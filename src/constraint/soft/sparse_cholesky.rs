@@ -1,14 +1,22 @@
 //! Cholesky factorization of the Newton Hessian H = M + Jᵀ D J that does only the work its
-//! nonzeros need (docs/constraints.md, "Soft constraints"): the tree sparsity of M (a dof couples only to its ancestors) plus the
-//! couplings of the active rows (a row touches only its bodies' ancestor dofs). Independent
-//! groups of dofs — bodies that touch nothing, separate piles, MuJoCo's constraint islands — stay
-//! uncoupled in the factor, so their cost adds instead of multiplying.
+//! nonzeros need (docs/constraints.md, "Soft constraints"): the tree sparsity of M (a dof couples
+//! only to its ancestors) plus the couplings of the rows (a row touches only its bodies'
+//! ancestor dofs). Independent groups of dofs — bodies that touch nothing, separate piles,
+//! MuJoCo's constraint islands — stay uncoupled in the factor, so their cost adds instead of
+//! multiplying.
 //!
 //! Method (Davis, *Direct Methods for Sparse Linear Systems*, SIAM 2006, §4.1–4.3): the
 //! elimination tree of H by Liu's algorithm with path compression; the pattern of each row k of
 //! L as the set reached from row k's nonzeros of H by walking up the tree (`ereach`); then the
 //! up-looking numeric factorization, row by row, in the natural dof order (MuJoCo's: a tree's
 //! M fills nothing in that order).
+//!
+//! The symbolic part (H's pattern, the tree, L's pattern by rows and by columns) is done by
+//! [`SparseCholesky::analyze`] from the rows' cliques and kept while they are unchanged — for all
+//! the iterations of a Newton solve, whose pattern covers every row that can press, and across
+//! steps while the contacts touch the same dofs; [`SparseCholesky::factor_analyzed`] is then
+//! only the numeric factorization (MuJoCo likewise keeps its sparse Hessian's structure,
+//! engine_solver.c).
 //!
 //! The arithmetic is the dense factorization's ([`crate::constraint::dense::cholesky`]) minus
 //! its products with structural zeros, in the same order: factor and solves agree with the dense
@@ -19,7 +27,8 @@ use nalgebra::DMatrix;
 
 const NONE: usize = usize::MAX;
 
-/// The factor L (H = L Lᵀ) and the scratch of its computation.
+/// The factor L (H = L Lᵀ), its symbolic structure (kept while the pattern is unchanged) and the
+/// scratch of its computation.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SparseCholesky {
     /// Strictly lower part of H by rows: row k's columns j < k with H[k, j] ≠ 0.
@@ -36,16 +45,28 @@ pub(crate) struct SparseCholesky {
     l_cols: Vec<usize>,
     l_vals: Vec<f64>,
     diag: Vec<f64>,
-    /// L's strictly lower part by columns (rows ascending): for the backward solve.
+    /// L's strictly lower part by columns (rows ascending): for the backward solve; `c_slot[u]` is
+    /// where row storage's entry u sits in it.
     c_start: Vec<usize>,
     c_rows: Vec<usize>,
     c_vals: Vec<f64>,
+    c_slot: Vec<usize>,
     /// Dense scratch row of L.
     x: Vec<f64>,
-    /// The rows whose columns form the cliques of the pattern, and each dof's cliques.
-    cliques: Vec<usize>,
+    /// The cliques of the pattern being analyzed (clique c's dofs are
+    /// `clique_cols[clique_start[c]..clique_start[c + 1]]`, ascending) and each dof's cliques.
+    clique_start: Vec<usize>,
+    clique_cols: Vec<usize>,
     d_start: Vec<usize>,
     d_cliques: Vec<usize>,
+    /// The cliques and size of the analyzed pattern (the symbolic structure's key).
+    key_start: Vec<usize>,
+    key_cols: Vec<usize>,
+    key_n: usize,
+    /// Whether the symbolic structure (H's and L's patterns, the elimination tree) is set.
+    analyzed: bool,
+    /// Symbolic analyses done (a pattern changed), for tests and profiles.
+    analyses: usize,
 }
 
 impl SparseCholesky {
@@ -66,15 +87,23 @@ impl SparseCholesky {
             c_start: Vec::with_capacity(n + 1),
             c_rows: Vec::with_capacity(nnz),
             c_vals: Vec::with_capacity(nnz),
+            c_slot: Vec::with_capacity(nnz),
             x: Vec::with_capacity(n),
-            cliques: Vec::with_capacity(n),
+            clique_start: Vec::with_capacity(n + 1),
+            clique_cols: Vec::with_capacity(nnz),
             d_start: Vec::with_capacity(n + 1),
             d_cliques: Vec::with_capacity(nnz),
+            key_start: Vec::with_capacity(n + 1),
+            key_cols: Vec::with_capacity(nnz),
+            key_n: 0,
+            analyzed: false,
+            analyses: 0,
         }
     }
 
-    /// The strictly lower nonzeros of H by rows, from the last factorization (its pattern): the
-    /// entries a caller that assembles H in place must clear before the next assembly.
+    /// The strictly lower nonzeros of H by rows, of the analyzed pattern: the entries a caller
+    /// that assembles H in place must clear before the next assembly (and before a new
+    /// [`Self::analyze`] replaces the pattern).
     pub fn pattern_row(&self, k: usize) -> &[usize] {
         if k + 1 < self.h_start.len() {
             &self.h_cols[self.h_start[k]..self.h_start[k + 1]]
@@ -83,41 +112,75 @@ impl SparseCholesky {
         }
     }
 
-    /// Factors `h` (lower triangle read) whose strictly lower nonzeros lie in M's tree pattern
-    /// (each dof's ancestors, `dof_parent`) and in the cliques of the constraint row groups
-    /// `groups` (rows `first..=last` with one Hessian block: the union of their columns
-    /// `nz_index[nz_start[r]..nz_start[r + 1]]` couple pairwise), without reading the rest of
-    /// `h`: the work is that of the nonzeros. Returns false if a pivot is not positive.
-    pub fn factor_structured(
+    /// How many symbolic analyses were done (each pattern change costs one).
+    #[allow(dead_code)]
+    pub fn analyses(&self) -> usize {
+        self.analyses
+    }
+
+    /// The symbolic structure of n × n Hessians whose strictly lower nonzeros lie in M's tree
+    /// pattern (each dof's ancestors, `dof_parent`) and in the cliques of the constraint row
+    /// groups `groups` (rows `first..=last`: the union of their columns
+    /// `nz_index[nz_start[r]..nz_start[r + 1]]` couple pairwise). Kept as is when the cliques are
+    /// those of the last analysis (the usual case from one Newton iteration or one step to the
+    /// next); else H's pattern, the elimination tree and L's pattern are recomputed. A pattern
+    /// that covers more entries than a Hessian's nonzeros factors it to the same bits: the extra
+    /// entries only add products with exact zeros.
+    pub fn analyze(
         &mut self,
-        h: &DMatrix<f64>,
         n: usize,
         dof_parent: &[usize],
         groups: &[(usize, usize)],
         nz_start: &[usize],
         nz_index: &[usize],
-    ) -> bool {
-        // A clique's columns: its group's rows' columns (repeats are harmless: marks dedupe).
-        let cols = |g: (usize, usize)| &nz_index[nz_start[g.0]..nz_start[g.1 + 1]];
-        // Cliques: the groups, consecutive single rows with equal columns (one contact's pyramid
-        // rows) taken once.
-        self.cliques.clear();
-        for (i, &g) in groups.iter().enumerate() {
-            let repeat = i > 0 && {
-                let last = groups[self.cliques[self.cliques.len() - 1]];
-                last.0 == last.1 && g.0 == g.1 && cols(last) == cols(g)
+    ) {
+        // The cliques' dofs (each group's rows' columns, once, ascending); a clique equal to the
+        // one before it (one contact after another on the same bodies) is taken once.
+        self.mark.clear();
+        self.mark.resize(n, NONE);
+        self.clique_start.clear();
+        self.clique_start.push(0);
+        self.clique_cols.clear();
+        for (c, &(first, last)) in groups.iter().enumerate() {
+            let begin = self.clique_cols.len();
+            for &p in &nz_index[nz_start[first]..nz_start[last + 1]] {
+                if self.mark[p] != c {
+                    self.mark[p] = c;
+                    self.clique_cols.push(p);
+                }
+            }
+            if first != last {
+                self.clique_cols[begin..].sort_unstable();
+            }
+            let nc = self.clique_start.len() - 1;
+            let repeat = nc > 0 && {
+                let prev = &self.clique_cols[self.clique_start[nc - 1]..begin];
+                prev == &self.clique_cols[begin..]
             };
-            if !repeat {
-                self.cliques.push(i);
+            // A clique of one dof couples nothing.
+            if repeat || self.clique_cols.len() - begin < 2 {
+                self.clique_cols.truncate(begin);
+            } else {
+                self.clique_start.push(self.clique_cols.len());
             }
         }
+        if self.analyzed
+            && self.key_n == n
+            && self.key_start == self.clique_start
+            && self.key_cols == self.clique_cols
+        {
+            return;
+        }
+        self.analyses += 1;
+        std::mem::swap(&mut self.key_start, &mut self.clique_start);
+        std::mem::swap(&mut self.key_cols, &mut self.clique_cols);
+        self.key_n = n;
+        let ncliques = self.key_start.len() - 1;
         // Each dof's cliques (counting sort).
         self.d_start.clear();
         self.d_start.resize(n + 1, 0);
-        for &c in &self.cliques {
-            for &p in cols(groups[c]) {
-                self.d_start[p + 1] += 1;
-            }
+        for &p in &self.key_cols {
+            self.d_start[p + 1] += 1;
         }
         for k in 0..n {
             self.d_start[k + 1] += self.d_start[k];
@@ -126,8 +189,8 @@ impl SparseCholesky {
         self.h_count.extend_from_slice(&self.d_start[..n]);
         self.d_cliques.clear();
         self.d_cliques.resize(self.d_start[n], 0);
-        for &c in &self.cliques {
-            for &p in cols(groups[c]) {
+        for c in 0..ncliques {
+            for &p in &self.key_cols[self.key_start[c]..self.key_start[c + 1]] {
                 self.d_cliques[self.h_count[p]] = c;
                 self.h_count[p] += 1;
             }
@@ -150,8 +213,12 @@ impl SparseCholesky {
                 l = dof_parent[l];
             }
             for &c in &self.d_cliques[self.d_start[k]..self.d_start[k + 1]] {
-                for &q in cols(groups[c]) {
-                    if q < k && self.mark[q] != k {
+                for &q in &self.key_cols[self.key_start[c]..self.key_start[c + 1]] {
+                    // A clique's dofs ascend: those below k come first.
+                    if q >= k {
+                        break;
+                    }
+                    if self.mark[q] != k {
                         self.mark[q] = k;
                         self.h_cols.push(q);
                     }
@@ -160,8 +227,14 @@ impl SparseCholesky {
             self.h_cols[begin..].sort_unstable();
             self.h_start.push(self.h_cols.len());
         }
-        self.elimination_tree(n);
-        self.numeric(h, n, 0.0)
+        self.symbolic(n);
+    }
+
+    /// Factors `h` (lower triangle read) with the symbolic structure of the last
+    /// [`Self::analyze`], without reading the rest of `h`: the work is that of the nonzeros.
+    /// Returns false if a pivot is not positive.
+    pub fn factor_analyzed(&mut self, h: &DMatrix<f64>) -> bool {
+        self.numeric(h, 0.0)
     }
 
     /// Factors the symmetric `h` (its lower triangle is read; n × n at the top left) into L.
@@ -169,8 +242,9 @@ impl SparseCholesky {
     #[cfg(test)]
     pub fn factor(&mut self, h: &DMatrix<f64>, n: usize, tol: f64) -> bool {
         self.pattern_of_h(h, n);
-        self.elimination_tree(n);
-        self.numeric(h, n, tol)
+        self.analyzed = false;
+        self.symbolic(n);
+        self.numeric(h, tol)
     }
 
     /// Row lists of H's strictly lower nonzeros, from its lower triangle read by columns
@@ -206,6 +280,65 @@ impl SparseCholesky {
         }
     }
 
+    /// From H's pattern: the elimination tree, L's pattern by rows (each row's `ereach`,
+    /// ascending) and by columns, and where each entry of the one sits in the other.
+    fn symbolic(&mut self, n: usize) {
+        self.elimination_tree(n);
+        self.mark.clear();
+        self.mark.resize(n, NONE);
+        self.l_start.clear();
+        self.l_start.push(0);
+        self.l_cols.clear();
+        for k in 0..n {
+            // Row k's pattern: every dof reached from H's row k up the tree (all below k).
+            self.mark[k] = k;
+            let begin = self.l_cols.len();
+            for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
+                let mut i = j;
+                while self.mark[i] != k {
+                    self.mark[i] = k;
+                    self.l_cols.push(i);
+                    i = self.parent[i];
+                }
+            }
+            self.l_cols[begin..].sort_unstable();
+            self.l_start.push(self.l_cols.len());
+        }
+        let nnz = self.l_cols.len();
+        self.l_vals.clear();
+        self.l_vals.resize(nnz, 0.0);
+        self.c_start.clear();
+        self.c_start.resize(n + 1, 0);
+        for &j in &self.l_cols {
+            self.c_start[j + 1] += 1;
+        }
+        for j in 0..n {
+            self.c_start[j + 1] += self.c_start[j];
+        }
+        self.h_count.clear();
+        self.h_count.extend_from_slice(&self.c_start[..n]);
+        self.c_rows.clear();
+        self.c_rows.resize(nnz, 0);
+        self.c_vals.clear();
+        self.c_vals.resize(nnz, 0.0);
+        self.c_slot.clear();
+        self.c_slot.resize(nnz, 0);
+        for k in 0..n {
+            for u in self.l_start[k]..self.l_start[k + 1] {
+                let j = self.l_cols[u];
+                let slot = self.h_count[j];
+                self.c_rows[slot] = k;
+                self.c_slot[u] = slot;
+                self.h_count[j] += 1;
+            }
+        }
+        self.x.clear();
+        self.x.resize(n, 0.0);
+        self.diag.clear();
+        self.diag.resize(n, 0.0);
+        self.analyzed = true;
+    }
+
     /// Liu's algorithm: parent[i] = the first row k > i with L[k, i] ≠ 0.
     fn elimination_tree(&mut self, n: usize) {
         self.parent.clear();
@@ -227,87 +360,43 @@ impl SparseCholesky {
         }
     }
 
-    /// Up-looking factorization: row k of L from rows j < k in its pattern.
-    fn numeric(&mut self, h: &DMatrix<f64>, n: usize, tol: f64) -> bool {
-        self.mark.clear();
-        self.mark.resize(n, NONE);
-        self.x.clear();
-        self.x.resize(n, 0.0);
-        self.diag.clear();
-        self.diag.resize(n, 0.0);
-        self.l_start.clear();
-        self.l_start.push(0);
-        self.l_cols.clear();
-        self.l_vals.clear();
+    /// Up-looking factorization on the analyzed pattern: row k of L from rows j < k in it.
+    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64) -> bool {
+        let n = self.diag.len();
+        let (l_start, l_cols, l_vals) = (&self.l_start, &self.l_cols, &mut self.l_vals);
+        let (x, diag) = (&mut self.x, &mut self.diag);
         for k in 0..n {
-            // Row k's pattern: every dof reached from H's row k up the tree (all below k).
-            self.mark[k] = k;
-            let begin = self.l_cols.len();
             for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
-                let mut i = j;
-                while self.mark[i] != k {
-                    self.mark[i] = k;
-                    self.l_cols.push(i);
-                    i = self.parent[i];
-                }
-            }
-            self.l_cols[begin..].sort_unstable();
-            for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
-                self.x[j] = h[(k, j)];
+                x[j] = h[(k, j)];
             }
             // L[k, j] = (H[k, j] − Σ_{p<j} L[j, p] L[k, p]) / L[j, j], ascending j and p.
-            let mut d = h[(k, k)];
-            for t in begin..self.l_cols.len() {
-                let j = self.l_cols[t];
-                let mut s = self.x[j];
-                for u in self.l_start[j]..self.l_start[j + 1] {
-                    s -= self.l_vals[u] * self.x[self.l_cols[u]];
+            let (begin, end) = (l_start[k], l_start[k + 1]);
+            for t in begin..end {
+                let j = l_cols[t];
+                let mut s = x[j];
+                for u in l_start[j]..l_start[j + 1] {
+                    s -= l_vals[u] * x[l_cols[u]];
                 }
-                let v = s / self.diag[j];
-                self.x[j] = v;
-                self.l_vals.push(v);
+                let v = s / diag[j];
+                x[j] = v;
+                l_vals[t] = v;
             }
-            for t in begin..self.l_cols.len() {
-                let v = self.l_vals[t];
+            let mut d = h[(k, k)];
+            for t in begin..end {
+                let v = l_vals[t];
                 d -= v * v;
-                self.x[self.l_cols[t]] = 0.0;
+                x[l_cols[t]] = 0.0;
             }
+            // (The scratch row is clean again for the next factorization.)
             if d <= tol {
                 return false;
             }
-            self.diag[k] = d.sqrt();
-            self.l_start.push(self.l_cols.len());
+            diag[k] = d.sqrt();
         }
-        self.transpose(n);
+        for (&slot, &v) in self.c_slot.iter().zip(self.l_vals.iter()) {
+            self.c_vals[slot] = v;
+        }
         true
-    }
-
-    /// L's columns (rows ascending) for the backward solve.
-    fn transpose(&mut self, n: usize) {
-        let nnz = self.l_cols.len();
-        self.c_start.clear();
-        self.c_start.resize(n + 1, 0);
-        for &j in &self.l_cols {
-            self.c_start[j + 1] += 1;
-        }
-        for j in 0..n {
-            self.c_start[j + 1] += self.c_start[j];
-        }
-        self.h_count.clear();
-        self.h_count.extend_from_slice(&self.c_start[..n]);
-        self.c_rows.clear();
-        self.c_rows.resize(nnz, 0);
-        self.c_vals.clear();
-        self.c_vals.resize(nnz, 0.0);
-        for k in 0..n {
-            for u in self.l_start[k]..self.l_start[k + 1] {
-                let j = self.l_cols[u];
-                let slot = self.h_count[j];
-                self.c_rows[slot] = k;
-                self.c_vals[slot] = self.l_vals[u];
-                self.h_count[j] += 1;
-            }
-        }
     }
 
     /// Solves H x = b in place with the last factor (b holds x on return).
@@ -389,18 +478,35 @@ mod tests {
             h[(a, b)] += v;
             h[(b, a)] += v;
         }
-        let (nz_start, nz_index) = ([0, 2, 4], [2, 4, 5, 6]);
+        let (nz_start, nz_index) = ([0, 2, 4, 6], [2, 4, 5, 6, 0, 3]);
         let mut structured = SparseCholesky::default();
-        assert!(structured.factor_structured(&h, n, &dof_parent, &[(0, 0), (1, 1)], &nz_start, &nz_index));
+        structured.analyze(n, &dof_parent, &[(0, 0), (1, 1)], &nz_start, &nz_index);
+        assert!(structured.factor_analyzed(&h));
         let mut scanning = SparseCholesky::default();
         assert!(scanning.factor(&h, n, 0.0));
         let rhs: Vec<f64> = (0..n).map(|i| 1.0 + i as f64).collect();
-        let (mut x1, mut x2) = (rhs.clone(), rhs);
+        let (mut x1, mut x2) = (rhs.clone(), rhs.clone());
         structured.solve(&mut x1);
         scanning.solve(&mut x2);
         assert_eq!(x1, x2);
         // Dof 6 couples only to 5: no fill reaches the first tree.
         assert_eq!(structured.pattern_row(6), &[5]);
+        // The same cliques again: the structure is kept, the factor the same.
+        structured.analyze(n, &dof_parent, &[(0, 0), (1, 1)], &nz_start, &nz_index);
+        assert_eq!(structured.analyses(), 1);
+        assert!(structured.factor_analyzed(&h));
+        let mut x3 = rhs.clone();
+        structured.solve(&mut x3);
+        assert_eq!(x3, x2);
+        // A wider pattern (a third group coupling dofs 0 and 3, whose entry of h is zero, and
+        // rows 0 and 1 as one group) factors the same h to the same bits.
+        structured.analyze(n, &dof_parent, &[(0, 1), (2, 2)], &nz_start, &nz_index);
+        assert_eq!(structured.analyses(), 2);
+        assert!(structured.pattern_row(3).contains(&0) && structured.pattern_row(5).contains(&2));
+        assert!(structured.factor_analyzed(&h));
+        let mut x4 = rhs;
+        structured.solve(&mut x4);
+        assert_eq!(x4, x2);
     }
 
     #[test]

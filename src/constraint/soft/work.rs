@@ -28,13 +28,20 @@ pub(crate) struct SoftWork {
     pub factor: super::sparse_cholesky::SparseCholesky,
     /// The dense Cholesky factor of small Hessians (nv × nv; empty above the dense size).
     pub dense_factor: DMatrix<f64>,
-    /// The row groups (first, last) with a Hessian block in the current Newton iteration.
+    /// The row groups (first, last) that can have a Hessian block (each row, a contact's rows
+    /// together): the cliques of the Newton Hessian's pattern.
     pub active_rows: Vec<(usize, usize)>,
     /// The nonzero columns of each row of J: row i's are `nz_index[nz_start[i]..nz_start[i + 1]]`.
     pub nz_start: Vec<usize>,
     pub nz_index: Vec<usize>,
     /// J's values at those entries, in the same order.
     pub nz_value: Vec<f64>,
+    /// Whether `nz_start`/`nz_index`/`nz_value` list J's nonzeros as the soft position stage
+    /// wrote them (rows 0..nz_start.len() − 1; every row after them zero): false until the
+    /// first, and whenever another writer (the exact rows) wrote `efc_j` since.
+    pub j_recorded: bool,
+    /// The dofs of one contact's two bodies while its rows are recorded (nv).
+    pub columns: Vec<usize>,
     /// (row, column) of J's nonzeros in column order, while `nz_start`/`nz_index` are built.
     pub nz_scratch: Vec<(usize, usize)>,
     /// One row of J at its nonzero columns times a Hessian weight, while H is assembled (nv).
@@ -68,6 +75,8 @@ impl SoftWork {
             nz_start: Vec::with_capacity(nefc + 1),
             nz_index: Vec::with_capacity(nefc * nv),
             nz_value: Vec::with_capacity(nefc * nv),
+            j_recorded: false,
+            columns: Vec::with_capacity(nv),
             nz_scratch: Vec::new(),
             weighted_row: vec![0.0; nv],
             ar: DMatrix::zeros(0, 0),
