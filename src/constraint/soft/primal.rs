@@ -120,9 +120,8 @@ fn add_weighted_outer(h: &mut DMatrix<f64>, nz: &Sparsity, a: usize, b: usize, w
         for t in 0..len {
             let (q, j_bq) = (row_a[t], j_b[t]);
             let column = &mut h[q * nv..(q + 1) * nv];
-            let (x_t, p_t) = (&weighted[t..], &row_a[t..]);
-            for u in 0..p_t.len() {
-                column[p_t[u]] += x_t[u] * j_bq;
+            for (&x, &p) in weighted[t..].iter().zip(&row_a[t..]) {
+                column[p] += x * j_bq;
             }
         }
         return;

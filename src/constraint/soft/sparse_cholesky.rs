@@ -369,23 +369,24 @@ impl SparseCholesky {
             for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
                 x[j] = h[(k, j)];
             }
-            // L[k, j] = (H[k, j] − Σ_{p<j} L[j, p] L[k, p]) / L[j, j], ascending j and p.
+            // L[k, j] = (H[k, j] − Σ_{p<j} L[j, p] L[k, p]) / L[j, j], ascending j and p (rows
+            // j < k of L are done: `done`).
             let (begin, end) = (l_start[k], l_start[k + 1]);
-            for t in begin..end {
-                let j = l_cols[t];
+            let (done, row_k) = l_vals.split_at_mut(begin);
+            for (&j, l_kj) in l_cols[begin..end].iter().zip(&mut row_k[..end - begin]) {
+                let (a, b) = (l_start[j], l_start[j + 1]);
                 let mut s = x[j];
-                for u in l_start[j]..l_start[j + 1] {
-                    s -= l_vals[u] * x[l_cols[u]];
+                for (&l_jp, &p) in done[a..b].iter().zip(&l_cols[a..b]) {
+                    s -= l_jp * x[p];
                 }
                 let v = s / diag[j];
                 x[j] = v;
-                l_vals[t] = v;
+                *l_kj = v;
             }
             let mut d = h[(k, k)];
-            for t in begin..end {
-                let v = l_vals[t];
+            for (&v, &j) in row_k[..end - begin].iter().zip(&l_cols[begin..end]) {
                 d -= v * v;
-                x[l_cols[t]] = 0.0;
+                x[j] = 0.0;
             }
             // (The scratch row is clean again for the next factorization.)
             if d <= tol {
@@ -402,17 +403,20 @@ impl SparseCholesky {
     /// Solves H x = b in place with the last factor (b holds x on return).
     pub fn solve(&self, b: &mut [f64]) {
         let n = self.diag.len();
+        let b = &mut b[..n];
         for i in 0..n {
+            let (lo, hi) = (self.l_start[i], self.l_start[i + 1]);
             let mut s = b[i];
-            for u in self.l_start[i]..self.l_start[i + 1] {
-                s -= self.l_vals[u] * b[self.l_cols[u]];
+            for (&l, &j) in self.l_vals[lo..hi].iter().zip(&self.l_cols[lo..hi]) {
+                s -= l * b[j];
             }
             b[i] = s / self.diag[i];
         }
         for i in (0..n).rev() {
+            let (lo, hi) = (self.c_start[i], self.c_start[i + 1]);
             let mut s = b[i];
-            for u in self.c_start[i]..self.c_start[i + 1] {
-                s -= self.c_vals[u] * b[self.c_rows[u]];
+            for (&l, &j) in self.c_vals[lo..hi].iter().zip(&self.c_rows[lo..hi]) {
+                s -= l * b[j];
             }
             b[i] = s / self.diag[i];
         }
