@@ -289,14 +289,24 @@ fn for_each_run(model: &Model, from: usize, mut run: impl FnMut(usize, usize)) {
     }
 }
 
+/// The first (lowest) dof of the ancestor chain of dof `k` (its tree's root run).
+#[inline]
+fn chain_start(model: &Model, k: usize) -> usize {
+    let mut lo = k;
+    for_each_run(model, k, |s, _| lo = s);
+    lo
+}
+
 /// Factorizes `data.mass_matrix` as M = Lᵀ D L into `data.mass_factor`, exploiting the tree's
 /// sparsity: fill-in stays on the ancestor paths λ (RBDA §6.3, Table 6.3). Run [`crba`] first.
 ///
 /// Storage: column k of `mass_factor` holds row k of L, `L[k][j]` at (j, k) for j an ancestor of
 /// k, and D on the diagonal. Row k of L is zero off the ancestor chain of k, and the chain of an
 /// ancestor i of k is the part of k's chain below i, so the update `L[i][j] −= a L[k][j]` over
-/// the chain of i (RBDA Table 6.3) may run over all j ≤ i: one contiguous, vectorizable slice of
-/// two columns instead of a walk through λ; the extra terms subtract zeros.
+/// the chain of i (RBDA Table 6.3) may run over all j from the chain's first dof to i: one
+/// contiguous, vectorizable slice of two columns instead of a walk through λ; the extra terms
+/// (other branches of the same tree) subtract zeros, and other trees' dofs are skipped, so a
+/// scene of many bodies costs O(nv), not O(nv²).
 ///
 /// A pivot below [`MIN_PIVOT`] (a mass matrix singular at this state: duplicated joints, a moving
 /// body without mass or inertia, or not positive) is raised to it, as MuJoCo 4.0's `mj_factorI`
@@ -309,15 +319,12 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
     let m = mass_matrix.as_slice();
     let h = mass_factor.as_mut_slice();
     let mut singular = None;
-    // The upper triangle of M (column k of M holds M[j][k] = M[k][j], j ≤ k), on k's chain only:
-    // the entries off the chain are zero in M and stay zero in the factor (nothing below writes
-    // them), so copying them, O(nv²), is not needed.
+    // The upper triangle of M (column k of M holds M[j][k] = M[k][j], j ≤ k), from the first dof
+    // of k's chain on (`chain_start`): the entries above it are off the chain, never read, so
+    // copying them, O(nv²) over many bodies, is not needed.
     for k in 0..nv {
-        let mut j = k;
-        while j != NO_DOF {
-            h[k * nv + j] = m[k * nv + j];
-            j = lambda[j];
-        }
+        let lo = chain_start(model, k);
+        h[k * nv + lo..=k * nv + k].copy_from_slice(&m[k * nv + lo..=k * nv + k]);
     }
     for k in (0..nv).rev() {
         let (before, rest) = h.split_at_mut(k * nv);
@@ -337,11 +344,11 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
             let a = col_k[i] / d_k;
             let col_i = &mut before[i * nv..i * nv + i + 1];
             // Column k is nonzero only on k's chain, whose rows up to i are i's chain: the
-            // update skips the products with zeros (the same bits as the whole column).
-            let mut j = i;
-            while j != NO_DOF {
-                col_i[j] -= a * col_k[j];
-                j = lambda[j];
+            // update runs over i's span from its chain's first dof (the same bits on the chain
+            // as the whole column, without the products with zeros of other trees).
+            let lo = chain_start(model, i);
+            for (x, y) in col_i[lo..].iter_mut().zip(&col_k[lo..=i]) {
+                *x -= a * y;
             }
             col_k[i] = a;
             i = lambda[i];
