@@ -150,6 +150,12 @@ pub struct Data {
     /// ancestor whose parent is the world): CRBA's reference point, as MuJoCo's `subtree_com` of
     /// the root is `mj_crb`'s (a world-origin reference loses digits with distance).
     pub p_world_tree: Vec<Vec3>,
+    /// CRBA's body poses about their tree's origin (world axes; `p_world_tree` apart), kept apart
+    /// from `x_world_body` so that the world poses of the same configuration survive it.
+    pub(crate) x_tree_body: Vec<Transform>,
+    /// The configuration `x_parent_body`, `x_world_body` and `s_body` were last formed at, while
+    /// they hold (one pose pass per evaluation).
+    pub(crate) poses_stamp: super::poses_stamp::PosesStamp,
     /// Spatial velocity of each body, body coordinates.
     pub v_body: Vec<Motion>,
     /// Spatial acceleration of each body (including the gravity offset in RNEA/ABA), body coords.
@@ -414,6 +420,8 @@ impl Data {
             s_body: vec![Motion::zero(); nv],
             s_world: vec![Motion::zero(); nv],
             p_world_tree: vec![Vec3::zeros(); nb],
+            x_tree_body: vec![Transform::identity(); nb],
+            poses_stamp: super::poses_stamp::PosesStamp::with_capacity(model.nq),
             v_body: vec![Motion::zero(); nb],
             a_body: vec![Motion::zero(); nb],
             c_body: vec![Motion::zero(); nb],
