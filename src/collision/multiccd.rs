@@ -483,7 +483,7 @@ fn clip(
         let q = if octagon {
             largest_quad(poly)
         } else {
-            super::plane_mesh::quad_from_first(poly.len(), &|i| poly[i])
+            super::plane_mesh::quad_from_first(poly.len(), |i| poly[i])
         };
         for i in q {
             report(&poly[i]);
