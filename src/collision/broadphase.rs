@@ -62,6 +62,9 @@ pub struct BroadphaseWork {
     /// the GJK test that proves most pairs apart (it would not), straight to its narrow phase.
     /// The contacts do not depend on it.
     pub(crate) touching: Vec<bool>,
+    /// Per candidate pair, the hill-climb starts of its two hulls in the separation test: the
+    /// last pass's support vertices (−1: none; see `ccd::separated`).
+    pub(crate) warm: Vec<[i32; 2]>,
 }
 
 impl BroadphaseWork {
@@ -71,6 +74,7 @@ impl BroadphaseWork {
             ends: Vec::with_capacity(model.geoms.len()),
             pairs: Vec::with_capacity(model.collision_pairs.len()),
             touching: vec![false; model.collision_pairs.len()],
+            warm: vec![[-1, -1]; model.collision_pairs.len()],
         }
     }
 }

@@ -1110,6 +1110,10 @@ fn penetration_with(
 /// separating them found within `iterations` (MuJoCo's early exit in `gjk` with no distance
 /// wanted: the first support point with x_k·s_k > 0). Exact when true — a separating plane is a
 /// certificate — so a caller may skip its own narrow phase; false leaves the pair undecided.
+/// `warm` holds the two hulls' hill-climb starts (−1: none), read before and written after: the
+/// last support vertices of the same pair at the previous pass, near this pass's (the certificate
+/// does not depend on them).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn separated(
     s1: &ConvexShape,
     x1: &Transform,
@@ -1118,11 +1122,14 @@ pub(crate) fn separated(
     margin: f64,
     tolerance: f64,
     iterations: usize,
+    warm: &mut [i32; 2],
 ) -> bool {
     let mut o1 = CcdObj::new(s1, x1, margin);
     let mut o2 = CcdObj::new(s2, x2, margin);
+    (o1.meshindex, o2.meshindex) = (warm[0], warm[1]);
     let mut st = Status::start(x1, x2, tolerance, iterations);
     gjk(&mut st, &mut o1, &mut o2);
+    *warm = [o1.meshindex, o2.meshindex];
     st.separated
 }
 

@@ -10,7 +10,7 @@ use crate::spatial::{Transform, Vec3};
 use parry3d_f64::math::{Pose, Rotation, Vector};
 use parry3d_f64::query::epa::EPA;
 use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 
 thread_local! {
     /// The EPA workspace of this thread, reused so that overlapping pairs do not allocate.
@@ -145,6 +145,7 @@ pub fn support_pair(
     reach: f64,
 ) -> Option<PairPoint> {
     let pos12 = to_parry(&(x1.inverse() * *x2));
+    let (s1, s2) = (&Warm::new(s1), &Warm::new(s2));
     // parry's `contact_support_map_support_map`, with this thread's EPA workspace reused (a fresh
     // EPA allocates on every overlapping pair).
     let mut simplex = VoronoiSimplex::new();
@@ -165,10 +166,38 @@ pub fn support_pair(
         normal: x1.rot * from_parry(normal1),
         dist: (point2_1 - point1).dot(normal1),
     };
-    if point.dist < 0.0 && s1.smooth() && s2.smooth() {
-        point = polish(x1, s1, x2, s2, point);
+    if point.dist < 0.0 && s1.shape.smooth() && s2.shape.smooth() {
+        point = polish(x1, s1.shape, x2, s2.shape, point);
     }
     (point.dist <= reach).then_some(point)
+}
+
+/// A shape whose hull support queries start from the previous answer: GJK and EPA ask for
+/// support points along a sequence of nearby directions, so the climb from the last vertex is
+/// short (MuJoCo's `mjc_hillclimbSupport` warm-starts the same way). The climb ends at a vertex
+/// farthest along the direction from any start; where several are exactly as far, the start
+/// picks among them.
+struct Warm<'a> {
+    shape: &'a ConvexShape,
+    /// The last support vertex of a hull (−1: none yet).
+    last: Cell<i32>,
+}
+
+impl<'a> Warm<'a> {
+    fn new(shape: &'a ConvexShape) -> Self {
+        Self { shape, last: Cell::new(-1) }
+    }
+}
+
+impl SupportMap for Warm<'_> {
+    fn local_support_point(&self, dir: Vector) -> Vector {
+        if let ConvexShape::Hull(h) = self.shape {
+            let i = h.support_index_warm(dir, self.last.get());
+            self.last.set(i as i32);
+            return h.polyhedron().points()[i];
+        }
+        self.shape.local_support_point(dir)
+    }
 }
 
 thread_local! {
@@ -181,8 +210,9 @@ thread_local! {
 /// (`ccd::penetration`: GJK/EPA on the geoms inflated by half of `margin` each, to the
 /// model's `ccd_tolerance` within `ccd_iterations`): witness points whose midpoint is MuJoCo's
 /// contact position, its normal and the contact distance; None when the inflated geoms do not
-/// overlap. `touching` (the pair touched at the last pass) skips the separation test of box and
-/// mesh pairs, which does not change the answer.
+/// overlap; boxes and meshes with a margin take parry's exact points instead ([`support_pair`]).
+/// `touching` (the pair touched at the last pass) skips the separation test of box and mesh
+/// pairs, which does not change the answer.
 pub fn mujoco_pair(
     x1: &Transform,
     s1: &ConvexShape,
@@ -192,15 +222,28 @@ pub fn mujoco_pair(
     options: &crate::model::Options,
     touching: bool,
 ) -> Option<PairPoint> {
+    mujoco_pair_warm(x1, s1, x2, s2, margin, options, touching, &mut [-1, -1])
+}
+
+/// [`mujoco_pair`] with the separation test's hill climbs started from `warm` and its last
+/// support vertices written back (see [`super::ccd::separated`]): the collision pass keeps them
+/// per pair from one pass to the next.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn mujoco_pair_warm(
+    x1: &Transform,
+    s1: &ConvexShape,
+    x2: &Transform,
+    s2: &ConvexShape,
+    margin: f64,
+    options: &crate::model::Options,
+    touching: bool,
+    warm: &mut [i32; 2],
+) -> Option<PairPoint> {
     let polytope = |s: &ConvexShape| matches!(s, ConvexShape::Cuboid(_) | ConvexShape::Hull(_));
     if polytope(s1) && polytope(s2) {
-        // Boxes and meshes against each other keep the exact EPA and multiccd's own feature
-        // search: with MuJoCo's solver 3 fewer box–mesh cases matched (its EPA face on coplanar
-        // facets depends on the hull's vertex order, which is parry's here, not MuJoCo's).
         LAST_FACE.with(|f| f.set(None));
-        // MuJoCo's GJK dismisses most candidate pairs after a few support points; the exact EPA
-        // runs only for the pairs GJK cannot prove apart (a pair touching at the last pass goes
-        // straight to it).
+        // MuJoCo's GJK dismisses most candidate pairs after a few support points (a pair
+        // touching at the last pass goes straight to the penetration).
         if !touching
             && super::ccd::separated(
                 s1,
@@ -210,11 +253,29 @@ pub fn mujoco_pair(
                 margin,
                 options.ccd_tolerance,
                 options.ccd_iterations as usize,
+                warm,
             )
         {
             return None;
         }
-        return support_pair(x1, s1, x2, s2, margin);
+        // Boxes and meshes without a margin: MuJoCo's own GJK/EPA (`ccd::penetration`, the
+        // cheaper; multiccd's feature search then starts from its normal). With a margin, the
+        // exact closest points of parry's GJK (EPA when overlapping): MuJoCo's EPA on the
+        // margin-inflated geoms stops at ccd_tolerance, and 3 of the margin box–mesh cases of
+        // tests/convex_mujoco.rs match MuJoCo's contacts only from parry's points.
+        if margin > 0.0 {
+            return support_pair(x1, s1, x2, s2, margin);
+        }
+        let c = super::ccd::penetration(
+            s1,
+            x1,
+            s2,
+            x2,
+            margin,
+            options.ccd_tolerance,
+            options.ccd_iterations as usize,
+        )?;
+        return Some(PairPoint { p1: c.x1, p2: c.x2, normal: c.normal, dist: c.dist });
     }
     let c = super::ccd::penetration(
         s1,

@@ -358,7 +358,8 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         }
         let point = match (&cm.shapes[g1], &cm.shapes[g2]) {
             (Some(s1), Some(s2)) => {
-                convex::mujoco_pair(&x1, s1, &x2, s2, within, &model.options, touching[idx])
+                let warm = &mut data.broadphase.warm[idx];
+                convex::mujoco_pair_warm(&x1, s1, &x2, s2, within, &model.options, touching[idx], warm)
             }
             _ => None,
         };

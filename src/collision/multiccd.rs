@@ -58,6 +58,7 @@ struct Scratch {
     face2: Vec<Vec3>,
     poly: Vec<Vec3>,
     clipped: Vec<Vec3>,
+    inside: Vec<bool>,
     normals1: Vec<(Vec3, u32)>,
     normals2: Vec<(Vec3, u32)>,
     feature1: Vec<u32>,
@@ -331,6 +332,7 @@ pub fn polytope_contacts(
                 false,
                 &mut s.poly,
                 &mut s.clipped,
+                &mut s.inside,
                 &mut |w1, w2, d| out(w1, w2, d, false, -n2),
             );
         } else if dim1 < 3 && dim1 <= dim2 {
@@ -351,6 +353,7 @@ pub fn polytope_contacts(
                     false,
                     &mut s.poly,
                     &mut s.clipped,
+                    &mut s.inside,
                     &mut |w1, w2, d| out(w1, w2, d, true, -n2),
                 );
             }
@@ -372,6 +375,7 @@ pub fn polytope_contacts(
                     false,
                     &mut s.poly,
                     &mut s.clipped,
+                    &mut s.inside,
                     &mut |w1, w2, d| out(w1, w2, d, false, n1),
                 );
             }
@@ -420,6 +424,7 @@ fn clip(
     octagon: bool,
     poly: &mut Vec<Vec3>,
     next: &mut Vec<Vec3>,
+    flags: &mut Vec<bool>,
     out: &mut dyn FnMut(Vec3, Vec3, f64),
 ) {
     if face.len() < 3 {
@@ -428,17 +433,33 @@ fn clip(
     poly.clear();
     poly.extend_from_slice(clipped_in);
     let m = face.len();
+    // A side plane that keeps every point only turns the polygon by one (the pass's output
+    // starts at the second point): such sides are counted instead of walked, the turns applied
+    // before the next side that cuts and at the end — the same points in the same order, one
+    // test per point instead of a pass per side (a face of many vertices, a finger pad's, keeps
+    // most of a polygon inside most of its sides).
+    let mut turns = 0;
     for k in 0..m {
         let (a, b) = (face[k], face[(k + 1) % m]);
         // Inward normal of the side plane through edge a→b (clockwise about n).
         let pn = (b - a).cross(n).normalize();
         let pd = pn.dot(&a);
         let inside = |p: &Vec3| (p - a).dot(&pn) > -MINVAL;
-        next.clear();
+        // Each point's side once.
+        flags.clear();
+        flags.extend(poly.iter().map(inside));
+        if flags.iter().all(|&f| f) {
+            turns += 1;
+            continue;
+        }
         let np = poly.len();
+        poly.rotate_left(turns % np);
+        flags.rotate_left(turns % np);
+        turns = 0;
+        next.clear();
         for i in 0..np {
             let (p, q) = (poly[i], poly[(i + 1) % np]);
-            let (ip, iq) = (inside(&p), inside(&q));
+            let (ip, iq) = (flags[i], flags[(i + 1) % np]);
             if !ip && !iq {
                 continue;
             }
@@ -459,6 +480,10 @@ fn clip(
             }
         }
         std::mem::swap(poly, next);
+    }
+    if !poly.is_empty() {
+        let np = poly.len();
+        poly.rotate_left(turns % np);
     }
     poly.retain(|p| (p - face[0]).dot(n) <= margin);
     if poly.is_empty() {
@@ -483,7 +508,7 @@ fn clip(
         let q = if octagon {
             largest_quad(poly)
         } else {
-            super::plane_mesh::quad_from_first(poly.len(), &|i| poly[i])
+            super::plane_mesh::quad_from_first(poly.len(), |i| poly[i])
         };
         for i in q {
             report(&poly[i]);
@@ -669,6 +694,7 @@ fn cap_polytope(
                 true,
                 &mut s.poly,
                 &mut s.clipped,
+                &mut s.inside,
                 &mut |w1, w2, d| {
                     emit(PairPoint { p1: w1, p2: w2, normal: -n2, dist: d });
                     count += 1;
@@ -723,6 +749,7 @@ fn segment_polytope(
                 false,
                 &mut s.poly,
                 &mut s.clipped,
+                &mut s.inside,
                 &mut |_, v, _| {
                     let d = (v - s.face2[0]).dot(&n2);
                     emit(PairPoint { p1: v - n2 * r, p2: v - n2 * d, normal: -n2, dist: d - r });

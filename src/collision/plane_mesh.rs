@@ -36,6 +36,7 @@ use super::plane::PlanePoint;
 /// face polygon (the mesh's single-precision vertices tilt coplanar triangles by up to ~1e-7).
 const COPLANAR: f64 = 1e-6;
 use crate::spatial::{Transform, Vec3};
+use std::cmp::Ordering;
 
 /// A mesh's convex hull prepared for plane contacts: vertices (geom frame), their neighbours and
 /// incident triangles, the triangles' outward unit normals, and the hill climb's start vertices.
@@ -319,7 +320,7 @@ pub fn plane_mesh(
     let len = polygon.len();
     let k = polygon.iter().position(|&v| v as usize == first).unwrap_or(0);
     let at = |i: usize| hull.vertices[polygon[(k + i) % len] as usize];
-    let corners = if len > 4 { quad_from_first(len, &at) } else { [0, 1, 2, 3] };
+    let corners = if len > 4 { quad_from_first(len, at) } else { [0, 1, 2, 3] };
     // MuJoCo's inclusion test: along −normal beyond the geom centre's height less the margin.
     let threshold = n.dot(&(x.pos - plane.pos)) - reach;
     for &c in corners.iter().skip(1).take(len.min(4) - 1) {
@@ -335,28 +336,33 @@ pub fn plane_mesh(
 /// increasing) of a large quadrilateral with its first vertex fixed: MuJoCo 4.0's pruning (the
 /// last corner advanced while the area grows, after each advance the third and then the second;
 /// not always the largest quadrilateral).
-pub fn quad_from_first(len: usize, at: &dyn Fn(usize) -> Vec3) -> [usize; 4] {
-    let area = |q: [usize; 4]| 0.5 * (at(q[2]) - at(q[0])).cross(&(at(q[3]) - at(q[1]))).norm();
+///
+/// The areas are compared as squared norms of the diagonals' cross product and the square root
+/// taken only where the two squares are too close for the order of the roots to be certain
+/// ([`grows`]): the same decisions as comparing the areas, without a square root per candidate
+/// (the pass's hot spot on polygons of many vertices, such as a finger pad's face).
+pub fn quad_from_first(len: usize, at: impl Fn(usize) -> Vec3) -> [usize; 4] {
+    let area2 = |q: [usize; 4]| (at(q[2]) - at(q[0])).cross(&(at(q[3]) - at(q[1]))).norm_squared();
     let mut q = [0, 1, 2, 3];
-    let mut m = area(q);
+    let mut m = area2(q);
     while q[3] + 1 < len {
-        let next = area([q[0], q[1], q[2], q[3] + 1]);
-        if next <= m {
+        let next = area2([q[0], q[1], q[2], q[3] + 1]);
+        if !grows(next, m) {
             break;
         }
         m = next;
         q[3] += 1;
         while q[2] + 1 < q[3] {
-            let next = area([q[0], q[1], q[2] + 1, q[3]]);
-            if next <= m {
+            let next = area2([q[0], q[1], q[2] + 1, q[3]]);
+            if !grows(next, m) {
                 break;
             }
             m = next;
             q[2] += 1;
         }
         while q[1] + 1 < q[2] {
-            let next = area([q[0], q[1] + 1, q[2], q[3]]);
-            if next <= m {
+            let next = area2([q[0], q[1] + 1, q[2], q[3]]);
+            if !grows(next, m) {
                 break;
             }
             m = next;
@@ -364,4 +370,21 @@ pub fn quad_from_first(len: usize, at: &dyn Fn(usize) -> Vec3) -> [usize; 4] {
         }
     }
     q
+}
+
+/// Whether the area `0.5·√next` exceeds `0.5·√best` (`next`, `best`: squared norms, as
+/// [`quad_from_first`] compares its areas), deciding from the squares where that is certain:
+/// `next ≤ best` gives a root no larger; `next > best·(1 + 8ε)` (best normal) a root larger by more
+/// than the two roots' rounding. In between, and for NaN, the rounded roots themselves decide
+/// (a NaN area grows, as `next <= best` is false for it).
+#[inline]
+fn grows(next: f64, best: f64) -> bool {
+    if next <= best {
+        return false;
+    }
+    if best >= f64::MIN_POSITIVE && next > best * (1.0 + 8.0 * f64::EPSILON) {
+        return true;
+    }
+    // As the areas' own test, `next ≤ best` stops and anything else (NaN too) grows.
+    !matches!((0.5 * next.sqrt()).partial_cmp(&(0.5 * best.sqrt())), Some(Ordering::Less | Ordering::Equal))
 }
