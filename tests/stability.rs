@@ -1,7 +1,7 @@
 //! Stability of contact-rich scenes (issue 26, item 5; not timed): a passive scene never gains
 //! energy beyond round-off, a stack at rest stays at rest, a bin of objects settles — in soft
-//! mode and in exact mode. The exact mode's known failures are ignored tests that say why (they
-//! run with `--include-ignored` and are counted as skipped).
+//! mode and in exact mode (the exact mode's unconverged solves limited by
+//! `constraint::energy_guard`; more in tests/exact_stability.rs).
 
 use lagrange::constraint::ConstraintMode;
 use lagrange::dynamics::{kinetic_energy, potential_energy};
@@ -117,7 +117,6 @@ fn a_soft_bin_settles_without_gaining_energy() {
 }
 
 #[test]
-#[ignore = "issue 26: the exact mode's Gauss-Seidel contact solver gains energy and diverges in bins (validation/bench.md, contact-rich scenes)"]
 fn an_exact_bin_settles_without_gaining_energy() {
     let model = load("bin10", &bin10(), ConstraintMode::Exact);
     let mut data = Data::new(&model);
