@@ -29,6 +29,7 @@ fn frame_index(model: &Model, function: &'static str, name: &str) -> Result<usiz
 /// Forward kinematics at the state's configuration (the state moved out and back, no copy).
 fn kinematics_at_state(model: &Model, data: &mut Data, velocities: bool) {
     let q = std::mem::take(&mut data.qpos);
+    data.poses_stamp.clear();
     forward_kinematics_unchecked(model, data, q.as_slice());
     data.qpos = q;
     if velocities {

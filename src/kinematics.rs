@@ -189,8 +189,13 @@ pub(crate) fn joint_velocity(model: &Model, data: &Data, b: usize, v: &[f64]) ->
 /// Root to leaves: joint transforms and subspaces (`update_joint`), then
 /// `x_world_body = x_world_parent · x_parent_body`. The first pass of FK and of CRBA.
 #[inline]
+/// Nothing when the poses already hold `q` (`Data::poses_stamp`, docs/architecture.md).
 pub(crate) fn body_poses(model: &Model, data: &mut Data, q: &[f64]) {
+    if data.poses_stamp.matches(q) {
+        return;
+    }
     body_poses_with::<Separate>(model, data, q);
+    data.poses_stamp.set(q);
 }
 
 #[inline(always)]
@@ -215,11 +220,13 @@ fn body_poses_with<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64]) {
 pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) -> Result<(), InputError> {
     check::data("forward_kinematics", model, data)?;
     check::q("forward_kinematics", model, q)?;
+    data.poses_stamp.clear();
     forward_kinematics_unchecked(model, data, q);
     Ok(())
 }
 
-/// [`forward_kinematics`] without the argument checks.
+/// [`forward_kinematics`] without the argument checks. The body poses are formed only when they
+/// do not already hold `q` (`Data::poses_stamp`); the frames always are.
 pub(crate) fn forward_kinematics_unchecked(model: &Model, data: &mut Data, q: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
@@ -240,7 +247,10 @@ unsafe fn forward_kinematics_fma(model: &Model, data: &mut Data, q: &[f64]) {
 
 #[inline(always)]
 fn forward_kinematics_with<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64]) {
-    body_poses_with::<A>(model, data, q);
+    if !data.poses_stamp.matches(q) {
+        body_poses_with::<A>(model, data, q);
+        data.poses_stamp.set(q);
+    }
     // Frames rigidly attached to bodies.
     for (f, frame) in model.frames.iter().enumerate() {
         data.x_world_frame[f] = match frame.mocap {

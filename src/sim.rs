@@ -427,6 +427,7 @@ impl Simulation {
     /// Forward kinematics at the current state (poses in `data`).
     pub fn kinematics(&mut self) {
         let q = std::mem::take(&mut self.data.qpos);
+        self.data.poses_stamp.clear();
         forward_kinematics_unchecked(&self.model, &mut self.data, q.as_slice());
         self.data.qpos = q;
     }

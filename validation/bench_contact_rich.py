@@ -1,26 +1,31 @@
 """Contact-rich scenes beside `mj_step` (issue 26, item 5): per-step time of lagrange's soft and
 exact modes against MuJoCo 4.0 in the same run, and the growth of the step time with the number
-of objects in a bin (time ∝ Nᵏ, fitted for both engines). Report only: writes the section
-"## Contact-rich scenes: soft and exact step beside mj_step" of validation/bench.md. Not part of
-.ci/run (the large bins take minutes in lagrange's dense solver); run it by hand:
+of objects in a bin (time ∝ Nᵏ, fitted for both engines), and the quality of each mode after
+`--settle` seconds: penetration, energy rise, unconverged solves, the rest state against MuJoCo's
+(soft) and the closed form (exact stacks). Report only: writes the section
+"## Contact-rich scenes: soft and exact step beside mj_step" of validation/bench.md. `.ci/run`
+runs `--quick` (under a minute); the large bins take minutes:
 
     validation/.venv/bin/python validation/bench_contact_rich.py [--quick] [--binary target/release/lagrange]
 
 Scenes (generated here, deterministic): box stacks of 5/10/20 on a floor, a heavy box on a light
 one at mass ratios 10/100/1000, bins of N = 10/50/100/200/400 mixed primitives (spheres, capsules,
-boxes) dropped into a walled bin, a 30-link capsule chain falling onto the floor; and the shipped
-go1 and dm_control humanoid scenes. Every scene: Euler, 2 ms, Newton (MuJoCo's defaults), pyramidal
+boxes) dropped into a walled bin, a 30-link capsule chain falling onto the floor, a parallel
+gripper holding a box (validation/scenes/gripper_box.xml, keyframe `hold`); and the shipped go1 and
+dm_control humanoid (a ragdoll: its motors at zero control) scenes. Every scene: Euler, 2 ms, Newton (MuJoCo's defaults), pyramidal
 cones, from rest. MuJoCo: `mjTIMER_STEP` per step (a C clock as `mjcb_time`), the best of 3 runs.
 lagrange: `eval --step S` from the same start, `step_us` (the best of 3 in one process), in soft
 and in exact mode (`--constraints exact`); a run that fails (divergence, NaN) is reported with its
-message. `--quick` keeps the small scenes only.
+message. `--quick` keeps the bins of 10 and 50 only.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import platform
+import subprocess
 import sys
 import tempfile
 import time
@@ -89,16 +94,29 @@ def chain(n: int = 30) -> str:
 def scenes(quick: bool) -> list[tuple[str, str, object, int]]:
     """(name, group, MJCF text or a path, steps)."""
     out: list[tuple[str, str, object, int]] = []
-    for n in (5, 10) if quick else (5, 10, 20):
+    for n in (5, 10, 20):
         out.append((f"stack_{n}", "stack", stack(n), 200))
-    for r in (10, 100) if quick else (10, 100, 1000):
+    for r in (10, 100, 1000):
         out.append((f"ratio_{r}", "ratio", mass_ratio(r), 200))
     for n in (10, 50) if quick else (10, 50, 100, 200, 400):
         out.append((f"bin_{n}", "bin", bin_scene(n), 200 if n <= 50 else 40 if n <= 100 else 10))
     out.append(("chain_30", "chain", chain(30), 200))
+    out.append(("gripper_box", "gripper", HERE / "scenes/gripper_box.xml", 200))
     out.append(("humanoid", "robot", REPO / "models/mjcf/humanoid/humanoid.xml", 200))
     out.append(("go1", "robot", REPO / "models/mjcf/unitree_go1/scene.xml", 200))
     return out
+
+
+# Scenes that start from a keyframe (with its controls) instead of qpos0 at rest.
+KEYFRAME = {"gripper_box": "hold"}
+# Scenes with a closed-form rest state: (free body index, centre height) per body.
+def closed_form(name: str) -> list[tuple[int, float]] | None:
+    kind, _, arg = name.partition("_")
+    if kind == "stack":
+        return [(k, 0.05 + 0.1 * k) for k in range(int(arg))]
+    if kind == "ratio":
+        return [(0, 0.05), (1, 0.15)]
+    return None
 
 
 def mujoco_step_us(mj, path: Path, steps: int) -> float:
@@ -117,7 +135,7 @@ def lagrange_step_us(binary: Path, path: Path, q0: list[float], steps: int, mode
     """The best of 3 runs of `steps` steps in `mode` (µs per step), or NaN and the failure."""
     try:
         out = lagrange_eval_json(binary, path, [{"q": q0}] * 3,
-                                 ["--step", str(steps), "--constraints", mode], timeout=3600, state_errors=True)
+                                 ["--step", str(steps), "--constraints", mode], timeout=900, state_errors=True)
     except (RuntimeError, Exception) as e:  # a timeout or a refusal: reported, never hidden
         return math.nan, str(e).splitlines()[0][:120]
     good = [r for r in out["results"] if "step_us" in r]
@@ -125,6 +143,55 @@ def lagrange_step_us(binary: Path, path: Path, q0: list[float], steps: int, mode
         return math.nan, str(out["results"][0].get("error", "failed"))[:120]
     finite = all(all(math.isfinite(x) for x in r["qpos"]) for r in good)
     return min(r["step_us"] for r in good), "" if finite else "non-finite state"
+
+
+def lagrange_quality(binary: Path, path: Path, mode: str, duration: float, keyframe: str | None) -> dict:
+    """`lagrange simulate` for `duration` s in `mode`: its JSON summary (final q, max penetration,
+    unconverged solves, warnings) and, from the per-step CSV, the largest rise of the total energy
+    above its initial value; {"error": ...} when the run fails."""
+    with tempfile.TemporaryDirectory() as tmp:
+        csv_path = Path(tmp) / "run.csv"
+        cmd = [str(binary), "simulate", str(path), "--duration", f"{duration}", "--constraints", mode, "--json",
+               "--out", str(csv_path)]
+        if keyframe:
+            cmd += ["--keyframe", keyframe]
+        try:
+            p = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        except subprocess.TimeoutExpired:
+            return {"error": "no result within 600 s"}
+        if p.returncode != 0:
+            return {"error": (p.stderr or p.stdout).strip().splitlines()[-1][:160] if (p.stderr or p.stdout) else
+                    f"exit {p.returncode}"}
+        out = json.loads(p.stdout)
+        energy = np.genfromtxt(csv_path, delimiter=",", names=True, usecols=("energy",))["energy"]
+    finite = all(math.isfinite(x) for x in out["q"]) and bool(np.all(np.isfinite(energy)))
+    return {"q": out["q"], "penetration": out["max_penetration"], "unconverged": out["solver"]["unconverged"],
+            "energy0": float(energy[0]), "rise": float(np.max(energy - energy[0])), "finite": finite,
+            "steps": out["steps"]}
+
+
+def mujoco_final(mj, path: Path, steps: int, keyframe: str | None):
+    """MuJoCo's model and data after `steps` mj_step from the scene's start."""
+    m = mj.MjModel.from_xml_path(str(path))
+    d = mj.MjData(m)
+    if keyframe:
+        mj.mj_resetDataKeyframe(m, d, mj.mj_name2id(m, mj.mjtObj.mjOBJ_KEY, keyframe))
+    mj.mj_step(m, d, nstep=steps)
+    return m, d
+
+
+def body_gap(mj, m, d_ref, q) -> float:
+    """The largest distance (m) between a body's position at lagrange's `q` and in MuJoCo's data."""
+    d = mj.MjData(m)
+    d.qpos[:] = q
+    mj.mj_kinematics(m, d)
+    return float(np.max(np.linalg.norm(d.xpos[1:] - d_ref.xpos[1:], axis=1))) if m.nbody > 1 else 0.0
+
+
+def closed_form_gap(name: str, q) -> float:
+    """The largest distance (m) of a stacked box's centre height from its closed form."""
+    bodies = closed_form(name)
+    return max(abs(q[7 * k + 2] - z) for k, z in bodies) if bodies else math.nan
 
 
 def fit_exponent(ns: list[int], ts: list[float]) -> float:
@@ -140,6 +207,8 @@ def main() -> int:
     ap.add_argument("--binary", type=Path, default=REPO / "target/release/lagrange")
     ap.add_argument("--quick", action="store_true", help="the small scenes only")
     ap.add_argument("--no-write", action="store_true", help="print, do not write validation/bench.md")
+    ap.add_argument("--settle", type=float, default=1.0,
+                    help="seconds simulated from the start for the rest state, energy and penetration (default 1)")
     args = ap.parse_args()
     import mujoco as mj
 
@@ -161,7 +230,19 @@ def main() -> int:
             r = rows[-1]
             print(f"{name:10s} nv {m.nv:5d}  mj_step {mj_us:10.1f} µs  soft {soft:12.1f} µs ({soft / mj_us:7.2f}×) "
                   f"exact {exact:12.1f} µs ({exact / mj_us:7.2f}×) {soft_err} {exact_err}", flush=True)
-    text = report(rows)
+            key = KEYFRAME.get(name)
+            settle_steps = round(args.settle / m.opt.timestep)
+            m_ref, d_ref = mujoco_final(mj, path, settle_steps, key)
+            # Passive: no actuator, or only motors (no bias) left at zero control from qpos0.
+            r["passive"] = key is None and bool(np.all(m.actuator_biastype == 0)) and not np.any(m.actuator_gainprm[:, 0] != 1)
+            for mode in ("soft", "exact"):
+                qual = lagrange_quality(args.binary, path, mode, args.settle, key)
+                if "q" in qual:
+                    qual["vs_mujoco"] = body_gap(mj, m_ref, d_ref, qual["q"]) if qual["finite"] else math.nan
+                    qual["vs_closed"] = closed_form_gap(name, qual["q"]) if qual["finite"] else math.nan
+                r[f"{mode}_quality"] = qual
+                print(f"    {mode}: {quality_cells(qual)}", flush=True)
+    text = report(rows, args.settle)
     print(text)
     if not args.no_write:
         replace_section(HERE / "bench.md", SECTION, text)
@@ -172,7 +253,7 @@ def ratio(a: float, b: float) -> str:
     return f"{a / b:.2f}" if math.isfinite(a) and math.isfinite(b) and b > 0 else "—"
 
 
-def report(rows) -> str:
+def report(rows, settle: float) -> str:
     import mujoco as mj
 
     bins = [r for r in rows if r["group"] == "bin"]
@@ -199,7 +280,40 @@ def report(rows) -> str:
         fail = "; ".join(f"{m}: {e}" for m, e in (("soft", r["soft_err"]), ("exact", r["exact_err"])) if e)
         lines.append(f"| {r['name']} | {r['nv']} | {r['ngeom']} | {r['steps']} | {r['mj']:.1f} | {r['soft']:.1f} | "
                      f"{ratio(r['soft'], r['mj'])} | {r['exact']:.1f} | {ratio(r['exact'], r['mj'])} | {fail} |")
+    lines += [
+        "",
+        f"Quality, each scene simulated {settle:g} s from its start in both modes (`lagrange simulate --json --out`): "
+        "the deepest penetration, the largest rise of the total energy above its initial value (J; on passive "
+        "scenes, marked *, it must stay within the solver's tolerance), the unconverged solves, and the rest state: "
+        "the largest distance of a body from its place in MuJoCo's run of as many steps (soft; chaotic scenes — "
+        "bins, a falling humanoid — diverge from any reference and are reported, not judged) and, for the stacks "
+        "and mass ratios, of a box centre from its closed-form height (exact).",
+        "",
+        "| scene | soft: penetration mm | soft: energy rise J | soft: unconverged | soft: Δ MuJoCo mm | "
+        "exact: penetration mm | exact: energy rise J | exact: unconverged | exact: Δ closed form mm |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        s, e = r.get("soft_quality", {}), r.get("exact_quality", {})
+        lines.append(f"| {r['name']}{' *' if r.get('passive') else ''} | {quality_cells(s, 'vs_mujoco')} | "
+                     f"{quality_cells(e, 'vs_closed')} |")
     return "\n".join(lines) + "\n"
+
+
+def quality_cells(q: dict, gap: str | None = None) -> str:
+    """Table cells of one quality run (all four, or the error across them)."""
+    if not q:
+        return "— | — | — | —" if gap else "—"
+    if "error" in q:
+        return f"failed: {q['error'][:90]} | | |" if gap else f"failed: {q['error']}"
+    mm = lambda x: "—" if not math.isfinite(x) else f"{1e3 * x:.3g}"
+    cells = [mm(q["penetration"]), f"{q['rise']:.2e}", str(q["unconverged"])]
+    if gap:
+        cells.append(mm(q[gap]))
+        return " | ".join(cells) + ("" if q["finite"] else " (non-finite state)")
+    return (f"penetration {mm(q['penetration'])} mm, energy rise {q['rise']:.2e} J (E0 {q['energy0']:.3g}), "
+            f"unconverged {q['unconverged']}, Δ MuJoCo {mm(q.get('vs_mujoco', math.nan))} mm, "
+            f"Δ closed form {mm(q.get('vs_closed', math.nan))} mm{'' if q['finite'] else ', NON-FINITE'}")
 
 
 if __name__ == "__main__":

@@ -104,6 +104,7 @@ pub(crate) fn add_contact_jacobian(model: &Model, data: &mut Data, contact: &Con
 /// dofs of both paths to the root below their lowest common ancestor, where a contact Jacobian
 /// can be nonzero (bodies are numbered parents first, so the path with the larger body index
 /// steps up until the two meet).
+#[inline]
 pub(crate) fn for_each_relative_dof(model: &Model, bodies: [usize; 2], mut column: impl FnMut(usize)) {
     let [mut a, mut b] = bodies;
     while a != b {

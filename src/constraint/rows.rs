@@ -350,6 +350,7 @@ impl ConstraintModel {
     pub fn collide(&self, model: &Model, data: &mut Data, q: &[f64]) -> Result<bool, InputError> {
         check::data("ConstraintModel::collide", model, data)?;
         check::q("ConstraintModel::collide", model, q)?;
+        data.poses_stamp.clear();
         Ok(self.collide_unchecked(model, data, q))
     }
 
@@ -560,6 +561,7 @@ impl ConstraintModel {
         check::data("ConstraintModel::evaluate", model, data)?;
         check::q("ConstraintModel::evaluate", model, q)?;
         check::v("ConstraintModel::evaluate", "v", model, v)?;
+        data.poses_stamp.clear();
         self.evaluate_unchecked(model, data, q, v);
         Ok(())
     }

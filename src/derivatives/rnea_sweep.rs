@@ -119,6 +119,7 @@ impl RneaSweep {
     ) {
         let nb = model.nbody();
         let gravity = Motion::new(Vec3::zeros(), -model.gravity);
+        data.poses_stamp.keep_if(q);
         // Forward: poses, velocities, accelerations, per-body terms and per-dof columns.
         for b in 1..nb {
             update_joint(model, data, b, q);

@@ -103,6 +103,7 @@ unsafe fn aba_avx2(model: &Model, data: &mut Data, q: &[f64], v: &[f64], tau: &[
 #[inline(always)]
 fn aba_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], tau: &[f64]) {
     let nb = model.nbody();
+    data.poses_stamp.keep_if(q);
     data.v_body[0] = Motion::zero();
     // Pass 1, root to leaves: velocities, velocity-product accelerations c, and the rigid-body
     // inertias and bias forces pᴬ = v ×* I v that start the articulated quantities.

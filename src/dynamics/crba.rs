@@ -23,8 +23,8 @@ use nalgebra::{DMatrix, DVector, Vector3};
 /// of mass (`subtree_com` of the root, engine_core_smooth.c): the poses of a tree are composed from
 /// its root placed at zero, so M does not depend on where the tree stands. About the world origin
 /// a body at distance d has moments of size m d² whose differences make M's entries: at d = 1e6 m
-/// and a 0.1 m link, 12 of the 16 digits were lost. `data.x_world_body` is the world pose again on
-/// return (the tree's origin added back).
+/// and a 0.1 m link, 12 of the 16 digits were lost. `data.x_world_body` holds the world poses on
+/// return.
 ///
 /// On x86-64 CPUs with AVX2 and FMA3 the kernel runs compiled for them (chosen at run time), its
 /// products and sums fused into multiply–adds ([`fused`]): one rounding instead of two, fewer and
@@ -47,6 +47,7 @@ use nalgebra::{DMatrix, DVector, Vector3};
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>, InputError> {
     check::data("crba", model, data)?;
     check::q("crba", model, q)?;
+    data.poses_stamp.clear();
     Ok(crba_unchecked(model, data, q))
 }
 
@@ -65,6 +66,7 @@ pub(crate) fn crba_unchecked<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -
 pub fn crba_upper<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>, InputError> {
     check::data("crba_upper", model, data)?;
     check::q("crba_upper", model, q)?;
+    data.poses_stamp.clear();
     crba_dispatch::<false>(model, data, q);
     Ok(&data.mass_matrix)
 }
@@ -89,6 +91,24 @@ unsafe fn crba_fma<const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64]
 
 #[inline(always)]
 fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64]) {
+    // The passes below compose the poses about each tree's origin in `x_tree_body` (swapped in
+    // for `x_world_body`, whose world poses of this q, if it holds them, survive).
+    let world_current = data.poses_stamp.matches(q);
+    std::mem::swap(&mut data.x_world_body, &mut data.x_tree_body);
+    crba_passes::<A, MIRROR>(model, data, q);
+    std::mem::swap(&mut data.x_world_body, &mut data.x_tree_body);
+    if !world_current {
+        // The world poses: the tree's origin added back.
+        for b in 1..model.nbody() {
+            let x = &data.x_tree_body[b];
+            data.x_world_body[b] = Transform::new(x.rot, x.pos + data.p_world_tree[b]);
+        }
+        data.poses_stamp.clear();
+    }
+}
+
+#[inline(always)]
+fn crba_passes<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64]) {
     // A floating base (a free joint on the world, numbered first, with an unrotated placement):
     // its six columns are (0, eᵢ) and (R eᵢ, p × R eᵢ) in world coordinates (R, p its pose), so
     // the six entries of a descendant's F are F_lin and Rᵀ (F_ang − p × F_lin), the moment about
@@ -149,10 +169,6 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
         if p != 0 {
             data.i_composite[p] += &i_c;
         }
-    }
-    // Back to world positions (pass 2 read no pose but the base's, taken above).
-    for b in 1..model.nbody() {
-        data.x_world_body[b].pos += data.p_world_tree[b];
     }
 }
 

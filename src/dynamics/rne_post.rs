@@ -139,24 +139,32 @@ pub fn rne_post_constraint(model: &Model, data: &mut Data) -> Result<(), InputEr
     let nmocap = model.mocap_pose0.len();
     InputError::check_len(F, "data.mocap_pos", data.mocap_pos.len(), nmocap, "mocap bodies")?;
     InputError::check_len(F, "data.mocap_quat", data.mocap_quat.len(), nmocap, "mocap bodies")?;
+    data.poses_stamp.clear();
     let q = std::mem::take(&mut data.qpos);
     let v = std::mem::take(&mut data.qvel);
-    rne_post_constraint_at(model, data, q.as_slice(), v.as_slice());
+    rne_post_constraint_at(model, data, q.as_slice(), v.as_slice(), true);
     data.qpos = q;
     data.qvel = v;
     Ok(())
 }
 
 /// [`rne_post_constraint`] at configuration `q` and velocity `v` (the state of the `forward_at`
-/// that left `qacc` and the constraint forces in `data`), without the argument checks.
-pub(crate) fn rne_post_constraint_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+/// that left `qacc` and the constraint forces in `data`), without the argument checks. Without
+/// `wrenches` (the sensor stage when no force or torque sensor reads them) `cfrc_ext` and
+/// `cfrc_int` are left zero and only the accelerations are formed.
+pub(crate) fn rne_post_constraint_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], wrenches: bool) {
     let mut w = std::mem::take(&mut data.rne_post);
     body_poses(model, data, q);
     compiled_motions(model, data, &mut w, v);
     com_frames(model, data, &mut w);
     link_motions(model, data, &mut w);
-    external_wrenches(model, data, &mut w);
-    interaction_wrenches(model, &mut w);
+    if wrenches {
+        external_wrenches(model, data, &mut w);
+        interaction_wrenches(model, &mut w);
+    } else {
+        w.cfrc_ext.fill(Force::zero());
+        w.cfrc_int.fill(Force::zero());
+    }
     data.rne_post = w;
 }
 

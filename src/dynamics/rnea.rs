@@ -44,6 +44,7 @@ pub(crate) fn rnea_unchecked<'d>(
     v: &[f64],
     qacc: &[f64],
 ) -> &'d DVector<f64> {
+    data.poses_stamp.keep_if(q);
     data.v_body[0] = Motion::zero();
     data.a_body[0] = Motion::new(Vec3::zeros(), -model.gravity);
     // Pass 1, root to leaves: body velocities, accelerations and the net force each needs.

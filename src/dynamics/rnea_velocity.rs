@@ -58,6 +58,7 @@ impl BiasDerivative {
     /// carried up c's ancestor chain alone (the other bodies add zeros, which are skipped).
     pub fn compute(&mut self, model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         let nb = model.nbody();
+        data.poses_stamp.keep_if(q);
         self.v_body[0] = Motion::zero();
         for b in 1..nb {
             update_joint(model, data, b, q);

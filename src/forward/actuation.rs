@@ -114,6 +114,7 @@ pub fn actuation(
     check::q("actuation", model, q)?;
     check::v("actuation", "v", model, v)?;
     InputError::check_len("actuation", "bias_velocity", bias_velocity.len(), model.actuators.len(), "nu")?;
+    data.poses_stamp.clear();
     crate::tendon::compute(model, data, q, v);
     actuation_unchecked(model, data, q, v, bias_velocity);
     Ok(())
@@ -338,14 +339,22 @@ fn add_actuator_derivative(
             continue;
         }
         any = true;
-        let moment = data.actuator_moment.row(i);
+        // Row i of the column-major nu × nv moment matrix, read in place; the products with its
+        // zeros (most of a joint or tendon transmission's row) are skipped: subtracting them
+        // changes nothing.
+        let (nu, moments) = (data.actuator_moment.nrows(), data.actuator_moment.as_slice());
+        let hd = h * d;
         for c in 0..nv {
-            let mc = moment[c];
+            let mc = moments[i + c * nu];
             if mc == 0.0 {
                 continue;
             }
-            for r in 0..nv {
-                matrix[r + c * nv] -= h * d * moment[r] * mc;
+            let column = &mut matrix[c * nv..(c + 1) * nv];
+            for (r, entry) in column.iter_mut().enumerate() {
+                let mr = moments[i + r * nu];
+                if mr != 0.0 {
+                    *entry -= hd * mr * mc;
+                }
             }
         }
     }

@@ -75,6 +75,8 @@ pub fn forward(model: &Model, data: &mut Data) {
 /// (`q₀ ⊕ θ`, a stage velocity) and the drift correction evaluate here; `data.qpos` and
 /// `data.qvel` are neither read nor written.
 pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+    // Every evaluation forms its body poses afresh, once (`Data::poses_stamp`).
+    data.poses_stamp.clear();
     let plan = &model.plan;
     let (rows, solver) = (&plan.constraints, &plan.solver);
     // Tendon lengths, Jacobians and velocities first: limits, passive forces, actuators and

@@ -7,19 +7,26 @@ use super::implicit_fast::implicit_acceleration;
 use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::forward::{advance_activations, forward_at};
 use crate::model::{integrate_configuration_unchecked, Data, Model};
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// Semi-implicit Euler stepper, with its buffer for the implicitly damped acceleration.
 pub struct SemiImplicitEuler {
     /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
     stage_act: DVector<f64>,
     damped: DVector<f64>,
+    /// M kept while M + h·diag(damping) is factored in its place.
+    mass_copy: DMatrix<f64>,
 }
 
 impl SemiImplicitEuler {
     /// The stepper with its buffers sized for `model`.
     pub fn new(model: &Model) -> Self {
-        Self { stage_act: DVector::zeros(model.na()), damped: DVector::zeros(model.nv) }
+        let nv = model.nv;
+        Self {
+            stage_act: DVector::zeros(model.na()),
+            damped: DVector::zeros(nv),
+            mass_copy: DMatrix::zeros(nv, nv),
+        }
     }
 }
 
@@ -49,7 +56,15 @@ impl Advance for SemiImplicitEuler {
         let flags = &model.options.flags;
         if flags.eulerdamp
             && flags.damper
-            && implicit_acceleration(model, data, state.q.as_slice(), &mut self.damped, h, None)
+            && implicit_acceleration(
+                model,
+                data,
+                state.q.as_slice(),
+                &mut self.damped,
+                &mut self.mass_copy,
+                h,
+                None,
+            )
         {
             state.v.axpy(h, &self.damped, 1.0);
         } else {

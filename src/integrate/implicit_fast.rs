@@ -16,19 +16,25 @@ use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
 use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
 use crate::model::{integrate_configuration_unchecked, Data, Model};
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// The implicitfast stepper with its force buffer.
 pub struct ImplicitFast {
     /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
     stage_act: DVector<f64>,
     force: DVector<f64>,
+    /// M kept while M − h D is factored in its place.
+    mass_copy: DMatrix<f64>,
 }
 
 impl ImplicitFast {
     /// The stepper with its buffers sized for `model`.
     pub fn new(model: &Model) -> Self {
-        Self { stage_act: DVector::zeros(model.na()), force: DVector::zeros(model.nv) }
+        Self {
+            stage_act: DVector::zeros(model.na()),
+            force: DVector::zeros(model.nv),
+            mass_copy: DMatrix::zeros(model.nv, model.nv),
+        }
     }
 }
 
@@ -45,12 +51,14 @@ pub(crate) fn add_force_derivative(model: &Model, matrix: &mut [f64], h: f64) {
 /// The velocity-implicit acceleration a = (M − h D)⁻¹ M qacc after `forward` at configuration
 /// `q`, into `out`, with D the joint damping and, given `actuator_bias_velocity`, the actuators'
 /// velocity derivatives. Returns false (and leaves `out` alone) when D is zero: the explicit
-/// `qacc` is the step's acceleration then. M is left as CRBA gives it; its factor is of M − h D.
+/// `qacc` is the step's acceleration then. M is left as CRBA gives it (kept in `mass_copy` while
+/// M − h D takes its place); its factor is of M − h D.
 pub(super) fn implicit_acceleration(
     model: &Model,
     data: &mut Data,
     q: &[f64],
     out: &mut DVector<f64>,
+    mass_copy: &mut DMatrix<f64>,
     h: f64,
     actuator_bias_velocity: Option<&[f64]>,
 ) -> bool {
@@ -58,24 +66,25 @@ pub(super) fn implicit_acceleration(
     if !damped && actuator_bias_velocity.is_none() {
         return false;
     }
-    crba_unchecked(model, data, q);
+    // M at q: the position stage's own when `forward` took the M path there (CRBA again would
+    // give the same bits), else formed here.
+    if !data.forward_skip.m_path {
+        crba_unchecked(model, data, q);
+    }
     out.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
+    mass_copy.copy_from(&data.mass_matrix);
     add_force_derivative(model, data.mass_matrix.as_mut_slice(), h);
     let mut m = std::mem::take(&mut data.mass_matrix);
     let from_actuators = actuator_bias_velocity
         .is_some_and(|b| add_actuator_velocity_derivative(model, data, b, m.as_mut_slice(), h));
+    data.mass_matrix = m;
     let implicit = damped || from_actuators;
     if implicit {
-        data.mass_matrix = m;
         factorize_mass_matrix(model, data);
         solve_with_factor_unchecked(model, &data.mass_factor, out.as_mut_slice());
-        m = std::mem::take(&mut data.mass_matrix);
     }
-    if let Some(b) = actuator_bias_velocity {
-        add_actuator_velocity_derivative(model, data, b, m.as_mut_slice(), -h);
-    }
-    data.mass_matrix = m;
-    add_force_derivative(model, data.mass_matrix.as_mut_slice(), -h);
+    // M itself again, bit for bit.
+    data.mass_matrix.copy_from(mass_copy);
     implicit
 }
 
@@ -105,7 +114,15 @@ impl Advance for ImplicitFast {
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         let actuated = !model.actuators.is_empty() && model.options.flags.actuation;
         let bias_velocity = actuated.then_some(model.plan.actuator_bias_velocity.as_slice());
-        if implicit_acceleration(model, data, state.q.as_slice(), &mut self.force, h, bias_velocity) {
+        if implicit_acceleration(
+            model,
+            data,
+            state.q.as_slice(),
+            &mut self.force,
+            &mut self.mass_copy,
+            h,
+            bias_velocity,
+        ) {
             state.v.axpy(h, &self.force, 1.0);
         } else {
             state.v.axpy(h, &data.qacc, 1.0);

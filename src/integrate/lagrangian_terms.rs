@@ -89,6 +89,7 @@ impl LagrangianTerms {
 
     /// [`compute`](Self::compute) without the argument checks.
     pub(crate) fn compute_unchecked(&mut self, model: &Model, data: &mut Data, q: &[f64], xi: &[f64]) {
+        data.poses_stamp.keep_if(q);
         for b in 1..model.nbody() {
             update_joint(model, data, b, q);
             self.x_parent_body[b] = data.x_parent_body[b];

@@ -150,6 +150,12 @@ pub struct Data {
     /// ancestor whose parent is the world): CRBA's reference point, as MuJoCo's `subtree_com` of
     /// the root is `mj_crb`'s (a world-origin reference loses digits with distance).
     pub p_world_tree: Vec<Vec3>,
+    /// CRBA's body poses about their tree's origin (world axes; `p_world_tree` apart), kept apart
+    /// from `x_world_body` so that the world poses of the same configuration survive it.
+    pub(crate) x_tree_body: Vec<Transform>,
+    /// The configuration `x_parent_body`, `x_world_body` and `s_body` were last formed at, while
+    /// they hold (one pose pass per evaluation).
+    pub(crate) poses_stamp: super::poses_stamp::PosesStamp,
     /// Spatial velocity of each body, body coordinates.
     pub v_body: Vec<Motion>,
     /// Spatial acceleration of each body (including the gravity offset in RNEA/ABA), body coords.
@@ -393,6 +399,16 @@ impl Data {
     /// Allocates every buffer for `model`; the state is the model's `qpos0` at rest at time 0,
     /// with zero controls, activations and applied forces (MuJoCo's `mj_makeData`).
     pub fn new(model: &Model) -> Self {
+        Self::build(model, true)
+    }
+
+    /// A `Data` for kinematics and dynamics only (the compiler's scratch: `set_acc0`, the soft
+    /// rows' inverse weights): no exact-mode matrices, whatever the model's mode.
+    pub(crate) fn scratch(model: &Model) -> Self {
+        Self::build(model, false)
+    }
+
+    fn build(model: &Model, exact_matrices: bool) -> Self {
         let nb = model.nbody();
         let nv = model.nv;
         let nwrap: usize = model.tendons.iter().map(|t| super::tendon::max_wrap_points(&t.kind)).sum();
@@ -417,6 +433,8 @@ impl Data {
             s_body: vec![Motion::zero(); nv],
             s_world: vec![Motion::zero(); nv],
             p_world_tree: vec![Vec3::zeros(); nb],
+            x_tree_body: vec![Transform::identity(); nb],
+            poses_stamp: super::poses_stamp::PosesStamp::with_capacity(model.nq),
             v_body: vec![Motion::zero(); nb],
             a_body: vec![Motion::zero(); nb],
             c_body: vec![Motion::zero(); nb],
@@ -476,7 +494,7 @@ impl Data {
             efc_unconverged_residual: 0.0,
             efc_energy_limited: 0,
             warnings: super::Warnings::new(nv),
-            exact: ExactWork::new(nv, nefc),
+            exact: exact_work(model, nefc, exact_matrices),
             lifecycle: RowLifecycle::new(model),
             stepper: StepperSlot::for_model(model),
             rne_post: RnePost::new(model),
@@ -641,4 +659,19 @@ impl Data {
         }
         k - i
     }
+}
+
+/// The exact mode's workspace for `nefc` rows: its per-row vectors, and its dense nefc² matrices
+/// only for a model in exact mode with constraint rows (a soft model, and the compiler's own
+/// scratch `Data`, never pay for them; they grow at their first use if the mode changes).
+fn exact_work(model: &Model, nefc: usize, exact_matrices: bool) -> ExactWork {
+    let mut work = ExactWork::new(model.nv, 0);
+    work.grow_vectors(nefc);
+    if exact_matrices
+        && matches!(model.plan.solver, crate::constraint::ConstraintSolver::Exact(_))
+        && model.plan.has_constraints()
+    {
+        work.grow_matrices(model.nv, nefc);
+    }
+    work
 }

@@ -120,7 +120,7 @@ pub(crate) fn set_acc0(model: &mut Model) {
         return;
     }
     let q0 = model.qpos0.clone();
-    let mut data = Data::new(model);
+    let mut data = Data::scratch(model);
     crate::dynamics::crba_unchecked(model, &mut data, &q0);
     crate::dynamics::factorize_mass_matrix(model, &mut data);
     crate::kinematics::forward_kinematics_unchecked(model, &mut data, &q0);

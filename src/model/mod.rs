@@ -16,6 +16,7 @@ pub mod lengthrange;
 pub(crate) mod lengthrange_sim;
 mod links;
 pub mod options;
+pub(crate) mod poses_stamp;
 pub mod reset;
 pub mod spec;
 pub mod tendon;

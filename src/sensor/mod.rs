@@ -52,6 +52,9 @@ pub struct SensorNeeds {
     pub kinetic: bool,
     /// Body accelerations and interaction forces (MuJoCo's `mj_rnePostConstraint`).
     pub rne_post: bool,
+    /// Of those, the external and interaction wrenches too (`cfrc_ext`, `cfrc_int`: force and
+    /// torque sensors); accelerometers and frame accelerations read `cacc` alone.
+    pub rne_post_wrenches: bool,
 }
 
 impl SensorNeeds {
@@ -75,6 +78,7 @@ impl SensorNeeds {
             subtree_velocities: has(&|k| matches!(k, SubtreeLinVel | SubtreeAngMom)),
             kinetic: has(&|k| k == EKinetic),
             rne_post: has(&|k| matches!(k, Accelerometer | Force | Torque | FrameLinAcc | FrameAngAcc)),
+            rne_post_wrenches: has(&|k| matches!(k, Force | Torque)),
         }
     }
 }
@@ -151,7 +155,7 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
         subtree::subtree_velocities(model, data, &mut work.subtree);
     }
     if needs.rne_post {
-        crate::dynamics::rne_post::rne_post_constraint_at(model, data, q, v);
+        crate::dynamics::rne_post::rne_post_constraint_at(model, data, q, v, needs.rne_post_wrenches);
     }
     if needs.kinetic {
         let bodies: f64 =

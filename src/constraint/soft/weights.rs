@@ -36,7 +36,7 @@ impl InverseWeights {
     /// The weights of `model` at `qpos0`.
     pub fn new(model: &Model) -> Self {
         let nv = model.nv;
-        let mut data = Data::new(model);
+        let mut data = Data::scratch(model);
         forward_kinematics_unchecked(model, &mut data, &model.qpos0);
         crba_unchecked(model, &mut data, &model.qpos0);
         factorize_mass_matrix(model, &mut data);
