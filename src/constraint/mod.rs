@@ -27,6 +27,7 @@ mod row_lifecycle;
 mod rows;
 pub mod soft;
 mod solver;
+mod velocity_check;
 
 pub use admm::{ExactContactSolver, ADMM_TOLERANCE};
 pub use contact::CONTACT_ACTIVE_DISTANCE;
