@@ -99,6 +99,17 @@ pub(crate) fn solve_coulomb(
     for i in 0..n {
         data.efc_force[i] = data.exact.rhs[i];
     }
+    if level != Level::Acceleration {
+        // Each row's force in the last acceleration-level solve, read by every sweep.
+        let mut i = 0;
+        while i < n {
+            let len = data.efc_block_len(i);
+            for k in 0..len {
+                data.exact.previous[i + k] = data.efc_previous_force(i, k);
+            }
+            i += len;
+        }
+    }
     let warm = level == Level::Acceleration
         && data.exact.warm_rows.len() == n
         && (0..n).all(|i| data.exact.warm_rows[i] == (data.efc_type[i], data.efc_id[i]));
@@ -154,17 +165,7 @@ pub(crate) fn solve_coulomb(
         // The change of the motion this sweep made, M⁻¹Jᵀ Δλ, against the constraint's whole
         // correction M⁻¹Jᵀ λ: redundant rows may still trade force between them (a box's corners),
         // which moves nothing.
-        let (mut moved, mut total) = (0.0f64, 0.0f64);
-        for k in 0..model.nv {
-            let (mut dk, mut tk) = (0.0, 0.0);
-            for i in 0..n {
-                let y = data.exact.minv_jt[(k, i)];
-                dk += y * (data.exact.rhs[i] - data.exact.lambda_prev[i]);
-                tk += y * data.exact.rhs[i];
-            }
-            moved = moved.max(dk.abs());
-            total = total.max(tk.abs());
-        }
+        let (moved, total) = sweep_motion(model.nv, data);
         if iterations == 1 {
             first_total = total;
         }
@@ -206,10 +207,34 @@ pub(crate) fn solve_coulomb(
     }
 }
 
-/// w_i = (A λ)_i − b_i with the current λ.
+/// max |M⁻¹Jᵀ Δλ| (the sweep's change, Δλ = λ − `lambda_prev`) and max |M⁻¹Jᵀ λ|. Column by
+/// column of M⁻¹Jᵀ, over each row's tree span (`exact.spans`; the column is zero outside it):
+/// per dof the same sum, in the same order, as the dense product.
+fn sweep_motion(nv: usize, data: &mut Data) -> (f64, f64) {
+    let n = data.nefc;
+    let ExactWork { minv_jt, rhs, lambda_prev, spans, motion, .. } = &mut data.exact;
+    let (change, whole) = motion.as_mut_slice()[..2 * nv].split_at_mut(nv);
+    change.fill(0.0);
+    whole.fill(0.0);
+    let y = minv_jt.as_slice();
+    for i in 0..n {
+        let (lo, hi) = spans[i];
+        let (l, dl) = (rhs[i], rhs[i] - lambda_prev[i]);
+        for k in lo..hi {
+            let yk = y[k + i * nv];
+            change[k] += yk * dl;
+            whole[k] += yk * l;
+        }
+    }
+    let moved = change.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let total = whole.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    (moved, total)
+}
+
+/// w_i = (A λ)_i − b_i with the current λ (read down column i of the symmetric A: contiguous).
 fn row_w(data: &Data, i: usize) -> f64 {
     let n = data.nefc;
-    (0..n).map(|j| data.exact.delassus[(i, j)] * data.exact.rhs[j]).sum::<f64>() - data.efc_force[i]
+    (0..n).map(|j| data.exact.delassus[(j, i)] * data.exact.rhs[j]).sum::<f64>() - data.efc_force[i]
 }
 
 /// Sets λ of rows i..i+len to 0; returns the change (times A_ii).
@@ -288,7 +313,7 @@ fn friction_dof(model: &Model, data: &mut Data, i: usize, level: Level) -> f64 {
     let dof = data.efc_id[i];
     let loss = model.joint_of(model.dof_body[dof]).friction;
     if let Level::Velocity { dt } = level {
-        let spent = dt * data.efc_previous_force(i, 0);
+        let spent = dt * data.exact.previous[i];
         return scalar_update(data, i, -loss * dt - spent, loss * dt - spent);
     }
     let speed = data.efc_vel[i];
@@ -320,6 +345,10 @@ const DIVERGED: f64 = 1e8;
 
 /// Sweeps after which the active set of the iterate is tried as an exact solve ([`polish`]).
 const POLISH_AFTER: u32 = 8;
+
+/// Fixed-point rounds of a polish with slipping contacts (their friction from the new normal
+/// forces) before it is abandoned.
+const POLISH_ROUNDS: u32 = 30;
 
 /// Multiply-adds one iterative solve may spend (sweeps × (n² + n·nv)) before it stops unconverged.
 const WORK_BUDGET: f64 = 2e7;
@@ -403,7 +432,7 @@ fn cone_solve(
         let mp = mu(friction, idx[p]);
         let own: f64 = (1..len).map(|k| data.exact.delassus[(rp, i + k)] * data.exact.rhs[i + k]).sum();
         let w_other: f64 =
-            (0..n).map(|j| data.exact.delassus[(rp, j)] * data.exact.rhs[j]).sum::<f64>() - own;
+            (0..n).map(|j| data.exact.delassus[(j, rp)] * data.exact.rhs[j]).sum::<f64>() - own;
         let shift: f64 = (1..len).map(|k| data.exact.delassus[(rp, i + k)] * spent[k - 1]).sum();
         g[p] = mp * (data.efc_force[rp] - w_other + shift);
         for q in 0..m {
@@ -584,10 +613,16 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     if k == 0 {
         return false;
     }
+    data.exact.in_active[..n].fill(false);
+    for a in 0..k {
+        let r = data.exact.active[a];
+        data.exact.in_active[r] = true;
+    }
     for j in 0..n {
         data.exact.lambda_prev[j] = data.exact.rhs[j];
     }
-    for round in 0..30 {
+    let mut last_change = f64::INFINITY;
+    for round in 0..POLISH_ROUNDS {
         let Data {
             efc_force,
             exact:
@@ -596,6 +631,7 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
                     sub: efc_sub,
                     sub_rhs: efc_sub_rhs,
                     active: efc_active,
+                    in_active,
                     lambda_prev: efc_lambda_prev,
                     factor: efc_factor,
                     eig: efc_eig,
@@ -606,13 +642,13 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         for (a, &r) in efc_active.iter().enumerate() {
             let mut rhs = efc_force[r];
             for j in 0..n {
-                if !efc_active.contains(&j) {
-                    rhs -= efc_delassus[(r, j)] * efc_lambda_prev[j];
+                if !in_active[j] {
+                    rhs -= efc_delassus[(j, r)] * efc_lambda_prev[j];
                 }
             }
             efc_sub_rhs[a] = rhs;
             for (c, &q) in efc_active.iter().enumerate() {
-                efc_sub[(a, c)] = efc_delassus[(r, q)];
+                efc_sub[(a, c)] = efc_delassus[(q, r)];
             }
         }
         solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..k], efc_factor, efc_eig);
@@ -627,14 +663,25 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         if change <= 1e-15 * scale {
             break;
         }
-        if round == 29 {
+        if round == POLISH_ROUNDS - 1 {
             return false;
         }
+        // Rounds left at this round's rate of contraction: a fixed point the remaining rounds
+        // cannot reach (or a round that did not contract) is abandoned now rather than at the
+        // last round (the iteration goes on either way).
+        let rate = change / last_change;
+        if round > 0 {
+            let needed = (1e-15 * scale / change).ln() / rate.ln();
+            if rate >= 1.0 || needed.is_nan() || needed > f64::from(POLISH_ROUNDS - 1 - round) {
+                return false;
+            }
+        }
+        last_change = change;
     }
     // Verify every row's law with w = A λ − b.
     let scale = 1.0 + (0..n).map(|j| data.efc_force[j].abs()).fold(0.0, f64::max);
     let w = |data: &Data, r: usize| -> f64 {
-        (0..n).map(|j| data.exact.delassus[(r, j)] * data.exact.lambda_prev[j]).sum::<f64>()
+        (0..n).map(|j| data.exact.delassus[(j, r)] * data.exact.lambda_prev[j]).sum::<f64>()
             - data.efc_force[r]
     };
     let force_scale = 1.0 + (0..n).map(|j| data.exact.lambda_prev[j].abs()).fold(0.0, f64::max);
@@ -649,7 +696,7 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
             | EfcType::ContactFrictionless
             | EfcType::ContactElliptic
             | EfcType::ContactPyramidal => {
-                let free = data.exact.active.contains(&i);
+                let free = data.exact.in_active[i];
                 let normal_ok = if data.exact.pressing[i] {
                     true
                 } else if free {
@@ -663,9 +710,7 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
                         let (_, spent) = cone_of(data, i, len, level);
                         let radius = match level {
                             Level::Acceleration => l,
-                            Level::Velocity { dt } => {
-                                l.max(0.0) + dt * data.efc_previous_force(i, 0).max(0.0)
-                            }
+                            Level::Velocity { dt } => l.max(0.0) + dt * data.exact.previous[i].max(0.0),
                         };
                         let y2: f64 = (1..len)
                             .filter(|&k| mu(&friction, k) > 0.0)
@@ -679,7 +724,7 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
             EfcType::FrictionDof => {
                 let (lo, hi) = friction_dof_bounds(model, data, i, level);
                 let slack = 1e-12 * force_scale;
-                if data.exact.active.contains(&i) {
+                if data.exact.in_active[i] {
                     l >= lo - slack && l <= hi + slack
                 } else {
                     let wi = w(data, i);
@@ -721,7 +766,7 @@ fn update_sliding_friction(data: &mut Data) -> f64 {
                 slip[k - 1] = if moving {
                     data.efc_vel[i + k]
                 } else {
-                    (0..n).map(|j| data.exact.delassus[(i + k, j)] * data.exact.lambda_prev[j]).sum::<f64>()
+                    (0..n).map(|j| data.exact.delassus[(j, i + k)] * data.exact.lambda_prev[j]).sum::<f64>()
                         - data.efc_force[i + k]
                 };
             }
@@ -745,7 +790,7 @@ fn friction_dof_bounds(model: &Model, data: &Data, i: usize, level: Level) -> (f
     match level {
         Level::Acceleration => (-loss, loss),
         Level::Velocity { dt } => {
-            let spent = dt * data.efc_previous_force(i, 0);
+            let spent = dt * data.exact.previous[i];
             (-loss * dt - spent, loss * dt - spent)
         }
     }
@@ -759,9 +804,9 @@ fn cone_of(data: &Data, i: usize, len: usize, level: Level) -> (f64, [f64; MAX_D
         Level::Acceleration => data.exact.rhs[i],
         Level::Velocity { dt } => {
             for k in 1..len {
-                spent[k - 1] = dt * data.efc_previous_force(i, k);
+                spent[k - 1] = dt * data.exact.previous[i + k];
             }
-            data.exact.rhs[i].max(0.0) + dt * data.efc_previous_force(i, 0).max(0.0)
+            data.exact.rhs[i].max(0.0) + dt * data.exact.previous[i].max(0.0)
         }
     };
     (radius, spent)

@@ -11,6 +11,7 @@
 use super::active_set::{solve_delassus, solve_mixed};
 use super::admm::{solve_admm, ExactContactSolver};
 use super::coulomb::{has_friction, solve_coulomb, Level, SolverSettings, SEPARATING_VELOCITY};
+use super::energy_guard::{free_row_velocity, limit_energy};
 use super::ConstraintModel;
 use super::ExactWork;
 use crate::collision::{collide, EXACT_REACH};
@@ -124,6 +125,10 @@ pub(crate) fn solve_exact(
         } else {
             let scale = data.qacc_smooth.amax();
             solve_coulomb(model, data, Level::Acceleration, settings, scale);
+        }
+        if !data.efc_converged {
+            let h = model.options.timestep;
+            limit_energy(data, h, |d, i| free_row_velocity(model, d, h, i));
         }
         // No rank to report: the iterative solve gives one of the equivalent force distributions.
         data.exact.active.clear();
@@ -260,6 +265,10 @@ pub(crate) fn project_velocities_unchecked(
         let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         solve_coulomb(model, data, Level::Velocity { dt }, settings, scale);
         data.exact.active.clear();
+        if !data.efc_converged {
+            // The row velocities v gives, J v = −b (b still in efc_force after the solve).
+            limit_energy(data, 1.0, |d, i| -d.efc_force[i]);
+        }
     } else {
         solve_mixed(data, |_, _| false);
     }

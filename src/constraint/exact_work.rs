@@ -21,6 +21,8 @@ pub(crate) struct ExactWork {
     pub eig: DVector<f64>,
     /// The unilateral solve's active set, its Delassus block and right-hand side.
     pub active: Vec<usize>,
+    /// Per row, whether it is in `active` (the Coulomb solve's polish).
+    pub in_active: Vec<bool>,
     pub sub: DMatrix<f64>,
     pub sub_rhs: DVector<f64>,
     /// Rows whose Delassus diagonal A_ii is at most this are round-off (their force would move
@@ -48,6 +50,12 @@ pub(crate) struct ExactWork {
     /// Per row, the dofs [lo, hi) of the kinematic trees it touches (`dynamics::tree_span`):
     /// M⁻¹ J_iᵀ is zero outside them, and A_ij = 0 when two rows' spans are disjoint.
     pub spans: Vec<(usize, usize)>,
+    /// Per row, during a velocity-level Coulomb solve: its force in the last acceleration-level
+    /// solve (`Data::efc_previous_force`, looked up once per solve rather than per sweep).
+    pub previous: DVector<f64>,
+    /// The Gauss–Seidel sweep's motion change M⁻¹Jᵀ Δλ (entries 0..nv) and correction M⁻¹Jᵀ λ
+    /// (nv..2nv).
+    pub motion: DVector<f64>,
 }
 
 impl ExactWork {
@@ -60,6 +68,7 @@ impl ExactWork {
             rhs: DVector::zeros(nefc),
             eig: DVector::zeros(nefc),
             active: Vec::with_capacity(nefc),
+            in_active: vec![false; nefc],
             sub: DMatrix::zeros(nefc, nefc),
             sub_rhs: DVector::zeros(nefc),
             a_floor: 0.0,
@@ -71,12 +80,17 @@ impl ExactWork {
             admm: Default::default(),
             jt: DMatrix::zeros(nv, nefc),
             spans: vec![(0, 0); nefc],
+            previous: DVector::zeros(nefc),
+            motion: DVector::zeros(2 * nv),
         }
     }
 
     /// The dense matrices (M⁻¹Jᵀ, the Delassus matrix and its factors) for `nefc` rows, if
     /// smaller: only the exact mode needs them (nefc² numbers each).
     pub fn grow_matrices(&mut self, nv: usize, nefc: usize) {
+        if self.motion.len() != 2 * nv {
+            self.motion = DVector::zeros(2 * nv);
+        }
         if self.delassus.nrows() >= nefc && self.minv_jt.nrows() == nv {
             return;
         }
@@ -89,12 +103,14 @@ impl ExactWork {
 
     /// The per-row vectors for `nefc` rows.
     pub fn grow_vectors(&mut self, nefc: usize) {
-        for v in [&mut self.rhs, &mut self.eig, &mut self.sub_rhs, &mut self.lambda_prev] {
+        for v in [&mut self.rhs, &mut self.eig, &mut self.sub_rhs, &mut self.lambda_prev, &mut self.previous]
+        {
             *v = DVector::zeros(nefc);
         }
         self.warm.resize_vertically_mut(nefc, 0.0);
         self.pressing.resize(nefc, false);
         self.slipping.resize(nefc, false);
+        self.in_active.resize(nefc, false);
         self.spans.resize(nefc, (0, 0));
         self.admm.grow(nefc);
         self.active.reserve(nefc.saturating_sub(self.active.len()));

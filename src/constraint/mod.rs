@@ -18,6 +18,7 @@ mod contact;
 pub mod contact_force;
 mod coulomb;
 mod dense;
+mod energy_guard;
 mod exact;
 mod exact_work;
 mod friction_loss;

@@ -296,6 +296,9 @@ pub struct Data {
     /// its last sweep; soft mode, the scaled gradient norm (Newton, CG; MuJoCo's
     /// `solver_gradient`) or the last sweep's scaled cost improvement (PGS).
     pub efc_unconverged_residual: f64,
+    /// Exact mode: unconverged solves whose forces would have added kinetic energy and were
+    /// scaled down instead (`constraint::energy_guard`, docs/constraints.md).
+    pub efc_energy_limited: u64,
     /// Run-time warnings (MuJoCo's `d->warning`): a singular mass matrix regularized, bad
     /// controls zeroed ([`Warnings`](super::Warnings)).
     pub warnings: super::Warnings,
@@ -489,6 +492,7 @@ impl Data {
             efc_converged: true,
             efc_unconverged: 0,
             efc_unconverged_residual: 0.0,
+            efc_energy_limited: 0,
             warnings: super::Warnings::new(nv),
             exact: exact_work(model, nefc, exact_matrices),
             lifecycle: RowLifecycle::new(model),

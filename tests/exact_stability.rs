@@ -1,0 +1,254 @@
+//! Stability of the exact (rigid) mode in contact-rich scenes (issue 26, item 2; not timed):
+//! passive scenes never gain energy beyond the tolerance — a stack of boxes, a 1000:1 mass-ratio
+//! stack, a small bin of mixed primitives, a capsule chain falling on the floor — also when a
+//! solve does not converge (`constraint::energy_guard`); a stack at rest stays at the closed-form
+//! heights with no penetration for 10 s; a bin settles; at rest the solve's forces satisfy
+//! Signorini's and Coulomb's laws to the solver's tolerance. The soft mode's energy is checked
+//! on the same scenes where MuJoCo's model is passive too.
+
+use lagrange::constraint::ConstraintMode;
+use lagrange::dynamics::{kinetic_energy, potential_energy};
+use lagrange::forward::forward;
+use lagrange::integrate::step;
+use lagrange::model::EfcType;
+use lagrange::{Data, Model};
+
+mod common;
+
+const OPTION: &str = "<option timestep='0.002' integrator='Euler' solver='Newton' cone='pyramidal'/>";
+
+/// Energy a passive scene may gain over a run (J): round-off of the energy of these scenes.
+const ENERGY_RISE: f64 = 1e-9;
+/// Penetration allowed after settling (m).
+const PENETRATION: f64 = 1e-6;
+
+/// n unit boxes of 0.1 m stacked on a floor, 0.1 mm apart (validation/bench_contact_rich.py's stack).
+fn stack(n: usize) -> String {
+    let bodies: String = (0..n)
+        .map(|k| {
+            format!(
+                "<body pos='0 0 {:.6}'><freejoint/><geom type='box' size='0.05 0.05 0.05' mass='1'/></body>",
+                0.05 + 0.1 * k as f64 + 1e-4 * k as f64
+            )
+        })
+        .collect();
+    format!("<mujoco>{OPTION}<worldbody><geom type='plane' size='0 0 1'/>{bodies}</worldbody></mujoco>")
+}
+
+/// A box of 1 kg under a box of `ratio` kg on a floor (validation/bench_contact_rich.py's scene).
+fn mass_ratio(ratio: f64) -> String {
+    format!(
+        "<mujoco>{OPTION}<worldbody><geom type='plane' size='0 0 1'/>\
+         <body pos='0 0 0.05'><freejoint/><geom type='box' size='0.05 0.05 0.05' mass='1'/></body>\
+         <body pos='0 0 0.1501'><freejoint/><geom type='box' size='0.1 0.1 0.05' mass='{ratio}'/></body>\
+         </worldbody></mujoco>"
+    )
+}
+
+/// `n` primitives (spheres, capsules, boxes) dropped into a walled bin from a grid, a pile about
+/// three deep (validation/bench_contact_rich.py's bin without its random jitter).
+fn bin(n: usize) -> String {
+    let side = ((n as f64 / 3.0).sqrt().ceil() as usize).max(2);
+    let half = 0.06 * side as f64;
+    let walls: String = [
+        (half + 0.01, 0.0, 0.01, half),
+        (-half - 0.01, 0.0, 0.01, half),
+        (0.0, half + 0.01, half, 0.01),
+        (0.0, -half - 0.01, half, 0.01),
+    ]
+    .iter()
+    .map(|(x, y, sx, sy)| format!("<geom type='box' pos='{x} {y} 0.3' size='{sx} {sy} 0.3'/>"))
+    .collect();
+    let geoms = [
+        "<geom type='sphere' size='0.04'/>",
+        "<geom type='capsule' size='0.025 0.03'/>",
+        "<geom type='box' size='0.035 0.035 0.035'/>",
+    ];
+    let bodies: String = (0..n)
+        .map(|k| {
+            let (i, j, layer) = (k % side, (k / side) % side, k / (side * side));
+            let x = -half + 0.06 + 0.12 * i as f64 + 0.003 * (k % 4) as f64;
+            let y = -half + 0.06 + 0.12 * j as f64 - 0.002 * (k % 3) as f64;
+            let z = 0.06 + 0.12 * layer as f64;
+            format!("<body pos='{x} {y} {z}' euler='{} 0 0'><freejoint/>{}</body>", 17 * k, geoms[k % 3])
+        })
+        .collect();
+    format!(
+        "<mujoco>{OPTION}<worldbody><geom type='plane' size='0 0 1'/>{walls}{bodies}</worldbody></mujoco>"
+    )
+}
+
+/// A capsule chain of `n` links on ball joints, its free root 0.3 m above the floor, lying
+/// horizontal (validation/bench_contact_rich.py's chain, shorter).
+fn chain(n: usize) -> String {
+    let mut inner = String::new();
+    for _ in 1..n {
+        inner = format!(
+            "<body pos='0.1 0 0'><joint type='ball'/><geom type='capsule' fromto='0 0 0 0.1 0 0' size='0.02'/>{inner}</body>"
+        );
+    }
+    format!(
+        "<mujoco>{OPTION}<worldbody><geom type='plane' size='0 0 1'/><body pos='0 0 0.3'><freejoint/>\
+         <geom type='capsule' fromto='0 0 0 0.1 0 0' size='0.02'/>{inner}</body></worldbody></mujoco>"
+    )
+}
+
+fn load(label: &str, mjcf: &str, mode: ConstraintMode) -> Model {
+    let mut model = common::load_mjcf_text("exact_stability", label, mjcf);
+    model.set_constraint_mode(mode);
+    model
+}
+
+/// Total mechanical energy (kinetic + gravitational).
+fn energy(model: &Model, data: &mut Data) -> f64 {
+    let (q, v) = (data.qpos.clone(), data.qvel.clone());
+    kinetic_energy(model, data, q.as_slice(), v.as_slice()).unwrap() + potential_energy(model, data)
+}
+
+/// What a run shows: the largest rise of the energy above its start, the final kinetic energy,
+/// the deepest penetration over the last `settled` seconds.
+struct Run {
+    rise: f64,
+    kinetic: f64,
+    penetration: f64,
+}
+
+/// Steps `seconds` from the scene's start; panics on a failed step or a non-finite state.
+fn run(model: &Model, data: &mut Data, seconds: f64, settled: f64) -> Run {
+    let e0 = energy(model, data);
+    let mut out = Run { rise: 0.0, kinetic: 0.0, penetration: 0.0 };
+    let n = (seconds / model.options.timestep).round() as usize;
+    let from = ((seconds - settled) / model.options.timestep).round() as usize;
+    for k in 0..n {
+        step(model, data).unwrap_or_else(|e| panic!("step {k}: {e}"));
+        assert!(data.qpos.iter().all(|x| x.is_finite()), "step {k}: non-finite state");
+        out.rise = out.rise.max(energy(model, data) - e0);
+        if k >= from {
+            let deepest = data.contacts.iter().map(|c| -c.dist).fold(0.0, f64::max);
+            out.penetration = out.penetration.max(deepest);
+        }
+    }
+    let (q, v) = (data.qpos.clone(), data.qvel.clone());
+    out.kinetic = kinetic_energy(model, data, q.as_slice(), v.as_slice()).unwrap();
+    out
+}
+
+#[test]
+fn an_exact_stack_rests_at_its_closed_form_heights_for_10_s() {
+    let n = 5;
+    let model = load("stack5", &stack(n), ConstraintMode::Exact);
+    let mut data = Data::new(&model);
+    let r = run(&model, &mut data, 10.0, 9.0);
+    eprintln!("stack5: rise {:e} J, kinetic {:e} J, penetration {:e} m", r.rise, r.kinetic, r.penetration);
+    assert!(r.rise <= ENERGY_RISE, "gained {:e} J", r.rise);
+    assert!(r.kinetic < 1e-10, "still moving: {:e} J", r.kinetic);
+    assert!(r.penetration <= PENETRATION, "penetration {:e} m", r.penetration);
+    // Rigid boxes of 0.1 m rest on each other: box k's centre at 0.05 + 0.1 k.
+    for b in 0..n {
+        let z = data.qpos[7 * b + 2];
+        let closed = 0.05 + 0.1 * b as f64;
+        assert!(
+            (z - closed).abs() <= PENETRATION * (b + 1) as f64,
+            "box {b} at {z} m, closed form {closed} m"
+        );
+        assert!(data.qpos[7 * b].hypot(data.qpos[7 * b + 1]) < 1e-9, "box {b} slid");
+    }
+    assert_eq!(data.efc_energy_limited, 0);
+}
+
+#[test]
+fn an_exact_1000_to_1_stack_rests_without_gaining_energy() {
+    let model = load("ratio1000", &mass_ratio(1000.0), ConstraintMode::Exact);
+    let mut data = Data::new(&model);
+    let r = run(&model, &mut data, 3.0, 2.0);
+    eprintln!("ratio1000: rise {:e} J, kinetic {:e} J, penetration {:e} m", r.rise, r.kinetic, r.penetration);
+    assert!(r.rise <= ENERGY_RISE, "gained {:e} J", r.rise);
+    assert!(r.kinetic < 1e-8, "still moving: {:e} J", r.kinetic);
+    assert!(r.penetration <= PENETRATION, "penetration {:e} m", r.penetration);
+    // The light box at 0.05 m, the heavy one on it at 0.15 m.
+    assert!((data.qpos[2] - 0.05).abs() <= 2.0 * PENETRATION, "light box at {}", data.qpos[2]);
+    assert!((data.qpos[9] - 0.15).abs() <= 2.0 * PENETRATION, "heavy box at {}", data.qpos[9]);
+}
+
+#[test]
+fn an_exact_bin_settles_without_gaining_energy() {
+    let model = load("bin6", &bin(6), ConstraintMode::Exact);
+    let mut data = Data::new(&model);
+    let r = run(&model, &mut data, 2.0, 0.5);
+    eprintln!(
+        "bin6: rise {:e} J, kinetic {:e} J, penetration {:e} m, unconverged {}, energy-limited {}",
+        r.rise, r.kinetic, r.penetration, data.efc_unconverged, data.efc_energy_limited
+    );
+    assert!(r.rise <= ENERGY_RISE, "gained {:e} J", r.rise);
+    assert!(r.kinetic < 1e-3, "still moving after 2 s: {:e} J", r.kinetic);
+    assert!(r.penetration <= PENETRATION, "penetration {:e} m", r.penetration);
+}
+
+#[test]
+fn an_exact_chain_falls_on_the_floor_without_gaining_energy() {
+    let model = load("chain10", &chain(10), ConstraintMode::Exact);
+    let mut data = Data::new(&model);
+    let r = run(&model, &mut data, 2.0, 0.5);
+    eprintln!(
+        "chain10: rise {:e} J, kinetic {:e} J, penetration {:e} m, unconverged {}",
+        r.rise, r.kinetic, r.penetration, data.efc_unconverged
+    );
+    assert!(r.rise <= ENERGY_RISE, "gained {:e} J", r.rise);
+    assert!(r.penetration <= PENETRATION, "penetration {:e} m", r.penetration);
+}
+
+/// At rest on the floor, the forces of a fresh solve obey the laws: per contact λ_n ≥ 0, the row
+/// acceleration w_n = J q̈ + J̇v ≥ 0, λ_n w_n = 0, the friction inside its cone; every residual
+/// at most the solver's tolerance relative to the forces and accelerations involved.
+#[test]
+fn an_exact_resting_stack_solves_the_contact_laws() {
+    let model = load("stack3", &stack(3), ConstraintMode::Exact);
+    let mut data = Data::new(&model);
+    run(&model, &mut data, 1.0, 0.5);
+    forward(&model, &mut data);
+    assert!(data.efc_converged, "the solve at rest converged");
+    let n = data.nefc;
+    assert!(n >= 12, "rows {n}");
+    let force_scale = (0..n).map(|i| data.efc_force[i].abs()).fold(0.0, f64::max);
+    let w: Vec<f64> = (0..n)
+        .map(|i| (0..model.nv).map(|k| data.efc_j[(i, k)] * data.qacc[k]).sum::<f64>() + data.efc_jdotv[i])
+        .collect();
+    let acc_scale = 9.81;
+    let tol = 1e-9;
+    let mut i = 0;
+    let mut worst = 0.0f64;
+    while i < n {
+        let len = data.efc_block_len(i);
+        assert_eq!(data.efc_type[i], EfcType::ContactElliptic);
+        let (l, wn) = (data.efc_force[i], w[i]);
+        assert!(l >= -tol * force_scale, "row {i}: λ_n {l}");
+        assert!(wn >= -tol * acc_scale, "row {i}: w_n {wn}");
+        worst = worst.max((l * wn).abs() / (force_scale * acc_scale));
+        let friction = data.contacts[data.efc_id[i]].friction;
+        let y: f64 = (1..len).map(|k| (data.efc_force[i + k] / friction[k - 1]).powi(2)).sum::<f64>().sqrt();
+        assert!(
+            y <= l.max(0.0) * (1.0 + tol) + tol * force_scale,
+            "row {i}: friction {y} outside the cone {l}"
+        );
+        // At rest the contact sticks: no slip acceleration.
+        for k in 1..len {
+            assert!(w[i + k].abs() <= tol * acc_scale, "row {}: slip acceleration {}", i + k, w[i + k]);
+        }
+        i += len;
+    }
+    eprintln!("stack3 at rest: {n} rows, complementarity residual {worst:e}");
+    assert!(worst <= tol, "complementarity residual {worst:e}");
+}
+
+#[test]
+fn soft_passive_scenes_do_not_gain_energy() {
+    for (label, mjcf, seconds) in
+        [("ratio1000", mass_ratio(1000.0), 3.0), ("chain10", chain(10), 2.0), ("bin6", bin(6), 2.0)]
+    {
+        let model = load(label, &mjcf, ConstraintMode::Soft);
+        let mut data = Data::new(&model);
+        let r = run(&model, &mut data, seconds, 0.0);
+        eprintln!("{label} soft: rise {:e} J", r.rise);
+        assert!(r.rise <= ENERGY_RISE, "{label}: gained {:e} J", r.rise);
+    }
+}
