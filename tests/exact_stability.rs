@@ -1,4 +1,4 @@
-//! Stability of the exact (rigid) mode in contact-rich scenes (issue 26, item 2; not timed):
+//! Stability of the exact (rigid) mode in contact-rich scenes (not timed; docs/constraints.md):
 //! passive scenes never gain energy beyond the tolerance — a stack of boxes, a 1000:1 mass-ratio
 //! stack, a small bin of mixed primitives, a capsule chain falling on the floor — also when a
 //! solve does not converge (`constraint::energy_guard`); a stack at rest stays at the closed-form

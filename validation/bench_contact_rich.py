@@ -1,4 +1,4 @@
-"""Contact-rich scenes beside `mj_step` (issue 26, item 5): per-step time of lagrange's soft and
+"""Contact-rich scenes beside `mj_step`: per-step time of lagrange's soft and
 exact modes against MuJoCo 4.0 in the same run, and the growth of the step time with the number
 of objects in a bin (time ∝ Nᵏ, fitted for both engines), and the quality of each mode after
 `--settle` seconds: penetration, energy rise, unconverged solves, the rest state against MuJoCo's
@@ -265,13 +265,13 @@ def report(rows, settle: float) -> str:
         f"Written by `validation/bench_contact_rich.py` on {time.strftime('%Y-%m-%d', time.gmtime())} (UTC), lagrange "
         f"{commit()}, MuJoCo {mj.__version__}, {platform.machine()}, load average "
         f"{' '.join(f'{x:.2f}' for x in __import__('os').getloadavg())} on {__import__('os').cpu_count()} CPUs "
-        "(not pinned: with more runnable processes than CPUs figures move by 2×). Report only (issue 26). Each scene "
+        "(not pinned: with more runnable processes than CPUs figures move by 2×). Report only. Each scene "
         "from rest, Euler 2 ms, Newton, pyramidal cones; per-step µs over the steps shown, the best of 3 runs, "
         "MuJoCo's `mjTIMER_STEP` against lagrange's `eval --step` in soft and exact mode. Ratios: lagrange / MuJoCo.",
         "",
         f"Median ratio of the contact-rich scenes (robots excluded): soft {med['soft']:.2f}, exact {med['exact']:.2f}. "
         f"Bins, time ∝ Nᵏ fitted over N = {', '.join(map(str, ns))}: MuJoCo k = {k['mj']:.2f}, lagrange soft "
-        f"k = {k['soft']:.2f}, exact k = {k['exact']:.2f} (issue 26 asks soft ≤ MuJoCo's + 0.1).",
+        f"k = {k['soft']:.2f}, exact k = {k['exact']:.2f} (the goal: soft ≤ MuJoCo's + 0.1).",
         "",
         "| scene | nv | geoms | steps | mj_step µs | soft µs | soft ratio | exact µs | exact ratio | failures |",
         "|---|---|---|---|---|---|---|---|---|---|",
