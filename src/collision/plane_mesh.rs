@@ -339,7 +339,7 @@ pub fn plane_mesh(
 ///
 /// The areas are compared as squared norms of the diagonals' cross product and the square root
 /// taken only where the two squares are too close for the order of the roots to be certain
-/// ([`grows`]): the same decisions as comparing the areas, without a square root per candidate
+/// (`grows`): the same decisions as comparing the areas, without a square root per candidate
 /// (the pass's hot spot on polygons of many vertices, such as a finger pad's face).
 pub fn quad_from_first(len: usize, at: impl Fn(usize) -> Vec3) -> [usize; 4] {
     let area2 = |q: [usize; 4]| (at(q[2]) - at(q[0])).cross(&(at(q[3]) - at(q[1]))).norm_squared();
