@@ -305,14 +305,6 @@ fn for_each_run(model: &Model, from: usize, mut run: impl FnMut(usize, usize)) {
     }
 }
 
-/// The first (lowest) dof of the ancestor chain of dof `k` (its tree's root run).
-#[inline]
-fn chain_start(model: &Model, k: usize) -> usize {
-    let mut lo = k;
-    for_each_run(model, k, |s, _| lo = s);
-    lo
-}
-
 /// Factorizes `data.mass_matrix` as M = Lᵀ D L into `data.mass_factor`, exploiting the tree's
 /// sparsity: fill-in stays on the ancestor paths λ (RBDA §6.3, Table 6.3). Run [`crba`] first.
 ///
@@ -336,10 +328,10 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
     let h = mass_factor.as_mut_slice();
     let mut singular = None;
     // The upper triangle of M (column k of M holds M[j][k] = M[k][j], j ≤ k), from the first dof
-    // of k's chain on (`chain_start`): the entries above it are off the chain, never read, so
+    // of k's chain on (`Model::dof_tree_start`): the entries above it are off the chain, never read, so
     // copying them, O(nv²) over many bodies, is not needed.
     for k in 0..nv {
-        let lo = chain_start(model, k);
+        let lo = model.dof_tree_start[k];
         h[k * nv + lo..=k * nv + k].copy_from_slice(&m[k * nv + lo..=k * nv + k]);
     }
     for k in (0..nv).rev() {
@@ -355,6 +347,8 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
             d_k = MIN_PIVOT;
             col_k[k] = d_k;
         }
+        // Every ancestor of k starts its chain where k's does (the tree's root dof).
+        let lo = model.dof_tree_start[k];
         let mut i = lambda[k];
         while i != NO_DOF {
             let a = col_k[i] / d_k;
@@ -362,7 +356,6 @@ pub fn factorize_mass_matrix(model: &Model, data: &mut Data) {
             // Column k is nonzero only on k's chain, whose rows up to i are i's chain: the
             // update runs over i's span from its chain's first dof (the same bits on the chain
             // as the whole column, without the products with zeros of other trees).
-            let lo = chain_start(model, i);
             for (x, y) in col_i[lo..].iter_mut().zip(&col_k[lo..=i]) {
                 *x -= a * y;
             }

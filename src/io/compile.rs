@@ -373,6 +373,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         nq,
         nv,
         dof_run_start: crate::model::dof_run_starts(&dof_parent),
+        dof_tree_start: crate::model::dof_tree_starts(&dof_parent),
         hinge_axis,
         placement_unrotated,
         dof_parent,

@@ -243,6 +243,9 @@ pub struct Model {
     /// (λ(j) = j − 1 for s < j ≤ k) that ends at k: the ancestor chain of k is such runs, each a
     /// contiguous slice (the LᵀDL factorization walks it run by run). See [`dof_run_starts`].
     pub dof_run_start: Vec<usize>,
+    /// For each degree of freedom, the first dof of its kinematic tree (the root of its ancestor
+    /// chain): the chain lies in `dof_tree_start[k]..=k`. See [`dof_tree_starts`].
+    pub dof_tree_start: Vec<usize>,
     /// For each degree of freedom, the body it moves.
     pub dof_body: Vec<usize>,
     /// For each body, the coordinate axis its hinge turns about ([`JointKind::hinge_axis`];
@@ -502,6 +505,17 @@ pub fn dof_run_starts(dof_parent: &[usize]) -> Vec<usize> {
     for k in 1..dof_parent.len() {
         if dof_parent[k] == k - 1 {
             start[k] = start[k - 1];
+        }
+    }
+    start
+}
+
+/// [`Model::dof_tree_start`] from `dof_parent`: each dof's root ancestor (parents come first).
+pub fn dof_tree_starts(dof_parent: &[usize]) -> Vec<usize> {
+    let mut start: Vec<usize> = (0..dof_parent.len()).collect();
+    for k in 0..dof_parent.len() {
+        if let Some(&p) = dof_parent.get(k).filter(|&&p| p < k) {
+            start[k] = start[p];
         }
     }
     start
