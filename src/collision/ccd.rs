@@ -8,10 +8,9 @@
 //! the pair's margin (MuJoCo's `support`); spheres and capsules are first shrunk to their centre
 //! and segment (a shallow contact is then the distance of the cores less the radii).
 //!
-//! The result is the EPA face's witness points and, for the multi-point contacts
-//! ([`super::multiccd`]), the geom vertices (box corner bits, hull vertex indices) of the face's
-//! three polytope vertices: MuJoCo reads the contact features off them. No allocation once the
-//! thread's workspace has grown.
+//! The result is the EPA face's witness points, normal and distance ([`super::multiccd`] finds
+//! the other points of a multi-point contact from that normal). No allocation once the thread's
+//! workspace has grown.
 
 use super::convex::ConvexShape;
 use crate::spatial::{Transform, Vec3};
@@ -977,8 +976,7 @@ fn tri_point_intersect(v1: &Vec3, v2: &Vec3, v3: &Vec3, p: &Vec3) -> bool {
 
 /// A contact from the solver: the witness points (of the geoms inflated by half the margin
 /// each; their midpoint is the contact position), the unit normal from geom 1 to geom 2, the
-/// contact distance (the margin plus the inflated geoms' signed distance) and, when EPA found
-/// it, the geom vertex indices of its final face's three polytope vertices (geom 1's, geom 2's).
+/// contact distance (the margin plus the inflated geoms' signed distance).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CcdContact {
     /// Witness point on geom 1 (world).
@@ -989,8 +987,6 @@ pub(crate) struct CcdContact {
     pub normal: Vec3,
     /// Contact distance (m).
     pub dist: f64,
-    /// The final EPA face's vertices: geom 1's and geom 2's vertex indices and points.
-    pub face: Option<FaceFeatures>,
 }
 
 /// MuJoCo's `mjc_penetration` with one contact: the penetration of the two geoms inflated by
@@ -1074,7 +1070,7 @@ fn penetration_with(
             if st.dist > st.dist_cutoff || st.dist >= 0.0 {
                 return None;
             }
-            return Some(contact(&st, margin, None));
+            return Some(contact(&st, margin));
         }
         st.gjk_iterations = 0;
         st.x1 = x1.pos;
@@ -1100,9 +1096,7 @@ fn penetration_with(
         if st.dist >= 0.0 {
             return None;
         }
-        let v = pt.faces[f].verts.map(|i| pt.verts[i]);
-        let face = (v.map(|v| v.index1), v.map(|v| v.index2), v.map(|v| v.vert1), v.map(|v| v.vert2));
-        Some(contact(&st, margin, Some(face)))
+        Some(contact(&st, margin))
     })
 }
 
@@ -1133,10 +1127,6 @@ pub(crate) fn separated(
     st.separated
 }
 
-/// A final EPA face's features: geom 1's and geom 2's vertex indices of its three polytope
-/// vertices, and their points on geom 1 and geom 2 (world).
-pub(crate) type FaceFeatures = ([i32; 3], [i32; 3], [Vec3; 3], [Vec3; 3]);
-
-fn contact(st: &Status, margin: f64, face: Option<FaceFeatures>) -> CcdContact {
-    CcdContact { x1: st.x1, x2: st.x2, normal: normalize3(&(st.x1 - st.x2)), dist: margin + st.dist, face }
+fn contact(st: &Status, margin: f64) -> CcdContact {
+    CcdContact { x1: st.x1, x2: st.x2, normal: normalize3(&(st.x1 - st.x2)), dist: margin + st.dist }
 }

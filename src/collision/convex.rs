@@ -200,12 +200,6 @@ impl SupportMap for Warm<'_> {
     }
 }
 
-thread_local! {
-    /// The EPA face features of this thread's last [`mujoco_pair`] (for [`super::multiccd`], which
-    /// the collision pass calls right after it on the same pair).
-    static LAST_FACE: std::cell::Cell<Option<super::ccd::FaceFeatures>> = const { std::cell::Cell::new(None) };
-}
-
 /// The first contact of a convex pair as MuJoCo 4.0's native solver finds it
 /// (`ccd::penetration`: GJK/EPA on the geoms inflated by half of `margin` each, to the
 /// model's `ccd_tolerance` within `ccd_iterations`): witness points whose midpoint is MuJoCo's
@@ -241,7 +235,6 @@ pub(crate) fn mujoco_pair_warm(
 ) -> Option<PairPoint> {
     let polytope = |s: &ConvexShape| matches!(s, ConvexShape::Cuboid(_) | ConvexShape::Hull(_));
     if polytope(s1) && polytope(s2) {
-        LAST_FACE.with(|f| f.set(None));
         // MuJoCo's GJK dismisses most candidate pairs after a few support points (a pair
         // touching at the last pass goes straight to the penetration).
         if !touching
@@ -266,16 +259,6 @@ pub(crate) fn mujoco_pair_warm(
         if margin > 0.0 {
             return support_pair(x1, s1, x2, s2, margin);
         }
-        let c = super::ccd::penetration(
-            s1,
-            x1,
-            s2,
-            x2,
-            margin,
-            options.ccd_tolerance,
-            options.ccd_iterations as usize,
-        )?;
-        return Some(PairPoint { p1: c.x1, p2: c.x2, normal: c.normal, dist: c.dist });
     }
     let c = super::ccd::penetration(
         s1,
@@ -285,9 +268,7 @@ pub(crate) fn mujoco_pair_warm(
         margin,
         options.ccd_tolerance,
         options.ccd_iterations as usize,
-    );
-    LAST_FACE.with(|f| f.set(c.and_then(|c| c.face)));
-    let c = c?;
+    )?;
     Some(PairPoint { p1: c.x1, p2: c.x2, normal: c.normal, dist: c.dist })
 }
 
