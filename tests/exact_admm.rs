@@ -9,17 +9,7 @@ use lagrange::{Data, Model};
 
 mod common;
 
-const OPTION: &str = "<option timestep='0.002' integrator='Euler' solver='Newton' cone='pyramidal'/>";
-
-/// A box of 1 kg under a box of `ratio` kg on a floor (validation/bench_contact_rich.py's scene).
-fn mass_ratio(ratio: f64) -> String {
-    format!(
-        "<mujoco>{OPTION}<worldbody><geom type='plane' size='0 0 1'/>\
-         <body pos='0 0 0.05'><freejoint/><geom type='box' size='0.05 0.05 0.05' mass='1'/></body>\
-         <body pos='0 0 0.1501'><freejoint/><geom type='box' size='0.1 0.1 0.05' mass='{ratio}'/></body>\
-         </worldbody></mujoco>"
-    )
-}
+use common::contact_scenes::mass_ratio;
 
 fn load_admm(label: &str, mjcf: &str) -> Model {
     let mut model = common::load_mjcf_text("exact_admm", label, mjcf);

@@ -15,68 +15,12 @@ use lagrange::{Data, Model};
 
 mod common;
 
-const OPTION: &str = "<option timestep='0.002' integrator='Euler' solver='Newton' cone='pyramidal'/>";
+use common::contact_scenes::{bin, mass_ratio, stack, OPTION};
 
 /// Energy a passive scene may gain over a run (J): round-off of the energy of these scenes.
 const ENERGY_RISE: f64 = 1e-9;
 /// Penetration allowed after settling (m).
 const PENETRATION: f64 = 1e-6;
-
-/// n unit boxes of 0.1 m stacked on a floor, 0.1 mm apart (validation/bench_contact_rich.py's stack).
-fn stack(n: usize) -> String {
-    let bodies: String = (0..n)
-        .map(|k| {
-            format!(
-                "<body pos='0 0 {:.6}'><freejoint/><geom type='box' size='0.05 0.05 0.05' mass='1'/></body>",
-                0.05 + 0.1 * k as f64 + 1e-4 * k as f64
-            )
-        })
-        .collect();
-    format!("<mujoco>{OPTION}<worldbody><geom type='plane' size='0 0 1'/>{bodies}</worldbody></mujoco>")
-}
-
-/// A box of 1 kg under a box of `ratio` kg on a floor (validation/bench_contact_rich.py's scene).
-fn mass_ratio(ratio: f64) -> String {
-    format!(
-        "<mujoco>{OPTION}<worldbody><geom type='plane' size='0 0 1'/>\
-         <body pos='0 0 0.05'><freejoint/><geom type='box' size='0.05 0.05 0.05' mass='1'/></body>\
-         <body pos='0 0 0.1501'><freejoint/><geom type='box' size='0.1 0.1 0.05' mass='{ratio}'/></body>\
-         </worldbody></mujoco>"
-    )
-}
-
-/// `n` primitives (spheres, capsules, boxes) dropped into a walled bin from a grid, a pile about
-/// three deep (validation/bench_contact_rich.py's bin without its random jitter).
-fn bin(n: usize) -> String {
-    let side = ((n as f64 / 3.0).sqrt().ceil() as usize).max(2);
-    let half = 0.06 * side as f64;
-    let walls: String = [
-        (half + 0.01, 0.0, 0.01, half),
-        (-half - 0.01, 0.0, 0.01, half),
-        (0.0, half + 0.01, half, 0.01),
-        (0.0, -half - 0.01, half, 0.01),
-    ]
-    .iter()
-    .map(|(x, y, sx, sy)| format!("<geom type='box' pos='{x} {y} 0.3' size='{sx} {sy} 0.3'/>"))
-    .collect();
-    let geoms = [
-        "<geom type='sphere' size='0.04'/>",
-        "<geom type='capsule' size='0.025 0.03'/>",
-        "<geom type='box' size='0.035 0.035 0.035'/>",
-    ];
-    let bodies: String = (0..n)
-        .map(|k| {
-            let (i, j, layer) = (k % side, (k / side) % side, k / (side * side));
-            let x = -half + 0.06 + 0.12 * i as f64 + 0.003 * (k % 4) as f64;
-            let y = -half + 0.06 + 0.12 * j as f64 - 0.002 * (k % 3) as f64;
-            let z = 0.06 + 0.12 * layer as f64;
-            format!("<body pos='{x} {y} {z}' euler='{} 0 0'><freejoint/>{}</body>", 17 * k, geoms[k % 3])
-        })
-        .collect();
-    format!(
-        "<mujoco>{OPTION}<worldbody><geom type='plane' size='0 0 1'/>{walls}{bodies}</worldbody></mujoco>"
-    )
-}
 
 /// A capsule chain of `n` links on ball joints, its free root 0.3 m above the floor, lying
 /// horizontal (validation/bench_contact_rich.py's chain, shorter).
@@ -172,7 +116,7 @@ fn an_exact_1000_to_1_stack_rests_without_gaining_energy() {
 
 #[test]
 fn an_exact_bin_settles_without_gaining_energy() {
-    let model = load("bin6", &bin(6), ConstraintMode::Exact);
+    let model = load("bin6", &bin(6, true), ConstraintMode::Exact);
     let mut data = Data::new(&model);
     let r = run(&model, &mut data, 2.0, 0.5);
     eprintln!(
@@ -243,7 +187,7 @@ fn an_exact_resting_stack_solves_the_contact_laws() {
 #[test]
 fn soft_passive_scenes_do_not_gain_energy() {
     for (label, mjcf, seconds) in
-        [("ratio1000", mass_ratio(1000.0), 3.0), ("chain10", chain(10), 2.0), ("bin6", bin(6), 2.0)]
+        [("ratio1000", mass_ratio(1000.0), 3.0), ("chain10", chain(10), 2.0), ("bin6", bin(6, true), 2.0)]
     {
         let model = load(label, &mjcf, ConstraintMode::Soft);
         let mut data = Data::new(&model);

@@ -11,50 +11,7 @@ use lagrange::{Data, Model};
 
 mod common;
 
-const OPTION: &str = "<option timestep='0.002' integrator='Euler' solver='Newton' cone='pyramidal'/>";
-
-/// n unit boxes of 0.1 m stacked on a floor, 0.1 mm apart (validation/bench_contact_rich.py's stack).
-fn stack(n: usize) -> String {
-    let bodies: String = (0..n)
-        .map(|k| {
-            format!(
-                "<body pos='0 0 {:.6}'><freejoint/><geom type='box' size='0.05 0.05 0.05' mass='1'/></body>",
-                0.05 + 0.1 * k as f64 + 1e-4 * k as f64
-            )
-        })
-        .collect();
-    format!("<mujoco>{OPTION}<worldbody><geom type='plane' size='0 0 1'/>{bodies}</worldbody></mujoco>")
-}
-
-/// Ten primitives (spheres, capsules, boxes) dropped into a walled bin from a grid 6–30 cm up.
-fn bin10() -> String {
-    let half = 0.12;
-    let walls: String = [
-        (half + 0.01, 0.0, 0.01, half),
-        (-half - 0.01, 0.0, 0.01, half),
-        (0.0, half + 0.01, half, 0.01),
-        (0.0, -half - 0.01, half, 0.01),
-    ]
-    .iter()
-    .map(|(x, y, sx, sy)| format!("<geom type='box' pos='{x} {y} 0.3' size='{sx} {sy} 0.3'/>"))
-    .collect();
-    let geoms = [
-        "<geom type='sphere' size='0.04'/>",
-        "<geom type='capsule' size='0.025 0.03'/>",
-        "<geom type='box' size='0.035 0.035 0.035'/>",
-    ];
-    let bodies: String = (0..10)
-        .map(|k| {
-            let (i, j, layer) = (k % 2, (k / 2) % 2, k / 4);
-            let (x, y, z) =
-                (-half + 0.06 + 0.12 * i as f64, -half + 0.06 + 0.12 * j as f64, 0.06 + 0.12 * layer as f64);
-            format!("<body pos='{x} {y} {z}' euler='{} 0 0'><freejoint/>{}</body>", 17 * k, geoms[k % 3])
-        })
-        .collect();
-    format!(
-        "<mujoco>{OPTION}<worldbody><geom type='plane' size='0 0 1'/>{walls}{bodies}</worldbody></mujoco>"
-    )
-}
+use common::contact_scenes::{bin, stack};
 
 fn load(label: &str, mjcf: &str, mode: ConstraintMode) -> Model {
     let mut model = common::load_mjcf_text("stability", label, mjcf);
@@ -110,7 +67,7 @@ fn an_exact_stack_stays_at_rest_for_10_s_without_gaining_energy() {
 
 #[test]
 fn a_soft_bin_settles_without_gaining_energy() {
-    let model = load("bin10", &bin10(), ConstraintMode::Soft);
+    let model = load("bin10", &bin(10, false), ConstraintMode::Soft);
     let mut data = Data::new(&model);
     let (rise, kinetic) = run(&model, &mut data, 3.0);
     assert!(rise <= 1e-9, "the bin gained {rise:e} J");
@@ -121,7 +78,7 @@ fn a_soft_bin_settles_without_gaining_energy() {
 /// tips over (5e-3 J at 2 s, 8e-3 J at 4 s, no energy rise) and everything rests by 5 s (4e-17 J).
 #[test]
 fn an_exact_bin_settles_without_gaining_energy() {
-    let model = load("bin10", &bin10(), ConstraintMode::Exact);
+    let model = load("bin10", &bin(10, false), ConstraintMode::Exact);
     let mut data = Data::new(&model);
     let (rise, kinetic) = run(&model, &mut data, 5.0);
     assert!(rise <= 1e-9, "the bin gained {rise:e} J");

@@ -5,6 +5,8 @@
 //! Each test binary uses a different subset of these helpers, hence the `dead_code` allowance.
 #![allow(dead_code)]
 
+pub mod contact_scenes;
+
 use lagrange::integrate::{IntegratorKind, State};
 use lagrange::io::compile;
 use lagrange::io::{load, LoadOptions};
