@@ -25,7 +25,7 @@
 //! themselves move nothing — or after the iteration limit; the last change is the residual. At the acceleration level it starts from the previous solve's
 //! forces when the rows are the same (warm start).
 
-use super::dense::solve_psd;
+use super::dense::{lu_solve, solve_psd};
 use super::ExactWork;
 use crate::model::{Data, EfcType, Model};
 
@@ -116,6 +116,7 @@ pub(crate) fn solve_coulomb(
     for i in 0..n {
         data.exact.rhs[i] = if warm { data.exact.warm[i] } else { 0.0 };
     }
+    data.exact.nu.as_mut_slice()[..n].fill(0.0);
     let mut change = 0.0;
     let mut iterations = 0;
     data.efc_converged = false;
@@ -190,7 +191,7 @@ pub(crate) fn solve_coulomb(
         }
         // Once the iterate has settled which rows stick, slide or lift, solve that active set
         // exactly; accepted only if every row's law then holds.
-        if (iterations == POLISH_AFTER || iterations == limit)
+        if ((iterations >= POLISH_AFTER && iterations.is_power_of_two()) || iterations == limit)
             && !data.efc_safe_friction
             && polish(model, data, level)
         {
@@ -377,7 +378,8 @@ fn contact_block(data: &mut Data, i: usize, len: usize, level: Level) -> f64 {
             // Maximal dissipation against the slip velocity u.
             max_dissipation(lambda_n, &friction, &data.efc_vel.as_slice()[i + 1..i + len], &mut new[..nf]);
         } else {
-            cone_solve(data, i, len, &friction, lambda_n, &spent[..nf], &mut new[..nf]);
+            let nu = cone_solve(data, i, len, &friction, lambda_n, &spent[..nf], &mut new[..nf]);
+            data.exact.nu[i] = nu;
         }
     }
     for k in 1..len {
@@ -400,7 +402,8 @@ fn max_dissipation(lambda_n: f64, friction: &[f64; 5], slip: &[f64], out: &mut [
 
 /// The friction forces `out` of the contact block at row i minimising ½ λᵀ A_ff λ − gᵀ λ with
 /// λ + `spent` in the elliptic cone of radius `lambda_n` (`spent` = 0 at the acceleration level),
-/// g = b_f − A_f,· λ without the block's own friction.
+/// g = b_f − A_f,· λ without the block's own friction. Returns the shift ν of the secular equation
+/// (0 when the stick solve lies inside the cone).
 #[allow(clippy::too_many_arguments)]
 fn cone_solve(
     data: &Data,
@@ -410,7 +413,7 @@ fn cone_solve(
     lambda_n: f64,
     spent: &[f64],
     out: &mut [f64],
-) {
+) -> f64 {
     let n = data.nefc;
     // Scaled problem in y_k = λ_k / μ_k over the friction rows with μ_k > 0.
     let mut idx = [0usize; MAX_DIM];
@@ -423,7 +426,7 @@ fn cone_solve(
     }
     out.fill(0.0);
     if m == 0 {
-        return;
+        return 0.0;
     }
     let mut a = [[0.0; MAX_DIM]; MAX_DIM];
     let mut g = [0.0; MAX_DIM];
@@ -441,11 +444,21 @@ fn cone_solve(
     }
     let mut y = [0.0; MAX_DIM];
     let trace: f64 = (0..m).map(|p| a[p][p]).sum();
-    let inside = shifted_solve(&a, m, 0.0, &g, &mut y, None)
-        && (0..m).map(|p| y[p] * y[p]).sum::<f64>().sqrt() <= lambda_n;
+    let regular = shifted_solve(&a, m, 0.0, &g, &mut y, None);
+    let inside = regular && (0..m).map(|p| y[p] * y[p]).sum::<f64>().sqrt() <= lambda_n;
+    let mut nu = 0.0;
     if !inside {
-        // Newton on 1/R − 1/‖y(ν)‖ = 0, ν ≥ 0 (monotone from below).
-        let mut nu = if shifted_solve(&a, m, 0.0, &g, &mut y, None) { 0.0 } else { 1e-14 * trace };
+        // Newton on 1/R − 1/‖y(ν)‖ = 0, ν ≥ 0 (monotone from below; from above, the first step
+        // lands below the root, or at 0), started from this contact's ν of the last sweep
+        // (`exact.nu`): a converging iteration changes the block's problem little.
+        let warm = data.exact.nu[i];
+        nu = if warm > 0.0 && warm.is_finite() {
+            warm
+        } else if regular {
+            0.0
+        } else {
+            1e-14 * trace
+        };
         let mut z = [0.0; MAX_DIM];
         for _ in 0..60 {
             if !shifted_solve(&a, m, nu, &g, &mut y, Some(&mut z)) {
@@ -477,6 +490,7 @@ fn cone_solve(
     for (o, s) in out.iter_mut().zip(spent) {
         *o -= s;
     }
+    nu
 }
 
 /// Solves (A + νI) y = g (m × m, symmetric) by Cholesky; with `z`, also z = L⁻¹ y. False if the
@@ -586,6 +600,9 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
                         continue;
                     }
                     if y2.sqrt() >= radius * (1.0 - TOL) && radius > 0.0 {
+                        // At the velocity level the friction's direction is the post-step slip,
+                        // which the solve itself decides: fixed-point rounds on it diverge near
+                        // sticking (measured on go1), so the iteration goes on.
                         if level != Level::Acceleration {
                             return false;
                         }
@@ -607,8 +624,11 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     }
     // Reduced system A_FF λ_F = b_F − A_F,X λ_X, the fixed forces λ_X taken from the candidate
     // (efc_lambda_prev; efc_rhs keeps the iterate if the polish fails). A sliding contact's friction
-    // is c · λ_n with c = −μ² u / ‖μ ∘ u‖ from its slip u: rounds update it from the new λ_n until
-    // it settles (a contraction for μ < 1 coupling).
+    // is d · λ_n with d = −μ² u / ‖μ ∘ u‖ from its slip u, substituted into the system (then not
+    // symmetric: LU, [`solve_substituted`]); a contact moving at the acceleration level has its
+    // slip fixed, so one solve is exact; for one starting to slip, u is the slip acceleration of
+    // the solution and rounds update d until it settles. Friction-loss rows kept at a bound are
+    // set exactly on it.
     let k = data.exact.active.len();
     if k == 0 {
         return false;
@@ -621,8 +641,34 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     for j in 0..n {
         data.exact.lambda_prev[j] = data.exact.rhs[j];
     }
+    snap_friction_dof_bounds(model, data, level);
     let mut last_change = f64::INFINITY;
     for round in 0..POLISH_ROUNDS {
+        // Slipping contacts: their friction, direction times the cone's radius, substituted into
+        // the normal's column (one non-symmetric solve); the symmetric solve with their friction
+        // fixed at the candidate's when that system is inconsistent.
+        if any_sliding {
+            slip_directions(data, level);
+            if solve_substituted(data, level) {
+                let change = update_sliding_friction(data, level);
+                let scale = 1.0 + (0..n).map(|j| data.exact.lambda_prev[j].abs()).fold(0.0, f64::max);
+                if change <= 1e-15 * scale {
+                    break;
+                }
+                if round == POLISH_ROUNDS - 1 {
+                    return false;
+                }
+                let rate = change / last_change;
+                if round > 0 {
+                    let needed = (1e-15 * scale / change).ln() / rate.ln();
+                    if rate >= 1.0 || needed.is_nan() || needed > f64::from(POLISH_ROUNDS - 1 - round) {
+                        return false;
+                    }
+                }
+                last_change = change;
+                continue;
+            }
+        }
         let Data {
             efc_force,
             exact:
@@ -658,7 +704,7 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         if !any_sliding {
             break;
         }
-        let change = update_sliding_friction(data);
+        let change = update_sliding_friction(data, level);
         let scale = 1.0 + (0..n).map(|j| data.exact.lambda_prev[j].abs()).fold(0.0, f64::max);
         if change <= 1e-15 * scale {
             break;
@@ -748,8 +794,9 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
 
 /// Sets each slipping contact's friction rows in the candidate (`efc_lambda_prev`) to the
 /// maximal-dissipation force of its slip (velocity, or acceleration for a contact starting to
-/// slip) for the candidate's normal force; returns the largest change.
-fn update_sliding_friction(data: &mut Data) -> f64 {
+/// slip; the post-step velocity at the velocity level) for the candidate's cone radius; returns
+/// the largest change.
+fn update_sliding_friction(data: &mut Data, level: Level) -> f64 {
     let n = data.nefc;
     let mut change = 0.0f64;
     let mut i = 0;
@@ -757,29 +804,179 @@ fn update_sliding_friction(data: &mut Data) -> f64 {
         let len = data.efc_block_len(i);
         if data.exact.slipping[i] {
             let friction = data.contacts[data.efc_id[i]].friction;
-            let lambda_n = data.exact.lambda_prev[i].max(0.0);
-            // The slip velocity, or for a contact starting to slip its slip acceleration w_f.
-            let moving =
-                (1..len).any(|k| data.efc_vel[i + k].abs() > SLIP_VELOCITY) && !data.efc_frozen_at_rest(i);
+            let (radius, spent) = candidate_cone(data, i, len, level);
             let mut slip = [0.0; MAX_DIM];
-            for k in 1..len {
-                slip[k - 1] = if moving {
-                    data.efc_vel[i + k]
-                } else {
-                    (0..n).map(|j| data.exact.delassus[(j, i + k)] * data.exact.lambda_prev[j]).sum::<f64>()
-                        - data.efc_force[i + k]
-                };
-            }
+            slip_of(data, i, len, level, &mut slip);
             let mut new = [0.0; MAX_DIM];
-            max_dissipation(lambda_n, &friction, &slip[..len - 1], &mut new[..len - 1]);
+            max_dissipation(radius, &friction, &slip[..len - 1], &mut new[..len - 1]);
             for k in 1..len {
-                change = change.max((new[k - 1] - data.exact.lambda_prev[i + k]).abs());
-                data.exact.lambda_prev[i + k] = new[k - 1];
+                let f = new[k - 1] - spent[k - 1];
+                change = change.max((f - data.exact.lambda_prev[i + k]).abs());
+                data.exact.lambda_prev[i + k] = f;
             }
         }
         i += len;
     }
     change
+}
+
+/// The slip of slipping contact i in the polish: its velocity when it moves (acceleration level),
+/// else its friction rows' w = A λ − b of the candidate (the slip acceleration, or at the
+/// velocity level the post-step slip velocity).
+fn slip_of(data: &Data, i: usize, len: usize, level: Level, slip: &mut [f64; MAX_DIM]) {
+    let n = data.nefc;
+    let moving = level == Level::Acceleration
+        && (1..len).any(|k| data.efc_vel[i + k].abs() > SLIP_VELOCITY)
+        && !data.efc_frozen_at_rest(i);
+    for k in 1..len {
+        slip[k - 1] = if moving {
+            data.efc_vel[i + k]
+        } else {
+            (0..n).map(|j| data.exact.delassus[(j, i + k)] * data.exact.lambda_prev[j]).sum::<f64>()
+                - data.efc_force[i + k]
+        };
+    }
+}
+
+/// The cone of slipping contact i for the candidate's normal force: its radius and the friction
+/// the step already spent (velocity level; zero at the acceleration level).
+fn candidate_cone(data: &Data, i: usize, len: usize, level: Level) -> (f64, [f64; MAX_DIM]) {
+    let mut spent = [0.0; MAX_DIM];
+    let l = data.exact.lambda_prev[i].max(0.0);
+    let radius = match level {
+        Level::Acceleration => l,
+        Level::Velocity { dt } => {
+            for k in 1..len {
+                spent[k - 1] = dt * data.exact.previous[i + k];
+            }
+            l + dt * data.exact.previous[i].max(0.0)
+        }
+    };
+    (radius, spent)
+}
+
+/// Each slipping contact's friction per unit cone radius, −μ_k² u_k / ‖μ ∘ u‖ from the
+/// candidate's slip u, into `exact.slip_dir` at its friction rows.
+fn slip_directions(data: &mut Data, level: Level) {
+    let n = data.nefc;
+    let mut i = 0;
+    while i < n {
+        let len = data.efc_block_len(i);
+        if data.exact.slipping[i] {
+            let friction = data.contacts[data.efc_id[i]].friction;
+            let mut slip = [0.0; MAX_DIM];
+            slip_of(data, i, len, level, &mut slip);
+            let mut dir = [0.0; MAX_DIM];
+            max_dissipation(1.0, &friction, &slip[..len - 1], &mut dir[..len - 1]);
+            for k in 1..len {
+                data.exact.slip_dir[i + k] = dir[k - 1];
+            }
+        }
+        i += len;
+    }
+}
+
+/// The polish's reduced system with each slipping contact's friction λ_f = d (λ_n + c) − s
+/// substituted (d from [`slip_directions`]; c the normal impulse the step already spent and s
+/// its friction, velocity level; both 0 at the acceleration level): the rows of `exact.active`
+/// solved by LU, the candidate's free rows and slipping friction rows set. False (the candidate
+/// untouched) when the system is singular.
+fn solve_substituted(data: &mut Data, level: Level) -> bool {
+    let n = data.nefc;
+    let k = data.exact.active.len();
+    let Data { efc_force, efc_type, efc_id, exact, .. } = &mut *data;
+    let ExactWork {
+        delassus,
+        sub,
+        sub_rhs,
+        active,
+        in_active,
+        lambda_prev,
+        slipping,
+        slip_dir,
+        previous,
+        pivots,
+        ..
+    } = exact;
+    // Per row: whether it is a friction row of a slipping contact (its force substituted).
+    // Rows per block, as `Data::efc_block_len`.
+    let block = |i: usize| {
+        if efc_type[i] != EfcType::ContactElliptic {
+            return 1;
+        }
+        (i + 1..n).take_while(|&q| efc_type[q] == efc_type[i] && efc_id[q] == efc_id[i]).count() + 1
+    };
+    let dt = match level {
+        Level::Acceleration => 0.0,
+        Level::Velocity { dt } => dt,
+    };
+    for (a, &r) in active.iter().enumerate() {
+        let mut rhs = efc_force[r];
+        for c in 0..k {
+            sub[(a, c)] = delassus[(active[c], r)];
+        }
+        let mut j = 0;
+        while j < n {
+            let len = block(j);
+            if efc_type[j] == EfcType::ContactElliptic && slipping[j] {
+                let c0 = dt * previous[j].max(0.0);
+                let mut coupling = 0.0;
+                for q in 1..len {
+                    let arf = delassus[(j + q, r)];
+                    coupling += arf * slip_dir[j + q];
+                    rhs -= arf * (slip_dir[j + q] * c0 - dt * previous[j + q]);
+                }
+                let col = active.iter().position(|&x| x == j).expect("a slipping contact's normal is active");
+                sub[(a, col)] += coupling;
+            } else {
+                for q in j..j + len {
+                    if !in_active[q] {
+                        rhs -= delassus[(q, r)] * lambda_prev[q];
+                    }
+                }
+            }
+            j += len;
+        }
+        sub_rhs[a] = rhs;
+    }
+    if !lu_solve(sub, &mut sub_rhs.as_mut_slice()[..k], &mut pivots[..2 * k]) {
+        return false;
+    }
+    for (a, &r) in active.iter().enumerate() {
+        lambda_prev[r] = sub_rhs[a];
+    }
+    let mut j = 0;
+    while j < n {
+        let len = block(j);
+        if efc_type[j] == EfcType::ContactElliptic && slipping[j] {
+            let c0 = dt * previous[j].max(0.0);
+            for q in 1..len {
+                lambda_prev[j + q] = slip_dir[j + q] * (lambda_prev[j] + c0) - dt * previous[j + q];
+            }
+        }
+        j += len;
+    }
+    true
+}
+
+/// Friction-loss rows the polish keeps at a bound (not in `exact.active`, not sliding) exactly at
+/// that bound in the candidate: the iterate reaches it only to within the classification's
+/// tolerance.
+fn snap_friction_dof_bounds(model: &Model, data: &mut Data, level: Level) {
+    for i in 0..data.nefc {
+        if data.efc_type[i] != EfcType::FrictionDof || data.exact.in_active[i] {
+            continue;
+        }
+        let sliding = level == Level::Acceleration
+            && data.efc_vel[i].abs() > SLIP_VELOCITY
+            && !data.efc_frozen_at_rest(i);
+        if sliding {
+            continue;
+        }
+        let (lo, hi) = friction_dof_bounds(model, data, i, level);
+        let l = data.exact.lambda_prev[i];
+        data.exact.lambda_prev[i] = if (l - lo).abs() <= (l - hi).abs() { lo } else { hi };
+    }
 }
 
 /// The box of a friction-loss row's force: ±f at the acceleration level; at the velocity level

@@ -37,6 +37,82 @@ pub(crate) fn solve_psd(
     min_norm_solve(a, n, b, work, vec, scale * RANK_TOLERANCE)
 }
 
+/// Solves the general (non-symmetric) `A x = b` for the top-left n × n block of `a`, n =
+/// `b.len()`, by LU factorization with complete pivoting (Golub & Van Loan, *Matrix
+/// Computations*, 4th ed., §3.4.8), in place: `a` holds the factors and `b` the solution on
+/// return; `piv` (at least 2n) is scratch. A rank-deficient system (redundant rows) gets a basic
+/// solution: the unknowns beyond the numerical rank (pivots at most `RANK_TOLERANCE` times the
+/// largest entry) are zero. False, with `b` unspecified, when the system is inconsistent (its
+/// eliminated right-hand side beyond the rank is not round-off) or not finite.
+pub(crate) fn lu_solve(a: &mut DMatrix<f64>, b: &mut [f64], piv: &mut [usize]) -> bool {
+    let n = b.len();
+    let (rows, cols) = piv[..2 * n].split_at_mut(n);
+    let mut scale = 0.0f64;
+    for j in 0..n {
+        for i in 0..n {
+            scale = scale.max(a[(i, j)].abs());
+        }
+    }
+    if !(scale > 0.0 && scale.is_finite()) {
+        return false;
+    }
+    let tol = scale * RANK_TOLERANCE;
+    let b_scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut rank = n;
+    for k in 0..n {
+        let (mut p, mut q, mut best) = (k, k, 0.0f64);
+        for j in k..n {
+            for i in k..n {
+                if a[(i, j)].abs() > best {
+                    (p, q, best) = (i, j, a[(i, j)].abs());
+                }
+            }
+        }
+        if best <= tol {
+            rank = k;
+            break;
+        }
+        rows[k] = p;
+        cols[k] = q;
+        a.swap_rows(p, k);
+        a.swap_columns(q, k);
+        b.swap(p, k);
+        let pivot = a[(k, k)];
+        for i in k + 1..n {
+            a[(i, k)] /= pivot;
+        }
+        for j in k + 1..n {
+            let akj = a[(k, j)];
+            if akj != 0.0 {
+                for i in k + 1..n {
+                    a[(i, j)] -= a[(i, k)] * akj;
+                }
+            }
+        }
+        let bk = b[k];
+        for i in k + 1..n {
+            b[i] -= a[(i, k)] * bk;
+        }
+    }
+    // Consistency of the equations beyond the rank.
+    if b[rank..].iter().any(|x| x.abs() > 1e-9 * b_scale) {
+        return false;
+    }
+    b[rank..].fill(0.0);
+    for k in (0..rank).rev() {
+        b[k] /= a[(k, k)];
+        let bk = b[k];
+        for i in 0..k {
+            b[i] -= a[(i, k)] * bk;
+        }
+    }
+    // Undo the column permutation (the unknowns were swapped as the columns were).
+    for k in (0..rank).rev() {
+        b.swap(k, cols[k]);
+    }
+    b.iter().all(|x| x.is_finite())
+}
+
 /// Lower Cholesky factor of A into `l`; false if a pivot is not above `tol`. Only A's lower
 /// triangle is read.
 ///

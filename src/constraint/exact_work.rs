@@ -43,6 +43,14 @@ pub(crate) struct ExactWork {
     /// Per row, the Coulomb solve's polish: a contact (at its normal row) whose friction is on
     /// its cone, slipping or starting to.
     pub slipping: Vec<bool>,
+    /// Per friction row of a slipping contact, during the polish: its force per unit of the
+    /// cone's radius, −μ_k² u_k / ‖μ ∘ u‖ (u the slip), the direction the polish substitutes.
+    pub slip_dir: DVector<f64>,
+    /// Per contact (at its normal row), the shift ν of its last cone solve's secular equation
+    /// (the Newton start of the next sweep's).
+    pub nu: DVector<f64>,
+    /// Row and column pivots of the polish's LU factorization.
+    pub pivots: Vec<usize>,
     /// The ADMM solve's per-row buffers ([`super::admm`]).
     pub admm: super::admm::AdmmWork,
     /// Jᵀ, nv × nefc (columns 0..nefc used): each row of J contiguous, for the Delassus products.
@@ -77,6 +85,9 @@ impl ExactWork {
             lambda_prev: DVector::zeros(nefc),
             pressing: vec![false; nefc],
             slipping: vec![false; nefc],
+            slip_dir: DVector::zeros(nefc),
+            nu: DVector::zeros(nefc),
+            pivots: vec![0; 2 * nefc],
             admm: Default::default(),
             jt: DMatrix::zeros(nv, nefc),
             spans: vec![(0, 0); nefc],
@@ -103,13 +114,21 @@ impl ExactWork {
 
     /// The per-row vectors for `nefc` rows.
     pub fn grow_vectors(&mut self, nefc: usize) {
-        for v in [&mut self.rhs, &mut self.eig, &mut self.sub_rhs, &mut self.lambda_prev, &mut self.previous]
-        {
+        for v in [
+            &mut self.rhs,
+            &mut self.eig,
+            &mut self.sub_rhs,
+            &mut self.lambda_prev,
+            &mut self.previous,
+            &mut self.slip_dir,
+            &mut self.nu,
+        ] {
             *v = DVector::zeros(nefc);
         }
         self.warm.resize_vertically_mut(nefc, 0.0);
         self.pressing.resize(nefc, false);
         self.slipping.resize(nefc, false);
+        self.pivots.resize(2 * nefc, 0);
         self.in_active.resize(nefc, false);
         self.spans.resize(nefc, (0, 0));
         self.admm.grow(nefc);
