@@ -46,25 +46,27 @@ pub(crate) fn solve_psd(
 /// eliminated right-hand side beyond the rank is not round-off) or not finite.
 pub(crate) fn lu_solve(a: &mut DMatrix<f64>, b: &mut [f64], piv: &mut [usize]) -> bool {
     let n = b.len();
-    let (rows, cols) = piv[..2 * n].split_at_mut(n);
+    let stride = a.nrows();
+    let m = a.as_mut_slice();
+    let (_rows, cols) = piv[..2 * n].split_at_mut(n);
     let mut scale = 0.0f64;
     for j in 0..n {
-        for i in 0..n {
-            scale = scale.max(a[(i, j)].abs());
+        for x in &m[j * stride..j * stride + n] {
+            scale = scale.max(x.abs());
         }
     }
     if !(scale > 0.0 && scale.is_finite()) {
         return false;
     }
     let tol = scale * RANK_TOLERANCE;
-    let b_scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let b_scale = b.iter().fold(0.0f64, |acc, x| acc.max(x.abs()));
     let mut rank = n;
     for k in 0..n {
         let (mut p, mut q, mut best) = (k, k, 0.0f64);
         for j in k..n {
-            for i in k..n {
-                if a[(i, j)].abs() > best {
-                    (p, q, best) = (i, j, a[(i, j)].abs());
+            for (i, x) in m[j * stride + k..j * stride + n].iter().enumerate() {
+                if x.abs() > best {
+                    (p, q, best) = (k + i, j, x.abs());
                 }
             }
         }
@@ -72,26 +74,36 @@ pub(crate) fn lu_solve(a: &mut DMatrix<f64>, b: &mut [f64], piv: &mut [usize]) -
             rank = k;
             break;
         }
-        rows[k] = p;
         cols[k] = q;
-        a.swap_rows(p, k);
-        a.swap_columns(q, k);
-        b.swap(p, k);
-        let pivot = a[(k, k)];
-        for i in k + 1..n {
-            a[(i, k)] /= pivot;
+        if p != k {
+            for j in 0..n {
+                m.swap(p + j * stride, k + j * stride);
+            }
+            b.swap(p, k);
         }
-        for j in k + 1..n {
-            let akj = a[(k, j)];
+        if q != k {
+            for i in 0..n {
+                m.swap(i + q * stride, i + k * stride);
+            }
+        }
+        let pivot = m[k + k * stride];
+        for x in &mut m[k * stride + k + 1..k * stride + n] {
+            *x /= pivot;
+        }
+        let (head, tail) = m.split_at_mut((k + 1) * stride);
+        let col_k = &head[k * stride + k + 1..k * stride + n];
+        for j in 0..n - k - 1 {
+            let col_j = &mut tail[j * stride..j * stride + n];
+            let akj = col_j[k];
             if akj != 0.0 {
-                for i in k + 1..n {
-                    a[(i, j)] -= a[(i, k)] * akj;
+                for (x, l) in col_j[k + 1..n].iter_mut().zip(col_k) {
+                    *x -= l * akj;
                 }
             }
         }
         let bk = b[k];
-        for i in k + 1..n {
-            b[i] -= a[(i, k)] * bk;
+        for (x, l) in b[k + 1..n].iter_mut().zip(col_k) {
+            *x -= l * bk;
         }
     }
     // Consistency of the equations beyond the rank.
@@ -100,10 +112,10 @@ pub(crate) fn lu_solve(a: &mut DMatrix<f64>, b: &mut [f64], piv: &mut [usize]) -
     }
     b[rank..].fill(0.0);
     for k in (0..rank).rev() {
-        b[k] /= a[(k, k)];
+        b[k] /= m[k + k * stride];
         let bk = b[k];
-        for i in 0..k {
-            b[i] -= a[(i, k)] * bk;
+        for (x, u) in b[..k].iter_mut().zip(&m[k * stride..k * stride + k]) {
+            *x -= u * bk;
         }
     }
     // Undo the column permutation (the unknowns were swapped as the columns were).

@@ -49,6 +49,12 @@ pub(crate) struct ExactWork {
     /// Per contact (at its normal row), the shift ν of its last cone solve's secular equation
     /// (the Newton start of the next sweep's).
     pub nu: DVector<f64>,
+    /// The polish's Newton unknowns (its active rows, then the friction rows of its slipping
+    /// contacts), per unknown the normal row of its contact (`usize::MAX` for an active row), and
+    /// per row its place among the unknowns (`usize::MAX` when fixed).
+    pub newton_rows: Vec<usize>,
+    pub newton_normal: Vec<usize>,
+    pub newton_pos: Vec<usize>,
     /// Row and column pivots of the polish's LU factorization.
     pub pivots: Vec<usize>,
     /// The ADMM solve's per-row buffers ([`super::admm`]).
@@ -87,6 +93,9 @@ impl ExactWork {
             slipping: vec![false; nefc],
             slip_dir: DVector::zeros(nefc),
             nu: DVector::zeros(nefc),
+            newton_rows: Vec::with_capacity(nefc),
+            newton_normal: Vec::with_capacity(nefc),
+            newton_pos: vec![usize::MAX; nefc],
             pivots: vec![0; 2 * nefc],
             admm: Default::default(),
             jt: DMatrix::zeros(nv, nefc),
@@ -129,6 +138,9 @@ impl ExactWork {
         self.pressing.resize(nefc, false);
         self.slipping.resize(nefc, false);
         self.pivots.resize(2 * nefc, 0);
+        self.newton_pos.resize(nefc, usize::MAX);
+        self.newton_rows.reserve(nefc.saturating_sub(self.newton_rows.len()));
+        self.newton_normal.reserve(nefc.saturating_sub(self.newton_normal.len()));
         self.in_active.resize(nefc, false);
         self.spans.resize(nefc, (0, 0));
         self.admm.grow(nefc);
