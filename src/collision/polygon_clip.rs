@@ -10,8 +10,8 @@
 //! - a side that keeps every point only turns the polygon by one: such sides are counted and the
 //!   turns applied (as an index offset) at the next side that cuts, and at the end;
 //! - in a side that cuts, the runs of kept points between the crossings are copied as slices;
-//! - when the polygon being clipped is convex about the face's normal (checked once, with a
-//!   margin far above rounding), the points a plane removes are one run of the polygon: a pass
+//! - when the polygon being clipped is convex about the face's normal (checked once, when
+//!   first needed, with a margin far above rounding), the points a plane removes are one run of the polygon: a pass
 //!   tests the crossing point the previous pass left beyond the face's next vertex and, when it is
 //!   outside, walks from it to the two ends of the run — the other points are inside. Otherwise
 //!   (no such point outside, or a polygon not certified convex) every point is tested.
@@ -52,9 +52,9 @@ fn strictly_convex_about(poly: &[Vec3], n: &Vec3) -> bool {
         let (p, q, r) = (poly[i], poly[(i + 1) % np], poly[(i + 2) % np]);
         let (e1, e2) = (q - p, r - q);
         let turn = e1.cross(&e2).dot(n);
-        let bound = CONVEX_SINE * e1.norm() * e2.norm();
-        // A NaN turn is not convex either.
-        if turn.abs().partial_cmp(&bound) != Some(std::cmp::Ordering::Greater) {
+        // |turn| > sine·|e1|·|e2|, squared; a NaN turn is not convex either.
+        let bound = CONVEX_SINE * CONVEX_SINE * e1.norm_squared() * e2.norm_squared();
+        if (turn * turn).partial_cmp(&bound) != Some(std::cmp::Ordering::Greater) {
             return false;
         }
         if sign == 0.0 {
@@ -85,7 +85,9 @@ fn strictly_convex_about(poly: &[Vec3], n: &Vec3) -> bool {
 pub fn clip_by_face_sides(face: &[Vec3], n: &Vec3, poly: &mut Vec<Vec3>, scratch: &mut ClipScratch) {
     let m = face.len();
     let ClipScratch { next, flags } = scratch;
-    let convex = strictly_convex_about(poly, n);
+    // Whether the polygon is strictly convex, found when first needed (a clipped convex polygon
+    // stays convex).
+    let mut convex: Option<bool> = None;
     // Physical index of the crossing point the last cut left farthest along its side.
     let mut hint: Option<usize> = None;
     // Pending turns: the polygon as the passes see it starts at poly[turns % len].
@@ -111,7 +113,9 @@ pub fn clip_by_face_sides(face: &[Vec3], n: &Vec3, poly: &mut Vec<Vec3>, scratch
             let t = (pd - pn.dot(&p)) / den;
             (0.0..=1.0).contains(&t).then(|| p + pq * t)
         };
-        if let Some(h) = hint.filter(|&h| convex && !inside(&poly[h])) {
+        let walk = hint
+            .filter(|&h| !inside(&poly[h]) && *convex.get_or_insert_with(|| strictly_convex_about(poly, n)));
+        if let Some(h) = walk {
             // The run s..=e of outside points through h (its ends found by walking from h).
             let (prev, succ) = (
                 |i: usize| if i == 0 { np - 1 } else { i - 1 },
