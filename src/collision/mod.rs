@@ -43,6 +43,7 @@ pub mod hfield_convex;
 pub mod hull_support;
 pub mod inside;
 pub mod mesh;
+pub mod mesh_graph;
 pub mod multiccd;
 pub mod obb;
 pub mod plane;
