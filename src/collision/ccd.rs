@@ -127,7 +127,7 @@ impl<'a> CcdObj<'a> {
                 s
             }
             ConvexShape::Hull(h) => {
-                let points = h.polyhedron().points();
+                let points = h.points();
                 let d = parry3d_f64::math::Vector::new(local.x, local.y, local.z);
                 let i = if points.len() < HILLCLIMB_MIN {
                     // Exhaustive, from the cached vertex (ties keep the earlier best).

@@ -93,6 +93,9 @@ impl MeshGraph {
         if scaled.len() != n || placed.len() != n {
             return Err(MeshGraphError::BadInput("vertex lists of different lengths".to_string()));
         }
+        if let Some(reason) = degenerate(file) {
+            return Err(MeshGraphError::BadInput(reason));
+        }
         let points: Vec<[f64; 3]> = file.iter().map(|v| [v.x, v.y, v.z]).collect();
         let g = qhull_src::hull_graph(&points, maxhullvert).map_err(MeshGraphError::Qhull)?;
         let nv = g.vert_globalid.len();
@@ -173,6 +176,48 @@ impl MeshGraph {
     pub fn neighbours(&self, v: usize) -> &[u32] {
         &self.adj[self.adj_start[v] as usize..self.adj_start[v + 1] as usize]
     }
+}
+
+/// Why `points` span no volume, by MuJoCo's checks before it runs qhull (`MakeGraph`: a second
+/// point apart from the first, a third off their line, a fourth off their plane, each beyond
+/// `mjMINVAL` = 1e-15); None when they do. Fewer than 4 distinct points count as degenerate too
+/// (MuJoCo builds no hull for fewer than 4 vertices).
+fn degenerate(points: &[Vec3]) -> Option<String> {
+    const MINVAL: f64 = 1e-15;
+    let mut distinct: Vec<[u64; 3]> =
+        points.iter().map(|v| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]).collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    if distinct.len() < 4 {
+        return Some(format!("it has {} distinct vertices, fewer than the 4 of a solid", distinct.len()));
+    }
+    if points.iter().any(|v| !v.iter().all(|x| x.is_finite())) {
+        return Some("a vertex is not finite".to_string());
+    }
+    let p0 = points[0];
+    let Some(i1) = (1..points.len()).find(|&i| (points[i] - p0).norm() > MINVAL) else {
+        return Some("all vertices are at one point".to_string());
+    };
+    let edge1 = points[i1] - p0;
+    let len1 = edge1.norm();
+    let normal = (1..points.len()).filter(|&i| i != i1).find_map(|i| {
+        let edge2 = points[i] - p0;
+        let len2 = edge2.norm();
+        if len2 < MINVAL {
+            return None;
+        }
+        let n = edge1.cross(&edge2);
+        let norm = n.norm();
+        (norm > MINVAL * len1 * len2).then(|| n / norm)
+    });
+    let Some(normal) = normal else {
+        return Some("all vertices are on one line".to_string());
+    };
+    let d = normal.dot(&p0);
+    if !points.iter().any(|p| (normal.dot(p) - d).abs() > MINVAL * len1) {
+        return Some("all vertices are in one plane".to_string());
+    }
+    None
 }
 
 /// The unit normal of triangle (a, b, c) (`mjuu_makenormal`: (1, 0, 0) when degenerate).
