@@ -22,6 +22,9 @@ pub struct HullSupport {
     /// Per grid direction (x, y, z in {−1, 0, 1}, index 9x + 3y + z after adding 1 to each), the
     /// vertex farthest along it: the climb's start.
     extrema: [u32; 27],
+    /// The hull vertices in the order of the mesh's vertex list (ascending `globalid`): the order
+    /// MuJoCo's exhaustive support (`mjc_meshSupport`) scans them in, which decides ties.
+    scan_order: Vec<u32>,
 }
 
 impl HullSupport {
@@ -34,7 +37,9 @@ impl HullSupport {
             let dir = Vector::new((k / 9) as f64 - 1.0, ((k / 3) % 3) as f64 - 1.0, (k % 3) as f64 - 1.0);
             *slot = scan(&points, dir) as u32;
         }
-        Self { graph, points, extrema }
+        let mut scan_order: Vec<u32> = (0..points.len() as u32).collect();
+        scan_order.sort_by_key(|&i| graph.globalid[i as usize]);
+        Self { graph, points, extrema, scan_order }
     }
 
     /// The hull's graph and face polygons.
@@ -45,6 +50,11 @@ impl HullSupport {
     /// The hull's vertices (geom frame).
     pub fn points(&self) -> &[Vector] {
         &self.points
+    }
+
+    /// The hull vertices in the mesh's vertex-list order (see the field).
+    pub fn scan_order(&self) -> &[u32] {
+        &self.scan_order
     }
 
     /// The neighbours of vertex `v` along the hull's edges.

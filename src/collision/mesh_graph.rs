@@ -35,6 +35,8 @@ pub struct MeshGraph {
     pub vertices: Vec<Vec3>,
     /// Per hull vertex, its index among the mesh's vertices (MuJoCo's `vert_globalid`).
     pub globalid: Vec<u32>,
+    /// The number of the mesh's vertices (MuJoCo's `mesh_vertnum`: hull vertices and the rest).
+    pub nvert: usize,
     /// Vertex i's neighbours are `adj[adj_start[i]..adj_start[i + 1]]`, in MuJoCo's order.
     pub adj_start: Vec<u32>,
     /// The neighbour lists (see `adj_start`).
@@ -146,6 +148,7 @@ impl MeshGraph {
         Ok(Self {
             vertices,
             globalid: g.vert_globalid,
+            nvert: n,
             adj_start,
             adj,
             faces,
