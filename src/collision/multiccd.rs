@@ -71,7 +71,7 @@ thread_local! {
 /// A polytope geom: a box (half-extents) or a mesh's hull.
 enum Poly<'a> {
     Cuboid(Vec3),
-    Hull(&'a parry3d_f64::shape::ConvexPolyhedron, &'a super::hull_support::HullSupport),
+    Hull(&'a super::hull_support::HullSupport),
 }
 
 impl<'a> Poly<'a> {
@@ -81,7 +81,7 @@ impl<'a> Poly<'a> {
                 let h = c.half_extents;
                 Some(Poly::Cuboid(Vec3::new(h.x, h.y, h.z)))
             }
-            ConvexShape::Hull(s) => Some(Poly::Hull(s.polyhedron(), s)),
+            ConvexShape::Hull(s) => Some(Poly::Hull(s)),
             _ => None,
         }
     }
@@ -89,7 +89,7 @@ impl<'a> Poly<'a> {
     fn nvert(&self) -> usize {
         match self {
             Poly::Cuboid(_) => 8,
-            Poly::Hull(p, _) => p.points().len(),
+            Poly::Hull(s) => s.points().len(),
         }
     }
 
@@ -101,8 +101,8 @@ impl<'a> Poly<'a> {
                 if i & 2 != 0 { h.y } else { -h.y },
                 if i & 4 != 0 { h.z } else { -h.z },
             ),
-            Poly::Hull(p, _) => {
-                let v: Vector = p.points()[i as usize];
+            Poly::Hull(s) => {
+                let v: Vector = s.points()[i as usize];
                 Vec3::new(v.x, v.y, v.z)
             }
         }
@@ -116,10 +116,7 @@ impl<'a> Poly<'a> {
                 n[(f / 2) as usize] = if f.is_multiple_of(2) { 1.0 } else { -1.0 };
                 n
             }
-            Poly::Hull(p, _) => {
-                let n = p.faces()[f as usize].normal;
-                Vec3::new(n.x, n.y, n.z)
-            }
+            Poly::Hull(s) => s.graph().poly_normal[f as usize],
         }
     }
 
@@ -133,12 +130,8 @@ impl<'a> Poly<'a> {
                     [[7, 3, 1, 5], [2, 6, 4, 0], [2, 3, 7, 6], [4, 5, 1, 0], [6, 7, 5, 4], [3, 2, 0, 1]];
                 out.extend_from_slice(&BOX_FACES[f as usize]);
             }
-            Poly::Hull(p, _) => {
-                let face = p.faces()[f as usize];
-                let start = face.first_vertex_or_edge as usize;
-                let n = face.num_vertices_or_edges as usize;
-                out.extend(p.vertices_adj_to_face()[start..start + n].iter().rev());
-            }
+            // MuJoCo's polygon (`mesh_polyvert`, counter-clockwise) read backwards (`meshFace`).
+            Poly::Hull(s) => out.extend(s.graph().polygon(f as usize).iter().rev()),
         }
     }
 
@@ -157,7 +150,7 @@ impl<'a> Poly<'a> {
 fn support_feature(poly: &Poly, x: &Transform, dir: &Vec3, tol: f64, out: &mut Vec<u32>) {
     out.clear();
     let local = x.rot.transpose() * dir;
-    if let Poly::Hull(_, support) = poly {
+    if let Poly::Hull(support) = poly {
         let top = support.support_index(Vector::new(local.x, local.y, local.z)) as u32;
         let threshold = poly.vertex(top).dot(&local) - tol;
         out.push(top);
@@ -189,13 +182,8 @@ fn support_feature(poly: &Poly, x: &Transform, dir: &Vec3, tol: f64, out: &mut V
 fn vertex_faces(poly: &Poly, v: u32, tmp: &mut Vec<u32>, out: &mut Vec<u32>) {
     out.clear();
     match poly {
-        Poly::Hull(p, _) => {
-            let vertex = p.vertices()[v as usize];
-            let start = vertex.first_adj_face_or_edge as usize;
-            let n = vertex.num_adj_faces_or_edge as usize;
-            out.extend_from_slice(&p.faces_adj_to_vertex()[start..start + n]);
-            out.sort_unstable();
-        }
+        // MuJoCo's `mesh_polymap`: ascending polygon indices.
+        Poly::Hull(s) => out.extend_from_slice(s.graph().vertex_polygons(v as usize)),
         Poly::Cuboid(_) => {
             for f in 0..6 {
                 if poly.face_has(f, v, tmp) {
