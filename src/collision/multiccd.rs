@@ -48,8 +48,6 @@ use std::cell::RefCell;
 const FACE_TOL: f64 = 0.996;
 /// |cosine| below which an edge counts as parallel to a face (MuJoCo's `mjEDGE_TOL`, ~5.1°).
 const EDGE_TOL: f64 = 0.0888;
-/// MuJoCo's `mjMINVAL`.
-const MINVAL: f64 = 1e-15;
 
 /// Scratch buffers of the clipping, reused per thread (no allocation once grown).
 #[derive(Default)]
@@ -57,8 +55,7 @@ struct Scratch {
     face1: Vec<Vec3>,
     face2: Vec<Vec3>,
     poly: Vec<Vec3>,
-    clipped: Vec<Vec3>,
-    inside: Vec<bool>,
+    clip: super::polygon_clip::ClipScratch,
     normals1: Vec<(Vec3, u32)>,
     normals2: Vec<(Vec3, u32)>,
     feature1: Vec<u32>,
@@ -74,7 +71,7 @@ thread_local! {
 /// A polytope geom: a box (half-extents) or a mesh's hull.
 enum Poly<'a> {
     Cuboid(Vec3),
-    Hull(&'a parry3d_f64::shape::ConvexPolyhedron, &'a super::hull_support::HullSupport),
+    Hull(&'a super::hull_support::HullSupport),
 }
 
 impl<'a> Poly<'a> {
@@ -84,7 +81,7 @@ impl<'a> Poly<'a> {
                 let h = c.half_extents;
                 Some(Poly::Cuboid(Vec3::new(h.x, h.y, h.z)))
             }
-            ConvexShape::Hull(s) => Some(Poly::Hull(s.polyhedron(), s)),
+            ConvexShape::Hull(s) => Some(Poly::Hull(s)),
             _ => None,
         }
     }
@@ -92,7 +89,7 @@ impl<'a> Poly<'a> {
     fn nvert(&self) -> usize {
         match self {
             Poly::Cuboid(_) => 8,
-            Poly::Hull(p, _) => p.points().len(),
+            Poly::Hull(s) => s.points().len(),
         }
     }
 
@@ -104,8 +101,8 @@ impl<'a> Poly<'a> {
                 if i & 2 != 0 { h.y } else { -h.y },
                 if i & 4 != 0 { h.z } else { -h.z },
             ),
-            Poly::Hull(p, _) => {
-                let v: Vector = p.points()[i as usize];
+            Poly::Hull(s) => {
+                let v: Vector = s.points()[i as usize];
                 Vec3::new(v.x, v.y, v.z)
             }
         }
@@ -119,10 +116,7 @@ impl<'a> Poly<'a> {
                 n[(f / 2) as usize] = if f.is_multiple_of(2) { 1.0 } else { -1.0 };
                 n
             }
-            Poly::Hull(p, _) => {
-                let n = p.faces()[f as usize].normal;
-                Vec3::new(n.x, n.y, n.z)
-            }
+            Poly::Hull(s) => s.graph().poly_normal[f as usize],
         }
     }
 
@@ -136,12 +130,8 @@ impl<'a> Poly<'a> {
                     [[7, 3, 1, 5], [2, 6, 4, 0], [2, 3, 7, 6], [4, 5, 1, 0], [6, 7, 5, 4], [3, 2, 0, 1]];
                 out.extend_from_slice(&BOX_FACES[f as usize]);
             }
-            Poly::Hull(p, _) => {
-                let face = p.faces()[f as usize];
-                let start = face.first_vertex_or_edge as usize;
-                let n = face.num_vertices_or_edges as usize;
-                out.extend(p.vertices_adj_to_face()[start..start + n].iter().rev());
-            }
+            // MuJoCo's polygon (`mesh_polyvert`, counter-clockwise) read backwards (`meshFace`).
+            Poly::Hull(s) => out.extend(s.graph().polygon(f as usize).iter().rev()),
         }
     }
 
@@ -160,7 +150,7 @@ impl<'a> Poly<'a> {
 fn support_feature(poly: &Poly, x: &Transform, dir: &Vec3, tol: f64, out: &mut Vec<u32>) {
     out.clear();
     let local = x.rot.transpose() * dir;
-    if let Poly::Hull(_, support) = poly {
+    if let Poly::Hull(support) = poly {
         let top = support.support_index(Vector::new(local.x, local.y, local.z)) as u32;
         let threshold = poly.vertex(top).dot(&local) - tol;
         out.push(top);
@@ -192,13 +182,8 @@ fn support_feature(poly: &Poly, x: &Transform, dir: &Vec3, tol: f64, out: &mut V
 fn vertex_faces(poly: &Poly, v: u32, tmp: &mut Vec<u32>, out: &mut Vec<u32>) {
     out.clear();
     match poly {
-        Poly::Hull(p, _) => {
-            let vertex = p.vertices()[v as usize];
-            let start = vertex.first_adj_face_or_edge as usize;
-            let n = vertex.num_adj_faces_or_edge as usize;
-            out.extend_from_slice(&p.faces_adj_to_vertex()[start..start + n]);
-            out.sort_unstable();
-        }
+        // MuJoCo's `mesh_polymap`: ascending polygon indices.
+        Poly::Hull(s) => out.extend_from_slice(s.graph().vertex_polygons(v as usize)),
         Poly::Cuboid(_) => {
             for f in 0..6 {
                 if poly.face_has(f, v, tmp) {
@@ -323,18 +308,9 @@ pub fn polytope_contacts(
             let (n2, f2) = s.normals2[j];
             face_polygon(&p1, x1, f1, &mut tmp, &mut s.face1);
             face_polygon(&p2, x2, f2, &mut tmp, &mut s.face2);
-            clip(
-                &s.face1,
-                &s.face2,
-                &n1,
-                &n2,
-                margin,
-                false,
-                &mut s.poly,
-                &mut s.clipped,
-                &mut s.inside,
-                &mut |w1, w2, d| out(w1, w2, d, false, -n2),
-            );
+            clip(&s.face1, &s.face2, &n1, &n2, margin, false, &mut s.poly, &mut s.clip, &mut |w1, w2, d| {
+                out(w1, w2, d, false, -n2)
+            });
         } else if dim1 < 3 && dim1 <= dim2 {
             // An edge of geom 1 against a face of geom 2.
             feature_edges(&p1, x1, &s.feature1, &mut tmp, &mut s.faces, &mut s.face1);
@@ -352,8 +328,7 @@ pub fn polytope_contacts(
                     margin,
                     false,
                     &mut s.poly,
-                    &mut s.clipped,
-                    &mut s.inside,
+                    &mut s.clip,
                     &mut |w1, w2, d| out(w1, w2, d, true, -n2),
                 );
             }
@@ -374,8 +349,7 @@ pub fn polytope_contacts(
                     margin,
                     false,
                     &mut s.poly,
-                    &mut s.clipped,
-                    &mut s.inside,
+                    &mut s.clip,
                     &mut |w1, w2, d| out(w1, w2, d, false, n1),
                 );
             }
@@ -423,8 +397,7 @@ fn clip(
     margin: f64,
     octagon: bool,
     poly: &mut Vec<Vec3>,
-    next: &mut Vec<Vec3>,
-    flags: &mut Vec<bool>,
+    scratch: &mut super::polygon_clip::ClipScratch,
     out: &mut dyn FnMut(Vec3, Vec3, f64),
 ) {
     if face.len() < 3 {
@@ -432,59 +405,7 @@ fn clip(
     }
     poly.clear();
     poly.extend_from_slice(clipped_in);
-    let m = face.len();
-    // A side plane that keeps every point only turns the polygon by one (the pass's output
-    // starts at the second point): such sides are counted instead of walked, the turns applied
-    // before the next side that cuts and at the end — the same points in the same order, one
-    // test per point instead of a pass per side (a face of many vertices, a finger pad's, keeps
-    // most of a polygon inside most of its sides).
-    let mut turns = 0;
-    for k in 0..m {
-        let (a, b) = (face[k], face[(k + 1) % m]);
-        // Inward normal of the side plane through edge a→b (clockwise about n).
-        let pn = (b - a).cross(n).normalize();
-        let pd = pn.dot(&a);
-        let inside = |p: &Vec3| (p - a).dot(&pn) > -MINVAL;
-        // Each point's side once.
-        flags.clear();
-        flags.extend(poly.iter().map(inside));
-        if flags.iter().all(|&f| f) {
-            turns += 1;
-            continue;
-        }
-        let np = poly.len();
-        poly.rotate_left(turns % np);
-        flags.rotate_left(turns % np);
-        turns = 0;
-        next.clear();
-        for i in 0..np {
-            let (p, q) = (poly[i], poly[(i + 1) % np]);
-            let (ip, iq) = (flags[i], flags[(i + 1) % np]);
-            if !ip && !iq {
-                continue;
-            }
-            if ip && iq {
-                next.push(q);
-                continue;
-            }
-            let pq = q - p;
-            let den = pn.dot(&pq);
-            if den != 0.0 {
-                let t = (pd - pn.dot(&p)) / den;
-                if (0.0..=1.0).contains(&t) {
-                    next.push(p + pq * t);
-                }
-            }
-            if iq {
-                next.push(q);
-            }
-        }
-        std::mem::swap(poly, next);
-    }
-    if !poly.is_empty() {
-        let np = poly.len();
-        poly.rotate_left(turns % np);
-    }
+    super::polygon_clip::clip_by_face_sides(face, n, poly, scratch);
     poly.retain(|p| (p - face[0]).dot(n) <= margin);
     if poly.is_empty() {
         return;
@@ -685,21 +606,10 @@ fn cap_polytope(
                 s.face1.push(centre + (e1 * t.cos() + e2 * t.sin()) * r);
             }
             face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
-            clip(
-                &s.face1,
-                &s.face2,
-                &n1,
-                &n2,
-                margin,
-                true,
-                &mut s.poly,
-                &mut s.clipped,
-                &mut s.inside,
-                &mut |w1, w2, d| {
-                    emit(PairPoint { p1: w1, p2: w2, normal: -n2, dist: d });
-                    count += 1;
-                },
-            );
+            clip(&s.face1, &s.face2, &n1, &n2, margin, true, &mut s.poly, &mut s.clip, &mut |w1, w2, d| {
+                emit(PairPoint { p1: w1, p2: w2, normal: -n2, dist: d });
+                count += 1;
+            });
         }
         s.tmp = tmp;
         count
@@ -748,8 +658,7 @@ fn segment_polytope(
                 margin + r,
                 false,
                 &mut s.poly,
-                &mut s.clipped,
-                &mut s.inside,
+                &mut s.clip,
                 &mut |_, v, _| {
                     let d = (v - s.face2[0]).dot(&n2);
                     emit(PairPoint { p1: v - n2 * r, p2: v - n2 * d, normal: -n2, dist: d - r });
