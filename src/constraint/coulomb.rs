@@ -642,6 +642,13 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     if k == 0 {
         return false;
     }
+    // Larger systems keep the symmetric rounds, and give up at the velocity level: the LU with
+    // complete pivoting, and Newton's repeated ones, cost several times the Cholesky there
+    // (bin_50 2.3× slower with them).
+    let substitute = k <= SUBSTITUTE_MAX;
+    if any_sliding && !substitute && level != Level::Acceleration {
+        return false;
+    }
     data.exact.in_active[..n].fill(false);
     for a in 0..k {
         let r = data.exact.active[a];
@@ -656,7 +663,7 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         // Slipping contacts: their friction, direction times the cone's radius, substituted into
         // the normal's column (one non-symmetric solve); the symmetric solve with their friction
         // fixed at the candidate's when that system is inconsistent.
-        if any_sliding {
+        if any_sliding && substitute {
             slip_directions(data, level);
             if solve_substituted(data, level) {
                 let change = update_sliding_friction(data, level);
@@ -979,6 +986,10 @@ fn slip_opposed(data: &Data, i: usize, len: usize, level: Level, force_scale: f6
         (1..len).map(|k| (data.exact.lambda_prev[i + k] + dt * data.exact.previous[i + k]) * u[k - 1]).sum();
     data.exact.lambda_prev[i] + c0 >= -1e-12 * force_scale && work <= 1e-12 * force_scale * norm
 }
+
+/// The largest reduced system (rows) whose slipping contacts the polish substitutes
+/// ([`solve_substituted`], [`newton_slipping`]).
+const SUBSTITUTE_MAX: usize = 64;
 
 /// Newton iterations of [`newton_slipping`] before it gives up.
 const NEWTON_ITERATIONS: u32 = 12;
