@@ -12,6 +12,7 @@
 //! `efc_state`). Nothing is projected after a step: drift is what the soft model allows.
 
 pub mod cost;
+mod hessian;
 pub mod impedance;
 mod jacobian;
 pub mod noslip;

@@ -15,6 +15,7 @@
 //! `tolerance`, the scale being 1 / (meaninertia · max(1, nv)).
 
 use super::cost::Rows;
+use super::hessian::Assembler;
 use crate::constraint::dense::{cholesky, cholesky_solve};
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, Model};
@@ -49,18 +50,23 @@ pub struct Settings {
 
 /// The nonzero columns of each row of J (rows enter the solve through their ancestor dofs only):
 /// row i's columns are `index[start[i]..start[i + 1]]`.
-struct Sparsity<'a> {
-    start: &'a [usize],
-    index: &'a [usize],
+pub(super) struct Sparsity<'a> {
+    pub start: &'a [usize],
+    pub index: &'a [usize],
     /// J's value at each of `index`'s entries (row i's are `value[start[i]..start[i + 1]]`).
-    value: &'a [f64],
+    pub value: &'a [f64],
 }
 
 impl Sparsity<'_> {
     /// Row i's nonzero columns and J's values there.
-    fn row_values(&self, i: usize) -> (&[usize], &[f64]) {
+    pub fn row_values(&self, i: usize) -> (&[usize], &[f64]) {
         let (s, e) = (self.start[i], self.start[i + 1]);
         (&self.index[s..e], &self.value[s..e])
+    }
+
+    /// Row i's nonzero columns.
+    pub fn columns(&self, i: usize) -> &[usize] {
+        &self.index[self.start[i]..self.start[i + 1]]
     }
 }
 
@@ -98,43 +104,6 @@ fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVect
 /// Up to this many dofs the Newton Hessian is assembled and factored dense (and M x is a dense
 /// product): below it the sparse bookkeeping costs more than the zeros it skips.
 pub(crate) const DENSE_NV: usize = 40;
-
-/// H[p][q] += (w J[a][p]) J[b][q] over the nonzero columns p ≥ q of rows a and b: the lower
-/// triangle of one Hessian term. Row a's weighted entries are gathered first (`weighted`, nv
-/// long, indexed like row a's nonzeros, from the rows' compact values `Sparsity::value`), and
-/// the sums are written column by column; each entry gets the same products in the same
-/// order as a direct double loop, so the same bits.
-#[inline]
-fn add_weighted_outer(h: &mut DMatrix<f64>, nz: &Sparsity, a: usize, b: usize, w: f64, weighted: &mut [f64]) {
-    let ((row_a, j_a), (row_b, j_b)) = (nz.row_values(a), nz.row_values(b));
-    for (x, &j_ap) in weighted.iter_mut().zip(j_a) {
-        *x = w * j_ap;
-    }
-    let nv = h.nrows();
-    let h = h.as_mut_slice();
-    if a == b {
-        // One row's own term (a row's columns ascend): the entries p ≥ q of column q are the
-        // row's columns from q's position on, with no test per entry.
-        let len = row_a.len();
-        let (weighted, j_b) = (&weighted[..len], &j_b[..len]);
-        for t in 0..len {
-            let (q, j_bq) = (row_a[t], j_b[t]);
-            let column = &mut h[q * nv..(q + 1) * nv];
-            for (&x, &p) in weighted[t..].iter().zip(&row_a[t..]) {
-                column[p] += x * j_bq;
-            }
-        }
-        return;
-    }
-    for (&q, &j_bq) in row_b.iter().zip(j_b) {
-        let column = &mut h[q * nv..(q + 1) * nv];
-        for (x, &p) in weighted.iter().zip(row_a) {
-            if p >= q {
-                column[p] += x * j_bq;
-            }
-        }
-    }
-}
 
 /// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
 /// `qfrc_smooth`, `qacc_smooth`, the mass matrix and its factor: writes `qacc`, `efc_force`,
@@ -264,15 +233,10 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                 if nv <= DENSE_NV {
                     // Small: H = M + Jᵀ (∂²s) J, its lower triangle (all the dense Cholesky
                     // reads), by dense Cholesky.
-                    let (h, weighted) = (&mut soft.hessian, &mut soft.weighted_row);
-                    h.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
-                    rows.hessian(&soft.jar, efc_state, |i, dim, block| {
-                        for (a, row) in (i..i + dim).zip(block) {
-                            for (b, &w) in (i..i + dim).zip(row) {
-                                add_weighted_outer(h, &nz, a, b, w, weighted);
-                            }
-                        }
-                    });
+                    soft.hessian.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
+                    let mut rows_h = Assembler::new(&mut soft.hessian, &nz, &mut soft.hessian_column);
+                    rows.hessian(&soft.jar, efc_state, |i, dim, block| rows_h.add(i, dim, block));
+                    rows_h.finish();
                     soft.dir.copy_from(&soft.grad);
                     if cholesky(&soft.hessian, nv, &mut soft.dense_factor, 0.0) {
                         cholesky_solve(&soft.dense_factor, nv, soft.dir.as_mut_slice());
@@ -314,14 +278,9 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                         soft.factor.analyze(nv, &model.dof_parent, &soft.active_rows, &nz_start, &nz_index);
                         analyzed = true;
                     }
-                    let weighted = &mut soft.weighted_row;
-                    rows.hessian(&soft.jar, efc_state, |i, dim, block| {
-                        for (a, row) in (i..i + dim).zip(block) {
-                            for (b, &w) in (i..i + dim).zip(row) {
-                                add_weighted_outer(h, &nz, a, b, w, weighted);
-                            }
-                        }
-                    });
+                    let mut rows_h = Assembler::new(h, &nz, &mut soft.hessian_column);
+                    rows.hessian(&soft.jar, efc_state, |i, dim, block| rows_h.add(i, dim, block));
+                    rows_h.finish();
                     soft.dir.copy_from(&soft.grad);
                     if soft.factor.factor_analyzed(&soft.hessian) {
                         soft.factor.solve(soft.dir.as_mut_slice());

@@ -1,0 +1,237 @@
+//! The rows' part of the Newton Hessian, Jᵀ (∂²s) J, added to the lower triangle of H = M + …
+//! (MuJoCo documentation, "Computation → Solver", Newton; MuJoCo's `MakeHessian` and
+//! `HessianCone`, engine_solver.c, which form Jᵀ D J and add the cones' blocks).
+//!
+//! The rows come one block at a time from [`Rows::hessian`](super::cost::Rows::hessian): a
+//! weight D on a quadratic row, or a dense block on an elliptic contact's rows. Rows of one contact
+//! share their nonzero columns (`jacobian::append_rows` records a contact's rows over the union of
+//! their nonzeros), so they are summed as a group: for each column q of the group, the group's
+//! contribution to H's column q is formed in a contiguous scratch vector (products of the rows'
+//! compact values, which the compiler vectorizes) and added to H once — instead of one scattered
+//! read–modify–write of H per row and entry. Consecutive scalar rows with the same columns (a
+//! pyramidal contact's edges in their quadratic state) form one group; an elliptic contact's
+//! block multiplies its rows first (W = B G, G the rows' values), then Gᵀ W is summed the same
+//! way. Rows whose columns differ (J recorded by the full scan, which drops exact zeros) are
+//! added pair by pair.
+
+use super::primal::Sparsity;
+use nalgebra::DMatrix;
+
+/// The most scalar rows summed as one group (a pyramidal contact of condim 6 has 10).
+const GROUP: usize = 16;
+
+/// Adds the rows' Hessian blocks to H's lower triangle (see the module doc). Scalar rows are
+/// held in a pending group until a row with other columns (or a block) arrives; [`finish`]
+/// adds the last group.
+///
+/// [`finish`]: Assembler::finish
+pub(super) struct Assembler<'a> {
+    h: &'a mut DMatrix<f64>,
+    nz: &'a Sparsity<'a>,
+    /// One column of a group's contribution (nv long).
+    column: &'a mut [f64],
+    /// The pending group: its rows and their weights.
+    rows: [usize; GROUP],
+    weights: [f64; GROUP],
+    len: usize,
+}
+
+impl<'a> Assembler<'a> {
+    /// An assembler adding to `h` (nv × nv) the rows of `nz`; `column` is nv-long scratch.
+    pub fn new(h: &'a mut DMatrix<f64>, nz: &'a Sparsity<'a>, column: &'a mut [f64]) -> Self {
+        Self { h, nz, column, rows: [0; GROUP], weights: [0.0; GROUP], len: 0 }
+    }
+
+    /// Adds block `block` (dim × dim, symmetric) on rows i..i + dim: Jᵀ B J over those rows.
+    pub fn add(&mut self, i: usize, dim: usize, block: &[[f64; 6]; 6]) {
+        if dim == 1 {
+            if self.len == GROUP || (self.len > 0 && self.nz.columns(self.rows[0]) != self.nz.columns(i)) {
+                self.flush();
+            }
+            self.rows[self.len] = i;
+            self.weights[self.len] = block[0][0];
+            self.len += 1;
+            return;
+        }
+        self.flush();
+        let cols = self.nz.columns(i);
+        if (i + 1..i + dim).all(|r| self.nz.columns(r) == cols) {
+            self.add_block(i, dim, block);
+        } else {
+            for a in i..i + dim {
+                for b in i..i + dim {
+                    self.add_pair(a, b, block[a - i][b - i]);
+                }
+            }
+        }
+    }
+
+    /// Adds the pending group.
+    pub fn finish(mut self) {
+        self.flush();
+    }
+
+    /// The pending scalar rows (same columns): H[p][q] += Σ_r w_r G_r[p] G_r[q], p ≥ q.
+    fn flush(&mut self) {
+        let k = self.len;
+        if k == 0 {
+            return;
+        }
+        self.len = 0;
+        let first = self.rows[0];
+        let (cols, _) = self.nz.row_values(first);
+        let n = cols.len();
+        let nv = self.h.nrows();
+        let h = self.h.as_mut_slice();
+        for q in 0..n {
+            let t = &mut self.column[q..n];
+            for (r, (&row, &w)) in self.rows[..k].iter().zip(&self.weights[..k]).enumerate() {
+                let g = &self.nz.row_values(row).1[q..n];
+                let c = w * g[0];
+                if r == 0 {
+                    for (t, &g) in t.iter_mut().zip(g) {
+                        *t = c * g;
+                    }
+                } else {
+                    for (t, &g) in t.iter_mut().zip(g) {
+                        *t += c * g;
+                    }
+                }
+            }
+            let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
+            for (&p, &v) in cols[q..n].iter().zip(t.iter()) {
+                column[p] += v;
+            }
+        }
+    }
+
+    /// Rows i..i + dim with the same columns and a dense block B: with G the rows' values,
+    /// H[p][q] += Σ_a G_a[p] (B G)_a[q], p ≥ q.
+    fn add_block(&mut self, i: usize, dim: usize, block: &[[f64; 6]; 6]) {
+        let (cols, _) = self.nz.row_values(i);
+        let n = cols.len();
+        let nv = self.h.nrows();
+        let h = self.h.as_mut_slice();
+        let mut g: [&[f64]; 6] = [&[]; 6];
+        for (a, g) in g.iter_mut().enumerate().take(dim) {
+            *g = self.nz.row_values(i + a).1;
+        }
+        for q in 0..n {
+            // (B G)[a][q] for each row a of the block.
+            let mut w = [0.0; 6];
+            for (a, w) in w.iter_mut().enumerate().take(dim) {
+                *w = (0..dim).map(|b| block[a][b] * g[b][q]).sum();
+            }
+            let t = &mut self.column[q..n];
+            for (a, &c) in w.iter().enumerate().take(dim) {
+                let ga = &g[a][q..n];
+                if a == 0 {
+                    for (t, &x) in t.iter_mut().zip(ga) {
+                        *t = c * x;
+                    }
+                } else {
+                    for (t, &x) in t.iter_mut().zip(ga) {
+                        *t += c * x;
+                    }
+                }
+            }
+            let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
+            for (&p, &v) in cols[q..n].iter().zip(t.iter()) {
+                column[p] += v;
+            }
+        }
+    }
+
+    /// H[p][q] += w J[a][p] J[b][q] over the nonzero columns p ≥ q of rows a and b.
+    fn add_pair(&mut self, a: usize, b: usize, w: f64) {
+        let ((row_a, j_a), (row_b, j_b)) = (self.nz.row_values(a), self.nz.row_values(b));
+        let nv = self.h.nrows();
+        let h = self.h.as_mut_slice();
+        for (&q, &j_bq) in row_b.iter().zip(j_b) {
+            let column = &mut h[q * nv..(q + 1) * nv];
+            let c = w * j_bq;
+            for (&p, &j_ap) in row_a.iter().zip(j_a) {
+                if p >= q {
+                    column[p] += j_ap * c;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Jᵀ B J (lower triangle) by the definition.
+    fn reference(j: &DMatrix<f64>, blocks: &[(usize, usize, [[f64; 6]; 6])], nv: usize) -> DMatrix<f64> {
+        let mut h = DMatrix::zeros(nv, nv);
+        for &(i, dim, b) in blocks {
+            for a in 0..dim {
+                for c in 0..dim {
+                    for p in 0..nv {
+                        for q in 0..=p {
+                            h[(p, q)] += j[(i + a, p)] * b[a][c] * j[(i + c, q)];
+                        }
+                    }
+                }
+            }
+        }
+        h
+    }
+
+    #[test]
+    fn grouped_rows_and_blocks_sum_to_jt_b_j() {
+        // Rows 0..2: one group on columns {1, 3, 4}; row 2 alone on {0, 4}; rows 3..6 a block
+        // on {0, 2, 3} (row 4 has an exact zero there, kept); rows 6..8 a block whose rows have
+        // different columns (pair by pair).
+        let nv = 5;
+        let cols: [&[usize]; 8] =
+            [&[1, 3, 4], &[1, 3, 4], &[0, 4], &[0, 2, 3], &[0, 2, 3], &[0, 2, 3], &[2], &[1, 2]];
+        let mut j = DMatrix::zeros(8, nv);
+        let (mut start, mut index, mut value) = (vec![0], vec![], vec![]);
+        for (i, c) in cols.iter().enumerate() {
+            for (t, &k) in c.iter().enumerate() {
+                let v = if i == 4 && k == 2 { 0.0 } else { 0.3 + 0.7 * ((i * 5 + t * 3) % 7) as f64 - 1.1 };
+                j[(i, k)] = v;
+                index.push(k);
+                value.push(v);
+            }
+            start.push(index.len());
+        }
+        let nz = Sparsity { start: &start, index: &index, value: &value };
+        let mut b3 = [[0.0; 6]; 6];
+        for (a, row) in b3.iter_mut().enumerate().take(3) {
+            for (c, x) in row.iter_mut().enumerate().take(3) {
+                *x = if a == c { 2.0 + a as f64 } else { 0.25 };
+            }
+        }
+        let mut b2 = [[0.0; 6]; 6];
+        b2[0] = [1.5, -0.5, 0.0, 0.0, 0.0, 0.0];
+        b2[1] = [-0.5, 0.75, 0.0, 0.0, 0.0, 0.0];
+        let scalar = |w: f64| {
+            let mut b = [[0.0; 6]; 6];
+            b[0][0] = w;
+            b
+        };
+        let blocks = [(0, 1, scalar(2.0)), (1, 1, scalar(0.5)), (2, 1, scalar(3.0)), (3, 3, b3), (6, 2, b2)];
+        let mut h = DMatrix::zeros(nv, nv);
+        let mut column = vec![0.0; nv];
+        let mut asm = Assembler::new(&mut h, &nz, &mut column);
+        for &(i, dim, b) in &blocks {
+            asm.add(i, dim, &b);
+        }
+        asm.finish();
+        let want = reference(&j, &blocks, nv);
+        for p in 0..nv {
+            for q in 0..nv {
+                let w = if q <= p { want[(p, q)] } else { 0.0 };
+                assert!(
+                    (h[(p, q)] - w).abs() <= 1e-14 * (1.0 + w.abs()),
+                    "H[{p}][{q}] = {} against {w}",
+                    h[(p, q)]
+                );
+            }
+        }
+    }
+}
