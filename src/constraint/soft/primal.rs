@@ -162,6 +162,16 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         contacts,
         mu: contact_mu,
     };
+    // The Gauss term ½ (x − a₀)ᵀ (M x − qfrc_smooth) at x, from M x.
+    let gauss = |x: &DVector<f64>, ma: &DVector<f64>| -> f64 {
+        let (x, a0) = (&x.as_slice()[..nv], &qacc_smooth.as_slice()[..nv]);
+        let (ma, f0) = (&ma.as_slice()[..nv], &qfrc_smooth.as_slice()[..nv]);
+        x.iter()
+            .zip(a0)
+            .zip(ma.iter().zip(f0))
+            .map(|((&x, &a0), (&ma, &f0))| 0.5 * (x - a0) * (ma - f0))
+            .sum()
+    };
     // The total cost at x (fills ma, jar, force, state).
     let total = |x: &DVector<f64>,
                  ma: &mut DVector<f64>,
@@ -173,19 +183,18 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         for (j, &r) in jar.as_mut_slice()[..nefc].iter_mut().zip(&efc_aref.as_slice()[..nefc]) {
             *j -= r;
         }
-        let (x, a0) = (&x.as_slice()[..nv], &qacc_smooth.as_slice()[..nv]);
-        let (ma, f0) = (&ma.as_slice()[..nv], &qfrc_smooth.as_slice()[..nv]);
-        let gauss: f64 = x
-            .iter()
-            .zip(a0)
-            .zip(ma.iter().zip(f0))
-            .map(|((&x, &a0), (&ma, &f0))| 0.5 * (x - a0) * (ma - f0))
-            .sum();
-        gauss + rows.update(jar, force, state)
+        gauss(x, ma) + rows.update(jar, force, state)
     };
     // Start: the warm start (the previous solution) if it costs less than qacc_smooth.
+    // At qacc_smooth the Gauss term is zero and M a = qfrc_smooth (qacc_smooth = M⁻¹
+    // qfrc_smooth): only J a − aref is formed (MuJoCo's cost(qacc_smooth) from efc_b likewise).
     qacc.copy_from(qacc_smooth);
-    let mut cost = total(qacc, &mut soft.ma, &mut soft.jar, efc_force, efc_state);
+    soft.ma.copy_from(qfrc_smooth);
+    mul_j(&nz, nefc, qacc, &mut soft.jar);
+    for (j, &r) in soft.jar.as_mut_slice()[..nefc].iter_mut().zip(&efc_aref.as_slice()[..nefc]) {
+        *j -= r;
+    }
+    let mut cost = rows.update(&soft.jar, efc_force, efc_state);
     if s.warmstart {
         let c = total(qacc_warmstart, &mut soft.mdir, &mut soft.jv, &mut soft.jar_trial, efc_state);
         if c < cost {
@@ -324,8 +333,14 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
             stalled = true;
             break;
         }
+        // The move: a, M a and J a − aref along the direction (MuJoCo's mj_solPrimal updates
+        // them the same way instead of forming the products again).
         qacc.axpy(alpha, &soft.dir, 1.0);
-        let new_cost = total(qacc, &mut soft.ma, &mut soft.jar, efc_force, efc_state);
+        soft.ma.axpy(alpha, &soft.mdir, 1.0);
+        for (j, &v) in soft.jar.as_mut_slice()[..nefc].iter_mut().zip(&soft.jv.as_slice()[..nefc]) {
+            *j += alpha * v;
+        }
+        let new_cost = gauss(qacc, &soft.ma) + rows.update(&soft.jar, efc_force, efc_state);
         improvement = s.scale * (cost - new_cost);
         cost = new_cost;
     }
