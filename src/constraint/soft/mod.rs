@@ -14,6 +14,7 @@
 pub mod cost;
 mod hessian;
 pub mod impedance;
+mod island;
 mod jacobian;
 pub mod noslip;
 pub mod pgs;

@@ -71,7 +71,7 @@ impl Sparsity<'_> {
 }
 
 /// r ← J x (rows 0..nefc).
-fn mul_j(s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
+pub(super) fn mul_j(s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
     let x = x.as_slice();
     for (i, r_i) in r.as_mut_slice()[..nefc].iter_mut().enumerate() {
         let (cols, vals) = s.row_values(i);
@@ -81,7 +81,7 @@ fn mul_j(s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
 
 /// r ← M x, reading only M's nonzeros: the diagonal and each dof's ancestor chain
 /// (`Model::dof_parent`; M[l][k] ≠ 0 only when l is an ancestor of k or k of l).
-fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
+pub(super) fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
     let nv = x.len();
     if nv <= DENSE_NV {
         m.mul_to(x, r);
@@ -211,35 +211,55 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         }
     }
     let mut improvement = f64::INFINITY;
-    let mut gradient;
+    let mut gradient = 0.0;
     let mut iter = 0;
     let mut have_dir = false;
     let mut stalled = false;
-    let mut analyzed = false;
-    loop {
-        // g = M a − qfrc_smooth − Jᵀ f.
-        for ((g, &ma), &f0) in
-            soft.grad.as_mut_slice().iter_mut().zip(soft.ma.as_slice()).zip(qfrc_smooth.as_slice())
-        {
-            *g = ma - f0;
-        }
-        let grad = soft.grad.as_mut_slice();
-        for (i, &f) in efc_force.as_slice()[..nefc].iter().enumerate() {
-            if f != 0.0 {
-                let (cols, vals) = nz.row_values(i);
-                for (&k, &j_ik) in cols.iter().zip(vals) {
-                    grad[k] -= j_ik * f;
+    let island_path = method == Primal::Newton && nv > DENSE_NV;
+    let mut converged_islands = false;
+    if island_path {
+        // Large problems: island by island (`island.rs`).
+        let problem = super::island::Problem {
+            model,
+            rows: &rows,
+            nz: &nz,
+            m: mass_matrix,
+            a0: qacc_smooth,
+            f0: qfrc_smooth,
+            settings: s,
+        };
+        let out = super::island::newton(&problem, soft, mass_factor, qacc, efc_force, efc_state);
+        iter = out.iterations;
+        improvement = out.improvement;
+        gradient = out.gradient;
+        converged_islands = out.converged;
+    }
+    // Small problems, and CG: every row together.
+    if !island_path {
+        loop {
+            // g = M a − qfrc_smooth − Jᵀ f.
+            for ((g, &ma), &f0) in
+                soft.grad.as_mut_slice().iter_mut().zip(soft.ma.as_slice()).zip(qfrc_smooth.as_slice())
+            {
+                *g = ma - f0;
+            }
+            let grad = soft.grad.as_mut_slice();
+            for (i, &f) in efc_force.as_slice()[..nefc].iter().enumerate() {
+                if f != 0.0 {
+                    let (cols, vals) = nz.row_values(i);
+                    for (&k, &j_ik) in cols.iter().zip(vals) {
+                        grad[k] -= j_ik * f;
+                    }
                 }
             }
-        }
-        gradient = s.scale * soft.grad.norm();
-        if gradient < s.tolerance || improvement < s.tolerance || iter >= s.iterations {
-            break;
-        }
-        iter += 1;
-        match method {
-            Primal::Newton => {
-                if nv <= DENSE_NV {
+            gradient = s.scale * soft.grad.norm();
+            if gradient < s.tolerance || improvement < s.tolerance || iter >= s.iterations {
+                break;
+            }
+            iter += 1;
+            match method {
+                Primal::Newton => {
+                    // (Large problems take the island path above.)
                     // Small: H = M + Jᵀ (∂²s) J, its lower triangle (all the dense Cholesky
                     // reads), by dense Cholesky.
                     soft.hessian.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
@@ -252,97 +272,54 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                     } else {
                         solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
                     }
-                } else {
-                    // H = M + Jᵀ (∂²s) J, lower triangle only, assembled over its nonzeros: the
-                    // last pattern's entries cleared, M's tree entries written, the rows' added.
-                    let h = &mut soft.hessian;
-                    for k in 0..nv {
-                        for &j in soft.factor.pattern_row(k) {
-                            h[(k, j)] = 0.0;
-                        }
-                        h[(k, k)] = mass_matrix[(k, k)];
-                        let mut l = model.dof_parent[k];
-                        while l != crate::model::NO_DOF {
-                            h[(k, l)] = mass_matrix[(k, l)];
-                            l = model.dof_parent[l];
-                        }
-                    }
-                    if !analyzed {
-                        // Once per solve (after the clear above, which needs the last pattern):
-                        // the pattern of every row that can have a Hessian block, whatever its
-                        // state — each row alone, a contact's rows as one group — so that it
-                        // holds for every iteration; kept from the last step when its cliques
-                        // are unchanged (`SparseCholesky::analyze`).
-                        soft.active_rows.clear();
-                        for i in 0..nefc {
-                            let same_contact = i > 0
-                                && efc_type[i].is_contact()
-                                && efc_type[i] == efc_type[i - 1]
-                                && efc_id[i] == efc_id[i - 1];
-                            match soft.active_rows.last_mut() {
-                                Some(g) if same_contact => g.1 = i,
-                                _ => soft.active_rows.push((i, i)),
-                            }
-                        }
-                        soft.factor.analyze(nv, &model.dof_parent, &soft.active_rows, &nz_start, &nz_index);
-                        analyzed = true;
-                    }
-                    let mut rows_h = Assembler::new(h, &nz, &mut soft.hessian_column);
-                    rows.hessian(&soft.jar, efc_state, |i, dim, block| rows_h.add(i, dim, block));
-                    rows_h.finish();
-                    soft.dir.copy_from(&soft.grad);
-                    if soft.factor.factor_analyzed(&soft.hessian) {
-                        soft.factor.solve(soft.dir.as_mut_slice());
-                    } else {
-                        solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
-                    }
+                    soft.dir.neg_mut();
                 }
-                soft.dir.neg_mut();
-            }
-            Primal::Cg => {
-                soft.mgrad.copy_from(&soft.grad);
-                solve_with_factor_unchecked(model, mass_factor, soft.mgrad.as_mut_slice());
-                let beta = if have_dir {
-                    let den = soft.grad_prev.dot(&soft.mgrad_prev);
-                    let num: f64 = (0..nv).map(|k| soft.grad[k] * (soft.mgrad[k] - soft.mgrad_prev[k])).sum();
-                    if den > 0.0 {
-                        (num / den).max(0.0)
+                Primal::Cg => {
+                    soft.mgrad.copy_from(&soft.grad);
+                    solve_with_factor_unchecked(model, mass_factor, soft.mgrad.as_mut_slice());
+                    let beta = if have_dir {
+                        let den = soft.grad_prev.dot(&soft.mgrad_prev);
+                        let num: f64 =
+                            (0..nv).map(|k| soft.grad[k] * (soft.mgrad[k] - soft.mgrad_prev[k])).sum();
+                        if den > 0.0 {
+                            (num / den).max(0.0)
+                        } else {
+                            0.0
+                        }
                     } else {
                         0.0
+                    };
+                    for k in 0..nv {
+                        soft.dir[k] = -soft.mgrad[k] + beta * soft.dir[k];
                     }
-                } else {
-                    0.0
-                };
-                for k in 0..nv {
-                    soft.dir[k] = -soft.mgrad[k] + beta * soft.dir[k];
+                    soft.grad_prev.copy_from(&soft.grad);
+                    soft.mgrad_prev.copy_from(&soft.mgrad);
+                    have_dir = true;
                 }
-                soft.grad_prev.copy_from(&soft.grad);
-                soft.mgrad_prev.copy_from(&soft.mgrad);
-                have_dir = true;
             }
+            mul_j(&nz, nefc, &soft.dir, &mut soft.jv);
+            mul_m(&model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
+            let g0: f64 = (soft.ma.iter().zip(qfrc_smooth.iter()).zip(soft.dir.iter()))
+                .map(|((&ma, &f0), &d)| (ma - f0) * d)
+                .sum();
+            let dmd = soft.dir.dot(&soft.mdir);
+            let alpha = line_search(&rows, &soft.jar, &soft.jv, &mut soft.jar_trial, g0, dmd, s);
+            if alpha == 0.0 {
+                // No descent along the direction (the minimum to round-off).
+                stalled = true;
+                break;
+            }
+            // The move: a, M a and J a − aref along the direction (MuJoCo's mj_solPrimal updates
+            // them the same way instead of forming the products again).
+            qacc.axpy(alpha, &soft.dir, 1.0);
+            soft.ma.axpy(alpha, &soft.mdir, 1.0);
+            for (j, &v) in soft.jar.as_mut_slice()[..nefc].iter_mut().zip(&soft.jv.as_slice()[..nefc]) {
+                *j += alpha * v;
+            }
+            let new_cost = gauss(qacc, &soft.ma) + rows.update(&soft.jar, efc_force, efc_state);
+            improvement = s.scale * (cost - new_cost);
+            cost = new_cost;
         }
-        mul_j(&nz, nefc, &soft.dir, &mut soft.jv);
-        mul_m(&model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
-        let g0: f64 = (soft.ma.iter().zip(qfrc_smooth.iter()).zip(soft.dir.iter()))
-            .map(|((&ma, &f0), &d)| (ma - f0) * d)
-            .sum();
-        let dmd = soft.dir.dot(&soft.mdir);
-        let alpha = line_search(&rows, &soft.jar, &soft.jv, &mut soft.jar_trial, g0, dmd, s);
-        if alpha == 0.0 {
-            // No descent along the direction (the minimum to round-off).
-            stalled = true;
-            break;
-        }
-        // The move: a, M a and J a − aref along the direction (MuJoCo's mj_solPrimal updates
-        // them the same way instead of forming the products again).
-        qacc.axpy(alpha, &soft.dir, 1.0);
-        soft.ma.axpy(alpha, &soft.mdir, 1.0);
-        for (j, &v) in soft.jar.as_mut_slice()[..nefc].iter_mut().zip(&soft.jv.as_slice()[..nefc]) {
-            *j += alpha * v;
-        }
-        let new_cost = gauss(qacc, &soft.ma) + rows.update(&soft.jar, efc_force, efc_state);
-        improvement = s.scale * (cost - new_cost);
-        cost = new_cost;
     }
     // qfrc_constraint = Jᵀ f.
     qfrc_constraint.fill(0.0);
@@ -364,7 +341,11 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     // MuJoCo's criterion: converged when the scaled gradient or improvement fell below the
     // tolerance (or the line search found no descent: the minimum to round-off); else the solve
     // stopped at its iteration limit, counted with its scaled gradient as the residual.
-    let converged = stalled || gradient < s.tolerance || improvement < s.tolerance;
+    let converged = if island_path {
+        converged_islands
+    } else {
+        stalled || gradient < s.tolerance || improvement < s.tolerance
+    };
     data.efc_converged = converged;
     if !converged {
         data.efc_unconverged += 1;
@@ -385,13 +366,20 @@ fn line_search(
     s: Settings,
 ) -> f64 {
     let n = rows.nefc;
-    let mut deriv = |alpha: f64| {
+    let deriv = |alpha: f64| {
         for ((t, &j), &v) in trial.as_mut_slice()[..n].iter_mut().zip(jar.as_slice()).zip(jv.as_slice()) {
             *t = j + alpha * v;
         }
         let (d1, d2) = rows.directional(trial, jv);
         (g0 + alpha * dmd + d1, dmd + d2)
     };
+    line_search_with(deriv, s)
+}
+
+/// The line search's iteration on the cost's slope and curvature along the direction at step α
+/// (`deriv(α)`): Newton steps safeguarded by a sign-change bracket (secant, then bisection).
+/// Returns 0 if the direction does not descend.
+pub(super) fn line_search_with(mut deriv: impl FnMut(f64) -> (f64, f64), s: Settings) -> f64 {
     let (f0, h0) = deriv(0.0);
     if f0 >= 0.0 || !f0.is_finite() {
         return 0.0;
