@@ -5,10 +5,9 @@
 //! The rows come one block at a time from [`Rows::hessian`](super::cost::Rows::hessian): a
 //! weight D on a quadratic row, or a dense block on an elliptic contact's rows. Rows of one contact
 //! share their nonzero columns (`jacobian::append_rows` records a contact's rows over the union of
-//! their nonzeros), so they are summed as a group: for each column q of the group, the group's
-//! contribution to H's column q is formed in a contiguous scratch vector (products of the rows'
-//! compact values, which the compiler vectorizes) and added to H once — instead of one scattered
-//! read–modify–write of H per row and entry. Consecutive scalar rows with the same columns (a
+//! their nonzeros), so they are summed as a group: each entry's sum over the group's rows is
+//! formed in a register from the rows' compact values and added to H once — instead of one
+//! scattered read–modify–write of H per row and entry. Consecutive scalar rows with the same columns (a
 //! pyramidal contact's edges in their quadratic state) form one group; an elliptic contact's
 //! block multiplies its rows first (W = B G, G the rows' values), then Gᵀ W is summed the same
 //! way. Rows whose columns differ (J recorded by the full scan, which drops exact zeros) are
@@ -17,8 +16,11 @@
 use super::primal::Sparsity;
 use nalgebra::DMatrix;
 
-/// The most scalar rows summed as one group (a pyramidal contact of condim 6 has 10).
-const GROUP: usize = 16;
+/// The most scalar rows summed as one group (a pyramidal contact of condim 3 has 4; larger
+/// groups are split: the sums are unrolled up to 4 rows).
+const GROUP: usize = 4;
+/// The most rows of a block (an elliptic contact of condim 6).
+const BLOCK: usize = 6;
 
 /// Adds the rows' Hessian blocks to H's lower triangle (see the module doc). Scalar rows are
 /// held in a pending group until a row with other columns (or a block) arrives; [`finish`]
@@ -28,8 +30,6 @@ const GROUP: usize = 16;
 pub(super) struct Assembler<'a> {
     h: &'a mut DMatrix<f64>,
     nz: &'a Sparsity<'a>,
-    /// One column of a group's contribution (nv long).
-    column: &'a mut [f64],
     /// The pending group: its rows and their weights.
     rows: [usize; GROUP],
     weights: [f64; GROUP],
@@ -37,9 +37,9 @@ pub(super) struct Assembler<'a> {
 }
 
 impl<'a> Assembler<'a> {
-    /// An assembler adding to `h` (nv × nv) the rows of `nz`; `column` is nv-long scratch.
-    pub fn new(h: &'a mut DMatrix<f64>, nz: &'a Sparsity<'a>, column: &'a mut [f64]) -> Self {
-        Self { h, nz, column, rows: [0; GROUP], weights: [0.0; GROUP], len: 0 }
+    /// An assembler adding to `h` (nv × nv) the rows of `nz`.
+    pub fn new(h: &'a mut DMatrix<f64>, nz: &'a Sparsity<'a>) -> Self {
+        Self { h, nz, rows: [0; GROUP], weights: [0.0; GROUP], len: 0 }
     }
 
     /// Adds block `block` (dim × dim, symmetric) on rows i..i + dim: Jᵀ B J over those rows.
@@ -78,68 +78,33 @@ impl<'a> Assembler<'a> {
             return;
         }
         self.len = 0;
-        let first = self.rows[0];
-        let (cols, _) = self.nz.row_values(first);
-        let n = cols.len();
-        let nv = self.h.nrows();
-        let h = self.h.as_mut_slice();
-        for q in 0..n {
-            let t = &mut self.column[q..n];
-            for (r, (&row, &w)) in self.rows[..k].iter().zip(&self.weights[..k]).enumerate() {
-                let g = &self.nz.row_values(row).1[q..n];
-                let c = w * g[0];
-                if r == 0 {
-                    for (t, &g) in t.iter_mut().zip(g) {
-                        *t = c * g;
-                    }
-                } else {
-                    for (t, &g) in t.iter_mut().zip(g) {
-                        *t += c * g;
-                    }
-                }
-            }
-            let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
-            for (&p, &v) in cols[q..n].iter().zip(t.iter()) {
-                column[p] += v;
-            }
+        let cols = self.nz.columns(self.rows[0]);
+        let mut g: [&[f64]; GROUP] = [&[]; GROUP];
+        for (g, &row) in g.iter_mut().zip(&self.rows[..k]) {
+            *g = self.nz.row_values(row).1;
         }
+        let weights = self.weights;
+        add_columns(self.h, cols, &g[..k], |q, c| {
+            for ((c, &w), g) in c.iter_mut().zip(&weights[..k]).zip(&g[..k]) {
+                *c = w * g[q];
+            }
+        });
     }
 
     /// Rows i..i + dim with the same columns and a dense block B: with G the rows' values,
     /// H[p][q] += Σ_a G_a[p] (B G)_a[q], p ≥ q.
     fn add_block(&mut self, i: usize, dim: usize, block: &[[f64; 6]; 6]) {
-        let (cols, _) = self.nz.row_values(i);
-        let n = cols.len();
-        let nv = self.h.nrows();
-        let h = self.h.as_mut_slice();
-        let mut g: [&[f64]; 6] = [&[]; 6];
+        let cols = self.nz.columns(i);
+        let mut g: [&[f64]; BLOCK] = [&[]; BLOCK];
         for (a, g) in g.iter_mut().enumerate().take(dim) {
             *g = self.nz.row_values(i + a).1;
         }
-        for q in 0..n {
-            // (B G)[a][q] for each row a of the block.
-            let mut w = [0.0; 6];
-            for (a, w) in w.iter_mut().enumerate().take(dim) {
-                *w = (0..dim).map(|b| block[a][b] * g[b][q]).sum();
+        let rows = g;
+        add_columns(self.h, cols, &g[..dim], |q, c| {
+            for (a, c) in c.iter_mut().enumerate() {
+                *c = (0..dim).map(|b| block[a][b] * rows[b][q]).sum();
             }
-            let t = &mut self.column[q..n];
-            for (a, &c) in w.iter().enumerate().take(dim) {
-                let ga = &g[a][q..n];
-                if a == 0 {
-                    for (t, &x) in t.iter_mut().zip(ga) {
-                        *t = c * x;
-                    }
-                } else {
-                    for (t, &x) in t.iter_mut().zip(ga) {
-                        *t += c * x;
-                    }
-                }
-            }
-            let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
-            for (&p, &v) in cols[q..n].iter().zip(t.iter()) {
-                column[p] += v;
-            }
-        }
+        });
     }
 
     /// H[p][q] += w J[a][p] J[b][q] over the nonzero columns p ≥ q of rows a and b.
@@ -153,6 +118,60 @@ impl<'a> Assembler<'a> {
             for (&p, &j_ap) in row_a.iter().zip(j_a) {
                 if p >= q {
                     column[p] += j_ap * c;
+                }
+            }
+        }
+    }
+}
+
+/// H[p][q] += Σ_r c_r(q) G_r[p] over columns q of `cols` and p ≥ q (rows `g`, all on `cols`;
+/// `coefficients(q, c)` writes c_r(q) for column position q): each entry's sum is formed in a
+/// register, in row order, and added to H once.
+fn add_columns(
+    h: &mut DMatrix<f64>,
+    cols: &[usize],
+    g: &[&[f64]],
+    mut coefficients: impl FnMut(usize, &mut [f64]),
+) {
+    let (n, k) = (cols.len(), g.len());
+    let nv = h.nrows();
+    let h = h.as_mut_slice();
+    let mut c = [0.0; BLOCK];
+    for q in 0..n {
+        coefficients(q, &mut c[..k]);
+        let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
+        let rows = &cols[q..];
+        match k {
+            1 => {
+                for (&p, &g0) in rows.iter().zip(&g[0][q..n]) {
+                    column[p] += c[0] * g0;
+                }
+            }
+            2 => {
+                for ((&p, &g0), &g1) in rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]) {
+                    column[p] += c[0] * g0 + c[1] * g1;
+                }
+            }
+            3 => {
+                for (((&p, &g0), &g1), &g2) in rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n])
+                {
+                    column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2;
+                }
+            }
+            4 => {
+                for ((((&p, &g0), &g1), &g2), &g3) in
+                    rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n]).zip(&g[3][q..n])
+                {
+                    column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2 + c[3] * g3;
+                }
+            }
+            _ => {
+                for (t, &p) in rows.iter().enumerate() {
+                    let mut v = c[0] * g[0][q + t];
+                    for r in 1..k {
+                        v += c[r] * g[r][q + t];
+                    }
+                    column[p] += v;
                 }
             }
         }
@@ -216,8 +235,7 @@ mod tests {
         };
         let blocks = [(0, 1, scalar(2.0)), (1, 1, scalar(0.5)), (2, 1, scalar(3.0)), (3, 3, b3), (6, 2, b2)];
         let mut h = DMatrix::zeros(nv, nv);
-        let mut column = vec![0.0; nv];
-        let mut asm = Assembler::new(&mut h, &nz, &mut column);
+        let mut asm = Assembler::new(&mut h, &nz);
         for &(i, dim, b) in &blocks {
             asm.add(i, dim, &b);
         }

@@ -39,7 +39,9 @@ pub(crate) struct Islands {
     pub dofs: Vec<usize>,
     pub row_start: Vec<usize>,
     pub rows: Vec<usize>,
-    /// Union–find parents over dofs, and each root's island while numbering.
+    /// Each dof's tree (its root dof), union–find parents over trees (by their root dofs), and
+    /// each root's island while numbering.
+    tree: Vec<usize>,
     parent: Vec<usize>,
     root_island: Vec<usize>,
     /// Per island: scale (1 / Σ M_kk), cost, last improvement and gradient, iterations, and
@@ -72,6 +74,7 @@ impl Islands {
             dofs: per(nv),
             row_start: per(nv),
             rows: per(nefc),
+            tree: per(nv),
             parent: per(nv),
             root_island: per(nv),
             scale: per(nv),
@@ -115,18 +118,25 @@ impl Islands {
         nz: &Sparsity,
         m: &DMatrix<f64>,
     ) {
+        // Each dof's tree (its root dof: parents come first), then one union per pair of trees
+        // a row joins (a row's columns run tree by tree).
+        self.tree.clear();
+        for k in 0..nv {
+            let t = if dof_parent[k] == NO_DOF { k } else { self.tree[dof_parent[k]] };
+            self.tree.push(t);
+        }
         self.parent.clear();
         self.parent.extend(0..nv);
-        for k in 0..nv {
-            if dof_parent[k] != NO_DOF {
-                self.union(k, dof_parent[k]);
-            }
-        }
         for i in 0..nefc {
             let cols = nz.columns(i);
             if let Some((&first, rest)) = cols.split_first() {
+                let (t0, mut last) = (self.tree[first], self.tree[first]);
                 for &c in rest {
-                    self.union(first, c);
+                    let t = self.tree[c];
+                    if t != last {
+                        self.union(t0, t);
+                        last = t;
+                    }
                 }
             }
         }
@@ -137,7 +147,7 @@ impl Islands {
         for i in 0..nefc {
             let island = match nz.columns(i).first() {
                 Some(&c) => {
-                    let r = self.find(c);
+                    let r = self.find(self.tree[c]);
                     if self.root_island[r] == NONE {
                         self.root_island[r] = self.n;
                         self.n += 1;
@@ -150,7 +160,7 @@ impl Islands {
         }
         self.dof.clear();
         for k in 0..nv {
-            let r = self.find(k);
+            let r = self.find(self.tree[k]);
             self.dof.push(self.root_island[r]);
         }
         let n = self.n;
@@ -358,7 +368,7 @@ pub(super) fn newton(
             analyzed = true;
         }
         {
-            let mut rows_h = Assembler::new(h, nz, &mut soft.hessian_column);
+            let mut rows_h = Assembler::new(h, nz);
             let (row_island, active) = (&isl.row, &isl.active);
             rows.hessian(&soft.jar, state, |i, dim, block| {
                 if row_island[i] != NONE && active[row_island[i]] {
