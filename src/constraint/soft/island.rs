@@ -127,8 +127,14 @@ impl Islands {
         }
         self.parent.clear();
         self.parent.extend(0..nv);
+        let mut previous: &[usize] = &[];
         for i in 0..nefc {
             let cols = nz.columns(i);
+            // A contact's rows share their columns: its first row joins them.
+            if cols == previous {
+                continue;
+            }
+            previous = cols;
             if let Some((&first, rest)) = cols.split_first() {
                 let (t0, mut last) = (self.tree[first], self.tree[first]);
                 for &c in rest {
