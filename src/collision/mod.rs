@@ -47,6 +47,7 @@ pub mod multiccd;
 pub mod obb;
 pub mod plane;
 pub mod plane_mesh;
+pub mod polygon_clip;
 pub mod ray;
 pub mod sphere_cylinder;
 

@@ -48,8 +48,6 @@ use std::cell::RefCell;
 const FACE_TOL: f64 = 0.996;
 /// |cosine| below which an edge counts as parallel to a face (MuJoCo's `mjEDGE_TOL`, ~5.1°).
 const EDGE_TOL: f64 = 0.0888;
-/// MuJoCo's `mjMINVAL`.
-const MINVAL: f64 = 1e-15;
 
 /// Scratch buffers of the clipping, reused per thread (no allocation once grown).
 #[derive(Default)]
@@ -57,8 +55,7 @@ struct Scratch {
     face1: Vec<Vec3>,
     face2: Vec<Vec3>,
     poly: Vec<Vec3>,
-    clipped: Vec<Vec3>,
-    inside: Vec<bool>,
+    clip: super::polygon_clip::ClipScratch,
     normals1: Vec<(Vec3, u32)>,
     normals2: Vec<(Vec3, u32)>,
     feature1: Vec<u32>,
@@ -323,18 +320,9 @@ pub fn polytope_contacts(
             let (n2, f2) = s.normals2[j];
             face_polygon(&p1, x1, f1, &mut tmp, &mut s.face1);
             face_polygon(&p2, x2, f2, &mut tmp, &mut s.face2);
-            clip(
-                &s.face1,
-                &s.face2,
-                &n1,
-                &n2,
-                margin,
-                false,
-                &mut s.poly,
-                &mut s.clipped,
-                &mut s.inside,
-                &mut |w1, w2, d| out(w1, w2, d, false, -n2),
-            );
+            clip(&s.face1, &s.face2, &n1, &n2, margin, false, &mut s.poly, &mut s.clip, &mut |w1, w2, d| {
+                out(w1, w2, d, false, -n2)
+            });
         } else if dim1 < 3 && dim1 <= dim2 {
             // An edge of geom 1 against a face of geom 2.
             feature_edges(&p1, x1, &s.feature1, &mut tmp, &mut s.faces, &mut s.face1);
@@ -352,8 +340,7 @@ pub fn polytope_contacts(
                     margin,
                     false,
                     &mut s.poly,
-                    &mut s.clipped,
-                    &mut s.inside,
+                    &mut s.clip,
                     &mut |w1, w2, d| out(w1, w2, d, true, -n2),
                 );
             }
@@ -374,8 +361,7 @@ pub fn polytope_contacts(
                     margin,
                     false,
                     &mut s.poly,
-                    &mut s.clipped,
-                    &mut s.inside,
+                    &mut s.clip,
                     &mut |w1, w2, d| out(w1, w2, d, false, n1),
                 );
             }
@@ -423,8 +409,7 @@ fn clip(
     margin: f64,
     octagon: bool,
     poly: &mut Vec<Vec3>,
-    next: &mut Vec<Vec3>,
-    flags: &mut Vec<bool>,
+    scratch: &mut super::polygon_clip::ClipScratch,
     out: &mut dyn FnMut(Vec3, Vec3, f64),
 ) {
     if face.len() < 3 {
@@ -432,59 +417,7 @@ fn clip(
     }
     poly.clear();
     poly.extend_from_slice(clipped_in);
-    let m = face.len();
-    // A side plane that keeps every point only turns the polygon by one (the pass's output
-    // starts at the second point): such sides are counted instead of walked, the turns applied
-    // before the next side that cuts and at the end — the same points in the same order, one
-    // test per point instead of a pass per side (a face of many vertices, a finger pad's, keeps
-    // most of a polygon inside most of its sides).
-    let mut turns = 0;
-    for k in 0..m {
-        let (a, b) = (face[k], face[(k + 1) % m]);
-        // Inward normal of the side plane through edge a→b (clockwise about n).
-        let pn = (b - a).cross(n).normalize();
-        let pd = pn.dot(&a);
-        let inside = |p: &Vec3| (p - a).dot(&pn) > -MINVAL;
-        // Each point's side once.
-        flags.clear();
-        flags.extend(poly.iter().map(inside));
-        if flags.iter().all(|&f| f) {
-            turns += 1;
-            continue;
-        }
-        let np = poly.len();
-        poly.rotate_left(turns % np);
-        flags.rotate_left(turns % np);
-        turns = 0;
-        next.clear();
-        for i in 0..np {
-            let (p, q) = (poly[i], poly[(i + 1) % np]);
-            let (ip, iq) = (flags[i], flags[(i + 1) % np]);
-            if !ip && !iq {
-                continue;
-            }
-            if ip && iq {
-                next.push(q);
-                continue;
-            }
-            let pq = q - p;
-            let den = pn.dot(&pq);
-            if den != 0.0 {
-                let t = (pd - pn.dot(&p)) / den;
-                if (0.0..=1.0).contains(&t) {
-                    next.push(p + pq * t);
-                }
-            }
-            if iq {
-                next.push(q);
-            }
-        }
-        std::mem::swap(poly, next);
-    }
-    if !poly.is_empty() {
-        let np = poly.len();
-        poly.rotate_left(turns % np);
-    }
+    super::polygon_clip::clip_by_face_sides(face, n, poly, scratch);
     poly.retain(|p| (p - face[0]).dot(n) <= margin);
     if poly.is_empty() {
         return;
@@ -685,21 +618,10 @@ fn cap_polytope(
                 s.face1.push(centre + (e1 * t.cos() + e2 * t.sin()) * r);
             }
             face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
-            clip(
-                &s.face1,
-                &s.face2,
-                &n1,
-                &n2,
-                margin,
-                true,
-                &mut s.poly,
-                &mut s.clipped,
-                &mut s.inside,
-                &mut |w1, w2, d| {
-                    emit(PairPoint { p1: w1, p2: w2, normal: -n2, dist: d });
-                    count += 1;
-                },
-            );
+            clip(&s.face1, &s.face2, &n1, &n2, margin, true, &mut s.poly, &mut s.clip, &mut |w1, w2, d| {
+                emit(PairPoint { p1: w1, p2: w2, normal: -n2, dist: d });
+                count += 1;
+            });
         }
         s.tmp = tmp;
         count
@@ -748,8 +670,7 @@ fn segment_polytope(
                 margin + r,
                 false,
                 &mut s.poly,
-                &mut s.clipped,
-                &mut s.inside,
+                &mut s.clip,
                 &mut |_, v, _| {
                     let d = (v - s.face2[0]).dot(&n2);
                     emit(PairPoint { p1: v - n2 * r, p2: v - n2 * d, normal: -n2, dist: d - r });
