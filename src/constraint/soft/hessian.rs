@@ -6,7 +6,8 @@
 //! weight D on a quadratic row, or a dense block on an elliptic contact's rows. Rows of one contact
 //! share their nonzero columns (`jacobian::append_rows` records a contact's rows over the union of
 //! their nonzeros), so they are summed as a group: each entry's sum over the group's rows is
-//! formed in a register from the rows' compact values and added to H once — instead of one
+//! formed from the rows' compact values (in a register, or four rows at a time in a scratch
+//! column for larger groups) and added to H once — instead of one
 //! scattered read–modify–write of H per row and entry. Consecutive scalar rows with the same columns (a
 //! pyramidal contact's edges in their quadratic state) form one group; an elliptic contact's
 //! block multiplies its rows first (W = B G, G the rows' values), then Gᵀ W is summed the same
@@ -16,9 +17,9 @@
 use super::primal::Sparsity;
 use nalgebra::DMatrix;
 
-/// The most scalar rows summed as one group (a pyramidal contact of condim 3 has 4; larger
-/// groups are split: the sums are unrolled up to 4 rows).
-const GROUP: usize = 4;
+/// The most scalar rows summed as one group (a pyramidal contact of condim 6 has 10; a box
+/// on a plane, four contacts on the same dofs, 16).
+const GROUP: usize = 16;
 /// The most rows of a block (an elliptic contact of condim 6).
 const BLOCK: usize = 6;
 
@@ -30,6 +31,8 @@ const BLOCK: usize = 6;
 pub(super) struct Assembler<'a> {
     h: &'a mut DMatrix<f64>,
     nz: &'a Sparsity<'a>,
+    /// One column of a group's sum, for groups of more than four rows (nv long).
+    column: &'a mut [f64],
     /// The pending group: its rows and their weights.
     rows: [usize; GROUP],
     weights: [f64; GROUP],
@@ -37,9 +40,9 @@ pub(super) struct Assembler<'a> {
 }
 
 impl<'a> Assembler<'a> {
-    /// An assembler adding to `h` (nv × nv) the rows of `nz`.
-    pub fn new(h: &'a mut DMatrix<f64>, nz: &'a Sparsity<'a>) -> Self {
-        Self { h, nz, rows: [0; GROUP], weights: [0.0; GROUP], len: 0 }
+    /// An assembler adding to `h` (nv × nv) the rows of `nz`; `column` is nv-long scratch.
+    pub fn new(h: &'a mut DMatrix<f64>, nz: &'a Sparsity<'a>, column: &'a mut [f64]) -> Self {
+        Self { h, nz, column, rows: [0; GROUP], weights: [0.0; GROUP], len: 0 }
     }
 
     /// Adds block `block` (dim × dim, symmetric) on rows i..i + dim: Jᵀ B J over those rows.
@@ -84,7 +87,7 @@ impl<'a> Assembler<'a> {
             *g = self.nz.row_values(row).1;
         }
         let weights = self.weights;
-        add_columns(self.h, cols, &g[..k], |q, c| {
+        add_columns(self.h, cols, &g[..k], self.column, |q, c| {
             for ((c, &w), g) in c.iter_mut().zip(&weights[..k]).zip(&g[..k]) {
                 *c = w * g[q];
             }
@@ -100,7 +103,7 @@ impl<'a> Assembler<'a> {
             *g = self.nz.row_values(i + a).1;
         }
         let rows = g;
-        add_columns(self.h, cols, &g[..dim], |q, c| {
+        add_columns(self.h, cols, &g[..dim], self.column, |q, c| {
             for (a, c) in c.iter_mut().enumerate() {
                 *c = (0..dim).map(|b| block[a][b] * rows[b][q]).sum();
             }
@@ -125,18 +128,20 @@ impl<'a> Assembler<'a> {
 }
 
 /// H[p][q] += Σ_r c_r(q) G_r[p] over columns q of `cols` and p ≥ q (rows `g`, all on `cols`;
-/// `coefficients(q, c)` writes c_r(q) for column position q): each entry's sum is formed in a
-/// register, in row order, and added to H once.
+/// `coefficients(q, c)` writes c_r(q) for column position q): each entry's sum is formed in row
+/// order — in a register up to four rows, in `scratch` four rows at a time beyond — and added to
+/// H once.
 fn add_columns(
     h: &mut DMatrix<f64>,
     cols: &[usize],
     g: &[&[f64]],
+    scratch: &mut [f64],
     mut coefficients: impl FnMut(usize, &mut [f64]),
 ) {
     let (n, k) = (cols.len(), g.len());
     let nv = h.nrows();
     let h = h.as_mut_slice();
-    let mut c = [0.0; BLOCK];
+    let mut c = [0.0; GROUP];
     for q in 0..n {
         coefficients(q, &mut c[..k]);
         let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
@@ -166,11 +171,50 @@ fn add_columns(
                 }
             }
             _ => {
-                for (t, &p) in rows.iter().enumerate() {
-                    let mut v = c[0] * g[0][q + t];
-                    for r in 1..k {
-                        v += c[r] * g[r][q + t];
+                // Four rows at a time into the scratch column, left to right (the same sum).
+                let t = &mut scratch[..n - q];
+                let (g0, g1, g2, g3) = (&g[0][q..n], &g[1][q..n], &g[2][q..n], &g[3][q..n]);
+                for ((((t, &a0), &a1), &a2), &a3) in t.iter_mut().zip(g0).zip(g1).zip(g2).zip(g3) {
+                    *t = c[0] * a0 + c[1] * a1 + c[2] * a2 + c[3] * a3;
+                }
+                let mut r = 4;
+                while r < k {
+                    match k - r {
+                        1 => {
+                            for (t, &a0) in t.iter_mut().zip(&g[r][q..n]) {
+                                *t += c[r] * a0;
+                            }
+                            r += 1;
+                        }
+                        2 => {
+                            for ((t, &a0), &a1) in t.iter_mut().zip(&g[r][q..n]).zip(&g[r + 1][q..n]) {
+                                *t = *t + c[r] * a0 + c[r + 1] * a1;
+                            }
+                            r += 2;
+                        }
+                        3 => {
+                            for (((t, &a0), &a1), &a2) in
+                                t.iter_mut().zip(&g[r][q..n]).zip(&g[r + 1][q..n]).zip(&g[r + 2][q..n])
+                            {
+                                *t = *t + c[r] * a0 + c[r + 1] * a1 + c[r + 2] * a2;
+                            }
+                            r += 3;
+                        }
+                        _ => {
+                            for ((((t, &a0), &a1), &a2), &a3) in t
+                                .iter_mut()
+                                .zip(&g[r][q..n])
+                                .zip(&g[r + 1][q..n])
+                                .zip(&g[r + 2][q..n])
+                                .zip(&g[r + 3][q..n])
+                            {
+                                *t = *t + c[r] * a0 + c[r + 1] * a1 + c[r + 2] * a2 + c[r + 3] * a3;
+                            }
+                            r += 4;
+                        }
                     }
+                }
+                for (&p, &v) in rows.iter().zip(t.iter()) {
                     column[p] += v;
                 }
             }
@@ -235,7 +279,8 @@ mod tests {
         };
         let blocks = [(0, 1, scalar(2.0)), (1, 1, scalar(0.5)), (2, 1, scalar(3.0)), (3, 3, b3), (6, 2, b2)];
         let mut h = DMatrix::zeros(nv, nv);
-        let mut asm = Assembler::new(&mut h, &nz);
+        let mut column = vec![0.0; nv];
+        let mut asm = Assembler::new(&mut h, &nz, &mut column);
         for &(i, dim, b) in &blocks {
             asm.add(i, dim, &b);
         }

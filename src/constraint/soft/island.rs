@@ -374,7 +374,7 @@ pub(super) fn newton(
             analyzed = true;
         }
         {
-            let mut rows_h = Assembler::new(h, nz);
+            let mut rows_h = Assembler::new(h, nz, &mut soft.hessian_column);
             let (row_island, active) = (&isl.row, &isl.active);
             rows.hessian(&soft.jar, state, |i, dim, block| {
                 if row_island[i] != NONE && active[row_island[i]] {

@@ -263,7 +263,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                     // Small: H = M + Jᵀ (∂²s) J, its lower triangle (all the dense Cholesky
                     // reads), by dense Cholesky.
                     soft.hessian.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
-                    let mut rows_h = Assembler::new(&mut soft.hessian, &nz);
+                    let mut rows_h = Assembler::new(&mut soft.hessian, &nz, &mut soft.hessian_column);
                     rows.hessian(&soft.jar, efc_state, |i, dim, block| rows_h.add(i, dim, block));
                     rows_h.finish();
                     soft.dir.copy_from(&soft.grad);
