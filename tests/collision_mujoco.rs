@@ -190,9 +190,9 @@ fn compare(model: &Model, data: &mut Data, case: &Case, worst: &mut Worst) -> Re
 /// test asserts they still differ, so that a fix shows up here. (Spheres and capsules follow
 /// MuJoCo's closed forms since src/collision/capsule.rs: its coincident-centre normals and the
 /// two contacts of parallel capsules match.)
-const KNOWN_DIFFERENCES: &[(&str, &str, &str)] = &[
-    ("plane_mesh_femoris", "face20", "the facing triangle and a neighbour within 1e-6 of coplanar are one face polygon here, whose fourth corner lies within the margin; MuJoCo 4.0 reports the deepest vertex alone (its compiler groups facets by normal angles rounded to 0.01 rad in the mesh's inertial frame, and these two fall in different groups; src/collision/plane_mesh.rs COPLANAR)"),
-];
+// (None since the mesh hulls are MuJoCo's qhull hulls and polygons, src/collision/mesh_graph.rs:
+// the femoris face that lagrange's own coplanar merging grouped differently now matches.)
+const KNOWN_DIFFERENCES: &[(&str, &str, &str)] = &[];
 
 fn golden(pair: &str) -> Golden {
     let file =

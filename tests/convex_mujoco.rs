@@ -50,34 +50,38 @@ struct MjContact {
     dist: f64,
 }
 
-const MESH: &str = "the first contact of a margin scene comes from MuJoCo's EPA on margin-inflated geoms, which stops at ccd_tolerance; more than \
-    four clipped points are pruned by MuJoCo 4.0's quadrilateral search, which keeps the clipped polygon's first point: \
-    that is where MuJoCo's mesh polygon starts (the first qhull facet merged into it, not known here; box_prism9); in a few edge contacts MuJoCo's EPA ends on a face with three vertices of one geom and clips an edge \
-    where lagrange finds no aligned feature";
+const MESH: &str = "the first contact of a margin scene comes from MuJoCo's EPA on margin-inflated geoms, which stops at ccd_tolerance \
+    (box_cube_margin); in a few edge contacts MuJoCo's EPA ends on a face with three vertices of one geom and clips an edge \
+    where lagrange finds no aligned feature (the count mismatches); box_link5/random12 clips another face pair (lagrange takes \
+    the most nearly opposite of the aligned pairs, MuJoCo the first it meets). The hulls and face polygons are MuJoCo's own \
+    (qhull, collision::mesh_graph), so clipped polygons start where MuJoCo's do";
 const SMOOTH: &str =
-    "lagrange runs MuJoCo's own GJK/EPA (collision::ccd) to ccd_tolerance; the rest start from another \
-    centre (a mesh geom's frame is the file's, MuJoCo's its inertial frame) or differ by round-off in \
-    a step of the tolerance-limited iteration: within MuJoCo's own ccd_tolerance-sized error";
+    "lagrange runs MuJoCo's own GJK/EPA (collision::ccd) to ccd_tolerance from geom poses equal to \
+    MuJoCo's to the bit; the rest start from another centre (a mesh geom's frame is the file's, MuJoCo's \
+    its inertial frame) or differ by round-off in a step of the tolerance-limited iteration (the live \
+    library's compiled sums pair terms differently from its source, as its mju_quat2Mat shows: the \
+    third GJK direction of ellipsoid_box/random4 already differs in the last bit), which moves the \
+    point along MuJoCo's own ccd_tolerance-sized error; which cases match is chaotic in the last bit";
 const SEGMENT: &str = "a capsule's segment, a cylinder's side line and its cap (an octagon) are clipped \
     against a polytope face as MuJoCo 4.0's contacts show, but the single contact they start from is any point of a \
-    flat overlap for EPA (MuJoCo's and parry's differ) and MuJoCo's curved geoms stop at ccd_tolerance; MuJoCo merges \
-    a mesh's coplanar facets into polygons differently from parry (other clip boundaries); the cap's quadrilateral \
-    depends on MuJoCo's polygon order; capsule/cylinder pairs with each other are one contact here";
+    flat overlap for EPA (MuJoCo's and lagrange's differ) and MuJoCo's curved geoms stop at ccd_tolerance; \
+    capsule/cylinder pairs with each other are one contact here; the EPA start is chaotic in the last bit of \
+    GJK's arithmetic (see SMOOTH)";
 
 /// Per pair type: (pair, fewest cases that must match MuJoCo to [`COLLISION_ABS`] (count and
 /// every contact; cases without contacts included), most cases whose contact count may differ,
 /// why the others differ). A regression bound on the figures measured at the commit.
 const EXPECTED: &[(&str, usize, usize, &str)] = &[
-    ("box_mesh", 85, 1, MESH),
-    ("mesh_mesh", 59, 3, MESH),
+    ("box_mesh", 102, 1, MESH),
+    ("mesh_mesh", 73, 3, MESH),
     ("capsule_mesh", 18, 4, SEGMENT),
-    ("capsule_cylinder", 17, 1, SEGMENT),
-    ("cylinder_box", 19, 0, SEGMENT),
+    ("capsule_cylinder", 16, 1, SEGMENT),
+    ("cylinder_box", 18, 0, SEGMENT),
     ("cylinder_cylinder", 14, 1, SEGMENT),
     ("cylinder_mesh", 11, 0, SEGMENT),
     ("sphere_mesh", 20, 0, SMOOTH),
     ("sphere_ellipsoid", 9, 0, SMOOTH),
-    ("capsule_ellipsoid", 8, 0, SMOOTH),
+    ("capsule_ellipsoid", 7, 0, SMOOTH),
     ("ellipsoid_ellipsoid", 7, 0, SMOOTH),
     ("ellipsoid_cylinder", 7, 0, SMOOTH),
     ("ellipsoid_box", 8, 0, SMOOTH),

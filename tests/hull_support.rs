@@ -5,11 +5,12 @@
 //! vertex unless two are exactly as far).
 
 use lagrange::collision::hull_support::HullSupport;
-use lagrange::mass::{convex_hull, read_mesh};
+use lagrange::collision::mesh_graph::{distinct_vertices, MeshGraph};
+use lagrange::mass::read_mesh;
 use lagrange::spatial::Vec3;
 use parry3d_f64::math::Vector;
-use parry3d_f64::shape::ConvexPolyhedron;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// The first point farthest along `dir` (the exhaustive scan).
 fn scan(points: &[Vector], dir: Vector) -> usize {
@@ -54,10 +55,9 @@ fn hill_climbing_support_equals_the_exhaustive_scan_on_every_corpus_hull() {
     let (mut hulls, mut queries, mut same_vertex) = (0, 0, 0);
     for path in meshes() {
         let mesh = read_mesh(&path, &Vec3::new(1.0, 1.0, 1.0)).unwrap();
-        let hull = convex_hull(&mesh.vertices).unwrap();
-        let points: Vec<Vector> = hull.vertices.iter().map(|v| Vector::new(v.x, v.y, v.z)).collect();
-        let support = HullSupport::new(ConvexPolyhedron::from_convex_hull(&points).unwrap());
-        let pts = support.polyhedron().points();
+        let (points, _) = distinct_vertices(&mesh.vertices);
+        let support = HullSupport::new(Arc::new(MeshGraph::new(&points, &points, &points, -1).unwrap()));
+        let pts = support.points();
         let mut dirs: Vec<Vector> = (0..27)
             .filter(|&k| k != 13)
             .map(|k| Vector::new((k / 9) as f64 - 1.0, ((k / 3) % 3) as f64 - 1.0, (k % 3) as f64 - 1.0))

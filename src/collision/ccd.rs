@@ -127,19 +127,21 @@ impl<'a> CcdObj<'a> {
                 s
             }
             ConvexShape::Hull(h) => {
-                let points = h.polyhedron().points();
+                let points = h.points();
                 let d = parry3d_f64::math::Vector::new(local.x, local.y, local.z);
-                let i = if points.len() < HILLCLIMB_MIN {
+                // MuJoCo climbs meshes of at least HILLCLIMB_MIN vertices (all of the mesh's,
+                // `mesh_vertnum`), and scans the others in their vertex-list order.
+                let i = if h.graph().nvert < HILLCLIMB_MIN {
                     // Exhaustive, from the cached vertex (ties keep the earlier best).
                     let (mut imax, mut max) = (0usize, f32::MIN as f64);
                     if self.vertindex >= 0 {
                         imax = self.vertindex as usize;
                         max = d.dot(points[imax]);
                     }
-                    for (i, p) in points.iter().enumerate() {
-                        let v = d.dot(*p);
+                    for &i in h.scan_order() {
+                        let v = d.dot(points[i as usize]);
                         if v > max {
-                            (max, imax) = (v, i);
+                            (max, imax) = (v, i as usize);
                         }
                     }
                     imax

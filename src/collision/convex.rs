@@ -194,7 +194,7 @@ impl SupportMap for Warm<'_> {
         if let ConvexShape::Hull(h) = self.shape {
             let i = h.support_index_warm(dir, self.last.get());
             self.last.set(i as i32);
-            return h.polyhedron().points()[i];
+            return h.points()[i];
         }
         self.shape.local_support_point(dir)
     }

@@ -5,64 +5,64 @@
 //! none is. On a convex polytope a vertex that no neighbour improves on is the farthest of all, so
 //! the result is the exhaustive scan's (vertices exactly as far apart along the direction may give
 //! another of them) at a cost that grows with the number of edges walked instead of the number of
-//! vertices (parry3d's `ConvexPolyhedron` scans every vertex).
+//! vertices. The hull, its vertex order and its edges' order are MuJoCo's mesh graph (qhull's,
+//! [`super::mesh_graph`]), so ties and warm starts walk as MuJoCo's climb does.
 
+use super::mesh_graph::MeshGraph;
 use parry3d_f64::math::Vector;
-use parry3d_f64::shape::{ConvexPolyhedron, SupportMap};
+use parry3d_f64::shape::SupportMap;
+use std::sync::Arc;
 
 /// A convex hull with its vertex adjacency, for hill-climbing support queries.
 #[derive(Clone, Debug)]
 pub struct HullSupport {
-    polyhedron: ConvexPolyhedron,
-    /// Vertex i's neighbours are `adj[adj_start[i]..adj_start[i + 1]]`.
-    adj_start: Vec<u32>,
-    adj: Vec<u32>,
+    graph: Arc<MeshGraph>,
+    /// The hull's vertices (the graph's, as parry vectors: what the climbs read).
+    points: Vec<Vector>,
     /// Per grid direction (x, y, z in {−1, 0, 1}, index 9x + 3y + z after adding 1 to each), the
     /// vertex farthest along it: the climb's start.
     extrema: [u32; 27],
+    /// The hull vertices in the order of the mesh's vertex list (ascending `globalid`): the order
+    /// MuJoCo's exhaustive support (`mjc_meshSupport`) scans them in, which decides ties.
+    scan_order: Vec<u32>,
 }
 
 impl HullSupport {
-    /// The adjacency and start vertices of `polyhedron`'s vertex graph (its edges).
-    pub fn new(polyhedron: ConvexPolyhedron) -> Self {
-        let n = polyhedron.points().len();
-        let mut count = vec![0u32; n + 1];
-        for e in polyhedron.edges() {
-            count[e.vertices[0] as usize + 1] += 1;
-            count[e.vertices[1] as usize + 1] += 1;
-        }
-        for i in 0..n {
-            count[i + 1] += count[i];
-        }
-        let adj_start = count.clone();
-        let mut fill = count;
-        let mut adj = vec![0u32; adj_start[n] as usize];
-        for e in polyhedron.edges() {
-            let [a, b] = e.vertices;
-            adj[fill[a as usize] as usize] = b;
-            fill[a as usize] += 1;
-            adj[fill[b as usize] as usize] = a;
-            fill[b as usize] += 1;
-        }
+    /// The support function of `graph`'s hull: its vertices and edges, and the climb's start
+    /// vertices.
+    pub fn new(graph: Arc<MeshGraph>) -> Self {
+        let points: Vec<Vector> = graph.vertices.iter().map(|v| Vector::new(v.x, v.y, v.z)).collect();
         let mut extrema = [0u32; 27];
         for (k, slot) in extrema.iter_mut().enumerate() {
             let dir = Vector::new((k / 9) as f64 - 1.0, ((k / 3) % 3) as f64 - 1.0, (k % 3) as f64 - 1.0);
-            *slot = scan(polyhedron.points(), dir) as u32;
+            *slot = scan(&points, dir) as u32;
         }
-        Self { polyhedron, adj_start, adj, extrema }
+        let mut scan_order: Vec<u32> = (0..points.len() as u32).collect();
+        scan_order.sort_by_key(|&i| graph.globalid[i as usize]);
+        Self { graph, points, extrema, scan_order }
     }
 
-    /// The hull.
-    pub fn polyhedron(&self) -> &ConvexPolyhedron {
-        &self.polyhedron
+    /// The hull's graph and face polygons.
+    pub fn graph(&self) -> &MeshGraph {
+        &self.graph
+    }
+
+    /// The hull's vertices (geom frame).
+    pub fn points(&self) -> &[Vector] {
+        &self.points
+    }
+
+    /// The hull vertices in the mesh's vertex-list order (see the field).
+    pub fn scan_order(&self) -> &[u32] {
+        &self.scan_order
     }
 
     /// The neighbours of vertex `v` along the hull's edges.
     pub fn neighbours(&self, v: usize) -> &[u32] {
-        &self.adj[self.adj_start[v] as usize..self.adj_start[v + 1] as usize]
+        self.graph.neighbours(v)
     }
 
-    /// The index (in `polyhedron().points()`) of the vertex farthest along `dir`, by hill climbing.
+    /// The index (in [`Self::points`]) of the vertex farthest along `dir`, by hill climbing.
     pub fn support_index(&self, dir: Vector) -> usize {
         self.support_index_warm(dir, -1)
     }
@@ -70,7 +70,7 @@ impl HullSupport {
     /// [`Self::support_index`] warm-started as MuJoCo's `mjc_hillclimbSupport`: from the better of
     /// the grid seed and `cached` (the previous answer of the same query sequence; −1: none).
     pub fn support_index_warm(&self, dir: Vector, cached: i32) -> usize {
-        let points = self.polyhedron.points();
+        let points = &self.points;
         let cell = |a: f64| (a > 0.4) as usize + 1 - (a < -0.4) as usize;
         let seed = self.extrema[9 * cell(dir.x) + 3 * cell(dir.y) + cell(dir.z)] as usize;
         let mut best = seed;
@@ -82,8 +82,7 @@ impl HullSupport {
         let mut best_dot = points[best].dot(dir);
         loop {
             let current = best;
-            let (s, e) = (self.adj_start[current] as usize, self.adj_start[current + 1] as usize);
-            for &j in &self.adj[s..e] {
+            for &j in self.graph.neighbours(current) {
                 let dot = points[j as usize].dot(dir);
                 if dot > best_dot {
                     best_dot = dot;
@@ -113,6 +112,6 @@ pub(crate) fn scan(points: &[Vector], dir: Vector) -> usize {
 
 impl SupportMap for HullSupport {
     fn local_support_point(&self, dir: Vector) -> Vector {
-        self.polyhedron.points()[self.support_index(dir)]
+        self.points[self.support_index(dir)]
     }
 }

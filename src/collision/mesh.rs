@@ -17,9 +17,8 @@ use crate::spatial::Vec3;
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
-use parry3d_f64::shape::ConvexPolyhedron;
 use std::path::Path;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// A mesh geom's file, with its triangles and hull read on first use (see the module
 /// documentation).
@@ -97,8 +96,8 @@ impl GeomMesh {
             .map_err(String::as_str)
     }
 
-    /// The convex hull, computed on the first call (from the triangles' vertices, with MuJoCo's
-    /// degeneracy checks, `mass::convex_hull`).
+    /// The convex hull, computed on the first call (qhull on the triangles' scaled vertices, with
+    /// MuJoCo's degeneracy checks, [`super::mesh_graph::MeshGraph`]).
     ///
     /// # Errors
     /// Why the file cannot be read or its points span no volume, as text.
@@ -106,12 +105,13 @@ impl GeomMesh {
         self.hull
             .get_or_init(|| {
                 let triangles = self.triangles().map_err(str::to_string)?;
-                let hull = mass::convex_hull(&triangles.vertices).map_err(|e| e.to_string())?;
-                let points: Vec<Vector> = hull.vertices.iter().map(|v| Vector::new(v.x, v.y, v.z)).collect();
-                let polyhedron = ConvexPolyhedron::from_convex_hull(&points)
-                    .ok_or_else(|| "its convex hull is degenerate".to_string())?;
-                let shape = ConvexShape::Hull(Box::new(super::hull_support::HullSupport::new(polyhedron)));
-                Ok(MeshHull { vertices: hull.vertices, shape })
+                let (points, _) = super::mesh_graph::distinct_vertices(&triangles.vertices);
+                let graph = super::mesh_graph::MeshGraph::new(&points, &points, &points, -1)
+                    .map_err(|e| format!("its convex hull fails: {e}"))?;
+                let vertices = graph.vertices.clone();
+                let shape =
+                    ConvexShape::Hull(Box::new(super::hull_support::HullSupport::new(Arc::new(graph))));
+                Ok(MeshHull { vertices, shape })
             })
             .as_ref()
             .map_err(String::as_str)

@@ -43,6 +43,7 @@ pub mod hfield_convex;
 pub mod hull_support;
 pub mod inside;
 pub mod mesh;
+pub mod mesh_graph;
 pub mod multiccd;
 pub mod obb;
 pub mod plane;
@@ -62,8 +63,6 @@ use crate::model::spec::Shape;
 use crate::model::{Contact, Data, Model};
 use crate::spatial::Vec3;
 use convex::PairPoint;
-use parry3d_f64::math::Vector;
-use parry3d_f64::shape::ConvexPolyhedron;
 use plane::PlanePoint;
 use plane_mesh::PlaneHull;
 use std::sync::Arc;
@@ -112,16 +111,14 @@ impl CollisionModel {
     pub fn new(model: &Model) -> Self {
         let mut shapes = Vec::with_capacity(model.geoms.len());
         let mut plane_hulls: Vec<Option<Arc<PlaneHull>>> = Vec::with_capacity(model.geoms.len());
-        let mut built: Vec<(*const Vec<Vec3>, Option<Arc<PlaneHull>>)> = Vec::new();
+        let mut built: Vec<(*const mesh_graph::MeshGraph, Option<Arc<PlaneHull>>)> = Vec::new();
         let mut rbound = Vec::with_capacity(model.geoms.len());
         for g in &model.geoms {
             let (shape, r) = match &g.shape {
-                Shape::Mesh { .. } => match &g.hull {
+                Shape::Mesh { .. } => match &g.hull_graph {
                     Some(h) => {
-                        let points: Vec<Vector> = h.iter().map(|v| Vector::new(v.x, v.y, v.z)).collect();
-                        let r = h.iter().map(|v| v.norm()).fold(0.0, f64::max);
-                        let hull = ConvexPolyhedron::from_convex_hull(&points);
-                        (hull.map(|p| ConvexShape::Hull(Box::new(hull_support::HullSupport::new(p)))), r)
+                        let r = h.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+                        (Some(ConvexShape::Hull(Box::new(hull_support::HullSupport::new(h.clone())))), r)
                     }
                     None => (None, 0.0),
                 },
@@ -133,7 +130,7 @@ impl CollisionModel {
             };
             shapes.push(shape);
             rbound.push(r);
-            plane_hulls.push(g.hull.as_ref().and_then(|h| {
+            plane_hulls.push(g.hull_graph.as_ref().and_then(|h| {
                 let key = Arc::as_ptr(h);
                 if let Some((_, p)) = built.iter().find(|(k, _)| *k == key) {
                     return p.clone();

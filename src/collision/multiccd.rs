@@ -71,7 +71,7 @@ thread_local! {
 /// A polytope geom: a box (half-extents) or a mesh's hull.
 enum Poly<'a> {
     Cuboid(Vec3),
-    Hull(&'a parry3d_f64::shape::ConvexPolyhedron, &'a super::hull_support::HullSupport),
+    Hull(&'a super::hull_support::HullSupport),
 }
 
 impl<'a> Poly<'a> {
@@ -81,7 +81,7 @@ impl<'a> Poly<'a> {
                 let h = c.half_extents;
                 Some(Poly::Cuboid(Vec3::new(h.x, h.y, h.z)))
             }
-            ConvexShape::Hull(s) => Some(Poly::Hull(s.polyhedron(), s)),
+            ConvexShape::Hull(s) => Some(Poly::Hull(s)),
             _ => None,
         }
     }
@@ -89,7 +89,7 @@ impl<'a> Poly<'a> {
     fn nvert(&self) -> usize {
         match self {
             Poly::Cuboid(_) => 8,
-            Poly::Hull(p, _) => p.points().len(),
+            Poly::Hull(s) => s.points().len(),
         }
     }
 
@@ -101,8 +101,8 @@ impl<'a> Poly<'a> {
                 if i & 2 != 0 { h.y } else { -h.y },
                 if i & 4 != 0 { h.z } else { -h.z },
             ),
-            Poly::Hull(p, _) => {
-                let v: Vector = p.points()[i as usize];
+            Poly::Hull(s) => {
+                let v: Vector = s.points()[i as usize];
                 Vec3::new(v.x, v.y, v.z)
             }
         }
@@ -116,10 +116,7 @@ impl<'a> Poly<'a> {
                 n[(f / 2) as usize] = if f.is_multiple_of(2) { 1.0 } else { -1.0 };
                 n
             }
-            Poly::Hull(p, _) => {
-                let n = p.faces()[f as usize].normal;
-                Vec3::new(n.x, n.y, n.z)
-            }
+            Poly::Hull(s) => s.graph().poly_normal[f as usize],
         }
     }
 
@@ -133,19 +130,19 @@ impl<'a> Poly<'a> {
                     [[7, 3, 1, 5], [2, 6, 4, 0], [2, 3, 7, 6], [4, 5, 1, 0], [6, 7, 5, 4], [3, 2, 0, 1]];
                 out.extend_from_slice(&BOX_FACES[f as usize]);
             }
-            Poly::Hull(p, _) => {
-                let face = p.faces()[f as usize];
-                let start = face.first_vertex_or_edge as usize;
-                let n = face.num_vertices_or_edges as usize;
-                out.extend(p.vertices_adj_to_face()[start..start + n].iter().rev());
-            }
+            // MuJoCo's polygon (`mesh_polyvert`, counter-clockwise) read backwards (`meshFace`).
+            Poly::Hull(s) => out.extend(s.graph().polygon(f as usize).iter().rev()),
         }
     }
 
-    /// Whether face `f` holds vertex `v`.
-    fn face_has(&self, f: u32, v: u32, tmp: &mut Vec<u32>) -> bool {
-        self.face_vertices(f, tmp);
-        tmp.contains(&v)
+    /// Whether face `f` holds vertex `v` (a hull's from the vertex's ascending polygon list,
+    /// MuJoCo's `mesh_polymap`, without forming the face).
+    fn face_has(&self, f: u32, v: u32) -> bool {
+        match self {
+            Poly::Hull(s) => s.graph().vertex_polygons(v as usize).binary_search(&f).is_ok(),
+            // Box face 2a (+axis a) holds the corners with bit a set, face 2a + 1 the others.
+            Poly::Cuboid(_) => ((v >> (f / 2)) & 1 == 1) == f.is_multiple_of(2),
+        }
     }
 }
 
@@ -157,7 +154,7 @@ impl<'a> Poly<'a> {
 fn support_feature(poly: &Poly, x: &Transform, dir: &Vec3, tol: f64, out: &mut Vec<u32>) {
     out.clear();
     let local = x.rot.transpose() * dir;
-    if let Poly::Hull(_, support) = poly {
+    if let Poly::Hull(support) = poly {
         let top = support.support_index(Vector::new(local.x, local.y, local.z)) as u32;
         let threshold = poly.vertex(top).dot(&local) - tol;
         out.push(top);
@@ -186,19 +183,14 @@ fn support_feature(poly: &Poly, x: &Transform, dir: &Vec3, tol: f64, out: &mut V
 }
 
 /// The faces around vertex `v`, in ascending order, into `out` (a box's three by scanning its six).
-fn vertex_faces(poly: &Poly, v: u32, tmp: &mut Vec<u32>, out: &mut Vec<u32>) {
+fn vertex_faces(poly: &Poly, v: u32, out: &mut Vec<u32>) {
     out.clear();
     match poly {
-        Poly::Hull(p, _) => {
-            let vertex = p.vertices()[v as usize];
-            let start = vertex.first_adj_face_or_edge as usize;
-            let n = vertex.num_adj_faces_or_edge as usize;
-            out.extend_from_slice(&p.faces_adj_to_vertex()[start..start + n]);
-            out.sort_unstable();
-        }
+        // MuJoCo's `mesh_polymap`: ascending polygon indices.
+        Poly::Hull(s) => out.extend_from_slice(s.graph().vertex_polygons(v as usize)),
         Poly::Cuboid(_) => {
             for f in 0..6 {
-                if poly.face_has(f, v, tmp) {
+                if poly.face_has(f, v) {
                     out.push(f);
                 }
             }
@@ -213,15 +205,14 @@ fn feature_faces(
     x: &Transform,
     feature: &[u32],
     dir: &Vec3,
-    tmp: &mut Vec<u32>,
     faces: &mut Vec<u32>,
     out: &mut Vec<(Vec3, u32)>,
 ) {
     out.clear();
     let Some(&v0) = feature.first() else { return };
-    vertex_faces(poly, v0, tmp, faces);
+    vertex_faces(poly, v0, faces);
     for &f in faces.iter() {
-        if feature.iter().skip(1).take(2).all(|&v| poly.face_has(f, v, tmp)) {
+        if feature.iter().skip(1).take(2).all(|&v| poly.face_has(f, v)) {
             out.push((x.rot * poly.face_normal(f), f));
         }
     }
@@ -257,7 +248,7 @@ fn feature_edges(
         out.push(x.act_point(&poly.vertex(feature[1])));
         return;
     }
-    vertex_faces(poly, v0, tmp, faces);
+    vertex_faces(poly, v0, faces);
     for &f in faces.iter() {
         poly.face_vertices(f, tmp);
         if let Some(k) = tmp.iter().position(|&v| v == v0) {
@@ -293,8 +284,8 @@ pub fn polytope_contacts(
         let mut tmp = std::mem::take(&mut s.tmp);
         support_feature(&p1, x1, &n, tol, &mut s.feature1);
         support_feature(&p2, x2, &-n, tol, &mut s.feature2);
-        feature_faces(&p1, x1, &s.feature1, &n, &mut tmp, &mut s.faces, &mut s.normals1);
-        feature_faces(&p2, x2, &s.feature2, &-n, &mut tmp, &mut s.faces, &mut s.normals2);
+        feature_faces(&p1, x1, &s.feature1, &n, &mut s.faces, &mut s.normals1);
+        feature_faces(&p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
         let (dim1, dim2) = (s.feature1.len().min(3), s.feature2.len().min(3));
         // The most nearly opposite face pair within the tolerance.
         let mut aligned: Option<(f64, usize, usize)> = None;
@@ -602,7 +593,7 @@ fn cap_polytope(
         let mut tmp = std::mem::take(&mut s.tmp);
         let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
         support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
-        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.faces, &mut s.normals2);
+        feature_faces(p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
         let opposite = s
             .normals2
             .iter()
@@ -655,7 +646,7 @@ fn segment_polytope(
         let mut tmp = std::mem::take(&mut s.tmp);
         let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
         support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
-        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.faces, &mut s.normals2);
+        feature_faces(p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
         s.face1.clear();
         s.face1.extend_from_slice(&seg);
         let mut count = 0;

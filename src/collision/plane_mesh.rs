@@ -24,39 +24,30 @@
 //! contact lies midway between the vertex and the plane, with the plane's normal and distance
 //! `n·(v − p_plane)`.
 //!
-//! MuJoCo groups its facets by their normal's azimuth and polar angle rounded to 0.01 rad in the
-//! mesh's inertial frame; lagrange merges connected triangles whose normals agree to
-//! `COPLANAR`. Flat faces (boxes, prisms, CAD soles) merge alike; facets a few 1e-3 rad apart
-//! that share MuJoCo's rounded angles are one polygon there and separate triangles here. Where a
-//! polygon's quadrilateral areas tie exactly (a regular polygon), the choice is round-off's.
+//! The hull and its face polygons are MuJoCo's own ([`super::mesh_graph`]: qhull's hull, its
+//! facets merged by their normals' rounded angles, in MuJoCo's polygon order and with MuJoCo's
+//! starting vertices), so ties between polygons resolve as MuJoCo's do. Where a polygon's
+//! quadrilateral areas tie exactly (a regular polygon), the choice is round-off's.
 
+use super::mesh_graph::MeshGraph;
 use super::plane::PlanePoint;
-
-/// Two adjacent hull triangles whose unit normals' dot product exceeds 1 − this lie in one flat
-/// face polygon (the mesh's single-precision vertices tilt coplanar triangles by up to ~1e-7).
-const COPLANAR: f64 = 1e-6;
 use crate::spatial::{Transform, Vec3};
 use std::cmp::Ordering;
 
-/// A mesh's convex hull prepared for plane contacts: vertices (geom frame), their neighbours and
-/// incident triangles, the triangles' outward unit normals, and the hill climb's start vertices.
+/// A mesh's convex hull prepared for plane contacts: vertices (geom frame), their neighbours,
+/// the hill climb's start vertices and MuJoCo's face polygons (all from its mesh graph).
 #[derive(Clone, Debug)]
 pub struct PlaneHull {
     vertices: Vec<Vec3>,
     /// Vertex i's neighbours are `adj[adj_start[i]..adj_start[i + 1]]`.
     adj_start: Vec<u32>,
     adj: Vec<u32>,
-    /// Vertex i's triangles are `tris[tri_start[i]..tri_start[i + 1]]`.
-    tri_start: Vec<u32>,
-    tris: Vec<u32>,
-    triangles: Vec<[u32; 3]>,
-    normals: Vec<Vec3>,
     extrema: [u32; 27],
     /// Face polygon p's vertices, counter-clockwise about its outward normal, are
     /// `poly[poly_start[p]..poly_start[p + 1]]`.
     poly_start: Vec<u32>,
     poly: Vec<u32>,
-    /// Face polygon p's outward unit normal (its triangles' area-weighted mean).
+    /// Face polygon p's outward unit normal (`mesh_polynormal`).
     poly_normal: Vec<Vec3>,
     /// Vertex i's polygons are `vpolys[vpoly_start[i]..vpoly_start[i + 1]]`.
     vpoly_start: Vec<u32>,
@@ -64,43 +55,13 @@ pub struct PlaneHull {
 }
 
 impl PlaneHull {
-    /// The hull of `points` (geom frame; the mesh's hull vertices) with its adjacency; None when
-    /// the points span no volume.
-    pub fn new(points: &[Vec3]) -> Option<Self> {
-        let hull = crate::mass::convex_hull(points).ok()?;
-        let (vertices, triangles) = (hull.vertices, hull.triangles);
-        let n = vertices.len();
-        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n];
-        let mut incident: Vec<Vec<u32>> = vec![Vec::new(); n];
-        let mut normals = Vec::with_capacity(triangles.len());
-        for (t, tri) in triangles.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                if !neighbours[a as usize].contains(&b) {
-                    neighbours[a as usize].push(b);
-                }
-                if !neighbours[b as usize].contains(&a) {
-                    neighbours[b as usize].push(a);
-                }
-                incident[a as usize].push(t as u32);
-            }
-            let [a, b, c] = tri.map(|i| vertices[i as usize]);
-            let normal = (b - a).cross(&(c - a));
-            let len = normal.norm();
-            normals.push(if len > 0.0 { normal / len } else { normal });
+    /// The hull of `graph` (MuJoCo's mesh graph and polygons of a mesh); None when it has no
+    /// vertices.
+    pub fn new(graph: &MeshGraph) -> Option<Self> {
+        let vertices = graph.vertices.clone();
+        if vertices.is_empty() {
+            return None;
         }
-        let csr = |lists: Vec<Vec<u32>>| {
-            let mut start = Vec::with_capacity(lists.len() + 1);
-            start.push(0u32);
-            let mut flat = Vec::new();
-            for l in lists {
-                flat.extend_from_slice(&l);
-                start.push(flat.len() as u32);
-            }
-            (start, flat)
-        };
-        let (adj_start, adj) = csr(neighbours);
-        let (tri_start, tris) = csr(incident);
         let mut extrema = [0u32; 27];
         for (k, slot) in extrema.iter_mut().enumerate() {
             let dir = Vec3::new((k / 9) as f64 - 1.0, ((k / 3) % 3) as f64 - 1.0, (k % 3) as f64 - 1.0);
@@ -113,144 +74,17 @@ impl PlaneHull {
             }
             *slot = best.0 as u32;
         }
-        let mut hull = Self {
+        Some(Self {
             vertices,
-            adj_start,
-            adj,
-            tri_start,
-            tris,
-            triangles,
-            normals,
+            adj_start: graph.adj_start.clone(),
+            adj: graph.adj.clone(),
             extrema,
-            poly_start: vec![0],
-            poly: Vec::new(),
-            poly_normal: Vec::new(),
-            vpoly_start: Vec::new(),
-            vpolys: Vec::new(),
-        };
-        hull.build_polygons();
-        Some(hull)
-    }
-
-    /// Merges connected coplanar triangles into face polygons and traces each one's boundary
-    /// (counter-clockwise about the outward normal, following the triangles' own edge order); a
-    /// group whose boundary is not one simple loop stays as its separate triangles.
-    fn build_polygons(&mut self) {
-        let nt = self.triangles.len();
-        let mut group = vec![u32::MAX; nt];
-        let mut members: Vec<Vec<usize>> = Vec::new();
-        for t in 0..nt {
-            if group[t] != u32::MAX {
-                continue;
-            }
-            let g = members.len() as u32;
-            let mut stack = vec![t];
-            let mut list = Vec::new();
-            group[t] = g;
-            while let Some(u) = stack.pop() {
-                list.push(u);
-                for j in 0..3 {
-                    if let Some(w) = self.across(u, j) {
-                        if group[w] == u32::MAX && self.coplanar(u, w) {
-                            group[w] = g;
-                            stack.push(w);
-                        }
-                    }
-                }
-            }
-            list.sort_unstable();
-            members.push(list);
-        }
-        let n = self.vertices.len();
-        let mut per_vertex: Vec<Vec<u32>> = vec![Vec::new(); n];
-        let mut next = vec![u32::MAX; n];
-        for list in &members {
-            let loops = self.boundary(list, &mut next);
-            let singles: Vec<Vec<u32>> = match loops {
-                Some(l) => vec![l],
-                None => list.iter().map(|&t| self.triangles[t].to_vec()).collect(),
-            };
-            for vs in singles {
-                let mut normal = Vec3::zeros();
-                if vs.len() == 3 {
-                    let [a, b, c] = [vs[0], vs[1], vs[2]].map(|i| self.vertices[i as usize]);
-                    normal = (b - a).cross(&(c - a));
-                } else {
-                    for &t in list {
-                        let [a, b, c] = self.triangles[t].map(|i| self.vertices[i as usize]);
-                        normal += (b - a).cross(&(c - a));
-                    }
-                }
-                let len = normal.norm();
-                let p = self.poly_normal.len() as u32;
-                self.poly_normal.push(if len > 0.0 { normal / len } else { normal });
-                for &v in &vs {
-                    per_vertex[v as usize].push(p);
-                }
-                self.poly.extend_from_slice(&vs);
-                self.poly_start.push(self.poly.len() as u32);
-            }
-        }
-        self.vpoly_start.push(0);
-        for l in per_vertex {
-            self.vpolys.extend_from_slice(&l);
-            self.vpoly_start.push(self.vpolys.len() as u32);
-        }
-    }
-
-    /// The boundary loop of the triangles `list` (one coplanar group), or None when it is not a
-    /// single simple loop. `next` is scratch (all `u32::MAX` on entry and on return).
-    fn boundary(&self, list: &[usize], next: &mut [u32]) -> Option<Vec<u32>> {
-        if list.len() == 1 {
-            return Some(self.triangles[list[0]].to_vec());
-        }
-        let mut edges = Vec::new();
-        for &t in list {
-            for j in 0..3 {
-                let inner = self.across(t, j).is_some_and(|w| list.binary_search(&w).is_ok());
-                if !inner {
-                    let tri = self.triangles[t];
-                    edges.push((tri[j], tri[(j + 1) % 3]));
-                }
-            }
-        }
-        let mut simple = true;
-        for &(a, b) in &edges {
-            if next[a as usize] != u32::MAX {
-                simple = false;
-            }
-            next[a as usize] = b;
-        }
-        let mut out = Vec::with_capacity(edges.len());
-        if simple {
-            let start = edges[0].0;
-            let mut v = start;
-            loop {
-                out.push(v);
-                v = next[v as usize];
-                if v == u32::MAX || v == start || out.len() > edges.len() {
-                    break;
-                }
-            }
-            simple = v == start && out.len() == edges.len();
-        }
-        for &(a, _) in &edges {
-            next[a as usize] = u32::MAX;
-        }
-        simple.then_some(out)
-    }
-
-    /// The triangle across edge (v_j, v_{j+1}) of triangle `t` (another incident triangle of both).
-    fn across(&self, t: usize, j: usize) -> Option<usize> {
-        let tri = self.triangles[t];
-        let (a, b) = (tri[j], tri[(j + 1) % 3]);
-        let (s, e) = (self.tri_start[a as usize] as usize, self.tri_start[a as usize + 1] as usize);
-        self.tris[s..e].iter().map(|&u| u as usize).find(|&u| u != t && self.triangles[u].contains(&b))
-    }
-
-    /// Whether triangles `t` and `u` lie in one plane (normals equal to round-off).
-    fn coplanar(&self, t: usize, u: usize) -> bool {
-        self.normals[t].dot(&self.normals[u]) > 1.0 - COPLANAR
+            poly_start: graph.poly_start.clone(),
+            poly: graph.poly.clone(),
+            poly_normal: graph.poly_normal.clone(),
+            vpoly_start: graph.vpoly_start.clone(),
+            vpolys: graph.vpolys.clone(),
+        })
     }
 
     /// The hull's vertices (geom frame).

@@ -201,7 +201,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             });
         }
         for (g, &mass) in link.geoms.iter().zip(&geom_masses[li]) {
-            let hull = crate::io::geom_hull::geom_hull(g, word, &link.name, &mut hulls, &mut warnings)?;
+            let (hull, hull_graph) =
+                crate::io::geom_hull::geom_hull(g, word, &link.name, &mut hulls, &mut warnings)?.unzip();
             let unreadable = matches!(g.shape, Shape::Mesh { .. }) && hull.is_none();
             geoms.push(Geom {
                 name: g.name.clone(),
@@ -214,6 +215,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 mass,
                 contact: g.contact,
                 hull,
+                hull_graph,
                 group: g.group,
                 rgba: g.rgba,
                 material_rgba: g.material_rgba,

@@ -1,8 +1,9 @@
 //! Convex hulls of mesh geoms that take part in collisions: MuJoCo collides a mesh by its convex
 //! hull (MuJoCo documentation, "Modeling → Meshes": "the collision geometry of a mesh is its convex
-//! hull"). The hull is computed once per compile with parry's quickhull (`mass::convex_hull`, MuJoCo's degeneracy checks), in the mesh file's frame
-//! after scaling (the frame in which lagrange places a mesh geom); each file, scale and inertia
-//! mode is read once.
+//! hull"). The hull is computed once per compile with qhull as MuJoCo's compiler runs it, on the
+//! file's unscaled vertices ([`crate::collision::mesh_graph`]: MuJoCo's vertex, edge and polygon
+//! orders), and placed in the mesh file's frame after scaling (the frame in which lagrange places
+//! a mesh geom); each file, scale and inertia mode is read once.
 //!
 //! The hull's vertices are placed where MuJoCo's collision reads them (`mjCMesh::Process`,
 //! user_mesh.cc): MuJoCo moves a mesh to its inertial frame — the centre of mass `c` of the mesh's
@@ -18,31 +19,37 @@
 //! not with lagrange's mass module (which converges further: its axes differ by up to ~1e-8).
 
 use super::{LinkWord, LoadError};
+use crate::collision::mesh_graph::{distinct_vertices, MeshGraph};
 use crate::mass;
 use crate::model::spec::{GeomSpec, Shape};
 use crate::spatial::{quat_to_matrix, Mat3, Vec3};
 use std::collections::HashMap;
 use std::sync::Arc;
 
-/// Hull vertices by (file, scale, inertia mode).
+/// A colliding mesh's hull: its vertices (qhull's order, where collision reads them) and MuJoCo's
+/// graph and polygons of it (the same vertices).
+pub type GeomHull = (Arc<Vec<Vec3>>, Arc<MeshGraph>);
+
+/// Hull vertices and graphs by (file, scale, inertia mode).
 #[derive(Default)]
 pub struct HullCache {
-    entries: HashMap<(mass::MeshSource, [u64; 3], mass::MeshInertia), Arc<Vec<Vec3>>>,
+    entries: HashMap<(mass::MeshSource, [u64; 3], mass::MeshInertia), GeomHull>,
 }
 
-/// The hull vertices of `g` if it is a colliding mesh geom (None for primitives and for meshes
-/// with contype = conaffinity = 0). A mesh whose points span no volume (fewer than 4 points, all
-/// coplanar or collinear) has no hull: a typed error naming the geom's file and line. A mesh file
-/// that cannot be read (missing, or a format lagrange does not decode, such as COLLADA) is a
-/// warning in `warnings` and None: the geom does not collide (a dynamics model stays loadable; the
-/// warning says what is lost).
+/// The hull of `g` if it is a colliding mesh geom (None for primitives and for meshes with
+/// contype = conaffinity = 0): its vertices (qhull's order, where MuJoCo's collision reads them)
+/// and MuJoCo's graph and polygons of it. A mesh whose points span no volume (fewer than 4 points,
+/// all coplanar or collinear) or that qhull cannot hull has no hull: a typed error naming the
+/// geom's file and line. A mesh file that cannot be read (missing, or a format lagrange does not
+/// decode, such as COLLADA) is a warning in `warnings` and None: the geom does not collide (a
+/// dynamics model stays loadable; the warning says what is lost).
 pub fn geom_hull(
     g: &GeomSpec,
     what: LinkWord,
     link: &str,
     cache: &mut HullCache,
     warnings: &mut Vec<String>,
-) -> Result<Option<Arc<Vec<Vec3>>>, LoadError> {
+) -> Result<Option<GeomHull>, LoadError> {
     let Shape::Mesh { source, scale } = &g.shape else { return Ok(None) };
     if !g.collision {
         return Ok(None);
@@ -58,7 +65,14 @@ pub fn geom_hull(
         path: source.to_string(),
         reason,
     };
-    let mesh = match source.read(scale) {
+    // The file's vertices as read (qhull runs on them unscaled, as MuJoCo's compiler does), then
+    // scaled.
+    let read = if scale.iter().all(|s| s.is_finite()) {
+        source.read(&Vec3::repeat(1.0))
+    } else {
+        Err(mass::MeshError::BadScale { x: scale.x, y: scale.y, z: scale.z })
+    };
+    let file = match read {
         Ok(m) => m,
         Err(e) => {
             warnings.push(format!(
@@ -68,17 +82,29 @@ pub fn geom_hull(
             return Ok(None);
         }
     };
-    let hull = mass::convex_hull(&mesh.vertices).map_err(|e| match e {
-        mass::MeshError::Hull { detail } => err(detail),
-        other => err(other.to_string()),
-    })?;
-    let mut vertices = hull.vertices;
+    let mut mesh = file.clone();
+    mesh.apply_scale(scale);
+    // MuJoCo removes repeated vertices of STL files (its OBJ and MSH readers and inline vertices
+    // keep them): the vertex list qhull numbers.
+    let stl = source.path().and_then(|p| p.extension()).is_some_and(|e| e.eq_ignore_ascii_case("stl"));
+    let (unscaled, scaled): (Vec<Vec3>, Vec<Vec3>) = if stl {
+        let (distinct, map) = distinct_vertices(&file.vertices);
+        let mut scaled = vec![Vec3::zeros(); distinct.len()];
+        for (i, &d) in map.iter().enumerate().rev() {
+            scaled[d as usize] = mesh.vertices[i];
+        }
+        (distinct, scaled)
+    } else {
+        (file.vertices.clone(), mesh.vertices.clone())
+    };
+    let mut placed = scaled.clone();
     if let Some((com, r)) = mujoco_mesh_frame(&mesh, g.mesh_inertia) {
-        round_as_mujoco(&mut vertices, &com, &r);
+        round_as_mujoco(&mut placed, &com, &r);
     }
-    let vertices = Arc::new(vertices);
-    cache.entries.insert(key, vertices.clone());
-    Ok(Some(vertices))
+    let graph = MeshGraph::new(&unscaled, &scaled, &placed, -1).map_err(|e| err(e.to_string()))?;
+    let entry = (Arc::new(graph.vertices.clone()), Arc::new(graph));
+    cache.entries.insert(key, entry.clone());
+    Ok(Some(entry))
 }
 
 /// Moves `vertices` (file frame) to where MuJoCo's `f32` copies of them lie (see the module

@@ -1,7 +1,7 @@
 //! Joint models: configuration → transform, motion subspace and velocity-product term
 //! (RBDA §4.4, Table 4.1), in MuJoCo's qpos/qvel layout (docs/architecture.md, "Conventions").
 
-use crate::spatial::{Mat3, Motion, Transform, Vec3};
+use crate::spatial::{quat_to_matrix, Mat3, Motion, Transform, Vec3};
 
 /// The kind of a movable joint, with its axis data in the joint frame. Fixed joints never reach a
 /// [`Model`](crate::Model): the compile step fuses them.
@@ -114,13 +114,10 @@ impl JointKind {
         match self {
             JointKind::Revolute { axis, .. } => Transform::new(axis_angle(axis, q[0]), Vec3::zeros()),
             JointKind::Prismatic { axis } => Transform::from_translation(axis * q[0]),
-            JointKind::Free => Transform::new(
-                to_unit_quat(&q[3..7]).to_rotation_matrix().into_inner(),
-                Vec3::new(q[0], q[1], q[2]),
-            ),
-            JointKind::Ball => {
-                Transform::new(to_unit_quat(&q[0..4]).to_rotation_matrix().into_inner(), Vec3::zeros())
+            JointKind::Free => {
+                Transform::new(quat_to_matrix(q[3], q[4], q[5], q[6]), Vec3::new(q[0], q[1], q[2]))
             }
+            JointKind::Ball => Transform::new(quat_to_matrix(q[0], q[1], q[2], q[3]), Vec3::zeros()),
             JointKind::Planar { axis1, axis2, normal } => {
                 Transform::new(axis_angle(normal, q[2]), axis1 * q[0] + axis2 * q[1])
             }

@@ -190,6 +190,10 @@ pub struct Geom {
     /// For a colliding mesh: the vertices of its convex hull in the geom frame (MuJoCo collides
     /// meshes by their hulls).
     pub hull: Option<std::sync::Arc<Vec<Vec3>>>,
+    /// For a colliding mesh: its hull as MuJoCo's compiler builds it with qhull (the vertices of
+    /// `hull` in the same order, their edges, the face polygons: MuJoCo's `mesh_graph` and
+    /// `mesh_polyvert`; [`crate::collision::mesh_graph`]).
+    pub hull_graph: Option<std::sync::Arc<crate::collision::mesh_graph::MeshGraph>>,
     /// MJCF `group` (MuJoCo's `geom_group`; 0 by default): ray casting can select groups.
     pub group: i32,
     /// MJCF `rgba` (MuJoCo's `geom_rgba`; 0.5 0.5 0.5 1 by default): ray casting skips a geom
