@@ -14,8 +14,8 @@
 //!   (`MeshPolygon::InsertFace`, `Paths`). The polygons come out in the iteration order of
 //!   MuJoCo's `std::unordered_map` over the keys, which is reproduced here for the libc++ that
 //!   MuJoCo 4.0's released library is built with (its `std::hash<double>` is the value's bits, the
-//!   pair hash a boost-style combination of them, [`pair_hash`]; buckets grow 2, 5, 11, 23, … as
-//!   prime or power-of-two counts; [`LibcxxOrder`]). Which polygon comes first decides MuJoCo's choice
+//!   pair hash a boost-style combination of them, `pair_hash`; buckets grow 2, 5, 11, 23, … as
+//!   prime or power-of-two counts; `LibcxxOrder`). Which polygon comes first decides MuJoCo's choice
 //!   among equally good faces,
 //!   and where a polygon starts decides which clipped points its multi-point contact keeps.
 //! - **Normals.** Each polygon's normal is that of its first three vertices (`MakePolygonNormals`)

@@ -135,10 +135,14 @@ impl<'a> Poly<'a> {
         }
     }
 
-    /// Whether face `f` holds vertex `v`.
-    fn face_has(&self, f: u32, v: u32, tmp: &mut Vec<u32>) -> bool {
-        self.face_vertices(f, tmp);
-        tmp.contains(&v)
+    /// Whether face `f` holds vertex `v` (a hull's from the vertex's ascending polygon list,
+    /// MuJoCo's `mesh_polymap`, without forming the face).
+    fn face_has(&self, f: u32, v: u32) -> bool {
+        match self {
+            Poly::Hull(s) => s.graph().vertex_polygons(v as usize).binary_search(&f).is_ok(),
+            // Box face 2a (+axis a) holds the corners with bit a set, face 2a + 1 the others.
+            Poly::Cuboid(_) => ((v >> (f / 2)) & 1 == 1) == f.is_multiple_of(2),
+        }
     }
 }
 
@@ -179,14 +183,14 @@ fn support_feature(poly: &Poly, x: &Transform, dir: &Vec3, tol: f64, out: &mut V
 }
 
 /// The faces around vertex `v`, in ascending order, into `out` (a box's three by scanning its six).
-fn vertex_faces(poly: &Poly, v: u32, tmp: &mut Vec<u32>, out: &mut Vec<u32>) {
+fn vertex_faces(poly: &Poly, v: u32, out: &mut Vec<u32>) {
     out.clear();
     match poly {
         // MuJoCo's `mesh_polymap`: ascending polygon indices.
         Poly::Hull(s) => out.extend_from_slice(s.graph().vertex_polygons(v as usize)),
         Poly::Cuboid(_) => {
             for f in 0..6 {
-                if poly.face_has(f, v, tmp) {
+                if poly.face_has(f, v) {
                     out.push(f);
                 }
             }
@@ -201,15 +205,14 @@ fn feature_faces(
     x: &Transform,
     feature: &[u32],
     dir: &Vec3,
-    tmp: &mut Vec<u32>,
     faces: &mut Vec<u32>,
     out: &mut Vec<(Vec3, u32)>,
 ) {
     out.clear();
     let Some(&v0) = feature.first() else { return };
-    vertex_faces(poly, v0, tmp, faces);
+    vertex_faces(poly, v0, faces);
     for &f in faces.iter() {
-        if feature.iter().skip(1).take(2).all(|&v| poly.face_has(f, v, tmp)) {
+        if feature.iter().skip(1).take(2).all(|&v| poly.face_has(f, v)) {
             out.push((x.rot * poly.face_normal(f), f));
         }
     }
@@ -245,7 +248,7 @@ fn feature_edges(
         out.push(x.act_point(&poly.vertex(feature[1])));
         return;
     }
-    vertex_faces(poly, v0, tmp, faces);
+    vertex_faces(poly, v0, faces);
     for &f in faces.iter() {
         poly.face_vertices(f, tmp);
         if let Some(k) = tmp.iter().position(|&v| v == v0) {
@@ -281,8 +284,8 @@ pub fn polytope_contacts(
         let mut tmp = std::mem::take(&mut s.tmp);
         support_feature(&p1, x1, &n, tol, &mut s.feature1);
         support_feature(&p2, x2, &-n, tol, &mut s.feature2);
-        feature_faces(&p1, x1, &s.feature1, &n, &mut tmp, &mut s.faces, &mut s.normals1);
-        feature_faces(&p2, x2, &s.feature2, &-n, &mut tmp, &mut s.faces, &mut s.normals2);
+        feature_faces(&p1, x1, &s.feature1, &n, &mut s.faces, &mut s.normals1);
+        feature_faces(&p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
         let (dim1, dim2) = (s.feature1.len().min(3), s.feature2.len().min(3));
         // The most nearly opposite face pair within the tolerance.
         let mut aligned: Option<(f64, usize, usize)> = None;
@@ -590,7 +593,7 @@ fn cap_polytope(
         let mut tmp = std::mem::take(&mut s.tmp);
         let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
         support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
-        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.faces, &mut s.normals2);
+        feature_faces(p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
         let opposite = s
             .normals2
             .iter()
@@ -643,7 +646,7 @@ fn segment_polytope(
         let mut tmp = std::mem::take(&mut s.tmp);
         let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
         support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
-        feature_faces(p2, x2, &s.feature2, &-n, &mut tmp, &mut s.faces, &mut s.normals2);
+        feature_faces(p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
         s.face1.clear();
         s.face1.extend_from_slice(&seg);
         let mut count = 0;

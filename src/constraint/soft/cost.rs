@@ -52,10 +52,23 @@ impl Rows<'_> {
 
     /// Forces and states at `jar` into `force` and `state`; returns the cost s(jar).
     pub fn update(&self, jar: &DVector<f64>, force: &mut DVector<f64>, state: &mut [EfcState]) -> f64 {
+        let mut cost = 0.0;
+        self.update_each(jar, force, state, |_, c| cost += c);
+        cost
+    }
+
+    /// As [`Self::update`], each term of the cost given to `each` with its row (an elliptic
+    /// contact's cone term with its first row) instead of summed.
+    pub fn update_each(
+        &self,
+        jar: &DVector<f64>,
+        force: &mut DVector<f64>,
+        state: &mut [EfcState],
+        mut each: impl FnMut(usize, f64),
+    ) {
         // Slices: the per-row loops index them without nalgebra's shape checks.
         let (jar, force) = (jar.as_slice(), force.as_mut_slice());
         let (d_all, r_all, floss) = (self.d.as_slice(), self.r.as_slice(), self.floss.as_slice());
-        let mut cost = 0.0;
         let mut i = 0;
         while i < self.nefc {
             let (x, d) = (jar[i], d_all[i]);
@@ -79,7 +92,7 @@ impl Rows<'_> {
                 };
                 state[i] = st;
                 force[i] = f;
-                cost += c;
+                each(i, c);
                 i += 1;
                 continue;
             }
@@ -99,13 +112,13 @@ impl Rows<'_> {
                 EfcState::Quadratic => {
                     for j in i..i + dim {
                         force[j] = -d_all[j] * jar[j];
-                        cost += 0.5 * d_all[j] * jar[j] * jar[j];
+                        each(j, 0.5 * d_all[j] * jar[j] * jar[j]);
                     }
                 }
                 _ => {
                     let dm = d / (mu * mu * (1.0 + mu * mu));
                     let nmt = n - mu * t;
-                    cost += 0.5 * dm * nmt * nmt;
+                    each(i, 0.5 * dm * nmt * nmt);
                     force[i] = -dm * nmt * mu;
                     for j in 1..dim {
                         let u = jar[i + j] * c.friction[j - 1];
@@ -116,71 +129,88 @@ impl Rows<'_> {
             state[i..i + dim].fill(zone);
             i += dim;
         }
-        cost
     }
 
     /// The first and second derivative of s(jar + α jv) in α, at α given by `jar` (already
     /// moved) along `jv`.
     pub fn directional(&self, jar: &DVector<f64>, jv: &DVector<f64>) -> (f64, f64) {
         let (jar, jv) = (jar.as_slice(), jv.as_slice());
-        let (d_all, r_all, floss) = (self.d.as_slice(), self.r.as_slice(), self.floss.as_slice());
         let (mut d1, mut d2) = (0.0, 0.0);
         let mut i = 0;
         while i < self.nefc {
-            let (x, v, d) = (jar[i], jv[i], d_all[i]);
-            let quadratic = if i < self.ne {
-                true
-            } else if i < self.ne + self.nf {
-                let rf = r_all[i] * floss[i];
-                if x <= -rf {
-                    d1 -= floss[i] * v;
-                    false
-                } else if x >= rf {
-                    d1 += floss[i] * v;
-                    false
-                } else {
-                    true
-                }
-            } else if self.kind[i] != EfcType::ContactElliptic {
-                x < 0.0
-            } else {
-                let dim = self.block(i);
-                let c = &self.contacts[self.id[i]];
-                let mu = self.mu[self.id[i]];
-                let (n, t, _) = cone_coordinates(jar, i, dim, mu, &c.friction);
-                if n >= mu * t || (t <= 0.0 && n >= 0.0) {
-                } else if mu * n + t <= 0.0 || (t <= 0.0 && n < 0.0) {
-                    for j in i..i + dim {
-                        d1 += d_all[j] * jar[j] * jv[j];
-                        d2 += d_all[j] * jv[j] * jv[j];
-                    }
-                } else {
-                    let dm = d / (mu * mu * (1.0 + mu * mu));
-                    let dn = mu * v;
-                    let (mut tu, mut tt) = (0.0, 0.0);
-                    for j in 1..dim {
-                        let f = c.friction[j - 1];
-                        let (u, du) = (jar[i + j] * f, jv[i + j] * f);
-                        tu += u * du;
-                        tt += du * du;
-                    }
-                    let dt = tu / t;
-                    let ddt = (tt - dt * dt) / t;
-                    let nmt = n - mu * t;
-                    let dnmt = dn - mu * dt;
-                    d1 += dm * nmt * dnmt;
-                    d2 += dm * (dnmt * dnmt - nmt * mu * ddt);
-                }
-                i += dim;
-                continue;
-            };
-            if quadratic {
-                d1 += d * x * v;
-                d2 += d * v * v;
-            }
-            i += 1;
+            i += self.directional_at(i, jar, jv, &mut d1, &mut d2);
         }
         (d1, d2)
+    }
+
+    /// As [`Self::directional`], over the rows `list` only (ascending, an elliptic contact's
+    /// rows all in it or none: one constraint island's, `island.rs`).
+    pub fn directional_rows(&self, jar: &DVector<f64>, jv: &DVector<f64>, list: &[usize]) -> (f64, f64) {
+        let (jar, jv) = (jar.as_slice(), jv.as_slice());
+        let (mut d1, mut d2) = (0.0, 0.0);
+        let mut t = 0;
+        while t < list.len() {
+            t += self.directional_at(list[t], jar, jv, &mut d1, &mut d2);
+        }
+        (d1, d2)
+    }
+
+    /// Adds the derivatives of the block at row i (one row, or an elliptic contact's rows) to
+    /// d1 and d2; returns the block's number of rows.
+    #[inline]
+    fn directional_at(&self, i: usize, jar: &[f64], jv: &[f64], d1: &mut f64, d2: &mut f64) -> usize {
+        let (d_all, r_all, floss) = (self.d.as_slice(), self.r.as_slice(), self.floss.as_slice());
+        let (x, v, d) = (jar[i], jv[i], d_all[i]);
+        let quadratic = if i < self.ne {
+            true
+        } else if i < self.ne + self.nf {
+            let rf = r_all[i] * floss[i];
+            if x <= -rf {
+                *d1 -= floss[i] * v;
+                false
+            } else if x >= rf {
+                *d1 += floss[i] * v;
+                false
+            } else {
+                true
+            }
+        } else if self.kind[i] != EfcType::ContactElliptic {
+            x < 0.0
+        } else {
+            let dim = self.block(i);
+            let c = &self.contacts[self.id[i]];
+            let mu = self.mu[self.id[i]];
+            let (n, t, _) = cone_coordinates(jar, i, dim, mu, &c.friction);
+            if n >= mu * t || (t <= 0.0 && n >= 0.0) {
+            } else if mu * n + t <= 0.0 || (t <= 0.0 && n < 0.0) {
+                for j in i..i + dim {
+                    *d1 += d_all[j] * jar[j] * jv[j];
+                    *d2 += d_all[j] * jv[j] * jv[j];
+                }
+            } else {
+                let dm = d / (mu * mu * (1.0 + mu * mu));
+                let dn = mu * v;
+                let (mut tu, mut tt) = (0.0, 0.0);
+                for j in 1..dim {
+                    let f = c.friction[j - 1];
+                    let (u, du) = (jar[i + j] * f, jv[i + j] * f);
+                    tu += u * du;
+                    tt += du * du;
+                }
+                let dt = tu / t;
+                let ddt = (tt - dt * dt) / t;
+                let nmt = n - mu * t;
+                let dnmt = dn - mu * dt;
+                *d1 += dm * nmt * dnmt;
+                *d2 += dm * (dnmt * dnmt - nmt * mu * ddt);
+            }
+            return dim;
+        };
+        if quadratic {
+            *d1 += d * x * v;
+            *d2 += d * v * v;
+        }
+        1
     }
 
     /// Calls `add(i, dim, h)` for each block of the Hessian of s in jar on the rows that have

@@ -7,7 +7,8 @@
 //!
 //! The record is valid while only the soft position stage writes `efc_j`: the exact rows'
 //! writer (`ConstraintModel::positions_unchecked`, which the variational integrator also
-//! calls) marks it stale, and a stale record is rebuilt or replaced by a full clear.
+//! calls) marks it stale, and a stale record is rebuilt or replaced by a full clear. A contact's
+//! rows are recorded over one shared column list (`append_rows`), exact zeros included.
 
 use crate::model::Model;
 use nalgebra::DMatrix;
@@ -81,12 +82,16 @@ pub(crate) fn chain_dofs(model: &Model, bodies: [usize; 2], out: &mut Vec<usize>
     out.dedup();
 }
 
-/// Appends rows `rows` of `j` to the record (rows 0..rows.start recorded already), each with
-/// its nonzeros among `columns` (ascending; a superset of the rows' nonzero columns).
+/// Appends rows `rows` of `j` to the record (rows 0..rows.start recorded already), every row
+/// over the same columns: those of `columns` (ascending; a superset of the rows' nonzero
+/// columns) where any of the rows is nonzero, which `columns` keeps on return. A row's exact
+/// zeros among them are recorded as entries: one contact's rows share one column list, so the
+/// Newton Hessian sums them as a group (`hessian.rs`); the products with those zeros add
+/// nothing.
 pub(crate) fn append_rows(
     j: &DMatrix<f64>,
     rows: std::ops::Range<usize>,
-    columns: &[usize],
+    columns: &mut Vec<usize>,
     start: &mut Vec<usize>,
     index: &mut Vec<usize>,
     value: &mut Vec<f64>,
@@ -94,13 +99,11 @@ pub(crate) fn append_rows(
     debug_assert_eq!(start.len(), rows.start + 1);
     let stride = j.nrows();
     let data = j.as_slice();
+    columns.retain(|&k| data[k * stride + rows.start..k * stride + rows.end].iter().any(|&v| v != 0.0));
     for i in rows {
-        for &k in columns {
-            let v = data[k * stride + i];
-            if v != 0.0 {
-                index.push(k);
-                value.push(v);
-            }
+        for &k in columns.iter() {
+            index.push(k);
+            value.push(data[k * stride + i]);
         }
         start.push(index.len());
     }

@@ -12,7 +12,9 @@
 //! `efc_state`). Nothing is projected after a step: drift is what the soft model allows.
 
 pub mod cost;
+mod hessian;
 pub mod impedance;
+mod island;
 mod jacobian;
 pub mod noslip;
 pub mod pgs;

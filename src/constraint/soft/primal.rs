@@ -15,6 +15,7 @@
 //! `tolerance`, the scale being 1 / (meaninertia · max(1, nv)).
 
 use super::cost::Rows;
+use super::hessian::Assembler;
 use crate::constraint::dense::{cholesky, cholesky_solve};
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, Model};
@@ -49,23 +50,28 @@ pub struct Settings {
 
 /// The nonzero columns of each row of J (rows enter the solve through their ancestor dofs only):
 /// row i's columns are `index[start[i]..start[i + 1]]`.
-struct Sparsity<'a> {
-    start: &'a [usize],
-    index: &'a [usize],
+pub(super) struct Sparsity<'a> {
+    pub start: &'a [usize],
+    pub index: &'a [usize],
     /// J's value at each of `index`'s entries (row i's are `value[start[i]..start[i + 1]]`).
-    value: &'a [f64],
+    pub value: &'a [f64],
 }
 
 impl Sparsity<'_> {
     /// Row i's nonzero columns and J's values there.
-    fn row_values(&self, i: usize) -> (&[usize], &[f64]) {
+    pub fn row_values(&self, i: usize) -> (&[usize], &[f64]) {
         let (s, e) = (self.start[i], self.start[i + 1]);
         (&self.index[s..e], &self.value[s..e])
+    }
+
+    /// Row i's nonzero columns.
+    pub fn columns(&self, i: usize) -> &[usize] {
+        &self.index[self.start[i]..self.start[i + 1]]
     }
 }
 
 /// r ← J x (rows 0..nefc).
-fn mul_j(s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
+pub(super) fn mul_j(s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
     let x = x.as_slice();
     for (i, r_i) in r.as_mut_slice()[..nefc].iter_mut().enumerate() {
         let (cols, vals) = s.row_values(i);
@@ -75,7 +81,7 @@ fn mul_j(s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
 
 /// r ← M x, reading only M's nonzeros: the diagonal and each dof's ancestor chain
 /// (`Model::dof_parent`; M[l][k] ≠ 0 only when l is an ancestor of k or k of l).
-fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
+pub(super) fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
     let nv = x.len();
     if nv <= DENSE_NV {
         m.mul_to(x, r);
@@ -98,43 +104,6 @@ fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVect
 /// Up to this many dofs the Newton Hessian is assembled and factored dense (and M x is a dense
 /// product): below it the sparse bookkeeping costs more than the zeros it skips.
 pub(crate) const DENSE_NV: usize = 40;
-
-/// H[p][q] += (w J[a][p]) J[b][q] over the nonzero columns p ≥ q of rows a and b: the lower
-/// triangle of one Hessian term. Row a's weighted entries are gathered first (`weighted`, nv
-/// long, indexed like row a's nonzeros, from the rows' compact values `Sparsity::value`), and
-/// the sums are written column by column; each entry gets the same products in the same
-/// order as a direct double loop, so the same bits.
-#[inline]
-fn add_weighted_outer(h: &mut DMatrix<f64>, nz: &Sparsity, a: usize, b: usize, w: f64, weighted: &mut [f64]) {
-    let ((row_a, j_a), (row_b, j_b)) = (nz.row_values(a), nz.row_values(b));
-    for (x, &j_ap) in weighted.iter_mut().zip(j_a) {
-        *x = w * j_ap;
-    }
-    let nv = h.nrows();
-    let h = h.as_mut_slice();
-    if a == b {
-        // One row's own term (a row's columns ascend): the entries p ≥ q of column q are the
-        // row's columns from q's position on, with no test per entry.
-        let len = row_a.len();
-        let (weighted, j_b) = (&weighted[..len], &j_b[..len]);
-        for t in 0..len {
-            let (q, j_bq) = (row_a[t], j_b[t]);
-            let column = &mut h[q * nv..(q + 1) * nv];
-            for (&x, &p) in weighted[t..].iter().zip(&row_a[t..]) {
-                column[p] += x * j_bq;
-            }
-        }
-        return;
-    }
-    for (&q, &j_bq) in row_b.iter().zip(j_b) {
-        let column = &mut h[q * nv..(q + 1) * nv];
-        for (x, &p) in weighted.iter().zip(row_a) {
-            if p >= q {
-                column[p] += x * j_bq;
-            }
-        }
-    }
-}
 
 /// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
 /// `qfrc_smooth`, `qacc_smooth`, the mass matrix and its factor: writes `qacc`, `efc_force`,
@@ -193,6 +162,16 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         contacts,
         mu: contact_mu,
     };
+    // The Gauss term ½ (x − a₀)ᵀ (M x − qfrc_smooth) at x, from M x.
+    let gauss = |x: &DVector<f64>, ma: &DVector<f64>| -> f64 {
+        let (x, a0) = (&x.as_slice()[..nv], &qacc_smooth.as_slice()[..nv]);
+        let (ma, f0) = (&ma.as_slice()[..nv], &qfrc_smooth.as_slice()[..nv]);
+        x.iter()
+            .zip(a0)
+            .zip(ma.iter().zip(f0))
+            .map(|((&x, &a0), (&ma, &f0))| 0.5 * (x - a0) * (ma - f0))
+            .sum()
+    };
     // The total cost at x (fills ma, jar, force, state).
     let total = |x: &DVector<f64>,
                  ma: &mut DVector<f64>,
@@ -204,19 +183,18 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         for (j, &r) in jar.as_mut_slice()[..nefc].iter_mut().zip(&efc_aref.as_slice()[..nefc]) {
             *j -= r;
         }
-        let (x, a0) = (&x.as_slice()[..nv], &qacc_smooth.as_slice()[..nv]);
-        let (ma, f0) = (&ma.as_slice()[..nv], &qfrc_smooth.as_slice()[..nv]);
-        let gauss: f64 = x
-            .iter()
-            .zip(a0)
-            .zip(ma.iter().zip(f0))
-            .map(|((&x, &a0), (&ma, &f0))| 0.5 * (x - a0) * (ma - f0))
-            .sum();
-        gauss + rows.update(jar, force, state)
+        gauss(x, ma) + rows.update(jar, force, state)
     };
     // Start: the warm start (the previous solution) if it costs less than qacc_smooth.
+    // At qacc_smooth the Gauss term is zero and M a = qfrc_smooth (qacc_smooth = M⁻¹
+    // qfrc_smooth): only J a − aref is formed (MuJoCo's cost(qacc_smooth) from efc_b likewise).
     qacc.copy_from(qacc_smooth);
-    let mut cost = total(qacc, &mut soft.ma, &mut soft.jar, efc_force, efc_state);
+    soft.ma.copy_from(qfrc_smooth);
+    mul_j(&nz, nefc, qacc, &mut soft.jar);
+    for (j, &r) in soft.jar.as_mut_slice()[..nefc].iter_mut().zip(&efc_aref.as_slice()[..nefc]) {
+        *j -= r;
+    }
+    let mut cost = rows.update(&soft.jar, efc_force, efc_state);
     if s.warmstart {
         let c = total(qacc_warmstart, &mut soft.mdir, &mut soft.jv, &mut soft.jar_trial, efc_state);
         if c < cost {
@@ -233,142 +211,115 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         }
     }
     let mut improvement = f64::INFINITY;
-    let mut gradient;
+    let mut gradient = 0.0;
     let mut iter = 0;
     let mut have_dir = false;
     let mut stalled = false;
-    let mut analyzed = false;
-    loop {
-        // g = M a − qfrc_smooth − Jᵀ f.
-        for ((g, &ma), &f0) in
-            soft.grad.as_mut_slice().iter_mut().zip(soft.ma.as_slice()).zip(qfrc_smooth.as_slice())
-        {
-            *g = ma - f0;
-        }
-        let grad = soft.grad.as_mut_slice();
-        for (i, &f) in efc_force.as_slice()[..nefc].iter().enumerate() {
-            if f != 0.0 {
-                let (cols, vals) = nz.row_values(i);
-                for (&k, &j_ik) in cols.iter().zip(vals) {
-                    grad[k] -= j_ik * f;
+    let island_path = method == Primal::Newton && nv > DENSE_NV;
+    let mut converged_islands = false;
+    if island_path {
+        // Large problems: island by island (`island.rs`).
+        let problem = super::island::Problem {
+            model,
+            rows: &rows,
+            nz: &nz,
+            m: mass_matrix,
+            a0: qacc_smooth,
+            f0: qfrc_smooth,
+            settings: s,
+        };
+        let out = super::island::newton(&problem, soft, mass_factor, qacc, efc_force, efc_state);
+        iter = out.iterations;
+        improvement = out.improvement;
+        gradient = out.gradient;
+        converged_islands = out.converged;
+    }
+    // Small problems, and CG: every row together.
+    if !island_path {
+        loop {
+            // g = M a − qfrc_smooth − Jᵀ f.
+            for ((g, &ma), &f0) in
+                soft.grad.as_mut_slice().iter_mut().zip(soft.ma.as_slice()).zip(qfrc_smooth.as_slice())
+            {
+                *g = ma - f0;
+            }
+            let grad = soft.grad.as_mut_slice();
+            for (i, &f) in efc_force.as_slice()[..nefc].iter().enumerate() {
+                if f != 0.0 {
+                    let (cols, vals) = nz.row_values(i);
+                    for (&k, &j_ik) in cols.iter().zip(vals) {
+                        grad[k] -= j_ik * f;
+                    }
                 }
             }
-        }
-        gradient = s.scale * soft.grad.norm();
-        if gradient < s.tolerance || improvement < s.tolerance || iter >= s.iterations {
-            break;
-        }
-        iter += 1;
-        match method {
-            Primal::Newton => {
-                if nv <= DENSE_NV {
+            gradient = s.scale * soft.grad.norm();
+            if gradient < s.tolerance || improvement < s.tolerance || iter >= s.iterations {
+                break;
+            }
+            iter += 1;
+            match method {
+                Primal::Newton => {
+                    // (Large problems take the island path above.)
                     // Small: H = M + Jᵀ (∂²s) J, its lower triangle (all the dense Cholesky
                     // reads), by dense Cholesky.
-                    let (h, weighted) = (&mut soft.hessian, &mut soft.weighted_row);
-                    h.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
-                    rows.hessian(&soft.jar, efc_state, |i, dim, block| {
-                        for (a, row) in (i..i + dim).zip(block) {
-                            for (b, &w) in (i..i + dim).zip(row) {
-                                add_weighted_outer(h, &nz, a, b, w, weighted);
-                            }
-                        }
-                    });
+                    soft.hessian.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
+                    let mut rows_h = Assembler::new(&mut soft.hessian, &nz, &mut soft.hessian_column);
+                    rows.hessian(&soft.jar, efc_state, |i, dim, block| rows_h.add(i, dim, block));
+                    rows_h.finish();
                     soft.dir.copy_from(&soft.grad);
                     if cholesky(&soft.hessian, nv, &mut soft.dense_factor, 0.0) {
                         cholesky_solve(&soft.dense_factor, nv, soft.dir.as_mut_slice());
                     } else {
                         solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
                     }
-                } else {
-                    // H = M + Jᵀ (∂²s) J, lower triangle only, assembled over its nonzeros: the
-                    // last pattern's entries cleared, M's tree entries written, the rows' added.
-                    let h = &mut soft.hessian;
-                    for k in 0..nv {
-                        for &j in soft.factor.pattern_row(k) {
-                            h[(k, j)] = 0.0;
-                        }
-                        h[(k, k)] = mass_matrix[(k, k)];
-                        let mut l = model.dof_parent[k];
-                        while l != crate::model::NO_DOF {
-                            h[(k, l)] = mass_matrix[(k, l)];
-                            l = model.dof_parent[l];
-                        }
-                    }
-                    if !analyzed {
-                        // Once per solve (after the clear above, which needs the last pattern):
-                        // the pattern of every row that can have a Hessian block, whatever its
-                        // state — each row alone, a contact's rows as one group — so that it
-                        // holds for every iteration; kept from the last step when its cliques
-                        // are unchanged (`SparseCholesky::analyze`).
-                        soft.active_rows.clear();
-                        for i in 0..nefc {
-                            let same_contact = i > 0
-                                && efc_type[i].is_contact()
-                                && efc_type[i] == efc_type[i - 1]
-                                && efc_id[i] == efc_id[i - 1];
-                            match soft.active_rows.last_mut() {
-                                Some(g) if same_contact => g.1 = i,
-                                _ => soft.active_rows.push((i, i)),
-                            }
-                        }
-                        soft.factor.analyze(nv, &model.dof_parent, &soft.active_rows, &nz_start, &nz_index);
-                        analyzed = true;
-                    }
-                    let weighted = &mut soft.weighted_row;
-                    rows.hessian(&soft.jar, efc_state, |i, dim, block| {
-                        for (a, row) in (i..i + dim).zip(block) {
-                            for (b, &w) in (i..i + dim).zip(row) {
-                                add_weighted_outer(h, &nz, a, b, w, weighted);
-                            }
-                        }
-                    });
-                    soft.dir.copy_from(&soft.grad);
-                    if soft.factor.factor_analyzed(&soft.hessian) {
-                        soft.factor.solve(soft.dir.as_mut_slice());
-                    } else {
-                        solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
-                    }
+                    soft.dir.neg_mut();
                 }
-                soft.dir.neg_mut();
-            }
-            Primal::Cg => {
-                soft.mgrad.copy_from(&soft.grad);
-                solve_with_factor_unchecked(model, mass_factor, soft.mgrad.as_mut_slice());
-                let beta = if have_dir {
-                    let den = soft.grad_prev.dot(&soft.mgrad_prev);
-                    let num: f64 = (0..nv).map(|k| soft.grad[k] * (soft.mgrad[k] - soft.mgrad_prev[k])).sum();
-                    if den > 0.0 {
-                        (num / den).max(0.0)
+                Primal::Cg => {
+                    soft.mgrad.copy_from(&soft.grad);
+                    solve_with_factor_unchecked(model, mass_factor, soft.mgrad.as_mut_slice());
+                    let beta = if have_dir {
+                        let den = soft.grad_prev.dot(&soft.mgrad_prev);
+                        let num: f64 =
+                            (0..nv).map(|k| soft.grad[k] * (soft.mgrad[k] - soft.mgrad_prev[k])).sum();
+                        if den > 0.0 {
+                            (num / den).max(0.0)
+                        } else {
+                            0.0
+                        }
                     } else {
                         0.0
+                    };
+                    for k in 0..nv {
+                        soft.dir[k] = -soft.mgrad[k] + beta * soft.dir[k];
                     }
-                } else {
-                    0.0
-                };
-                for k in 0..nv {
-                    soft.dir[k] = -soft.mgrad[k] + beta * soft.dir[k];
+                    soft.grad_prev.copy_from(&soft.grad);
+                    soft.mgrad_prev.copy_from(&soft.mgrad);
+                    have_dir = true;
                 }
-                soft.grad_prev.copy_from(&soft.grad);
-                soft.mgrad_prev.copy_from(&soft.mgrad);
-                have_dir = true;
             }
+            mul_j(&nz, nefc, &soft.dir, &mut soft.jv);
+            mul_m(&model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
+            let g0: f64 = (soft.ma.iter().zip(qfrc_smooth.iter()).zip(soft.dir.iter()))
+                .map(|((&ma, &f0), &d)| (ma - f0) * d)
+                .sum();
+            let dmd = soft.dir.dot(&soft.mdir);
+            let alpha = line_search(&rows, &soft.jar, &soft.jv, &mut soft.jar_trial, g0, dmd, s);
+            if alpha == 0.0 {
+                // No descent along the direction (the minimum to round-off).
+                stalled = true;
+                break;
+            }
+            // The move: a, M a and J a − aref along the direction (MuJoCo's mj_solPrimal updates
+            // them the same way instead of forming the products again).
+            qacc.axpy(alpha, &soft.dir, 1.0);
+            soft.ma.axpy(alpha, &soft.mdir, 1.0);
+            for (j, &v) in soft.jar.as_mut_slice()[..nefc].iter_mut().zip(&soft.jv.as_slice()[..nefc]) {
+                *j += alpha * v;
+            }
+            let new_cost = gauss(qacc, &soft.ma) + rows.update(&soft.jar, efc_force, efc_state);
+            improvement = s.scale * (cost - new_cost);
+            cost = new_cost;
         }
-        mul_j(&nz, nefc, &soft.dir, &mut soft.jv);
-        mul_m(&model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
-        let g0: f64 = (soft.ma.iter().zip(qfrc_smooth.iter()).zip(soft.dir.iter()))
-            .map(|((&ma, &f0), &d)| (ma - f0) * d)
-            .sum();
-        let dmd = soft.dir.dot(&soft.mdir);
-        let alpha = line_search(&rows, &soft.jar, &soft.jv, &mut soft.jar_trial, g0, dmd, s);
-        if alpha == 0.0 {
-            // No descent along the direction (the minimum to round-off).
-            stalled = true;
-            break;
-        }
-        qacc.axpy(alpha, &soft.dir, 1.0);
-        let new_cost = total(qacc, &mut soft.ma, &mut soft.jar, efc_force, efc_state);
-        improvement = s.scale * (cost - new_cost);
-        cost = new_cost;
     }
     // qfrc_constraint = Jᵀ f.
     qfrc_constraint.fill(0.0);
@@ -390,7 +341,11 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     // MuJoCo's criterion: converged when the scaled gradient or improvement fell below the
     // tolerance (or the line search found no descent: the minimum to round-off); else the solve
     // stopped at its iteration limit, counted with its scaled gradient as the residual.
-    let converged = stalled || gradient < s.tolerance || improvement < s.tolerance;
+    let converged = if island_path {
+        converged_islands
+    } else {
+        stalled || gradient < s.tolerance || improvement < s.tolerance
+    };
     data.efc_converged = converged;
     if !converged {
         data.efc_unconverged += 1;
@@ -411,13 +366,20 @@ fn line_search(
     s: Settings,
 ) -> f64 {
     let n = rows.nefc;
-    let mut deriv = |alpha: f64| {
+    let deriv = |alpha: f64| {
         for ((t, &j), &v) in trial.as_mut_slice()[..n].iter_mut().zip(jar.as_slice()).zip(jv.as_slice()) {
             *t = j + alpha * v;
         }
         let (d1, d2) = rows.directional(trial, jv);
         (g0 + alpha * dmd + d1, dmd + d2)
     };
+    line_search_with(deriv, s)
+}
+
+/// The line search's iteration on the cost's slope and curvature along the direction at step α
+/// (`deriv(α)`): Newton steps safeguarded by a sign-change bracket (secant, then bisection).
+/// Returns 0 if the direction does not descend.
+pub(super) fn line_search_with(mut deriv: impl FnMut(f64) -> (f64, f64), s: Settings) -> f64 {
     let (f0, h0) = deriv(0.0);
     if f0 >= 0.0 || !f0.is_finite() {
         return 0.0;

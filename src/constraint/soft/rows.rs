@@ -285,7 +285,7 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
         super::jacobian::append_rows(
             efc_j,
             r..r + rows,
-            &soft.columns,
+            &mut soft.columns,
             &mut soft.nz_start,
             &mut soft.nz_index,
             &mut soft.nz_value,

@@ -14,7 +14,7 @@
 //! The symbolic part (H's pattern, the tree, L's pattern by rows and by columns) is done by
 //! [`SparseCholesky::analyze`] from the rows' cliques and kept while they are unchanged — for all
 //! the iterations of a Newton solve, whose pattern covers every row that can press, and across
-//! steps while the contacts touch the same dofs; [`SparseCholesky::factor_analyzed`] is then
+//! steps while the contacts touch the same dofs; [`SparseCholesky::factor_kept`] is then
 //! only the numeric factorization (MuJoCo likewise keeps its sparse Hessian's structure,
 //! engine_solver.c).
 //!
@@ -233,8 +233,17 @@ impl SparseCholesky {
     /// Factors `h` (lower triangle read) with the symbolic structure of the last
     /// [`Self::analyze`], without reading the rest of `h`: the work is that of the nonzeros.
     /// Returns false if a pivot is not positive.
+    #[cfg(test)]
     pub fn factor_analyzed(&mut self, h: &DMatrix<f64>) -> bool {
-        self.numeric(h, 0.0)
+        self.numeric(h, 0.0, None)
+    }
+
+    /// Factors `h` (lower triangle read) with the symbolic structure of the last
+    /// [`Self::analyze`], the rows k with `keep[k]` only: those of independent
+    /// groups of dofs (constraint islands, `island.rs`) that no kept row couples to; the other
+    /// rows of L keep stale values, which [`Self::solve_kept`] does not read.
+    pub fn factor_kept(&mut self, h: &DMatrix<f64>, keep: &[bool]) -> bool {
+        self.numeric(h, 0.0, Some(keep))
     }
 
     /// Factors the symmetric `h` (its lower triangle is read; n × n at the top left) into L.
@@ -244,7 +253,7 @@ impl SparseCholesky {
         self.pattern_of_h(h, n);
         self.analyzed = false;
         self.symbolic(n);
-        self.numeric(h, tol)
+        self.numeric(h, tol, None)
     }
 
     /// Row lists of H's strictly lower nonzeros, from its lower triangle read by columns
@@ -361,11 +370,14 @@ impl SparseCholesky {
     }
 
     /// Up-looking factorization on the analyzed pattern: row k of L from rows j < k in it.
-    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64) -> bool {
+    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64, keep: Option<&[bool]>) -> bool {
         let n = self.diag.len();
         let (l_start, l_cols, l_vals) = (&self.l_start, &self.l_cols, &mut self.l_vals);
         let (x, diag) = (&mut self.x, &mut self.diag);
         for k in 0..n {
+            if keep.is_some_and(|keep| !keep[k]) {
+                continue;
+            }
             for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
                 x[j] = h[(k, j)];
             }
@@ -401,10 +413,25 @@ impl SparseCholesky {
     }
 
     /// Solves H x = b in place with the last factor (b holds x on return).
+    #[cfg(test)]
     pub fn solve(&self, b: &mut [f64]) {
+        self.solve_where(b, None);
+    }
+
+    /// Solves H x = b in place (b holds x on return) on the rows k with `keep[k]` of the last
+    /// [`Self::factor_kept`] (the other entries of b are left as they are).
+    pub fn solve_kept(&self, b: &mut [f64], keep: &[bool]) {
+        self.solve_where(b, Some(keep));
+    }
+
+    fn solve_where(&self, b: &mut [f64], keep: Option<&[bool]>) {
         let n = self.diag.len();
         let b = &mut b[..n];
+        let skip = |i: usize| keep.is_some_and(|keep| !keep[i]);
         for i in 0..n {
+            if skip(i) {
+                continue;
+            }
             let (lo, hi) = (self.l_start[i], self.l_start[i + 1]);
             let mut s = b[i];
             for (&l, &j) in self.l_vals[lo..hi].iter().zip(&self.l_cols[lo..hi]) {
@@ -413,6 +440,9 @@ impl SparseCholesky {
             b[i] = s / self.diag[i];
         }
         for i in (0..n).rev() {
+            if skip(i) {
+                continue;
+            }
             let (lo, hi) = (self.c_start[i], self.c_start[i + 1]);
             let mut s = b[i];
             for (&l, &j) in self.c_vals[lo..hi].iter().zip(&self.c_rows[lo..hi]) {
@@ -511,6 +541,39 @@ mod tests {
         let mut x4 = rhs;
         structured.solve(&mut x4);
         assert_eq!(x4, x2);
+    }
+
+    #[test]
+    fn a_kept_factor_solves_its_rows_as_the_whole_factor() {
+        // Two uncoupled trees 0 → 1 → 2 and 3 → 4, a row coupling 1 and 2 only: keeping the
+        // first tree's rows gives the whole factor's solution there and leaves the rest of b.
+        let n = 5;
+        let dof_parent = [NONE, 0, 1, NONE, 3];
+        let mut h = DMatrix::zeros(n, n);
+        for k in 0..n {
+            h[(k, k)] = 3.0 + k as f64;
+            let mut l = dof_parent[k];
+            while l != NONE {
+                h[(k, l)] = 0.4;
+                h[(l, k)] = 0.4;
+                l = dof_parent[l];
+            }
+        }
+        let (nz_start, nz_index) = ([0, 2], [1, 2]);
+        let mut f = SparseCholesky::default();
+        f.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(f.factor_analyzed(&h));
+        let rhs = [1.0, -2.0, 0.5, 3.0, -1.0];
+        let mut whole = rhs;
+        f.solve(&mut whole);
+        let keep = [true, true, true, false, false];
+        let mut g = SparseCholesky::default();
+        g.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(g.factor_kept(&h, &keep));
+        let mut kept = rhs;
+        g.solve_kept(&mut kept, &keep);
+        assert_eq!(&kept[..3], &whole[..3]);
+        assert_eq!(&kept[3..], &rhs[3..]);
     }
 
     #[test]

@@ -44,8 +44,11 @@ pub(crate) struct SoftWork {
     pub columns: Vec<usize>,
     /// (row, column) of J's nonzeros in column order, while `nz_start`/`nz_index` are built.
     pub nz_scratch: Vec<(usize, usize)>,
-    /// One row of J at its nonzero columns times a Hessian weight, while H is assembled (nv).
-    pub weighted_row: Vec<f64>,
+    /// One column of a row group's Hessian term, while H is assembled (nv; `hessian.rs`).
+    pub hessian_column: Vec<f64>,
+    /// The constraint islands of the sparse Newton solve (`island.rs`) and one cost per island.
+    pub islands: super::island::Islands,
+    pub island_cost: Vec<f64>,
     /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
     pub ar: DMatrix<f64>,
     pub minv_jt: DMatrix<f64>,
@@ -78,7 +81,9 @@ impl SoftWork {
             j_recorded: false,
             columns: Vec::with_capacity(nv),
             nz_scratch: Vec::new(),
-            weighted_row: vec![0.0; nv],
+            hessian_column: vec![0.0; nv],
+            islands: super::island::Islands::with_capacity(nv, nefc),
+            island_cost: Vec::with_capacity(nv + 1),
             ar: DMatrix::zeros(0, 0),
             minv_jt: DMatrix::zeros(0, 0),
         }

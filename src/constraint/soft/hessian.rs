@@ -1,0 +1,300 @@
+//! The rows' part of the Newton Hessian, Jᵀ (∂²s) J, added to the lower triangle of H = M + …
+//! (MuJoCo documentation, "Computation → Solver", Newton; MuJoCo's `MakeHessian` and
+//! `HessianCone`, engine_solver.c, which form Jᵀ D J and add the cones' blocks).
+//!
+//! The rows come one block at a time from [`Rows::hessian`](super::cost::Rows::hessian): a
+//! weight D on a quadratic row, or a dense block on an elliptic contact's rows. Rows of one contact
+//! share their nonzero columns (`jacobian::append_rows` records a contact's rows over the union of
+//! their nonzeros), so they are summed as a group: each entry's sum over the group's rows is
+//! formed from the rows' compact values (in a register, or four rows at a time in a scratch
+//! column for larger groups) and added to H once — instead of one
+//! scattered read–modify–write of H per row and entry. Consecutive scalar rows with the same columns (a
+//! pyramidal contact's edges in their quadratic state) form one group; an elliptic contact's
+//! block multiplies its rows first (W = B G, G the rows' values), then Gᵀ W is summed the same
+//! way. Rows whose columns differ (J recorded by the full scan, which drops exact zeros) are
+//! added pair by pair.
+
+use super::primal::Sparsity;
+use nalgebra::DMatrix;
+
+/// The most scalar rows summed as one group (a pyramidal contact of condim 6 has 10; a box
+/// on a plane, four contacts on the same dofs, 16).
+const GROUP: usize = 16;
+/// The most rows of a block (an elliptic contact of condim 6).
+const BLOCK: usize = 6;
+
+/// Adds the rows' Hessian blocks to H's lower triangle (see the module doc). Scalar rows are
+/// held in a pending group until a row with other columns (or a block) arrives; [`finish`]
+/// adds the last group.
+///
+/// [`finish`]: Assembler::finish
+pub(super) struct Assembler<'a> {
+    h: &'a mut DMatrix<f64>,
+    nz: &'a Sparsity<'a>,
+    /// One column of a group's sum, for groups of more than four rows (nv long).
+    column: &'a mut [f64],
+    /// The pending group: its rows and their weights.
+    rows: [usize; GROUP],
+    weights: [f64; GROUP],
+    len: usize,
+}
+
+impl<'a> Assembler<'a> {
+    /// An assembler adding to `h` (nv × nv) the rows of `nz`; `column` is nv-long scratch.
+    pub fn new(h: &'a mut DMatrix<f64>, nz: &'a Sparsity<'a>, column: &'a mut [f64]) -> Self {
+        Self { h, nz, column, rows: [0; GROUP], weights: [0.0; GROUP], len: 0 }
+    }
+
+    /// Adds block `block` (dim × dim, symmetric) on rows i..i + dim: Jᵀ B J over those rows.
+    pub fn add(&mut self, i: usize, dim: usize, block: &[[f64; 6]; 6]) {
+        if dim == 1 {
+            if self.len == GROUP || (self.len > 0 && self.nz.columns(self.rows[0]) != self.nz.columns(i)) {
+                self.flush();
+            }
+            self.rows[self.len] = i;
+            self.weights[self.len] = block[0][0];
+            self.len += 1;
+            return;
+        }
+        self.flush();
+        let cols = self.nz.columns(i);
+        if (i + 1..i + dim).all(|r| self.nz.columns(r) == cols) {
+            self.add_block(i, dim, block);
+        } else {
+            for a in i..i + dim {
+                for b in i..i + dim {
+                    self.add_pair(a, b, block[a - i][b - i]);
+                }
+            }
+        }
+    }
+
+    /// Adds the pending group.
+    pub fn finish(mut self) {
+        self.flush();
+    }
+
+    /// The pending scalar rows (same columns): H[p][q] += Σ_r w_r G_r[p] G_r[q], p ≥ q.
+    fn flush(&mut self) {
+        let k = self.len;
+        if k == 0 {
+            return;
+        }
+        self.len = 0;
+        let cols = self.nz.columns(self.rows[0]);
+        let mut g: [&[f64]; GROUP] = [&[]; GROUP];
+        for (g, &row) in g.iter_mut().zip(&self.rows[..k]) {
+            *g = self.nz.row_values(row).1;
+        }
+        let weights = self.weights;
+        add_columns(self.h, cols, &g[..k], self.column, |q, c| {
+            for ((c, &w), g) in c.iter_mut().zip(&weights[..k]).zip(&g[..k]) {
+                *c = w * g[q];
+            }
+        });
+    }
+
+    /// Rows i..i + dim with the same columns and a dense block B: with G the rows' values,
+    /// H[p][q] += Σ_a G_a[p] (B G)_a[q], p ≥ q.
+    fn add_block(&mut self, i: usize, dim: usize, block: &[[f64; 6]; 6]) {
+        let cols = self.nz.columns(i);
+        let mut g: [&[f64]; BLOCK] = [&[]; BLOCK];
+        for (a, g) in g.iter_mut().enumerate().take(dim) {
+            *g = self.nz.row_values(i + a).1;
+        }
+        let rows = g;
+        add_columns(self.h, cols, &g[..dim], self.column, |q, c| {
+            for (a, c) in c.iter_mut().enumerate() {
+                *c = (0..dim).map(|b| block[a][b] * rows[b][q]).sum();
+            }
+        });
+    }
+
+    /// H[p][q] += w J[a][p] J[b][q] over the nonzero columns p ≥ q of rows a and b.
+    fn add_pair(&mut self, a: usize, b: usize, w: f64) {
+        let ((row_a, j_a), (row_b, j_b)) = (self.nz.row_values(a), self.nz.row_values(b));
+        let nv = self.h.nrows();
+        let h = self.h.as_mut_slice();
+        for (&q, &j_bq) in row_b.iter().zip(j_b) {
+            let column = &mut h[q * nv..(q + 1) * nv];
+            let c = w * j_bq;
+            for (&p, &j_ap) in row_a.iter().zip(j_a) {
+                if p >= q {
+                    column[p] += j_ap * c;
+                }
+            }
+        }
+    }
+}
+
+/// H[p][q] += Σ_r c_r(q) G_r[p] over columns q of `cols` and p ≥ q (rows `g`, all on `cols`;
+/// `coefficients(q, c)` writes c_r(q) for column position q): each entry's sum is formed in row
+/// order — in a register up to four rows, in `scratch` four rows at a time beyond — and added to
+/// H once.
+fn add_columns(
+    h: &mut DMatrix<f64>,
+    cols: &[usize],
+    g: &[&[f64]],
+    scratch: &mut [f64],
+    mut coefficients: impl FnMut(usize, &mut [f64]),
+) {
+    let (n, k) = (cols.len(), g.len());
+    let nv = h.nrows();
+    let h = h.as_mut_slice();
+    let mut c = [0.0; GROUP];
+    for q in 0..n {
+        coefficients(q, &mut c[..k]);
+        let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
+        let rows = &cols[q..];
+        match k {
+            1 => {
+                for (&p, &g0) in rows.iter().zip(&g[0][q..n]) {
+                    column[p] += c[0] * g0;
+                }
+            }
+            2 => {
+                for ((&p, &g0), &g1) in rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]) {
+                    column[p] += c[0] * g0 + c[1] * g1;
+                }
+            }
+            3 => {
+                for (((&p, &g0), &g1), &g2) in rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n])
+                {
+                    column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2;
+                }
+            }
+            4 => {
+                for ((((&p, &g0), &g1), &g2), &g3) in
+                    rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n]).zip(&g[3][q..n])
+                {
+                    column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2 + c[3] * g3;
+                }
+            }
+            _ => {
+                // Four rows at a time into the scratch column, left to right (the same sum).
+                let t = &mut scratch[..n - q];
+                let (g0, g1, g2, g3) = (&g[0][q..n], &g[1][q..n], &g[2][q..n], &g[3][q..n]);
+                for ((((t, &a0), &a1), &a2), &a3) in t.iter_mut().zip(g0).zip(g1).zip(g2).zip(g3) {
+                    *t = c[0] * a0 + c[1] * a1 + c[2] * a2 + c[3] * a3;
+                }
+                let mut r = 4;
+                while r < k {
+                    match k - r {
+                        1 => {
+                            for (t, &a0) in t.iter_mut().zip(&g[r][q..n]) {
+                                *t += c[r] * a0;
+                            }
+                            r += 1;
+                        }
+                        2 => {
+                            for ((t, &a0), &a1) in t.iter_mut().zip(&g[r][q..n]).zip(&g[r + 1][q..n]) {
+                                *t = *t + c[r] * a0 + c[r + 1] * a1;
+                            }
+                            r += 2;
+                        }
+                        3 => {
+                            for (((t, &a0), &a1), &a2) in
+                                t.iter_mut().zip(&g[r][q..n]).zip(&g[r + 1][q..n]).zip(&g[r + 2][q..n])
+                            {
+                                *t = *t + c[r] * a0 + c[r + 1] * a1 + c[r + 2] * a2;
+                            }
+                            r += 3;
+                        }
+                        _ => {
+                            for ((((t, &a0), &a1), &a2), &a3) in t
+                                .iter_mut()
+                                .zip(&g[r][q..n])
+                                .zip(&g[r + 1][q..n])
+                                .zip(&g[r + 2][q..n])
+                                .zip(&g[r + 3][q..n])
+                            {
+                                *t = *t + c[r] * a0 + c[r + 1] * a1 + c[r + 2] * a2 + c[r + 3] * a3;
+                            }
+                            r += 4;
+                        }
+                    }
+                }
+                for (&p, &v) in rows.iter().zip(t.iter()) {
+                    column[p] += v;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Jᵀ B J (lower triangle) by the definition.
+    fn reference(j: &DMatrix<f64>, blocks: &[(usize, usize, [[f64; 6]; 6])], nv: usize) -> DMatrix<f64> {
+        let mut h = DMatrix::zeros(nv, nv);
+        for &(i, dim, b) in blocks {
+            for a in 0..dim {
+                for c in 0..dim {
+                    for p in 0..nv {
+                        for q in 0..=p {
+                            h[(p, q)] += j[(i + a, p)] * b[a][c] * j[(i + c, q)];
+                        }
+                    }
+                }
+            }
+        }
+        h
+    }
+
+    #[test]
+    fn grouped_rows_and_blocks_sum_to_jt_b_j() {
+        // Rows 0..2: one group on columns {1, 3, 4}; row 2 alone on {0, 4}; rows 3..6 a block
+        // on {0, 2, 3} (row 4 has an exact zero there, kept); rows 6..8 a block whose rows have
+        // different columns (pair by pair).
+        let nv = 5;
+        let cols: [&[usize]; 8] =
+            [&[1, 3, 4], &[1, 3, 4], &[0, 4], &[0, 2, 3], &[0, 2, 3], &[0, 2, 3], &[2], &[1, 2]];
+        let mut j = DMatrix::zeros(8, nv);
+        let (mut start, mut index, mut value) = (vec![0], vec![], vec![]);
+        for (i, c) in cols.iter().enumerate() {
+            for (t, &k) in c.iter().enumerate() {
+                let v = if i == 4 && k == 2 { 0.0 } else { 0.3 + 0.7 * ((i * 5 + t * 3) % 7) as f64 - 1.1 };
+                j[(i, k)] = v;
+                index.push(k);
+                value.push(v);
+            }
+            start.push(index.len());
+        }
+        let nz = Sparsity { start: &start, index: &index, value: &value };
+        let mut b3 = [[0.0; 6]; 6];
+        for (a, row) in b3.iter_mut().enumerate().take(3) {
+            for (c, x) in row.iter_mut().enumerate().take(3) {
+                *x = if a == c { 2.0 + a as f64 } else { 0.25 };
+            }
+        }
+        let mut b2 = [[0.0; 6]; 6];
+        b2[0] = [1.5, -0.5, 0.0, 0.0, 0.0, 0.0];
+        b2[1] = [-0.5, 0.75, 0.0, 0.0, 0.0, 0.0];
+        let scalar = |w: f64| {
+            let mut b = [[0.0; 6]; 6];
+            b[0][0] = w;
+            b
+        };
+        let blocks = [(0, 1, scalar(2.0)), (1, 1, scalar(0.5)), (2, 1, scalar(3.0)), (3, 3, b3), (6, 2, b2)];
+        let mut h = DMatrix::zeros(nv, nv);
+        let mut column = vec![0.0; nv];
+        let mut asm = Assembler::new(&mut h, &nz, &mut column);
+        for &(i, dim, b) in &blocks {
+            asm.add(i, dim, &b);
+        }
+        asm.finish();
+        let want = reference(&j, &blocks, nv);
+        for p in 0..nv {
+            for q in 0..nv {
+                let w = if q <= p { want[(p, q)] } else { 0.0 };
+                assert!(
+                    (h[(p, q)] - w).abs() <= 1e-14 * (1.0 + w.abs()),
+                    "H[{p}][{q}] = {} against {w}",
+                    h[(p, q)]
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,484 @@
+//! Constraint islands of the soft Newton solve (MuJoCo 4.0's engine_island.c, `mj_island`, and
+//! `mj_solNewton_island`, engine_solver.c): the groups of dofs that the mass matrix (a dof
+//! couples to its tree) and the rows (a row couples the dofs of its nonzero columns) join. The
+//! soft problem separates over islands — its cost is the sum of theirs — so each island's
+//! minimizer is found on its own: its own Newton iterations, line search and termination
+//! test, scaled by its own inertia (MuJoCo's island scale 1 / Σ M_kk over its dofs). A pile
+//! that has come to rest stops iterating while a tumbling one goes on; the work of a solve is
+//! the sum of the islands' work instead of the largest island's iteration count times the
+//! whole problem.
+//!
+//! [`Islands::discover`] finds them (union–find over dofs from the trees and the rows'
+//! recorded columns); [`newton`] runs the iterations on every island still iterating at once:
+//! the Hessian's rows, its factor (`SparseCholesky::factor_kept`) and the solve only for
+//! those islands' dofs, one exact line search per island over its own rows. Dofs of trees no
+//! row touches keep `qacc_smooth` (MuJoCo does the same).
+
+use super::cost::Rows;
+use super::hessian::Assembler;
+use super::primal::{line_search_with, mul_j, mul_m, Settings, Sparsity};
+use super::work::SoftWork;
+use crate::dynamics::solve_with_factor_unchecked;
+use crate::model::{EfcState, Model, NO_DOF};
+use nalgebra::{DMatrix, DVector};
+
+const NONE: usize = usize::MAX;
+
+/// The islands of one solve and each island's iteration state.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Islands {
+    /// Number of islands.
+    pub n: usize,
+    /// Each dof's island (`NONE`: no row touches its tree) and each row's (`NONE`: a row with
+    /// no nonzero column).
+    pub dof: Vec<usize>,
+    pub row: Vec<usize>,
+    /// Island i's dofs are `dofs[dof_start[i]..dof_start[i + 1]]`, its rows
+    /// `rows[row_start[i]..row_start[i + 1]]` (both ascending).
+    pub dof_start: Vec<usize>,
+    pub dofs: Vec<usize>,
+    pub row_start: Vec<usize>,
+    pub rows: Vec<usize>,
+    /// Each dof's tree (its root dof), union–find parents over trees (by their root dofs), and
+    /// each root's island while numbering.
+    tree: Vec<usize>,
+    parent: Vec<usize>,
+    root_island: Vec<usize>,
+    /// Per island: scale (1 / Σ M_kk), cost, last improvement and gradient, iterations, and
+    /// whether it still iterates; the step and the line search's slope and curvature terms.
+    scale: Vec<f64>,
+    cost: Vec<f64>,
+    improvement: Vec<f64>,
+    gradient: Vec<f64>,
+    iterations: Vec<u32>,
+    active: Vec<bool>,
+    converged: Vec<bool>,
+    alpha: Vec<f64>,
+    g0: Vec<f64>,
+    dmd: Vec<f64>,
+    /// Per dof: whether its island still iterates (the factor's and the solve's mask).
+    keep: Vec<bool>,
+}
+
+impl Islands {
+    /// Buffers for nv dofs and nefc rows (they grow with larger problems only).
+    pub fn with_capacity(nv: usize, nefc: usize) -> Self {
+        fn per<T>(n: usize) -> Vec<T> {
+            Vec::with_capacity(n + 1)
+        }
+        Self {
+            n: 0,
+            dof: per(nv),
+            row: per(nefc),
+            dof_start: per(nv),
+            dofs: per(nv),
+            row_start: per(nv),
+            rows: per(nefc),
+            tree: per(nv),
+            parent: per(nv),
+            root_island: per(nv),
+            scale: per(nv),
+            cost: per(nv),
+            improvement: per(nv),
+            gradient: per(nv),
+            iterations: per(nv),
+            active: per(nv),
+            converged: per(nv),
+            alpha: per(nv),
+            g0: per(nv),
+            dmd: per(nv),
+            keep: per(nv),
+        }
+    }
+
+    fn find(&mut self, mut x: usize) -> usize {
+        while self.parent[x] != x {
+            self.parent[x] = self.parent[self.parent[x]];
+            x = self.parent[x];
+        }
+        x
+    }
+
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            // The smaller root becomes the parent: deterministic, whatever the row order.
+            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+            self.parent[hi] = lo;
+        }
+    }
+
+    /// The islands of the `nefc` rows of `nz` over `nv` dofs with tree parents `dof_parent`,
+    /// numbered in the order of their first row; the scale of each from M's diagonal `m`.
+    pub(super) fn discover(
+        &mut self,
+        nv: usize,
+        dof_parent: &[usize],
+        nefc: usize,
+        nz: &Sparsity,
+        m: &DMatrix<f64>,
+    ) {
+        // Each dof's tree (its root dof: parents come first), then one union per pair of trees
+        // a row joins (a row's columns run tree by tree).
+        self.tree.clear();
+        for k in 0..nv {
+            let t = if dof_parent[k] == NO_DOF { k } else { self.tree[dof_parent[k]] };
+            self.tree.push(t);
+        }
+        self.parent.clear();
+        self.parent.extend(0..nv);
+        let mut previous: &[usize] = &[];
+        for i in 0..nefc {
+            let cols = nz.columns(i);
+            // A contact's rows share their columns: its first row joins them.
+            if cols == previous {
+                continue;
+            }
+            previous = cols;
+            if let Some((&first, rest)) = cols.split_first() {
+                let (t0, mut last) = (self.tree[first], self.tree[first]);
+                for &c in rest {
+                    let t = self.tree[c];
+                    if t != last {
+                        self.union(t0, t);
+                        last = t;
+                    }
+                }
+            }
+        }
+        self.root_island.clear();
+        self.root_island.resize(nv, NONE);
+        self.row.clear();
+        self.n = 0;
+        for i in 0..nefc {
+            let island = match nz.columns(i).first() {
+                Some(&c) => {
+                    let r = self.find(self.tree[c]);
+                    if self.root_island[r] == NONE {
+                        self.root_island[r] = self.n;
+                        self.n += 1;
+                    }
+                    self.root_island[r]
+                }
+                None => NONE,
+            };
+            self.row.push(island);
+        }
+        self.dof.clear();
+        for k in 0..nv {
+            let r = self.find(self.tree[k]);
+            self.dof.push(self.root_island[r]);
+        }
+        let n = self.n;
+        counting_lists(n, &self.dof, &mut self.dof_start, &mut self.dofs);
+        counting_lists(n, &self.row, &mut self.row_start, &mut self.rows);
+        self.scale.clear();
+        for i in 0..n {
+            let inertia: f64 =
+                self.dofs[self.dof_start[i]..self.dof_start[i + 1]].iter().map(|&k| m[(k, k)]).sum();
+            self.scale.push(1.0 / inertia);
+        }
+        for v in [
+            &mut self.cost,
+            &mut self.improvement,
+            &mut self.gradient,
+            &mut self.alpha,
+            &mut self.g0,
+            &mut self.dmd,
+        ] {
+            v.clear();
+            v.resize(n, 0.0);
+        }
+        self.improvement.fill(f64::INFINITY);
+        self.iterations.clear();
+        self.iterations.resize(n, 0);
+        self.active.clear();
+        self.active.resize(n, true);
+        self.converged.clear();
+        self.converged.resize(n, false);
+        self.keep.clear();
+        self.keep.extend(self.dof.iter().map(|&i| i != NONE));
+    }
+}
+
+/// Island lists from each item's island (`NONE`: in none): items of island i in
+/// `items[start[i]..start[i + 1]]`, ascending.
+fn counting_lists(n: usize, of: &[usize], start: &mut Vec<usize>, items: &mut Vec<usize>) {
+    start.clear();
+    start.resize(n + 1, 0);
+    for &i in of {
+        if i != NONE {
+            start[i + 1] += 1;
+        }
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    items.clear();
+    items.resize(start[n], 0);
+    // start[i] is island i's next free slot while filling, then shifted back.
+    for (k, &i) in of.iter().enumerate() {
+        if i != NONE {
+            items[start[i]] = k;
+            start[i] += 1;
+        }
+    }
+    for i in (1..=n).rev() {
+        start[i] = start[i - 1];
+    }
+    start[0] = 0;
+}
+
+/// The problem of one solve, read-only.
+pub(super) struct Problem<'a> {
+    pub model: &'a Model,
+    pub rows: &'a Rows<'a>,
+    pub nz: &'a Sparsity<'a>,
+    /// M, `qacc_smooth`, `qfrc_smooth` and `efc_aref`.
+    pub m: &'a DMatrix<f64>,
+    pub a0: &'a DVector<f64>,
+    pub f0: &'a DVector<f64>,
+    pub settings: Settings,
+}
+
+/// What the solve ended with: the most iterations of an island, the largest last scaled
+/// improvement and gradient of an island, and whether every island converged.
+pub(super) struct Outcome {
+    pub iterations: u32,
+    pub improvement: f64,
+    pub gradient: f64,
+    pub converged: bool,
+}
+
+/// Newton's method island by island (see the module doc) from `qacc` (with `soft.ma` = M qacc,
+/// `soft.jar` = J qacc − aref, and `force`, `state` at it); leaves the solution in `qacc` and
+/// the forces and states at it.
+pub(super) fn newton(
+    p: &Problem,
+    soft: &mut SoftWork,
+    mass_factor: &DMatrix<f64>,
+    qacc: &mut DVector<f64>,
+    force: &mut DVector<f64>,
+    state: &mut [EfcState],
+) -> Outcome {
+    let (model, rows, nz, s) = (p.model, p.rows, p.nz, p.settings);
+    let (nv, nefc) = (model.nv, rows.nefc);
+    let isl = &mut soft.islands;
+    isl.discover(nv, &model.dof_parent, nefc, nz, p.m);
+    let n = isl.n;
+    // Trees without rows: the unconstrained acceleration (M a = qfrc_smooth there).
+    for k in 0..nv {
+        if isl.dof[k] == NONE {
+            qacc[k] = p.a0[k];
+            soft.ma[k] = p.f0[k];
+        }
+    }
+    let costs = |isl: &mut Islands,
+                 qacc: &DVector<f64>,
+                 ma: &DVector<f64>,
+                 jar: &DVector<f64>,
+                 force: &mut DVector<f64>,
+                 state: &mut [EfcState],
+                 out: &mut [f64]| {
+        out[..n].fill(0.0);
+        for (k, &i) in isl.dof.iter().enumerate() {
+            if i != NONE {
+                out[i] += 0.5 * (qacc[k] - p.a0[k]) * (ma[k] - p.f0[k]);
+            }
+        }
+        let row_island = &isl.row;
+        rows.update_each(jar, force, state, |r, c| {
+            if row_island[r] != NONE {
+                out[row_island[r]] += c;
+            }
+        });
+    };
+    let mut cost = std::mem::take(&mut isl.cost);
+    costs(isl, qacc, &soft.ma, &soft.jar, force, state, &mut cost);
+    let mut new_cost = std::mem::take(&mut soft.island_cost);
+    new_cost.clear();
+    new_cost.resize(n, 0.0);
+    let mut iterations = 0;
+    let mut analyzed = false;
+    loop {
+        // g = M a − qfrc_smooth − Jᵀ f, and each island's scaled norm of it.
+        for ((g, &ma), &f0) in
+            soft.grad.as_mut_slice().iter_mut().zip(soft.ma.as_slice()).zip(p.f0.as_slice())
+        {
+            *g = ma - f0;
+        }
+        let grad = soft.grad.as_mut_slice();
+        for (i, &f) in force.as_slice()[..nefc].iter().enumerate() {
+            if f != 0.0 {
+                let (cols, vals) = nz.row_values(i);
+                for (&k, &j_ik) in cols.iter().zip(vals) {
+                    grad[k] -= j_ik * f;
+                }
+            }
+        }
+        let mut any = false;
+        for i in 0..n {
+            if !isl.active[i] {
+                continue;
+            }
+            let g2: f64 =
+                isl.dofs[isl.dof_start[i]..isl.dof_start[i + 1]].iter().map(|&k| grad[k] * grad[k]).sum();
+            isl.gradient[i] = isl.scale[i] * g2.sqrt();
+            if isl.gradient[i] < s.tolerance || isl.improvement[i] < s.tolerance {
+                isl.active[i] = false;
+                isl.converged[i] = true;
+            } else if isl.iterations[i] >= s.iterations {
+                isl.active[i] = false;
+            } else {
+                isl.iterations[i] += 1;
+                iterations = iterations.max(isl.iterations[i]);
+                any = true;
+            }
+        }
+        if !any {
+            break;
+        }
+        for k in 0..nv {
+            isl.keep[k] = isl.dof[k] != NONE && isl.active[isl.dof[k]];
+        }
+        // H = M + Jᵀ (∂²s) J on the iterating islands' dofs (all of them the first time, which
+        // clears the last solve's pattern before the new one is analyzed).
+        let h = &mut soft.hessian;
+        for k in 0..nv {
+            if analyzed && !isl.keep[k] {
+                continue;
+            }
+            for &j in soft.factor.pattern_row(k) {
+                h[(k, j)] = 0.0;
+            }
+            h[(k, k)] = p.m[(k, k)];
+            let mut l = model.dof_parent[k];
+            while l != NO_DOF {
+                h[(k, l)] = p.m[(k, l)];
+                l = model.dof_parent[l];
+            }
+        }
+        if !analyzed {
+            soft.active_rows.clear();
+            for i in 0..nefc {
+                let same_contact = i > 0
+                    && rows.kind[i].is_contact()
+                    && rows.kind[i] == rows.kind[i - 1]
+                    && rows.id[i] == rows.id[i - 1];
+                match soft.active_rows.last_mut() {
+                    Some(g) if same_contact => g.1 = i,
+                    _ => soft.active_rows.push((i, i)),
+                }
+            }
+            soft.factor.analyze(nv, &model.dof_parent, &soft.active_rows, nz.start, nz.index);
+            analyzed = true;
+        }
+        {
+            let mut rows_h = Assembler::new(h, nz, &mut soft.hessian_column);
+            let (row_island, active) = (&isl.row, &isl.active);
+            rows.hessian(&soft.jar, state, |i, dim, block| {
+                if row_island[i] != NONE && active[row_island[i]] {
+                    rows_h.add(i, dim, block);
+                }
+            });
+            rows_h.finish();
+        }
+        soft.dir.copy_from(&soft.grad);
+        if soft.factor.factor_kept(&soft.hessian, &isl.keep) {
+            soft.factor.solve_kept(soft.dir.as_mut_slice(), &isl.keep);
+        } else {
+            solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
+        }
+        for (d, &keep) in soft.dir.as_mut_slice().iter_mut().zip(&isl.keep) {
+            *d = if keep { -*d } else { 0.0 };
+        }
+        mul_j(nz, nefc, &soft.dir, &mut soft.jv);
+        mul_m(&model.dof_parent, p.m, &soft.dir, &mut soft.mdir);
+        // One exact line search per iterating island, over its dofs and rows.
+        for i in 0..n {
+            isl.alpha[i] = 0.0;
+            if !isl.active[i] {
+                continue;
+            }
+            let (mut g0, mut dmd) = (0.0, 0.0);
+            for &k in &isl.dofs[isl.dof_start[i]..isl.dof_start[i + 1]] {
+                g0 += (soft.ma[k] - p.f0[k]) * soft.dir[k];
+                dmd += soft.dir[k] * soft.mdir[k];
+            }
+            let list = &isl.rows[isl.row_start[i]..isl.row_start[i + 1]];
+            let (jar, jv, trial) = (&soft.jar, &soft.jv, &mut soft.jar_trial);
+            let alpha = line_search_with(
+                |alpha| {
+                    for &r in list {
+                        trial[r] = jar[r] + alpha * jv[r];
+                    }
+                    let (d1, d2) = rows.directional_rows(trial, jv, list);
+                    (g0 + alpha * dmd + d1, dmd + d2)
+                },
+                s,
+            );
+            if alpha == 0.0 {
+                // No descent along the direction (the island's minimum to round-off).
+                isl.active[i] = false;
+                isl.converged[i] = true;
+            }
+            isl.alpha[i] = alpha;
+        }
+        for k in 0..nv {
+            let i = isl.dof[k];
+            if i != NONE && isl.alpha[i] != 0.0 {
+                let alpha = isl.alpha[i];
+                qacc[k] += alpha * soft.dir[k];
+                soft.ma[k] += alpha * soft.mdir[k];
+            }
+        }
+        for r in 0..nefc {
+            let i = isl.row[r];
+            if i != NONE && isl.alpha[i] != 0.0 {
+                soft.jar[r] += isl.alpha[i] * soft.jv[r];
+            }
+        }
+        costs(isl, qacc, &soft.ma, &soft.jar, force, state, &mut new_cost);
+        for i in 0..n {
+            if isl.alpha[i] != 0.0 {
+                isl.improvement[i] = isl.scale[i] * (cost[i] - new_cost[i]);
+                cost[i] = new_cost[i];
+            }
+        }
+    }
+    let outcome = Outcome {
+        iterations,
+        improvement: (0..n).map(|i| isl.improvement[i]).filter(|x| x.is_finite()).fold(0.0, f64::max),
+        gradient: (0..n).map(|i| isl.gradient[i]).fold(0.0, f64::max),
+        converged: isl.converged[..n].iter().all(|&c| c),
+    };
+    isl.cost = cost;
+    soft.island_cost = new_cost;
+    outcome
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn islands_join_trees_through_rows() {
+        // Trees {0, 1}, {2, 3}, {4}, {5}: row 0 couples 1 and 3, row 1 has no column, row 2
+        // touches 5 only; dof 4 is in no island.
+        let nv = 6;
+        let dof_parent = [NO_DOF, 0, NO_DOF, 2, NO_DOF, NO_DOF];
+        let (start, index, value) = ([0, 2, 2, 3], [1, 3, 5], [1.0, -1.0, 2.0]);
+        let nz = Sparsity { start: &start, index: &index, value: &value };
+        let m = DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]));
+        let mut isl = Islands::with_capacity(nv, 3);
+        isl.discover(nv, &dof_parent, 3, &nz, &m);
+        assert_eq!(isl.n, 2);
+        assert_eq!(isl.dof, [0, 0, 0, 0, NONE, 1]);
+        assert_eq!(isl.row, [0, NONE, 1]);
+        assert_eq!(&isl.dofs[isl.dof_start[0]..isl.dof_start[1]], &[0, 1, 2, 3]);
+        assert_eq!(&isl.rows[isl.row_start[1]..isl.row_start[2]], &[2]);
+        // MuJoCo's island scale: 1 / Σ M_kk over the island's dofs.
+        assert_eq!(isl.scale, [0.1, 1.0 / 6.0]);
+        assert_eq!(isl.keep, [true, true, true, true, false, true]);
+    }
+}
