@@ -17,6 +17,7 @@ mod admm;
 mod contact;
 pub mod contact_force;
 mod coulomb;
+mod coulomb_polish;
 mod dense;
 mod energy_guard;
 mod exact;
