@@ -261,7 +261,7 @@ fn mesh_collides_by_its_hull() {
         "<asset><mesh name=\"cube\" file=\"{}\"/></asset><worldbody><geom type=\"plane\" size=\"1 1 0.1\"/>{}</worldbody>",
         cube.display(),
         free("0 0 -0.01", "", "<geom type=\"mesh\" mesh=\"cube\"/>"))).unwrap();
-    let hull = m.geoms[1].hull.as_ref().expect("a colliding mesh has a hull");
+    let hull = m.geoms[1].hull().expect("a colliding mesh has a hull");
     let lowest = hull.iter().map(|v| v.z).fold(f64::INFINITY, f64::min);
     let c = contacts(&m);
     println!("cube hull: {} vertices, lowest z {lowest}; {} contacts", hull.len(), c.len());

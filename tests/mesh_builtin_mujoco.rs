@@ -53,7 +53,7 @@ fn builtin_mass_com_inertia_and_hull_are_mujocos() {
         let g = model.geoms.iter().find(|g| g.body == 1 && g.mesh.is_some()).unwrap();
         if !case["collides"].as_bool().unwrap() {
             // A flat built-in as a visual geom beside a sphere: no hull, mass checked above.
-            assert!(g.hull.is_none() && !g.collision, "{label}: a visual geom");
+            assert!(g.hull().is_none() && !g.collision, "{label}: a visual geom");
             println!(
                 "{label}: mass {:.6} (MuJoCo {mass:.6}), mass/com/inertia rel err {err:.1e}, visual",
                 body.mass()
@@ -61,7 +61,7 @@ fn builtin_mass_com_inertia_and_hull_are_mujocos() {
             worst_mass = worst_mass.max(err);
             continue;
         }
-        let hull = g.hull.as_ref().expect("a built-in mesh collides by its hull");
+        let hull = g.hull().expect("a built-in mesh collides by its hull");
         let mut ours: Vec<f64> =
             hull.iter().map(|v| (g.x_body_geom.act_point(v) - body.com()).norm()).collect();
         let mut theirs: Vec<f64> = case["vert"]

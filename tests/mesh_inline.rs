@@ -51,7 +51,7 @@ fn inline_mesh_masses_and_hulls_are_mujocos() {
         // MuJoCo's mesh_vert are in the mesh's inertial frame (origin at the centre of mass): the
         // distances of the hull's vertices from the body's centre of mass are theirs (f32).
         let g = model.geoms.iter().find(|g| g.body == i + 1).unwrap();
-        let hull = g.hull.as_ref().expect("an inline mesh collides by its hull");
+        let hull = g.hull().expect("an inline mesh collides by its hull");
         let mut ours: Vec<f64> =
             hull.iter().map(|v| (g.x_body_geom.act_point(v) - body.com()).norm()).collect();
         let mut theirs: Vec<f64> = mesh["vert"]

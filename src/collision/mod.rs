@@ -151,11 +151,7 @@ impl CollisionModel {
             })
             .collect();
         let sweep = broadphase::Broadphase::new(model, &rbound);
-        let local_box = model
-            .geoms
-            .iter()
-            .map(|g| obb::LocalBox::of(&g.shape, g.hull.as_deref().map(|h| &h[..])))
-            .collect();
+        let local_box = model.geoms.iter().map(|g| obb::LocalBox::of(&g.shape, g.hull())).collect();
         Self { shapes, rbound, broad, plane_hulls, sweep, local_box }
     }
 }

@@ -201,9 +201,8 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             });
         }
         for (g, &mass) in link.geoms.iter().zip(&geom_masses[li]) {
-            let (hull, hull_graph) =
-                crate::io::geom_hull::geom_hull(g, word, &link.name, &mut hulls, &mut warnings)?.unzip();
-            let unreadable = matches!(g.shape, Shape::Mesh { .. }) && hull.is_none();
+            let hull_graph = crate::io::geom_hull::geom_hull(g, word, &link.name, &mut hulls, &mut warnings)?;
+            let unreadable = matches!(g.shape, Shape::Mesh { .. }) && hull_graph.is_none();
             geoms.push(Geom {
                 name: g.name.clone(),
                 link: link.name.clone(),
@@ -214,7 +213,6 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                 collision: g.collision && !unreadable,
                 mass,
                 contact: g.contact,
-                hull,
                 hull_graph,
                 group: g.group,
                 rgba: g.rgba,

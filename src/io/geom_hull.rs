@@ -26,9 +26,9 @@ use crate::spatial::{quat_to_matrix, Mat3, Vec3};
 use std::collections::HashMap;
 use std::sync::Arc;
 
-/// A colliding mesh's hull: its vertices (qhull's order, where collision reads them) and MuJoCo's
-/// graph and polygons of it (the same vertices).
-pub type GeomHull = (Arc<Vec<Vec3>>, Arc<MeshGraph>);
+/// A colliding mesh's hull: MuJoCo's graph and polygons of it, its vertices in qhull's order
+/// where collision reads them.
+pub type GeomHull = Arc<MeshGraph>;
 
 /// Hull vertices and graphs by (file, scale, inertia mode).
 #[derive(Default)]
@@ -102,7 +102,7 @@ pub fn geom_hull(
         round_as_mujoco(&mut placed, &com, &r);
     }
     let graph = MeshGraph::new(&unscaled, &scaled, &placed, -1).map_err(|e| err(e.to_string()))?;
-    let entry = (Arc::new(graph.vertices.clone()), Arc::new(graph));
+    let entry = Arc::new(graph);
     cache.entries.insert(key, entry.clone());
     Ok(Some(entry))
 }

@@ -187,12 +187,10 @@ pub struct Geom {
     pub mass: f64,
     /// Contact parameters (MuJoCo's defaults for URDF collision geoms).
     pub contact: spec::GeomContact,
-    /// For a colliding mesh: the vertices of its convex hull in the geom frame (MuJoCo collides
-    /// meshes by their hulls).
-    pub hull: Option<std::sync::Arc<Vec<Vec3>>>,
-    /// For a colliding mesh: its hull as MuJoCo's compiler builds it with qhull (the vertices of
-    /// `hull` in the same order, their edges, the face polygons: MuJoCo's `mesh_graph` and
-    /// `mesh_polyvert`; [`crate::collision::mesh_graph`]).
+    /// For a colliding mesh: its convex hull as MuJoCo's compiler builds it with qhull (the
+    /// vertices in the geom frame, their edges, the face polygons: MuJoCo's `mesh_graph` and
+    /// `mesh_polyvert`; [`crate::collision::mesh_graph`]). MuJoCo collides meshes by their hulls;
+    /// [`Geom::hull`] reads the vertices.
     pub hull_graph: Option<std::sync::Arc<crate::collision::mesh_graph::MeshGraph>>,
     /// MJCF `group` (MuJoCo's `geom_group`; 0 by default): ray casting can select groups.
     pub group: i32,
@@ -209,6 +207,14 @@ pub struct Geom {
     /// `fluidshape="ellipsoid"` with its five `fluidcoef` (MuJoCo's `geom_fluid[1..6]`), if set:
     /// the geom's body then feels the ellipsoid fluid model instead of the inertia-box one.
     pub fluid: Option<[f64; 5]>,
+}
+
+impl Geom {
+    /// For a colliding mesh, the vertices of its convex hull in the geom frame (qhull's order,
+    /// where MuJoCo's collision reads them); None for primitives and non-colliding meshes.
+    pub fn hull(&self) -> Option<&[Vec3]> {
+        self.hull_graph.as_deref().map(|g| &g.vertices[..])
+    }
 }
 
 /// The compiled, immutable model. Build it with a loader (e.g. [`crate::io::load`]) or by
