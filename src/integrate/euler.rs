@@ -3,30 +3,24 @@
 //! "Computation → Numerical integration"), joint damping is integrated implicitly:
 //! v ← v + h (M + h·diag(damping))⁻¹ M v̇, which keeps strongly damped joints stable.
 
-use super::implicit_fast::implicit_acceleration;
 use super::{correct_drift, Advance, State, StepReport, Stepper};
+use crate::dynamics::{crba_unchecked, factorize_mass_matrix_damped, solve_with_factor_unchecked};
 use crate::forward::{advance_activations, forward_at};
 use crate::model::{integrate_configuration_unchecked, Data, Model};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 /// Semi-implicit Euler stepper, with its buffer for the implicitly damped acceleration.
 pub struct SemiImplicitEuler {
     /// The activations `forward` reads in a stage (`data.act` while the state is moved out).
     stage_act: DVector<f64>,
     damped: DVector<f64>,
-    /// M kept while M + h·diag(damping) is factored in its place.
-    mass_copy: DMatrix<f64>,
 }
 
 impl SemiImplicitEuler {
     /// The stepper with its buffers sized for `model`.
     pub fn new(model: &Model) -> Self {
         let nv = model.nv;
-        Self {
-            stage_act: DVector::zeros(model.na()),
-            damped: DVector::zeros(nv),
-            mass_copy: DMatrix::zeros(nv, nv),
-        }
+        Self { stage_act: DVector::zeros(model.na()), damped: DVector::zeros(nv) }
     }
 }
 
@@ -54,18 +48,8 @@ impl Advance for SemiImplicitEuler {
         crate::sensor::compute_at(model, data, state.q.as_slice(), state.v.as_slice(), state.time);
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         let flags = &model.options.flags;
-        if flags.eulerdamp
-            && flags.damper
-            && implicit_acceleration(
-                model,
-                data,
-                state.q.as_slice(),
-                &mut self.damped,
-                &mut self.mass_copy,
-                h,
-                None,
-            )
-        {
+        if flags.eulerdamp && flags.damper && model.has_damping() {
+            damped_acceleration(model, data, state.q.as_slice(), &mut self.damped, h);
             state.v.axpy(h, &self.damped, 1.0);
         } else {
             state.v.axpy(h, &data.qacc, 1.0);
@@ -74,4 +58,19 @@ impl Advance for SemiImplicitEuler {
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }
+}
+
+/// The implicitly damped acceleration (M + h·diag(damping))⁻¹ M qacc after `forward` at
+/// configuration `q`, into `out` (MuJoCo's `mj_EulerSkip`). M + h·diag(damping) is factored in
+/// the factor's storage (`factorize_mass_matrix_damped`), so M itself stays as CRBA gave it and
+/// `data.mass_factor` holds the factor of the damped matrix afterwards.
+fn damped_acceleration(model: &Model, data: &mut Data, q: &[f64], out: &mut DVector<f64>, h: f64) {
+    // M at q: the position stage's own when `forward` took the M path there (CRBA again would
+    // give the same bits), else formed here.
+    if !data.forward_skip.m_path {
+        crba_unchecked(model, data, q);
+    }
+    out.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
+    factorize_mass_matrix_damped(model, data, h, &model.dof_damping);
+    solve_with_factor_unchecked(model, &data.mass_factor, out.as_mut_slice());
 }
