@@ -186,6 +186,42 @@ fn cholesky_kernel(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f64) -
     true
 }
 
+/// Updates the lower Cholesky factor `l` of A (top-left n × n) in place to the factor of
+/// A + sign · x xᵀ (`sign` +1: a rank-one update; −1: a downdate), by the rotations of the
+/// classical algorithm (Golub & Van Loan, *Matrix Computations*, 4th ed., §6.5.4; Gill, Golub,
+/// Murray & Saunders 1974): O(n²) instead of the O(n³) of factoring again. `x` (n long) is
+/// overwritten. Entries of x that are zero before their column is reached are skipped (they
+/// rotate nothing). Returns false, leaving `l` unusable, when a downdate leaves a pivot not
+/// positive (A − x xᵀ not positive definite to working precision) or a value is not finite.
+pub(crate) fn cholesky_rank_one(l: &mut DMatrix<f64>, n: usize, x: &mut [f64], sign: f64) -> bool {
+    let stride = l.nrows();
+    let ls = l.as_mut_slice();
+    let x = &mut x[..n];
+    for k in 0..n {
+        let xk = x[k];
+        if xk == 0.0 {
+            continue;
+        }
+        let col = &mut ls[k * stride + k..k * stride + n];
+        let lkk = col[0];
+        let r2 = lkk * lkk + sign * xk * xk;
+        // A pivot that cancels to round-off: the downdated matrix is singular at working
+        // precision; the caller factors it afresh instead.
+        if !(r2 > 1e-12 * lkk * lkk) || !r2.is_finite() {
+            return false;
+        }
+        let r = r2.sqrt();
+        let (c, s) = (r / lkk, xk / lkk);
+        col[0] = r;
+        let (_, tail) = x.split_at_mut(k + 1);
+        for (lik, xi) in col[1..].iter_mut().zip(tail.iter_mut()) {
+            *lik = (*lik + sign * s * *xi) / c;
+            *xi = c * *xi - s * *lik;
+        }
+    }
+    true
+}
+
 /// Solves L Lᵀ x = b in place with the factor of [`cholesky`] (forward substitution column by
 /// column, per entry in the same order as the row form; back substitution by rows of Lᵀ, which
 /// are L's columns).
@@ -357,6 +393,52 @@ mod tests {
         let mut b = [2.0, 2.0];
         assert_eq!(solve_psd(&mut a, &mut b, &mut w, &mut v), 1);
         assert!((b[0] - 1.0).abs() < 1e-14 && (b[1] - 1.0).abs() < 1e-14, "{b:?}");
+    }
+
+    /// Rank-one updates and downdates of a factor against factoring A ± x xᵀ afresh, with a
+    /// sparse x (leading zeros, as a constraint row's Jacobian on a chain of dofs), and the
+    /// downdate that removes a direction A needs refused.
+    #[test]
+    fn rank_one_update_and_downdate_match_a_fresh_factor() {
+        let mut seed = 11u64;
+        let mut rand = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        for n in [1, 4, 9, 27] {
+            let b = DMatrix::from_fn(n, n, |_, _| rand());
+            let a = &b * b.transpose() + DMatrix::identity(n, n);
+            let x = DVector::from_fn(n, |i, _| if i < n / 3 { 0.0 } else { rand() });
+            for sign in [1.0, -1.0] {
+                let a_new = &a + sign * &x * x.transpose();
+                let mut l = DMatrix::zeros(n, n);
+                assert!(cholesky(&a, n, &mut l, 0.0));
+                let mut xs = x.as_slice().to_vec();
+                // The downdate of a + x xᵀ by x is A: update first, then check both ways.
+                if sign < 0.0 {
+                    let a_up = &a + &x * x.transpose();
+                    assert!(cholesky(&a_up, n, &mut l, 0.0));
+                    xs.copy_from_slice(x.as_slice());
+                    assert!(cholesky_rank_one(&mut l, n, &mut xs, -1.0));
+                    let got = &l * l.transpose();
+                    let err = (&got - &a).abs().max();
+                    assert!(err < 1e-12 * (1.0 + a.abs().max()), "n {n} downdate: {err:e}");
+                    continue;
+                }
+                assert!(cholesky_rank_one(&mut l, n, &mut xs, sign));
+                let mut fresh = DMatrix::zeros(n, n);
+                assert!(cholesky(&a_new, n, &mut fresh, 0.0));
+                let err = (l.lower_triangle() - fresh.lower_triangle()).abs().max();
+                assert!(err < 1e-12 * (1.0 + fresh.abs().max()), "n {n} update: {err:e}");
+            }
+        }
+        // Removing more than A holds: A = 1 + x xᵀ downdated by 2x is not positive definite.
+        let x = DVector::from_vec(vec![0.0, 1.0, 2.0]);
+        let a = DMatrix::identity(3, 3) + &x * x.transpose();
+        let mut l = DMatrix::zeros(3, 3);
+        assert!(cholesky(&a, 3, &mut l, 0.0));
+        let mut xs = vec![0.0, 2.0, 4.0];
+        assert!(!cholesky_rank_one(&mut l, 3, &mut xs, -1.0));
     }
 
     /// A = B Bᵀ with B n × r (rank r < n), b = A z: the solution is A⁺ b, the component of z in

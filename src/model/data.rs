@@ -639,6 +639,7 @@ impl Data {
         self.efc_id.resize(new, 0);
         self.efc_kbip.resize(new, [0.0; 4]);
         self.efc_state.resize(new, EfcState::Satisfied);
+        self.soft.factor_state.resize(new, EfcState::Satisfied);
     }
 
     /// Whether row `i` is a limit row or a contact's normal row (the rows with a gap φ ≥ 0).

@@ -16,9 +16,9 @@
 
 use super::cost::Rows;
 use super::hessian::Assembler;
-use crate::constraint::dense::{cholesky, cholesky_solve};
+use crate::constraint::dense::{cholesky, cholesky_rank_one, cholesky_solve};
 use crate::dynamics::solve_with_factor_unchecked;
-use crate::model::{Data, Model};
+use crate::model::{Data, EfcState, Model};
 use nalgebra::{DMatrix, DVector};
 
 /// Which primal method.
@@ -214,6 +214,8 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     let mut gradient = 0.0;
     let mut iter = 0;
     let mut have_dir = false;
+    // Whether `soft.dense_factor` holds the factor of the Hessian at `soft.factor_state`.
+    let mut factor_valid = false;
     let mut stalled = false;
     let island_path = method == Primal::Newton && nv > DENSE_NV;
     let mut converged_islands = false;
@@ -260,14 +262,30 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
             match method {
                 Primal::Newton => {
                     // (Large problems take the island path above.)
-                    // Small: H = M + Jᵀ (∂²s) J, its lower triangle (all the dense Cholesky
-                    // reads), by dense Cholesky.
-                    soft.hessian.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
-                    let mut rows_h = Assembler::new(&mut soft.hessian, &nz, &mut soft.hessian_column);
-                    rows.hessian(&soft.jar, efc_state, |i, dim, block| rows_h.add(i, dim, block));
-                    rows_h.finish();
+                    // Small: H = M + Jᵀ (∂²s) J by dense Cholesky: the previous iteration's
+                    // factor updated row by row where the states changed (MuJoCo's
+                    // `HessianIncremental`), else formed and factored afresh (its lower
+                    // triangle, all the dense Cholesky reads).
+                    let updated = factor_valid
+                        && update_factor(
+                            &nz,
+                            efc_d.as_slice(),
+                            &efc_state[..nefc],
+                            &mut soft.factor_state[..nefc],
+                            &mut soft.dense_factor,
+                            &mut soft.rank_one,
+                        );
+                    factor_valid = updated || {
+                        soft.hessian.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
+                        let mut rows_h = Assembler::new(&mut soft.hessian, &nz, &mut soft.hessian_column);
+                        rows.hessian(&soft.jar, efc_state, |i, dim, block| rows_h.add(i, dim, block));
+                        rows_h.finish();
+                        let ok = cholesky(&soft.hessian, nv, &mut soft.dense_factor, 0.0);
+                        soft.factor_state[..nefc].copy_from_slice(&efc_state[..nefc]);
+                        ok
+                    };
                     soft.dir.copy_from(&soft.grad);
-                    if cholesky(&soft.hessian, nv, &mut soft.dense_factor, 0.0) {
+                    if factor_valid {
                         cholesky_solve(&soft.dense_factor, nv, soft.dir.as_mut_slice());
                     } else {
                         solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
@@ -351,6 +369,52 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         data.efc_unconverged += 1;
         data.efc_unconverged_residual = data.efc_unconverged_residual.max(gradient);
     }
+}
+
+/// Brings the dense Cholesky factor `l` of the Newton Hessian H = M + Σ D_i J_iᵀ J_i (the sum over
+/// the rows in their quadratic state) from the row states it was formed for (`factored`) to
+/// `state`: one rank-one update by √D_i J_i for each row that entered its quadratic state and one
+/// downdate for each row that left it, O(nv²) each instead of assembling and factoring H afresh
+/// (MuJoCo's `HessianIncremental`, engine_solver.c). `factored` becomes `state`. `x` is nv-long
+/// scratch. Returns false (the caller factors H afresh) when a row is on an elliptic cone's
+/// surface in either (its Hessian block is not a rank-one term of the row), when more rows
+/// changed than H has dofs (a fresh factor is as cheap), or when a downdate fails.
+fn update_factor(
+    nz: &Sparsity,
+    d: &[f64],
+    state: &[EfcState],
+    factored: &mut [EfcState],
+    l: &mut DMatrix<f64>,
+    x: &mut [f64],
+) -> bool {
+    let nv = x.len();
+    let mut changed = 0;
+    for (s, f) in state.iter().zip(factored.iter()) {
+        if *s == EfcState::Cone || *f == EfcState::Cone {
+            return false;
+        }
+        changed += usize::from((*s == EfcState::Quadratic) != (*f == EfcState::Quadratic));
+    }
+    if changed > nv {
+        return false;
+    }
+    for (i, (s, f)) in state.iter().zip(factored.iter_mut()).enumerate() {
+        let (now, before) = (*s == EfcState::Quadratic, *f == EfcState::Quadratic);
+        *f = *s;
+        if now == before {
+            continue;
+        }
+        x.fill(0.0);
+        let (cols, vals) = nz.row_values(i);
+        let w = d[i].sqrt();
+        for (&k, &j_ik) in cols.iter().zip(vals) {
+            x[k] = w * j_ik;
+        }
+        if !cholesky_rank_one(l, nv, x, if now { 1.0 } else { -1.0 }) {
+            return false;
+        }
+    }
+    true
 }
 
 /// The step α ≥ 0 minimizing the cost along the direction: g0 + α dmd + ds/dα = 0 with ds/dα

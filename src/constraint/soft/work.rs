@@ -3,6 +3,7 @@
 //! [`Data`](crate::Data), private to the solvers; their outputs (`efc_force`, `efc_state`,
 //! `qacc`, `solver_niter`, …) are `Data`'s own fields.
 
+use crate::model::EfcState;
 use nalgebra::{DMatrix, DVector};
 
 /// Scratch of the soft solvers (`crate::constraint::soft`).
@@ -28,6 +29,10 @@ pub(crate) struct SoftWork {
     pub factor: super::sparse_cholesky::SparseCholesky,
     /// The dense Cholesky factor of small Hessians (nv × nv; empty above the dense size).
     pub dense_factor: DMatrix<f64>,
+    /// The row states `dense_factor` was formed for (the Newton iterations after the first
+    /// update it row by row as states change; `primal.rs`), and the scaled row of one update (nv).
+    pub factor_state: Vec<EfcState>,
+    pub rank_one: Vec<f64>,
     /// The row groups (first, last) that can have a Hessian block (each row, a contact's rows
     /// together): the cliques of the Newton Hessian's pattern.
     pub active_rows: Vec<(usize, usize)>,
@@ -74,6 +79,8 @@ impl SoftWork {
             } else {
                 DMatrix::zeros(0, 0)
             },
+            factor_state: vec![EfcState::Satisfied; nefc],
+            rank_one: vec![0.0; nv],
             active_rows: Vec::with_capacity(nefc),
             nz_start: Vec::with_capacity(nefc + 1),
             nz_index: Vec::with_capacity(nefc * nv),
