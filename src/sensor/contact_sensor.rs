@@ -18,6 +18,10 @@ use crate::constraint::contact_force::contact_force;
 use crate::model::{Data, Model};
 use crate::spatial::Vec3;
 
+/// The grid of the sorted reductions' criteria, relative to the largest: values closer than one
+/// part in 10¹² are ties.
+const TIE_DIGITS: f64 = 1e12;
+
 /// Whether the contact side (MuJoCo body `body`, geom `geom`) matches criterion `obj`
 /// (MuJoCo's `checkMatch`; a site passed its zone test already).
 fn check_match(model: &Model, body: usize, geom: usize, obj: SensorObject) -> bool {
@@ -131,6 +135,16 @@ pub(crate) fn compute(
         return;
     }
     if spec.reduce == 1 || spec.reduce == 2 {
+        // Criteria equal to 12 significant digits (of the largest) are ties, kept in contact
+        // order — MuJoCo's order for exact ties — so that round-off in the forces of symmetric
+        // contacts (a box's four corners) does not reorder them. The criteria are rounded to
+        // that grid first, which keeps the order a total one.
+        let scale = matches.iter().fold(0.0f64, |m, x| m.max(x.0.abs()));
+        if scale > 0.0 && scale.is_finite() {
+            for m in matches.iter_mut() {
+                m.0 = (m.0 / scale * TIE_DIGITS).round();
+            }
+        }
         matches.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     }
     for (slot, &(_, c, flip)) in matches.iter().take(spec.num).enumerate() {
