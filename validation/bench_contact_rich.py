@@ -212,8 +212,14 @@ def main() -> int:
     args = ap.parse_args()
     import mujoco as mj
 
-    clock = time.perf_counter
-    mj.set_mjcb_time(lambda: clock() * 1e6)  # µs: the timers' unit below
+    # MuJoCo's timers call mjcb_time directly: a C clock (µs), never a Python callable, whose
+    # own call cost (≈ 5 µs per humanoid step) would be counted in MuJoCo's step time.
+    from crossval_sensors import timer_callback
+
+    clock = timer_callback()
+    if clock is None:
+        sys.exit("bench_contact_rich: no C compiler for the clock MuJoCo's timers call (cc)")
+    mj.set_mjcb_time(clock)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name, group, scene, steps in scenes(args.quick):
