@@ -141,7 +141,7 @@ pub(crate) fn actuation_unchecked(
     let zeroed = bad.is_some();
     let mut act_adr = 0;
     // Every moment row from zero (one contiguous fill, not a strided one per row).
-    data.actuator_moment.fill(0.0);
+    data.actuator_moment.as_mut_slice().fill(0.0);
     for (i, a) in model.actuators.iter().enumerate() {
         let act_index = (a.actnum() == 1).then_some(act_adr);
         act_adr += a.actnum();
