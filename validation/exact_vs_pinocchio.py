@@ -7,9 +7,9 @@ with at least 4 contacts, each solved by
 
 - lagrange's projected Gauss–Seidel with its polish (the exact mode's default) and its ADMM, from a
   cold start, timed in Rust around the solve alone (the best of 10, `eval` prints it);
-- Pinocchio's `ADMMConstraintSolver` and `PGSConstraintSolver` (Pinocchio 4.1 names what the paper
-  calls `ADMMContactSolver`/`PGSContactSolver`) on `DelassusOperatorDense(G)`, g and one constraint
-  model per block, timed in Python around `solve` alone (the best of 10, a fresh solver, result and
+- Pinocchio's `ADMMConstraintSolver` and `PGSConstraintSolver` (Pinocchio 4.1's names of its
+  contact solvers, `ADMMContactSolver`/`PGSContactSolver` before) on `DelassusOperatorDense(G)`, g
+  and one constraint model per block, timed in Python around `solve` alone (the best of 10, a fresh solver, result and
   operator each time, made outside the timer),
 
 and reports per problem the time, iterations, the residual of every solution by one function here
