@@ -144,9 +144,10 @@ fn eval_step_dumps_the_exact_contact_problem() {
     let n = p["nefc"].as_u64().unwrap() as usize;
     assert_eq!(n, 12, "four contacts of three rows");
     let g: Vec<Vec<f64>> = p["G"].as_array().unwrap().iter().map(floats).collect();
-    for i in 0..n {
-        for j in 0..n {
-            assert_eq!(g[i][j], g[j][i], "G[{i}][{j}]");
+    for (i, row) in g.iter().enumerate() {
+        assert_eq!(row.len(), n);
+        for (j, x) in row.iter().enumerate() {
+            assert_eq!(*x, g[j][i], "G[{i}][{j}]");
         }
     }
     assert!(p["blocks"].as_array().unwrap().iter().all(|b| b["law"] == "cone" && b["len"] == 3));
