@@ -122,6 +122,12 @@ enum Command {
         /// analytic).
         #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "all")]
         derivatives: Option<eval::Derivatives>,
+        /// With `--step N` and `--constraints exact`: write to FILE the exact mode's constraint
+        /// problem at the state after the steps (Delassus matrix, free row accelerations, row laws,
+        /// the solver's forces, and its Gauss–Seidel and ADMM solves again from a cold start,
+        /// timed; docs/constraints.md, "Exporting the exact mode's problem").
+        #[arg(long, value_name = "FILE")]
+        dump_contact_problem: Option<PathBuf>,
     },
     /// Simulate from a keyframe, a given state, or the model's reference configuration at rest,
     /// under gravity, with zero torques.
@@ -378,9 +384,26 @@ fn main() -> ExitCode {
             };
             view::run(&model, &options, &request)
         }
-        Some(Command::Eval { model, states, json: _, jacobians, kernels_only, step, derivatives }) => {
-            eval::run(&model, &options, &states, &jacobians, mode, kernels_only, step, derivatives)
-        }
+        Some(Command::Eval {
+            model,
+            states,
+            json: _,
+            jacobians,
+            kernels_only,
+            step,
+            derivatives,
+            dump_contact_problem,
+        }) => eval::run(
+            &model,
+            &options,
+            &states,
+            &jacobians,
+            mode,
+            kernels_only,
+            step,
+            derivatives,
+            dump_contact_problem.as_deref(),
+        ),
         Some(Command::Simulate {
             model,
             duration,

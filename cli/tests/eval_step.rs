@@ -121,3 +121,52 @@ fn eval_step_refuses_bad_input() {
     std::fs::remove_file(&file).ok();
     assert!(!ok && err.contains("'qacc_warmstart' has 1 values, the model needs 6"), "{err}");
 }
+
+/// `--dump-contact-problem`: the exact mode's problem at the state after the steps, one per state
+/// — the box of edges.json resting on the floor: four contacts of three rows, a symmetric G, the
+/// forward's and the cold solves' λ solving it (their residual ≤ 1e-8), best-of times; without
+/// `--step` or in soft mode the flag is refused.
+#[test]
+fn eval_step_dumps_the_exact_contact_problem() {
+    let states = json!([{"q": [0.0, 0.0, 0.1, 1.0, 0.0, 0.0, 0.0]}]);
+    let file = states_file("dump", &states);
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lagrange-eval-step-{}-problem.json", std::process::id()));
+    let (states_arg, out_arg) = (file.to_str().unwrap(), out.to_str().unwrap());
+    let base = ["eval", BOX, "--states", states_arg];
+    let (ok, _, err) = lagrange(
+        &[&base[..], &["--step", "50", "--constraints", "exact", "--dump-contact-problem", out_arg]].concat(),
+    );
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let p = &v["problems"][0];
+    assert_eq!(p["step"], 50);
+    let n = p["nefc"].as_u64().unwrap() as usize;
+    assert_eq!(n, 12, "four contacts of three rows");
+    let g: Vec<Vec<f64>> = p["G"].as_array().unwrap().iter().map(floats).collect();
+    for (i, row) in g.iter().enumerate() {
+        assert_eq!(row.len(), n);
+        for (j, x) in row.iter().enumerate() {
+            assert_eq!(*x, g[j][i], "G[{i}][{j}]");
+        }
+    }
+    assert!(p["blocks"].as_array().unwrap().iter().all(|b| b["law"] == "cone" && b["len"] == 3));
+    for solve in ["forward", "pgs", "admm"] {
+        let r = p[solve]["ccp_residual"]["relative"].as_f64().unwrap();
+        assert!(r <= 1e-8, "{solve}: residual {r:e}");
+        assert_eq!(floats(&p[solve]["lambda"]).len(), n);
+    }
+    for solve in ["pgs", "admm"] {
+        assert!(p[solve]["solve_us"].as_f64().unwrap() > 0.0);
+        assert_eq!(p[solve]["converged"], true);
+    }
+    std::fs::remove_file(&out).ok();
+    let (ok, _, err) =
+        lagrange(&[&base[..], &["--constraints", "exact", "--dump-contact-problem", out_arg]].concat());
+    assert!(!ok && err.contains("--step"), "{err}");
+    let (ok, _, err) = lagrange(
+        &[&base[..], &["--step", "1", "--constraints", "soft", "--dump-contact-problem", out_arg]].concat(),
+    );
+    assert!(!ok && err.contains("--constraints exact"), "{err}");
+    std::fs::remove_file(&file).ok();
+}

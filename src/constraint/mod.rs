@@ -16,6 +16,7 @@ mod active_set;
 mod admm;
 mod contact;
 pub mod contact_force;
+mod contact_problem;
 mod coulomb;
 mod coulomb_polish;
 mod dense;
@@ -32,6 +33,7 @@ mod velocity_check;
 
 pub use admm::{ExactContactSolver, ADMM_TOLERANCE};
 pub use contact::CONTACT_ACTIVE_DISTANCE;
+pub use contact_problem::{BlockLaw, ContactProblem, ProblemBlock, ProblemResidual, ProblemSolution};
 pub use coulomb::{Level, SolverSettings, SEPARATING_VELOCITY, SLIP_VELOCITY};
 pub(crate) use dense::{cholesky, cholesky_solve};
 pub(crate) use exact::{project_positions, project_velocities_unchecked, solve_exact};

@@ -390,8 +390,14 @@ pub fn run(
     kernels_only: bool,
     step: Option<u32>,
     derivatives: Option<Derivatives>,
+    dump_problem: Option<&Path>,
 ) -> Result<(), CliError> {
     let step = step.map(super::eval_step::check_steps).transpose()?;
+    if dump_problem.is_some() && step.is_none() {
+        return Err(CliError::Usage(
+            "--dump-contact-problem writes the problem at the state after --step N: add e.g. --step 1".into(),
+        ));
+    }
     if kernels_only && derivatives.is_some() {
         return Err(CliError::Usage(
             "--derivatives needs the forward pipeline (its qacc, actuators and step): drop --kernels-only"
@@ -408,6 +414,12 @@ pub fn run(
     if let Some(mode) = mode {
         model.set_constraint_mode(mode);
     }
+    if dump_problem.is_some() && model.plan.solver.exact().is_none() {
+        return Err(CliError::Usage(
+            "--dump-contact-problem writes the exact mode's problem: add --constraints exact".into(),
+        ));
+    }
+    let mut problems = Vec::new();
     let file = states.display().to_string();
     let frame_ids = jacobians
         .iter()
@@ -442,6 +454,9 @@ pub fn run(
             Some(n) => super::eval_step::evaluate(&model, &mut data, &s, n)?,
             None => evaluate(&model, &mut data, &s, &frame_ids, kernels_only, buffers.as_mut())?,
         };
+        if let (Some(n), Some(_)) = (step, dump_problem) {
+            problems.push(super::contact_problem::problem_json(&model, &mut data, n)?);
+        }
         if let Some(path) = first_null(&result) {
             let reason = format!("states[{i}]: {} is not finite (NaN or infinite)", describe(&path));
             failed += 1;
@@ -461,6 +476,12 @@ pub fn run(
     out.json(&sensors_not_computed_json(&model))?;
     out.print("}\n")?;
     out.finish()?;
+    if let Some(file) = dump_problem {
+        let text = serde_json::to_string(&json!({ "problems": problems }))
+            .map_err(|e| CliError::Usage(format!("--dump-contact-problem: {e}")))?;
+        std::fs::write(file, text)
+            .map_err(|source| CliError::Io { file: file.display().to_string(), source })?;
+    }
     if failed > 0 {
         return Err(CliError::StatesFailed {
             failed,

@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod bench_native;
+pub mod contact_problem;
 pub mod eval;
 pub mod eval_step;
 pub mod eval_stream;
