@@ -46,8 +46,10 @@ pub struct SensorNeeds {
     pub quats: bool,
     /// Subtree centres of mass.
     pub subtree_com: bool,
-    /// Subtree linear velocities and angular momenta.
+    /// Subtree linear velocities (and angular momenta when `subtree_angmom`).
     pub subtree_velocities: bool,
+    /// Subtree angular momenta (a `subtreeangmom` sensor).
+    pub subtree_angmom: bool,
     /// Kinetic energy.
     pub kinetic: bool,
     /// Body accelerations and interaction forces (MuJoCo's `mj_rnePostConstraint`).
@@ -76,6 +78,7 @@ impl SensorNeeds {
             quats: has(&|k| k == FrameQuat),
             subtree_com: has(&|k| matches!(k, SubtreeCom | SubtreeLinVel | SubtreeAngMom | InsideSite)),
             subtree_velocities: has(&|k| matches!(k, SubtreeLinVel | SubtreeAngMom)),
+            subtree_angmom: has(&|k| k == SubtreeAngMom),
             kinetic: has(&|k| k == EKinetic),
             rne_post: has(&|k| matches!(k, Accelerometer | Force | Torque | FrameLinAcc | FrameAngAcc)),
             rne_post_wrenches: has(&|k| matches!(k, Force | Torque)),
@@ -152,7 +155,7 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
         subtree::subtree_com(model, data, &mut work.subtree);
     }
     if needs.subtree_velocities {
-        subtree::subtree_velocities(model, data, &mut work.subtree);
+        subtree::subtree_velocities(model, data, &mut work.subtree, needs.subtree_angmom);
     }
     if needs.rne_post {
         crate::dynamics::rne_post::rne_post_constraint_at(model, data, q, v, needs.rne_post_wrenches);

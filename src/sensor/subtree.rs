@@ -71,8 +71,9 @@ pub(crate) fn subtree_com(model: &Model, data: &Data, s: &mut Subtree) {
     }
 }
 
-/// `subtree_linvel` and `subtree_angmom`, after [`subtree_com`] and with `v_body` at the state.
-pub(crate) fn subtree_velocities(model: &Model, data: &Data, s: &mut Subtree) {
+/// `subtree_linvel` and, with `angmom`, `subtree_angmom` (otherwise left as they were), after
+/// [`subtree_com`] and with `v_body` at the state.
+pub(crate) fn subtree_velocities(model: &Model, data: &Data, s: &mut Subtree, angmom: bool) {
     let links = &model.links;
     for b in 0..links.len() {
         let f = links.frame[b];
@@ -81,8 +82,10 @@ pub(crate) fn subtree_velocities(model: &Model, data: &Data, s: &mut Subtree) {
         let (w, v) = point_velocity(data, frame.body, &s.xipos[b]);
         s.body_vel[b] = (w, v);
         s.linvel[b] = v * inertia.mass;
-        let r = data.x_world_frame[f].rot;
-        s.angmom[b] = r * (inertia.i_com() * r.tr_mul(&w));
+        if angmom {
+            let r = data.x_world_frame[f].rot;
+            s.angmom[b] = r * (inertia.i_com() * r.tr_mul(&w));
+        }
     }
     for b in (0..links.len()).rev() {
         if b > 0 {
@@ -90,6 +93,9 @@ pub(crate) fn subtree_velocities(model: &Model, data: &Data, s: &mut Subtree) {
             s.linvel[links.parent[b]] += lv;
         }
         s.linvel[b] /= s.mass[b].max(MIN_MASS);
+    }
+    if !angmom {
+        return;
     }
     for b in (1..links.len()).rev() {
         let p = links.parent[b];
