@@ -207,7 +207,7 @@ pub(crate) fn cholesky_rank_one(l: &mut DMatrix<f64>, n: usize, x: &mut [f64], s
         let r2 = lkk * lkk + sign * xk * xk;
         // A pivot that cancels to round-off: the downdated matrix is singular at working
         // precision; the caller factors it afresh instead.
-        if !(r2 > 1e-12 * lkk * lkk) || !r2.is_finite() {
+        if !r2.is_finite() || r2 <= 1e-12 * lkk * lkk {
             return false;
         }
         let r = r2.sqrt();
