@@ -51,7 +51,9 @@ pub(crate) struct SparseCholesky {
     c_rows: Vec<usize>,
     c_vals: Vec<f64>,
     c_slot: Vec<usize>,
-    /// Dense scratch row of L.
+    /// The inverse of `c_slot`: where column storage's entry sits in row storage.
+    r_slot: Vec<usize>,
+    /// Dense scratch row of L (zero between calls).
     x: Vec<f64>,
     /// The cliques of the pattern being analyzed (clique c's dofs are
     /// `clique_cols[clique_start[c]..clique_start[c + 1]]`, ascending) and each dof's cliques.
@@ -88,6 +90,7 @@ impl SparseCholesky {
             c_rows: Vec::with_capacity(nnz),
             c_vals: Vec::with_capacity(nnz),
             c_slot: Vec::with_capacity(nnz),
+            r_slot: Vec::with_capacity(nnz),
             x: Vec::with_capacity(n),
             clique_start: Vec::with_capacity(n + 1),
             clique_cols: Vec::with_capacity(nnz),
@@ -239,11 +242,12 @@ impl SparseCholesky {
     }
 
     /// Factors `h` (lower triangle read) with the symbolic structure of the last
-    /// [`Self::analyze`], the rows k with `keep[k]` only: those of independent
-    /// groups of dofs (constraint islands, `island.rs`) that no kept row couples to; the other
-    /// rows of L keep stale values, which [`Self::solve_kept`] does not read.
-    pub fn factor_kept(&mut self, h: &DMatrix<f64>, keep: &[bool]) -> bool {
-        self.numeric(h, 0.0, Some(keep))
+    /// [`Self::analyze`], the rows `rows` only, in that order: the dofs of independent groups
+    /// (constraint islands, `island.rs`), each group's ascending, that no other row of L couples
+    /// to; the other rows of L keep stale values, which [`Self::solve_rows`] does not read. The
+    /// work is that of the listed rows' nonzeros.
+    pub fn factor_rows(&mut self, h: &DMatrix<f64>, rows: &[usize]) -> bool {
+        self.numeric(h, 0.0, Some(rows))
     }
 
     /// Factors the symmetric `h` (its lower triangle is read; n × n at the top left) into L.
@@ -332,12 +336,15 @@ impl SparseCholesky {
         self.c_vals.resize(nnz, 0.0);
         self.c_slot.clear();
         self.c_slot.resize(nnz, 0);
+        self.r_slot.clear();
+        self.r_slot.resize(nnz, 0);
         for k in 0..n {
             for u in self.l_start[k]..self.l_start[k + 1] {
                 let j = self.l_cols[u];
                 let slot = self.h_count[j];
                 self.c_rows[slot] = k;
                 self.c_slot[u] = slot;
+                self.r_slot[slot] = u;
                 self.h_count[j] += 1;
             }
         }
@@ -370,14 +377,12 @@ impl SparseCholesky {
     }
 
     /// Up-looking factorization on the analyzed pattern: row k of L from rows j < k in it.
-    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64, keep: Option<&[bool]>) -> bool {
+    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64, rows: Option<&[usize]>) -> bool {
         let n = self.diag.len();
         let (l_start, l_cols, l_vals) = (&self.l_start, &self.l_cols, &mut self.l_vals);
         let (x, diag) = (&mut self.x, &mut self.diag);
-        for k in 0..n {
-            if keep.is_some_and(|keep| !keep[k]) {
-                continue;
-            }
+        let all = 0..if rows.is_some() { 0 } else { n };
+        for k in all.chain(rows.unwrap_or(&[]).iter().copied()) {
             for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
                 x[j] = h[(k, j)];
             }
@@ -406,10 +411,69 @@ impl SparseCholesky {
             }
             diag[k] = d.sqrt();
         }
-        for (&slot, &v) in self.c_slot.iter().zip(self.l_vals.iter()) {
-            self.c_vals[slot] = v;
+        // L by columns, for the backward solve: the factored rows' entries.
+        match rows {
+            None => {
+                for (&slot, &v) in self.c_slot.iter().zip(self.l_vals.iter()) {
+                    self.c_vals[slot] = v;
+                }
+            }
+            Some(rows) => {
+                for &k in rows {
+                    let (a, b) = (self.l_start[k], self.l_start[k + 1]);
+                    for (&slot, &v) in self.c_slot[a..b].iter().zip(&self.l_vals[a..b]) {
+                        self.c_vals[slot] = v;
+                    }
+                }
+            }
         }
         true
+    }
+
+    /// The factor of H ± w wᵀ from that of H (a rank-one update, `add`, or downdate), with
+    /// w = `scale` · v, v nonzero on the columns `cols` (ascending) with values `vals`: the
+    /// columns of L on the elimination-tree path from w's first column to its root change
+    /// (Davis, *Direct Methods for Sparse Linear Systems*, §4.8; MuJoCo's Newton solver keeps its
+    /// factor the same way as rows enter and leave their quadratic state, `HessianIncremental`,
+    /// engine_solver.c). w's pattern must lie in the analyzed one (a row of the analyzed
+    /// cliques). Returns false if a downdate leaves a pivot at or below 1e-10 of its square
+    /// before: the factor is then spoiled and the caller factors H afresh.
+    pub fn rank_one(&mut self, cols: &[usize], vals: &[f64], scale: f64, add: bool) -> bool {
+        let Some(&first) = cols.first() else {
+            return true;
+        };
+        let sign = if add { 1.0 } else { -1.0 };
+        let x = &mut self.x;
+        for (&k, &v) in cols.iter().zip(vals) {
+            x[k] = scale * v;
+        }
+        // x is nonzero only on the path (a column's rows are its ancestors): each entry is
+        // cleared as its column is passed, so x is zero again at the end.
+        let mut k = first;
+        let mut ok = true;
+        while k != NONE {
+            let (l_kk, w_k) = (self.diag[k], x[k]);
+            x[k] = 0.0;
+            if ok && w_k != 0.0 {
+                let r2 = l_kk * l_kk + sign * w_k * w_k;
+                if r2 <= 1e-10 * l_kk * l_kk {
+                    ok = false;
+                } else {
+                    let r = r2.sqrt();
+                    let (c, s) = (r / l_kk, w_k / l_kk);
+                    self.diag[k] = r;
+                    for slot in self.c_start[k]..self.c_start[k + 1] {
+                        let i = self.c_rows[slot];
+                        let l = (self.c_vals[slot] + sign * s * x[i]) / c;
+                        x[i] = c * x[i] - s * l;
+                        self.c_vals[slot] = l;
+                        self.l_vals[self.r_slot[slot]] = l;
+                    }
+                }
+            }
+            k = self.parent[k];
+        }
+        ok
     }
 
     /// Solves H x = b in place with the last factor (b holds x on return).
@@ -418,20 +482,20 @@ impl SparseCholesky {
         self.solve_where(b, None);
     }
 
-    /// Solves H x = b in place (b holds x on return) on the rows k with `keep[k]` of the last
-    /// [`Self::factor_kept`] (the other entries of b are left as they are).
-    pub fn solve_kept(&self, b: &mut [f64], keep: &[bool]) {
-        self.solve_where(b, Some(keep));
+    /// Solves H x = b in place (b holds x on return) on the rows `rows` of the last
+    /// [`Self::factor_rows`] (the other entries of b are left as they are).
+    pub fn solve_rows(&self, b: &mut [f64], rows: &[usize]) {
+        self.solve_where(b, Some(rows));
     }
 
-    fn solve_where(&self, b: &mut [f64], keep: Option<&[bool]>) {
+    /// Forward then backward substitution over every row (`rows` None) or the listed ones (each
+    /// independent group's ascending; backward in the reverse order).
+    fn solve_where(&self, b: &mut [f64], rows: Option<&[usize]>) {
         let n = self.diag.len();
         let b = &mut b[..n];
-        let skip = |i: usize| keep.is_some_and(|keep| !keep[i]);
-        for i in 0..n {
-            if skip(i) {
-                continue;
-            }
+        let all = 0..if rows.is_some() { 0 } else { n };
+        let listed = rows.unwrap_or(&[]);
+        for i in all.clone().chain(listed.iter().copied()) {
             let (lo, hi) = (self.l_start[i], self.l_start[i + 1]);
             let mut s = b[i];
             for (&l, &j) in self.l_vals[lo..hi].iter().zip(&self.l_cols[lo..hi]) {
@@ -439,10 +503,7 @@ impl SparseCholesky {
             }
             b[i] = s / self.diag[i];
         }
-        for i in (0..n).rev() {
-            if skip(i) {
-                continue;
-            }
+        for i in all.rev().chain(listed.iter().rev().copied()) {
             let (lo, hi) = (self.c_start[i], self.c_start[i + 1]);
             let mut s = b[i];
             for (&l, &j) in self.c_vals[lo..hi].iter().zip(&self.c_rows[lo..hi]) {
@@ -566,14 +627,70 @@ mod tests {
         let rhs = [1.0, -2.0, 0.5, 3.0, -1.0];
         let mut whole = rhs;
         f.solve(&mut whole);
-        let keep = [true, true, true, false, false];
+        let first_tree = [0, 1, 2];
         let mut g = SparseCholesky::default();
         g.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
-        assert!(g.factor_kept(&h, &keep));
+        assert!(g.factor_rows(&h, &first_tree));
         let mut kept = rhs;
-        g.solve_kept(&mut kept, &keep);
+        g.solve_rows(&mut kept, &first_tree);
         assert_eq!(&kept[..3], &whole[..3]);
         assert_eq!(&kept[3..], &rhs[3..]);
+    }
+
+    #[test]
+    fn rank_one_updates_and_downdates_give_the_factor_of_the_modified_matrix() {
+        // The kept-factor sample's two trees and a row coupling dofs 1, 2 and 4 (one clique):
+        // H + w wᵀ factored afresh against the update, then the downdate back to H's factor.
+        let n = 5;
+        let dof_parent = [NONE, 0, 1, NONE, 3];
+        let mut h = DMatrix::zeros(n, n);
+        for k in 0..n {
+            h[(k, k)] = 3.0 + k as f64;
+            let mut l = dof_parent[k];
+            while l != NONE {
+                h[(k, l)] = 0.4;
+                h[(l, k)] = 0.4;
+                l = dof_parent[l];
+            }
+        }
+        let (nz_start, nz_index) = ([0, 3], [1, 2, 4]);
+        let (cols, vals, scale) = ([1, 2, 4], [0.5, -1.5, 2.0], 1.7);
+        let mut f = SparseCholesky::default();
+        f.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(f.factor_analyzed(&h));
+        assert!(f.rank_one(&cols, &vals, scale, true));
+        let mut h_plus = h.clone();
+        for a in 0..3 {
+            for b in 0..3 {
+                h_plus[(cols[a], cols[b])] += scale * scale * vals[a] * vals[b];
+            }
+        }
+        let mut g = SparseCholesky::default();
+        g.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(g.factor_analyzed(&h_plus));
+        let rhs = [1.0, -2.0, 0.5, 3.0, -1.0];
+        let (mut x1, mut x2) = (rhs, rhs);
+        f.solve(&mut x1);
+        g.solve(&mut x2);
+        for k in 0..n {
+            assert!((x1[k] - x2[k]).abs() <= 1e-13 * (1.0 + x2[k].abs()), "{x1:?} against {x2:?}");
+            assert!((f.diag[k] - g.diag[k]).abs() <= 1e-13 * g.diag[k]);
+        }
+        // The scratch is clean, and the downdate returns H's factor.
+        assert!(f.x.iter().all(|&v| v == 0.0));
+        assert!(f.rank_one(&cols, &vals, scale, false));
+        let mut h_factor = SparseCholesky::default();
+        h_factor.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(h_factor.factor_analyzed(&h));
+        let (mut y1, mut y2) = (rhs, rhs);
+        f.solve(&mut y1);
+        h_factor.solve(&mut y2);
+        for k in 0..n {
+            assert!((y1[k] - y2[k]).abs() <= 1e-13 * (1.0 + y2[k].abs()), "{y1:?} against {y2:?}");
+        }
+        // A downdate that would leave H indefinite is refused.
+        assert!(!f.rank_one(&cols, &vals, 10.0, false));
+        assert!(f.x.iter().all(|&v| v == 0.0));
     }
 
     #[test]

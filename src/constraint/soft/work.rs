@@ -46,9 +46,8 @@ pub(crate) struct SoftWork {
     pub nz_scratch: Vec<(usize, usize)>,
     /// One column of a row group's Hessian term, while H is assembled (nv; `hessian.rs`).
     pub hessian_column: Vec<f64>,
-    /// The constraint islands of the sparse Newton solve (`island.rs`) and one cost per island.
+    /// The constraint islands of the sparse Newton solve (`island.rs`).
     pub islands: super::island::Islands,
-    pub island_cost: Vec<f64>,
     /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
     pub ar: DMatrix<f64>,
     pub minv_jt: DMatrix<f64>,
@@ -83,7 +82,6 @@ impl SoftWork {
             nz_scratch: Vec::new(),
             hessian_column: vec![0.0; nv],
             islands: super::island::Islands::with_capacity(nv, nefc),
-            island_cost: Vec::with_capacity(nv + 1),
             ar: DMatrix::zeros(0, 0),
             minv_jt: DMatrix::zeros(0, 0),
         }
