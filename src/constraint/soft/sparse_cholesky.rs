@@ -160,8 +160,17 @@ impl SparseCholesky {
                 let prev = &self.clique_cols[self.clique_start[nc - 1]..begin];
                 prev == &self.clique_cols[begin..]
             };
-            // A clique of one dof couples nothing.
-            if repeat || self.clique_cols.len() - begin < 2 {
+            // A clique of one dof couples nothing, nor one whose dofs lie on one chain of a tree
+            // (each an ancestor of the next: a body's contact with the world) — M's pattern holds
+            // it already. Left out, such rows appearing and leaving do not change the key.
+            let chain = self.clique_cols[begin..].windows(2).all(|w| {
+                let mut l = dof_parent[w[1]];
+                while l != NONE && l > w[0] {
+                    l = dof_parent[l];
+                }
+                l == w[0]
+            });
+            if repeat || chain {
                 self.clique_cols.truncate(begin);
             } else {
                 self.clique_start.push(self.clique_cols.len());

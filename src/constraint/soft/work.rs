@@ -37,8 +37,9 @@ pub(crate) struct SoftWork {
     /// J's values at those entries, in the same order.
     pub nz_value: Vec<f64>,
     /// Whether `nz_start`/`nz_index`/`nz_value` list J's nonzeros as the soft position stage
-    /// wrote them (rows 0..nz_start.len() − 1; every row after them zero): false until the
-    /// first, and whenever another writer (the exact rows) wrote `efc_j` since.
+    /// wrote them (rows 0..nz_start.len() − 1; every row after them zero): true from the start
+    /// (`efc_j` is allocated zero, the record empty: the first position stage clears nothing),
+    /// false whenever another writer (the exact rows) wrote `efc_j` since.
     pub j_recorded: bool,
     /// The dofs of one contact's two bodies while its rows are recorded (nv).
     pub columns: Vec<usize>,
@@ -74,10 +75,14 @@ impl SoftWork {
                 DMatrix::zeros(0, 0)
             },
             active_rows: Vec::with_capacity(nefc),
-            nz_start: Vec::with_capacity(nefc + 1),
+            nz_start: {
+                let mut start = Vec::with_capacity(nefc + 1);
+                start.push(0);
+                start
+            },
             nz_index: Vec::with_capacity(nefc * nv),
             nz_value: Vec::with_capacity(nefc * nv),
-            j_recorded: false,
+            j_recorded: true,
             columns: Vec::with_capacity(nv),
             nz_scratch: Vec::new(),
             hessian_column: vec![0.0; nv],
