@@ -146,13 +146,17 @@ impl SparseCholesky {
         self.clique_cols.clear();
         for (c, &(first, last)) in groups.iter().enumerate() {
             let begin = self.clique_cols.len();
-            for &p in &nz_index[nz_start[first]..nz_start[last + 1]] {
-                if self.mark[p] != c {
-                    self.mark[p] = c;
-                    self.clique_cols.push(p);
+            let row = |r: usize| &nz_index[nz_start[r]..nz_start[r + 1]];
+            if (first + 1..=last).all(|r| row(r) == row(first)) {
+                // The usual group: a contact's rows over one shared column list (ascending).
+                self.clique_cols.extend_from_slice(row(first));
+            } else {
+                for &p in &nz_index[nz_start[first]..nz_start[last + 1]] {
+                    if self.mark[p] != c {
+                        self.mark[p] = c;
+                        self.clique_cols.push(p);
+                    }
                 }
-            }
-            if first != last {
                 self.clique_cols[begin..].sort_unstable();
             }
             let nc = self.clique_start.len() - 1;
@@ -469,14 +473,18 @@ impl SparseCholesky {
                     ok = false;
                 } else {
                     let r = r2.sqrt();
-                    let (c, s) = (r / l_kk, w_k / l_kk);
+                    let (c, s, inv_c) = (r / l_kk, w_k / l_kk, l_kk / r);
+                    let signed_s = sign * s;
                     self.diag[k] = r;
-                    for slot in self.c_start[k]..self.c_start[k + 1] {
-                        let i = self.c_rows[slot];
-                        let l = (self.c_vals[slot] + sign * s * x[i]) / c;
-                        x[i] = c * x[i] - s * l;
-                        self.c_vals[slot] = l;
-                        self.l_vals[self.r_slot[slot]] = l;
+                    let (a, b) = (self.c_start[k], self.c_start[k + 1]);
+                    for ((&i, l_ik), &u) in
+                        self.c_rows[a..b].iter().zip(&mut self.c_vals[a..b]).zip(&self.r_slot[a..b])
+                    {
+                        let x_i = x[i];
+                        let l = (*l_ik + signed_s * x_i) * inv_c;
+                        x[i] = c * x_i - s * l;
+                        *l_ik = l;
+                        self.l_vals[u] = l;
                     }
                 }
             }
