@@ -451,7 +451,7 @@ pub(super) fn newton(
                 });
                 rows_h.finish();
             }
-            factored = soft.factor.factor_rows(&soft.hessian, &isl.fresh_dofs);
+            factored = soft.factor.factor_rows(&soft.hessian, &isl.fresh_dofs, &isl.dof);
             for i in 0..n {
                 if isl.fresh[i] {
                     isl.factored[i] = factored;

@@ -65,6 +65,9 @@ pub(crate) struct SparseCholesky {
     key_start: Vec<usize>,
     key_cols: Vec<usize>,
     key_n: usize,
+    /// Stamps of the coverage test (`covers_cliques`): per dof, and the last one given.
+    cover: Vec<usize>,
+    stamp: usize,
     /// Whether the symbolic structure (H's and L's patterns, the elimination tree) is set.
     analyzed: bool,
     /// Symbolic analyses done (a pattern changed), for tests and profiles.
@@ -99,6 +102,8 @@ impl SparseCholesky {
             key_start: Vec::with_capacity(n + 1),
             key_cols: Vec::with_capacity(nnz),
             key_n: 0,
+            cover: Vec::with_capacity(n),
+            stamp: 0,
             analyzed: false,
             analyses: 0,
         }
@@ -182,8 +187,8 @@ impl SparseCholesky {
         }
         if self.analyzed
             && self.key_n == n
-            && self.key_start == self.clique_start
-            && self.key_cols == self.clique_cols
+            && ((self.key_start == self.clique_start && self.key_cols == self.clique_cols)
+                || self.covers_cliques())
         {
             return;
         }
@@ -219,7 +224,6 @@ impl SparseCholesky {
         self.h_cols.clear();
         for k in 0..n {
             self.mark[k] = k;
-            let begin = self.h_cols.len();
             let mut l = dof_parent[k];
             while l != NONE {
                 if self.mark[l] != k {
@@ -240,7 +244,8 @@ impl SparseCholesky {
                     }
                 }
             }
-            self.h_cols[begin..].sort_unstable();
+            // (In any order: the elimination tree, the row patterns and the numeric scatter
+            // do not depend on it.)
             self.h_start.push(self.h_cols.len());
         }
         self.symbolic(n);
@@ -258,9 +263,11 @@ impl SparseCholesky {
     /// [`Self::analyze`], the rows `rows` only, in that order: the dofs of independent groups
     /// (constraint islands, `island.rs`), each group's ascending, that no other row of L couples
     /// to; the other rows of L keep stale values, which [`Self::solve_rows`] does not read. The
-    /// work is that of the listed rows' nonzeros.
-    pub fn factor_rows(&mut self, h: &DMatrix<f64>, rows: &[usize]) -> bool {
-        self.numeric(h, 0.0, Some(rows))
+    /// work is that of the listed rows' nonzeros. `group` gives each dof's group: a listed
+    /// row's entries in another group's columns (a kept pattern's coupling that no row makes
+    /// now, [`Self::analyze`]) are set to zero, as the factor of H has them.
+    pub fn factor_rows(&mut self, h: &DMatrix<f64>, rows: &[usize], group: &[usize]) -> bool {
+        self.numeric(h, 0.0, Some((rows, group)))
     }
 
     /// Factors the symmetric `h` (its lower triangle is read; n × n at the top left) into L.
@@ -306,6 +313,32 @@ impl SparseCholesky {
         }
     }
 
+    /// Whether the analyzed H pattern holds every pair of every clique just built (the
+    /// contacts of a step are those of an earlier one, or fewer of them), while the analyzed
+    /// pattern has at most twice as many cliques as the new one (a pattern left over from many
+    /// contacts since gone is analyzed afresh rather than kept, its fill costing every factor).
+    /// A kept pattern may couple dofs no row couples now — other islands: the factor of one
+    /// island's rows then zeroes its entries in another's columns (`numeric`'s `group`).
+    fn covers_cliques(&mut self) -> bool {
+        let (new, kept) = (self.clique_start.len() - 1, self.key_start.len() - 1);
+        if kept > 2 * new + 8 {
+            return false;
+        }
+        for c in 0..new {
+            let clique = &self.clique_cols[self.clique_start[c]..self.clique_start[c + 1]];
+            for (t, &p) in clique.iter().enumerate().skip(1) {
+                self.stamp += 1;
+                for &q in &self.h_cols[self.h_start[p]..self.h_start[p + 1]] {
+                    self.cover[q] = self.stamp;
+                }
+                if clique[..t].iter().any(|&q| self.cover[q] != self.stamp) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
     /// From H's pattern: the elimination tree, L's pattern by rows (each row's `ereach`,
     /// ascending) and by columns, and where each entry of the one sits in the other.
     fn symbolic(&mut self, n: usize) {
@@ -316,9 +349,9 @@ impl SparseCholesky {
         self.l_start.push(0);
         self.l_cols.clear();
         for k in 0..n {
-            // Row k's pattern: every dof reached from H's row k up the tree (all below k).
+            // Row k's pattern: every dof reached from H's row k up the tree (all below k), in
+            // the order reached (sorted below).
             self.mark[k] = k;
-            let begin = self.l_cols.len();
             for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
                 let mut i = j;
                 while self.mark[i] != k {
@@ -327,7 +360,6 @@ impl SparseCholesky {
                     i = self.parent[i];
                 }
             }
-            self.l_cols[begin..].sort_unstable();
             self.l_start.push(self.l_cols.len());
         }
         let nnz = self.l_cols.len();
@@ -351,20 +383,36 @@ impl SparseCholesky {
         self.c_slot.resize(nnz, 0);
         self.r_slot.clear();
         self.r_slot.resize(nnz, 0);
+        // L by columns: rows taken in ascending order, so each column's rows ascend.
         for k in 0..n {
             for u in self.l_start[k]..self.l_start[k + 1] {
                 let j = self.l_cols[u];
-                let slot = self.h_count[j];
-                self.c_rows[slot] = k;
+                self.c_rows[self.h_count[j]] = k;
+                self.h_count[j] += 1;
+            }
+        }
+        // L by rows again from its columns, taken in ascending order: each row's columns ascend
+        // (two counting passes instead of a sort per row); and where each entry sits in the
+        // other storage. (`ancestor` is free scratch after the elimination tree.)
+        let next = &mut self.ancestor;
+        next.clear();
+        next.extend_from_slice(&self.l_start[..n]);
+        for j in 0..n {
+            for slot in self.c_start[j]..self.c_start[j + 1] {
+                let k = self.c_rows[slot];
+                let u = next[k];
+                next[k] += 1;
+                self.l_cols[u] = j;
                 self.c_slot[u] = slot;
                 self.r_slot[slot] = u;
-                self.h_count[j] += 1;
             }
         }
         self.x.clear();
         self.x.resize(n, 0.0);
         self.diag.clear();
         self.diag.resize(n, 0.0);
+        self.cover.clear();
+        self.cover.resize(n, 0);
         self.analyzed = true;
     }
 
@@ -390,12 +438,13 @@ impl SparseCholesky {
     }
 
     /// Up-looking factorization on the analyzed pattern: row k of L from rows j < k in it.
-    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64, rows: Option<&[usize]>) -> bool {
+    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64, rows: Option<(&[usize], &[usize])>) -> bool {
         let n = self.diag.len();
         let (l_start, l_cols, l_vals) = (&self.l_start, &self.l_cols, &mut self.l_vals);
         let (x, diag) = (&mut self.x, &mut self.diag);
         let all = 0..if rows.is_some() { 0 } else { n };
-        for k in all.chain(rows.unwrap_or(&[]).iter().copied()) {
+        let (listed, group) = rows.unwrap_or((&[], &[]));
+        for k in all.chain(listed.iter().copied()) {
             for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
                 x[j] = h[(k, j)];
             }
@@ -404,6 +453,11 @@ impl SparseCholesky {
             let (begin, end) = (l_start[k], l_start[k + 1]);
             let (done, row_k) = l_vals.split_at_mut(begin);
             for (&j, l_kj) in l_cols[begin..end].iter().zip(&mut row_k[..end - begin]) {
+                if !group.is_empty() && group[j] != group[k] {
+                    x[j] = 0.0;
+                    *l_kj = 0.0;
+                    continue;
+                }
                 let (a, b) = (l_start[j], l_start[j + 1]);
                 let mut s = x[j];
                 for (&l_jp, &p) in done[a..b].iter().zip(&l_cols[a..b]) {
@@ -431,11 +485,22 @@ impl SparseCholesky {
                     self.c_vals[slot] = v;
                 }
             }
-            Some(rows) => {
+            Some((rows, group)) => {
                 for &k in rows {
                     let (a, b) = (self.l_start[k], self.l_start[k + 1]);
                     for (&slot, &v) in self.c_slot[a..b].iter().zip(&self.l_vals[a..b]) {
                         self.c_vals[slot] = v;
+                    }
+                    // Column k's entries in other groups' rows (left by an earlier factor in
+                    // which they were coupled) are zero in this one: the backward solve reads
+                    // them.
+                    if !group.is_empty() {
+                        for slot in self.c_start[k]..self.c_start[k + 1] {
+                            if group[self.c_rows[slot]] != group[k] {
+                                self.c_vals[slot] = 0.0;
+                                self.l_vals[self.r_slot[slot]] = 0.0;
+                            }
+                        }
                     }
                 }
             }
@@ -647,7 +712,7 @@ mod tests {
         let first_tree = [0, 1, 2];
         let mut g = SparseCholesky::default();
         g.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
-        assert!(g.factor_rows(&h, &first_tree));
+        assert!(g.factor_rows(&h, &first_tree, &[0, 0, 0, 1, 1]));
         let mut kept = rhs;
         g.solve_rows(&mut kept, &first_tree);
         assert_eq!(&kept[..3], &whole[..3]);
@@ -708,6 +773,47 @@ mod tests {
         // A downdate that would leave H indefinite is refused.
         assert!(!f.rank_one(&cols, &vals, 10.0, false));
         assert!(f.x.iter().all(|&v| v == 0.0));
+    }
+
+    #[test]
+    fn a_kept_wider_pattern_factors_one_group_as_its_own_pattern_does() {
+        // Trees 0 → 1 → 2 and 3 → 4; first a row couples 2 and 4 (one group), factored whole;
+        // then no row couples them: the wider pattern is kept, and factoring the first tree's
+        // rows alone (its entries in the second tree's rows and columns, left coupled by the
+        // first factor, zeroed) solves its part as a factor of its own pattern does.
+        let n = 5;
+        let dof_parent = [NONE, 0, 1, NONE, 3];
+        let mut h = DMatrix::zeros(n, n);
+        for k in 0..n {
+            h[(k, k)] = 3.0 + k as f64;
+            let mut l = dof_parent[k];
+            while l != NONE {
+                h[(k, l)] = 0.4;
+                h[(l, k)] = 0.4;
+                l = dof_parent[l];
+            }
+        }
+        let mut coupled = h.clone();
+        coupled[(4, 2)] = 0.9;
+        coupled[(2, 4)] = 0.9;
+        let (nz_start, nz_index) = ([0, 2], [2, 4]);
+        let mut f = SparseCholesky::default();
+        f.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(f.factor_analyzed(&coupled));
+        f.analyze(n, &dof_parent, &[], &nz_start, &nz_index);
+        assert_eq!(f.analyses(), 1);
+        let (first_tree, group) = ([0, 1, 2], [0, 0, 0, 1, 1]);
+        assert!(f.factor_rows(&h, &first_tree, &group));
+        let rhs = [1.0, -2.0, 0.5, 3.0, -1.0];
+        let mut kept = rhs;
+        f.solve_rows(&mut kept, &first_tree);
+        let mut own = SparseCholesky::default();
+        own.analyze(n, &dof_parent, &[], &nz_start, &nz_index);
+        assert!(own.factor_analyzed(&h));
+        let mut want = rhs;
+        own.solve(&mut want);
+        assert_eq!(&kept[..3], &want[..3]);
+        assert_eq!(&kept[3..], &rhs[3..]);
     }
 
     #[test]
