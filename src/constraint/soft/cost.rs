@@ -68,67 +68,98 @@ impl Rows<'_> {
     ) {
         // Slices: the per-row loops index them without nalgebra's shape checks.
         let (jar, force) = (jar.as_slice(), force.as_mut_slice());
-        let (d_all, r_all, floss) = (self.d.as_slice(), self.r.as_slice(), self.floss.as_slice());
         let mut i = 0;
         while i < self.nefc {
-            let (x, d) = (jar[i], d_all[i]);
-            if i < self.ne || self.kind[i] != EfcType::ContactElliptic {
-                // One scalar row: its state, force and cost.
-                let (st, f, c) = if i < self.ne {
-                    (EfcState::Quadratic, -d * x, 0.5 * d * x * x)
-                } else if i < self.ne + self.nf {
-                    let (f, r) = (floss[i], r_all[i]);
-                    if x <= -r * f {
-                        (EfcState::LinearNeg, f, -0.5 * r * f * f - f * x)
-                    } else if x >= r * f {
-                        (EfcState::LinearPos, -f, -0.5 * r * f * f + f * x)
-                    } else {
-                        (EfcState::Quadratic, -d * x, 0.5 * d * x * x)
-                    }
-                } else if x >= 0.0 {
-                    (EfcState::Satisfied, 0.0, 0.0)
+            i += self.update_at(i, jar, force, state, &mut each);
+        }
+    }
+
+    /// As [`Self::update_each`], over the rows `list` only (ascending, an elliptic contact's rows
+    /// all in it or none: one constraint island's, `island.rs`); the other rows' forces and
+    /// states are left as they are.
+    pub fn update_rows(
+        &self,
+        jar: &DVector<f64>,
+        force: &mut DVector<f64>,
+        state: &mut [EfcState],
+        list: &[usize],
+        mut each: impl FnMut(usize, f64),
+    ) {
+        let (jar, force) = (jar.as_slice(), force.as_mut_slice());
+        let mut t = 0;
+        while t < list.len() {
+            t += self.update_at(list[t], jar, force, state, &mut each);
+        }
+    }
+
+    /// The state, force and cost terms of the block at row i (one row, or an elliptic
+    /// contact's rows); returns the block's number of rows.
+    #[inline]
+    fn update_at(
+        &self,
+        i: usize,
+        jar: &[f64],
+        force: &mut [f64],
+        state: &mut [EfcState],
+        each: &mut impl FnMut(usize, f64),
+    ) -> usize {
+        let (d_all, r_all, floss) = (self.d.as_slice(), self.r.as_slice(), self.floss.as_slice());
+        let (x, d) = (jar[i], d_all[i]);
+        if i < self.ne || self.kind[i] != EfcType::ContactElliptic {
+            // One scalar row: its state, force and cost.
+            let (st, f, c) = if i < self.ne {
+                (EfcState::Quadratic, -d * x, 0.5 * d * x * x)
+            } else if i < self.ne + self.nf {
+                let (f, r) = (floss[i], r_all[i]);
+                if x <= -r * f {
+                    (EfcState::LinearNeg, f, -0.5 * r * f * f - f * x)
+                } else if x >= r * f {
+                    (EfcState::LinearPos, -f, -0.5 * r * f * f + f * x)
                 } else {
                     (EfcState::Quadratic, -d * x, 0.5 * d * x * x)
-                };
-                state[i] = st;
-                force[i] = f;
-                each(i, c);
-                i += 1;
-                continue;
-            }
-            let dim = self.block(i);
-            let c = &self.contacts[self.id[i]];
-            let mu = self.mu[self.id[i]];
-            let (n, t, _) = cone_coordinates(jar, i, dim, mu, &c.friction);
-            let zone = if n >= mu * t || (t <= 0.0 && n >= 0.0) {
-                EfcState::Satisfied
-            } else if mu * n + t <= 0.0 || (t <= 0.0 && n < 0.0) {
-                EfcState::Quadratic
+                }
+            } else if x >= 0.0 {
+                (EfcState::Satisfied, 0.0, 0.0)
             } else {
-                EfcState::Cone
+                (EfcState::Quadratic, -d * x, 0.5 * d * x * x)
             };
-            match zone {
-                EfcState::Satisfied => force[i..i + dim].fill(0.0),
-                EfcState::Quadratic => {
-                    for j in i..i + dim {
-                        force[j] = -d_all[j] * jar[j];
-                        each(j, 0.5 * d_all[j] * jar[j] * jar[j]);
-                    }
-                }
-                _ => {
-                    let dm = d / (mu * mu * (1.0 + mu * mu));
-                    let nmt = n - mu * t;
-                    each(i, 0.5 * dm * nmt * nmt);
-                    force[i] = -dm * nmt * mu;
-                    for j in 1..dim {
-                        let u = jar[i + j] * c.friction[j - 1];
-                        force[i + j] = -force[i] / t * u * c.friction[j - 1];
-                    }
+            state[i] = st;
+            force[i] = f;
+            each(i, c);
+            return 1;
+        }
+        let dim = self.block(i);
+        let c = &self.contacts[self.id[i]];
+        let mu = self.mu[self.id[i]];
+        let (n, t, _) = cone_coordinates(jar, i, dim, mu, &c.friction);
+        let zone = if n >= mu * t || (t <= 0.0 && n >= 0.0) {
+            EfcState::Satisfied
+        } else if mu * n + t <= 0.0 || (t <= 0.0 && n < 0.0) {
+            EfcState::Quadratic
+        } else {
+            EfcState::Cone
+        };
+        match zone {
+            EfcState::Satisfied => force[i..i + dim].fill(0.0),
+            EfcState::Quadratic => {
+                for j in i..i + dim {
+                    force[j] = -d_all[j] * jar[j];
+                    each(j, 0.5 * d_all[j] * jar[j] * jar[j]);
                 }
             }
-            state[i..i + dim].fill(zone);
-            i += dim;
+            _ => {
+                let dm = d / (mu * mu * (1.0 + mu * mu));
+                let nmt = n - mu * t;
+                each(i, 0.5 * dm * nmt * nmt);
+                force[i] = -dm * nmt * mu;
+                for j in 1..dim {
+                    let u = jar[i + j] * c.friction[j - 1];
+                    force[i + j] = -force[i] / t * u * c.friction[j - 1];
+                }
+            }
         }
+        state[i..i + dim].fill(zone);
+        dim
     }
 
     /// The first and second derivative of s(jar + α jv) in α, at α given by `jar` (already

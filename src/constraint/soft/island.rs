@@ -10,13 +10,15 @@
 //!
 //! [`Islands::discover`] finds them (union–find over dofs from the trees and the rows'
 //! recorded columns); [`newton`] runs the iterations on every island still iterating at once:
-//! the Hessian's rows, its factor (`SparseCholesky::factor_kept`) and the solve only for
-//! those islands' dofs, one exact line search per island over its own rows. Dofs of trees no
-//! row touches keep `qacc_smooth` (MuJoCo does the same).
+//! the gradient, the Hessian's rows, its factor (`SparseCholesky::factor_rows`), the solve,
+//! J d and M d only on those islands' dofs and rows, one exact line search per island over its
+//! own rows — an iteration costs what its islands hold, not what the model holds (MuJoCo's
+//! island solves work on island-local copies to the same end). Dofs of trees no row touches
+//! keep `qacc_smooth` (MuJoCo does the same).
 
 use super::cost::Rows;
 use super::hessian::Assembler;
-use super::primal::{line_search_with, mul_j, mul_m, Settings, Sparsity};
+use super::primal::{line_search_with, Settings, Sparsity};
 use super::work::SoftWork;
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{EfcState, Model, NO_DOF};
@@ -56,8 +58,16 @@ pub(crate) struct Islands {
     alpha: Vec<f64>,
     g0: Vec<f64>,
     dmd: Vec<f64>,
-    /// Per dof: whether its island still iterates (the factor's and the solve's mask).
-    keep: Vec<bool>,
+    /// The dofs (island after island, each ascending) of the islands still iterating, and of
+    /// those among them whose factor is formed anew, while an iteration runs.
+    active_dofs: Vec<usize>,
+    fresh_dofs: Vec<usize>,
+    /// Per island: whether the factor's rows hold its factor (at the rows' `factor_state`), and
+    /// whether this iteration forms it anew.
+    factored: Vec<bool>,
+    fresh: Vec<bool>,
+    /// Per row: its state when its island's factor was last formed or updated.
+    factor_state: Vec<EfcState>,
 }
 
 impl Islands {
@@ -87,8 +97,22 @@ impl Islands {
             alpha: per(nv),
             g0: per(nv),
             dmd: per(nv),
-            keep: per(nv),
+            active_dofs: per(nv),
+            fresh_dofs: per(nv),
+            factored: per(nv),
+            fresh: per(nv),
+            factor_state: per(nefc),
         }
+    }
+
+    /// Island i's dofs, ascending.
+    fn dofs_of(&self, i: usize) -> &[usize] {
+        &self.dofs[self.dof_start[i]..self.dof_start[i + 1]]
+    }
+
+    /// Island i's rows, ascending.
+    fn rows_of(&self, i: usize) -> &[usize] {
+        &self.rows[self.row_start[i]..self.row_start[i + 1]]
     }
 
     fn find(&mut self, mut x: usize) -> usize {
@@ -196,8 +220,12 @@ impl Islands {
         self.active.resize(n, true);
         self.converged.clear();
         self.converged.resize(n, false);
-        self.keep.clear();
-        self.keep.extend(self.dof.iter().map(|&i| i != NONE));
+        self.factored.clear();
+        self.factored.resize(n, false);
+        self.fresh.clear();
+        self.fresh.resize(n, false);
+        self.factor_state.clear();
+        self.factor_state.resize(nefc, EfcState::Satisfied);
     }
 }
 
@@ -252,7 +280,9 @@ pub(super) struct Outcome {
 
 /// Newton's method island by island (see the module doc) from `qacc` (with `soft.ma` = M qacc,
 /// `soft.jar` = J qacc − aref, and `force`, `state` at it); leaves the solution in `qacc` and
-/// the forces and states at it.
+/// the forces and states at it. Each iteration's work is that of the islands still iterating:
+/// their dofs, rows and factor rows (the other islands' values stay as their last iteration
+/// left them, and nothing reads them).
 pub(super) fn newton(
     p: &Problem,
     soft: &mut SoftWork,
@@ -263,6 +293,19 @@ pub(super) fn newton(
 ) -> Outcome {
     let (model, rows, nz, s) = (p.model, p.rows, p.nz, p.settings);
     let (nv, nefc) = (model.nv, rows.nefc);
+    // H is zero outside the rows the last solve wrote: its islands' dofs, on the pattern it
+    // was analyzed with (still the current one). Those rows are cleared here, so that H is zero
+    // before this solve's pattern is analyzed and its islands' rows are formed.
+    {
+        let isl = &soft.islands;
+        let h = &mut soft.hessian;
+        for &k in &isl.dofs {
+            for &j in soft.factor.pattern_row(k) {
+                h[(k, j)] = 0.0;
+            }
+            h[(k, k)] = 0.0;
+        }
+    }
     let isl = &mut soft.islands;
     isl.discover(nv, &model.dof_parent, nefc, nz, p.m);
     let n = isl.n;
@@ -273,56 +316,51 @@ pub(super) fn newton(
             soft.ma[k] = p.f0[k];
         }
     }
-    let costs = |isl: &mut Islands,
-                 qacc: &DVector<f64>,
-                 ma: &DVector<f64>,
-                 jar: &DVector<f64>,
-                 force: &mut DVector<f64>,
-                 state: &mut [EfcState],
-                 out: &mut [f64]| {
-        out[..n].fill(0.0);
-        for (k, &i) in isl.dof.iter().enumerate() {
-            if i != NONE {
-                out[i] += 0.5 * (qacc[k] - p.a0[k]) * (ma[k] - p.f0[k]);
-            }
+    // Island i's cost (Gauss term over its dofs, then its rows' terms, each in ascending order)
+    // at the current point, with its rows' forces and states.
+    let island_cost = |isl: &Islands,
+                       i: usize,
+                       qacc: &DVector<f64>,
+                       ma: &DVector<f64>,
+                       jar: &DVector<f64>,
+                       force: &mut DVector<f64>,
+                       state: &mut [EfcState]|
+     -> f64 {
+        let mut c = 0.0;
+        for &k in isl.dofs_of(i) {
+            c += 0.5 * (qacc[k] - p.a0[k]) * (ma[k] - p.f0[k]);
         }
-        let row_island = &isl.row;
-        rows.update_each(jar, force, state, |r, c| {
-            if row_island[r] != NONE {
-                out[row_island[r]] += c;
-            }
-        });
+        rows.update_rows(jar, force, state, isl.rows_of(i), |_, t| c += t);
+        c
     };
     let mut cost = std::mem::take(&mut isl.cost);
-    costs(isl, qacc, &soft.ma, &soft.jar, force, state, &mut cost);
-    let mut new_cost = std::mem::take(&mut soft.island_cost);
-    new_cost.clear();
-    new_cost.resize(n, 0.0);
+    for (i, c) in cost.iter_mut().enumerate().take(n) {
+        *c = island_cost(isl, i, qacc, &soft.ma, &soft.jar, force, state);
+    }
     let mut iterations = 0;
     let mut analyzed = false;
     loop {
-        // g = M a − qfrc_smooth − Jᵀ f, and each island's scaled norm of it.
-        for ((g, &ma), &f0) in
-            soft.grad.as_mut_slice().iter_mut().zip(soft.ma.as_slice()).zip(p.f0.as_slice())
-        {
-            *g = ma - f0;
-        }
+        // g = M a − qfrc_smooth − Jᵀ f on each iterating island, and its scaled norm.
         let grad = soft.grad.as_mut_slice();
-        for (i, &f) in force.as_slice()[..nefc].iter().enumerate() {
-            if f != 0.0 {
-                let (cols, vals) = nz.row_values(i);
-                for (&k, &j_ik) in cols.iter().zip(vals) {
-                    grad[k] -= j_ik * f;
-                }
-            }
-        }
         let mut any = false;
         for i in 0..n {
             if !isl.active[i] {
                 continue;
             }
-            let g2: f64 =
-                isl.dofs[isl.dof_start[i]..isl.dof_start[i + 1]].iter().map(|&k| grad[k] * grad[k]).sum();
+            let dofs = isl.dofs_of(i);
+            for &k in dofs {
+                grad[k] = soft.ma[k] - p.f0[k];
+            }
+            for &r in isl.rows_of(i) {
+                let f = force[r];
+                if f != 0.0 {
+                    let (cols, vals) = nz.row_values(r);
+                    for (&k, &j_rk) in cols.iter().zip(vals) {
+                        grad[k] -= j_rk * f;
+                    }
+                }
+            }
+            let g2: f64 = dofs.iter().map(|&k| grad[k] * grad[k]).sum();
             isl.gradient[i] = isl.scale[i] * g2.sqrt();
             if isl.gradient[i] < s.tolerance || isl.improvement[i] < s.tolerance {
                 isl.active[i] = false;
@@ -338,24 +376,39 @@ pub(super) fn newton(
         if !any {
             break;
         }
-        for k in 0..nv {
-            isl.keep[k] = isl.dof[k] != NONE && isl.active[isl.dof[k]];
-        }
-        // H = M + Jᵀ (∂²s) J on the iterating islands' dofs (all of them the first time, which
-        // clears the last solve's pattern before the new one is analyzed).
-        let h = &mut soft.hessian;
-        for k in 0..nv {
-            if analyzed && !isl.keep[k] {
+        // Each iterating island's factor brought to its rows' current states: rank-one
+        // updates for the rows that entered or left the quadratic state since it was formed
+        // (MuJoCo's `HessianIncremental`), or a new one — the first iteration, a cone's block
+        // (not a rank-one term), a failed downdate.
+        isl.active_dofs.clear();
+        isl.fresh_dofs.clear();
+        for i in 0..n {
+            isl.fresh[i] = false;
+            if !isl.active[i] {
                 continue;
             }
-            for &j in soft.factor.pattern_row(k) {
-                h[(k, j)] = 0.0;
+            let (d0, d1) = (isl.dof_start[i], isl.dof_start[i + 1]);
+            isl.active_dofs.extend_from_slice(&isl.dofs[d0..d1]);
+            if isl.factored[i] {
+                for &r in &isl.rows[isl.row_start[i]..isl.row_start[i + 1]] {
+                    let (was, is) = (isl.factor_state[r], state[r]);
+                    if was == EfcState::Cone || is == EfcState::Cone {
+                        isl.factored[i] = false;
+                        break;
+                    }
+                    if (was == EfcState::Quadratic) != (is == EfcState::Quadratic) {
+                        isl.factor_state[r] = is;
+                        let (cols, vals) = nz.row_values(r);
+                        if !soft.factor.rank_one(cols, vals, rows.d[r].sqrt(), is == EfcState::Quadratic) {
+                            isl.factored[i] = false;
+                            break;
+                        }
+                    }
+                }
             }
-            h[(k, k)] = p.m[(k, k)];
-            let mut l = model.dof_parent[k];
-            while l != NO_DOF {
-                h[(k, l)] = p.m[(k, l)];
-                l = model.dof_parent[l];
+            if !isl.factored[i] {
+                isl.fresh[i] = true;
+                isl.fresh_dofs.extend_from_slice(&isl.dofs[d0..d1]);
             }
         }
         if !analyzed {
@@ -373,27 +426,63 @@ pub(super) fn newton(
             soft.factor.analyze(nv, &model.dof_parent, &soft.active_rows, nz.start, nz.index);
             analyzed = true;
         }
-        {
-            let mut rows_h = Assembler::new(h, nz, &mut soft.hessian_column);
-            let (row_island, active) = (&isl.row, &isl.active);
-            rows.hessian(&soft.jar, state, |i, dim, block| {
-                if row_island[i] != NONE && active[row_island[i]] {
-                    rows_h.add(i, dim, block);
+        // A new factor: H = M + Jᵀ (∂²s) J on those islands' dofs, factored.
+        let mut factored = true;
+        if !isl.fresh_dofs.is_empty() {
+            let h = &mut soft.hessian;
+            for &k in &isl.fresh_dofs {
+                for &j in soft.factor.pattern_row(k) {
+                    h[(k, j)] = 0.0;
                 }
-            });
-            rows_h.finish();
+                h[(k, k)] = p.m[(k, k)];
+                let mut l = model.dof_parent[k];
+                while l != NO_DOF {
+                    h[(k, l)] = p.m[(k, l)];
+                    l = model.dof_parent[l];
+                }
+            }
+            {
+                let mut rows_h = Assembler::new(h, nz, &mut soft.hessian_column);
+                let (row_island, fresh) = (&isl.row, &isl.fresh);
+                rows.hessian(&soft.jar, state, |i, dim, block| {
+                    if row_island[i] != NONE && fresh[row_island[i]] {
+                        rows_h.add(i, dim, block);
+                    }
+                });
+                rows_h.finish();
+            }
+            factored = soft.factor.factor_rows(&soft.hessian, &isl.fresh_dofs, &isl.dof);
+            for i in 0..n {
+                if isl.fresh[i] {
+                    isl.factored[i] = factored;
+                    for &r in &isl.rows[isl.row_start[i]..isl.row_start[i + 1]] {
+                        isl.factor_state[r] = state[r];
+                    }
+                }
+            }
         }
-        soft.dir.copy_from(&soft.grad);
-        if soft.factor.factor_kept(&soft.hessian, &isl.keep) {
-            soft.factor.solve_kept(soft.dir.as_mut_slice(), &isl.keep);
+        let dir = soft.dir.as_mut_slice();
+        for &k in &isl.active_dofs {
+            dir[k] = soft.grad[k];
+        }
+        if factored {
+            soft.factor.solve_rows(dir, &isl.active_dofs);
         } else {
-            solve_with_factor_unchecked(model, mass_factor, soft.dir.as_mut_slice());
+            // (M⁻¹ is block diagonal by tree: the other trees' entries are not read.)
+            solve_with_factor_unchecked(model, mass_factor, dir);
         }
-        for (d, &keep) in soft.dir.as_mut_slice().iter_mut().zip(&isl.keep) {
-            *d = if keep { -*d } else { 0.0 };
+        for &k in &isl.active_dofs {
+            dir[k] = -dir[k];
         }
-        mul_j(nz, nefc, &soft.dir, &mut soft.jv);
-        mul_m(&model.dof_parent, p.m, &soft.dir, &mut soft.mdir);
+        // J d and M d on the iterating islands' rows and dofs.
+        let (jv, mdir) = (soft.jv.as_mut_slice(), soft.mdir.as_mut_slice());
+        for i in (0..n).filter(|&i| isl.active[i]) {
+            for &r in isl.rows_of(i) {
+                let (cols, vals) = nz.row_values(r);
+                jv[r] = cols.iter().zip(vals).map(|(&k, &j_rk)| j_rk * dir[k]).sum();
+            }
+        }
+        mul_m_on(&model.dof_parent, p.m, &isl.active_dofs, dir, mdir);
         // One exact line search per iterating island, over its dofs and rows.
         for i in 0..n {
             isl.alpha[i] = 0.0;
@@ -401,7 +490,7 @@ pub(super) fn newton(
                 continue;
             }
             let (mut g0, mut dmd) = (0.0, 0.0);
-            for &k in &isl.dofs[isl.dof_start[i]..isl.dof_start[i + 1]] {
+            for &k in isl.dofs_of(i) {
                 g0 += (soft.ma[k] - p.f0[k]) * soft.dir[k];
                 dmd += soft.dir[k] * soft.mdir[k];
             }
@@ -421,29 +510,20 @@ pub(super) fn newton(
                 // No descent along the direction (the island's minimum to round-off).
                 isl.active[i] = false;
                 isl.converged[i] = true;
+                continue;
             }
             isl.alpha[i] = alpha;
-        }
-        for k in 0..nv {
-            let i = isl.dof[k];
-            if i != NONE && isl.alpha[i] != 0.0 {
-                let alpha = isl.alpha[i];
+            // The move, and the island's new cost.
+            for &k in isl.dofs_of(i) {
                 qacc[k] += alpha * soft.dir[k];
                 soft.ma[k] += alpha * soft.mdir[k];
             }
-        }
-        for r in 0..nefc {
-            let i = isl.row[r];
-            if i != NONE && isl.alpha[i] != 0.0 {
-                soft.jar[r] += isl.alpha[i] * soft.jv[r];
+            for &r in list {
+                soft.jar[r] += alpha * soft.jv[r];
             }
-        }
-        costs(isl, qacc, &soft.ma, &soft.jar, force, state, &mut new_cost);
-        for i in 0..n {
-            if isl.alpha[i] != 0.0 {
-                isl.improvement[i] = isl.scale[i] * (cost[i] - new_cost[i]);
-                cost[i] = new_cost[i];
-            }
+            let new_cost = island_cost(isl, i, qacc, &soft.ma, &soft.jar, force, state);
+            isl.improvement[i] = isl.scale[i] * (cost[i] - new_cost);
+            cost[i] = new_cost;
         }
     }
     let outcome = Outcome {
@@ -453,8 +533,25 @@ pub(super) fn newton(
         converged: isl.converged[..n].iter().all(|&c| c),
     };
     isl.cost = cost;
-    soft.island_cost = new_cost;
     outcome
+}
+
+/// r ← M x on the dofs `dofs` (whole trees, each tree's dofs ascending):
+/// [`mul_m`](super::primal::mul_m)'s
+/// arithmetic on those dofs only (M couples a dof only to its tree).
+fn mul_m_on(dof_parent: &[usize], m: &DMatrix<f64>, dofs: &[usize], x: &[f64], r: &mut [f64]) {
+    for &k in dofs {
+        r[k] = m[(k, k)] * x[k];
+    }
+    for &k in dofs {
+        let mut l = dof_parent[k];
+        while l != NO_DOF {
+            let m_lk = m[(l, k)];
+            r[l] += m_lk * x[k];
+            r[k] += m_lk * x[l];
+            l = dof_parent[l];
+        }
+    }
 }
 
 #[cfg(test)]
@@ -479,6 +576,5 @@ mod tests {
         assert_eq!(&isl.rows[isl.row_start[1]..isl.row_start[2]], &[2]);
         // MuJoCo's island scale: 1 / Σ M_kk over the island's dofs.
         assert_eq!(isl.scale, [0.1, 1.0 / 6.0]);
-        assert_eq!(isl.keep, [true, true, true, true, false, true]);
     }
 }

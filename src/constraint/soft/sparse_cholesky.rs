@@ -51,7 +51,9 @@ pub(crate) struct SparseCholesky {
     c_rows: Vec<usize>,
     c_vals: Vec<f64>,
     c_slot: Vec<usize>,
-    /// Dense scratch row of L.
+    /// The inverse of `c_slot`: where column storage's entry sits in row storage.
+    r_slot: Vec<usize>,
+    /// Dense scratch row of L (zero between calls).
     x: Vec<f64>,
     /// The cliques of the pattern being analyzed (clique c's dofs are
     /// `clique_cols[clique_start[c]..clique_start[c + 1]]`, ascending) and each dof's cliques.
@@ -63,6 +65,9 @@ pub(crate) struct SparseCholesky {
     key_start: Vec<usize>,
     key_cols: Vec<usize>,
     key_n: usize,
+    /// Stamps of the coverage test (`covers_cliques`): per dof, and the last one given.
+    cover: Vec<usize>,
+    stamp: usize,
     /// Whether the symbolic structure (H's and L's patterns, the elimination tree) is set.
     analyzed: bool,
     /// Symbolic analyses done (a pattern changed), for tests and profiles.
@@ -88,6 +93,7 @@ impl SparseCholesky {
             c_rows: Vec::with_capacity(nnz),
             c_vals: Vec::with_capacity(nnz),
             c_slot: Vec::with_capacity(nnz),
+            r_slot: Vec::with_capacity(nnz),
             x: Vec::with_capacity(n),
             clique_start: Vec::with_capacity(n + 1),
             clique_cols: Vec::with_capacity(nnz),
@@ -96,6 +102,8 @@ impl SparseCholesky {
             key_start: Vec::with_capacity(n + 1),
             key_cols: Vec::with_capacity(nnz),
             key_n: 0,
+            cover: Vec::with_capacity(n),
+            stamp: 0,
             analyzed: false,
             analyses: 0,
         }
@@ -143,13 +151,17 @@ impl SparseCholesky {
         self.clique_cols.clear();
         for (c, &(first, last)) in groups.iter().enumerate() {
             let begin = self.clique_cols.len();
-            for &p in &nz_index[nz_start[first]..nz_start[last + 1]] {
-                if self.mark[p] != c {
-                    self.mark[p] = c;
-                    self.clique_cols.push(p);
+            let row = |r: usize| &nz_index[nz_start[r]..nz_start[r + 1]];
+            if (first + 1..=last).all(|r| row(r) == row(first)) {
+                // The usual group: a contact's rows over one shared column list (ascending).
+                self.clique_cols.extend_from_slice(row(first));
+            } else {
+                for &p in &nz_index[nz_start[first]..nz_start[last + 1]] {
+                    if self.mark[p] != c {
+                        self.mark[p] = c;
+                        self.clique_cols.push(p);
+                    }
                 }
-            }
-            if first != last {
                 self.clique_cols[begin..].sort_unstable();
             }
             let nc = self.clique_start.len() - 1;
@@ -157,8 +169,17 @@ impl SparseCholesky {
                 let prev = &self.clique_cols[self.clique_start[nc - 1]..begin];
                 prev == &self.clique_cols[begin..]
             };
-            // A clique of one dof couples nothing.
-            if repeat || self.clique_cols.len() - begin < 2 {
+            // A clique of one dof couples nothing, nor one whose dofs lie on one chain of a tree
+            // (each an ancestor of the next: a body's contact with the world) — M's pattern holds
+            // it already. Left out, such rows appearing and leaving do not change the key.
+            let chain = self.clique_cols[begin..].windows(2).all(|w| {
+                let mut l = dof_parent[w[1]];
+                while l != NONE && l > w[0] {
+                    l = dof_parent[l];
+                }
+                l == w[0]
+            });
+            if repeat || chain {
                 self.clique_cols.truncate(begin);
             } else {
                 self.clique_start.push(self.clique_cols.len());
@@ -166,8 +187,8 @@ impl SparseCholesky {
         }
         if self.analyzed
             && self.key_n == n
-            && self.key_start == self.clique_start
-            && self.key_cols == self.clique_cols
+            && ((self.key_start == self.clique_start && self.key_cols == self.clique_cols)
+                || self.covers_cliques())
         {
             return;
         }
@@ -203,7 +224,6 @@ impl SparseCholesky {
         self.h_cols.clear();
         for k in 0..n {
             self.mark[k] = k;
-            let begin = self.h_cols.len();
             let mut l = dof_parent[k];
             while l != NONE {
                 if self.mark[l] != k {
@@ -224,7 +244,8 @@ impl SparseCholesky {
                     }
                 }
             }
-            self.h_cols[begin..].sort_unstable();
+            // (In any order: the elimination tree, the row patterns and the numeric scatter
+            // do not depend on it.)
             self.h_start.push(self.h_cols.len());
         }
         self.symbolic(n);
@@ -239,11 +260,14 @@ impl SparseCholesky {
     }
 
     /// Factors `h` (lower triangle read) with the symbolic structure of the last
-    /// [`Self::analyze`], the rows k with `keep[k]` only: those of independent
-    /// groups of dofs (constraint islands, `island.rs`) that no kept row couples to; the other
-    /// rows of L keep stale values, which [`Self::solve_kept`] does not read.
-    pub fn factor_kept(&mut self, h: &DMatrix<f64>, keep: &[bool]) -> bool {
-        self.numeric(h, 0.0, Some(keep))
+    /// [`Self::analyze`], the rows `rows` only, in that order: the dofs of independent groups
+    /// (constraint islands, `island.rs`), each group's ascending, that no other row of L couples
+    /// to; the other rows of L keep stale values, which [`Self::solve_rows`] does not read. The
+    /// work is that of the listed rows' nonzeros. `group` gives each dof's group: a listed
+    /// row's entries in another group's columns (a kept pattern's coupling that no row makes
+    /// now, [`Self::analyze`]) are set to zero, as the factor of H has them.
+    pub fn factor_rows(&mut self, h: &DMatrix<f64>, rows: &[usize], group: &[usize]) -> bool {
+        self.numeric(h, 0.0, Some((rows, group)))
     }
 
     /// Factors the symmetric `h` (its lower triangle is read; n × n at the top left) into L.
@@ -289,6 +313,32 @@ impl SparseCholesky {
         }
     }
 
+    /// Whether the analyzed H pattern holds every pair of every clique just built (the
+    /// contacts of a step are those of an earlier one, or fewer of them), while the analyzed
+    /// pattern has at most twice as many cliques as the new one (a pattern left over from many
+    /// contacts since gone is analyzed afresh rather than kept, its fill costing every factor).
+    /// A kept pattern may couple dofs no row couples now — other islands: the factor of one
+    /// island's rows then zeroes its entries in another's columns (`numeric`'s `group`).
+    fn covers_cliques(&mut self) -> bool {
+        let (new, kept) = (self.clique_start.len() - 1, self.key_start.len() - 1);
+        if kept > 2 * new + 8 {
+            return false;
+        }
+        for c in 0..new {
+            let clique = &self.clique_cols[self.clique_start[c]..self.clique_start[c + 1]];
+            for (t, &p) in clique.iter().enumerate().skip(1) {
+                self.stamp += 1;
+                for &q in &self.h_cols[self.h_start[p]..self.h_start[p + 1]] {
+                    self.cover[q] = self.stamp;
+                }
+                if clique[..t].iter().any(|&q| self.cover[q] != self.stamp) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
     /// From H's pattern: the elimination tree, L's pattern by rows (each row's `ereach`,
     /// ascending) and by columns, and where each entry of the one sits in the other.
     fn symbolic(&mut self, n: usize) {
@@ -299,9 +349,9 @@ impl SparseCholesky {
         self.l_start.push(0);
         self.l_cols.clear();
         for k in 0..n {
-            // Row k's pattern: every dof reached from H's row k up the tree (all below k).
+            // Row k's pattern: every dof reached from H's row k up the tree (all below k), in
+            // the order reached (sorted below).
             self.mark[k] = k;
-            let begin = self.l_cols.len();
             for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
                 let mut i = j;
                 while self.mark[i] != k {
@@ -310,7 +360,6 @@ impl SparseCholesky {
                     i = self.parent[i];
                 }
             }
-            self.l_cols[begin..].sort_unstable();
             self.l_start.push(self.l_cols.len());
         }
         let nnz = self.l_cols.len();
@@ -332,19 +381,38 @@ impl SparseCholesky {
         self.c_vals.resize(nnz, 0.0);
         self.c_slot.clear();
         self.c_slot.resize(nnz, 0);
+        self.r_slot.clear();
+        self.r_slot.resize(nnz, 0);
+        // L by columns: rows taken in ascending order, so each column's rows ascend.
         for k in 0..n {
             for u in self.l_start[k]..self.l_start[k + 1] {
                 let j = self.l_cols[u];
-                let slot = self.h_count[j];
-                self.c_rows[slot] = k;
-                self.c_slot[u] = slot;
+                self.c_rows[self.h_count[j]] = k;
                 self.h_count[j] += 1;
+            }
+        }
+        // L by rows again from its columns, taken in ascending order: each row's columns ascend
+        // (two counting passes instead of a sort per row); and where each entry sits in the
+        // other storage. (`ancestor` is free scratch after the elimination tree.)
+        let next = &mut self.ancestor;
+        next.clear();
+        next.extend_from_slice(&self.l_start[..n]);
+        for j in 0..n {
+            for slot in self.c_start[j]..self.c_start[j + 1] {
+                let k = self.c_rows[slot];
+                let u = next[k];
+                next[k] += 1;
+                self.l_cols[u] = j;
+                self.c_slot[u] = slot;
+                self.r_slot[slot] = u;
             }
         }
         self.x.clear();
         self.x.resize(n, 0.0);
         self.diag.clear();
         self.diag.resize(n, 0.0);
+        self.cover.clear();
+        self.cover.resize(n, 0);
         self.analyzed = true;
     }
 
@@ -370,14 +438,13 @@ impl SparseCholesky {
     }
 
     /// Up-looking factorization on the analyzed pattern: row k of L from rows j < k in it.
-    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64, keep: Option<&[bool]>) -> bool {
+    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64, rows: Option<(&[usize], &[usize])>) -> bool {
         let n = self.diag.len();
         let (l_start, l_cols, l_vals) = (&self.l_start, &self.l_cols, &mut self.l_vals);
         let (x, diag) = (&mut self.x, &mut self.diag);
-        for k in 0..n {
-            if keep.is_some_and(|keep| !keep[k]) {
-                continue;
-            }
+        let all = 0..if rows.is_some() { 0 } else { n };
+        let (listed, group) = rows.unwrap_or((&[], &[]));
+        for k in all.chain(listed.iter().copied()) {
             for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
                 x[j] = h[(k, j)];
             }
@@ -386,6 +453,11 @@ impl SparseCholesky {
             let (begin, end) = (l_start[k], l_start[k + 1]);
             let (done, row_k) = l_vals.split_at_mut(begin);
             for (&j, l_kj) in l_cols[begin..end].iter().zip(&mut row_k[..end - begin]) {
+                if !group.is_empty() && group[j] != group[k] {
+                    x[j] = 0.0;
+                    *l_kj = 0.0;
+                    continue;
+                }
                 let (a, b) = (l_start[j], l_start[j + 1]);
                 let mut s = x[j];
                 for (&l_jp, &p) in done[a..b].iter().zip(&l_cols[a..b]) {
@@ -406,10 +478,84 @@ impl SparseCholesky {
             }
             diag[k] = d.sqrt();
         }
-        for (&slot, &v) in self.c_slot.iter().zip(self.l_vals.iter()) {
-            self.c_vals[slot] = v;
+        // L by columns, for the backward solve: the factored rows' entries.
+        match rows {
+            None => {
+                for (&slot, &v) in self.c_slot.iter().zip(self.l_vals.iter()) {
+                    self.c_vals[slot] = v;
+                }
+            }
+            Some((rows, group)) => {
+                for &k in rows {
+                    let (a, b) = (self.l_start[k], self.l_start[k + 1]);
+                    for (&slot, &v) in self.c_slot[a..b].iter().zip(&self.l_vals[a..b]) {
+                        self.c_vals[slot] = v;
+                    }
+                    // Column k's entries in other groups' rows (left by an earlier factor in
+                    // which they were coupled) are zero in this one: the backward solve reads
+                    // them.
+                    if !group.is_empty() {
+                        for slot in self.c_start[k]..self.c_start[k + 1] {
+                            if group[self.c_rows[slot]] != group[k] {
+                                self.c_vals[slot] = 0.0;
+                                self.l_vals[self.r_slot[slot]] = 0.0;
+                            }
+                        }
+                    }
+                }
+            }
         }
         true
+    }
+
+    /// The factor of H ± w wᵀ from that of H (a rank-one update, `add`, or downdate), with
+    /// w = `scale` · v, v nonzero on the columns `cols` (ascending) with values `vals`: the
+    /// columns of L on the elimination-tree path from w's first column to its root change
+    /// (Davis, *Direct Methods for Sparse Linear Systems*, §4.8; MuJoCo's Newton solver keeps its
+    /// factor the same way as rows enter and leave their quadratic state, `HessianIncremental`,
+    /// engine_solver.c). w's pattern must lie in the analyzed one (a row of the analyzed
+    /// cliques). Returns false if a downdate leaves a pivot at or below 1e-10 of its square
+    /// before: the factor is then spoiled and the caller factors H afresh.
+    pub fn rank_one(&mut self, cols: &[usize], vals: &[f64], scale: f64, add: bool) -> bool {
+        let Some(&first) = cols.first() else {
+            return true;
+        };
+        let sign = if add { 1.0 } else { -1.0 };
+        let x = &mut self.x;
+        for (&k, &v) in cols.iter().zip(vals) {
+            x[k] = scale * v;
+        }
+        // x is nonzero only on the path (a column's rows are its ancestors): each entry is
+        // cleared as its column is passed, so x is zero again at the end.
+        let mut k = first;
+        let mut ok = true;
+        while k != NONE {
+            let (l_kk, w_k) = (self.diag[k], x[k]);
+            x[k] = 0.0;
+            if ok && w_k != 0.0 {
+                let r2 = l_kk * l_kk + sign * w_k * w_k;
+                if r2 <= 1e-10 * l_kk * l_kk {
+                    ok = false;
+                } else {
+                    let r = r2.sqrt();
+                    let (c, s, inv_c) = (r / l_kk, w_k / l_kk, l_kk / r);
+                    let signed_s = sign * s;
+                    self.diag[k] = r;
+                    let (a, b) = (self.c_start[k], self.c_start[k + 1]);
+                    for ((&i, l_ik), &u) in
+                        self.c_rows[a..b].iter().zip(&mut self.c_vals[a..b]).zip(&self.r_slot[a..b])
+                    {
+                        let x_i = x[i];
+                        let l = (*l_ik + signed_s * x_i) * inv_c;
+                        x[i] = c * x_i - s * l;
+                        *l_ik = l;
+                        self.l_vals[u] = l;
+                    }
+                }
+            }
+            k = self.parent[k];
+        }
+        ok
     }
 
     /// Solves H x = b in place with the last factor (b holds x on return).
@@ -418,20 +564,20 @@ impl SparseCholesky {
         self.solve_where(b, None);
     }
 
-    /// Solves H x = b in place (b holds x on return) on the rows k with `keep[k]` of the last
-    /// [`Self::factor_kept`] (the other entries of b are left as they are).
-    pub fn solve_kept(&self, b: &mut [f64], keep: &[bool]) {
-        self.solve_where(b, Some(keep));
+    /// Solves H x = b in place (b holds x on return) on the rows `rows` of the last
+    /// [`Self::factor_rows`] (the other entries of b are left as they are).
+    pub fn solve_rows(&self, b: &mut [f64], rows: &[usize]) {
+        self.solve_where(b, Some(rows));
     }
 
-    fn solve_where(&self, b: &mut [f64], keep: Option<&[bool]>) {
+    /// Forward then backward substitution over every row (`rows` None) or the listed ones (each
+    /// independent group's ascending; backward in the reverse order).
+    fn solve_where(&self, b: &mut [f64], rows: Option<&[usize]>) {
         let n = self.diag.len();
         let b = &mut b[..n];
-        let skip = |i: usize| keep.is_some_and(|keep| !keep[i]);
-        for i in 0..n {
-            if skip(i) {
-                continue;
-            }
+        let all = 0..if rows.is_some() { 0 } else { n };
+        let listed = rows.unwrap_or(&[]);
+        for i in all.clone().chain(listed.iter().copied()) {
             let (lo, hi) = (self.l_start[i], self.l_start[i + 1]);
             let mut s = b[i];
             for (&l, &j) in self.l_vals[lo..hi].iter().zip(&self.l_cols[lo..hi]) {
@@ -439,10 +585,7 @@ impl SparseCholesky {
             }
             b[i] = s / self.diag[i];
         }
-        for i in (0..n).rev() {
-            if skip(i) {
-                continue;
-            }
+        for i in all.rev().chain(listed.iter().rev().copied()) {
             let (lo, hi) = (self.c_start[i], self.c_start[i + 1]);
             let mut s = b[i];
             for (&l, &j) in self.c_vals[lo..hi].iter().zip(&self.c_rows[lo..hi]) {
@@ -566,13 +709,110 @@ mod tests {
         let rhs = [1.0, -2.0, 0.5, 3.0, -1.0];
         let mut whole = rhs;
         f.solve(&mut whole);
-        let keep = [true, true, true, false, false];
+        let first_tree = [0, 1, 2];
         let mut g = SparseCholesky::default();
         g.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
-        assert!(g.factor_kept(&h, &keep));
+        assert!(g.factor_rows(&h, &first_tree, &[0, 0, 0, 1, 1]));
         let mut kept = rhs;
-        g.solve_kept(&mut kept, &keep);
+        g.solve_rows(&mut kept, &first_tree);
         assert_eq!(&kept[..3], &whole[..3]);
+        assert_eq!(&kept[3..], &rhs[3..]);
+    }
+
+    #[test]
+    fn rank_one_updates_and_downdates_give_the_factor_of_the_modified_matrix() {
+        // The kept-factor sample's two trees and a row coupling dofs 1, 2 and 4 (one clique):
+        // H + w wᵀ factored afresh against the update, then the downdate back to H's factor.
+        let n = 5;
+        let dof_parent = [NONE, 0, 1, NONE, 3];
+        let mut h = DMatrix::zeros(n, n);
+        for k in 0..n {
+            h[(k, k)] = 3.0 + k as f64;
+            let mut l = dof_parent[k];
+            while l != NONE {
+                h[(k, l)] = 0.4;
+                h[(l, k)] = 0.4;
+                l = dof_parent[l];
+            }
+        }
+        let (nz_start, nz_index) = ([0, 3], [1, 2, 4]);
+        let (cols, vals, scale) = ([1, 2, 4], [0.5, -1.5, 2.0], 1.7);
+        let mut f = SparseCholesky::default();
+        f.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(f.factor_analyzed(&h));
+        assert!(f.rank_one(&cols, &vals, scale, true));
+        let mut h_plus = h.clone();
+        for a in 0..3 {
+            for b in 0..3 {
+                h_plus[(cols[a], cols[b])] += scale * scale * vals[a] * vals[b];
+            }
+        }
+        let mut g = SparseCholesky::default();
+        g.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(g.factor_analyzed(&h_plus));
+        let rhs = [1.0, -2.0, 0.5, 3.0, -1.0];
+        let (mut x1, mut x2) = (rhs, rhs);
+        f.solve(&mut x1);
+        g.solve(&mut x2);
+        for k in 0..n {
+            assert!((x1[k] - x2[k]).abs() <= 1e-13 * (1.0 + x2[k].abs()), "{x1:?} against {x2:?}");
+            assert!((f.diag[k] - g.diag[k]).abs() <= 1e-13 * g.diag[k]);
+        }
+        // The scratch is clean, and the downdate returns H's factor.
+        assert!(f.x.iter().all(|&v| v == 0.0));
+        assert!(f.rank_one(&cols, &vals, scale, false));
+        let mut h_factor = SparseCholesky::default();
+        h_factor.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(h_factor.factor_analyzed(&h));
+        let (mut y1, mut y2) = (rhs, rhs);
+        f.solve(&mut y1);
+        h_factor.solve(&mut y2);
+        for k in 0..n {
+            assert!((y1[k] - y2[k]).abs() <= 1e-13 * (1.0 + y2[k].abs()), "{y1:?} against {y2:?}");
+        }
+        // A downdate that would leave H indefinite is refused.
+        assert!(!f.rank_one(&cols, &vals, 10.0, false));
+        assert!(f.x.iter().all(|&v| v == 0.0));
+    }
+
+    #[test]
+    fn a_kept_wider_pattern_factors_one_group_as_its_own_pattern_does() {
+        // Trees 0 → 1 → 2 and 3 → 4; first a row couples 2 and 4 (one group), factored whole;
+        // then no row couples them: the wider pattern is kept, and factoring the first tree's
+        // rows alone (its entries in the second tree's rows and columns, left coupled by the
+        // first factor, zeroed) solves its part as a factor of its own pattern does.
+        let n = 5;
+        let dof_parent = [NONE, 0, 1, NONE, 3];
+        let mut h = DMatrix::zeros(n, n);
+        for k in 0..n {
+            h[(k, k)] = 3.0 + k as f64;
+            let mut l = dof_parent[k];
+            while l != NONE {
+                h[(k, l)] = 0.4;
+                h[(l, k)] = 0.4;
+                l = dof_parent[l];
+            }
+        }
+        let mut coupled = h.clone();
+        coupled[(4, 2)] = 0.9;
+        coupled[(2, 4)] = 0.9;
+        let (nz_start, nz_index) = ([0, 2], [2, 4]);
+        let mut f = SparseCholesky::default();
+        f.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(f.factor_analyzed(&coupled));
+        f.analyze(n, &dof_parent, &[], &nz_start, &nz_index);
+        assert_eq!(f.analyses(), 1);
+        let (first_tree, group) = ([0, 1, 2], [0, 0, 0, 1, 1]);
+        assert!(f.factor_rows(&h, &first_tree, &group));
+        let rhs = [1.0, -2.0, 0.5, 3.0, -1.0];
+        let mut kept = rhs;
+        f.solve_rows(&mut kept, &first_tree);
+        let mut own = SparseCholesky::default();
+        own.analyze(n, &dof_parent, &[], &nz_start, &nz_index);
+        assert!(own.factor_analyzed(&h));
+        let mut want = rhs;
+        own.solve(&mut want);
+        assert_eq!(&kept[..3], &want[..3]);
         assert_eq!(&kept[3..], &rhs[3..]);
     }
 

@@ -42,8 +42,9 @@ pub(crate) struct SoftWork {
     /// J's values at those entries, in the same order.
     pub nz_value: Vec<f64>,
     /// Whether `nz_start`/`nz_index`/`nz_value` list J's nonzeros as the soft position stage
-    /// wrote them (rows 0..nz_start.len() − 1; every row after them zero): false until the
-    /// first, and whenever another writer (the exact rows) wrote `efc_j` since.
+    /// wrote them (rows 0..nz_start.len() − 1; every row after them zero): true from the start
+    /// (`efc_j` is allocated zero, the record empty: the first position stage clears nothing),
+    /// false whenever another writer (the exact rows) wrote `efc_j` since.
     pub j_recorded: bool,
     /// The dofs of one contact's two bodies while its rows are recorded (nv).
     pub columns: Vec<usize>,
@@ -51,9 +52,8 @@ pub(crate) struct SoftWork {
     pub nz_scratch: Vec<(usize, usize)>,
     /// One column of a row group's Hessian term, while H is assembled (nv; `hessian.rs`).
     pub hessian_column: Vec<f64>,
-    /// The constraint islands of the sparse Newton solve (`island.rs`) and one cost per island.
+    /// The constraint islands of the sparse Newton solve (`island.rs`).
     pub islands: super::island::Islands,
-    pub island_cost: Vec<f64>,
     /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
     pub ar: DMatrix<f64>,
     pub minv_jt: DMatrix<f64>,
@@ -82,15 +82,18 @@ impl SoftWork {
             factor_state: vec![EfcState::Satisfied; nefc],
             rank_one: vec![0.0; nv],
             active_rows: Vec::with_capacity(nefc),
-            nz_start: Vec::with_capacity(nefc + 1),
+            nz_start: {
+                let mut start = Vec::with_capacity(nefc + 1);
+                start.push(0);
+                start
+            },
             nz_index: Vec::with_capacity(nefc * nv),
             nz_value: Vec::with_capacity(nefc * nv),
-            j_recorded: false,
+            j_recorded: true,
             columns: Vec::with_capacity(nv),
             nz_scratch: Vec::new(),
             hessian_column: vec![0.0; nv],
             islands: super::island::Islands::with_capacity(nv, nefc),
-            island_cost: Vec::with_capacity(nv + 1),
             ar: DMatrix::zeros(0, 0),
             minv_jt: DMatrix::zeros(0, 0),
         }
