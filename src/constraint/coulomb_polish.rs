@@ -82,6 +82,12 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     if data.exact.active.is_empty() {
         return false;
     }
+    // A set this solve's polish has tried (and failed on) is not tried again.
+    let set = set_hash(data);
+    if set == data.exact.polish_set {
+        return false;
+    }
+    data.exact.polish_set = set;
     // The candidate starts at the iterate, friction-loss rows kept at a bound exactly on it.
     for j in 0..n {
         data.exact.lambda_prev[j] = data.exact.rhs[j];
@@ -151,6 +157,25 @@ fn restart_from_iterate(data: &mut Data) {
         }
         j += len;
     }
+}
+
+/// A hash (FNV-1a) of the polish's active set: its free rows and its slipping contacts; never 0.
+fn set_hash(data: &Data) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut mix = |x: usize| {
+        h ^= x as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    };
+    for &r in &data.exact.active {
+        mix(r);
+    }
+    mix(usize::MAX);
+    for i in 0..data.nefc {
+        if data.exact.slipping[i] {
+            mix(i);
+        }
+    }
+    h.max(1)
 }
 
 /// A row's place in the polish's active set is decided with this relative margin (of a box's
@@ -260,6 +285,7 @@ fn solve_active_set(
                     lambda_prev: efc_lambda_prev,
                     factor: efc_factor,
                     eig: efc_eig,
+                    polish_work,
                     ..
                 },
             ..
@@ -280,6 +306,7 @@ fn solve_active_set(
                 efc_sub[(a, c)] = col[q];
             }
         }
+        *polish_work += (k * k * k) as f64 / 3.0;
         redundant |= solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..k], efc_factor, efc_eig) < k;
         for (a, &r) in efc_active.iter().enumerate() {
             if from_candidate {
@@ -683,6 +710,7 @@ fn solve_substituted(data: &mut Data, level: Level) -> bool {
         }
         sub_rhs[a] = rhs;
     }
+    exact.polish_work += (2 * k * k * k) as f64 / 3.0;
     if !lu_solve(sub, &mut sub_rhs.as_mut_slice()[..k], &mut pivots[..2 * k], 0.0) {
         return false;
     }
@@ -778,7 +806,8 @@ fn newton_slipping(data: &mut Data, level: Level) -> bool {
             return true;
         }
         {
-            let ExactWork { sub, sub_rhs, pivots, eig, .. } = &mut data.exact;
+            let ExactWork { sub, sub_rhs, pivots, eig, polish_work, .. } = &mut data.exact;
+            *polish_work += (2 * m * m * m) as f64 / 3.0;
             if !lu_solve(sub, &mut sub_rhs.as_mut_slice()[..m], &mut pivots[..2 * m], NEWTON_TOLERANCE) {
                 return false;
             }
