@@ -4,7 +4,8 @@
 //! keep their force; a slipping contact's friction (on its cone, against the slip) is substituted
 //! into the reduced system — one LU solve with complete pivoting for a contact already moving,
 //! Newton's method on the maximal-dissipation law for one whose slip direction is the solution's
-//! own — and the result is kept only if every row's law holds (docs/constraints.md, exact mode).
+//! own — and the result is kept only if every row's law holds (docs/constraints.md, exact mode);
+//! a row that breaks its law changes sides (a principal pivot) and the set is solved again.
 
 use super::coulomb::{
     column_dot, max_dissipation, mu, separating, Level, MAX_DIM, POLISH_ROUNDS, SLIP_VELOCITY,
