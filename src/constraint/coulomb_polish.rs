@@ -4,7 +4,8 @@
 //! keep their force; a slipping contact's friction (on its cone, against the slip) is substituted
 //! into the reduced system — one LU solve with complete pivoting for a contact already moving,
 //! Newton's method on the maximal-dissipation law for one whose slip direction is the solution's
-//! own — and the result is kept only if every row's law holds (docs/constraints.md, exact mode).
+//! own — and the result is kept only if every row's law holds (docs/constraints.md, exact mode);
+//! a row that breaks its law changes sides (a principal pivot) and the set is solved again.
 
 use super::coulomb::{
     column_dot, max_dissipation, mu, separating, Level, MAX_DIM, POLISH_ROUNDS, SLIP_VELOCITY,
@@ -16,19 +17,22 @@ use crate::model::{Data, EfcType, Model};
 /// The exact solve of the active set the Gauss–Seidel iterate has found (the "polish" of
 /// active-set methods, Cottle, Pang & Stone §4): equality rows, normals carrying force, sticking
 /// friction rows and friction-loss rows inside their bounds have w = 0; every other row keeps its
-/// force (0, a friction-loss bound, a sliding friction). The reduced symmetric system is solved
-/// exactly (minimum-norm for redundant rows); the result is kept only if every row's law holds
-/// (λ_n ≥ 0, w ≥ 0 off contact, friction inside its cone or box, w opposing a friction at its
-/// bound). A contact whose friction is on its cone's boundary makes the system unsymmetric: then
-/// there is no polish and the iteration goes on.
+/// force (0, a friction-loss bound, a sliding friction). The reduced system is solved for the
+/// correction of the iterate's forces, minimum-norm: rows that are parallel (a limit and a
+/// friction loss on one dof, two contacts with one Jacobian) make it singular, and along its null
+/// space the forces keep the iterate's split, which respects every row's bounds. The result is
+/// kept only if every row's law holds (λ_n ≥ 0, w ≥ 0 off contact, friction inside its cone or
+/// box, w opposing a friction at its bound); when one does not, the row that breaks its law the
+/// most changes sides (a friction loss outside its box goes to that bound, a normal pulling leaves,
+/// a friction leaving its cone slips, …: one principal pivot) and the system is solved again, at
+/// most [`PIVOTS`] times, before the iteration goes on.
 pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
     let n = data.nefc;
-    const TOL: f64 = 1e-9;
-    let mut i = 0;
-    let mut any_sliding = false;
     data.exact.active.clear();
     data.exact.slipping[..n].fill(false);
-    // Classify rows: Free rows go into efc_active; every other row keeps its force.
+    let mut any_sliding = false;
+    // Classify rows: Free rows go into `exact.active`; every other row keeps its force.
+    let mut i = 0;
     while i < n {
         let len = data.efc_block_len(i);
         match data.efc_type[i] {
@@ -44,10 +48,10 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
             EfcType::FrictionDof => {
                 let (lo, hi) = friction_dof_bounds(model, data, i, level);
                 let l = data.exact.rhs[i];
-                let sliding = level == Level::Acceleration
-                    && data.efc_vel[i].abs() > SLIP_VELOCITY
-                    && !data.efc_frozen_at_rest(i);
-                if !sliding && l > lo + TOL * (hi - lo).abs() && l < hi - TOL * (hi - lo).abs() {
+                if !dof_sliding(data, i, level)
+                    && l > lo + TOL * (hi - lo).abs()
+                    && l < hi - TOL * (hi - lo).abs()
+                {
                     data.exact.active.push(i);
                 }
             }
@@ -56,85 +60,218 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
                     data.exact.active.push(i);
                     let friction = data.contacts[data.efc_id[i]].friction;
                     let (radius, spent) = cone_of(data, i, len, level);
-                    let sliding = level == Level::Acceleration
-                        && (1..len).any(|k| data.efc_vel[i + k].abs() > SLIP_VELOCITY)
-                        && !data.efc_frozen_at_rest(i);
                     let y2: f64 = (1..len)
                         .filter(|&k| mu(&friction, k) > 0.0)
                         .map(|k| ((data.exact.rhs[i + k] + spent[k - 1]) / mu(&friction, k)).powi(2))
                         .sum();
-                    if sliding {
-                        // Friction fixed by the slip: c · λ_n, updated in the rounds below.
+                    // Moving (friction fixed by the slip, c · λ_n, updated in the rounds below)
+                    // or starting to slip (friction on the cone, opposing the slip acceleration;
+                    // at the velocity level, the post-step slip velocity).
+                    if contact_moving(data, i, len, level)
+                        || (y2.sqrt() >= radius * (1.0 - TOL) && radius > 0.0)
+                    {
                         data.exact.slipping[i] = true;
                         any_sliding = true;
-                        i += len;
-                        continue;
-                    }
-                    if y2.sqrt() >= radius * (1.0 - TOL) && radius > 0.0 {
-                        // Starting to slip: friction on the cone, opposing the slip acceleration
-                        // (at the velocity level, the post-step slip velocity).
-                        data.exact.slipping[i] = true;
-                        any_sliding = true;
-                        i += len;
-                        continue;
-                    }
-                    for k in 1..len {
-                        if mu(&friction, k) > 0.0 {
-                            data.exact.active.push(i + k);
-                        }
+                    } else {
+                        push_sticking_friction(data, i, len);
                     }
                 }
             }
         }
         i += len;
     }
-    // Reduced system A_FF λ_F = b_F − A_F,X λ_X, the fixed forces λ_X taken from the candidate
-    // (efc_lambda_prev; efc_rhs keeps the iterate if the polish fails). A sliding contact's friction
-    // is d · λ_n with d = −μ² u / ‖μ ∘ u‖ from its slip u, substituted into the system (then not
-    // symmetric: LU, [`solve_substituted`]); a contact moving at the acceleration level has its
-    // slip fixed, so one solve is exact; for one starting to slip, u is the slip acceleration of
-    // the solution and rounds update d until it settles. Friction-loss rows kept at a bound are
-    // set exactly on it.
-    let k = data.exact.active.len();
-    if k == 0 {
+    if data.exact.active.is_empty() {
         return false;
     }
-    // Larger systems keep the symmetric rounds, and give up at the velocity level: the LU with
-    // complete pivoting, and Newton's repeated ones, cost several times the Cholesky there
-    // (bin_50 2.3× slower with them).
-    let substitute = k <= SUBSTITUTE_MAX;
-    if any_sliding && !substitute && level != Level::Acceleration {
+    // A set this solve's polish has tried (and failed on) is not tried again.
+    let set = set_hash(data);
+    if set == data.exact.polish_set {
         return false;
     }
-    data.exact.in_active[..n].fill(false);
-    for a in 0..k {
-        let r = data.exact.active[a];
-        data.exact.in_active[r] = true;
-    }
+    data.exact.polish_set = set;
+    // The candidate starts at the iterate, friction-loss rows kept at a bound exactly on it.
     for j in 0..n {
         data.exact.lambda_prev[j] = data.exact.rhs[j];
     }
+    set_in_active(data);
     snap_friction_dof_bounds(model, data, level);
+    let mut pivoted = [(usize::MAX, 0u8); 2 * PIVOTS as usize];
+    for pivot in 0..=PIVOTS {
+        let k = data.exact.active.len();
+        // Larger systems keep the symmetric rounds, and give up at the velocity level: the LU
+        // with complete pivoting, and Newton's repeated ones, cost several times the Cholesky
+        // there (bin_50 2.3× slower with them).
+        let substitute = k <= SUBSTITUTE_MAX;
+        if any_sliding && !substitute && level != Level::Acceleration {
+            return false;
+        }
+        if pivot > 0 {
+            restart_from_iterate(data);
+        }
+        let Some(redundant) = solve_active_set(data, level, any_sliding, substitute, false) else {
+            return false;
+        };
+        let mut verdict = verify(model, data, level, &pivoted[..2 * pivot as usize]);
+        if redundant && !matches!(verdict, Verdict::Holds) {
+            // Redundant free rows: their minimum-norm forces (an even split) broke a law; the
+            // iterate's split, corrected by the minimum-norm change, respects each row's bounds
+            // (a limit and a friction loss on one dof).
+            restart_from_iterate(data);
+            if solve_active_set(data, level, any_sliding, substitute, true).is_none() {
+                return false;
+            }
+            verdict = verify(model, data, level, &pivoted[..2 * pivot as usize]);
+        }
+        match verdict {
+            Verdict::Holds => {
+                for j in 0..n {
+                    data.exact.rhs[j] = data.exact.lambda_prev[j];
+                }
+                return true;
+            }
+            Verdict::Fails => return false,
+            Verdict::Pivot(p) => {
+                if pivot == PIVOTS {
+                    return false;
+                }
+                pivoted[2 * pivot as usize] = p.source(data);
+                pivoted[2 * pivot as usize + 1] = p.target();
+                any_sliding |= apply_pivot(data, p, level);
+            }
+        }
+    }
+    false
+}
+
+/// The candidate's free rows (and slipping contacts' friction) back at the iterate's forces; the
+/// fixed rows keep the forces the pivots gave them.
+fn restart_from_iterate(data: &mut Data) {
+    let n = data.nefc;
+    let mut j = 0;
+    while j < n {
+        let len = data.efc_block_len(j);
+        let slipping = data.exact.slipping[j];
+        for q in j..j + len {
+            if data.exact.in_active[q] || (slipping && q > j) {
+                data.exact.lambda_prev[q] = data.exact.rhs[q];
+            }
+        }
+        j += len;
+    }
+}
+
+/// A hash (FNV-1a) of the polish's active set: its free rows and its slipping contacts; never 0.
+fn set_hash(data: &Data) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut mix = |x: usize| {
+        h ^= x as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    };
+    for &r in &data.exact.active {
+        mix(r);
+    }
+    mix(usize::MAX);
+    for i in 0..data.nefc {
+        if data.exact.slipping[i] {
+            mix(i);
+        }
+    }
+    h.max(1)
+}
+
+/// A row's place in the polish's active set is decided with this relative margin (of a box's
+/// width, or of a cone's radius).
+const TOL: f64 = 1e-9;
+
+/// Principal pivots one polish may take after its first solve.
+const PIVOTS: u32 = 8;
+
+/// Whether friction-loss row i slides (its force fixed at −f sign(q̇); acceleration level only).
+fn dof_sliding(data: &Data, i: usize, level: Level) -> bool {
+    level == Level::Acceleration && data.efc_vel[i].abs() > SLIP_VELOCITY && !data.efc_frozen_at_rest(i)
+}
+
+/// Whether contact i slips at the acceleration level (its friction fixed by its slip velocity).
+fn contact_moving(data: &Data, i: usize, len: usize, level: Level) -> bool {
+    level == Level::Acceleration
+        && (1..len).any(|k| data.efc_vel[i + k].abs() > SLIP_VELOCITY)
+        && !data.efc_frozen_at_rest(i)
+}
+
+/// Adds contact i's friction rows (those with μ > 0) to the active set: the contact sticks.
+fn push_sticking_friction(data: &mut Data, i: usize, len: usize) {
+    let friction = data.contacts[data.efc_id[i]].friction;
+    for k in 1..len {
+        if mu(&friction, k) > 0.0 {
+            insert_active(data, i + k);
+        }
+    }
+}
+
+/// Inserts row r into the (ascending) active set.
+fn insert_active(data: &mut Data, r: usize) {
+    let active = &mut data.exact.active;
+    if let Err(at) = active.binary_search(&r) {
+        active.insert(at, r);
+    }
+    data.exact.in_active[r] = true;
+}
+
+/// Removes row r from the active set.
+fn remove_active(data: &mut Data, r: usize) {
+    if let Ok(at) = data.exact.active.binary_search(&r) {
+        data.exact.active.remove(at);
+    }
+    data.exact.in_active[r] = false;
+}
+
+/// `exact.in_active` from `exact.active`.
+fn set_in_active(data: &mut Data) {
+    let n = data.nefc;
+    let ExactWork { active, in_active, .. } = &mut data.exact;
+    in_active[..n].fill(false);
+    for &r in active.iter() {
+        in_active[r] = true;
+    }
+}
+
+/// The candidate for the current active set (`exact.lambda_prev`, from its starting forces):
+/// slipping contacts substituted (LU, Newton) or, for larger systems, symmetric rounds with their
+/// friction fixed. The symmetric solve takes, for redundant free rows, the minimum-norm forces,
+/// or with `from_candidate` the candidate's forces changed by the minimum-norm correction. None
+/// when the rounds or Newton's method fail; else whether the symmetric system was redundant.
+fn solve_active_set(
+    data: &mut Data,
+    level: Level,
+    any_sliding: bool,
+    substitute: bool,
+    from_candidate: bool,
+) -> Option<bool> {
+    let n = data.nefc;
+    let k = data.exact.active.len();
     let mut last_change = f64::INFINITY;
+    let mut redundant = false;
     for round in 0..POLISH_ROUNDS {
         // Slipping contacts: their friction, direction times the cone's radius, substituted into
         // the normal's column (one non-symmetric solve); the symmetric solve with their friction
         // fixed at the candidate's when that system is inconsistent.
+        if any_sliding && substitute && !all_moving(data, level) {
+            // A contact whose slip direction is the solution's own: Newton from the iterate
+            // (a direction taken from a candidate's slip near the stick–slip boundary is noise).
+            return newton_slipping(data, level).then_some(false);
+        }
         if any_sliding && substitute {
             slip_directions(data, level);
             if solve_substituted(data, level) {
                 let change = update_sliding_friction(data, level);
                 let scale = 1.0 + (0..n).map(|j| data.exact.lambda_prev[j].abs()).fold(0.0, f64::max);
                 if change <= 1e-15 * scale {
-                    break;
+                    return Some(false);
                 }
                 // The slip directions moved with the solution (a contact starting to slip, or
                 // slipping after the step): Newton on the whole system, directions included
                 // (fixed-point rounds on them diverge near sticking, measured on go1).
-                if newton_slipping(data, level) {
-                    break;
-                }
-                return false;
+                return newton_slipping(data, level).then_some(false);
             }
         }
         let Data {
@@ -149,36 +286,46 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
                     lambda_prev: efc_lambda_prev,
                     factor: efc_factor,
                     eig: efc_eig,
+                    polish_work,
                     ..
                 },
             ..
         } = &mut *data;
+        // A_FF λ_F = b_F − A_F,X λ_X, the fixed forces λ_X the candidate's; minimum-norm for
+        // redundant rows (a box's corners share its load evenly). From the candidate: the
+        // correction δ_F of its free forces, A_FF δ_F = −w_F (w = A λ − b), minimum-norm.
         for (a, &r) in efc_active.iter().enumerate() {
+            let col = &efc_delassus.as_slice()[r * efc_delassus.nrows()..r * efc_delassus.nrows() + n];
             let mut rhs = efc_force[r];
             for j in 0..n {
-                if !in_active[j] {
-                    rhs -= efc_delassus[(j, r)] * efc_lambda_prev[j];
+                if from_candidate || !in_active[j] {
+                    rhs -= col[j] * efc_lambda_prev[j];
                 }
             }
             efc_sub_rhs[a] = rhs;
             for (c, &q) in efc_active.iter().enumerate() {
-                efc_sub[(a, c)] = efc_delassus[(q, r)];
+                efc_sub[(a, c)] = col[q];
             }
         }
-        solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..k], efc_factor, efc_eig);
+        *polish_work += (k * k * k) as f64 / 3.0;
+        redundant |= solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..k], efc_factor, efc_eig) < k;
         for (a, &r) in efc_active.iter().enumerate() {
-            efc_lambda_prev[r] = efc_sub_rhs[a];
+            if from_candidate {
+                efc_lambda_prev[r] += efc_sub_rhs[a];
+            } else {
+                efc_lambda_prev[r] = efc_sub_rhs[a];
+            }
         }
         if !any_sliding {
-            break;
+            return Some(redundant);
         }
         let change = update_sliding_friction(data, level);
         let scale = 1.0 + (0..n).map(|j| data.exact.lambda_prev[j].abs()).fold(0.0, f64::max);
         if change <= 1e-15 * scale {
-            break;
+            return Some(redundant);
         }
         if round == POLISH_ROUNDS - 1 {
-            return false;
+            return None;
         }
         // Rounds left at this round's rate of contraction: a fixed point the remaining rounds
         // cannot reach (or a round that did not contract) is abandoned now rather than at the
@@ -187,78 +334,235 @@ pub(crate) fn polish(model: &Model, data: &mut Data, level: Level) -> bool {
         if round > 0 {
             let needed = (1e-15 * scale / change).ln() / rate.ln();
             if rate >= 1.0 || needed.is_nan() || needed > f64::from(POLISH_ROUNDS - 1 - round) {
-                return false;
+                return None;
             }
         }
         last_change = change;
     }
-    // Verify every row's law with w = A λ − b.
+    None
+}
+
+/// Whether every slipping contact moves (acceleration level): their friction is then fixed by
+/// their velocity and one substituted solve is exact.
+fn all_moving(data: &Data, level: Level) -> bool {
+    let n = data.nefc;
+    let mut i = 0;
+    while i < n {
+        let len = data.efc_block_len(i);
+        if data.exact.slipping[i] && !contact_moving(data, i, len, level) {
+            return false;
+        }
+        i += len;
+    }
+    true
+}
+
+/// The outcome of checking a polish candidate against every row's law.
+enum Verdict {
+    /// Every law holds: the candidate is the solution.
+    Holds,
+    /// A law fails in a way no pivot mends (a contact moving against its own friction).
+    Fails,
+    /// The row breaking its law the most, and how it changes sides.
+    Pivot(Pivot),
+}
+
+/// One principal pivot of the polish's active set.
+#[derive(Clone, Copy, Debug)]
+enum Pivot {
+    /// A free friction-loss row left its box: held at that bound.
+    FixDof(usize, f64),
+    /// A friction-loss row held at a bound pushes into its box: free.
+    FreeDof(usize),
+    /// A free limit or contact normal pulls: it (and a contact's friction) leaves, with no force.
+    DropNormal(usize),
+    /// A limit or contact normal with no force is penetrating: it (and a sticking contact's
+    /// friction) joins.
+    AddNormal(usize),
+    /// A sticking contact's friction left its cone: it slips.
+    Slip(usize),
+    /// A slipping contact's friction does not oppose its slip: it sticks.
+    Stick(usize),
+}
+
+/// Checks the candidate (`exact.lambda_prev`) against every row's law with w = A λ − b; the
+/// violation kept is the largest, forces relative to the largest force, row motions w to the
+/// largest b, among the pivots that do not return a row to a side it had in this polish
+/// (`pivoted`: that would be a cycle; when only such pivots are left, the polish fails).
+fn verify(model: &Model, data: &Data, level: Level, pivoted: &[(usize, u8)]) -> Verdict {
+    let n = data.nefc;
     let scale = 1.0 + (0..n).map(|j| data.efc_force[j].abs()).fold(0.0, f64::max);
-    let w = |data: &Data, r: usize| -> f64 {
-        (0..n).map(|j| data.exact.delassus[(j, r)] * data.exact.lambda_prev[j]).sum::<f64>()
-            - data.efc_force[r]
+    let w = |r: usize| -> f64 {
+        column_dot(data, r, &data.exact.lambda_prev.as_slice()[..n]) - data.efc_force[r]
     };
     let force_scale = 1.0 + (0..n).map(|j| data.exact.lambda_prev[j].abs()).fold(0.0, f64::max);
+    let mut worst: Option<(f64, Pivot)> = None;
+    let mut blocked = false;
+    let mut note = |size: f64, p: Pivot| {
+        if pivoted.contains(&p.target()) {
+            blocked = true;
+        } else if worst.is_none_or(|(s, _)| size > s) {
+            worst = Some((size, p));
+        }
+    };
     let mut i = 0;
     while i < n {
         let len = data.efc_block_len(i);
         let l = data.exact.lambda_prev[i];
-        let ok = match data.efc_type[i] {
-            EfcType::Equality | EfcType::FrictionTendon => true,
+        match data.efc_type[i] {
+            EfcType::Equality | EfcType::FrictionTendon => {}
             EfcType::LimitJoint
             | EfcType::LimitTendon
             | EfcType::ContactFrictionless
             | EfcType::ContactElliptic
             | EfcType::ContactPyramidal => {
                 let free = data.exact.in_active[i];
-                let normal_ok = if data.exact.pressing[i] {
-                    true
+                if data.exact.pressing[i] {
+                    // Held closed: its force has no sign.
                 } else if free {
-                    l >= -1e-12 * force_scale
-                } else {
-                    separating(data, i, level) || w(data, i) >= -1e-12 * scale
-                };
-                normal_ok
-                    && (data.efc_type[i] != EfcType::ContactElliptic || !free || {
-                        let friction = data.contacts[data.efc_id[i]].friction;
-                        let (_, spent) = cone_of(data, i, len, level);
-                        let radius = match level {
-                            Level::Acceleration => l,
-                            Level::Velocity { dt } => l.max(0.0) + dt * data.exact.previous[i].max(0.0),
-                        };
-                        let y2: f64 = (1..len)
-                            .filter(|&k| mu(&friction, k) > 0.0)
-                            .map(|k| {
-                                ((data.exact.lambda_prev[i + k] + spent[k - 1]) / mu(&friction, k)).powi(2)
-                            })
-                            .sum();
-                        y2.sqrt() <= radius * (1.0 + 1e-12) + 1e-12 * force_scale
-                    })
-                    && (!data.exact.slipping[i] || slip_opposed(data, i, len, level, force_scale))
+                    if l < -1e-12 * force_scale {
+                        note(-l / force_scale, Pivot::DropNormal(i));
+                        i += len;
+                        continue;
+                    }
+                } else if !separating(data, i, level) {
+                    let wi = w(i);
+                    if wi < -1e-12 * scale {
+                        note(-wi / scale, Pivot::AddNormal(i));
+                    }
+                }
+                if data.efc_type[i] == EfcType::ContactElliptic && free {
+                    let friction = data.contacts[data.efc_id[i]].friction;
+                    let (_, spent) = cone_of(data, i, len, level);
+                    let radius = match level {
+                        Level::Acceleration => l,
+                        Level::Velocity { dt } => l.max(0.0) + dt * data.exact.previous[i].max(0.0),
+                    };
+                    let y2: f64 = (1..len)
+                        .filter(|&k| mu(&friction, k) > 0.0)
+                        .map(|k| ((data.exact.lambda_prev[i + k] + spent[k - 1]) / mu(&friction, k)).powi(2))
+                        .sum();
+                    let excess = y2.sqrt() - radius * (1.0 + 1e-12) - 1e-12 * force_scale;
+                    if data.exact.slipping[i] {
+                        if !slip_opposed(data, i, len, level, force_scale) {
+                            if contact_moving(data, i, len, level) {
+                                return Verdict::Fails;
+                            }
+                            note(0.0, Pivot::Stick(i));
+                        }
+                    } else if excess > 0.0 {
+                        note(excess / force_scale, Pivot::Slip(i));
+                    }
+                }
             }
             EfcType::FrictionDof => {
                 let (lo, hi) = friction_dof_bounds(model, data, i, level);
                 let slack = 1e-12 * force_scale;
                 if data.exact.in_active[i] {
-                    l >= lo - slack && l <= hi + slack
-                } else {
-                    let wi = w(data, i);
+                    if l > hi + slack {
+                        note((l - hi) / force_scale, Pivot::FixDof(i, hi));
+                    } else if l < lo - slack {
+                        note((lo - l) / force_scale, Pivot::FixDof(i, lo));
+                    }
+                } else if !dof_sliding(data, i, level) {
                     // At the upper bound the dof must be accelerating the other way, and back.
-                    (l >= hi - slack && wi <= 1e-12 * scale) || (l <= lo + slack && wi >= -1e-12 * scale) || {
-                        level == Level::Acceleration && data.efc_vel[i].abs() > SLIP_VELOCITY
+                    let wi = w(i);
+                    let at_hi = l >= hi - slack;
+                    let at_lo = l <= lo + slack;
+                    if !((at_hi && wi <= 1e-12 * scale) || (at_lo && wi >= -1e-12 * scale)) {
+                        note(wi.abs() / scale, Pivot::FreeDof(i));
                     }
                 }
             }
-        };
-        if !ok {
-            return false;
         }
         i += len;
     }
-    for j in 0..n {
-        data.exact.rhs[j] = data.exact.lambda_prev[j];
+    match worst {
+        None if blocked => Verdict::Fails,
+        None => Verdict::Holds,
+        Some((_, p)) => Verdict::Pivot(p),
     }
-    true
+}
+
+impl Pivot {
+    /// The row (a contact's normal row) that changes sides and the side it leaves: a friction
+    /// loss at a bound or free, a normal with or without force, a contact sticking or slipping.
+    fn source(self, data: &Data) -> (usize, u8) {
+        match self {
+            Pivot::FixDof(i, _) => (i, SIDE_FREE),
+            Pivot::FreeDof(i) => (i, if data.exact.lambda_prev[i] > 0.0 { SIDE_HIGH } else { SIDE_LOW }),
+            Pivot::DropNormal(i) => (i, SIDE_ON),
+            Pivot::AddNormal(i) => (i, SIDE_OFF),
+            Pivot::Slip(i) => (i, SIDE_STICK),
+            Pivot::Stick(i) => (i, SIDE_SLIP),
+        }
+    }
+
+    /// The row that changes sides and the side it takes.
+    fn target(self) -> (usize, u8) {
+        match self {
+            Pivot::FixDof(i, bound) => (i, if bound > 0.0 { SIDE_HIGH } else { SIDE_LOW }),
+            Pivot::FreeDof(i) => (i, SIDE_FREE),
+            Pivot::DropNormal(i) => (i, SIDE_OFF),
+            Pivot::AddNormal(i) => (i, SIDE_ON),
+            Pivot::Slip(i) => (i, SIDE_SLIP),
+            Pivot::Stick(i) => (i, SIDE_STICK),
+        }
+    }
+}
+
+/// The sides of a row in the polish's active set ([`Pivot::source`]).
+const SIDE_LOW: u8 = 0;
+const SIDE_HIGH: u8 = 1;
+const SIDE_FREE: u8 = 2;
+const SIDE_OFF: u8 = 3;
+const SIDE_ON: u8 = 4;
+const SIDE_STICK: u8 = 5;
+const SIDE_SLIP: u8 = 6;
+
+/// Applies pivot `p` to the active set and the candidate's fixed forces; returns whether a
+/// contact now slips.
+fn apply_pivot(data: &mut Data, p: Pivot, level: Level) -> bool {
+    match p {
+        Pivot::FixDof(i, bound) => {
+            remove_active(data, i);
+            data.exact.lambda_prev[i] = bound;
+        }
+        Pivot::FreeDof(i) => insert_active(data, i),
+        Pivot::DropNormal(i) => {
+            let len = data.efc_block_len(i);
+            for r in i..i + len {
+                remove_active(data, r);
+                data.exact.lambda_prev[r] = 0.0;
+            }
+            data.exact.slipping[i] = false;
+        }
+        Pivot::AddNormal(i) => {
+            insert_active(data, i);
+            if data.efc_type[i] == EfcType::ContactElliptic {
+                let len = data.efc_block_len(i);
+                if contact_moving(data, i, len, level) {
+                    data.exact.slipping[i] = true;
+                    return true;
+                }
+                push_sticking_friction(data, i, len);
+            }
+        }
+        Pivot::Slip(i) => {
+            let len = data.efc_block_len(i);
+            for r in i + 1..i + len {
+                remove_active(data, r);
+            }
+            data.exact.slipping[i] = true;
+            return true;
+        }
+        Pivot::Stick(i) => {
+            let len = data.efc_block_len(i);
+            data.exact.slipping[i] = false;
+            push_sticking_friction(data, i, len);
+        }
+    }
+    false
 }
 
 /// Sets each slipping contact's friction rows in the candidate (`efc_lambda_prev`) to the
@@ -301,8 +605,7 @@ fn slip_of(data: &Data, i: usize, len: usize, level: Level, slip: &mut [f64; MAX
         slip[k - 1] = if moving {
             data.efc_vel[i + k]
         } else {
-            (0..n).map(|j| data.exact.delassus[(j, i + k)] * data.exact.lambda_prev[j]).sum::<f64>()
-                - data.efc_force[i + k]
+            column_dot(data, i + k, &data.exact.lambda_prev.as_slice()[..n]) - data.efc_force[i + k]
         };
     }
 }
@@ -349,7 +652,7 @@ fn slip_directions(data: &mut Data, level: Level) {
 /// substituted (d from [`slip_directions`]; c the normal impulse the step already spent and s
 /// its friction, velocity level; both 0 at the acceleration level): the rows of `exact.active`
 /// solved by LU, the candidate's free rows and slipping friction rows set. False (the candidate
-/// untouched) when the system is singular.
+/// untouched) when the system is inconsistent.
 fn solve_substituted(data: &mut Data, level: Level) -> bool {
     let n = data.nefc;
     let k = data.exact.active.len();
@@ -408,7 +711,8 @@ fn solve_substituted(data: &mut Data, level: Level) -> bool {
         }
         sub_rhs[a] = rhs;
     }
-    if !lu_solve(sub, &mut sub_rhs.as_mut_slice()[..k], &mut pivots[..2 * k]) {
+    exact.polish_work += (2 * k * k * k) as f64 / 3.0;
+    if !lu_solve(sub, &mut sub_rhs.as_mut_slice()[..k], &mut pivots[..2 * k], 0.0) {
         return false;
     }
     for (a, &r) in active.iter().enumerate() {
@@ -451,20 +755,22 @@ const SUBSTITUTE_MAX: usize = 64;
 /// Newton iterations of [`newton_slipping`] before it gives up.
 const NEWTON_ITERATIONS: u32 = 12;
 
+/// Step halvings of one Newton iteration's backtracking before [`newton_slipping`] gives up.
+const HALVINGS: u32 = 6;
+
+/// [`newton_slipping`]'s residual at convergence: each equation's, relative to 1 + the largest b
+/// (rows held at w = 0) or 1 + the largest force (slipping friction).
+const NEWTON_TOLERANCE: f64 = 1e-14;
+
 /// The polish's system with its slipping contacts solved by Newton's method (the semismooth
-/// Newton of the active set, e.g. Acary & Brogliato §13.4, on the maximal-dissipation law): the
-/// unknowns are the active rows' forces, with w_r = (A λ − b)_r = 0, and the slipping contacts'
-/// friction, with λ_f + s = R(λ_n) φ(u), φ_k(u) = −μ_k² u_k / ‖μ ∘ u‖, u the slip (the rows' w,
-/// or their velocity for a contact moving at the acceleration level), R = λ_n + c and s the
-/// normal and friction impulses the step already spent (velocity level; 0 at the acceleration
-/// level). Each iteration solves the Jacobian system by LU; the other rows keep the candidate's
-/// forces (`exact.lambda_prev`, updated). True when the residual reaches round-off.
+/// Newton of the active set, e.g. Acary & Brogliato §13.4, on the maximal-dissipation law),
+/// started from the candidate (`exact.lambda_prev`, updated; the other rows keep its forces):
+/// the unknowns are the active rows' forces, with w_r = (A λ − b)_r = 0, and the slipping
+/// contacts' friction ([`newton_assemble`] gives each law). Each iteration solves the Jacobian
+/// system by LU and backtracks until the largest residual falls; true when it reaches
+/// [`NEWTON_TOLERANCE`].
 fn newton_slipping(data: &mut Data, level: Level) -> bool {
     let n = data.nefc;
-    let dt = match level {
-        Level::Acceleration => 0.0,
-        Level::Velocity { dt } => dt,
-    };
     // The unknowns.
     {
         let ExactWork { active, newton_rows, newton_normal, .. } = &mut data.exact;
@@ -493,87 +799,45 @@ fn newton_slipping(data: &mut Data, level: Level) -> bool {
         data.exact.newton_pos[r] = c;
     }
     let b_scale = 1.0 + (0..n).map(|j| data.efc_force[j].abs()).fold(0.0, f64::max);
-    let mut last_worst = f64::INFINITY;
+    let Some(mut worst) = newton_assemble(data, level, m, b_scale) else {
+        return false;
+    };
     for _ in 0..NEWTON_ITERATIONS {
-        let l_scale = 1.0 + (0..n).map(|j| data.exact.lambda_prev[j].abs()).fold(0.0, f64::max);
-        let mut worst = 0.0f64;
-        for a in 0..m {
-            let r = data.exact.newton_rows[a];
-            let s = data.exact.newton_normal[a];
-            if s == usize::MAX {
-                // An active row: w_r = 0.
-                let w = column_dot(data, r, &data.exact.lambda_prev.as_slice()[..n]) - data.efc_force[r];
-                for c in 0..m {
-                    let q = data.exact.newton_rows[c];
-                    data.exact.sub[(a, c)] = data.exact.delassus[(q, r)];
-                }
-                data.exact.sub_rhs[a] = -w;
-                worst = worst.max(w.abs() / b_scale);
-                continue;
-            }
-            // A friction row k of slipping contact s.
-            let len = data.efc_block_len(s);
-            let k = r - s;
-            let friction = data.contacts[data.efc_id[s]].friction;
-            let moving = level == Level::Acceleration
-                && (1..len).any(|q| data.efc_vel[s + q].abs() > SLIP_VELOCITY)
-                && !data.efc_frozen_at_rest(s);
-            let mut u = [0.0; MAX_DIM];
-            slip_of(data, s, len, level, &mut u);
-            let norm = (1..len).map(|q| (mu(&friction, q) * u[q - 1]).powi(2)).sum::<f64>().sqrt();
-            if !(norm > 0.0 && norm.is_finite()) {
-                return false;
-            }
-            let mk2 = mu(&friction, k).powi(2);
-            let phi = -mk2 * u[k - 1] / norm;
-            let c0 = dt * data.exact.previous[s].max(0.0);
-            let spent = dt * data.exact.previous[r];
-            let radius = data.exact.lambda_prev[s] + c0;
-            let f = data.exact.lambda_prev[r] + spent - radius * phi;
-            worst = worst.max(f.abs() / l_scale);
-            data.exact.sub_rhs[a] = -f;
-            for c in 0..m {
-                data.exact.sub[(a, c)] = 0.0;
-            }
-            data.exact.sub[(a, a)] = 1.0;
-            let cs = data.exact.newton_pos[s];
-            data.exact.sub[(a, cs)] -= phi;
-            if !moving {
-                // −R Σ_l ∂φ_k/∂u_l ∂u_l/∂λ, ∂u_l/∂λ_j = A_(s+l) j.
-                for l in 1..len {
-                    let ml2 = mu(&friction, l).powi(2);
-                    let dphi = -mk2
-                        * ((if l == k { 1.0 } else { 0.0 }) / norm
-                            - u[k - 1] * ml2 * u[l - 1] / norm.powi(3));
-                    if dphi == 0.0 {
-                        continue;
-                    }
-                    for c in 0..m {
-                        let q = data.exact.newton_rows[c];
-                        let v = data.exact.delassus[(q, s + l)];
-                        data.exact.sub[(a, c)] -= radius * dphi * v;
-                    }
-                }
-            }
-        }
-        if worst <= 1e-14 {
+        if worst <= NEWTON_TOLERANCE {
             return true;
         }
-        // Near a solution Newton's residual falls fast; one that does not is in the wrong
-        // active set (the Gauss–Seidel iteration goes on).
-        if worst > 0.9 * last_worst {
-            return false;
+        {
+            let ExactWork { sub, sub_rhs, pivots, eig, polish_work, .. } = &mut data.exact;
+            *polish_work += (2 * m * m * m) as f64 / 3.0;
+            if !lu_solve(sub, &mut sub_rhs.as_mut_slice()[..m], &mut pivots[..2 * m], NEWTON_TOLERANCE) {
+                return false;
+            }
+            eig.as_mut_slice()[..m].copy_from_slice(&sub_rhs.as_slice()[..m]);
         }
-        last_worst = worst;
-        let ExactWork { sub, sub_rhs, pivots, newton_rows, lambda_prev, .. } = &mut data.exact;
-        if !lu_solve(sub, &mut sub_rhs.as_mut_slice()[..m], &mut pivots[..2 * m]) {
-            return false;
+        // Backtracking on the largest residual (Armijo): far from the solution a full step can
+        // overshoot the law's curvature.
+        let (mut alpha, mut applied) = (1.0, 0.0);
+        let mut accepted = false;
+        for _ in 0..=HALVINGS {
+            let ExactWork { newton_rows, lambda_prev, eig, .. } = &mut data.exact;
+            for c in 0..m {
+                lambda_prev[newton_rows[c]] += (alpha - applied) * eig[c];
+            }
+            applied = alpha;
+            match newton_assemble(data, level, m, b_scale) {
+                Some(w) if w <= (1.0 - 1e-4 * alpha) * worst => {
+                    worst = w;
+                    accepted = true;
+                    break;
+                }
+                _ => alpha *= 0.5,
+            }
         }
-        for c in 0..m {
-            lambda_prev[newton_rows[c]] += sub_rhs[c];
+        if !accepted {
+            return false;
         }
     }
-    false
+    worst <= NEWTON_TOLERANCE
 }
 
 /// Friction-loss rows the polish keeps at a bound (not in `exact.active`, not sliding) exactly at
@@ -624,4 +888,132 @@ pub(super) fn cone_of(data: &Data, i: usize, len: usize, level: Level) -> (f64, 
         }
     };
     (radius, spent)
+}
+
+/// The Newton system of [`newton_slipping`] at the candidate: the Jacobian into `exact.sub`
+/// (m × m), minus the residual into `exact.sub_rhs`; returns the largest scaled residual, or None
+/// when a slip direction is undefined. A slipping contact's friction law, with R = λ_n + c and s
+/// the normal and friction impulses the step already spent (velocity level; 0 at the
+/// acceleration level): for a contact moving at the acceleration level, λ_f + s = R φ(u) with
+/// φ_k(u) = −μ_k² u_k / ‖μ ∘ u‖ of its slip velocity u (fixed); otherwise, in the scaled friction
+/// y = (λ_f + s)/μ and slip ũ = μ ∘ u (u the rows' w), y = R z/‖z‖ with z = y − ρ ũ — the
+/// projection form of maximal dissipation, which stays regular where the slip vanishes.
+fn newton_assemble(data: &mut Data, level: Level, m: usize, b_scale: f64) -> Option<f64> {
+    let n = data.nefc;
+    let dt = match level {
+        Level::Acceleration => 0.0,
+        Level::Velocity { dt } => dt,
+    };
+    let l_scale = 1.0 + (0..n).map(|j| data.exact.lambda_prev[j].abs()).fold(0.0, f64::max);
+    let mut worst = 0.0f64;
+    // The slip of the contact whose friction rows are being assembled (consecutive unknowns).
+    let mut slip: (usize, [f64; MAX_DIM]) = (usize::MAX, [0.0; MAX_DIM]);
+    for a in 0..m {
+        let r = data.exact.newton_rows[a];
+        let s = data.exact.newton_normal[a];
+        if s == usize::MAX {
+            // An active row: w_r = 0.
+            let w = column_dot(data, r, &data.exact.lambda_prev.as_slice()[..n]) - data.efc_force[r];
+            for c in 0..m {
+                let q = data.exact.newton_rows[c];
+                data.exact.sub[(a, c)] = data.exact.delassus[(q, r)];
+            }
+            data.exact.sub_rhs[a] = -w;
+            worst = worst.max(w.abs() / b_scale);
+            continue;
+        }
+        // A friction row k of slipping contact s.
+        let len = data.efc_block_len(s);
+        let k = r - s;
+        let friction = data.contacts[data.efc_id[s]].friction;
+        let mk = mu(&friction, k);
+        let c0 = dt * data.exact.previous[s].max(0.0);
+        let spent = dt * data.exact.previous[r];
+        let radius = data.exact.lambda_prev[s] + c0;
+        for c in 0..m {
+            data.exact.sub[(a, c)] = 0.0;
+        }
+        data.exact.sub[(a, a)] = 1.0;
+        let cs = data.exact.newton_pos[s];
+        if mk == 0.0 {
+            // No friction along this row: its whole impulse stays 0.
+            let f = data.exact.lambda_prev[r] + spent;
+            worst = worst.max(f.abs() / l_scale);
+            data.exact.sub_rhs[a] = -f;
+            continue;
+        }
+        if slip.0 != s {
+            slip_of(data, s, len, level, &mut slip.1);
+            slip.0 = s;
+        }
+        let u = slip.1;
+        if contact_moving(data, s, len, level) {
+            // The direction is the slip velocity's: λ_k = R φ_k(u), φ_k = −μ_k² u_k / ‖μ ∘ u‖.
+            let norm = (1..len).map(|q| (mu(&friction, q) * u[q - 1]).powi(2)).sum::<f64>().sqrt();
+            if !(norm > 0.0 && norm.is_finite()) {
+                return None;
+            }
+            let phi = -mk * mk * u[k - 1] / norm;
+            let f = data.exact.lambda_prev[r] + spent - radius * phi;
+            worst = worst.max(f.abs() / l_scale);
+            data.exact.sub_rhs[a] = -f;
+            data.exact.sub[(a, cs)] -= phi;
+            continue;
+        }
+        // The direction is the solution's own: in the scaled friction y_q = (λ_q + s_q)/μ_q
+        // and slip ũ_q = μ_q u_q, y = R z/‖z‖ with z = y − ρ ũ (ρ > 0: the projection of
+        // y − ρ ũ onto the cone's boundary). It holds exactly when ‖y‖ = R and ũ = −t y, t ≥ 0
+        // (maximal dissipation, t checked by the verification), and stays regular as the slip
+        // vanishes, where −μ² u/‖μ ∘ u‖ has no direction (a contact at the stick–slip
+        // boundary). ρ = 1 / the mean diagonal of the scaled block.
+        let mut z = [0.0; MAX_DIM];
+        let (mut diag, mut count) = (0.0, 0.0);
+        for q in 1..len {
+            let mq = mu(&friction, q);
+            if mq > 0.0 {
+                diag += mq * mq * data.exact.delassus[(s + q, s + q)];
+                count += 1.0;
+            }
+        }
+        let rho = if diag > 0.0 { count / diag } else { 0.0 };
+        for q in 1..len {
+            let mq = mu(&friction, q);
+            if mq > 0.0 {
+                let y = (data.exact.lambda_prev[s + q] + dt * data.exact.previous[s + q]) / mq;
+                z[q - 1] = y - rho * mq * u[q - 1];
+            }
+        }
+        let norm = z.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !(norm > 0.0 && norm.is_finite()) {
+            return None;
+        }
+        let ek = z[k - 1] / norm;
+        let f = data.exact.lambda_prev[r] + spent - radius * mk * ek;
+        worst = worst.max(f.abs() / l_scale);
+        data.exact.sub_rhs[a] = -f;
+        data.exact.sub[(a, cs)] -= mk * ek;
+        // −R μ_k Σ_l ∂e_k/∂z_l ∂z_l/∂λ, ∂e_k/∂z_l = (δ_kl − e_k e_l)/‖z‖,
+        // ∂z_l/∂λ_j = [j = s + l]/μ_l − ρ μ_l A_(s+l) j.
+        for l in 1..len {
+            let ml = mu(&friction, l);
+            if ml == 0.0 {
+                continue;
+            }
+            let el = z[l - 1] / norm;
+            let coef = -radius * mk * ((if l == k { 1.0 } else { 0.0 }) - ek * el) / norm;
+            if coef == 0.0 {
+                continue;
+            }
+            let pl = data.exact.newton_pos[s + l];
+            if pl != usize::MAX {
+                data.exact.sub[(a, pl)] += coef / ml;
+            }
+            for c in 0..m {
+                let q = data.exact.newton_rows[c];
+                let v = data.exact.delassus[(q, s + l)];
+                data.exact.sub[(a, c)] -= coef * rho * ml * v;
+            }
+        }
+    }
+    Some(worst)
 }

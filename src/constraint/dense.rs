@@ -43,8 +43,10 @@ pub(crate) fn solve_psd(
 /// return; `piv` (at least 2n) is scratch. A rank-deficient system (redundant rows) gets a basic
 /// solution: the unknowns beyond the numerical rank (pivots at most `RANK_TOLERANCE` times the
 /// largest entry) are zero. False, with `b` unspecified, when the system is inconsistent (its
-/// eliminated right-hand side beyond the rank is not round-off) or not finite.
-pub(crate) fn lu_solve(a: &mut DMatrix<f64>, b: &mut [f64], piv: &mut [usize]) -> bool {
+/// eliminated right-hand side beyond the rank is above 1e-9 of b's largest entry plus `floor`,
+/// the size of the round-off b itself carries: a Newton residual near convergence is that
+/// round-off) or not finite.
+pub(crate) fn lu_solve(a: &mut DMatrix<f64>, b: &mut [f64], piv: &mut [usize], floor: f64) -> bool {
     let n = b.len();
     let stride = a.nrows();
     let m = a.as_mut_slice();
@@ -107,7 +109,7 @@ pub(crate) fn lu_solve(a: &mut DMatrix<f64>, b: &mut [f64], piv: &mut [usize]) -
         }
     }
     // Consistency of the equations beyond the rank.
-    if b[rank..].iter().any(|x| x.abs() > 1e-9 * b_scale) {
+    if b[rank..].iter().any(|x| x.abs() > 1e-9 * b_scale + floor) {
         return false;
     }
     b[rank..].fill(0.0);

@@ -67,6 +67,12 @@ pub(crate) struct ExactWork {
     /// Per row, during a velocity-level Coulomb solve: its force in the last acceleration-level
     /// solve (`Data::efc_previous_force`, looked up once per solve rather than per sweep).
     pub previous: DVector<f64>,
+    /// The active set (a hash of its free rows and slipping contacts) of the last polish tried in
+    /// the current Coulomb solve: a retry on the same set is skipped.
+    pub polish_set: u64,
+    /// The multiply-adds of the current Coulomb solve's polishes so far (their factorizations):
+    /// a retry is allowed while they stay below the sweeps'.
+    pub polish_work: f64,
     /// The Gauss–Seidel sweep's motion change M⁻¹Jᵀ Δλ (entries 0..nv) and correction M⁻¹Jᵀ λ
     /// (nv..2nv).
     pub motion: DVector<f64>,
@@ -101,6 +107,8 @@ impl ExactWork {
             jt: DMatrix::zeros(nv, nefc),
             spans: vec![(0, 0); nefc],
             previous: DVector::zeros(nefc),
+            polish_set: 0,
+            polish_work: 0.0,
             motion: DVector::zeros(2 * nv),
         }
     }
