@@ -60,7 +60,7 @@ PERTURB = 1e-12
 SENSITIVE = 1e-8
 BENCH_STEPS = 200
 # Timing rounds per scene, MuJoCo and lagrange alternating (`bench`).
-BENCH_ROUNDS = 3
+BENCH_ROUNDS = 5
 SECTION = "## Contact scenes"
 BENCH_SECTION = "## Contact scenes: step and collision time beside MuJoCo"
 
