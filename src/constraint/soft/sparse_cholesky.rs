@@ -686,12 +686,10 @@ mod tests {
         assert_eq!(x4, x2);
     }
 
-    #[test]
-    fn a_kept_factor_solves_its_rows_as_the_whole_factor() {
-        // Two uncoupled trees 0 → 1 → 2 and 3 → 4, a row coupling 1 and 2 only: keeping the
-        // first tree's rows gives the whole factor's solution there and leaves the rest of b.
-        let n = 5;
-        let dof_parent = [NONE, 0, 1, NONE, 3];
+    /// A positive definite matrix with M's pattern for the tree `dof_parent`: 3 + k on the
+    /// diagonal, 0.4 between each dof and its ancestors.
+    fn tree_matrix(dof_parent: &[usize]) -> DMatrix<f64> {
+        let n = dof_parent.len();
         let mut h = DMatrix::zeros(n, n);
         for k in 0..n {
             h[(k, k)] = 3.0 + k as f64;
@@ -702,6 +700,16 @@ mod tests {
                 l = dof_parent[l];
             }
         }
+        h
+    }
+
+    #[test]
+    fn a_kept_factor_solves_its_rows_as_the_whole_factor() {
+        // Two uncoupled trees 0 → 1 → 2 and 3 → 4, a row coupling 1 and 2 only: keeping the
+        // first tree's rows gives the whole factor's solution there and leaves the rest of b.
+        let n = 5;
+        let dof_parent = [NONE, 0, 1, NONE, 3];
+        let h = tree_matrix(&dof_parent);
         let (nz_start, nz_index) = ([0, 2], [1, 2]);
         let mut f = SparseCholesky::default();
         f.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
@@ -725,16 +733,7 @@ mod tests {
         // H + w wᵀ factored afresh against the update, then the downdate back to H's factor.
         let n = 5;
         let dof_parent = [NONE, 0, 1, NONE, 3];
-        let mut h = DMatrix::zeros(n, n);
-        for k in 0..n {
-            h[(k, k)] = 3.0 + k as f64;
-            let mut l = dof_parent[k];
-            while l != NONE {
-                h[(k, l)] = 0.4;
-                h[(l, k)] = 0.4;
-                l = dof_parent[l];
-            }
-        }
+        let h = tree_matrix(&dof_parent);
         let (nz_start, nz_index) = ([0, 3], [1, 2, 4]);
         let (cols, vals, scale) = ([1, 2, 4], [0.5, -1.5, 2.0], 1.7);
         let mut f = SparseCholesky::default();
@@ -783,16 +782,7 @@ mod tests {
         // first factor, zeroed) solves its part as a factor of its own pattern does.
         let n = 5;
         let dof_parent = [NONE, 0, 1, NONE, 3];
-        let mut h = DMatrix::zeros(n, n);
-        for k in 0..n {
-            h[(k, k)] = 3.0 + k as f64;
-            let mut l = dof_parent[k];
-            while l != NONE {
-                h[(k, l)] = 0.4;
-                h[(l, k)] = 0.4;
-                l = dof_parent[l];
-            }
-        }
+        let h = tree_matrix(&dof_parent);
         let mut coupled = h.clone();
         coupled[(4, 2)] = 0.9;
         coupled[(2, 4)] = 0.9;
