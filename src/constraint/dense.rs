@@ -397,16 +397,20 @@ mod tests {
         assert!((b[0] - 1.0).abs() < 1e-14 && (b[1] - 1.0).abs() < 1e-14, "{b:?}");
     }
 
+    /// A deterministic stream of numbers in [−½, ½) (a 64-bit linear congruential generator).
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        }
+    }
+
     /// Rank-one updates and downdates of a factor against factoring A ± x xᵀ afresh, with a
     /// sparse x (leading zeros, as a constraint row's Jacobian on a chain of dofs), and the
     /// downdate that removes a direction A needs refused.
     #[test]
     fn rank_one_update_and_downdate_match_a_fresh_factor() {
-        let mut seed = 11u64;
-        let mut rand = move || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rand = uniform(11);
         for n in [1, 4, 9, 27] {
             let b = DMatrix::from_fn(n, n, |_, _| rand());
             let a = &b * b.transpose() + DMatrix::identity(n, n);
@@ -447,11 +451,7 @@ mod tests {
     /// range(A), checked against the projection onto range(B) by normal equations in f64.
     #[test]
     fn minimum_norm_solution_of_rank_deficient_systems() {
-        let mut seed = 7u64;
-        let mut rand = move || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rand = uniform(7);
         for (n, r) in [(2, 1), (5, 3), (12, 6), (30, 17), (40, 39)] {
             let bm = DMatrix::from_fn(n, r, |_, _| rand());
             let z = DVector::from_fn(n, |_, _| rand());
