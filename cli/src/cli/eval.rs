@@ -479,8 +479,10 @@ pub fn run(
     if let Some(file) = dump_problem {
         let text = serde_json::to_string(&json!({ "problems": problems }))
             .map_err(|e| CliError::Usage(format!("--dump-contact-problem: {e}")))?;
-        std::fs::write(file, text)
-            .map_err(|source| CliError::Io { file: file.display().to_string(), source })?;
+        // Under a temporary name, renamed onto the target once complete (never a destroyed file).
+        let mut dump = super::output_file::OutputFile::create(file)?;
+        dump.write_all(text.as_bytes())?;
+        dump.commit()?;
     }
     if failed > 0 {
         return Err(CliError::StatesFailed {
