@@ -18,7 +18,7 @@
 
 use super::cost::Rows;
 use super::hessian::Assembler;
-use super::primal::{line_search_with, Settings, Sparsity};
+use super::primal::{line_search_with, mul_m_on, term_change, Settings, Sparsity, TermChange};
 use super::work::SoftWork;
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{EfcState, Model, NO_DOF};
@@ -391,15 +391,15 @@ pub(super) fn newton(
             isl.active_dofs.extend_from_slice(&isl.dofs[d0..d1]);
             if isl.factored[i] {
                 for &r in &isl.rows[isl.row_start[i]..isl.row_start[i + 1]] {
-                    let (was, is) = (isl.factor_state[r], state[r]);
-                    if was == EfcState::Cone || is == EfcState::Cone {
+                    let change = term_change(isl.factor_state[r], state[r]);
+                    if change == TermChange::Block {
                         isl.factored[i] = false;
                         break;
                     }
-                    if (was == EfcState::Quadratic) != (is == EfcState::Quadratic) {
-                        isl.factor_state[r] = is;
+                    if change != TermChange::Same {
+                        isl.factor_state[r] = state[r];
                         let (cols, vals) = nz.row_values(r);
-                        if !soft.factor.rank_one(cols, vals, rows.d[r].sqrt(), is == EfcState::Quadratic) {
+                        if !soft.factor.rank_one(cols, vals, rows.d[r].sqrt(), change == TermChange::Enters) {
                             isl.factored[i] = false;
                             break;
                         }
@@ -482,7 +482,7 @@ pub(super) fn newton(
                 jv[r] = cols.iter().zip(vals).map(|(&k, &j_rk)| j_rk * dir[k]).sum();
             }
         }
-        mul_m_on(&model.dof_parent, p.m, &isl.active_dofs, dir, mdir);
+        mul_m_on(&model.dof_parent, p.m, isl.active_dofs.iter().copied(), dir, mdir);
         // One exact line search per iterating island, over its dofs and rows.
         for i in 0..n {
             isl.alpha[i] = 0.0;
@@ -534,24 +534,6 @@ pub(super) fn newton(
     };
     isl.cost = cost;
     outcome
-}
-
-/// r ← M x on the dofs `dofs` (whole trees, each tree's dofs ascending):
-/// [`mul_m`](super::primal::mul_m)'s
-/// arithmetic on those dofs only (M couples a dof only to its tree).
-fn mul_m_on(dof_parent: &[usize], m: &DMatrix<f64>, dofs: &[usize], x: &[f64], r: &mut [f64]) {
-    for &k in dofs {
-        r[k] = m[(k, k)] * x[k];
-    }
-    for &k in dofs {
-        let mut l = dof_parent[k];
-        while l != NO_DOF {
-            let m_lk = m[(l, k)];
-            r[l] += m_lk * x[k];
-            r[k] += m_lk * x[l];
-            l = dof_parent[l];
-        }
-    }
 }
 
 #[cfg(test)]

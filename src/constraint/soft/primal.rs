@@ -87,10 +87,23 @@ pub(super) fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r:
         m.mul_to(x, r);
         return;
     }
-    for k in 0..nv {
+    mul_m_on(dof_parent, m, 0..nv, x.as_slice(), r.as_mut_slice());
+}
+
+/// r ← M x on the dofs `dofs` (whole trees, each tree's dofs ascending; M couples a dof only to
+/// its tree), reading M's nonzeros only: the diagonal and each dof's ancestor chain. The other
+/// entries of r are left as they are.
+pub(super) fn mul_m_on(
+    dof_parent: &[usize],
+    m: &DMatrix<f64>,
+    dofs: impl IntoIterator<Item = usize> + Clone,
+    x: &[f64],
+    r: &mut [f64],
+) {
+    for k in dofs.clone() {
         r[k] = m[(k, k)] * x[k];
     }
-    for k in 0..nv {
+    for k in dofs {
         let mut l = dof_parent[k];
         while l != crate::model::NO_DOF {
             let m_lk = m[(l, k)];
@@ -390,18 +403,19 @@ fn update_factor(
     let nv = x.len();
     let mut changed = 0;
     for (s, f) in state.iter().zip(factored.iter()) {
-        if *s == EfcState::Cone || *f == EfcState::Cone {
-            return false;
+        match term_change(*f, *s) {
+            TermChange::Block => return false,
+            TermChange::Same => {}
+            TermChange::Enters | TermChange::Leaves => changed += 1,
         }
-        changed += usize::from((*s == EfcState::Quadratic) != (*f == EfcState::Quadratic));
     }
     if changed > nv {
         return false;
     }
     for (i, (s, f)) in state.iter().zip(factored.iter_mut()).enumerate() {
-        let (now, before) = (*s == EfcState::Quadratic, *f == EfcState::Quadratic);
+        let change = term_change(*f, *s);
         *f = *s;
-        if now == before {
+        if change == TermChange::Same {
             continue;
         }
         x.fill(0.0);
@@ -410,11 +424,37 @@ fn update_factor(
         for (&k, &j_ik) in cols.iter().zip(vals) {
             x[k] = w * j_ik;
         }
-        if !cholesky_rank_one(l, nv, x, if now { 1.0 } else { -1.0 }) {
+        if !cholesky_rank_one(l, nv, x, if change == TermChange::Enters { 1.0 } else { -1.0 }) {
             return false;
         }
     }
     true
+}
+
+/// How a row's term of the Newton Hessian changed from one state to the next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum TermChange {
+    /// The same term (both quadratic, or neither with a term).
+    Same,
+    /// The row entered its quadratic state: + D_i J_iᵀ J_i, a rank-one update.
+    Enters,
+    /// The row left it: a rank-one downdate.
+    Leaves,
+    /// On an elliptic cone's surface in either state: a dense block, not a rank-one term.
+    Block,
+}
+
+/// The change of a row's Hessian term from state `was` to `is` (see [`TermChange`]): what the
+/// dense and the islands' factor updates both go by.
+pub(super) fn term_change(was: EfcState, is: EfcState) -> TermChange {
+    if was == EfcState::Cone || is == EfcState::Cone {
+        return TermChange::Block;
+    }
+    match (was == EfcState::Quadratic, is == EfcState::Quadratic) {
+        (false, true) => TermChange::Enters,
+        (true, false) => TermChange::Leaves,
+        _ => TermChange::Same,
+    }
 }
 
 /// The step α ≥ 0 minimizing the cost along the direction: g0 + α dmd + ds/dα = 0 with ds/dα
