@@ -6,9 +6,8 @@
 //! weight D on a quadratic row, or a dense block on an elliptic contact's rows. Rows of one contact
 //! share their nonzero columns (`jacobian::append_rows` records a contact's rows over the union of
 //! their nonzeros), so they are summed as a group: each entry's sum over the group's rows is
-//! formed from the rows' compact values (in a register, or four rows at a time in a scratch
-//! column for larger groups) and added to H once — instead of one
-//! scattered read–modify–write of H per row and entry. Consecutive scalar rows with the same columns (a
+//! one dot product of two contiguous vectors (the group's values laid out transposed in scratch)
+//! added to H once — instead of one scattered read–modify–write of H per row and entry. Consecutive scalar rows with the same columns (a
 //! pyramidal contact's edges in their quadratic state) form one group; an elliptic contact's
 //! block multiplies its rows first (W = B G, G the rows' values), then Gᵀ W is summed the same
 //! way. Rows whose columns differ (J recorded by the full scan, which drops exact zeros) are
@@ -23,6 +22,12 @@ const GROUP: usize = 16;
 /// The most rows of a block (an elliptic contact of condim 6).
 const BLOCK: usize = 6;
 
+/// The length of the assembler's scratch for `nv` dofs (a group's transposed values and
+/// coefficients, at most `GROUP` rows on at most nv columns each).
+pub(super) const fn scratch_len(nv: usize) -> usize {
+    2 * GROUP.div_ceil(4) * 4 * nv
+}
+
 /// Adds the rows' Hessian blocks to H's lower triangle (see the module doc). Scalar rows are
 /// held in a pending group until a row with other columns (or a block) arrives; [`finish`]
 /// adds the last group.
@@ -31,7 +36,7 @@ const BLOCK: usize = 6;
 pub(super) struct Assembler<'a> {
     h: &'a mut DMatrix<f64>,
     nz: &'a Sparsity<'a>,
-    /// One column of a group's sum, for groups of more than four rows (nv long).
+    /// Scratch for a group's values laid out transposed, 2 · GROUP · nv long (`add_columns`).
     column: &'a mut [f64],
     /// The pending group: its rows and their weights.
     rows: [usize; GROUP],
@@ -40,7 +45,8 @@ pub(super) struct Assembler<'a> {
 }
 
 impl<'a> Assembler<'a> {
-    /// An assembler adding to `h` (nv × nv) the rows of `nz`; `column` is nv-long scratch.
+    /// An assembler adding to `h` (nv × nv) the rows of `nz`; `column` is scratch of
+    /// [`scratch_len`]`(nv)`.
     pub fn new(h: &'a mut DMatrix<f64>, nz: &'a Sparsity<'a>, column: &'a mut [f64]) -> Self {
         Self { h, nz, column, rows: [0; GROUP], weights: [0.0; GROUP], len: 0 }
     }
@@ -87,9 +93,9 @@ impl<'a> Assembler<'a> {
             *g = self.nz.row_values(row).1;
         }
         let weights = self.weights;
-        add_columns(self.h, cols, &g[..k], self.column, |q, c| {
-            for ((c, &w), g) in c.iter_mut().zip(&weights[..k]).zip(&g[..k]) {
-                *c = w * g[q];
+        add_columns(self.h, cols, &g[..k], self.column, |g_q, c| {
+            for ((c, &w), &g) in c.iter_mut().zip(&weights[..k]).zip(g_q) {
+                *c = w * g;
             }
         });
     }
@@ -102,10 +108,9 @@ impl<'a> Assembler<'a> {
         for (a, g) in g.iter_mut().enumerate().take(dim) {
             *g = self.nz.row_values(i + a).1;
         }
-        let rows = g;
-        add_columns(self.h, cols, &g[..dim], self.column, |q, c| {
+        add_columns(self.h, cols, &g[..dim], self.column, |g_q, c| {
             for (a, c) in c.iter_mut().enumerate() {
-                *c = (0..dim).map(|b| block[a][b] * rows[b][q]).sum();
+                *c = (0..dim).map(|b| block[a][b] * g_q[b]).sum();
             }
         });
     }
@@ -128,98 +133,94 @@ impl<'a> Assembler<'a> {
 }
 
 /// H[p][q] += Σ_r c_r(q) G_r[p] over columns q of `cols` and p ≥ q (rows `g`, all on `cols`;
-/// `coefficients(q, c)` writes c_r(q) for column position q): each entry's sum is formed in row
-/// order — in a register up to four rows, in `scratch` four rows at a time beyond — and added to
-/// H once.
+/// `coefficients(g_q, c)` writes c_r(q) from the rows' values g_q = (G_0[q], …) at column
+/// position q). Up to four rows, each entry's sum is formed in a register from the rows' values;
+/// more rows are first laid out transposed in `scratch` — Gᵀ[p] = (G_0[p], …, G_{k−1}[p]) and
+/// C[q] = (c_0(q), …) contiguous, zero-padded to a multiple of four — so that each entry is one
+/// dot product of two contiguous vectors (`dot4`). Either way it is added to H once.
 fn add_columns(
     h: &mut DMatrix<f64>,
     cols: &[usize],
     g: &[&[f64]],
     scratch: &mut [f64],
-    mut coefficients: impl FnMut(usize, &mut [f64]),
+    mut coefficients: impl FnMut(&[f64], &mut [f64]),
 ) {
     let (n, k) = (cols.len(), g.len());
     let nv = h.nrows();
     let h = h.as_mut_slice();
-    let mut c = [0.0; GROUP];
-    for q in 0..n {
-        coefficients(q, &mut c[..k]);
-        let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
-        let rows = &cols[q..];
-        match k {
-            1 => {
-                for (&p, &g0) in rows.iter().zip(&g[0][q..n]) {
-                    column[p] += c[0] * g0;
-                }
+    if k <= 4 {
+        // Up to four rows: each entry's sum in a register, straight from the rows' values.
+        let (mut g_q, mut c) = ([0.0; 4], [0.0; 4]);
+        for q in 0..n {
+            for (x, g) in g_q.iter_mut().zip(g) {
+                *x = g[q];
             }
-            2 => {
-                for ((&p, &g0), &g1) in rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]) {
-                    column[p] += c[0] * g0 + c[1] * g1;
-                }
-            }
-            3 => {
-                for (((&p, &g0), &g1), &g2) in rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n])
-                {
-                    column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2;
-                }
-            }
-            4 => {
-                for ((((&p, &g0), &g1), &g2), &g3) in
-                    rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n]).zip(&g[3][q..n])
-                {
-                    column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2 + c[3] * g3;
-                }
-            }
-            _ => {
-                // Four rows at a time into the scratch column, left to right (the same sum).
-                let t = &mut scratch[..n - q];
-                let (g0, g1, g2, g3) = (&g[0][q..n], &g[1][q..n], &g[2][q..n], &g[3][q..n]);
-                for ((((t, &a0), &a1), &a2), &a3) in t.iter_mut().zip(g0).zip(g1).zip(g2).zip(g3) {
-                    *t = c[0] * a0 + c[1] * a1 + c[2] * a2 + c[3] * a3;
-                }
-                let mut r = 4;
-                while r < k {
-                    match k - r {
-                        1 => {
-                            for (t, &a0) in t.iter_mut().zip(&g[r][q..n]) {
-                                *t += c[r] * a0;
-                            }
-                            r += 1;
-                        }
-                        2 => {
-                            for ((t, &a0), &a1) in t.iter_mut().zip(&g[r][q..n]).zip(&g[r + 1][q..n]) {
-                                *t = *t + c[r] * a0 + c[r + 1] * a1;
-                            }
-                            r += 2;
-                        }
-                        3 => {
-                            for (((t, &a0), &a1), &a2) in
-                                t.iter_mut().zip(&g[r][q..n]).zip(&g[r + 1][q..n]).zip(&g[r + 2][q..n])
-                            {
-                                *t = *t + c[r] * a0 + c[r + 1] * a1 + c[r + 2] * a2;
-                            }
-                            r += 3;
-                        }
-                        _ => {
-                            for ((((t, &a0), &a1), &a2), &a3) in t
-                                .iter_mut()
-                                .zip(&g[r][q..n])
-                                .zip(&g[r + 1][q..n])
-                                .zip(&g[r + 2][q..n])
-                                .zip(&g[r + 3][q..n])
-                            {
-                                *t = *t + c[r] * a0 + c[r + 1] * a1 + c[r + 2] * a2 + c[r + 3] * a3;
-                            }
-                            r += 4;
-                        }
+            coefficients(&g_q[..k], &mut c[..k]);
+            let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
+            let rows = &cols[q..];
+            match k {
+                1 => {
+                    for (&p, &g0) in rows.iter().zip(&g[0][q..n]) {
+                        column[p] += c[0] * g0;
                     }
                 }
-                for (&p, &v) in rows.iter().zip(t.iter()) {
-                    column[p] += v;
+                2 => {
+                    for ((&p, &g0), &g1) in rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]) {
+                        column[p] += c[0] * g0 + c[1] * g1;
+                    }
+                }
+                3 => {
+                    for (((&p, &g0), &g1), &g2) in
+                        rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n])
+                    {
+                        column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2;
+                    }
+                }
+                _ => {
+                    for ((((&p, &g0), &g1), &g2), &g3) in
+                        rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n]).zip(&g[3][q..n])
+                    {
+                        column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2 + c[3] * g3;
+                    }
                 }
             }
         }
+        return;
     }
+    let kp = k.div_ceil(4) * 4;
+    let (gt, rest) = scratch.split_at_mut(n * kp);
+    let c = &mut rest[..n * kp];
+    for (p, gt_p) in gt.chunks_exact_mut(kp).enumerate() {
+        for (r, g) in g.iter().enumerate() {
+            gt_p[r] = g[p];
+        }
+        gt_p[k..].fill(0.0);
+    }
+    for (g_q, c_q) in gt.chunks_exact(kp).zip(c.chunks_exact_mut(kp)) {
+        coefficients(&g_q[..k], &mut c_q[..k]);
+        c_q[k..].fill(0.0);
+    }
+    for (q, (&col_q, c_q)) in cols.iter().zip(c.chunks_exact(kp)).enumerate() {
+        let column = &mut h[col_q * nv..(col_q + 1) * nv];
+        for (&p, g_p) in cols[q..].iter().zip(gt[q * kp..].chunks_exact(kp)) {
+            column[p] += dot4(g_p, c_q);
+        }
+    }
+}
+
+/// Σ a_i b_i of two equally long vectors whose length is a multiple of four: four partial
+/// sums (the lanes of a vector register) combined at the end.
+#[inline]
+fn dot4(a: &[f64], b: &[f64]) -> f64 {
+    let mut s = [0.0; 4];
+    for (x, y) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        let (x, y): (&[f64; 4], &[f64; 4]) =
+            (x.try_into().unwrap_or(&[0.0; 4]), y.try_into().unwrap_or(&[0.0; 4]));
+        for l in 0..4 {
+            s[l] += x[l] * y[l];
+        }
+    }
+    (s[0] + s[2]) + (s[1] + s[3])
 }
 
 #[cfg(test)]
@@ -279,7 +280,7 @@ mod tests {
         };
         let blocks = [(0, 1, scalar(2.0)), (1, 1, scalar(0.5)), (2, 1, scalar(3.0)), (3, 3, b3), (6, 2, b2)];
         let mut h = DMatrix::zeros(nv, nv);
-        let mut column = vec![0.0; nv];
+        let mut column = vec![0.0; scratch_len(nv)];
         let mut asm = Assembler::new(&mut h, &nz, &mut column);
         for &(i, dim, b) in &blocks {
             asm.add(i, dim, &b);

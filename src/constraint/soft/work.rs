@@ -50,7 +50,7 @@ pub(crate) struct SoftWork {
     pub columns: Vec<usize>,
     /// (row, column) of J's nonzeros in column order, while `nz_start`/`nz_index` are built.
     pub nz_scratch: Vec<(usize, usize)>,
-    /// One column of a row group's Hessian term, while H is assembled (nv; `hessian.rs`).
+    /// Scratch of a row group's Hessian term while H is assembled (`hessian::scratch_len`).
     pub hessian_column: Vec<f64>,
     /// The constraint islands of the sparse Newton solve (`island.rs`).
     pub islands: super::island::Islands,
@@ -92,7 +92,7 @@ impl SoftWork {
             j_recorded: true,
             columns: Vec::with_capacity(nv),
             nz_scratch: Vec::new(),
-            hessian_column: vec![0.0; nv],
+            hessian_column: vec![0.0; super::hessian::scratch_len(nv)],
             islands: super::island::Islands::with_capacity(nv, nefc),
             ar: DMatrix::zeros(0, 0),
             minv_jt: DMatrix::zeros(0, 0),
