@@ -8,9 +8,9 @@
 //! The record is valid while only the soft position stage writes `efc_j`: the exact rows'
 //! writer (`ConstraintModel::positions_unchecked`, which the variational integrator also
 //! calls) marks it stale, and a stale record is rebuilt or replaced by a full clear. A contact's
-//! rows are recorded over one shared column list (`append_rows`), exact zeros included.
+//! rows are recorded as they are written (`rows.rs`, `contact_rows`) over one shared column list,
+//! exact zeros included.
 
-use crate::model::Model;
 use nalgebra::DMatrix;
 
 /// The nonzero columns of J's rows 0..nefc, ascending, into `start`/`index` (row i's are
@@ -65,48 +65,6 @@ pub(crate) fn record(
         start[i] = start[i - 1];
     }
     start[0] = 0;
-}
-
-/// The dofs that move body `a` or body `b` (both chains to the world), ascending and once each,
-/// into `out`: the only columns where a contact row between them can be nonzero.
-pub(crate) fn chain_dofs(model: &Model, bodies: [usize; 2], out: &mut Vec<usize>) {
-    out.clear();
-    for mut b in bodies {
-        while b != 0 {
-            let j = model.joint_of(b);
-            out.extend(j.dof_adr..j.dof_adr + j.kind.nv());
-            b = model.bodies[b].parent;
-        }
-    }
-    out.sort_unstable();
-    out.dedup();
-}
-
-/// Appends rows `rows` of `j` to the record (rows 0..rows.start recorded already), every row
-/// over the same columns: those of `columns` (ascending; a superset of the rows' nonzero
-/// columns) where any of the rows is nonzero, which `columns` keeps on return. A row's exact
-/// zeros among them are recorded as entries: one contact's rows share one column list, so the
-/// Newton Hessian sums them as a group (`hessian.rs`); the products with those zeros add
-/// nothing.
-pub(crate) fn append_rows(
-    j: &DMatrix<f64>,
-    rows: std::ops::Range<usize>,
-    columns: &mut Vec<usize>,
-    start: &mut Vec<usize>,
-    index: &mut Vec<usize>,
-    value: &mut Vec<f64>,
-) {
-    debug_assert_eq!(start.len(), rows.start + 1);
-    let stride = j.nrows();
-    let data = j.as_slice();
-    columns.retain(|&k| data[k * stride + rows.start..k * stride + rows.end].iter().any(|&v| v != 0.0));
-    for i in rows {
-        for &k in columns.iter() {
-            index.push(k);
-            value.push(data[k * stride + i]);
-        }
-        start.push(index.len());
-    }
 }
 
 /// Zeroes rows `first..` of `j` that the record (`start`, `index`, rows 0..start.len() − 1)

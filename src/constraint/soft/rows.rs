@@ -17,7 +17,7 @@
 //! `efc_vel` = J v for every row; `efc_jdotv` is J̇ v of connect and weld rows (MuJoCo 4
 //! subtracts it from their reference acceleration), 0 elsewhere.
 
-use crate::constraint::contact::add_contact_jacobian;
+use crate::constraint::contact::contact_jacobian_columns;
 use crate::constraint::limits::{quat_angle_axis, LimitKind, LimitRow};
 use crate::constraint::rows::EqualityRows;
 use crate::constraint::rows::{point_motion, RowGeometry};
@@ -248,55 +248,79 @@ fn tendon_limit_sides(model: &Model, data: &Data, t: usize) -> [Option<(f64, f64
 }
 
 /// The contact rows from row `r` on, their nonzeros appended to the record of J's
-/// (`jacobian.rs`, rows 0..r recorded); returns the next free row.
+/// (`jacobian.rs`, rows 0..r recorded) and written to `efc_j`; returns the next free row.
+///
+/// Each contact's frame rows (normal, tangents, torsion, rolling) are formed compactly over the
+/// dofs that move one body and not the other (`contact_jacobian_columns`); a pyramidal cone's
+/// rows are the edges J_n ± μ_i J_i of those. A row's record holds the columns where any of the
+/// contact's rows is nonzero (its rows share their columns, as the Hessian's grouping expects),
+/// exact zeros included.
 fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usize {
-    for c in 0..data.contacts.len() {
-        let contact = data.contacts[c];
+    let Data {
+        contacts,
+        efc_j,
+        efc_id,
+        efc_type,
+        efc_pos,
+        efc_margin,
+        efc_frictionloss,
+        x_world_body,
+        s_body,
+        soft,
+        ..
+    } = &mut *data;
+    let stride = efc_j.nrows();
+    let j = efc_j.as_mut_slice();
+    for (c, contact) in contacts.iter().enumerate() {
         if contact.dist >= contact.includemargin {
             continue;
         }
         let dim = contact.condim.clamp(1, 6) as usize;
-        // The contact-frame Jacobian rows (normal, tangents, torsion, rolling) in rows r..r+dim.
-        let rows = if dim == 1 || cone == Cone::Elliptic { dim } else { 2 * (dim - 1) };
-        add_contact_jacobian(model, data, &contact, r, dim);
-        let kind = if dim == 1 {
-            EfcType::ContactFrictionless
-        } else if cone == Cone::Elliptic {
-            EfcType::ContactElliptic
+        let pyramidal = dim > 1 && cone != Cone::Elliptic;
+        let (rows, kind) = if dim == 1 {
+            (1, EfcType::ContactFrictionless)
+        } else if pyramidal {
+            (2 * (dim - 1), EfcType::ContactPyramidal)
         } else {
-            // Pyramid edges J_n ± μ_i J_i, in place from the last pair down (row r + 2k − 2 and
-            // r + 2k − 1 for friction direction k; direction k ≥ 1 sits in row r + k, which the
-            // pairs below it have not overwritten yet).
-            // Only the columns of the dofs that move one body and not the other can be nonzero
-            // (a common ancestor's columns cancel to exact zeros, which the edges keep).
-            let bodies = contact.geom.map(|g| model.geoms[g].body);
-            for k in (1..dim).rev() {
-                let mu = contact.friction[k - 1];
-                crate::constraint::contact::for_each_relative_dof(model, bodies, |col| {
-                    let (n, t) = (data.efc_j[(r, col)], data.efc_j[(r + k, col)]);
-                    data.efc_j[(r + 2 * k - 2, col)] = n + mu * t;
-                    data.efc_j[(r + 2 * k - 1, col)] = n - mu * t;
-                });
-            }
-            EfcType::ContactPyramidal
+            (dim, EfcType::ContactElliptic)
         };
-        let Data { efc_j, soft, .. } = &mut *data;
-        super::jacobian::chain_dofs(model, contact.geom.map(|g| model.geoms[g].body), &mut soft.columns);
-        super::jacobian::append_rows(
-            efc_j,
-            r..r + rows,
-            &mut soft.columns,
-            &mut soft.nz_start,
-            &mut soft.nz_index,
-            &mut soft.nz_value,
-        );
-        for i in r..r + rows {
-            data.efc_id[i] = c;
-            data.efc_type[i] = kind;
-            let first = i == r || kind == EfcType::ContactPyramidal;
-            data.efc_pos[i] = if first { contact.dist } else { 0.0 };
-            data.efc_margin[i] = if first { contact.includemargin } else { 0.0 };
-            data.efc_frictionloss[i] = 0.0;
+        let (columns, values) = (&mut soft.columns, &mut soft.column_values);
+        contact_jacobian_columns(model, x_world_body, s_body, contact, dim, columns, values);
+        if pyramidal {
+            // The edges J_n ± μ_k J_k (pair k − 1 in rows 2k − 2, 2k − 1) in place of the frame
+            // rows, and only the columns where an edge is nonzero.
+            let mut kept = 0;
+            for t in 0..columns.len() {
+                let v = values[t];
+                let mut e = [0.0; 10];
+                for k in 1..dim {
+                    let mu = contact.friction[k - 1];
+                    e[2 * k - 2] = v[0] + mu * v[k];
+                    e[2 * k - 1] = v[0] - mu * v[k];
+                }
+                if e[..rows].iter().any(|&x| x != 0.0) {
+                    columns[kept] = columns[t];
+                    soft.edge_values[kept] = e;
+                    kept += 1;
+                }
+            }
+            columns.truncate(kept);
+        }
+        for i in 0..rows {
+            for (t, &k) in columns.iter().enumerate() {
+                let v = if pyramidal { soft.edge_values[t][i] } else { soft.column_values[t][i] };
+                soft.nz_index.push(k);
+                soft.nz_value.push(v);
+                j[k * stride + r + i] = v;
+            }
+            soft.nz_start.push(soft.nz_index.len());
+            let row = r + i;
+            efc_id[row] = c;
+            efc_type[row] = kind;
+            let first = i == 0 || pyramidal;
+            efc_pos[row] = if first { contact.dist } else { 0.0 };
+            efc_margin[row] = if first { contact.includemargin } else { 0.0 };
+            efc_frictionloss[row] = 0.0;
         }
         r += rows;
     }

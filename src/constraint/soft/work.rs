@@ -46,8 +46,12 @@ pub(crate) struct SoftWork {
     /// (`efc_j` is allocated zero, the record empty: the first position stage clears nothing),
     /// false whenever another writer (the exact rows) wrote `efc_j` since.
     pub j_recorded: bool,
-    /// The dofs of one contact's two bodies while its rows are recorded (nv).
+    /// The nonzero columns of one contact's rows while they are recorded (nv).
     pub columns: Vec<usize>,
+    /// Their values in the contact's frame rows (`contact::contact_jacobian_columns`; nv).
+    pub column_values: Vec<[f64; 6]>,
+    /// Their values in a pyramidal contact's edge rows (nv).
+    pub edge_values: Vec<[f64; 10]>,
     /// (row, column) of J's nonzeros in column order, while `nz_start`/`nz_index` are built.
     pub nz_scratch: Vec<(usize, usize)>,
     /// Scratch of a row group's Hessian term while H is assembled (`hessian::scratch_len`).
@@ -91,6 +95,8 @@ impl SoftWork {
             nz_value: Vec::with_capacity(nefc * nv),
             j_recorded: true,
             columns: Vec::with_capacity(nv),
+            column_values: Vec::with_capacity(nv),
+            edge_values: vec![[0.0; 10]; nv],
             nz_scratch: Vec::new(),
             hessian_column: vec![0.0; super::hessian::scratch_len(nv)],
             islands: super::island::Islands::with_capacity(nv, nefc),
