@@ -330,7 +330,8 @@ def main() -> int:
         rows.append({"scene": name, "trajectory": err, "ok": ok})
     print(f"soft: {len(rows) - failed} passed, {failed} failed ({time.time() - t0:.0f} s)")
     if args.json:
-        Path(args.json).write_text(json.dumps(rows, indent=1))
+        # numpy scalars (the comparisons' bools and floats) as Python's own.
+        Path(args.json).write_text(json.dumps(rows, indent=1, default=lambda x: x.item()))
     return 1 if failed else 0
 
 

@@ -37,6 +37,15 @@ pub fn impedance(solimp: &[f64; 5], x: f64) -> (f64, f64) {
     }
     let (f, df) = if power == 1.0 {
         (y, 1.0)
+    } else if power == 2.0 {
+        // MJCF's default: the same halves without calls to pow (x¹ = x, x² = x · x).
+        if y <= mid {
+            let a = 1.0 / mid;
+            (a * (y * y), power * a * y)
+        } else {
+            let (b, z) = (1.0 / (1.0 - mid), 1.0 - y);
+            (1.0 - b * (z * z), power * b * z)
+        }
     } else if y <= mid {
         let a = 1.0 / mid.powf(power - 1.0);
         (a * y.powf(power), power * a * y.powf(power - 1.0))
@@ -207,23 +216,30 @@ pub(crate) fn make_impedance(model: &Model, w: &InverseWeights, data: &mut Data)
         let frictional_dof = matches!(kind, EfcType::FrictionDof | EfcType::FrictionTendon);
         let (solref, solreffriction, solimp) = parameters(model, data, i);
         let (solref, solimp) = sanitize(model, solref, solimp, false);
-        let (solreffriction, _) = sanitize(model, solreffriction, solimp, true);
         let (x, dim) = violation(model, data, i);
         let (imp, imp_d) = impedance(&solimp, x - data.efc_margin[i]);
+        // (k, b) of the block's first row, and of an elliptic contact's friction rows (k = 0,
+        // b from `solreffriction` when it is given, else from `solref`).
+        let (mut k, b) = stiffness_damping(&solref, solimp[1]);
+        if frictional_dof {
+            k = 0.0;
+        }
+        let friction_b = if kind == EfcType::ContactElliptic && dim > 1 {
+            let (solreffriction, _) = sanitize(model, solreffriction, solimp, true);
+            let sref =
+                if solreffriction[0] != 0.0 || solreffriction[1] != 0.0 { &solreffriction } else { &solref };
+            stiffness_damping(sref, solimp[1]).1
+        } else {
+            b
+        };
         for j in 0..dim {
             let r = i + j;
             data.efc_r[r] = ((1.0 - imp) * data.efc_diag_a[r] / imp).max(MINVAL);
-            let elliptic_friction = kind == EfcType::ContactElliptic && j > 0;
-            let sref = if elliptic_friction && (solreffriction[0] != 0.0 || solreffriction[1] != 0.0) {
-                &solreffriction
+            data.efc_kbip[r] = if kind == EfcType::ContactElliptic && j > 0 {
+                [0.0, friction_b, imp, imp_d]
             } else {
-                &solref
+                [k, b, imp, imp_d]
             };
-            let (mut k, b) = stiffness_damping(sref, solimp[1]);
-            if frictional_dof || elliptic_friction {
-                k = 0.0;
-            }
-            data.efc_kbip[r] = [k, b, imp, imp_d];
         }
         i += dim;
     }
@@ -256,5 +272,44 @@ pub(crate) fn make_impedance(model: &Model, w: &InverseWeights, data: &mut Data)
         data.efc_diag_a[i] = data.efc_r[i] * imp / (1.0 - imp);
         data.efc_aref[i] =
             -b * data.efc_vel[i] - k * imp * (data.efc_pos[i] - data.efc_margin[i]) - data.efc_jdotv[i];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::impedance;
+
+    /// MuJoCo's `getimpedance` halves with `pow`, as the general branch computes them.
+    fn by_pow(solimp: &[f64; 5], x: f64) -> (f64, f64) {
+        let [dmin, dmax, width, mid, power] = *solimp;
+        let y = (x / width).abs();
+        let (f, df) = if y <= mid {
+            let a = 1.0 / mid.powf(power - 1.0);
+            (a * y.powf(power), power * a * y.powf(power - 1.0))
+        } else {
+            let b = 1.0 / (1.0 - mid).powf(power - 1.0);
+            (1.0 - b * (1.0 - y).powf(power), power * b * (1.0 - y).powf(power - 1.0))
+        };
+        (dmin + f * (dmax - dmin), df * x.signum() * (dmax - dmin) / width)
+    }
+
+    #[test]
+    fn power_two_without_pow_agrees_with_pow_to_round_off() {
+        for mid in [0.5, 0.3, 0.9] {
+            let solimp = [0.9, 0.95, 0.001, mid, 2.0];
+            for t in 1..200 {
+                let x = -0.001 + 0.002 * f64::from(t) / 200.0;
+                if x == 0.0 {
+                    continue;
+                }
+                let (d, dd) = impedance(&solimp, x);
+                let (d_pow, dd_pow) = by_pow(&solimp, x);
+                assert!((d - d_pow).abs() <= 4.0 * f64::EPSILON * d_pow.abs(), "d at {x}: {d} vs {d_pow}");
+                assert!(
+                    (dd - dd_pow).abs() <= 8.0 * f64::EPSILON * dd_pow.abs(),
+                    "d' at {x}: {dd} vs {dd_pow}"
+                );
+            }
+        }
     }
 }
