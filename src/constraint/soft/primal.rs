@@ -70,13 +70,79 @@ impl Sparsity<'_> {
     }
 }
 
-/// r ← J x (rows 0..nefc).
-pub(super) fn mul_j(s: &Sparsity, nefc: usize, x: &DVector<f64>, r: &mut DVector<f64>) {
+/// r ← J x (rows 0..nefc): from J's dense storage `dense` when given (small problems: column by
+/// column, products that vectorize, each row's sum still in ascending column order), else row by
+/// row over the record of J's nonzeros.
+pub(super) fn mul_j(
+    s: &Sparsity,
+    dense: Option<&DMatrix<f64>>,
+    nefc: usize,
+    x: &DVector<f64>,
+    r: &mut DVector<f64>,
+) {
     let x = x.as_slice();
-    for (i, r_i) in r.as_mut_slice()[..nefc].iter_mut().enumerate() {
+    let r = &mut r.as_mut_slice()[..nefc];
+    if let Some(j) = dense {
+        let (stride, j) = (j.nrows(), j.as_slice());
+        r.fill(0.0);
+        for (k, &x_k) in x.iter().enumerate() {
+            if x_k != 0.0 {
+                for (r_i, &j_ik) in r.iter_mut().zip(&j[k * stride..k * stride + nefc]) {
+                    *r_i += j_ik * x_k;
+                }
+            }
+        }
+        return;
+    }
+    for (i, r_i) in r.iter_mut().enumerate() {
         let (cols, vals) = s.row_values(i);
         *r_i = cols.iter().zip(vals).map(|(&k, &j_ik)| j_ik * x[k]).sum();
     }
+}
+
+/// out ← Jᵀ f (rows 0..nefc): from J's dense storage `dense` when given (one dot product per
+/// column, in four partial sums), else over the record of J's nonzeros, row after row.
+pub(super) fn mul_jt(
+    s: &Sparsity,
+    dense: Option<&DMatrix<f64>>,
+    nefc: usize,
+    f: &DVector<f64>,
+    out: &mut [f64],
+) {
+    let f = &f.as_slice()[..nefc];
+    if let Some(j) = dense {
+        let (stride, j) = (j.nrows(), j.as_slice());
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = dot(&j[k * stride..k * stride + nefc], f);
+        }
+        return;
+    }
+    out.fill(0.0);
+    for (i, &f_i) in f.iter().enumerate() {
+        if f_i != 0.0 {
+            let (cols, vals) = s.row_values(i);
+            for (&k, &j_ik) in cols.iter().zip(vals) {
+                out[k] += f_i * j_ik;
+            }
+        }
+    }
+}
+
+/// Σ a_i b_i in four partial sums (the lanes of a vector register), then the remainder.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut s = [0.0; 4];
+    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (a4.remainder(), b4.remainder());
+    for (x, y) in a4.zip(b4) {
+        for l in 0..4 {
+            s[l] += x[l] * y[l];
+        }
+    }
+    let mut t = (s[0] + s[2]) + (s[1] + s[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        t += x * y;
+    }
+    t
 }
 
 /// r ← M x, reading only M's nonzeros: the diagonal and each dof's ancestor chain
@@ -138,6 +204,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
         );
     }
     let Data {
+        efc_j,
         efc_type,
         efc_id,
         efc_d,
@@ -163,6 +230,8 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     let (nz_start, nz_index) = (std::mem::take(&mut soft.nz_start), std::mem::take(&mut soft.nz_index));
     let nz_value = std::mem::take(&mut soft.nz_value);
     let nz = Sparsity { start: &nz_start, index: &nz_index, value: &nz_value };
+    // Small problems: J's products from its dense storage (`mul_j`, `mul_jt`).
+    let j_dense = (nv <= DENSE_NV).then_some(&*efc_j);
     let rows = Rows {
         ne: *ne,
         nf: *nf,
@@ -192,7 +261,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                  force: &mut DVector<f64>,
                  state: &mut [_]| {
         mul_m(&model.dof_parent, mass_matrix, x, ma);
-        mul_j(&nz, nefc, x, jar);
+        mul_j(&nz, j_dense, nefc, x, jar);
         for (j, &r) in jar.as_mut_slice()[..nefc].iter_mut().zip(&efc_aref.as_slice()[..nefc]) {
             *j -= r;
         }
@@ -203,7 +272,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     // qfrc_smooth): only J a − aref is formed (MuJoCo's cost(qacc_smooth) from efc_b likewise).
     qacc.copy_from(qacc_smooth);
     soft.ma.copy_from(qfrc_smooth);
-    mul_j(&nz, nefc, qacc, &mut soft.jar);
+    mul_j(&nz, j_dense, nefc, qacc, &mut soft.jar);
     for (j, &r) in soft.jar.as_mut_slice()[..nefc].iter_mut().zip(&efc_aref.as_slice()[..nefc]) {
         *j -= r;
     }
@@ -252,20 +321,18 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     // Small problems, and CG: every row together.
     if !island_path {
         loop {
-            // g = M a − qfrc_smooth − Jᵀ f.
-            for ((g, &ma), &f0) in
-                soft.grad.as_mut_slice().iter_mut().zip(soft.ma.as_slice()).zip(qfrc_smooth.as_slice())
+            // g = M a − qfrc_smooth − Jᵀ f (Jᵀ f in qfrc_constraint: at the last iteration,
+            // the forces' own).
+            mul_jt(&nz, j_dense, nefc, efc_force, qfrc_constraint.as_mut_slice());
+            for (((g, &ma), &f0), &jtf) in soft
+                .grad
+                .as_mut_slice()
+                .iter_mut()
+                .zip(soft.ma.as_slice())
+                .zip(qfrc_smooth.as_slice())
+                .zip(qfrc_constraint.as_slice())
             {
-                *g = ma - f0;
-            }
-            let grad = soft.grad.as_mut_slice();
-            for (i, &f) in efc_force.as_slice()[..nefc].iter().enumerate() {
-                if f != 0.0 {
-                    let (cols, vals) = nz.row_values(i);
-                    for (&k, &j_ik) in cols.iter().zip(vals) {
-                        grad[k] -= j_ik * f;
-                    }
-                }
+                *g = ma - f0 - jtf;
             }
             gradient = s.scale * soft.grad.norm();
             if gradient < s.tolerance || improvement < s.tolerance || iter >= s.iterations {
@@ -328,7 +395,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                     have_dir = true;
                 }
             }
-            mul_j(&nz, nefc, &soft.dir, &mut soft.jv);
+            mul_j(&nz, j_dense, nefc, &soft.dir, &mut soft.jv);
             mul_m(&model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
             let g0: f64 = (soft.ma.iter().zip(qfrc_smooth.iter()).zip(soft.dir.iter()))
                 .map(|((&ma, &f0), &d)| (ma - f0) * d)
@@ -352,16 +419,9 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
             cost = new_cost;
         }
     }
-    // qfrc_constraint = Jᵀ f.
-    qfrc_constraint.fill(0.0);
-    let qfrc = qfrc_constraint.as_mut_slice();
-    for (i, &f) in efc_force.as_slice()[..nefc].iter().enumerate() {
-        if f != 0.0 {
-            let (cols, vals) = nz.row_values(i);
-            for (&k, &j_ik) in cols.iter().zip(vals) {
-                qfrc[k] += f * j_ik;
-            }
-        }
+    // qfrc_constraint = Jᵀ f (the loop above left it at the final forces).
+    if island_path {
+        mul_jt(&nz, j_dense, nefc, efc_force, qfrc_constraint.as_mut_slice());
     }
     data.soft.nz_start = nz_start;
     data.soft.nz_index = nz_index;
