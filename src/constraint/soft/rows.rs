@@ -307,10 +307,15 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
             columns.truncate(kept);
         }
         for i in 0..rows {
-            for (t, &k) in columns.iter().enumerate() {
-                let v = if pyramidal { soft.edge_values[t][i] } else { soft.column_values[t][i] };
-                soft.nz_index.push(k);
-                soft.nz_value.push(v);
+            // Exact-size extends: one capacity check per row, not per entry.
+            soft.nz_index.extend_from_slice(columns);
+            if pyramidal {
+                soft.nz_value.extend(soft.edge_values[..columns.len()].iter().map(|e| e[i]));
+            } else {
+                soft.nz_value.extend(soft.column_values.iter().map(|v| v[i]));
+            }
+            let row_values = &soft.nz_value[soft.nz_value.len() - columns.len()..];
+            for (&k, &v) in columns.iter().zip(row_values) {
                 j[k * stride + r + i] = v;
             }
             soft.nz_start.push(soft.nz_index.len());
