@@ -513,7 +513,7 @@ impl Data {
             solver_niter: 0,
             solver_improvement: 0.0,
             solver_gradient: 0.0,
-            soft: SoftWork::new(nv, nefc),
+            soft: SoftWork::new(model, nefc),
             x_world_geom: vec![Transform::identity(); model.geoms.len()],
             broadphase: crate::collision::broadphase::BroadphaseWork::new(model),
             contacts: Vec::with_capacity(model.max_contacts().min(crate::model::INITIAL_CONTACTS)),

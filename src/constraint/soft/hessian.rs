@@ -4,7 +4,7 @@
 //!
 //! The rows come one block at a time from [`Rows::hessian`](super::cost::Rows::hessian): a
 //! weight D on a quadratic row, or a dense block on an elliptic contact's rows. Rows of one contact
-//! share their nonzero columns (`jacobian::append_rows` records a contact's rows over the union of
+//! share their nonzero columns (`rows.rs`, `contact_rows`, records a contact's rows over the union of
 //! their nonzeros), so they are summed as a group: each entry's sum over the group's rows is
 //! one dot product of two contiguous vectors (the group's values laid out transposed in scratch)
 //! added to H once — instead of one scattered read–modify–write of H per row and entry. Consecutive scalar rows with the same columns (a

@@ -145,11 +145,18 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     t
 }
 
-/// r ← M x, reading only M's nonzeros: the diagonal and each dof's ancestor chain
-/// (`Model::dof_parent`; M[l][k] ≠ 0 only when l is an ancestor of k or k of l).
-pub(super) fn mul_m(dof_parent: &[usize], m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
+/// r ← M x: a dense product for the dense Newton path (`dense`), else reading only M's
+/// nonzeros: the diagonal and each dof's ancestor chain (`Model::dof_parent`; M[l][k] ≠ 0 only
+/// when l is an ancestor of k or k of l).
+pub(super) fn mul_m(
+    dense: bool,
+    dof_parent: &[usize],
+    m: &DMatrix<f64>,
+    x: &DVector<f64>,
+    r: &mut DVector<f64>,
+) {
     let nv = x.len();
-    if nv <= DENSE_NV {
+    if dense {
         m.mul_to(x, r);
         return;
     }
@@ -183,6 +190,36 @@ pub(super) fn mul_m_on(
 /// Up to this many dofs the Newton Hessian is assembled and factored dense (and M x is a dense
 /// product): below it the sparse bookkeeping costs more than the zeros it skips.
 pub(crate) const DENSE_NV: usize = 40;
+
+/// Up to this many dofs the Hessian is also dense when the mass matrix is at least half
+/// nonzero (long chains: H and its factor are then dense whatever the rows, and the island
+/// path's sparse factorization only adds indirection — a 30-link chain's solve 2.7× cheaper).
+const DENSE_NV_CHAIN: usize = 200;
+
+/// Whether `model`'s soft Newton solves take the dense path (one dense Hessian and Cholesky
+/// factor for all rows) rather than the islands' sparse one (`island.rs`): nv ≤ [`DENSE_NV`],
+/// or nv ≤ `DENSE_NV_CHAIN` with M's lower triangle (each dof and its ancestors) at least half
+/// of nv (nv + 1) / 2 entries. Fixed by the model's trees; `Data::new` records it in `SoftWork`.
+pub(crate) fn dense_newton(model: &Model) -> bool {
+    let nv = model.nv;
+    if nv <= DENSE_NV {
+        return true;
+    }
+    if nv > DENSE_NV_CHAIN {
+        return false;
+    }
+    let lower: usize = (0..nv)
+        .map(|k| {
+            let (mut n, mut d) = (1, k);
+            while model.dof_parent[d] != crate::model::NO_DOF {
+                d = model.dof_parent[d];
+                n += 1;
+            }
+            n
+        })
+        .sum();
+    2 * lower >= nv * (nv + 1) / 2
+}
 
 /// Solves the soft problem from the rows of `data` (with `efc_aref`, `efc_r`, `efc_d` set) and
 /// `qfrc_smooth`, `qacc_smooth`, the mass matrix and its factor: writes `qacc`, `efc_force`,
@@ -230,8 +267,9 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     let (nz_start, nz_index) = (std::mem::take(&mut soft.nz_start), std::mem::take(&mut soft.nz_index));
     let nz_value = std::mem::take(&mut soft.nz_value);
     let nz = Sparsity { start: &nz_start, index: &nz_index, value: &nz_value };
-    // Small problems: J's products from its dense storage (`mul_j`, `mul_jt`).
-    let j_dense = (nv <= DENSE_NV).then_some(&*efc_j);
+    // The dense path (`dense_newton`): J's products from its dense storage (`mul_j`, `mul_jt`).
+    let dense = soft.dense;
+    let j_dense = dense.then_some(&*efc_j);
     let rows = Rows {
         ne: *ne,
         nf: *nf,
@@ -260,7 +298,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                  jar: &mut DVector<f64>,
                  force: &mut DVector<f64>,
                  state: &mut [_]| {
-        mul_m(&model.dof_parent, mass_matrix, x, ma);
+        mul_m(dense, &model.dof_parent, mass_matrix, x, ma);
         mul_j(&nz, j_dense, nefc, x, jar);
         for (j, &r) in jar.as_mut_slice()[..nefc].iter_mut().zip(&efc_aref.as_slice()[..nefc]) {
             *j -= r;
@@ -299,7 +337,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     // Whether `soft.dense_factor` holds the factor of the Hessian at `soft.factor_state`.
     let mut factor_valid = false;
     let mut stalled = false;
-    let island_path = method == Primal::Newton && nv > DENSE_NV;
+    let island_path = method == Primal::Newton && !dense;
     let mut converged_islands = false;
     if island_path {
         // Large problems: island by island (`island.rs`).
@@ -396,7 +434,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                 }
             }
             mul_j(&nz, j_dense, nefc, &soft.dir, &mut soft.jv);
-            mul_m(&model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
+            mul_m(dense, &model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
             let g0: f64 = (soft.ma.iter().zip(qfrc_smooth.iter()).zip(soft.dir.iter()))
                 .map(|((&ma, &f0), &d)| (ma - f0) * d)
                 .sum();
@@ -589,5 +627,42 @@ pub(super) fn line_search_with(mut deriv: impl FnMut(f64) -> (f64, f64), s: Sett
         0.5 * hi
     } else {
         alpha
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::dense_newton;
+    use crate::model::Model;
+
+    /// An MJCF world of `chains` chains of `links` bodies each, every link a ball joint (the
+    /// first of each chain free).
+    fn chains(chains: usize, links: usize) -> Model {
+        let mut xml = String::from("<mujoco><worldbody>");
+        for c in 0..chains {
+            xml += &format!("<body pos='{c} 0 1'><freejoint/><geom size='.05'/>");
+            for _ in 1..links {
+                xml += "<body pos='.1 0 0'><joint type='ball'/><geom size='.05'/>";
+            }
+            xml += &"</body>".repeat(links);
+        }
+        xml += "</worldbody></mujoco>";
+        Model::from_str(&xml).expect("the test model compiles")
+    }
+
+    #[test]
+    fn dense_path_for_small_models_and_long_chains_only() {
+        // nv 12: small.
+        assert!(dense_newton(&chains(2, 3)));
+        // One chain of 30 links, nv 93: M is dense.
+        assert!(dense_newton(&chains(1, 30)));
+        // Ten free bodies, nv 60: M block-diagonal, the islands' path.
+        assert!(!dense_newton(&chains(10, 1)));
+        // Two chains of 15, nv 96: M's two dense blocks just over half of it.
+        assert!(dense_newton(&chains(2, 15)));
+        // Three chains of 12, nv 117: a third of it.
+        assert!(!dense_newton(&chains(3, 12)));
+        // A chain of 70 links, nv 213: beyond the dense path's size.
+        assert!(!dense_newton(&chains(1, 70)));
     }
 }

@@ -3,7 +3,7 @@
 //! [`Data`](crate::Data), private to the solvers; their outputs (`efc_force`, `efc_state`,
 //! `qacc`, `solver_niter`, …) are `Data`'s own fields.
 
-use crate::model::EfcState;
+use crate::model::{EfcState, Model};
 use nalgebra::{DMatrix, DVector};
 
 /// Scratch of the soft solvers (`crate::constraint::soft`).
@@ -27,7 +27,10 @@ pub(crate) struct SoftWork {
     /// its factor's pattern), and its sparse Cholesky factor.
     pub hessian: DMatrix<f64>,
     pub factor: super::sparse_cholesky::SparseCholesky,
-    /// The dense Cholesky factor of small Hessians (nv × nv; empty above the dense size).
+    /// Whether the model's Newton solves take the dense path (`primal::dense_newton`).
+    pub dense: bool,
+    /// The dense Cholesky factor of the dense path's Hessians (nv × nv; empty on the islands'
+    /// path).
     pub dense_factor: DMatrix<f64>,
     /// The row states `dense_factor` was formed for (the Newton iterations after the first
     /// update it row by row as states change; `primal.rs`), and the scaled row of one update (nv).
@@ -64,7 +67,10 @@ pub(crate) struct SoftWork {
 }
 
 impl SoftWork {
-    pub fn new(nv: usize, nefc: usize) -> Self {
+    /// The workspace for `model` and `nefc` rows.
+    pub fn new(model: &Model, nefc: usize) -> Self {
+        let nv = model.nv;
+        let dense = super::primal::dense_newton(model);
         Self {
             jar: DVector::zeros(nefc),
             jv: DVector::zeros(nefc),
@@ -78,11 +84,8 @@ impl SoftWork {
             mgrad_prev: DVector::zeros(nv),
             hessian: DMatrix::zeros(nv, nv),
             factor: super::sparse_cholesky::SparseCholesky::with_capacity(nv),
-            dense_factor: if nv <= super::primal::DENSE_NV {
-                DMatrix::zeros(nv, nv)
-            } else {
-                DMatrix::zeros(0, 0)
-            },
+            dense,
+            dense_factor: if dense { DMatrix::zeros(nv, nv) } else { DMatrix::zeros(0, 0) },
             factor_state: vec![EfcState::Satisfied; nefc],
             rank_one: vec![0.0; nv],
             active_rows: Vec::with_capacity(nefc),
