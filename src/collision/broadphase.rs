@@ -65,6 +65,9 @@ pub struct BroadphaseWork {
     /// Per candidate pair, the hill-climb starts of its two hulls in the separation test: the
     /// last pass's support vertices (−1: none; see `ccd::separated`).
     pub(crate) warm: Vec<[i32; 2]>,
+    /// Per geom, the world axes of its bounding box when they are not the geom's own
+    /// (`obb::LocalBox::axes`, a mesh's principal axes), formed once per collision pass.
+    pub(crate) box_axes: Vec<crate::spatial::Mat3>,
 }
 
 impl BroadphaseWork {
@@ -75,6 +78,7 @@ impl BroadphaseWork {
             pairs: Vec::with_capacity(model.collision_pairs.len()),
             touching: vec![false; model.collision_pairs.len()],
             warm: vec![[-1, -1]; model.collision_pairs.len()],
+            box_axes: vec![crate::spatial::Mat3::identity(); model.geoms.len()],
         }
     }
 }

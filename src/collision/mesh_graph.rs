@@ -24,7 +24,7 @@
 //! The golden file tests/data/mujoco/qhull.json (validation/mujoco_qhull_golden.py) holds MuJoCo's
 //! graphs and polygons for the corpus meshes; tests/mesh_graph.rs compares them exactly.
 
-use crate::spatial::Vec3;
+use crate::spatial::{Mat3, Vec3};
 use std::collections::HashMap;
 
 /// A mesh's hull graph and face polygons in MuJoCo's orders (see the module documentation).
@@ -55,6 +55,10 @@ pub struct MeshGraph {
     pub vpoly_start: Vec<u32>,
     /// The vertex-to-polygon lists (see `vpoly_start`).
     pub vpolys: Vec<u32>,
+    /// MuJoCo's frame of the mesh in the geom frame — its centre of mass and principal axes
+    /// (`mjCMesh::Process`) — in which MuJoCo's bounding box of the geom (`geom_aabb`) is
+    /// axis-aligned (`obb::LocalBox`); the geom frame itself (identity) when it is not known.
+    pub box_frame: (Vec3, Mat3),
 }
 
 /// Why a mesh has no hull graph.
@@ -157,6 +161,7 @@ impl MeshGraph {
             poly_normal,
             vpoly_start,
             vpolys,
+            box_frame: (Vec3::zeros(), Mat3::identity()),
         })
     }
 

@@ -61,7 +61,7 @@ pub use ray::{ray, ray_site, RayFilter, RayHit};
 
 use crate::model::spec::Shape;
 use crate::model::{Contact, Data, Model};
-use crate::spatial::Vec3;
+use crate::spatial::{Transform, Vec3};
 use convex::PairPoint;
 use plane::PlanePoint;
 use plane_mesh::PlaneHull;
@@ -89,7 +89,7 @@ pub struct CollisionModel {
     /// The sweep and prune over the geoms' boxes ([`broadphase`]).
     pub sweep: broadphase::Broadphase,
     /// Per geom, its bounding box in its own frame for the [`obb`] test (None for planes, height
-    /// fields and meshes without a hull).
+    /// fields and meshes without a hull); a mesh's along MuJoCo's axes of it (`geom_aabb`'s).
     pub local_box: Vec<Option<obb::LocalBox>>,
 }
 
@@ -151,7 +151,11 @@ impl CollisionModel {
             })
             .collect();
         let sweep = broadphase::Broadphase::new(model, &rbound);
-        let local_box = model.geoms.iter().map(|g| obb::LocalBox::of(&g.shape, g.hull())).collect();
+        let local_box = model
+            .geoms
+            .iter()
+            .map(|g| obb::LocalBox::of(&g.shape, g.hull(), g.hull_graph.as_ref().map(|h| &h.box_frame)))
+            .collect();
         Self { shapes, rbound, broad, plane_hulls, sweep, local_box }
     }
 }
@@ -167,6 +171,9 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
     for (g, geom) in model.geoms.iter().enumerate() {
         if cm.shapes[g].is_some() || geom.collision {
             data.x_world_geom[g] = data.attached_pose(geom.body, geom.mocap, &geom.x_body_geom);
+            if let Some(Some(axes)) = cm.local_box.get(g).map(|b| b.as_ref().and_then(|b| b.axes)) {
+                data.broadphase.box_axes[g] = data.x_world_geom[g].rot * axes;
+            }
         }
     }
     // Sweep and prune narrows the candidate pairs first when there are many (same pairs, same
@@ -215,7 +222,14 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
         let (x1, x2) = (data.x_world_geom[g1], data.x_world_geom[g2]);
         let within = pair.margin + pair.gap + reach;
         if let (Some(b1), Some(b2)) = (&cm.local_box[g1], &cm.local_box[g2]) {
-            if obb::apart(b1, &x1, b2, &x2, within) {
+            let axes = |b: &obb::LocalBox, g: usize, x: &Transform| {
+                if b.axes.is_some() {
+                    data.broadphase.box_axes[g]
+                } else {
+                    x.rot
+                }
+            };
+            if obb::apart_along(b1, &x1, &axes(b1, g1, &x1), b2, &x2, &axes(b2, g2, &x2), within) {
                 continue;
             }
         }

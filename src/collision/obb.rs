@@ -19,15 +19,20 @@ use crate::spatial::{Mat3, Transform, Vec3};
 pub struct LocalBox {
     /// Centre (geom frame, m).
     pub centre: Vec3,
-    /// Half-extents along the geom's axes (m).
+    /// Half-extents along the box's axes (m).
     pub half: Vec3,
+    /// The box's axes in the geom frame (columns; MuJoCo's mesh frame for a mesh, `None` for the
+    /// geom's own axes).
+    pub axes: Option<Mat3>,
 }
 
 impl LocalBox {
-    /// The box of a primitive `shape`, or of a mesh geom's `hull` vertices (geom frame); None for
-    /// planes, height fields and meshes without a hull.
-    pub fn of(shape: &Shape, hull: Option<&[Vec3]>) -> Option<Self> {
-        let at_origin = |half: Vec3| Some(Self { centre: Vec3::zeros(), half });
+    /// The box of a primitive `shape`, or of a mesh geom's `hull` vertices (geom frame) along
+    /// the axes of `frame` = (origin, axes) — MuJoCo's mesh frame, where its `geom_aabb` is
+    /// axis-aligned (the principal axes hug an elongated mesh far better than the file's); None
+    /// for planes, height fields and meshes without a hull.
+    pub fn of(shape: &Shape, hull: Option<&[Vec3]>, frame: Option<&(Vec3, Mat3)>) -> Option<Self> {
+        let at_origin = |half: Vec3| Some(Self { centre: Vec3::zeros(), half, axes: None });
         match shape {
             Shape::Sphere { radius } => at_origin(Vec3::repeat(*radius)),
             Shape::Capsule { radius, length } => {
@@ -38,9 +43,19 @@ impl LocalBox {
             Shape::Ellipsoid { radii } => at_origin(*radii),
             Shape::Mesh { .. } => {
                 let hull = hull?;
-                let first = *hull.first()?;
-                let (lo, hi) = hull.iter().fold((first, first), |(lo, hi), v| (lo.inf(v), hi.sup(v)));
-                Some(Self { centre: (lo + hi) / 2.0, half: (hi - lo) / 2.0 })
+                let (origin, axes) = frame.copied().unwrap_or((Vec3::zeros(), Mat3::identity()));
+                let local = |v: &Vec3| axes.tr_mul(&(v - origin));
+                let first = local(hull.first()?);
+                let (lo, hi) = hull.iter().fold((first, first), |(lo, hi), v| {
+                    let u = local(v);
+                    (lo.inf(&u), hi.sup(&u))
+                });
+                let rotated = axes != Mat3::identity();
+                Some(Self {
+                    centre: origin + axes * ((lo + hi) / 2.0),
+                    half: (hi - lo) / 2.0,
+                    axes: rotated.then_some(axes),
+                })
             }
             Shape::Plane { .. } | Shape::Hfield { .. } => None,
         }
@@ -54,11 +69,26 @@ const PARALLEL_EPS: f64 = 1e-12;
 /// Whether boxes `b1` at pose `x1` and `b2` at pose `x2` are farther apart than `margin` along
 /// one of the 15 separating axes (then the geoms cannot touch within `margin`).
 pub fn apart(b1: &LocalBox, x1: &Transform, b2: &LocalBox, x2: &Transform, margin: f64) -> bool {
+    let axes = |x: &Transform, b: &LocalBox| b.axes.map_or(x.rot, |a| x.rot * a);
+    apart_along(b1, x1, &axes(x1, b1), b2, x2, &axes(x2, b2), margin)
+}
+
+/// [`apart`] with the boxes' world axes given (`rot1` = x1.rot · b1's axes, likewise `rot2`:
+/// the collision pass forms them once per geom).
+pub fn apart_along(
+    b1: &LocalBox,
+    x1: &Transform,
+    rot1: &Mat3,
+    b2: &LocalBox,
+    x2: &Transform,
+    rot2: &Mat3,
+    margin: f64,
+) -> bool {
     // Box 2 in box 1's axes: rotation r, centre offset t.
-    let r: Mat3 = x1.rot.transpose() * x2.rot;
+    let r: Mat3 = rot1.transpose() * rot2;
     let c1 = x1.act_point(&b1.centre);
     let c2 = x2.act_point(&b2.centre);
-    let t = x1.rot.tr_mul(&(c2 - c1));
+    let t = rot1.tr_mul(&(c2 - c1));
     let abs = r.map(|a| a.abs() + PARALLEL_EPS);
     let (a, b) = (&b1.half, &b2.half);
     // Box 1's face normals.
@@ -120,10 +150,14 @@ mod tests {
             let b1 = LocalBox {
                 centre: Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5) * 0.2,
                 half: Vec3::new(rand(), rand(), rand()) * 0.3 + Vec3::repeat(0.01),
+                axes: None,
             };
+            // Box 2 along axes of its own in its geom frame (a mesh's principal axes) half the time.
+            let axes = pose([0.0; 3], [rand() - 0.5, rand() - 0.5, rand() - 0.5], 6.0 * rand()).rot;
             let b2 = LocalBox {
                 centre: Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5) * 0.2,
                 half: Vec3::new(rand(), rand(), rand()) * 0.3 + Vec3::repeat(0.01),
+                axes: (rand() < 0.5).then_some(axes),
             };
             let x1 = pose([rand(), rand(), rand()], [rand() - 0.5, rand() - 0.5, rand() - 0.5], 6.0 * rand());
             let x2 = pose([rand(), rand(), rand()], [rand() - 0.5, rand() - 0.5, rand() - 0.5], 6.0 * rand());
@@ -134,7 +168,8 @@ mod tests {
             rejected += 1;
             let to_pose = |x: &Transform, b: &LocalBox| {
                 let c = x.act_point(&b.centre);
-                let [w, qx, qy, qz] = x.quat_wxyz();
+                let box_frame = Transform { rot: b.axes.map_or(x.rot, |a| x.rot * a), pos: c };
+                let [w, qx, qy, qz] = box_frame.quat_wxyz();
                 parry3d_f64::math::Pose::from_parts(
                     parry3d_f64::math::Vector::new(c.x, c.y, c.z),
                     parry3d_f64::math::Rotation::from_xyzw(qx, qy, qz, w),
@@ -152,15 +187,24 @@ mod tests {
 
     #[test]
     fn boxes_of_primitives_and_hulls() {
-        let b = LocalBox::of(&Shape::Capsule { radius: 0.25, length: 1.0 }, None).unwrap();
+        let b = LocalBox::of(&Shape::Capsule { radius: 0.25, length: 1.0 }, None, None).unwrap();
         assert_eq!(b.half, Vec3::new(0.25, 0.25, 0.75));
         let hull = [Vec3::new(1.0, 2.0, 3.0), Vec3::new(-1.0, 0.0, 5.0)];
         let b = LocalBox::of(
             &Shape::Mesh { source: crate::mass::MeshSource::File("m.stl".into()), scale: Vec3::repeat(1.0) },
             Some(&hull),
+            None,
         )
         .unwrap();
         assert_eq!((b.centre, b.half), (Vec3::new(0.0, 1.0, 4.0), Vec3::new(1.0, 1.0, 1.0)));
-        assert!(LocalBox::of(&Shape::Plane { size: Vec3::repeat(1.0) }, None).is_none());
+        // Along a frame turned 90° about z with its origin at (1, 0, 0): u = Rᵀ (v − o).
+        let turn = Mat3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+        let mesh =
+            Shape::Mesh { source: crate::mass::MeshSource::File("m.stl".into()), scale: Vec3::repeat(1.0) };
+        let b = LocalBox::of(&mesh, Some(&hull), Some(&(Vec3::new(1.0, 0.0, 0.0), turn))).unwrap();
+        assert_eq!(b.axes, Some(turn));
+        assert!((b.half - Vec3::new(1.0, 1.0, 1.0)).norm() < 1e-15);
+        assert!((b.centre - Vec3::new(0.0, 1.0, 4.0)).norm() < 1e-15);
+        assert!(LocalBox::of(&Shape::Plane { size: Vec3::repeat(1.0) }, None, None).is_none());
     }
 }

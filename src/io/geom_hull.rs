@@ -98,10 +98,14 @@ pub fn geom_hull(
         (file.vertices.clone(), mesh.vertices.clone())
     };
     let mut placed = scaled.clone();
-    if let Some((com, r)) = mujoco_mesh_frame(&mesh, g.mesh_inertia) {
+    let frame = mujoco_mesh_frame(&mesh, g.mesh_inertia);
+    if let Some((com, r)) = frame {
         round_as_mujoco(&mut placed, &com, &r);
     }
-    let graph = MeshGraph::new(&unscaled, &scaled, &placed, -1).map_err(|e| err(e.to_string()))?;
+    let mut graph = MeshGraph::new(&unscaled, &scaled, &placed, -1).map_err(|e| err(e.to_string()))?;
+    if let Some(frame) = frame {
+        graph.box_frame = frame;
+    }
     let entry = Arc::new(graph);
     cache.entries.insert(key, entry.clone());
     Ok(Some(entry))
