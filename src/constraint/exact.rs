@@ -122,6 +122,7 @@ pub(crate) fn solve_exact(
     if has_friction(data) {
         if settings.solver == ExactContactSolver::Admm {
             solve_admm(model, data, settings);
+            data.exact.warm_exact = false;
         } else {
             let scale = data.qacc_smooth.amax();
             solve_coulomb(model, data, Level::Acceleration, settings, scale);

@@ -33,6 +33,14 @@ pub(crate) struct ExactWork {
     /// the (type, id) of each of its rows; reused when the rows are the same.
     pub warm: DVector<f64>,
     pub warm_rows: Vec<(EfcType, usize)>,
+    /// Whether the last acceleration-level Coulomb solve ended with an exact solve of its active
+    /// set (a polish that held): the next solve of the same rows tries that set first.
+    pub warm_exact: bool,
+    /// The factorization work (multiply-adds) of that polish, and what the sweeps of the last
+    /// warm-started solve that swept cost (sweeps × (n² + n·nv) and their polishes; 0 after a
+    /// cold start): the polish is tried first while it is the cheaper.
+    pub warm_polish_work: f64,
+    pub warm_sweep_work: f64,
     /// λ at the start of a Gauss–Seidel sweep.
     pub lambda_prev: DVector<f64>,
     /// Per row, during the velocity projection: a limit or contact row that carried a compressive
@@ -94,6 +102,9 @@ impl ExactWork {
             a_floor: 0.0,
             warm: DVector::zeros(nefc),
             warm_rows: Vec::with_capacity(nefc),
+            warm_exact: false,
+            warm_polish_work: 0.0,
+            warm_sweep_work: 0.0,
             lambda_prev: DVector::zeros(nefc),
             pressing: vec![false; nefc],
             slipping: vec![false; nefc],
