@@ -15,10 +15,10 @@ use super::energy_guard::{free_row_velocity, limit_energy};
 use super::ConstraintModel;
 use super::ExactWork;
 use crate::collision::{collide, EXACT_REACH};
-use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_span_unchecked, tree_span};
+use crate::dynamics::{crba_unchecked, factorize_mass_matrix, tree_span};
 use crate::error::{check, InputError};
 use crate::kinematics::body_poses;
-use crate::model::{integrate_configuration_unchecked, Data, EfcType, Model};
+use crate::model::{integrate_configuration_unchecked, Data, EfcType, Model, NO_DOF};
 
 /// Y = M⁻¹Jᵀ into `efc_minv_jt` and A = J M⁻¹ Jᵀ into `efc_delassus` for the current rows (needs
 /// the factor of M in `mass_factor`). Each row touches the dofs of at most two kinematic trees,
@@ -35,25 +35,33 @@ fn delassus(model: &Model, data: &mut Data) {
     let Data {
         efc_j,
         mass_factor,
-        exact: ExactWork { minv_jt: efc_minv_jt, delassus: efc_delassus, jt, spans, .. },
+        exact: ExactWork { minv_jt: efc_minv_jt, delassus: efc_delassus, jt, spans, yt, yt_acc, yt_run, .. },
         ..
     } = data;
-    // Jᵀ, read down J's columns (contiguous in its storage).
+    // Jᵀ, read down J's columns (contiguous in its storage), and each row's span.
     let jt = &mut jt.as_mut_slice()[..nv * n];
+    let yt = &mut yt[..n * nv];
     for k in 0..nv {
-        for (i, &jik) in efc_j.column(k).as_slice()[..n].iter().enumerate() {
+        let col = &efc_j.as_slice()[k * efc_j.nrows()..k * efc_j.nrows() + n];
+        yt[k * n..(k + 1) * n].copy_from_slice(col);
+        for (i, &jik) in col.iter().enumerate() {
             jt[k + i * nv] = jik;
         }
     }
-    let y = &mut efc_minv_jt.as_mut_slice()[..nv * n];
-    y.copy_from_slice(jt);
     for i in 0..n {
-        let col = &mut y[i * nv..(i + 1) * nv];
-        spans[i] = match (col.iter().position(|&x| x != 0.0), col.iter().rposition(|&x| x != 0.0)) {
+        let row = &jt[i * nv..(i + 1) * nv];
+        spans[i] = match (row.iter().position(|&x| x != 0.0), row.iter().rposition(|&x| x != 0.0)) {
             (Some(first), Some(last)) => tree_span(model, first, last),
             _ => (0, 0),
         };
-        solve_with_factor_span_unchecked(model, mass_factor, col, spans[i]);
+    }
+    // Y = M⁻¹Jᵀ for all rows at once, on its transpose.
+    solve_rows(model, mass_factor.as_slice(), yt, n, &mut yt_acc[..n], &mut yt_run[..n]);
+    let y = &mut efc_minv_jt.as_mut_slice()[..nv * n];
+    for k in 0..nv {
+        for (i, &x) in yt[k * n..(k + 1) * n].iter().enumerate() {
+            y[k + i * nv] = x;
+        }
     }
     // The upper triangle column by column (contiguous writes): A_ij = J_i · Y_j over the dofs of
     // both rows' trees, ascending (outside them a term of the dense sum is an exact zero).
@@ -82,6 +90,100 @@ fn delassus(model: &Model, data: &mut Data) {
                     a[j + i * stride] = a[i + j * stride];
                 }
             }
+        }
+    }
+}
+
+/// Solves M X = B for the n right-hand sides of `yt` (Bᵀ on entry, Xᵀ on return: n × nv,
+/// column-major, one dof's column of n entries contiguous) with the tree-sparse factor of M: each
+/// step of the solve updates a whole column, across every right-hand side. Per right-hand side
+/// the operations, and their order, are those of `dynamics::crba::solve_with_factor_span_unchecked`
+/// (Lᵀ z = b from the leaves up, D w = z, L x = w from the root down with each run of the
+/// ancestor chain summed apart), so the same bits: dofs outside a row's trees hold zeros and
+/// stay zero. `acc` and `run` (n each) are scratch.
+fn solve_rows(model: &Model, factor: &[f64], yt: &mut [f64], n: usize, acc: &mut [f64], run: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `solve_rows_avx2` requires.
+        unsafe { solve_rows_avx2(model, factor, yt, n, acc, run) };
+        return;
+    }
+    solve_rows_kernel(model, factor, yt, n, acc, run);
+}
+
+/// [`solve_rows_kernel`] compiled for AVX2: the same operations in the same order (no fused
+/// multiply–adds), four right-hand sides per instruction, so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn solve_rows_avx2(
+    model: &Model,
+    factor: &[f64],
+    yt: &mut [f64],
+    n: usize,
+    acc: &mut [f64],
+    run: &mut [f64],
+) {
+    solve_rows_kernel(model, factor, yt, n, acc, run);
+}
+
+#[inline(always)]
+fn solve_rows_kernel(model: &Model, h: &[f64], yt: &mut [f64], n: usize, acc: &mut [f64], run: &mut [f64]) {
+    let nv = model.nv;
+    let lambda = &model.dof_parent[..nv];
+    // The empty sum, as `Iterator::sum` starts it.
+    let zero: f64 = std::iter::empty::<f64>().sum();
+    // Lᵀ z = b: x[j] −= L[i][j] x[i] over the ancestor chain of each dof, from the leaves up.
+    for i in (0..nv).rev() {
+        if lambda[i] == NO_DOF {
+            continue;
+        }
+        let col_l = &h[i * nv..(i + 1) * nv];
+        let (before, rest) = yt.split_at_mut(i * n);
+        let x_i = &rest[..n];
+        let mut e = lambda[i];
+        while e != NO_DOF {
+            let s = model.dof_run_start[e];
+            for j in s..=e {
+                let l = col_l[j];
+                for (a, b) in before[j * n..(j + 1) * n].iter_mut().zip(x_i) {
+                    *a -= l * b;
+                }
+            }
+            e = lambda[s];
+        }
+    }
+    // D w = z.
+    for i in 0..nv {
+        let d = h[i + i * nv];
+        for a in &mut yt[i * n..(i + 1) * n] {
+            *a /= d;
+        }
+    }
+    // L x = w: x[i] −= Σ over the runs of its ancestor chain (each run summed, then added).
+    for i in 0..nv {
+        if lambda[i] == NO_DOF {
+            continue;
+        }
+        let col_l = &h[i * nv..(i + 1) * nv];
+        let (before, rest) = yt.split_at_mut(i * n);
+        acc.fill(0.0);
+        let mut e = lambda[i];
+        while e != NO_DOF {
+            let s = model.dof_run_start[e];
+            run.fill(zero);
+            for j in s..=e {
+                let l = col_l[j];
+                for (r, x) in run.iter_mut().zip(&before[j * n..(j + 1) * n]) {
+                    *r += x * l;
+                }
+            }
+            for (a, r) in acc.iter_mut().zip(run.iter()) {
+                *a += r;
+            }
+            e = lambda[s];
+        }
+        for (x, a) in rest[..n].iter_mut().zip(acc.iter()) {
+            *x -= a;
         }
     }
 }

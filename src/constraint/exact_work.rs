@@ -69,6 +69,11 @@ pub(crate) struct ExactWork {
     pub admm: super::admm::AdmmWork,
     /// Jᵀ, nv × nefc (columns 0..nefc used): each row of J contiguous, for the Delassus products.
     pub jt: DMatrix<f64>,
+    /// M⁻¹Jᵀ transposed while it is solved, nefc × nv column-major (stride nefc: one dof's
+    /// entries over the rows contiguous), and two per-row sums of its back substitution.
+    pub yt: Vec<f64>,
+    pub yt_acc: Vec<f64>,
+    pub yt_run: Vec<f64>,
     /// Per row, the dofs [lo, hi) of the kinematic trees it touches (`dynamics::tree_span`):
     /// M⁻¹ J_iᵀ is zero outside them, and A_ij = 0 when two rows' spans are disjoint.
     pub spans: Vec<(usize, usize)>,
@@ -116,6 +121,9 @@ impl ExactWork {
             pivots: vec![0; 2 * nefc],
             admm: Default::default(),
             jt: DMatrix::zeros(nv, nefc),
+            yt: vec![0.0; nv * nefc],
+            yt_acc: vec![0.0; nefc],
+            yt_run: vec![0.0; nefc],
             spans: vec![(0, 0); nefc],
             previous: DVector::zeros(nefc),
             polish_set: 0,
@@ -135,6 +143,9 @@ impl ExactWork {
         }
         self.minv_jt = DMatrix::zeros(nv, nefc);
         self.jt = DMatrix::zeros(nv, nefc);
+        self.yt = vec![0.0; nv * nefc];
+        self.yt_acc = vec![0.0; nefc];
+        self.yt_run = vec![0.0; nefc];
         for m in [&mut self.delassus, &mut self.factor, &mut self.sub] {
             *m = DMatrix::zeros(nefc, nefc);
         }
