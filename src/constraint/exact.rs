@@ -188,17 +188,24 @@ fn solve_rows_kernel(model: &Model, h: &[f64], yt: &mut [f64], n: usize, acc: &m
     }
 }
 
-/// J_i · x for row `i` of the current rows.
+/// J_i · x for row `i` of the current rows, over its trees' dofs (`exact.spans`; J_i is zero
+/// outside them): the dense sum's terms in its order, without its exact zeros. Needs the rows'
+/// Jᵀ and spans of [`delassus`] at the current J.
 fn row_dot(data: &Data, nv: usize, i: usize, x: &[f64]) -> f64 {
-    (0..nv).map(|k| data.efc_j[(i, k)] * x[k]).sum()
+    let (lo, hi) = data.exact.spans[i];
+    let row = &data.exact.jt.as_slice()[i * nv..(i + 1) * nv];
+    row[lo..hi].iter().zip(&x[lo..hi]).map(|(j, x)| j * x).sum()
 }
 
-/// x += s · M⁻¹Jᵀ μ with μ the first nefc entries of `efc_rhs` (the result of a Delassus solve).
+/// x += s · M⁻¹Jᵀ μ with μ the first nefc entries of `efc_rhs` (the result of a Delassus solve),
+/// each row's column over its trees' dofs (zero outside them).
 fn add_minv_jt_mu(data: &Data, nv: usize, s: f64, x: &mut [f64]) {
+    let y = data.exact.minv_jt.as_slice();
     for i in 0..data.nefc {
         let mu = s * data.exact.rhs[i];
-        for k in 0..nv {
-            x[k] += data.exact.minv_jt[(k, i)] * mu;
+        let (lo, hi) = data.exact.spans[i];
+        for (x, y) in x[lo..hi].iter_mut().zip(&y[i * nv + lo..i * nv + hi]) {
+            *x += y * mu;
         }
     }
 }
@@ -253,8 +260,10 @@ pub(crate) fn solve_exact(
         data.efc_force[i] = lambda;
         data.exact.warm[i] = lambda;
         data.exact.warm_rows.push((data.efc_type[i], data.efc_id[i]));
-        for k in 0..nv {
-            data.qfrc_constraint[k] += data.efc_j[(i, k)] * lambda;
+        let (lo, hi) = data.exact.spans[i];
+        let row = &data.exact.jt.as_slice()[i * nv + lo..i * nv + hi];
+        for (f, j) in data.qfrc_constraint.as_mut_slice()[lo..hi].iter_mut().zip(row) {
+            *f += j * lambda;
         }
     }
 }
