@@ -35,7 +35,10 @@ fn delassus(model: &Model, data: &mut Data) {
     let Data {
         efc_j,
         mass_factor,
-        exact: ExactWork { minv_jt: efc_minv_jt, delassus: efc_delassus, jt, spans, yt, yt_acc, yt_run, .. },
+        exact:
+            ExactWork {
+                minv_jt: efc_minv_jt, delassus: efc_delassus, jt, spans, yt, yt_acc, yt_run, order, ..
+            },
         ..
     } = data;
     // Jᵀ, read down J's columns (contiguous in its storage), and each row's span.
@@ -63,10 +66,30 @@ fn delassus(model: &Model, data: &mut Data) {
             y[k + i * nv] = x;
         }
     }
-    // The upper triangle column by column (contiguous writes): A_ij = J_i · Y_j over the dofs of
-    // both rows' trees, ascending (outside them a term of the dense sum is an exact zero).
+    // A_ij = J_i · Y_j over the dofs of both rows' trees, ascending (outside them a term of the
+    // dense sum is an exact zero), for i ≤ j, mirrored to A_ji; zero when the trees are disjoint.
     let stride = efc_delassus.nrows();
     let a = efc_delassus.as_mut_slice();
+    let width = spans[..n].iter().map(|&(lo, hi)| hi - lo).max().unwrap_or(0);
+    if 2 * width >= nv {
+        delassus_all_pairs(a, stride, n, nv, jt, y, spans);
+    } else {
+        delassus_meeting_pairs(a, stride, n, nv, jt, y, spans, &mut order[..n], width);
+    }
+}
+
+/// A_ij = J_i · Y_j (over both rows' spans) for every pair i ≤ j, column by column (contiguous
+/// writes), and the lower triangle by symmetry: when most rows' trees meet (one robot, a pair of
+/// boxes).
+fn delassus_all_pairs(
+    a: &mut [f64],
+    stride: usize,
+    n: usize,
+    nv: usize,
+    jt: &[f64],
+    y: &[f64],
+    spans: &[(usize, usize)],
+) {
     for j in 0..n {
         let (lo_j, hi_j) = spans[j];
         let y_j = &y[j * nv..(j + 1) * nv];
@@ -80,8 +103,8 @@ fn delassus(model: &Model, data: &mut Data) {
             };
         }
     }
-    // The lower triangle by symmetry, in 8 × 8 tiles (each tile's reads and writes stay in a few
-    // cache lines of the nefc-capacity-strided matrix).
+    // The lower triangle in 8 × 8 tiles (each tile's reads and writes stay in a few cache lines
+    // of the capacity-strided matrix).
     const TILE: usize = 8;
     for ib in (0..n).step_by(TILE) {
         for jb in (ib..n).step_by(TILE) {
@@ -90,6 +113,59 @@ fn delassus(model: &Model, data: &mut Data) {
                     a[j + i * stride] = a[i + j * stride];
                 }
             }
+        }
+    }
+}
+
+/// [`delassus_all_pairs`] visiting only the pairs whose spans meet, for rows on many separate
+/// trees (a stack, a bin: each row touches one or two of them): the rest is zero. The rows in
+/// order of their span's first dof (`order`); row i can meet row j only if
+/// lo_j − `width` < lo_i < hi_j (`width` the widest span).
+#[allow(clippy::too_many_arguments)]
+fn delassus_meeting_pairs(
+    a: &mut [f64],
+    stride: usize,
+    n: usize,
+    nv: usize,
+    jt: &[f64],
+    y: &[f64],
+    spans: &[(usize, usize)],
+    order: &mut [usize],
+    width: usize,
+) {
+    // Insertion sort, stable: the rows come mostly in order already (a contact's rows together,
+    // contacts by body).
+    for k in 0..n {
+        let lo = spans[k].0;
+        let mut p = k;
+        while p > 0 && spans[order[p - 1]].0 > lo {
+            order[p] = order[p - 1];
+            p -= 1;
+        }
+        order[p] = k;
+    }
+    for j in 0..n {
+        a[j * stride..j * stride + n].fill(0.0);
+    }
+    for j in 0..n {
+        let (lo_j, hi_j) = spans[j];
+        if lo_j >= hi_j {
+            continue;
+        }
+        let y_j = &y[j * nv..(j + 1) * nv];
+        let start = order.partition_point(|&i| spans[i].0 + width <= lo_j);
+        for &i in &order[start..] {
+            let (lo_i, hi_i) = spans[i];
+            if lo_i >= hi_j {
+                break;
+            }
+            let (lo, hi) = (lo_i.max(lo_j), hi_i.min(hi_j));
+            if i > j || lo >= hi {
+                continue;
+            }
+            let v: f64 = jt[i * nv + lo..i * nv + hi].iter().zip(&y_j[lo..hi]).map(|(x, y)| x * y).sum();
+            a[i + j * stride] = v;
+            a[j + i * stride] = v;
         }
     }
 }
@@ -404,7 +480,8 @@ mod tests {
     /// pendulum touching the floor, a free capsule.
     #[test]
     fn delassus_equals_the_dense_products() {
-        let mut model = crate::Model::from_str(
+        // All pairs visited (the trees' spans cover most dofs).
+        check_delassus(
             "<mujoco><worldbody><geom type='plane' size='0 0 1'/>\
              <body pos='0 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
              <body pos='0 0 0.148'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
@@ -412,8 +489,25 @@ mod tests {
              <body pos='0 0 -0.3'><joint type='hinge' axis='1 0 0'/><geom size='0.03'/></body></body>\
              <body pos='1 0 0.019' euler='0 90 0'><freejoint/><geom type='capsule' size='0.02 0.1'/></body>\
              </worldbody></mujoco>",
-        )
-        .unwrap();
+        );
+        // Only the meeting pairs visited: two stacks of two boxes and three lone boxes, in an
+        // order whose rows do not come sorted by tree (a stack's upper box first).
+        check_delassus(
+            "<mujoco><worldbody><geom type='plane' size='0 0 1'/>\
+             <body pos='0 0 0.148'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='0.3 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='0 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='0.6 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='0.9 0 0.148'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='1.2 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='0.9 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             </worldbody></mujoco>",
+        );
+    }
+
+    /// [`delassus`] of the scene `xml` in exact mode against the dense products.
+    fn check_delassus(xml: &str) {
+        let mut model = crate::Model::from_str(xml).unwrap();
         model.set_constraint_mode(ConstraintMode::Exact);
         let mut data = Data::new(&model);
         crate::forward::forward(&model, &mut data);

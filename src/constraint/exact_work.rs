@@ -74,6 +74,8 @@ pub(crate) struct ExactWork {
     pub yt: Vec<f64>,
     pub yt_acc: Vec<f64>,
     pub yt_run: Vec<f64>,
+    /// The rows in order of the first dof of their span (the Delassus products' pairing).
+    pub order: Vec<usize>,
     /// Per row, the dofs [lo, hi) of the kinematic trees it touches (`dynamics::tree_span`):
     /// M⁻¹ J_iᵀ is zero outside them, and A_ij = 0 when two rows' spans are disjoint.
     pub spans: Vec<(usize, usize)>,
@@ -124,6 +126,7 @@ impl ExactWork {
             yt: vec![0.0; nv * nefc],
             yt_acc: vec![0.0; nefc],
             yt_run: vec![0.0; nefc],
+            order: vec![0; nefc],
             spans: vec![(0, 0); nefc],
             previous: DVector::zeros(nefc),
             polish_set: 0,
@@ -146,6 +149,7 @@ impl ExactWork {
         self.yt = vec![0.0; nv * nefc];
         self.yt_acc = vec![0.0; nefc];
         self.yt_run = vec![0.0; nefc];
+        self.order = vec![0; nefc];
         for m in [&mut self.delassus, &mut self.factor, &mut self.sub] {
             *m = DMatrix::zeros(nefc, nefc);
         }
