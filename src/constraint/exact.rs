@@ -20,7 +20,8 @@ use crate::error::{check, InputError};
 use crate::kinematics::body_poses;
 use crate::model::{integrate_configuration_unchecked, Data, EfcType, Model, NO_DOF};
 
-/// Y = M⁻¹Jᵀ into `efc_minv_jt` and A = J M⁻¹ Jᵀ into `efc_delassus` for the current rows (needs
+/// Y = M⁻¹Jᵀ into `efc_minv_jt` (each row's column over its span only: zero outside it, and not
+/// written there) and A = J M⁻¹ Jᵀ into `efc_delassus` for the current rows (needs
 /// the factor of M in `mass_factor`). Each row touches the dofs of at most two kinematic trees,
 /// and M is block-diagonal over trees: Y_i is solved over its row's trees only and A_ij is
 /// J_i · Y_j over the dofs both rows' trees share (zero when there are none) — the dense
@@ -60,10 +61,11 @@ fn delassus(model: &Model, data: &mut Data) {
     }
     // Y = M⁻¹Jᵀ for all rows at once, on its transpose.
     solve_rows(model, mass_factor.as_slice(), yt, n, &mut yt_acc[..n], &mut yt_run[..n]);
+    // Each row's column of M⁻¹Jᵀ over its span (zero outside it, where no reader looks).
     let y = &mut efc_minv_jt.as_mut_slice()[..nv * n];
-    for k in 0..nv {
-        for (i, &x) in yt[k * n..(k + 1) * n].iter().enumerate() {
-            y[k + i * nv] = x;
+    for (i, &(lo, hi)) in spans[..n].iter().enumerate() {
+        for (k, x) in (lo..hi).zip(&mut y[i * nv + lo..i * nv + hi]) {
+            *x = yt[k * n + i];
         }
     }
     // A_ij = J_i · Y_j over the dofs of both rows' trees, ascending (outside them a term of the
@@ -526,7 +528,12 @@ mod tests {
                 let dense_upper: f64 = (0..nv).map(|k| j[(r, k)] * y[(k, s)]).sum();
                 assert_eq!(data.exact.delassus[(i, c)], dense_upper, "({i}, {c})");
                 assert!((dense - dense_upper).abs() <= 1e-12 * (1.0 + dense.abs()));
-                assert_eq!(data.exact.minv_jt[(i % nv, c)], y[(i % nv, c)]);
+                let (lo, hi) = data.exact.spans[c];
+                if (lo..hi).contains(&(i % nv)) {
+                    assert_eq!(data.exact.minv_jt[(i % nv, c)], y[(i % nv, c)]);
+                } else {
+                    assert_eq!(y[(i % nv, c)], 0.0);
+                }
             }
         }
     }

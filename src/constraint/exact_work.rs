@@ -11,7 +11,8 @@ use nalgebra::{DMatrix, DVector};
 /// sized for the row capacity of [`Data`](crate::Data) (grown with it by `Data::reserve_rows`).
 #[derive(Clone, Debug)]
 pub(crate) struct ExactWork {
-    /// M⁻¹Jᵀ, nv × nefc (columns 0..nefc used).
+    /// M⁻¹Jᵀ, nv × nefc (columns 0..nefc used, each over its row's span in `spans` only: the
+    /// column is zero outside it, and those entries are not written).
     pub minv_jt: DMatrix<f64>,
     /// The Delassus matrix J M⁻¹ Jᵀ, nefc × nefc, and its factor or eigenvectors.
     pub delassus: DMatrix<f64>,
