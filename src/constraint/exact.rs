@@ -38,7 +38,16 @@ fn delassus(model: &Model, data: &mut Data) {
         mass_factor,
         exact:
             ExactWork {
-                minv_jt: efc_minv_jt, delassus: efc_delassus, jt, spans, yt, yt_acc, yt_run, order, ..
+                minv_jt: efc_minv_jt,
+                delassus: efc_delassus,
+                jt,
+                spans,
+                yt,
+                yt_acc,
+                yt_run,
+                order,
+                dof_rows,
+                ..
             },
         ..
     } = data;
@@ -59,8 +68,15 @@ fn delassus(model: &Model, data: &mut Data) {
             _ => (0, 0),
         };
     }
+    // Per dof, the rows that may touch it (its tree's: the spans are whole trees).
+    dof_rows.fill((n, 0));
+    for (i, &(lo, hi)) in spans[..n].iter().enumerate() {
+        for r in &mut dof_rows[lo..hi] {
+            *r = (r.0.min(i), r.1.max(i + 1));
+        }
+    }
     // Y = M⁻¹Jᵀ for all rows at once, on its transpose.
-    solve_rows(model, mass_factor.as_slice(), yt, n, &mut yt_acc[..n], &mut yt_run[..n]);
+    solve_rows(model, mass_factor.as_slice(), yt, n, dof_rows, &mut yt_acc[..n], &mut yt_run[..n]);
     // Each row's column of M⁻¹Jᵀ over its span (zero outside it, where no reader looks).
     let y = &mut efc_minv_jt.as_mut_slice()[..nv * n];
     for (i, &(lo, hi)) in spans[..n].iter().enumerate() {
@@ -178,15 +194,24 @@ fn delassus_meeting_pairs(
 /// the operations, and their order, are those of `dynamics::crba::solve_with_factor_span_unchecked`
 /// (Lᵀ z = b from the leaves up, D w = z, L x = w from the root down with each run of the
 /// ancestor chain summed apart), so the same bits: dofs outside a row's trees hold zeros and
-/// stay zero. `acc` and `run` (n each) are scratch.
-fn solve_rows(model: &Model, factor: &[f64], yt: &mut [f64], n: usize, acc: &mut [f64], run: &mut [f64]) {
+/// stay zero, and each dof's step runs over `rows[dof]` only, the rows that may touch its tree.
+/// `acc` and `run` (n each) are scratch.
+fn solve_rows(
+    model: &Model,
+    factor: &[f64],
+    yt: &mut [f64],
+    n: usize,
+    rows: &[(usize, usize)],
+    acc: &mut [f64],
+    run: &mut [f64],
+) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (checked just above), all `solve_rows_avx2` requires.
-        unsafe { solve_rows_avx2(model, factor, yt, n, acc, run) };
+        unsafe { solve_rows_avx2(model, factor, yt, n, rows, acc, run) };
         return;
     }
-    solve_rows_kernel(model, factor, yt, n, acc, run);
+    solve_rows_kernel(model, factor, yt, n, rows, acc, run);
 }
 
 /// [`solve_rows_kernel`] compiled for AVX2: the same operations in the same order (no fused
@@ -198,32 +223,43 @@ unsafe fn solve_rows_avx2(
     factor: &[f64],
     yt: &mut [f64],
     n: usize,
+    rows: &[(usize, usize)],
     acc: &mut [f64],
     run: &mut [f64],
 ) {
-    solve_rows_kernel(model, factor, yt, n, acc, run);
+    solve_rows_kernel(model, factor, yt, n, rows, acc, run);
 }
 
 #[inline(always)]
-fn solve_rows_kernel(model: &Model, h: &[f64], yt: &mut [f64], n: usize, acc: &mut [f64], run: &mut [f64]) {
+fn solve_rows_kernel(
+    model: &Model,
+    h: &[f64],
+    yt: &mut [f64],
+    n: usize,
+    rows: &[(usize, usize)],
+    acc: &mut [f64],
+    run: &mut [f64],
+) {
     let nv = model.nv;
     let lambda = &model.dof_parent[..nv];
     // The empty sum, as `Iterator::sum` starts it.
     let zero: f64 = std::iter::empty::<f64>().sum();
-    // Lᵀ z = b: x[j] −= L[i][j] x[i] over the ancestor chain of each dof, from the leaves up.
+    // Lᵀ z = b: x[j] −= L[i][j] x[i] over the ancestor chain of each dof, from the leaves up
+    // (rows [r0, r1) only: the others are zero on the dof's tree and stay so).
     for i in (0..nv).rev() {
-        if lambda[i] == NO_DOF {
+        let (r0, r1) = rows[i];
+        if lambda[i] == NO_DOF || r0 >= r1 {
             continue;
         }
         let col_l = &h[i * nv..(i + 1) * nv];
         let (before, rest) = yt.split_at_mut(i * n);
-        let x_i = &rest[..n];
+        let x_i = &rest[r0..r1];
         let mut e = lambda[i];
         while e != NO_DOF {
             let s = model.dof_run_start[e];
             for j in s..=e {
                 let l = col_l[j];
-                for (a, b) in before[j * n..(j + 1) * n].iter_mut().zip(x_i) {
+                for (a, b) in before[j * n + r0..j * n + r1].iter_mut().zip(x_i) {
                     *a -= l * b;
                 }
             }
@@ -232,18 +268,21 @@ fn solve_rows_kernel(model: &Model, h: &[f64], yt: &mut [f64], n: usize, acc: &m
     }
     // D w = z.
     for i in 0..nv {
+        let (r0, r1) = rows[i];
         let d = h[i + i * nv];
-        for a in &mut yt[i * n..(i + 1) * n] {
+        for a in &mut yt[i * n + r0.min(r1)..i * n + r1] {
             *a /= d;
         }
     }
     // L x = w: x[i] −= Σ over the runs of its ancestor chain (each run summed, then added).
     for i in 0..nv {
-        if lambda[i] == NO_DOF {
+        let (r0, r1) = rows[i];
+        if lambda[i] == NO_DOF || r0 >= r1 {
             continue;
         }
         let col_l = &h[i * nv..(i + 1) * nv];
         let (before, rest) = yt.split_at_mut(i * n);
+        let (acc, run) = (&mut acc[r0..r1], &mut run[r0..r1]);
         acc.fill(0.0);
         let mut e = lambda[i];
         while e != NO_DOF {
@@ -251,7 +290,7 @@ fn solve_rows_kernel(model: &Model, h: &[f64], yt: &mut [f64], n: usize, acc: &m
             run.fill(zero);
             for j in s..=e {
                 let l = col_l[j];
-                for (r, x) in run.iter_mut().zip(&before[j * n..(j + 1) * n]) {
+                for (r, x) in run.iter_mut().zip(&before[j * n + r0..j * n + r1]) {
                     *r += x * l;
                 }
             }
@@ -260,7 +299,7 @@ fn solve_rows_kernel(model: &Model, h: &[f64], yt: &mut [f64], n: usize, acc: &m
             }
             e = lambda[s];
         }
-        for (x, a) in rest[..n].iter_mut().zip(acc.iter()) {
+        for (x, a) in rest[r0..r1].iter_mut().zip(acc.iter()) {
             *x -= a;
         }
     }

@@ -77,6 +77,9 @@ pub(crate) struct ExactWork {
     pub yt_run: Vec<f64>,
     /// The rows in order of the first dof of their span (the Delassus products' pairing).
     pub order: Vec<usize>,
+    /// Per dof, the rows [first, last + 1) among which are all the rows whose span holds it
+    /// (empty when none does): the M⁻¹Jᵀ solve updates only those.
+    pub dof_rows: Vec<(usize, usize)>,
     /// Per row, the dofs [lo, hi) of the kinematic trees it touches (`dynamics::tree_span`):
     /// M⁻¹ J_iᵀ is zero outside them, and A_ij = 0 when two rows' spans are disjoint.
     pub spans: Vec<(usize, usize)>,
@@ -128,6 +131,7 @@ impl ExactWork {
             yt_acc: vec![0.0; nefc],
             yt_run: vec![0.0; nefc],
             order: vec![0; nefc],
+            dof_rows: vec![(0, 0); nv],
             spans: vec![(0, 0); nefc],
             previous: DVector::zeros(nefc),
             polish_set: 0,
@@ -141,6 +145,9 @@ impl ExactWork {
     pub fn grow_matrices(&mut self, nv: usize, nefc: usize) {
         if self.motion.len() != 2 * nv {
             self.motion = DVector::zeros(2 * nv);
+        }
+        if self.dof_rows.len() != nv {
+            self.dof_rows = vec![(0, 0); nv];
         }
         if self.delassus.nrows() >= nefc && self.minv_jt.nrows() == nv {
             return;
