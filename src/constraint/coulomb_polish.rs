@@ -198,6 +198,27 @@ fn contact_moving(data: &Data, i: usize, len: usize, level: Level) -> bool {
         && !data.efc_frozen_at_rest(i)
 }
 
+/// Whether some contact that is not separating slips at the acceleration level: its friction is
+/// then fixed by its slip velocity, and the rows' problem is no longer the convex one of sticking
+/// and static friction (whose row accelerations are unique: any active set that satisfies every
+/// law gives the same motion) — with maximal dissipation along a given slip, two active sets may
+/// both satisfy every law and move differently.
+pub(super) fn any_contact_moving(data: &Data, level: Level) -> bool {
+    let n = data.nefc;
+    let mut i = 0;
+    while i < n {
+        let len = data.efc_block_len(i);
+        if data.efc_type[i] == EfcType::ContactElliptic
+            && !separating(data, i, level)
+            && contact_moving(data, i, len, level)
+        {
+            return true;
+        }
+        i += len;
+    }
+    false
+}
+
 /// Adds contact i's friction rows (those with μ > 0) to the active set: the contact sticks.
 fn push_sticking_friction(data: &mut Data, i: usize, len: usize) {
     let friction = data.contacts[data.efc_id[i]].friction;

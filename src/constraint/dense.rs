@@ -274,35 +274,52 @@ fn min_norm_solve(
     perm: &mut DVector<f64>,
     tol: f64,
 ) -> usize {
-    // 1. Pivoted Cholesky on the full symmetric copy (both triangles kept up to date, so that a
-    // symmetric swap is a swap of rows and of columns).
-    for j in 0..n {
-        for i in 0..n {
-            l[(i, j)] = a[(i.max(j), i.min(j))];
+    let (ls, a_stride) = (l.nrows(), a.nrows());
+    let lm = l.as_mut_slice();
+    // 1. Pivoted Cholesky on the lower triangle (LAPACK's dpstf2 order): a symmetric swap of k
+    // and p exchanges rows k and p of the finished columns, the two diagonal entries, column k
+    // below p with column p, and column k between k and p with row p. Every entry gets the same
+    // updates, in the same order, as on the full symmetric matrix.
+    {
+        let am = a.as_slice();
+        for j in 0..n {
+            lm[j * ls + j..j * ls + n].copy_from_slice(&am[j * a_stride + j..j * a_stride + n]);
+            perm[j] = j as f64;
         }
-        perm[j] = j as f64;
     }
     let mut rank = n;
     for k in 0..n {
-        let p = (k..n).fold(k, |best, j| if l[(j, j)] > l[(best, best)] { j } else { best });
-        if l[(p, p)] <= tol {
+        let p = (k..n).fold(k, |best, j| if lm[j + j * ls] > lm[best + best * ls] { j } else { best });
+        if lm[p + p * ls] <= tol {
             rank = k;
             break;
         }
         if p != k {
-            l.swap_rows(k, p);
-            l.swap_columns(k, p);
+            for c in 0..k {
+                lm.swap(k + c * ls, p + c * ls);
+            }
+            lm.swap(k + k * ls, p + p * ls);
+            for i in k + 1..p {
+                lm.swap(i + k * ls, p + i * ls);
+            }
+            for i in p + 1..n {
+                lm.swap(i + k * ls, i + p * ls);
+            }
             perm.swap_rows(k, p);
         }
-        let d = l[(k, k)].sqrt();
-        l[(k, k)] = d;
-        for i in k + 1..n {
-            l[(i, k)] /= d;
+        let (head, tail) = lm.split_at_mut((k + 1) * ls);
+        let col_k = &mut head[k * ls + k..k * ls + n];
+        let d = col_k[0].sqrt();
+        col_k[0] = d;
+        for x in &mut col_k[1..] {
+            *x /= d;
         }
+        let col_k = &col_k[1..];
         for j in k + 1..n {
-            let ljk = l[(j, k)];
-            for i in k + 1..n {
-                l[(i, j)] -= l[(i, k)] * ljk;
+            let ljk = col_k[j - k - 1];
+            let col_j = &mut tail[(j - k - 1) * ls + j..(j - k - 1) * ls + n];
+            for (x, &y) in col_j.iter_mut().zip(&col_k[j - k - 1..]) {
+                *x -= y * ljk;
             }
         }
     }
@@ -313,66 +330,70 @@ fn min_norm_solve(
     }
     // L's strict upper part of its first r columns is zero.
     for j in 0..r {
-        for i in 0..j {
-            l[(i, j)] = 0.0;
-        }
+        lm[j * ls..j * ls + j].fill(0.0);
     }
     // 2. Householder QR of L's first r columns, in place (LAPACK's dlarfg convention: v₀ = 1
     // implicit, the rest below the diagonal, τ in a's column 0, R on and above the diagonal).
+    let (taus, rest) = a.as_mut_slice().split_at_mut(a_stride);
     for j in 0..r {
-        let x0 = l[(j, j)];
-        let tail: f64 = (j + 1..n).map(|i| l[(i, j)] * l[(i, j)]).sum::<f64>().sqrt();
-        if tail == 0.0 {
-            a[(j, 0)] = 0.0;
+        let (head, tail) = lm.split_at_mut((j + 1) * ls);
+        let col_j = &mut head[j * ls + j..j * ls + n];
+        let x0 = col_j[0];
+        let norm: f64 = col_j[1..].iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm == 0.0 {
+            taus[j] = 0.0;
             continue;
         }
-        let beta = -x0.signum() * x0.hypot(tail);
+        let beta = -x0.signum() * x0.hypot(norm);
         let tau = (beta - x0) / beta;
         let scale = 1.0 / (x0 - beta);
-        for i in j + 1..n {
-            l[(i, j)] *= scale;
+        for x in &mut col_j[1..] {
+            *x *= scale;
         }
-        l[(j, j)] = beta;
-        a[(j, 0)] = tau;
+        col_j[0] = beta;
+        taus[j] = tau;
+        let v = &col_j[1..];
         for c in j + 1..r {
-            let s = l[(j, c)] + (j + 1..n).map(|i| l[(i, j)] * l[(i, c)]).sum::<f64>();
-            l[(j, c)] -= tau * s;
-            for i in j + 1..n {
-                l[(i, c)] -= tau * s * l[(i, j)];
+            let col_c = &mut tail[(c - j - 1) * ls + j..(c - j - 1) * ls + n];
+            let s = col_c[0] + v.iter().zip(&col_c[1..]).map(|(x, y)| x * y).sum::<f64>();
+            col_c[0] -= tau * s;
+            for (x, &y) in col_c[1..].iter_mut().zip(v) {
+                *x -= tau * s * y;
             }
         }
     }
     // 3. c = P b in a's column 1; Qᵀ c; R⁻¹, then R⁻ᵀ on its first r entries; Q back.
+    let c = &mut rest[..n];
     for i in 0..n {
-        a[(i, 1)] = b[perm[i] as usize];
+        c[i] = b[perm[i] as usize];
     }
-    let reflect = |a: &mut DMatrix<f64>, l: &DMatrix<f64>, j: usize| {
-        let tau = a[(j, 0)];
-        let s = a[(j, 1)] + (j + 1..n).map(|i| l[(i, j)] * a[(i, 1)]).sum::<f64>();
-        a[(j, 1)] -= tau * s;
-        for i in j + 1..n {
-            a[(i, 1)] -= tau * s * l[(i, j)];
+    let reflect = |c: &mut [f64], j: usize| {
+        let tau = taus[j];
+        let v = &lm[j * ls + j + 1..j * ls + n];
+        let s = c[j] + v.iter().zip(&c[j + 1..n]).map(|(x, y)| x * y).sum::<f64>();
+        c[j] -= tau * s;
+        for (x, &y) in c[j + 1..n].iter_mut().zip(v) {
+            *x -= tau * s * y;
         }
     };
     for j in 0..r {
-        reflect(a, l, j);
+        reflect(c, j);
     }
     for i in (0..r).rev() {
-        let s = a[(i, 1)] - (i + 1..r).map(|k| l[(i, k)] * a[(k, 1)]).sum::<f64>();
-        a[(i, 1)] = s / l[(i, i)];
+        let s = c[i] - (i + 1..r).map(|k| lm[i + k * ls] * c[k]).sum::<f64>();
+        c[i] = s / lm[i + i * ls];
     }
     for i in 0..r {
-        let s = a[(i, 1)] - (0..i).map(|k| l[(k, i)] * a[(k, 1)]).sum::<f64>();
-        a[(i, 1)] = s / l[(i, i)];
+        let col_i = &lm[i * ls..i * ls + i];
+        let s = c[i] - col_i.iter().zip(&c[..i]).map(|(x, y)| x * y).sum::<f64>();
+        c[i] = s / lm[i + i * ls];
     }
-    for i in r..n {
-        a[(i, 1)] = 0.0;
-    }
+    c[r..n].fill(0.0);
     for j in (0..r).rev() {
-        reflect(a, l, j);
+        reflect(c, j);
     }
     for i in 0..n {
-        b[perm[i] as usize] = a[(i, 1)];
+        b[perm[i] as usize] = c[i];
     }
     rank
 }

@@ -15,12 +15,13 @@ use super::energy_guard::{free_row_velocity, limit_energy};
 use super::ConstraintModel;
 use super::ExactWork;
 use crate::collision::{collide, EXACT_REACH};
-use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_span_unchecked, tree_span};
+use crate::dynamics::{crba_unchecked, factorize_mass_matrix, tree_span};
 use crate::error::{check, InputError};
 use crate::kinematics::body_poses;
-use crate::model::{integrate_configuration_unchecked, Data, EfcType, Model};
+use crate::model::{integrate_configuration_unchecked, Data, EfcType, Model, NO_DOF};
 
-/// Y = M⁻¹Jᵀ into `efc_minv_jt` and A = J M⁻¹ Jᵀ into `efc_delassus` for the current rows (needs
+/// Y = M⁻¹Jᵀ into `efc_minv_jt` (each row's column over its span only: zero outside it, and not
+/// written there) and A = J M⁻¹ Jᵀ into `efc_delassus` for the current rows (needs
 /// the factor of M in `mass_factor`). Each row touches the dofs of at most two kinematic trees,
 /// and M is block-diagonal over trees: Y_i is solved over its row's trees only and A_ij is
 /// J_i · Y_j over the dofs both rows' trees share (zero when there are none) — the dense
@@ -35,30 +36,78 @@ fn delassus(model: &Model, data: &mut Data) {
     let Data {
         efc_j,
         mass_factor,
-        exact: ExactWork { minv_jt: efc_minv_jt, delassus: efc_delassus, jt, spans, .. },
+        exact:
+            ExactWork {
+                minv_jt: efc_minv_jt,
+                delassus: efc_delassus,
+                jt,
+                spans,
+                yt,
+                yt_acc,
+                yt_run,
+                order,
+                dof_rows,
+                ..
+            },
         ..
     } = data;
-    // Jᵀ, read down J's columns (contiguous in its storage).
+    // Jᵀ, read down J's columns (contiguous in its storage), and each row's span.
     let jt = &mut jt.as_mut_slice()[..nv * n];
+    let yt = &mut yt[..n * nv];
     for k in 0..nv {
-        for (i, &jik) in efc_j.column(k).as_slice()[..n].iter().enumerate() {
+        let col = &efc_j.as_slice()[k * efc_j.nrows()..k * efc_j.nrows() + n];
+        yt[k * n..(k + 1) * n].copy_from_slice(col);
+        for (i, &jik) in col.iter().enumerate() {
             jt[k + i * nv] = jik;
         }
     }
-    let y = &mut efc_minv_jt.as_mut_slice()[..nv * n];
-    y.copy_from_slice(jt);
     for i in 0..n {
-        let col = &mut y[i * nv..(i + 1) * nv];
-        spans[i] = match (col.iter().position(|&x| x != 0.0), col.iter().rposition(|&x| x != 0.0)) {
+        let row = &jt[i * nv..(i + 1) * nv];
+        spans[i] = match (row.iter().position(|&x| x != 0.0), row.iter().rposition(|&x| x != 0.0)) {
             (Some(first), Some(last)) => tree_span(model, first, last),
             _ => (0, 0),
         };
-        solve_with_factor_span_unchecked(model, mass_factor, col, spans[i]);
     }
-    // The upper triangle column by column (contiguous writes): A_ij = J_i · Y_j over the dofs of
-    // both rows' trees, ascending (outside them a term of the dense sum is an exact zero).
+    // Per dof, the rows that may touch it (its tree's: the spans are whole trees).
+    dof_rows.fill((n, 0));
+    for (i, &(lo, hi)) in spans[..n].iter().enumerate() {
+        for r in &mut dof_rows[lo..hi] {
+            *r = (r.0.min(i), r.1.max(i + 1));
+        }
+    }
+    // Y = M⁻¹Jᵀ for all rows at once, on its transpose.
+    solve_rows(model, mass_factor.as_slice(), yt, n, dof_rows, &mut yt_acc[..n], &mut yt_run[..n]);
+    // Each row's column of M⁻¹Jᵀ over its span (zero outside it, where no reader looks).
+    let y = &mut efc_minv_jt.as_mut_slice()[..nv * n];
+    for (i, &(lo, hi)) in spans[..n].iter().enumerate() {
+        for (k, x) in (lo..hi).zip(&mut y[i * nv + lo..i * nv + hi]) {
+            *x = yt[k * n + i];
+        }
+    }
+    // A_ij = J_i · Y_j over the dofs of both rows' trees, ascending (outside them a term of the
+    // dense sum is an exact zero), for i ≤ j, mirrored to A_ji; zero when the trees are disjoint.
     let stride = efc_delassus.nrows();
     let a = efc_delassus.as_mut_slice();
+    let width = spans[..n].iter().map(|&(lo, hi)| hi - lo).max().unwrap_or(0);
+    if 2 * width >= nv {
+        delassus_all_pairs(a, stride, n, nv, jt, y, spans);
+    } else {
+        delassus_meeting_pairs(a, stride, n, nv, jt, y, spans, &mut order[..n], width);
+    }
+}
+
+/// A_ij = J_i · Y_j (over both rows' spans) for every pair i ≤ j, column by column (contiguous
+/// writes), and the lower triangle by symmetry: when most rows' trees meet (one robot, a pair of
+/// boxes).
+fn delassus_all_pairs(
+    a: &mut [f64],
+    stride: usize,
+    n: usize,
+    nv: usize,
+    jt: &[f64],
+    y: &[f64],
+    spans: &[(usize, usize)],
+) {
     for j in 0..n {
         let (lo_j, hi_j) = spans[j];
         let y_j = &y[j * nv..(j + 1) * nv];
@@ -72,8 +121,8 @@ fn delassus(model: &Model, data: &mut Data) {
             };
         }
     }
-    // The lower triangle by symmetry, in 8 × 8 tiles (each tile's reads and writes stay in a few
-    // cache lines of the nefc-capacity-strided matrix).
+    // The lower triangle in 8 × 8 tiles (each tile's reads and writes stay in a few cache lines
+    // of the capacity-strided matrix).
     const TILE: usize = 8;
     for ib in (0..n).step_by(TILE) {
         for jb in (ib..n).step_by(TILE) {
@@ -86,17 +135,194 @@ fn delassus(model: &Model, data: &mut Data) {
     }
 }
 
-/// J_i · x for row `i` of the current rows.
-fn row_dot(data: &Data, nv: usize, i: usize, x: &[f64]) -> f64 {
-    (0..nv).map(|k| data.efc_j[(i, k)] * x[k]).sum()
+/// [`delassus_all_pairs`] visiting only the pairs whose spans meet, for rows on many separate
+/// trees (a stack, a bin: each row touches one or two of them): the rest is zero. The rows in
+/// order of their span's first dof (`order`); row i can meet row j only if
+/// lo_j − `width` < lo_i < hi_j (`width` the widest span).
+#[allow(clippy::too_many_arguments)]
+fn delassus_meeting_pairs(
+    a: &mut [f64],
+    stride: usize,
+    n: usize,
+    nv: usize,
+    jt: &[f64],
+    y: &[f64],
+    spans: &[(usize, usize)],
+    order: &mut [usize],
+    width: usize,
+) {
+    // Insertion sort, stable: the rows come mostly in order already (a contact's rows together,
+    // contacts by body).
+    for k in 0..n {
+        let lo = spans[k].0;
+        let mut p = k;
+        while p > 0 && spans[order[p - 1]].0 > lo {
+            order[p] = order[p - 1];
+            p -= 1;
+        }
+        order[p] = k;
+    }
+    for j in 0..n {
+        a[j * stride..j * stride + n].fill(0.0);
+    }
+    for j in 0..n {
+        let (lo_j, hi_j) = spans[j];
+        if lo_j >= hi_j {
+            continue;
+        }
+        let y_j = &y[j * nv..(j + 1) * nv];
+        let start = order.partition_point(|&i| spans[i].0 + width <= lo_j);
+        for &i in &order[start..] {
+            let (lo_i, hi_i) = spans[i];
+            if lo_i >= hi_j {
+                break;
+            }
+            let (lo, hi) = (lo_i.max(lo_j), hi_i.min(hi_j));
+            if i > j || lo >= hi {
+                continue;
+            }
+            let v: f64 = jt[i * nv + lo..i * nv + hi].iter().zip(&y_j[lo..hi]).map(|(x, y)| x * y).sum();
+            a[i + j * stride] = v;
+            a[j + i * stride] = v;
+        }
+    }
 }
 
-/// x += s · M⁻¹Jᵀ μ with μ the first nefc entries of `efc_rhs` (the result of a Delassus solve).
+/// Solves M X = B for the n right-hand sides of `yt` (Bᵀ on entry, Xᵀ on return: n × nv,
+/// column-major, one dof's column of n entries contiguous) with the tree-sparse factor of M: each
+/// step of the solve updates a whole column, across every right-hand side. Per right-hand side
+/// the operations, and their order, are those of `dynamics::crba::solve_with_factor_span_unchecked`
+/// (Lᵀ z = b from the leaves up, D w = z, L x = w from the root down with each run of the
+/// ancestor chain summed apart), so the same bits: dofs outside a row's trees hold zeros and
+/// stay zero, and each dof's step runs over `rows[dof]` only, the rows that may touch its tree.
+/// `acc` and `run` (n each) are scratch.
+fn solve_rows(
+    model: &Model,
+    factor: &[f64],
+    yt: &mut [f64],
+    n: usize,
+    rows: &[(usize, usize)],
+    acc: &mut [f64],
+    run: &mut [f64],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `solve_rows_avx2` requires.
+        unsafe { solve_rows_avx2(model, factor, yt, n, rows, acc, run) };
+        return;
+    }
+    solve_rows_kernel(model, factor, yt, n, rows, acc, run);
+}
+
+/// [`solve_rows_kernel`] compiled for AVX2: the same operations in the same order (no fused
+/// multiply–adds), four right-hand sides per instruction, so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn solve_rows_avx2(
+    model: &Model,
+    factor: &[f64],
+    yt: &mut [f64],
+    n: usize,
+    rows: &[(usize, usize)],
+    acc: &mut [f64],
+    run: &mut [f64],
+) {
+    solve_rows_kernel(model, factor, yt, n, rows, acc, run);
+}
+
+#[inline(always)]
+fn solve_rows_kernel(
+    model: &Model,
+    h: &[f64],
+    yt: &mut [f64],
+    n: usize,
+    rows: &[(usize, usize)],
+    acc: &mut [f64],
+    run: &mut [f64],
+) {
+    let nv = model.nv;
+    let lambda = &model.dof_parent[..nv];
+    // The empty sum, as `Iterator::sum` starts it.
+    let zero: f64 = std::iter::empty::<f64>().sum();
+    // Lᵀ z = b: x[j] −= L[i][j] x[i] over the ancestor chain of each dof, from the leaves up
+    // (rows [r0, r1) only: the others are zero on the dof's tree and stay so).
+    for i in (0..nv).rev() {
+        let (r0, r1) = rows[i];
+        if lambda[i] == NO_DOF || r0 >= r1 {
+            continue;
+        }
+        let col_l = &h[i * nv..(i + 1) * nv];
+        let (before, rest) = yt.split_at_mut(i * n);
+        let x_i = &rest[r0..r1];
+        let mut e = lambda[i];
+        while e != NO_DOF {
+            let s = model.dof_run_start[e];
+            for j in s..=e {
+                let l = col_l[j];
+                for (a, b) in before[j * n + r0..j * n + r1].iter_mut().zip(x_i) {
+                    *a -= l * b;
+                }
+            }
+            e = lambda[s];
+        }
+    }
+    // D w = z.
+    for i in 0..nv {
+        let (r0, r1) = rows[i];
+        let d = h[i + i * nv];
+        for a in &mut yt[i * n + r0.min(r1)..i * n + r1] {
+            *a /= d;
+        }
+    }
+    // L x = w: x[i] −= Σ over the runs of its ancestor chain (each run summed, then added).
+    for i in 0..nv {
+        let (r0, r1) = rows[i];
+        if lambda[i] == NO_DOF || r0 >= r1 {
+            continue;
+        }
+        let col_l = &h[i * nv..(i + 1) * nv];
+        let (before, rest) = yt.split_at_mut(i * n);
+        let (acc, run) = (&mut acc[r0..r1], &mut run[r0..r1]);
+        acc.fill(0.0);
+        let mut e = lambda[i];
+        while e != NO_DOF {
+            let s = model.dof_run_start[e];
+            run.fill(zero);
+            for j in s..=e {
+                let l = col_l[j];
+                for (r, x) in run.iter_mut().zip(&before[j * n + r0..j * n + r1]) {
+                    *r += x * l;
+                }
+            }
+            for (a, r) in acc.iter_mut().zip(run.iter()) {
+                *a += r;
+            }
+            e = lambda[s];
+        }
+        for (x, a) in rest[r0..r1].iter_mut().zip(acc.iter()) {
+            *x -= a;
+        }
+    }
+}
+
+/// J_i · x for row `i` of the current rows, over its trees' dofs (`exact.spans`; J_i is zero
+/// outside them): the dense sum's terms in its order, without its exact zeros. Needs the rows'
+/// Jᵀ and spans of [`delassus`] at the current J.
+fn row_dot(data: &Data, nv: usize, i: usize, x: &[f64]) -> f64 {
+    let (lo, hi) = data.exact.spans[i];
+    let row = &data.exact.jt.as_slice()[i * nv..(i + 1) * nv];
+    row[lo..hi].iter().zip(&x[lo..hi]).map(|(j, x)| j * x).sum()
+}
+
+/// x += s · M⁻¹Jᵀ μ with μ the first nefc entries of `efc_rhs` (the result of a Delassus solve),
+/// each row's column over its trees' dofs (zero outside them).
 fn add_minv_jt_mu(data: &Data, nv: usize, s: f64, x: &mut [f64]) {
+    let y = data.exact.minv_jt.as_slice();
     for i in 0..data.nefc {
         let mu = s * data.exact.rhs[i];
-        for k in 0..nv {
-            x[k] += data.exact.minv_jt[(k, i)] * mu;
+        let (lo, hi) = data.exact.spans[i];
+        for (x, y) in x[lo..hi].iter_mut().zip(&y[i * nv + lo..i * nv + hi]) {
+            *x += y * mu;
         }
     }
 }
@@ -122,6 +348,7 @@ pub(crate) fn solve_exact(
     if has_friction(data) {
         if settings.solver == ExactContactSolver::Admm {
             solve_admm(model, data, settings);
+            data.exact.warm_exact = false;
         } else {
             let scale = data.qacc_smooth.amax();
             solve_coulomb(model, data, Level::Acceleration, settings, scale);
@@ -150,8 +377,10 @@ pub(crate) fn solve_exact(
         data.efc_force[i] = lambda;
         data.exact.warm[i] = lambda;
         data.exact.warm_rows.push((data.efc_type[i], data.efc_id[i]));
-        for k in 0..nv {
-            data.qfrc_constraint[k] += data.efc_j[(i, k)] * lambda;
+        let (lo, hi) = data.exact.spans[i];
+        let row = &data.exact.jt.as_slice()[i * nv + lo..i * nv + hi];
+        for (f, j) in data.qfrc_constraint.as_mut_slice()[lo..hi].iter_mut().zip(row) {
+            *f += j * lambda;
         }
     }
 }
@@ -292,7 +521,8 @@ mod tests {
     /// pendulum touching the floor, a free capsule.
     #[test]
     fn delassus_equals_the_dense_products() {
-        let mut model = crate::Model::from_str(
+        // All pairs visited (the trees' spans cover most dofs).
+        check_delassus(
             "<mujoco><worldbody><geom type='plane' size='0 0 1'/>\
              <body pos='0 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
              <body pos='0 0 0.148'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
@@ -300,8 +530,25 @@ mod tests {
              <body pos='0 0 -0.3'><joint type='hinge' axis='1 0 0'/><geom size='0.03'/></body></body>\
              <body pos='1 0 0.019' euler='0 90 0'><freejoint/><geom type='capsule' size='0.02 0.1'/></body>\
              </worldbody></mujoco>",
-        )
-        .unwrap();
+        );
+        // Only the meeting pairs visited: two stacks of two boxes and three lone boxes, in an
+        // order whose rows do not come sorted by tree (a stack's upper box first).
+        check_delassus(
+            "<mujoco><worldbody><geom type='plane' size='0 0 1'/>\
+             <body pos='0 0 0.148'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='0.3 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='0 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='0.6 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='0.9 0 0.148'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='1.2 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             <body pos='0.9 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
+             </worldbody></mujoco>",
+        );
+    }
+
+    /// [`delassus`] of the scene `xml` in exact mode against the dense products.
+    fn check_delassus(xml: &str) {
+        let mut model = crate::Model::from_str(xml).unwrap();
         model.set_constraint_mode(ConstraintMode::Exact);
         let mut data = Data::new(&model);
         crate::forward::forward(&model, &mut data);
@@ -320,7 +567,12 @@ mod tests {
                 let dense_upper: f64 = (0..nv).map(|k| j[(r, k)] * y[(k, s)]).sum();
                 assert_eq!(data.exact.delassus[(i, c)], dense_upper, "({i}, {c})");
                 assert!((dense - dense_upper).abs() <= 1e-12 * (1.0 + dense.abs()));
-                assert_eq!(data.exact.minv_jt[(i % nv, c)], y[(i % nv, c)]);
+                let (lo, hi) = data.exact.spans[c];
+                if (lo..hi).contains(&(i % nv)) {
+                    assert_eq!(data.exact.minv_jt[(i % nv, c)], y[(i % nv, c)]);
+                } else {
+                    assert_eq!(y[(i % nv, c)], 0.0);
+                }
             }
         }
     }

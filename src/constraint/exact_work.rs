@@ -11,7 +11,8 @@ use nalgebra::{DMatrix, DVector};
 /// sized for the row capacity of [`Data`](crate::Data) (grown with it by `Data::reserve_rows`).
 #[derive(Clone, Debug)]
 pub(crate) struct ExactWork {
-    /// M⁻¹Jᵀ, nv × nefc (columns 0..nefc used).
+    /// M⁻¹Jᵀ, nv × nefc (columns 0..nefc used, each over its row's span in `spans` only: the
+    /// column is zero outside it, and those entries are not written).
     pub minv_jt: DMatrix<f64>,
     /// The Delassus matrix J M⁻¹ Jᵀ, nefc × nefc, and its factor or eigenvectors.
     pub delassus: DMatrix<f64>,
@@ -33,6 +34,14 @@ pub(crate) struct ExactWork {
     /// the (type, id) of each of its rows; reused when the rows are the same.
     pub warm: DVector<f64>,
     pub warm_rows: Vec<(EfcType, usize)>,
+    /// Whether the last acceleration-level Coulomb solve ended with an exact solve of its active
+    /// set (a polish that held): the next solve of the same rows tries that set first.
+    pub warm_exact: bool,
+    /// The factorization work (multiply-adds) of that polish, and what the sweeps of the last
+    /// warm-started solve that swept cost (sweeps × (n² + n·nv) and their polishes; 0 after a
+    /// cold start): the polish is tried first while it is the cheaper.
+    pub warm_polish_work: f64,
+    pub warm_sweep_work: f64,
     /// λ at the start of a Gauss–Seidel sweep.
     pub lambda_prev: DVector<f64>,
     /// Per row, during the velocity projection: a limit or contact row that carried a compressive
@@ -61,6 +70,16 @@ pub(crate) struct ExactWork {
     pub admm: super::admm::AdmmWork,
     /// Jᵀ, nv × nefc (columns 0..nefc used): each row of J contiguous, for the Delassus products.
     pub jt: DMatrix<f64>,
+    /// M⁻¹Jᵀ transposed while it is solved, nefc × nv column-major (stride nefc: one dof's
+    /// entries over the rows contiguous), and two per-row sums of its back substitution.
+    pub yt: Vec<f64>,
+    pub yt_acc: Vec<f64>,
+    pub yt_run: Vec<f64>,
+    /// The rows in order of the first dof of their span (the Delassus products' pairing).
+    pub order: Vec<usize>,
+    /// Per dof, the rows [first, last + 1) among which are all the rows whose span holds it
+    /// (empty when none does): the M⁻¹Jᵀ solve updates only those.
+    pub dof_rows: Vec<(usize, usize)>,
     /// Per row, the dofs [lo, hi) of the kinematic trees it touches (`dynamics::tree_span`):
     /// M⁻¹ J_iᵀ is zero outside them, and A_ij = 0 when two rows' spans are disjoint.
     pub spans: Vec<(usize, usize)>,
@@ -94,6 +113,9 @@ impl ExactWork {
             a_floor: 0.0,
             warm: DVector::zeros(nefc),
             warm_rows: Vec::with_capacity(nefc),
+            warm_exact: false,
+            warm_polish_work: 0.0,
+            warm_sweep_work: 0.0,
             lambda_prev: DVector::zeros(nefc),
             pressing: vec![false; nefc],
             slipping: vec![false; nefc],
@@ -105,6 +127,11 @@ impl ExactWork {
             pivots: vec![0; 2 * nefc],
             admm: Default::default(),
             jt: DMatrix::zeros(nv, nefc),
+            yt: vec![0.0; nv * nefc],
+            yt_acc: vec![0.0; nefc],
+            yt_run: vec![0.0; nefc],
+            order: vec![0; nefc],
+            dof_rows: vec![(0, 0); nv],
             spans: vec![(0, 0); nefc],
             previous: DVector::zeros(nefc),
             polish_set: 0,
@@ -119,11 +146,18 @@ impl ExactWork {
         if self.motion.len() != 2 * nv {
             self.motion = DVector::zeros(2 * nv);
         }
+        if self.dof_rows.len() != nv {
+            self.dof_rows = vec![(0, 0); nv];
+        }
         if self.delassus.nrows() >= nefc && self.minv_jt.nrows() == nv {
             return;
         }
         self.minv_jt = DMatrix::zeros(nv, nefc);
         self.jt = DMatrix::zeros(nv, nefc);
+        self.yt = vec![0.0; nv * nefc];
+        self.yt_acc = vec![0.0; nefc];
+        self.yt_run = vec![0.0; nefc];
+        self.order = vec![0; nefc];
         for m in [&mut self.delassus, &mut self.factor, &mut self.sub] {
             *m = DMatrix::zeros(nefc, nefc);
         }

@@ -13,8 +13,16 @@ use crate::model::{Data, EfcType};
 /// velocity projection's conditions to `tol_v` (m/s or rad/s per row).
 pub(crate) fn already_projected(data: &mut Data, nv: usize, v: &[f64], tol_v: f64) -> bool {
     let n = data.nefc;
-    for i in 0..n {
-        data.efc_vel[i] = (0..nv).map(|k| data.efc_j[(i, k)] * v[k]).sum();
+    // J v down J's columns (contiguous in its storage): per row the terms of the row-wise sum in
+    // its order, started from the same empty sum, so the same bits.
+    let zero: f64 = std::iter::empty::<f64>().sum();
+    let stride = data.efc_j.nrows();
+    let (j, vel) = (data.efc_j.as_slice(), &mut data.efc_vel.as_mut_slice()[..n]);
+    vel.fill(zero);
+    for (k, &vk) in v[..nv].iter().enumerate() {
+        for (x, &jik) in vel.iter_mut().zip(&j[k * stride..k * stride + n]) {
+            *x += jik * vk;
+        }
     }
     let mut i = 0;
     while i < n {
