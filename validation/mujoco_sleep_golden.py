@@ -1,9 +1,12 @@
 """Reference data for sleeping islands (`<flag sleep>`): MuJoCo's mj_step on
 tests/data/mjcf/sleep/drop.xml (three boxes and a sphere dropped on a floor fall asleep; a sphere
-dropped from higher up lands on box b1, wakes it, and the two fall asleep together), Euler, sleep
-enabled. Records `tree_asleep` after every step and qpos, qvel every 10 steps, for 500 steps, and
-the model's `dof_length` and `tree_sleep_policy`. Writes tests/data/mujoco/sleep.json (generated:
-do not edit); with --check, recomputes and exits 1 when the committed file differs beyond 1e-12.
+dropped from higher up lands on box b1, wakes it, and the two fall asleep together), sleep
+enabled, stepped by Euler and implicitfast (not RK4: MuJoCo's RK4 wakes a tree again at the step
+after it sleeps, by its stage configurations); and tests/data/mjcf/sleep/bin50.xml (50 spheres
+dropped in a bin, all asleep at step 147), Euler. Records `tree_asleep` after every step and qpos,
+qvel every 20 steps (500 and 300 steps), and the model's `dof_length` and `tree_sleep_policy`. Writes
+tests/data/mujoco/sleep.json (generated: do not edit); with --check, recomputes and exits 1 when
+the committed file differs beyond 1e-12.
 
   python validation/mujoco_sleep_golden.py [--check]
 """
@@ -20,22 +23,30 @@ from golden_common import golden_main  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "tests/data/mujoco/sleep.json"
-SCENES = {"drop": ROOT / "tests/data/mjcf/sleep/drop.xml"}
-STEPS = 500
-EVERY = 10
+SCENES = {
+    "drop": (ROOT / "tests/data/mjcf/sleep/drop.xml", ["euler", "implicitfast"], 500),
+    "bin50": (ROOT / "tests/data/mjcf/sleep/bin50.xml", ["euler"], 300),
+}
+INTEGRATORS = {
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+}
+EVERY = 20
 
 
-def run(path: Path) -> dict:
+def run(path: Path, integrator: str, steps: int) -> dict:
     m = mujoco.MjModel.from_xml_path(str(path))
+    m.opt.integrator = INTEGRATORS[integrator]
     d = mujoco.MjData(m)
     asleep, samples = [], []
-    for k in range(1, STEPS + 1):
+    for k in range(1, steps + 1):
         mujoco.mj_step(m, d)
         asleep.append([int(x) for x in d.tree_asleep])
         if k % EVERY == 0:
             samples.append({"step": k, "qpos": d.qpos.tolist(), "qvel": d.qvel.tolist(), "ncon": int(d.ncon)})
     return {
         "model": str(path.relative_to(ROOT)),
+        "integrator": integrator,
         "dof_length": m.dof_length.tolist(),
         "tree_sleep_policy": [int(x) for x in m.tree_sleep_policy],
         "tree_asleep": asleep,
@@ -44,7 +55,7 @@ def run(path: Path) -> dict:
 
 
 def scenes() -> dict:
-    return {name: run(path) for name, path in SCENES.items()}
+    return {f"{name}_{i}": run(path, i, n) for name, (path, integrators, n) in SCENES.items() for i in integrators}
 
 
 if __name__ == "__main__":

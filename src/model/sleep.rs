@@ -371,6 +371,11 @@ impl SleepState {
         (z1 && z2) || (z1 && s2) || (z2 && s1)
     }
 
+    /// Whether dof `k` of `model` is on a sleeping tree.
+    pub fn dof_asleep(&self, model: &Model, k: usize) -> bool {
+        self.ntree_awake < self.tree_awake.len() && !self.tree_awake[model.sleep.dof_tree[k]]
+    }
+
     /// Whether compiled body `b` (of `model`) is on a sleeping tree (the world never is).
     pub fn body_asleep(&self, model: &Model, b: usize) -> bool {
         let t = model.sleep.body_tree[b];

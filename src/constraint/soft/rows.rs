@@ -144,7 +144,11 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
         r += n;
     }
     let mut r = ne;
+    // Sleeping islands: a sleeping tree's own rows are left out (`forward::sleep`).
     for f in &cm.friction {
+        if data.sleep.dof_asleep(model, f.dof) {
+            continue;
+        }
         f.write_row(data, r);
         data.efc_margin[r] = 0.0;
         data.efc_frictionloss[r] = f.loss;
@@ -161,6 +165,9 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
     }
     let nf = r - ne;
     for l in &cm.limits {
+        if data.sleep.dof_asleep(model, l.dof_adr) {
+            continue;
+        }
         let margin = model.joints[l.joint].soft.margin;
         let ndof = if matches!(l.kind, LimitKind::Cone { .. }) { 3 } else { 1 };
         for (dist, dir) in joint_limit_sides(l, q, margin).into_iter().flatten() {
