@@ -368,7 +368,7 @@ impl SleepState {
             (asleep, fixed)
         };
         let ((z1, s1), (z2, s2)) = (side(geom[0]), side(geom[1]));
-        (z1 && z2) || (z1 && s2) || (z2 && s1)
+        (z1 && (z2 || s2)) || (z2 && s1)
     }
 
     /// Whether dof `k` of `model` is on a sleeping tree.
