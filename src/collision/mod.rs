@@ -161,6 +161,11 @@ impl CollisionModel {
 /// buffers have held as many contacts: a pass that finds more than every earlier one grows them).
 pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) {
     data.contacts.clear();
+    // Sleeping islands: with every tree asleep no pair passes the sleep filter.
+    if data.sleep.all_asleep(model) {
+        data.sleep.pairs_tested = 0;
+        return;
+    }
     let budget = model.contact_budget();
     let dropped_before = data.contacts_dropped;
     // World poses of the colliding geoms, once per pass (MuJoCo's geom_xpos, geom_xmat).

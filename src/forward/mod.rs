@@ -125,6 +125,9 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
             }
             StageKind::Passive => passive(model, data, q, v),
             StageKind::Actuation => actuation_unchecked(model, data, q, v, &plan.actuator_bias_velocity),
+            // Sleeping islands: with every tree asleep nothing accelerates (MuJoCo skips the
+            // sleeping dofs' smooth dynamics).
+            StageKind::Acceleration if !m_path && data.sleep.all_asleep(model) => data.qacc_smooth.fill(0.0),
             StageKind::Acceleration => acceleration(model, data, q, v, m_path),
             StageKind::Constraint if m_path => solver.solve(model, data),
             // Row sources are built by the position stage; the rest are listings.

@@ -77,6 +77,8 @@ pub struct SleepModel {
     pub dof_length: Vec<f64>,
     /// The name of each tree's root body (messages).
     pub root_name: Vec<String>,
+    /// Whether a geom is on a mocap body (awake whatever the trees do).
+    pub mocap_geoms: bool,
 }
 
 impl SleepModel {
@@ -202,7 +204,18 @@ impl SleepModel {
             }
         }
         let dof_length = dof_lengths(model, &body_link, x_world_body);
-        Ok(Self { tree_dof, tree_joint, dof_tree, body_tree, link_tree, policy, dof_length, root_name })
+        let mocap_geoms = model.geoms.iter().any(|g| g.mocap.is_some());
+        Ok(Self {
+            tree_dof,
+            tree_joint,
+            dof_tree,
+            body_tree,
+            link_tree,
+            policy,
+            dof_length,
+            root_name,
+            mocap_geoms,
+        })
     }
 }
 
@@ -369,6 +382,12 @@ impl SleepState {
         };
         let ((z1, s1), (z2, s2)) = (side(geom[0]), side(geom[1]));
         (z1 && (z2 || s2)) || (z2 && s1)
+    }
+
+    /// Whether every tree of `model` sleeps and no mocap geom could touch one: nothing moves, no
+    /// pair can touch (the collision pass and the smooth dynamics are skipped).
+    pub fn all_asleep(&self, model: &Model) -> bool {
+        self.ntree_awake == 0 && !self.tree_awake.is_empty() && !model.sleep.mocap_geoms
     }
 
     /// Whether dof `k` of `model` is on a sleeping tree.
