@@ -672,7 +672,6 @@ pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
         "max_penetration": s.max_penetration,
         "max_contacts": s.max_contacts,
         "contacts_dropped": s.contacts_dropped,
-        "sleep": s.sleep.map(|[asleep, trees, slept, woken]| json!({"asleep": asleep, "trees": trees, "slept": slept, "woken": woken})),
         "solver": {"max_iterations": s.max_solver_iterations, "unconverged": s.unconverged.0,
                    "worst_unconverged_residual": s.unconverged.1},
         "q": s.final_state.q.as_slice(),
@@ -681,6 +680,9 @@ pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
         "sensors": s.sensors,
         "warnings": s.warnings,
     });
+    if let Some([asleep, trees, slept, woken]) = s.sleep {
+        out["sleep"] = json!({"asleep": asleep, "trees": trees, "slept": slept, "woken": woken});
+    }
     if let Some(i) = &s.interrupted {
         out["interrupted"] = json!({
             "planned_steps": i.planned_steps,
