@@ -275,3 +275,16 @@ fn init_trees_start_asleep_and_wake_when_touched() {
     reset(&model, &mut data).unwrap();
     assert_eq!(data.sleep.nasleep(), 1, "reset puts it back to sleep");
 }
+
+#[test]
+fn transition_jacobians_leave_the_sleep_state_as_it_was() {
+    use lagrange::derivatives::{transition_jacobians, TransitionOptions, TransitionWork};
+    // The nudged steps move sleeping trees (and so wake them); each starts from the nominal's
+    // sleep state, and the caller's is the same afterwards.
+    let (model, mut data) = settled_bin(true);
+    let before = data.sleep.tree_asleep.clone();
+    let mut work = TransitionWork::new(&model);
+    transition_jacobians(&model, &mut data, &mut work, &TransitionOptions::default()).unwrap();
+    assert_eq!(data.sleep.tree_asleep, before);
+    assert_eq!(data.sleep.nasleep(), 50);
+}

@@ -349,6 +349,17 @@ impl SleepState {
         self.update();
     }
 
+    /// Copies the state of `other` (same model) into `self` without allocating (the transition
+    /// Jacobians' nudged steps start from the nominal's sleep state).
+    pub fn copy_from(&mut self, other: &SleepState) {
+        self.tree_asleep.copy_from_slice(&other.tree_asleep);
+        self.qpos_asleep.copy_from_slice(&other.qpos_asleep);
+        self.slept = other.slept;
+        self.woken = other.woken;
+        self.pairs_tested = other.pairs_tested;
+        self.update();
+    }
+
     /// `tree_awake` and `ntree_awake` from `tree_asleep` (MuJoCo's `mj_updateSleep`).
     pub fn update(&mut self) {
         let mut n = 0;
