@@ -288,3 +288,32 @@ fn transition_jacobians_leave_the_sleep_state_as_it_was() {
     assert_eq!(data.sleep.tree_asleep, before);
     assert_eq!(data.sleep.nasleep(), 50);
 }
+
+#[test]
+fn a_sleeping_tree_held_by_an_equality_to_the_world_has_no_rows() {
+    // A damped box hanging from the world by a connect equality: MuJoCo 4.0.0 puts it to sleep
+    // at step 50 (3 rows at that step's start), and it then has no rows.
+    let model = Model::from_str(
+        r#"<mujoco><option><flag sleep="enable"/></option><worldbody>
+           <body name="b" pos="0.2 0 1"><joint type="free" damping="0.5"/><geom type="box" size="0.05 0.05 0.05"/></body>
+           </worldbody><equality><connect body1="b" body2="world" anchor="0 0 0.3"/></equality></mujoco>"#,
+    )
+    .unwrap();
+    let mut data = Data::new(&model);
+    let mut asleep_at = None;
+    for k in 1..=200 {
+        step(&model, &mut data).unwrap();
+        if data.sleep.nasleep() == 1 {
+            asleep_at = Some(k);
+            assert_eq!(data.nefc, 3, "the step it falls asleep starts with the equality's rows");
+            break;
+        }
+    }
+    assert_eq!(asleep_at, Some(50));
+    let q = data.qpos.clone();
+    for _ in 0..10 {
+        step(&model, &mut data).unwrap();
+        assert_eq!(data.nefc, 0);
+    }
+    assert_eq!(data.qpos, q);
+}

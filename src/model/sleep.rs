@@ -401,6 +401,37 @@ impl SleepState {
         self.ntree_awake == 0 && !self.tree_awake.is_empty() && !model.sleep.mocap_geoms
     }
 
+    /// Whether equality `e` of `model` has rows: active, and not joining only sleeping trees and
+    /// static bodies (MuJoCo leaves those rows out; a mocap body counts as awake).
+    pub fn equality_has_rows(&self, model: &Model, e: usize, active: bool) -> bool {
+        if !active || self.ntree_awake == self.tree_awake.len() {
+            return active;
+        }
+        use super::EqualityKind;
+        // (asleep, awake) of a compiled body, its mocap index when it is a mocap body's frame.
+        let side = |body: usize, mocap: bool| {
+            let t = model.sleep.body_tree[body];
+            if t == NO_TREE {
+                (false, mocap)
+            } else {
+                (!self.tree_awake[t], self.tree_awake[t])
+            }
+        };
+        let frame = |f: usize| side(model.frames[f].body, model.frames[f].mocap.is_some());
+        let joint = |j: usize| side(model.joints[j].body, false);
+        let ((z1, a1), (z2, a2)) = match model.equalities[e].kind {
+            EqualityKind::Connect { frame1, frame2, .. } | EqualityKind::Weld { frame1, frame2, .. } => {
+                (frame(frame1), frame(frame2))
+            }
+            EqualityKind::Joint { joint1, joint2, .. } => {
+                (joint(joint1), joint2.map_or((false, false), joint))
+            }
+            EqualityKind::Mimic { joint: j, leader, .. } => (joint(j), joint(leader)),
+            _ => return true,
+        };
+        a1 || a2 || !(z1 || z2)
+    }
+
     /// Whether dof `k` of `model` is on a sleeping tree.
     pub fn dof_asleep(&self, model: &Model, k: usize) -> bool {
         self.ntree_awake < self.tree_awake.len() && !self.tree_awake[model.sleep.dof_tree[k]]
