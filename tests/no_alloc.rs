@@ -208,3 +208,27 @@ fn geometric_queries_do_not_allocate() {
     });
     assert_eq!(n, 0, "geometric queries allocated {n} times");
 }
+
+#[test]
+fn sleeping_islands_do_not_allocate() {
+    // drop.xml: bodies fall asleep, a falling sphere wakes one (contact wake, a second collision
+    // pass), both fall asleep again — all within the counted steps, after a warm-up run (and a
+    // reset) that grew the buffers to the scene's largest contact count.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let model = load(&root.join("tests/data/mjcf/sleep/drop.xml"), &LoadOptions::default()).unwrap();
+    let mut data = Data::new(&model);
+    for _ in 0..500 {
+        lagrange::prelude::step(&model, &mut data).unwrap();
+    }
+    lagrange::prelude::reset(&model, &mut data).unwrap();
+    let (mut slept, mut woken) = (0, 0);
+    let steps = allocations(|| {
+        for _ in 0..500 {
+            lagrange::prelude::step(&model, &mut data).unwrap();
+        }
+        slept = data.sleep.slept;
+        woken = data.sleep.woken;
+    });
+    assert!(slept >= 6 && woken >= 1, "{slept} trees fell asleep, {woken} woke");
+    assert_eq!(steps, 0, "sleeping, waking and stepping allocated {steps} times");
+}

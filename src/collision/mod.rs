@@ -165,6 +165,11 @@ impl CollisionModel {
 /// buffers have held as many contacts: a pass that finds more than every earlier one grows them).
 pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) {
     data.contacts.clear();
+    // Sleeping islands: with every tree asleep no pair passes the sleep filter.
+    if data.sleep.all_asleep(model) {
+        data.sleep.pairs_tested = 0;
+        return;
+    }
     let budget = model.contact_budget();
     let dropped_before = data.contacts_dropped;
     // World poses of the colliding geoms, once per pass (MuJoCo's geom_xpos, geom_xmat).
@@ -186,6 +191,8 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
     let mut touching = std::mem::take(&mut data.broadphase.touching);
     let all = 0..model.collision_pairs.len();
     let mut next = 0;
+    let asleep = data.sleep.any_asleep();
+    let mut tested = 0;
     // The pair being collided and the contact count before it: whether it touched is known at
     // the next pair.
     let mut open: Option<(usize, usize)> = None;
@@ -204,8 +211,13 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
             break;
         };
         next += 1;
-        open = Some((idx, data.contacts.len()));
         let (pair, b) = (&model.collision_pairs[idx], &cm.broad[idx]);
+        // Sleeping islands: no pair of two sleeping trees or of a sleeping tree and the world.
+        if asleep && data.sleep.pair_skipped(model, pair.geom) {
+            continue;
+        }
+        tested += 1;
+        open = Some((idx, data.contacts.len()));
         // Bounding spheres (a plane: the other geom's sphere against the plane).
         let (x1, x2) = (&data.x_world_geom[b.geom[0] as usize], &data.x_world_geom[b.geom[1] as usize]);
         let d = x2.pos - x1.pos;
@@ -387,6 +399,7 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
     }
     data.broadphase.pairs = swept;
     data.broadphase.touching = touching;
+    data.sleep.pairs_tested = tested;
     if data.contacts_dropped > dropped_before {
         let found = data.contacts.len() + (data.contacts_dropped - dropped_before) as usize;
         data.warnings.contacts_full(found, data.time);

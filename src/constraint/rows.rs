@@ -415,7 +415,7 @@ impl ConstraintModel {
     pub(crate) fn equality_rows(&self, model: &Model, data: &mut Data, q: &[f64]) -> usize {
         let mut r = 0;
         for e in &self.equalities {
-            if !data.eq_active[e.id] {
+            if !data.sleep.equality_has_rows(model, e.id, data.eq_active[e.id]) {
                 continue;
             }
             let n = e.geometry.nrow();
@@ -486,7 +486,7 @@ impl ConstraintModel {
         bias_accelerations_unchecked(model, data, v);
         let mut r = 0;
         for e in &self.equalities {
-            if !data.eq_active[e.id] {
+            if !data.sleep.equality_has_rows(model, e.id, data.eq_active[e.id]) {
                 continue;
             }
             let n = e.geometry.nrow();

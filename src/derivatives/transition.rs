@@ -111,6 +111,8 @@ struct Saved {
     nudge_warmstart: DVector<f64>,
     time: f64,
     steps: u64,
+    /// The sleeping islands (`Data::sleep`): every nudged step starts from the nominal's.
+    sleep: crate::model::sleep::SleepState,
 }
 
 /// A step's result: the next (q, v, act).
@@ -152,6 +154,7 @@ impl TransitionWork {
                 nudge_warmstart: DVector::zeros(nv),
                 time: 0.0,
                 steps: 0,
+                sleep: crate::model::sleep::SleepState::new(model),
             },
             next: Next::new(model),
             plus: Next::new(model),
@@ -183,6 +186,7 @@ impl TransitionWork {
         s.nudge_warmstart.copy_from(&data.qacc_warmstart);
         s.time = data.time;
         s.steps = data.stepper.steps;
+        s.sleep.copy_from(&data.sleep);
     }
 
     fn restore(&self, data: &mut Data) {
@@ -195,6 +199,7 @@ impl TransitionWork {
         data.time = s.time;
         data.stepper.steps = s.steps;
         data.stepper.failed = None;
+        data.sleep.copy_from(&s.sleep);
     }
 
     /// Column `col` of `out` from the nudged results: centred (plus − minus) / 2ε when both are

@@ -24,6 +24,7 @@ pub mod history;
 pub mod muscle;
 mod plan;
 mod skip;
+pub(crate) mod sleep;
 pub(crate) mod transmission;
 mod xfrc;
 
@@ -89,7 +90,16 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     // stages, its collision and its M-path decision included.
     let skip = std::mem::take(&mut data.forward_skip.stage);
     let m_path = if skip == SkipStage::None {
-        plan.has_constraints() && solver.rows_exist(rows, model, data, q)
+        // Sleeping islands (`sleep`): the user's changes wake trees before collision, a touch
+        // by an awake tree after it (collided again, for the woken trees' own contacts), then
+        // an equality to an awake tree.
+        sleep::wake_perturbed(model, data, q, v);
+        let mut exist = plan.has_constraints() && solver.rows_exist(rows, model, data, q);
+        if sleep::wake_touched(model, data) > 0 {
+            exist = plan.has_constraints() && solver.rows_exist(rows, model, data, q);
+        }
+        sleep::wake_joined(model, data);
+        exist
     } else {
         data.forward_skip.m_path
     };
@@ -115,6 +125,9 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
             }
             StageKind::Passive => passive(model, data, q, v),
             StageKind::Actuation => actuation_unchecked(model, data, q, v, &plan.actuator_bias_velocity),
+            // Sleeping islands: with every tree asleep nothing accelerates (MuJoCo skips the
+            // sleeping dofs' smooth dynamics).
+            StageKind::Acceleration if !m_path && data.sleep.all_asleep(model) => data.qacc_smooth.fill(0.0),
             StageKind::Acceleration => acceleration(model, data, q, v, m_path),
             StageKind::Constraint if m_path => solver.solve(model, data),
             // Row sources are built by the position stage; the rest are listings.
@@ -128,6 +141,7 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         data.ne = 0;
         data.nf = 0;
     }
+    sleep::zero_sleeping_acceleration(model, data);
 }
 
 /// Passive forces: joint damping −d ⊙ v and the springs of hinge and slide joints

@@ -559,8 +559,18 @@ fn soft_description(model: &Model) -> String {
         missing.sort();
         format!("; not simulated in soft mode: {}", missing.join(", "))
     };
+    let sleep = if o.flags.sleep {
+        let may = model.sleep.policy.iter().filter(|p| p.may_sleep()).count();
+        format!(
+            "; sleeping islands on (sleep_tolerance {:e}: {may} of {} trees may sleep)",
+            o.sleep_tolerance,
+            model.sleep.ntree()
+        )
+    } else {
+        String::new()
+    };
     format!(
-        "soft mode (MuJoCo's convex model): solref/solimp impedance, R from the diagonal approximation, aref = −b·Jv − k·d·r; {solver}, {cone} cones, impratio {}, iterations {}, tolerance {:e}, ls_iterations {}, ls_tolerance {:e}, warm start {}{missing}",
+        "soft mode (MuJoCo's convex model): solref/solimp impedance, R from the diagonal approximation, aref = −b·Jv − k·d·r; {solver}, {cone} cones, impratio {}, iterations {}, tolerance {:e}, ls_iterations {}, ls_tolerance {:e}, warm start {}{sleep}{missing}",
         o.impratio,
         o.iterations,
         o.tolerance,

@@ -6,7 +6,7 @@
 use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix_damped, solve_with_factor_unchecked};
 use crate::forward::{advance_activations, forward_at};
-use crate::model::{integrate_configuration_unchecked, Data, Model};
+use crate::model::{Data, Model};
 use nalgebra::DVector;
 
 /// Semi-implicit Euler stepper, with its buffer for the implicitly damped acceleration.
@@ -47,6 +47,8 @@ impl Advance for SemiImplicitEuler {
         // MuJoCo's mj_step: the sensors of the state the step starts from.
         crate::sensor::compute_at(model, data, state.q.as_slice(), state.v.as_slice(), state.time);
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
+        // MuJoCo's mj_advance: islands at rest fall asleep (their v zeroed) before v advances.
+        crate::forward::sleep::sleep_islands(model, data, state.q.as_slice(), state.v.as_mut_slice());
         let flags = &model.options.flags;
         if flags.eulerdamp && flags.damper && model.has_damping() {
             damped_acceleration(model, data, state.q.as_slice(), &mut self.damped, h);
@@ -54,7 +56,8 @@ impl Advance for SemiImplicitEuler {
         } else {
             state.v.axpy(h, &data.qacc, 1.0);
         }
-        integrate_configuration_unchecked(model, state.q.as_mut_slice(), state.v.as_slice(), h);
+        crate::forward::sleep::hold_velocities(model, data, state.v.as_mut_slice());
+        crate::forward::sleep::integrate_awake(model, data, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }

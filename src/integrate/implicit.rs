@@ -14,7 +14,7 @@ use super::{add_force_derivative, correct_drift, Advance, State, StepReport, Ste
 use crate::dynamics::crba_unchecked;
 use crate::dynamics::BiasDerivative;
 use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
-use crate::model::{integrate_configuration_unchecked, Data, Model};
+use crate::model::{Data, Model};
 use nalgebra::{DMatrix, DVector};
 
 /// The implicit stepper with its derivative pass, LU matrix and force buffer.
@@ -100,6 +100,8 @@ impl Advance for Implicit {
         crate::sensor::compute_at(model, data, state.q.as_slice(), state.v.as_slice(), state.time);
         // Activations as in MuJoCo's `mj_advance` (explicit in act_dot; filterexact exact).
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
+        // MuJoCo's mj_advance: islands at rest fall asleep (their v zeroed) before v advances.
+        crate::forward::sleep::sleep_islands(model, data, state.q.as_slice(), state.v.as_mut_slice());
         crba_unchecked(model, data, state.q.as_slice());
         self.force.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
         self.derivative.compute(model, data, state.q.as_slice(), state.v.as_slice());
@@ -122,7 +124,8 @@ impl Advance for Implicit {
         lu_factor_in_place(self.lu.as_mut_slice(), nv, nv);
         lu_solve_in_place(self.lu.as_slice(), nv, nv, self.force.as_mut_slice());
         state.v.axpy(h, &self.force, 1.0);
-        integrate_configuration_unchecked(model, state.q.as_mut_slice(), state.v.as_slice(), h);
+        crate::forward::sleep::hold_velocities(model, data, state.v.as_mut_slice());
+        crate::forward::sleep::integrate_awake(model, data, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }

@@ -15,7 +15,7 @@
 use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
 use crate::forward::{add_actuator_velocity_derivative, advance_activations, forward_at};
-use crate::model::{integrate_configuration_unchecked, Data, Model};
+use crate::model::{Data, Model};
 use nalgebra::{DMatrix, DVector};
 
 /// The implicitfast stepper with its force buffer.
@@ -112,6 +112,8 @@ impl Advance for ImplicitFast {
         crate::sensor::compute_at(model, data, state.q.as_slice(), state.v.as_slice(), state.time);
         // Activations as in MuJoCo's `mj_advance` (explicit in act_dot; filterexact exact).
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
+        // MuJoCo's mj_advance: islands at rest fall asleep (their v zeroed) before v advances.
+        crate::forward::sleep::sleep_islands(model, data, state.q.as_slice(), state.v.as_mut_slice());
         let actuated = !model.actuators.is_empty() && model.options.flags.actuation;
         let bias_velocity = actuated.then_some(model.plan.actuator_bias_velocity.as_slice());
         if implicit_acceleration(
@@ -127,7 +129,8 @@ impl Advance for ImplicitFast {
         } else {
             state.v.axpy(h, &data.qacc, 1.0);
         }
-        integrate_configuration_unchecked(model, state.q.as_mut_slice(), state.v.as_slice(), h);
+        crate::forward::sleep::hold_velocities(model, data, state.v.as_mut_slice());
+        crate::forward::sleep::integrate_awake(model, data, state.q.as_mut_slice(), state.v.as_slice(), h);
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }

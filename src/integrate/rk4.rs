@@ -13,7 +13,7 @@
 use super::stage::{evaluate_stage, StageInput};
 use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::forward::advance_activations;
-use crate::model::{integrate_configuration_unchecked, Data, Model};
+use crate::model::{Data, Model};
 use nalgebra::DVector;
 
 /// RK4 stepper with its stage buffers.
@@ -95,6 +95,8 @@ impl Advance for RungeKutta4 {
                 data.freeze_rows(false);
             }
         }
+        // MuJoCo's mj_advance: islands at rest fall asleep (their v zeroed) before v advances.
+        crate::forward::sleep::sleep_islands(model, data, state.q.as_slice(), state.v.as_mut_slice());
         // Weighted means (1, 2, 2, 1)/6 of the stage slopes of θ and v.
         let [r1, r2, r3, r4] = &self.theta_rate;
         let [a1, a2, a3, a4] = &self.a_stage;
@@ -107,7 +109,14 @@ impl Advance for RungeKutta4 {
             self.act_mean[k] = (w1[k] + 2.0 * w2[k] + 2.0 * w3[k] + w4[k]) / 6.0;
         }
         advance_activations(model, state.act.as_mut_slice(), self.act_mean.as_slice(), h);
-        integrate_configuration_unchecked(model, state.q.as_mut_slice(), self.theta.as_slice(), 1.0);
+        crate::forward::sleep::hold_velocities(model, data, state.v.as_mut_slice());
+        crate::forward::sleep::integrate_awake(
+            model,
+            data,
+            state.q.as_mut_slice(),
+            self.theta.as_slice(),
+            1.0,
+        );
         state.time += h;
         StepReport::fixed_step(h, correct_drift(model, data, state, h))
     }

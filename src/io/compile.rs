@@ -399,6 +399,7 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         elements: spec.elements.clone(),
         warnings,
         plan: crate::forward::Plan::default(),
+        sleep: Default::default(),
     };
     let mut e = crate::io::compile_elements::compile_elements(spec, &model)?;
     model.equalities = e.equalities;
@@ -480,7 +481,39 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     crate::tendon::resolve_spring_lengths(&mut model);
     crate::model::lengthrange::set_acc0(&mut model);
     model.plan = crate::forward::Plan::new(&model, None);
+    model.sleep = sleep_model(spec, &model, &link_body)?;
     Ok(model)
+}
+
+/// MuJoCo's trees, sleep policies and `dof_length` ([`crate::model::sleep::SleepModel`]), with
+/// the file's `<body sleep>` policies checked: only on the root body of a tree.
+fn sleep_model(
+    spec: &ModelSpec,
+    model: &Model,
+    link_body: &[(usize, Transform)],
+) -> Result<crate::model::sleep::SleepModel, LoadError> {
+    let user: Vec<(usize, crate::model::sleep::SleepPolicy)> =
+        spec.sleep.iter().map(|&(l, p)| (model.body_root[link_body[l].0], p)).collect();
+    let mut data = crate::model::Data::scratch(model);
+    let q = model.qpos0.clone();
+    let v = vec![0.0; model.nv];
+    crate::kinematics::forward_kinematics_unchecked(model, &mut data, &q);
+    crate::tendon::compute(model, &mut data, &q, &v);
+    crate::model::sleep::SleepModel::new(model, &user, &data.ten_j, &data.x_world_body).map_err(
+        |(b, detail)| {
+            let link =
+                spec.sleep.iter().find(|&&(l, _)| model.body_root[link_body[l].0] == b).map(|&(l, _)| l);
+            let loc = link.map_or_else(
+                || SourceLoc {
+                    file: spec.source.as_ref().map(|p| p.display().to_string()).unwrap_or_default(),
+                    line: 0,
+                },
+                |l| spec.links[l].loc.clone(),
+            );
+            let name = link.map_or_else(|| model.bodies[b].name.clone(), |l| spec.links[l].name.clone());
+            LoadError::Invalid { loc, element: "body".into(), detail: format!("body '{name}': {detail}") }
+        },
+    )
 }
 
 /// The actuators whose `actuator_lengthrange` neither the file nor a limit settles

@@ -393,6 +393,9 @@ pub struct Data {
     pub wrap_obj: Vec<i64>,
     /// Per wrap point: its world position (MuJoCo's `wrap_xpos`; zero for a pulley).
     pub wrap_xpos: Vec<crate::spatial::Vec3>,
+    /// Sleeping islands: MuJoCo's `tree_asleep` and what derives from it, and the counts of
+    /// trees put to sleep and woken ([`super::sleep::SleepState`]; `<flag sleep>`).
+    pub sleep: super::sleep::SleepState,
 }
 
 impl Data {
@@ -528,6 +531,7 @@ impl Data {
             ten_wrapnum: vec![0; model.tendons.len()],
             wrap_obj: vec![0; nwrap],
             wrap_xpos: vec![crate::spatial::Vec3::zeros(); nwrap],
+            sleep: super::sleep::SleepState::new(model),
         }
     }
 }

@@ -18,6 +18,7 @@ mod links;
 pub mod options;
 pub(crate) mod poses_stamp;
 pub mod reset;
+pub mod sleep;
 pub mod spec;
 pub mod tendon;
 pub mod warning;
@@ -321,6 +322,9 @@ pub struct Model {
     /// Gravity compensation (MJCF body `gravcomp`), one entry per compiled body that has any
     /// ([`crate::dynamics::gravcomp`]).
     pub gravcomp: Vec<GravComp>,
+    /// MuJoCo's kinematic trees, their sleep policies and the dofs' lengths, for sleeping
+    /// islands (`<flag sleep>`; [`sleep::SleepModel`]).
+    pub sleep: sleep::SleepModel,
 }
 
 /// The gravity compensation of one compiled body: the links fused into it that have a `gravcomp`

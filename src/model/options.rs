@@ -121,6 +121,10 @@ pub struct Flags {
     /// Constraint island discovery (`mjENBL_ISLAND`); islands are solved as one problem, listed by
     /// `info`.
     pub island: bool,
+    /// Sleeping islands (`mjENBL_SLEEP`, off by default): trees at rest for `mjMINAWAKE` steps
+    /// are put to sleep with their island and skipped by collision, rows and integration until
+    /// woken (`forward::sleep`, docs/constraints.md "Sleeping islands"; soft mode only).
+    pub sleep: bool,
 }
 
 impl Default for Flags {
@@ -150,6 +154,7 @@ impl Default for Flags {
             invdiscrete: false,
             multiccd: true,
             island: false,
+            sleep: false,
         }
     }
 }
@@ -182,13 +187,14 @@ impl Flags {
             "invdiscrete" => &mut self.invdiscrete,
             "multiccd" => &mut self.multiccd,
             "island" => &mut self.island,
+            "sleep" => &mut self.sleep,
             _ => return None,
         })
     }
 
     /// The switches that differ from MuJoCo's defaults, as (MJCF name, on).
     pub fn changed(&self) -> Vec<(&'static str, bool)> {
-        const NAMES: [&str; 24] = [
+        const NAMES: [&str; 25] = [
             "constraint",
             "equality",
             "frictionloss",
@@ -213,6 +219,7 @@ impl Flags {
             "invdiscrete",
             "multiccd",
             "island",
+            "sleep",
         ];
         let (mut this, mut default) = (*self, Flags::default());
         NAMES
@@ -268,6 +275,9 @@ pub struct Options {
     /// Iteration limit of MuJoCo's convex collision solver (`ccd_iterations`, 35), read by
     /// lagrange's copy of that solver (`collision::ccd`).
     pub ccd_iterations: u32,
+    /// The velocity (m/s, each dof's speed scaled by its `dof_length`) below which a tree may
+    /// fall asleep (MuJoCo's `sleep_tolerance`, default 1e-3; read with `<flag sleep>`).
+    pub sleep_tolerance: f64,
     /// The `<flag>` switches.
     pub flags: Flags,
     /// Contact margin under `<flag override>` (m; MuJoCo's `o_margin`, default 0).
@@ -302,6 +312,7 @@ impl Default for Options {
             magnetic: [0.0, -0.5, 0.0],
             ccd_tolerance: 1e-6,
             ccd_iterations: 35,
+            sleep_tolerance: 1e-3,
             flags: Flags::default(),
             o_margin: 0.0,
             o_solref: [0.02, 1.0],

@@ -49,6 +49,7 @@ pub fn reset(model: &Model, data: &mut Data) -> Result<(), InputError> {
     data.stepper.steps = 0;
     data.stepper.failed = None;
     data.warnings.clear();
+    data.sleep.reset(model);
     Ok(())
 }
 

@@ -47,6 +47,9 @@ pub struct ModelSpec {
     /// Gravity compensation (MJCF body `gravcomp`): (index in [`links`](Self::links), fraction of
     /// the link's weight cancelled), for the links where it is nonzero.
     pub gravcomp: Vec<(usize, f64)>,
+    /// Sleep policies other than `auto` (MJCF body `sleep`): (index in [`links`](Self::links),
+    /// policy).
+    pub sleep: Vec<(usize, crate::model::sleep::SleepPolicy)>,
 }
 
 /// MuJoCo's `<compiler>` rules for mass properties, applied per link in this order: inertia from

@@ -132,6 +132,9 @@ pub struct Summary {
     pub passive: bool,
     /// Contacts dropped because a collision pass found more than the model's contact budget.
     pub contacts_dropped: u64,
+    /// With `<flag sleep>`: trees asleep at the end, trees, and how many fell asleep and woke
+    /// during the run.
+    pub sleep: Option<[u64; 4]>,
     /// Whether the model has constraint rows (equalities, mimics, joint limits).
     pub constrained: bool,
     pub dt: f64,
@@ -483,6 +486,10 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
         warnings: sim.data.warnings.messages(model),
         passive,
         contacts_dropped: sim.data.contacts_dropped,
+        sleep: sim.model.options.flags.sleep.then(|| {
+            let sl = &sim.data.sleep;
+            [sl.nasleep() as u64, sim.model.sleep.ntree() as u64, sl.slept, sl.woken]
+        }),
         constrained: sim.model.plan.has_constraints(),
         integrator: sim.integrator(),
         dt,
@@ -673,6 +680,9 @@ pub fn summary_json(model: &Model, s: &Summary) -> serde_json::Value {
         "sensors": s.sensors,
         "warnings": s.warnings,
     });
+    if let Some([asleep, trees, slept, woken]) = s.sleep {
+        out["sleep"] = json!({"asleep": asleep, "trees": trees, "slept": slept, "woken": woken});
+    }
     if let Some(i) = &s.interrupted {
         out["interrupted"] = json!({
             "planned_steps": i.planned_steps,
@@ -769,6 +779,12 @@ pub fn summary_text(model: &Model, request: &Request, s: &Summary) -> String {
             out,
             "contacts: up to {} touching, deepest penetration after a step {:.3e} m",
             s.max_contacts, s.max_penetration
+        );
+    }
+    if let Some([asleep, trees, slept, woken]) = s.sleep {
+        let _ = writeln!(
+            out,
+            "sleeping islands: {asleep} of {trees} trees asleep at the end ({slept} fell asleep, {woken} woke during the run)"
         );
     }
     if s.contacts_dropped > 0 {

@@ -79,7 +79,7 @@ fn row_bound(cm: &ConstraintModel, model: &Model, data: &Data) -> usize {
     let eq: usize = cm
         .equalities
         .iter()
-        .filter(|e| data.eq_active[e.id])
+        .filter(|e| data.sleep.equality_has_rows(model, e.id, data.eq_active[e.id]))
         .map(|e| model.equalities[e.id].kind.nrow())
         .sum();
     let contacts: usize = data.contacts.iter().map(|c| 2 * (c.condim.clamp(1, 6) as usize)).sum();
@@ -116,7 +116,7 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
     // MuJoCo's weld rotation rows.
     let mut r = 0;
     for e in &cm.equalities {
-        if !data.eq_active[e.id] {
+        if !data.sleep.equality_has_rows(model, e.id, data.eq_active[e.id]) {
             continue;
         }
         let n = model.equalities[e.id].kind.nrow();
@@ -144,7 +144,11 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
         r += n;
     }
     let mut r = ne;
+    // Sleeping islands: a sleeping tree's own rows are left out (`forward::sleep`).
     for f in &cm.friction {
+        if data.sleep.dof_asleep(model, f.dof) {
+            continue;
+        }
         f.write_row(data, r);
         data.efc_margin[r] = 0.0;
         data.efc_frictionloss[r] = f.loss;
@@ -161,6 +165,9 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
     }
     let nf = r - ne;
     for l in &cm.limits {
+        if data.sleep.dof_asleep(model, l.dof_adr) {
+            continue;
+        }
         let margin = model.joints[l.joint].soft.margin;
         let ndof = if matches!(l.kind, LimitKind::Cone { .. }) { 3 } else { 1 };
         for (dist, dir) in joint_limit_sides(l, q, margin).into_iter().flatten() {
@@ -368,7 +375,7 @@ pub(crate) fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Da
     bias_accelerations_unchecked(model, data, v);
     let mut r = 0;
     for e in &cm.equalities {
-        if !data.eq_active[e.id] {
+        if !data.sleep.equality_has_rows(model, e.id, data.eq_active[e.id]) {
             continue;
         }
         let n = model.equalities[e.id].kind.nrow();
@@ -418,7 +425,7 @@ pub(crate) fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Da
 pub(crate) fn soft_active(cm: &ConstraintModel, model: &Model, data: &mut Data, q: &[f64]) -> bool {
     let mut active = !cm.friction.is_empty()
         || !cm.tendon_friction.is_empty()
-        || cm.equalities.iter().any(|e| data.eq_active[e.id]);
+        || cm.equalities.iter().any(|e| data.sleep.equality_has_rows(model, e.id, data.eq_active[e.id]));
     if cm.has_collision() {
         crate::kinematics::body_poses(model, data, q);
         crate::collision::collide(model, &cm.collision, data, 0.0);

@@ -170,7 +170,15 @@ fn expand_at(
     let mut root = root.clone();
     replicate::expand(&mut root, &compiler.angles)?;
     let models = sub_models(&mut root, dir)?;
-    let mut ctx = Ctx { models, compiler, depth, warnings, cache: HashMap::new(), merged: Vec::new() };
+    let mut ctx = Ctx {
+        models,
+        compiler,
+        depth,
+        warnings,
+        cache: HashMap::new(),
+        shared: HashSet::new(),
+        merged: Vec::new(),
+    };
     for wb in root.children.iter_mut().filter(|c| c.tag == "worldbody") {
         ctx.walk(wb)?;
     }
@@ -218,6 +226,9 @@ struct Ctx<'a> {
     depth: usize,
     warnings: &'a mut Vec<String>,
     cache: HashMap<String, std::rc::Rc<Child>>,
+    /// The (model, prefix) already attached: their classes and assets are merged once (the
+    /// copies of a replicated `<attach>` share them, as in MuJoCo).
+    shared: HashSet<(String, String)>,
     /// Root-level elements to append (per attach: its default classes, assets and sections).
     merged: Vec<Element>,
 }
@@ -328,6 +339,9 @@ impl Ctx<'_> {
             ));
         };
         let prefix = prefix.to_string();
+        // The suffixes of the replicates around this attach (`replicate::ATTACH_SUFFIX`).
+        let suffix = at.attr(replicate::ATTACH_SUFFIX).unwrap_or("").to_string();
+        let first = self.shared.insert((model.to_string(), prefix.clone()));
         let child = self.child(model, at)?;
 
         // The subtree and the class it inherits in the child.
@@ -375,19 +389,21 @@ impl Ctx<'_> {
             loc: at.loc.clone(),
         };
         let mut queued = Vec::new();
-        for e in &child.root.children {
+        for e in child.root.children.iter().filter(|_| first) {
             match e.tag.as_str() {
                 "default" => defaults.children.extend(e.children.iter().cloned()),
                 ATTACHED_DEFAULTS => queued.push(e.clone()),
                 _ => {}
             }
         }
-        queued.insert(0, defaults);
+        if first {
+            queued.insert(0, defaults);
+        }
 
         // Assets: all of them, files made absolute (the child's mesh folder).
         let mut assets =
             Element { tag: "asset".into(), attrs: vec![], children: vec![], loc: at.loc.clone() };
-        for section in child.root.children.iter().filter(|c| c.tag == "asset") {
+        for section in child.root.children.iter().filter(|c| first && c.tag == "asset") {
             for a in &section.children {
                 let mut a = a.clone();
                 if let Some(file) = a.attr("file").map(str::to_string) {
@@ -419,7 +435,13 @@ impl Ctx<'_> {
             }
             queued.push(out);
         }
-        for k in child.root.children.iter().filter(|c| c.tag == "keyframe").flat_map(|s| s.children.iter()) {
+        for k in child
+            .root
+            .children
+            .iter()
+            .filter(|c| first && c.tag == "keyframe")
+            .flat_map(|s| s.children.iter())
+        {
             self.warnings.push(format!(
                 "{}: keyframe '{}' of the attached model '{model}' is not merged (MuJoCo 4.0 would add it as '{prefix}{}' on the merged qpos); write the key in this model",
                 k.loc,
@@ -436,6 +458,9 @@ impl Ctx<'_> {
                 }
             }
             prefix_names(q, &prefix);
+            if !SHARED_TAGS.contains(&q.tag.as_str()) {
+                suffix_names(q, &suffix);
+            }
         }
         self.merged.extend(queued);
         let mut frame = Element {
@@ -445,6 +470,7 @@ impl Ctx<'_> {
             loc: at.loc.clone(),
         };
         prefix_names(&mut frame, &prefix);
+        suffix_names(&mut frame, &suffix);
         Ok(frame)
     }
 }
@@ -501,6 +527,29 @@ fn prefix_names(e: &mut Element, prefix: &str) {
     }
     for c in &mut e.children {
         prefix_names(c, prefix);
+    }
+}
+
+/// The merged sections a replicated attach shares among its copies (no suffix).
+const SHARED_TAGS: [&str; 2] = [ATTACHED_DEFAULTS, "asset"];
+
+/// Names that a replicate's suffix leaves alone: classes and assets are shared by the copies.
+const SHARED_REFS: [&str; 6] = ["class", "childclass", "mesh", "material", "texture", "hfield"];
+
+/// Appends a replicate's `suffix` to every name and reference of the copied elements (`world`,
+/// classes and assets excepted).
+fn suffix_names(e: &mut Element, suffix: &str) {
+    if suffix.is_empty() {
+        return;
+    }
+    for (k, v) in &mut e.attrs {
+        let named = NAME_ATTRS.contains(&k.as_str()) && !SHARED_REFS.contains(&k.as_str());
+        if named && !v.is_empty() && !(v == "world" && k != "name") {
+            v.push_str(suffix);
+        }
+    }
+    for c in &mut e.children {
+        suffix_names(c, suffix);
     }
 }
 

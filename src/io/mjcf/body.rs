@@ -45,6 +45,8 @@ pub(crate) struct TreeBuilder<'a> {
     pub kept: Vec<crate::model::Element>,
     /// Body `gravcomp` where nonzero: (link index, fraction).
     pub gravcomp: Vec<(usize, f64)>,
+    /// Body `sleep` other than `auto`: (link index, policy).
+    pub sleep: Vec<(usize, crate::model::sleep::SleepPolicy)>,
     /// MuJoCo's body and joint ids so far (world = body 0), for naming unnamed ones.
     next_body: usize,
     next_joint: usize,
@@ -66,6 +68,7 @@ impl<'a> TreeBuilder<'a> {
             warnings: Vec::new(),
             kept: Vec::new(),
             gravcomp: Vec::new(),
+            sleep: Vec::new(),
             next_body: 1,
             next_joint: 0,
         }
@@ -206,6 +209,10 @@ impl<'a> TreeBuilder<'a> {
             return Err(a.error("mocap", "is only allowed on a top-level body without joints"));
         }
         let gravcomp = a.real("gravcomp")?.unwrap_or(0.0);
+        let sleep = match a.keyword("sleep", &["auto", "never", "allowed", "init"])? {
+            Some(w) => crate::model::sleep::SleepPolicy::from_mjcf(&w),
+            None => None,
+        };
 
         // The link chain: the body link hangs from `parent` directly or from its joint links.
         let mut chain_parent = parent;
@@ -287,6 +294,9 @@ impl<'a> TreeBuilder<'a> {
         let link = self.links.len() - 1;
         if gravcomp != 0.0 {
             self.gravcomp.push((link, gravcomp));
+        }
+        if let Some(p) = sleep.filter(|p| *p != crate::model::sleep::SleepPolicy::Auto) {
+            self.sleep.push((link, p));
         }
         self.attach_geoms_and_sites(link, &content, Transform::identity(), from_geoms)?;
         for (b, x, bclass) in &content.bodies {

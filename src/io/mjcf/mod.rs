@@ -168,5 +168,6 @@ fn parse_root(root: &xml::Element, path: &Path, load: &LoadOptions) -> Result<Mo
         elements,
         warnings,
         gravcomp: builder.gravcomp,
+        sleep: builder.sleep,
     })
 }

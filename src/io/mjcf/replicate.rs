@@ -101,8 +101,19 @@ fn copies(r: &Element, angles: &AngleConvention, budget: &mut usize) -> Result<V
     Ok(out)
 }
 
-/// Appends `suffix` to every `name` in the subtree (unnamed elements stay unnamed, as in MuJoCo).
+/// The attribute in which an `<attach>` inside a replicate collects the copies' suffixes (not an
+/// MJCF attribute: it cannot come from a file); the attach gives them to every name it copies.
+pub(crate) const ATTACH_SUFFIX: &str = "suffix:replicate";
+
+/// Appends `suffix` to every `name` in the subtree (unnamed elements stay unnamed, as in MuJoCo),
+/// and to the names an `<attach>` in it will copy (MuJoCo names them so: `_torso-00-00`).
 fn add_suffix(e: &mut Element, suffix: &str) {
+    if e.tag == "attach" {
+        match e.attrs.iter_mut().find(|(k, _)| k == ATTACH_SUFFIX) {
+            Some((_, v)) => v.push_str(suffix),
+            None => e.attrs.push((ATTACH_SUFFIX.to_string(), suffix.to_string())),
+        }
+    }
     for (k, v) in &mut e.attrs {
         if k == "name" && !v.is_empty() {
             v.push_str(suffix);

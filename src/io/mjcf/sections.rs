@@ -142,6 +142,7 @@ pub(crate) fn options(root: &Element) -> Result<(Options, Vec3), LoadError> {
             ("density", &mut o.density),
             ("viscosity", &mut o.viscosity),
             ("ccd_tolerance", &mut o.ccd_tolerance),
+            ("sleep_tolerance", &mut o.sleep_tolerance),
         ] {
             if let Some(v) = a.real(attr)? {
                 if v < 0.0 {
