@@ -109,8 +109,12 @@ impl<'a> Assembler<'a> {
             *g = self.nz.row_values(i + a).1;
         }
         add_columns(self.h, cols, &g[..dim], self.column, |g_q, c| {
-            for (a, c) in c.iter_mut().enumerate() {
-                *c = (0..dim).map(|b| block[a][b] * g_q[b]).sum();
+            for (c, row) in c.iter_mut().zip(block) {
+                let mut s = 0.0;
+                for (&b_ab, &g_b) in row.iter().zip(g_q) {
+                    s += b_ab * g_b;
+                }
+                *c = s;
             }
         });
     }
@@ -134,10 +138,12 @@ impl<'a> Assembler<'a> {
 
 /// H[p][q] += Σ_r c_r(q) G_r[p] over columns q of `cols` and p ≥ q (rows `g`, all on `cols`;
 /// `coefficients(g_q, c)` writes c_r(q) from the rows' values g_q = (G_0[q], …) at column
-/// position q). Up to four rows, each entry's sum is formed in a register from the rows' values;
-/// more rows are first laid out transposed in `scratch` — Gᵀ[p] = (G_0[p], …, G_{k−1}[p]) and
+/// position q). Up to eight rows, each entry's sum is formed in registers from the rows' values,
+/// four rows at a time (an elliptic contact of condim 6 is two such passes); more rows are first
+/// laid out transposed in `scratch` — Gᵀ[p] = (G_0[p], …, G_{k−1}[p]) and
 /// C[q] = (c_0(q), …) contiguous, zero-padded to a multiple of four — so that each entry is one
 /// dot product of two contiguous vectors (`dot4`). Either way it is added to H once.
+#[inline(always)]
 fn add_columns(
     h: &mut DMatrix<f64>,
     cols: &[usize],
@@ -148,9 +154,10 @@ fn add_columns(
     let (n, k) = (cols.len(), g.len());
     let nv = h.nrows();
     let h = h.as_mut_slice();
-    if k <= 4 {
-        // Up to four rows: each entry's sum in a register, straight from the rows' values.
-        let (mut g_q, mut c) = ([0.0; 4], [0.0; 4]);
+    if k <= 8 {
+        // Up to eight rows: each entry's sum over (up to) four rows at a time in a register,
+        // straight from the rows' values.
+        let (mut g_q, mut c) = ([0.0; 8], [0.0; 8]);
         for q in 0..n {
             for (x, g) in g_q.iter_mut().zip(g) {
                 *x = g[q];
@@ -158,29 +165,31 @@ fn add_columns(
             coefficients(&g_q[..k], &mut c[..k]);
             let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
             let rows = &cols[q..];
-            match k {
-                1 => {
-                    for (&p, &g0) in rows.iter().zip(&g[0][q..n]) {
-                        column[p] += c[0] * g0;
+            for (g, c) in g.chunks(4).zip(c[..k].chunks(4)) {
+                match g.len() {
+                    1 => {
+                        for (&p, &g0) in rows.iter().zip(&g[0][q..n]) {
+                            column[p] += c[0] * g0;
+                        }
                     }
-                }
-                2 => {
-                    for ((&p, &g0), &g1) in rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]) {
-                        column[p] += c[0] * g0 + c[1] * g1;
+                    2 => {
+                        for ((&p, &g0), &g1) in rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]) {
+                            column[p] += c[0] * g0 + c[1] * g1;
+                        }
                     }
-                }
-                3 => {
-                    for (((&p, &g0), &g1), &g2) in
-                        rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n])
-                    {
-                        column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2;
+                    3 => {
+                        for (((&p, &g0), &g1), &g2) in
+                            rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n])
+                        {
+                            column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2;
+                        }
                     }
-                }
-                _ => {
-                    for ((((&p, &g0), &g1), &g2), &g3) in
-                        rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n]).zip(&g[3][q..n])
-                    {
-                        column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2 + c[3] * g3;
+                    _ => {
+                        for ((((&p, &g0), &g1), &g2), &g3) in
+                            rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n]).zip(&g[3][q..n])
+                        {
+                            column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2 + c[3] * g3;
+                        }
                     }
                 }
             }
@@ -248,11 +257,15 @@ mod tests {
     fn grouped_rows_and_blocks_sum_to_jt_b_j() {
         // Rows 0..2: one group on columns {1, 3, 4}; row 2 alone on {0, 4}; rows 3..6 a block
         // on {0, 2, 3} (row 4 has an exact zero there, kept); rows 6..8 a block whose rows have
-        // different columns (pair by pair).
+        // different columns (pair by pair); rows 8..14 a group of six on {0, 1, 3, 4} (two
+        // passes of the register path) and rows 14..26 a group of twelve on {0, 2, 4} (the
+        // transposed path).
         let nv = 5;
-        let cols: [&[usize]; 8] =
-            [&[1, 3, 4], &[1, 3, 4], &[0, 4], &[0, 2, 3], &[0, 2, 3], &[0, 2, 3], &[2], &[1, 2]];
-        let mut j = DMatrix::zeros(8, nv);
+        let mut cols: Vec<&[usize]> =
+            vec![&[1, 3, 4], &[1, 3, 4], &[0, 4], &[0, 2, 3], &[0, 2, 3], &[0, 2, 3], &[2], &[1, 2]];
+        cols.extend([&[0usize, 1, 3, 4][..]; 6]);
+        cols.extend([&[0usize, 2, 4][..]; 12]);
+        let mut j = DMatrix::zeros(cols.len(), nv);
         let (mut start, mut index, mut value) = (vec![0], vec![], vec![]);
         for (i, c) in cols.iter().enumerate() {
             for (t, &k) in c.iter().enumerate() {
@@ -278,7 +291,9 @@ mod tests {
             b[0][0] = w;
             b
         };
-        let blocks = [(0, 1, scalar(2.0)), (1, 1, scalar(0.5)), (2, 1, scalar(3.0)), (3, 3, b3), (6, 2, b2)];
+        let mut blocks =
+            vec![(0, 1, scalar(2.0)), (1, 1, scalar(0.5)), (2, 1, scalar(3.0)), (3, 3, b3), (6, 2, b2)];
+        blocks.extend((8..26).map(|i| (i, 1, scalar(0.2 + 0.1 * i as f64))));
         let mut h = DMatrix::zeros(nv, nv);
         let mut column = vec![0.0; scratch_len(nv)];
         let mut asm = Assembler::new(&mut h, &nz, &mut column);
