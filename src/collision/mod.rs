@@ -91,6 +91,9 @@ pub struct CollisionModel {
     /// Per geom, its bounding box in its own frame for the [`obb`] test (None for planes, height
     /// fields and meshes without a hull); a mesh's along MuJoCo's axes of it (`geom_aabb`'s).
     pub local_box: Vec<Option<obb::LocalBox>>,
+    /// Per mesh geom whose principal axes are not its geom frame's: its box along the geom
+    /// frame's axes, a second test after `local_box`'s (None elsewhere).
+    pub file_box: Vec<Option<obb::LocalBox>>,
 }
 
 /// The bounding-sphere test of one candidate pair (see [`CollisionModel::broad`]).
@@ -156,7 +159,17 @@ impl CollisionModel {
             .iter()
             .map(|g| obb::LocalBox::of(&g.shape, g.hull(), g.hull_graph.as_ref().map(|h| &h.box_frame)))
             .collect();
-        Self { shapes, rbound, broad, plane_hulls, sweep, local_box }
+        // A mesh's box along its geom frame's axes too, where those differ from its principal
+        // axes: a part modelled along its own axes (a robot link) is hugged better by those.
+        let file_box = model
+            .geoms
+            .iter()
+            .zip(&local_box)
+            .map(|(g, b): (_, &Option<obb::LocalBox>)| {
+                b.as_ref().and_then(|b| b.axes).and_then(|_| obb::LocalBox::of(&g.shape, g.hull(), None))
+            })
+            .collect();
+        Self { shapes, rbound, broad, plane_hulls, sweep, local_box, file_box }
     }
 }
 
@@ -243,6 +256,15 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
             };
             if obb::apart_along(b1, &x1, &axes(b1, g1, &x1), b2, &x2, &axes(b2, g2, &x2), within) {
                 continue;
+            }
+            // Then the geom frames' boxes where a mesh has one (any box that separates the pair
+            // proves it apart).
+            if cm.file_box[g1].is_some() || cm.file_box[g2].is_some() {
+                let (f1, f2) =
+                    (cm.file_box[g1].as_ref().unwrap_or(b1), cm.file_box[g2].as_ref().unwrap_or(b2));
+                if obb::apart_along(f1, &x1, &axes(f1, g1, &x1), f2, &x2, &axes(f2, g2, &x2), within) {
+                    continue;
+                }
             }
         }
         let start = data.contacts.len();
