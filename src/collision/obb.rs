@@ -1,6 +1,8 @@
 //! The oriented-bounding-box test between the broad and the narrow phase (MuJoCo's
 //! `mj_collideOBB`, engine_collision_driver.c, on its `geom_aabb`): each colliding geom's box in
-//! its own frame — centre and half-extents of the primitive, or of a mesh's hull vertices — and a
+//! its own frame — centre and half-extents of the primitive, or of a mesh's hull vertices along
+//! MuJoCo's axes of the mesh (its principal axes, where `geom_aabb` is axis-aligned; the collision
+//! pass tries the box along the geom frame's axes too, `CollisionModel::file_box`) — and a
 //! separating-axis test of two such boxes at the geoms' world poses over the 15 axes of two boxes
 //! (the 3 face normals of each, the 9 cross products of their edges; Gottschalk, Lin & Manocha,
 //! "OBBTree", SIGGRAPH 1996).
