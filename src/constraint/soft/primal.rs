@@ -189,7 +189,7 @@ pub(super) fn mul_m_on(
 
 /// Up to this many dofs the Newton Hessian is assembled and factored dense (and M x is a dense
 /// product): below it the sparse bookkeeping costs more than the zeros it skips.
-pub(crate) const DENSE_NV: usize = 40;
+const DENSE_NV: usize = 40;
 
 /// Up to this many dofs the Hessian is also dense when the mass matrix is at least half
 /// nonzero (long chains: H and its factor are then dense whatever the rows, and the island
