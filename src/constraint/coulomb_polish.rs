@@ -10,7 +10,7 @@
 use super::coulomb::{
     column_dot, max_dissipation, mu, separating, Level, MAX_DIM, POLISH_ROUNDS, SLIP_VELOCITY,
 };
-use super::dense::{lu_solve, solve_psd};
+use super::dense::solve_psd;
 use super::ExactWork;
 use crate::model::{Data, EfcType, Model};
 
@@ -688,7 +688,7 @@ fn solve_substituted(data: &mut Data, level: Level) -> bool {
         slipping,
         slip_dir,
         previous,
-        pivots,
+        lu,
         ..
     } = exact;
     // Per row: whether it is a friction row of a slipping contact (its force substituted).
@@ -733,7 +733,7 @@ fn solve_substituted(data: &mut Data, level: Level) -> bool {
         sub_rhs[a] = rhs;
     }
     exact.polish_work += (2 * k * k * k) as f64 / 3.0;
-    if !lu_solve(sub, &mut sub_rhs.as_mut_slice()[..k], &mut pivots[..2 * k], 0.0) {
+    if !lu.solve(sub, &mut sub_rhs.as_mut_slice()[..k], 0.0) {
         return false;
     }
     for (a, &r) in active.iter().enumerate() {
@@ -828,9 +828,9 @@ fn newton_slipping(data: &mut Data, level: Level) -> bool {
             return true;
         }
         {
-            let ExactWork { sub, sub_rhs, pivots, eig, polish_work, .. } = &mut data.exact;
+            let ExactWork { sub, sub_rhs, lu, eig, polish_work, .. } = &mut data.exact;
             *polish_work += (2 * m * m * m) as f64 / 3.0;
-            if !lu_solve(sub, &mut sub_rhs.as_mut_slice()[..m], &mut pivots[..2 * m], NEWTON_TOLERANCE) {
+            if !lu.solve(sub, &mut sub_rhs.as_mut_slice()[..m], NEWTON_TOLERANCE) {
                 return false;
             }
             eig.as_mut_slice()[..m].copy_from_slice(&sub_rhs.as_slice()[..m]);

@@ -45,23 +45,84 @@ pub(crate) fn solve_psd(
 /// largest entry) are zero. False, with `b` unspecified, when the system is inconsistent (its
 /// eliminated right-hand side beyond the rank is above 1e-9 of b's largest entry plus `floor`,
 /// the size of the round-off b itself carries: a Newton residual near convergence is that
-/// round-off) or not finite.
+/// round-off) or not finite. The solver solves its systems block by block
+/// ([`super::block_lu::BlockLu`], the same result); this whole-matrix form is the reference its
+/// tests compare with.
+#[cfg(test)]
 pub(crate) fn lu_solve(a: &mut DMatrix<f64>, b: &mut [f64], piv: &mut [usize], floor: f64) -> bool {
     let n = b.len();
     let stride = a.nrows();
     let m = a.as_mut_slice();
-    let (_rows, cols) = piv[..2 * n].split_at_mut(n);
+    let scale = largest_entry(m, stride, n);
+    if !(scale > 0.0 && scale.is_finite()) {
+        return false;
+    }
+    let b_scale = b.iter().fold(0.0f64, |acc, x| acc.max(x.abs()));
+    lu_kernel_dispatch(m, stride, b, piv, LuBounds { tol: scale * RANK_TOLERANCE, b_scale, floor })
+        && (n == 0 || b.iter().all(|x| x.is_finite()))
+}
+
+/// The thresholds of [`lu_solve`] for a system (the whole system's, also when it is solved block
+/// by block).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LuBounds {
+    /// Pivots at most this are zero: `RANK_TOLERANCE` times the matrix's largest entry.
+    pub tol: f64,
+    /// The right-hand side's largest entry.
+    pub b_scale: f64,
+    /// The round-off floor of the consistency test.
+    pub floor: f64,
+}
+
+/// The largest |entry| of the top-left n × n block of `m` (column-major, `stride`).
+pub(crate) fn largest_entry(m: &[f64], stride: usize, n: usize) -> f64 {
     let mut scale = 0.0f64;
     for j in 0..n {
         for x in &m[j * stride..j * stride + n] {
             scale = scale.max(x.abs());
         }
     }
-    if !(scale > 0.0 && scale.is_finite()) {
-        return false;
+    scale
+}
+
+/// [`lu_kernel`], compiled for AVX2 where the CPU has it.
+pub(crate) fn lu_kernel_dispatch(
+    m: &mut [f64],
+    stride: usize,
+    b: &mut [f64],
+    piv: &mut [usize],
+    bounds: LuBounds,
+) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `lu_kernel_avx2` requires.
+        return unsafe { lu_kernel_avx2(m, stride, b, piv, bounds) };
     }
-    let tol = scale * RANK_TOLERANCE;
-    let b_scale = b.iter().fold(0.0f64, |acc, x| acc.max(x.abs()));
+    lu_kernel(m, stride, b, piv, bounds)
+}
+
+/// [`lu_kernel`] compiled for AVX2: the same operations in the same order (no fused
+/// multiply–adds), four entries of a column per instruction, so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn lu_kernel_avx2(
+    m: &mut [f64],
+    stride: usize,
+    b: &mut [f64],
+    piv: &mut [usize],
+    bounds: LuBounds,
+) -> bool {
+    lu_kernel(m, stride, b, piv, bounds)
+}
+
+/// The elimination and solve of [`lu_solve`] on the top-left n × n block of `m` (column-major,
+/// `stride`), n = `b.len()`, with the given thresholds; true when the system is consistent (the
+/// caller checks finiteness).
+#[inline(always)]
+fn lu_kernel(m: &mut [f64], stride: usize, b: &mut [f64], piv: &mut [usize], bounds: LuBounds) -> bool {
+    let n = b.len();
+    let (_rows, cols) = piv[..2 * n].split_at_mut(n);
+    let LuBounds { tol, b_scale, floor } = bounds;
     let mut rank = n;
     for k in 0..n {
         let (mut p, mut q, mut best) = (k, k, 0.0f64);
@@ -124,7 +185,7 @@ pub(crate) fn lu_solve(a: &mut DMatrix<f64>, b: &mut [f64], piv: &mut [usize], f
     for k in (0..rank).rev() {
         b.swap(k, cols[k]);
     }
-    b.iter().all(|x| x.is_finite())
+    true
 }
 
 /// Lower Cholesky factor of A into `l`; false if a pivot is not above `tol`. Only A's lower
@@ -267,6 +328,39 @@ pub(crate) fn cholesky_solve(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
 /// O(n³)). Scratch: `l` (n × n) holds L, then Q's reflectors and R; `a` is overwritten (P b and
 /// the reflectors' coefficients); `perm` holds P.
 fn min_norm_solve(
+    a: &mut DMatrix<f64>,
+    n: usize,
+    b: &mut [f64],
+    l: &mut DMatrix<f64>,
+    perm: &mut DVector<f64>,
+    tol: f64,
+) -> usize {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `min_norm_solve_avx2` requires.
+        return unsafe { min_norm_solve_avx2(a, n, b, l, perm, tol) };
+    }
+    min_norm_kernel(a, n, b, l, perm, tol)
+}
+
+/// [`min_norm_kernel`] compiled for AVX2: the same operations in the same order (no fused
+/// multiply–adds, sums in their order), the updates four entries per instruction, so the same
+/// bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn min_norm_solve_avx2(
+    a: &mut DMatrix<f64>,
+    n: usize,
+    b: &mut [f64],
+    l: &mut DMatrix<f64>,
+    perm: &mut DVector<f64>,
+    tol: f64,
+) -> usize {
+    min_norm_kernel(a, n, b, l, perm, tol)
+}
+
+#[inline(always)]
+fn min_norm_kernel(
     a: &mut DMatrix<f64>,
     n: usize,
     b: &mut [f64],

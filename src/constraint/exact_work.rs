@@ -64,8 +64,8 @@ pub(crate) struct ExactWork {
     pub newton_rows: Vec<usize>,
     pub newton_normal: Vec<usize>,
     pub newton_pos: Vec<usize>,
-    /// Row and column pivots of the polish's LU factorization.
-    pub pivots: Vec<usize>,
+    /// The polish's LU solves, block by block over the constraint islands.
+    pub lu: super::block_lu::BlockLu,
     /// The ADMM solve's per-row buffers ([`super::admm`]).
     pub admm: super::admm::AdmmWork,
     /// Jᵀ, nv × nefc (columns 0..nefc used): each row of J contiguous, for the Delassus products.
@@ -124,7 +124,7 @@ impl ExactWork {
             newton_rows: Vec::with_capacity(nefc),
             newton_normal: Vec::with_capacity(nefc),
             newton_pos: vec![usize::MAX; nefc],
-            pivots: vec![0; 2 * nefc],
+            lu: Default::default(),
             admm: Default::default(),
             jt: DMatrix::zeros(nv, nefc),
             yt: vec![0.0; nv * nefc],
@@ -179,7 +179,7 @@ impl ExactWork {
         self.warm.resize_vertically_mut(nefc, 0.0);
         self.pressing.resize(nefc, false);
         self.slipping.resize(nefc, false);
-        self.pivots.resize(2 * nefc, 0);
+        self.lu.grow(nefc);
         self.newton_pos.resize(nefc, usize::MAX);
         self.newton_rows.reserve(nefc.saturating_sub(self.newton_rows.len()));
         self.newton_normal.reserve(nefc.saturating_sub(self.newton_normal.len()));

@@ -14,6 +14,7 @@
 
 mod active_set;
 mod admm;
+mod block_lu;
 mod contact;
 pub mod contact_force;
 mod contact_problem;
