@@ -62,9 +62,9 @@ pub struct BroadphaseWork {
     /// pair touching at the pass before this one skips the GJK test that proves most pairs
     /// apart (it would not), straight to its narrow phase. The contacts do not depend on it.
     pub(crate) touched: Vec<u64>,
-    /// Per candidate pair, the hill-climb starts of its two hulls in the separation test: the
-    /// last pass's support vertices (−1: none; see `ccd::separated`).
-    pub(crate) warm: Vec<[i32; 2]>,
+    /// Per candidate pair, what its separation test keeps from the last pass (the hill-climb
+    /// starts of its two hulls, the direction that proved it apart; see `ccd::separated`).
+    pub(crate) warm: Vec<super::ccd::SeparationWarm>,
     /// The collision pass's number (counts the passes from 2): stamps the world boxes below and
     /// the touching pairs.
     pub(crate) pass: u64,
@@ -88,7 +88,7 @@ impl BroadphaseWork {
             ends: Vec::with_capacity(model.geoms.len()),
             pairs: Vec::with_capacity(model.collision_pairs.len()),
             touched: vec![0; model.collision_pairs.len()],
-            warm: vec![[-1, -1]; model.collision_pairs.len()],
+            warm: vec![super::ccd::SeparationWarm::none(); model.collision_pairs.len()],
             pass: 1,
             boxes: vec![super::obb::WorldBox::default(); model.geoms.len()],
             file_boxes: vec![super::obb::WorldBox::default(); model.geoms.len()],
