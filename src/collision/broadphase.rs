@@ -58,16 +58,27 @@ pub struct BroadphaseWork {
     ends: Vec<(f64, u32)>,
     /// The candidate pairs that passed, ascending.
     pub(crate) pairs: Vec<u32>,
-    /// Per candidate pair, whether the last collision pass found it touching: such a pair skips
-    /// the GJK test that proves most pairs apart (it would not), straight to its narrow phase.
-    /// The contacts do not depend on it.
-    pub(crate) touching: Vec<bool>,
-    /// Per candidate pair, the hill-climb starts of its two hulls in the separation test: the
-    /// last pass's support vertices (−1: none; see `ccd::separated`).
-    pub(crate) warm: Vec<[i32; 2]>,
-    /// Per geom, the world axes of its bounding box when they are not the geom's own
-    /// (`obb::LocalBox::axes`, a mesh's principal axes), formed once per collision pass.
-    pub(crate) box_axes: Vec<crate::spatial::Mat3>,
+    /// Per candidate pair, the last collision pass (`pass`) that found it touching (0: none); a
+    /// pair touching at the pass before this one skips the GJK test that proves most pairs
+    /// apart (it would not), straight to its narrow phase. The contacts do not depend on it.
+    pub(crate) touched: Vec<u64>,
+    /// Per candidate pair, what its separation test keeps from the last pass (the hill-climb
+    /// starts of its two hulls, the direction that proved it apart; see `ccd::separated`).
+    pub(crate) warm: Vec<super::ccd::SeparationWarm>,
+    /// The collision pass's number (counts the passes from 2): stamps the world boxes below and
+    /// the touching pairs.
+    pub(crate) pass: u64,
+    /// Per geom with a bounding box (`CollisionModel::local_box`), that box at the geom's world
+    /// pose for the oriented-bounding-box test, formed at the first pair of the pass that
+    /// needs it: valid when `box_pass` holds this pass's number.
+    pub(crate) boxes: Vec<super::obb::WorldBox>,
+    /// Likewise the box along the geom frame's axes of a mesh that has one
+    /// (`CollisionModel::file_box`), valid when `file_pass` holds this pass's number.
+    pub(crate) file_boxes: Vec<super::obb::WorldBox>,
+    /// The pass at which each geom's `boxes` entry was formed.
+    pub(crate) box_pass: Vec<u64>,
+    /// The pass at which each geom's `file_boxes` entry was formed.
+    pub(crate) file_pass: Vec<u64>,
 }
 
 impl BroadphaseWork {
@@ -76,10 +87,41 @@ impl BroadphaseWork {
         Self {
             ends: Vec::with_capacity(model.geoms.len()),
             pairs: Vec::with_capacity(model.collision_pairs.len()),
-            touching: vec![false; model.collision_pairs.len()],
-            warm: vec![[-1, -1]; model.collision_pairs.len()],
-            box_axes: vec![crate::spatial::Mat3::identity(); model.geoms.len()],
+            touched: vec![0; model.collision_pairs.len()],
+            warm: vec![super::ccd::SeparationWarm::none(); model.collision_pairs.len()],
+            pass: 1,
+            boxes: vec![super::obb::WorldBox::default(); model.geoms.len()],
+            file_boxes: vec![super::obb::WorldBox::default(); model.geoms.len()],
+            box_pass: vec![0; model.geoms.len()],
+            file_pass: vec![0; model.geoms.len()],
         }
+    }
+}
+
+impl BroadphaseWork {
+    /// Forms geom `g`'s world box (its `local` box at world pose `x`) unless this pass has.
+    #[inline]
+    pub(crate) fn form_box(&mut self, g: usize, local: &super::obb::LocalBox, x: &Transform) {
+        if self.box_pass[g] != self.pass {
+            self.box_pass[g] = self.pass;
+            self.boxes[g] = super::obb::WorldBox::new(local, x);
+        }
+    }
+
+    /// Geom `g`'s box along its geom frame's axes (`file` at world pose `x`), formed unless
+    /// this pass has.
+    #[inline]
+    pub(crate) fn form_file_box(
+        &mut self,
+        g: usize,
+        file: &super::obb::LocalBox,
+        x: &Transform,
+    ) -> super::obb::WorldBox {
+        if self.file_pass[g] != self.pass {
+            self.file_pass[g] = self.pass;
+            self.file_boxes[g] = super::obb::WorldBox::new(file, x);
+        }
+        self.file_boxes[g]
     }
 }
 

@@ -237,6 +237,9 @@ struct Status {
     gjk_iterations: usize,
     simplex: [Vertex; 4],
     nsimplex: usize,
+    /// When GJK proves the geoms apart by a support plane: the plane's normal direction x_k
+    /// (zero otherwise).
+    axis: Vec3,
 }
 
 impl Status {
@@ -254,6 +257,7 @@ impl Status {
             gjk_iterations: 0,
             simplex: [ZERO_VERTEX; 4],
             nsimplex: 0,
+            axis: Vec3::zeros(),
         }
     }
 }
@@ -289,9 +293,11 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
         let lower = x_k.dot(&s_k);
         if !get_dist {
             if lower > 0.0 {
+                st.axis = x_k;
                 return separated(st, k);
             }
         } else if st.dist_cutoff < MAX_LIMIT && lower > 0.0 && lower >= st.dist_cutoff * x_norm {
+            st.axis = x_k;
             return separated(st, k);
         }
         if n == 3 && backup {
@@ -335,6 +341,7 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
     let tmp = gjk_support(o1, o2, &x_k, x_norm);
     if x_k.dot(&tmp.vert) > 0.0 {
         st.separated = true;
+        st.axis = x_k;
     }
     st.gjk_iterations = k;
     st.nsimplex = n;
@@ -381,9 +388,12 @@ fn gjk_intersect(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) -> i32 {
         }
         let dir = f[index].0;
         simplex[s[index]] = support(o1, o2, &dir, &-dir);
-        if dir.dot(&simplex[s[index]].vert) < 0.0 {
+        let reach = dir.dot(&simplex[s[index]].vert);
+        if reach < 0.0 {
             st.nsimplex = 0;
             st.gjk_iterations = k;
+            // The Minkowski difference lies beyond the plane of normal −dir: GJK's x_k of it.
+            st.axis = dir * reach;
             return 0;
         }
         s.swap((index + 1) & 3, (index + 2) & 3);
@@ -1102,13 +1112,33 @@ fn penetration_with(
     })
 }
 
+/// What the separation test of one candidate pair keeps from one collision pass to the next
+/// (none of it changes the answer, only how soon it is found).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SeparationWarm {
+    /// The two hulls' hill-climb starts: the last support vertices (−1: none).
+    pub index: [i32; 2],
+    /// The direction x_k of the support plane that proved the pair apart at the last test (zero:
+    /// none): geoms that moved little since are proved apart again by its first support point.
+    pub axis: Vec3,
+}
+
+impl SeparationWarm {
+    /// Nothing kept: the climbs start from their grid of extreme vertices, GJK from MuJoCo's
+    /// geom centres.
+    pub(crate) fn none() -> Self {
+        Self { index: [-1, -1], axis: Vec3::zeros() }
+    }
+}
+
 /// Whether GJK proves the two geoms, inflated by half of `margin` each, apart: a support plane
 /// separating them found within `iterations` (MuJoCo's early exit in `gjk` with no distance
 /// wanted: the first support point with x_k·s_k > 0). Exact when true — a separating plane is a
-/// certificate — so a caller may skip its own narrow phase; false leaves the pair undecided.
-/// `warm` holds the two hulls' hill-climb starts (−1: none), read before and written after: the
-/// last support vertices of the same pair at the previous pass, near this pass's (the certificate
-/// does not depend on them).
+/// certificate, whatever direction GJK started from — so a caller may skip its own narrow phase;
+/// false leaves the pair undecided. `warm` is read before and written after: the hill climbs
+/// start from the same pair's last support vertices, GJK from the direction that separated the
+/// pair at the last test or else from MuJoCo's geom centres (`mjc_center`: a mesh's at its centre
+/// of mass, where MuJoCo places the geom; the file's origin can lie far outside the mesh).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn separated(
     s1: &ConvexShape,
@@ -1118,15 +1148,28 @@ pub(crate) fn separated(
     margin: f64,
     tolerance: f64,
     iterations: usize,
-    warm: &mut [i32; 2],
+    warm: &mut SeparationWarm,
 ) -> bool {
     let mut o1 = CcdObj::new(s1, x1, margin);
     let mut o2 = CcdObj::new(s2, x2, margin);
-    (o1.meshindex, o2.meshindex) = (warm[0], warm[1]);
+    (o1.meshindex, o2.meshindex) = (warm.index[0], warm.index[1]);
     let mut st = Status::start(x1, x2, tolerance, iterations);
+    let c1 = centre(s1, x1);
+    // GJK's first direction is st.x1 − st.x2.
+    (st.x1, st.x2) = if warm.axis != Vec3::zeros() { (c1, c1 - warm.axis) } else { (c1, centre(s2, x2)) };
     gjk(&mut st, &mut o1, &mut o2);
-    *warm = [o1.meshindex, o2.meshindex];
+    warm.index = [o1.meshindex, o2.meshindex];
+    warm.axis = if st.separated { st.axis } else { Vec3::zeros() };
     st.separated
+}
+
+/// MuJoCo's centre of a geom at pose `x` (world): its mesh frame's origin for a hull, the geom
+/// origin otherwise.
+fn centre(s: &ConvexShape, x: &Transform) -> Vec3 {
+    match s {
+        ConvexShape::Hull(h) => x.act_point(&h.graph().box_frame.0),
+        _ => x.pos,
+    }
 }
 
 fn contact(st: &Status, margin: f64) -> CcdContact {

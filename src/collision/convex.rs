@@ -216,12 +216,12 @@ pub fn mujoco_pair(
     options: &crate::model::Options,
     touching: bool,
 ) -> Option<PairPoint> {
-    mujoco_pair_warm(x1, s1, x2, s2, margin, options, touching, &mut [-1, -1])
+    mujoco_pair_warm(x1, s1, x2, s2, margin, options, touching, &mut super::ccd::SeparationWarm::none())
 }
 
-/// [`mujoco_pair`] with the separation test's hill climbs started from `warm` and its last
-/// support vertices written back (see [`super::ccd::separated`]): the collision pass keeps them
-/// per pair from one pass to the next.
+/// [`mujoco_pair`] with the separation test started from `warm` and what it found written back
+/// (its last support vertices and separating direction, see [`super::ccd::separated`]): the
+/// collision pass keeps them per pair from one pass to the next.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn mujoco_pair_warm(
     x1: &Transform,
@@ -231,7 +231,7 @@ pub(crate) fn mujoco_pair_warm(
     margin: f64,
     options: &crate::model::Options,
     touching: bool,
-    warm: &mut [i32; 2],
+    warm: &mut super::ccd::SeparationWarm,
 ) -> Option<PairPoint> {
     let polytope = |s: &ConvexShape| matches!(s, ConvexShape::Cuboid(_) | ConvexShape::Hull(_));
     if polytope(s1) && polytope(s2) {

@@ -6,9 +6,12 @@
 //! "Computation → Collision detection").
 //!
 //! On scenes with many candidate pairs a sweep and prune over the geoms' bounding cubes picks the
-//! pairs that may touch ([`broadphase`], MuJoCo's `mj_broadphase`); a bounding-sphere test then
+//! pairs that may touch ([`broadphase`], MuJoCo's `mj_broadphase`); on the others the pairs between
+//! the same two bodies are skipped together when the bodies' bounding spheres are apart
+//! ([`PairRun`], MuJoCo's body-level broad phase); a bounding-sphere test then
 //! rejects far pairs (MuJoCo's `mj_filterSphere`), and an oriented-bounding-box test the pairs of
-//! convex geoms whose boxes are apart ([`obb`], MuJoCo's `mj_collideOBB`); the narrow phase
+//! convex geoms whose boxes are apart ([`obb`], MuJoCo's `mj_collideOBB`; docs/constraints.md,
+//! "Collision"); the narrow phase
 //! is closed form for planes ([`plane`], meshes on planes [`plane_mesh`]), spheres and capsules, spheres against cylinders
 //! ([`sphere_cylinder`]), and boxes against spheres,
 //! capsules ([`box_primitive`]) and boxes ([`box_box`]) with MuJoCo's multi-point manifolds, and
@@ -94,6 +97,134 @@ pub struct CollisionModel {
     /// Per mesh geom whose principal axes are not its geom frame's: its box along the geom
     /// frame's axes, a second test after `local_box`'s (None elsewhere).
     pub file_box: Vec<Option<obb::LocalBox>>,
+    /// The geoms posed by each collision pass (those with a support-map shape or that collide),
+    /// ascending.
+    pub posed: Vec<u32>,
+    /// The candidate pairs in runs of consecutive pairs between the same two parts, each with
+    /// the parts' bounding spheres ([`PairRun`]), in `Model::collision_pairs` order.
+    pub runs: Vec<PairRun>,
+}
+
+/// Consecutive candidate pairs (`Model::collision_pairs[start..end]`) between the same two
+/// rigid parts — two bodies (a geom's body with its mocap frame, if any), or a plane and a body —
+/// and a bounding sphere of each part's geoms in the run: a collision pass that finds the spheres
+/// apart skips every pair of the run, each of whose own bounding-sphere tests would fail (the
+/// body-level broad phase of MuJoCo's `mj_collision`, on spheres).
+#[derive(Clone, Copy, Debug)]
+pub struct PairRun {
+    /// The first pair of the run (index in `Model::collision_pairs`).
+    pub start: u32,
+    /// One past the last pair of the run.
+    pub end: u32,
+    /// A geom of each part (the plane first for a plane's run), whose origin centres the part's
+    /// sphere.
+    pub anchor: [u32; 2],
+    /// The largest margin + gap of the run's pairs plus both spheres' radii (the body's alone
+    /// against a plane), widened by a relative 1e-9 so that rounding never drops a pair its own
+    /// test would keep (m); infinite when a part is unbounded (a height field) or both are one.
+    pub reach: f64,
+    /// Whether the first part is a plane.
+    pub plane: bool,
+}
+
+impl PairRun {
+    /// Whether the two parts' spheres are farther apart than the run's reach plus `reach` at
+    /// the geoms' world poses `x` (a plane: the body's sphere above the plane).
+    #[inline]
+    pub fn apart(&self, x: &[Transform], reach: f64) -> bool {
+        let (x1, x2) = (&x[self.anchor[0] as usize], &x[self.anchor[1] as usize]);
+        let d = x2.pos - x1.pos;
+        if self.plane {
+            x1.rot.column(2).dot(&d) > self.reach + reach
+        } else {
+            d.norm_squared() > (self.reach + reach) * (self.reach + reach)
+        }
+    }
+
+    /// The runs of `model`'s candidate pairs, with the geoms' bounding radii `rbound`.
+    fn of(model: &Model, rbound: &[f64]) -> Vec<PairRun> {
+        // A geom's part: an unbounded geom (plane, height field) is its own part.
+        #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+        enum Part {
+            Body(usize, Option<usize>),
+            Unbounded(usize),
+        }
+        let part = |g: usize| {
+            let geom = &model.geoms[g];
+            if rbound[g].is_finite() {
+                Part::Body(geom.body, geom.mocap)
+            } else {
+                Part::Unbounded(g)
+            }
+        };
+        let key = |i: usize| {
+            let [g1, g2] = model.collision_pairs[i].geom;
+            let (p1, p2) = (part(g1), part(g2));
+            if p1 <= p2 {
+                (p1, p2)
+            } else {
+                (p2, p1)
+            }
+        };
+        let mut runs = Vec::new();
+        let n = model.collision_pairs.len();
+        let mut start = 0;
+        while start < n {
+            let k = key(start);
+            let mut end = start + 1;
+            while end < n && key(end) == k {
+                end += 1;
+            }
+            let pairs = &model.collision_pairs[start..end];
+            let margin = pairs.iter().map(|p| p.margin + p.gap).fold(0.0, f64::max);
+            // Each side's geoms in the run, the first its anchor.
+            let side = |p: Part| -> (usize, f64) {
+                let geoms = pairs.iter().flat_map(|q| q.geom).filter(|&g| part(g) == p);
+                let anchor = geoms.clone().next().unwrap_or(0);
+                let at = model.geoms[anchor].x_body_geom.pos;
+                let radius = geoms
+                    .map(|g| (model.geoms[g].x_body_geom.pos - at).norm() + rbound[g])
+                    .fold(0.0, f64::max);
+                (anchor, radius)
+            };
+            let run = match k {
+                (Part::Body(..), Part::Unbounded(g))
+                    if matches!(model.geoms[g].shape, Shape::Plane { .. }) =>
+                {
+                    let (a, r) = side(k.0);
+                    PairRun { start: 0, end: 0, anchor: [g as u32, a as u32], reach: margin + r, plane: true }
+                }
+                (p1 @ Part::Body(..), p2 @ Part::Body(..)) if p1 != p2 => {
+                    let ((a1, r1), (a2, r2)) = (side(p1), side(p2));
+                    PairRun {
+                        start: 0,
+                        end: 0,
+                        anchor: [a1 as u32, a2 as u32],
+                        reach: margin + r1 + r2,
+                        plane: false,
+                    }
+                }
+                _ => {
+                    let [g1, g2] = pairs[0].geom;
+                    PairRun {
+                        start: 0,
+                        end: 0,
+                        anchor: [g1 as u32, g2 as u32],
+                        reach: f64::INFINITY,
+                        plane: false,
+                    }
+                }
+            };
+            runs.push(PairRun {
+                start: start as u32,
+                end: end as u32,
+                reach: run.reach * (1.0 + 1e-9),
+                ..run
+            });
+            start = end;
+        }
+        runs
+    }
 }
 
 /// The bounding-sphere test of one candidate pair (see [`CollisionModel::broad`]).
@@ -154,7 +285,7 @@ impl CollisionModel {
             })
             .collect();
         let sweep = broadphase::Broadphase::new(model, &rbound);
-        let local_box = model
+        let local_box: Vec<Option<obb::LocalBox>> = model
             .geoms
             .iter()
             .map(|g| obb::LocalBox::of(&g.shape, g.hull(), g.hull_graph.as_ref().map(|h| &h.box_frame)))
@@ -169,7 +300,12 @@ impl CollisionModel {
                 b.as_ref().and_then(|b| b.axes).and_then(|_| obb::LocalBox::of(&g.shape, g.hull(), None))
             })
             .collect();
-        Self { shapes, rbound, broad, plane_hulls, sweep, local_box, file_box }
+        let posed = (0..model.geoms.len())
+            .filter(|&g| shapes[g].is_some() || model.geoms[g].collision)
+            .map(|g| g as u32)
+            .collect();
+        let runs = PairRun::of(model, &rbound);
+        Self { shapes, rbound, broad, plane_hulls, sweep, local_box, file_box, posed, runs }
     }
 }
 
@@ -186,14 +322,12 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
     let budget = model.contact_budget();
     let dropped_before = data.contacts_dropped;
     // World poses of the colliding geoms, once per pass (MuJoCo's geom_xpos, geom_xmat).
-    for (g, geom) in model.geoms.iter().enumerate() {
-        if cm.shapes[g].is_some() || geom.collision {
-            data.x_world_geom[g] = data.attached_pose(geom.body, geom.mocap, &geom.x_body_geom);
-            if let Some(Some(axes)) = cm.local_box.get(g).map(|b| b.as_ref().and_then(|b| b.axes)) {
-                data.broadphase.box_axes[g] = data.x_world_geom[g].rot * axes;
-            }
-        }
+    for &g in &cm.posed {
+        let geom = &model.geoms[g as usize];
+        data.x_world_geom[g as usize] = data.attached_pose(geom.body, geom.mocap, &geom.x_body_geom);
     }
+    // The geoms' world boxes are formed when a pair first needs them (`world_boxes`).
+    data.broadphase.pass += 1;
     // Sweep and prune narrows the candidate pairs first when there are many (same pairs, same
     // order as the full loop: see [`broadphase`]).
     if cm.sweep.sweep {
@@ -201,226 +335,25 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
     }
     // Taken out while contacts are written, put back after (no allocation).
     let swept = std::mem::take(&mut data.broadphase.pairs);
-    let mut touching = std::mem::take(&mut data.broadphase.touching);
-    let all = 0..model.collision_pairs.len();
-    let mut next = 0;
     let asleep = data.sleep.any_asleep();
     let mut tested = 0;
-    // The pair being collided and the contact count before it: whether it touched is known at
-    // the next pair.
-    let mut open: Option<(usize, usize)> = None;
-    loop {
-        if let Some((i, before)) = open.take() {
-            touching[i] = data.contacts.len() > before;
+    if cm.sweep.sweep {
+        for &idx in &swept {
+            tested += test_pair(model, cm, data, idx as usize, reach, budget, asleep) as usize;
         }
-        let idx = if cm.sweep.sweep {
-            match swept.get(next) {
-                Some(&i) => i as usize,
-                None => break,
-            }
-        } else if next < all.end {
-            next
-        } else {
-            break;
-        };
-        next += 1;
-        let (pair, b) = (&model.collision_pairs[idx], &cm.broad[idx]);
-        // Sleeping islands: no pair of two sleeping trees or of a sleeping tree and the world.
-        if asleep && data.sleep.pair_skipped(model, pair.geom) {
-            continue;
-        }
-        tested += 1;
-        open = Some((idx, data.contacts.len()));
-        // Bounding spheres (a plane: the other geom's sphere against the plane).
-        let (x1, x2) = (&data.x_world_geom[b.geom[0] as usize], &data.x_world_geom[b.geom[1] as usize]);
-        let d = x2.pos - x1.pos;
-        let far = if b.plane {
-            x1.rot.column(2).dot(&d) > b.reach + reach
-        } else {
-            d.norm_squared() > (b.reach + reach) * (b.reach + reach)
-        };
-        if far {
-            continue;
-        }
-        let [g1, g2] = pair.geom;
-        let (geom1, geom2) = (&model.geoms[g1], &model.geoms[g2]);
-        let (x1, x2) = (data.x_world_geom[g1], data.x_world_geom[g2]);
-        let within = pair.margin + pair.gap + reach;
-        if let (Some(b1), Some(b2)) = (&cm.local_box[g1], &cm.local_box[g2]) {
-            let axes = |b: &obb::LocalBox, g: usize, x: &Transform| {
-                if b.axes.is_some() {
-                    data.broadphase.box_axes[g]
-                } else {
-                    x.rot
-                }
-            };
-            if obb::apart_along(b1, &x1, &axes(b1, g1, &x1), b2, &x2, &axes(b2, g2, &x2), within) {
+    } else {
+        // Runs of pairs between the same two parts: skipped together when the parts' bounding
+        // spheres are apart (a run of one pair goes straight to its own test).
+        for run in &cm.runs {
+            if run.end - run.start > 1 && run.apart(&data.x_world_geom, reach) {
                 continue;
             }
-            // Then the geom frames' boxes where a mesh has one (any box that separates the pair
-            // proves it apart).
-            if cm.file_box[g1].is_some() || cm.file_box[g2].is_some() {
-                let (f1, f2) =
-                    (cm.file_box[g1].as_ref().unwrap_or(b1), cm.file_box[g2].as_ref().unwrap_or(b2));
-                if obb::apart_along(f1, &x1, &axes(f1, g1, &x1), f2, &x2, &axes(f2, g2, &x2), within) {
-                    continue;
-                }
+            for idx in run.start as usize..run.end as usize {
+                tested += test_pair(model, cm, data, idx, reach, budget, asleep) as usize;
             }
-        }
-        let start = data.contacts.len();
-        let mut push = |p1: Vec3, p2: Vec3, normal: Vec3, dist: f64, hint: Option<Vec3>, feature: u32| {
-            if data.contacts.len() - start >= pair.max_contacts {
-                return;
-            }
-            if data.contacts.len() >= budget {
-                data.contacts_dropped += 1;
-                return;
-            }
-            data.contacts.push(Contact {
-                geom: pair.geom,
-                pos: (p1 + p2) * 0.5,
-                frame: contact_frame(&normal, hint.as_ref()),
-                dist,
-                includemargin: pair.margin,
-                gap: pair.gap,
-                condim: pair.condim,
-                friction: pair.friction,
-                solref: pair.solref,
-                solreffriction: pair.solreffriction,
-                solimp: pair.solimp,
-                pair: pair.pair,
-                feature,
-            });
-        };
-        // Height fields against spheres: MuJoCo's prisms ([`hfield`]).
-        if let (Shape::Hfield { field, .. }, Shape::Sphere { radius }) = (&geom1.shape, &geom2.shape) {
-            let mut out = |p: hfield::HfieldPoint| push(p.p1, p.p2, p.normal, p.dist, None, 0);
-            hfield::sphere(&x1, field, &x2.pos, *radius, pair.margin, &mut out);
-            continue;
-        }
-        // Height fields against the other convex geoms: MuJoCo's prisms by GJK/EPA ([`hfield_convex`]).
-        if let Shape::Hfield { field, .. } = &geom1.shape {
-            if let Some(s2) = &cm.shapes[g2] {
-                let mut out = |p: hfield::HfieldPoint| push(p.p1, p.p2, p.normal, p.dist, None, 0);
-                hfield_convex::convex(&x1, field, s2, &x2, pair.margin, &model.options, &mut out);
-            }
-            continue;
-        }
-        if let Shape::Plane { .. } = geom1.shape {
-            let n = x1.rot.column(2).into_owned();
-            let mut out =
-                |p: PlanePoint| push(p.surface - n * p.dist, p.surface, n, p.dist, p.hint, p.feature);
-            match &geom2.shape {
-                Shape::Sphere { radius } => plane::sphere(&x1, &x2.pos, *radius, within, &mut out),
-                Shape::Capsule { radius, length } => {
-                    plane::capsule(&x1, &x2, *radius, 0.5 * length, within, &mut out)
-                }
-                Shape::Box { size } => plane::cuboid(&x1, &x2, &(size / 2.0), within, &mut out),
-                Shape::Cylinder { radius, length } => {
-                    plane::cylinder(&x1, &x2, *radius, 0.5 * length, within, &mut out)
-                }
-                Shape::Ellipsoid { radii } => plane::ellipsoid(&x1, &x2, radii, within, &mut out),
-                Shape::Mesh { .. } => {
-                    if let Some(h) = &cm.plane_hulls[g2] {
-                        plane_mesh::plane_mesh(&x1, &x2, h, within, &mut out)
-                    }
-                }
-                Shape::Plane { .. } | Shape::Hfield { .. } => {}
-            }
-            continue;
-        }
-        // Boxes against spheres, capsules and boxes, spheres against cylinders: MuJoCo's closed
-        // forms (geom 1 the lower type; a pair given the other way round is swapped and its normal
-        // turned back).
-        let mut emit = |p: PairPoint, feature: u32, swap: bool| match swap {
-            false => push(p.p1, p.p2, p.normal, p.dist, None, feature),
-            true => push(p.p2, p.p1, -p.normal, p.dist, None, feature),
-        };
-        let boxed = match (&geom1.shape, &geom2.shape) {
-            (Shape::Sphere { radius }, Shape::Box { size })
-            | (Shape::Box { size }, Shape::Sphere { radius }) => {
-                let (xs, xb, swap) =
-                    if let Shape::Box { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
-                let mut out = |p, f| emit(p, f, swap);
-                box_primitive::sphere_box(&xs.pos, *radius, &xb, &(size / 2.0), within, 0, &mut out);
-                true
-            }
-            (Shape::Capsule { radius, length }, Shape::Box { size })
-            | (Shape::Box { size }, Shape::Capsule { radius, length }) => {
-                let (xc, xb, swap) =
-                    if let Shape::Box { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
-                let mut out = |p, f| emit(p, f, swap);
-                box_primitive::capsule_box(&xc, *radius, 0.5 * length, &xb, &(size / 2.0), within, &mut out);
-                true
-            }
-            (Shape::Sphere { radius }, Shape::Cylinder { radius: rc, length })
-            | (Shape::Cylinder { radius: rc, length }, Shape::Sphere { radius }) => {
-                let (xs, xc, swap) =
-                    if let Shape::Cylinder { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
-                let z = xs.rot.column(2).into_owned();
-                if let Some(p) =
-                    sphere_cylinder::sphere_cylinder(&xs.pos, &z, *radius, &xc, *rc, 0.5 * length, within)
-                {
-                    emit(p, 0, swap);
-                }
-                true
-            }
-            (Shape::Box { size: s1 }, Shape::Box { size: s2 }) => {
-                box_box::box_box(&x1, &(s1 / 2.0), &x2, &(s2 / 2.0), within, &mut |p, f| emit(p, f, false));
-                true
-            }
-            // Spheres and capsules: MuJoCo's sphere–sphere tests of segment points ([`capsule`]).
-            (Shape::Sphere { radius: r1 }, Shape::Sphere { radius: r2 }) => {
-                if let Some(p) = capsule::sphere_sphere_pair(&x1, *r1, &x2, *r2, within) {
-                    emit(p, 0, false);
-                }
-                true
-            }
-            (Shape::Sphere { radius }, Shape::Capsule { radius: rc, length })
-            | (Shape::Capsule { radius: rc, length }, Shape::Sphere { radius }) => {
-                let (xs, xc, swap) =
-                    if let Shape::Capsule { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
-                if let Some(p) = capsule::sphere_capsule(&xs, *radius, &xc, *rc, 0.5 * length, within) {
-                    emit(p, 0, swap);
-                }
-                true
-            }
-            (Shape::Capsule { radius: r1, length: l1 }, Shape::Capsule { radius: r2, length: l2 }) => {
-                let mut k = 0;
-                capsule::capsule_capsule(&x1, *r1, 0.5 * l1, &x2, *r2, 0.5 * l2, within, &mut |p| {
-                    emit(p, k, false);
-                    k += 1;
-                });
-                true
-            }
-            _ => false,
-        };
-        if boxed {
-            continue;
-        }
-        let point = match (&cm.shapes[g1], &cm.shapes[g2]) {
-            (Some(s1), Some(s2)) => {
-                let warm = &mut data.broadphase.warm[idx];
-                convex::mujoco_pair_warm(&x1, s1, &x2, s2, within, &model.options, touching[idx], warm)
-            }
-            _ => None,
-        };
-        if let Some(p) = point {
-            if let (true, Some(s1), Some(s2)) = (pair.max_contacts > 1, &cm.shapes[g1], &cm.shapes[g2]) {
-                // Feature ids: the order of the points (distinct within the pair).
-                let mut k = 0;
-                let mut out = |q: PairPoint| {
-                    push(q.p1, q.p2, q.normal, q.dist, None, k);
-                    k += 1;
-                };
-                multiccd::convex_contacts(&x1, s1, &x2, s2, p, pair.margin + pair.gap, &mut out);
-                continue;
-            }
-            push(p.p1, p.p2, p.normal, p.dist, None, 0);
         }
     }
     data.broadphase.pairs = swept;
-    data.broadphase.touching = touching;
     data.sleep.pairs_tested = tested;
     if data.contacts_dropped > dropped_before {
         let found = data.contacts.len() + (data.contacts_dropped - dropped_before) as usize;
@@ -430,5 +363,239 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
     // pass found more contacts than any before.
     if data.contact_mu.len() < data.contacts.len() {
         data.contact_mu.resize(data.contacts.len(), 0.0);
+    }
+}
+
+/// Candidate pair `idx` through the sleep filter and the bounding-sphere test (a plane: the other
+/// geom's sphere against the plane), then [`narrow_pair`]; whether it passed the sleep filter.
+#[inline(always)]
+fn test_pair(
+    model: &Model,
+    cm: &CollisionModel,
+    data: &mut Data,
+    idx: usize,
+    reach: f64,
+    budget: usize,
+    asleep: bool,
+) -> bool {
+    let b = &cm.broad[idx];
+    // Sleeping islands: no pair of two sleeping trees or of a sleeping tree and the world (a
+    // pair touching at the last pass is still taken as touching when tested again).
+    if asleep && data.sleep.pair_skipped(model, [b.geom[0] as usize, b.geom[1] as usize]) {
+        let bw = &mut data.broadphase;
+        if bw.touched[idx] + 1 == bw.pass {
+            bw.touched[idx] = bw.pass;
+        }
+        return false;
+    }
+    let (x1, x2) = (&data.x_world_geom[b.geom[0] as usize], &data.x_world_geom[b.geom[1] as usize]);
+    let d = x2.pos - x1.pos;
+    let far = if b.plane {
+        x1.rot.column(2).dot(&d) > b.reach + reach
+    } else {
+        d.norm_squared() > (b.reach + reach) * (b.reach + reach)
+    };
+    if !far {
+        narrow_pair(model, cm, data, idx, reach, budget);
+    }
+    true
+}
+
+/// Candidate pair `idx`, whose bounding spheres overlap: the oriented-bounding-box test ([`obb`]),
+/// then its narrow phase, its contacts pushed onto `data.contacts` (at most the pair's
+/// `max_contacts`, none past `budget`: those are counted in `contacts_dropped`); a pair that
+/// found contacts is stamped touching for the next pass.
+#[inline(always)]
+fn narrow_pair(model: &Model, cm: &CollisionModel, data: &mut Data, idx: usize, reach: f64, budget: usize) {
+    let pair = &model.collision_pairs[idx];
+    let [g1, g2] = pair.geom;
+    let within = pair.margin + pair.gap + reach;
+    if let (Some(l1), Some(l2)) = (&cm.local_box[g1], &cm.local_box[g2]) {
+        let (bw, xg) = (&mut data.broadphase, &data.x_world_geom);
+        bw.form_box(g1, l1, &xg[g1]);
+        bw.form_box(g2, l2, &xg[g2]);
+        if bw.boxes[g1].apart(&bw.boxes[g2], within) {
+            return;
+        }
+        // Then the geom frames' boxes where a mesh has one (any box that separates the pair
+        // proves it apart).
+        let (f1, f2) = (&cm.file_box[g1], &cm.file_box[g2]);
+        if f1.is_some() || f2.is_some() {
+            let b1 = match f1 {
+                Some(f) => bw.form_file_box(g1, f, &xg[g1]),
+                None => bw.boxes[g1],
+            };
+            let b2 = match f2 {
+                Some(f) => bw.form_file_box(g2, f, &xg[g2]),
+                None => bw.boxes[g2],
+            };
+            if b1.apart(&b2, within) {
+                return;
+            }
+        }
+    }
+    let before = data.contacts.len();
+    narrow_phase(model, cm, data, idx, within, budget);
+    if data.contacts.len() > before {
+        data.broadphase.touched[idx] = data.broadphase.pass;
+    }
+}
+
+/// The narrow phase of candidate pair `idx` (see [`narrow_pair`]), contacts closer than `within`.
+#[inline(never)]
+fn narrow_phase(model: &Model, cm: &CollisionModel, data: &mut Data, idx: usize, within: f64, budget: usize) {
+    let pair = &model.collision_pairs[idx];
+    let [g1, g2] = pair.geom;
+    let (geom1, geom2) = (&model.geoms[g1], &model.geoms[g2]);
+    let (x1, x2) = (data.x_world_geom[g1], data.x_world_geom[g2]);
+    let start = data.contacts.len();
+    let mut push = |p1: Vec3, p2: Vec3, normal: Vec3, dist: f64, hint: Option<Vec3>, feature: u32| {
+        if data.contacts.len() - start >= pair.max_contacts {
+            return;
+        }
+        if data.contacts.len() >= budget {
+            data.contacts_dropped += 1;
+            return;
+        }
+        data.contacts.push(Contact {
+            geom: pair.geom,
+            pos: (p1 + p2) * 0.5,
+            frame: contact_frame(&normal, hint.as_ref()),
+            dist,
+            includemargin: pair.margin,
+            gap: pair.gap,
+            condim: pair.condim,
+            friction: pair.friction,
+            solref: pair.solref,
+            solreffriction: pair.solreffriction,
+            solimp: pair.solimp,
+            pair: pair.pair,
+            feature,
+        });
+    };
+    // Height fields against spheres: MuJoCo's prisms ([`hfield`]).
+    if let (Shape::Hfield { field, .. }, Shape::Sphere { radius }) = (&geom1.shape, &geom2.shape) {
+        let mut out = |p: hfield::HfieldPoint| push(p.p1, p.p2, p.normal, p.dist, None, 0);
+        hfield::sphere(&x1, field, &x2.pos, *radius, pair.margin, &mut out);
+        return;
+    }
+    // Height fields against the other convex geoms: MuJoCo's prisms by GJK/EPA ([`hfield_convex`]).
+    if let Shape::Hfield { field, .. } = &geom1.shape {
+        if let Some(s2) = &cm.shapes[g2] {
+            let mut out = |p: hfield::HfieldPoint| push(p.p1, p.p2, p.normal, p.dist, None, 0);
+            hfield_convex::convex(&x1, field, s2, &x2, pair.margin, &model.options, &mut out);
+        }
+        return;
+    }
+    if let Shape::Plane { .. } = geom1.shape {
+        let n = x1.rot.column(2).into_owned();
+        let mut out = |p: PlanePoint| push(p.surface - n * p.dist, p.surface, n, p.dist, p.hint, p.feature);
+        match &geom2.shape {
+            Shape::Sphere { radius } => plane::sphere(&x1, &x2.pos, *radius, within, &mut out),
+            Shape::Capsule { radius, length } => {
+                plane::capsule(&x1, &x2, *radius, 0.5 * length, within, &mut out)
+            }
+            Shape::Box { size } => plane::cuboid(&x1, &x2, &(size / 2.0), within, &mut out),
+            Shape::Cylinder { radius, length } => {
+                plane::cylinder(&x1, &x2, *radius, 0.5 * length, within, &mut out)
+            }
+            Shape::Ellipsoid { radii } => plane::ellipsoid(&x1, &x2, radii, within, &mut out),
+            Shape::Mesh { .. } => {
+                if let Some(h) = &cm.plane_hulls[g2] {
+                    plane_mesh::plane_mesh(&x1, &x2, h, within, &mut out)
+                }
+            }
+            Shape::Plane { .. } | Shape::Hfield { .. } => {}
+        }
+        return;
+    }
+    // Boxes against spheres, capsules and boxes, spheres against cylinders: MuJoCo's closed
+    // forms (geom 1 the lower type; a pair given the other way round is swapped and its normal
+    // turned back).
+    let mut emit = |p: PairPoint, feature: u32, swap: bool| match swap {
+        false => push(p.p1, p.p2, p.normal, p.dist, None, feature),
+        true => push(p.p2, p.p1, -p.normal, p.dist, None, feature),
+    };
+    let boxed = match (&geom1.shape, &geom2.shape) {
+        (Shape::Sphere { radius }, Shape::Box { size }) | (Shape::Box { size }, Shape::Sphere { radius }) => {
+            let (xs, xb, swap) =
+                if let Shape::Box { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
+            let mut out = |p, f| emit(p, f, swap);
+            box_primitive::sphere_box(&xs.pos, *radius, &xb, &(size / 2.0), within, 0, &mut out);
+            true
+        }
+        (Shape::Capsule { radius, length }, Shape::Box { size })
+        | (Shape::Box { size }, Shape::Capsule { radius, length }) => {
+            let (xc, xb, swap) =
+                if let Shape::Box { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
+            let mut out = |p, f| emit(p, f, swap);
+            box_primitive::capsule_box(&xc, *radius, 0.5 * length, &xb, &(size / 2.0), within, &mut out);
+            true
+        }
+        (Shape::Sphere { radius }, Shape::Cylinder { radius: rc, length })
+        | (Shape::Cylinder { radius: rc, length }, Shape::Sphere { radius }) => {
+            let (xs, xc, swap) =
+                if let Shape::Cylinder { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
+            let z = xs.rot.column(2).into_owned();
+            if let Some(p) =
+                sphere_cylinder::sphere_cylinder(&xs.pos, &z, *radius, &xc, *rc, 0.5 * length, within)
+            {
+                emit(p, 0, swap);
+            }
+            true
+        }
+        (Shape::Box { size: s1 }, Shape::Box { size: s2 }) => {
+            box_box::box_box(&x1, &(s1 / 2.0), &x2, &(s2 / 2.0), within, &mut |p, f| emit(p, f, false));
+            true
+        }
+        // Spheres and capsules: MuJoCo's sphere–sphere tests of segment points ([`capsule`]).
+        (Shape::Sphere { radius: r1 }, Shape::Sphere { radius: r2 }) => {
+            if let Some(p) = capsule::sphere_sphere_pair(&x1, *r1, &x2, *r2, within) {
+                emit(p, 0, false);
+            }
+            true
+        }
+        (Shape::Sphere { radius }, Shape::Capsule { radius: rc, length })
+        | (Shape::Capsule { radius: rc, length }, Shape::Sphere { radius }) => {
+            let (xs, xc, swap) =
+                if let Shape::Capsule { .. } = geom2.shape { (x1, x2, false) } else { (x2, x1, true) };
+            if let Some(p) = capsule::sphere_capsule(&xs, *radius, &xc, *rc, 0.5 * length, within) {
+                emit(p, 0, swap);
+            }
+            true
+        }
+        (Shape::Capsule { radius: r1, length: l1 }, Shape::Capsule { radius: r2, length: l2 }) => {
+            let mut k = 0;
+            capsule::capsule_capsule(&x1, *r1, 0.5 * l1, &x2, *r2, 0.5 * l2, within, &mut |p| {
+                emit(p, k, false);
+                k += 1;
+            });
+            true
+        }
+        _ => false,
+    };
+    if boxed {
+        return;
+    }
+    let point = match (&cm.shapes[g1], &cm.shapes[g2]) {
+        (Some(s1), Some(s2)) => {
+            let bw = &mut data.broadphase;
+            let touching = bw.touched[idx] + 1 == bw.pass;
+            convex::mujoco_pair_warm(&x1, s1, &x2, s2, within, &model.options, touching, &mut bw.warm[idx])
+        }
+        _ => None,
+    };
+    if let Some(p) = point {
+        if let (true, Some(s1), Some(s2)) = (pair.max_contacts > 1, &cm.shapes[g1], &cm.shapes[g2]) {
+            // Feature ids: the order of the points (distinct within the pair).
+            let mut k = 0;
+            let mut out = |q: PairPoint| {
+                push(q.p1, q.p2, q.normal, q.dist, None, k);
+                k += 1;
+            };
+            multiccd::convex_contacts(&x1, s1, &x2, s2, p, pair.margin + pair.gap, &mut out);
+            return;
+        }
+        push(p.p1, p.p2, p.normal, p.dist, None, 0);
     }
 }

@@ -3,7 +3,9 @@
 //! its own frame — centre and half-extents of the primitive, or of a mesh's hull vertices along
 //! MuJoCo's axes of the mesh (its principal axes, where `geom_aabb` is axis-aligned; the collision
 //! pass tries the box along the geom frame's axes too, `CollisionModel::file_box`) — and a
-//! separating-axis test of two such boxes at the geoms' world poses over the 15 axes of two boxes
+//! separating-axis test of two such boxes at the geoms' world poses ([`WorldBox`], formed at most
+//! once per geom and pass): first along the three world axes (the boxes' world-axis-aligned
+//! bounds, which reject most far pairs for a few comparisons), then over the 15 axes of two boxes
 //! (the 3 face normals of each, the 9 cross products of their edges; Gottschalk, Lin & Manocha,
 //! "OBBTree", SIGGRAPH 1996).
 //!
@@ -68,61 +70,106 @@ impl LocalBox {
 /// separate boxes by round-off; it only makes the test more conservative.
 const PARALLEL_EPS: f64 = 1e-12;
 
-/// Whether boxes `b1` at pose `x1` and `b2` at pose `x2` are farther apart than `margin` along
-/// one of the 15 separating axes (then the geoms cannot touch within `margin`).
-pub fn apart(b1: &LocalBox, x1: &Transform, b2: &LocalBox, x2: &Transform, margin: f64) -> bool {
-    let axes = |x: &Transform, b: &LocalBox| b.axes.map_or(x.rot, |a| x.rot * a);
-    apart_along(b1, x1, &axes(x1, b1), b2, x2, &axes(x2, b2), margin)
+/// A geom's box at the geom's world pose, formed once per collision pass: its world centre and
+/// axes, and the half-extents of the world-axis-aligned box around it (the first, cheapest test
+/// of [`WorldBox::apart`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldBox {
+    /// Centre (world, m).
+    pub centre: Vec3,
+    /// The box's axes in world coordinates (columns).
+    pub axes: Mat3,
+    /// Half-extents along `axes` (m).
+    pub half: Vec3,
+    /// Half-extents of the world-axis-aligned box that holds it (m): Σ_j |axes_kj| half_j.
+    pub extent: Vec3,
 }
 
-/// [`apart`] with the boxes' world axes given (`rot1` = x1.rot · b1's axes, likewise `rot2`:
-/// the collision pass forms them once per geom).
-pub fn apart_along(
-    b1: &LocalBox,
-    x1: &Transform,
-    rot1: &Mat3,
-    b2: &LocalBox,
-    x2: &Transform,
-    rot2: &Mat3,
-    margin: f64,
-) -> bool {
-    // Box 2 in box 1's axes: rotation r, centre offset t.
-    let r: Mat3 = rot1.transpose() * rot2;
-    let c1 = x1.act_point(&b1.centre);
-    let c2 = x2.act_point(&b2.centre);
-    let t = rot1.tr_mul(&(c2 - c1));
-    let abs = r.map(|a| a.abs() + PARALLEL_EPS);
-    let (a, b) = (&b1.half, &b2.half);
-    // Box 1's face normals.
-    for i in 0..3 {
-        let rb = b.x * abs[(i, 0)] + b.y * abs[(i, 1)] + b.z * abs[(i, 2)];
-        if t[i].abs() > a[i] + rb + margin {
+impl Default for WorldBox {
+    fn default() -> Self {
+        Self { centre: Vec3::zeros(), axes: Mat3::identity(), half: Vec3::zeros(), extent: Vec3::zeros() }
+    }
+}
+
+impl WorldBox {
+    /// Box `b` of a geom at world pose `x`.
+    #[inline]
+    pub fn new(b: &LocalBox, x: &Transform) -> Self {
+        let axes = match &b.axes {
+            Some(a) => x.rot * a,
+            None => x.rot,
+        };
+        let centre = x.act_point(&b.centre);
+        let h = &b.half;
+        let extent = Vec3::from_fn(|k, _| {
+            axes[(k, 0)].abs() * h.x + axes[(k, 1)].abs() * h.y + axes[(k, 2)].abs() * h.z
+        });
+        Self { centre, axes, half: b.half, extent }
+    }
+
+    /// Whether this box and `other` are farther apart than `margin` along a world axis or one
+    /// of the 15 separating axes of two boxes (then the geoms cannot touch within `margin`).
+    /// The world axes first (the boxes' world-aligned bounds, three comparisons), then the face
+    /// normals of each box, then the edge cross products: the rows of the relative rotation are
+    /// formed as the tests reach them, so a pair rejected early costs little.
+    #[inline]
+    pub fn apart(&self, other: &WorldBox, margin: f64) -> bool {
+        let d = other.centre - self.centre;
+        if d.x.abs() > self.extent.x + other.extent.x + margin
+            || d.y.abs() > self.extent.y + other.extent.y + margin
+            || d.z.abs() > self.extent.z + other.extent.z + margin
+        {
             return true;
         }
-    }
-    // Box 2's face normals.
-    for j in 0..3 {
-        let ra = a.x * abs[(0, j)] + a.y * abs[(1, j)] + a.z * abs[(2, j)];
-        let tj = t.x * r[(0, j)] + t.y * r[(1, j)] + t.z * r[(2, j)];
-        if tj.abs() > ra + b[j] + margin {
-            return true;
-        }
-    }
-    // Edge cross products A_i × B_j (unnormalised: lengths sin θ_ij, the margin scaled alike).
-    for i in 0..3 {
-        let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
-        for j in 0..3 {
-            let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
-            let ra = a[i1] * abs[(i2, j)] + a[i2] * abs[(i1, j)];
-            let rb = b[j1] * abs[(i, j2)] + b[j2] * abs[(i, j1)];
-            let tl = t[i2] * r[(i1, j)] - t[i1] * r[(i2, j)];
-            let length = (1.0 - r[(i, j)] * r[(i, j)]).max(0.0).sqrt();
-            if tl.abs() > ra + rb + margin * length + PARALLEL_EPS {
+        let (u, v) = (&self.axes, &other.axes);
+        let (a, b) = (&self.half, &other.half);
+        // Box 2 in box 1's axes: rotation r (row i: box 1's axis i against box 2's axes), centre
+        // offset t; each row tested as soon as formed (box 1's face normal i).
+        let mut r = [[0.0f64; 3]; 3];
+        let mut abs = [[0.0f64; 3]; 3];
+        let mut t = [0.0f64; 3];
+        for i in 0..3 {
+            let (ux, uy, uz) = (u[(0, i)], u[(1, i)], u[(2, i)]);
+            t[i] = ux * d.x + uy * d.y + uz * d.z;
+            for j in 0..3 {
+                r[i][j] = ux * v[(0, j)] + uy * v[(1, j)] + uz * v[(2, j)];
+                abs[i][j] = r[i][j].abs() + PARALLEL_EPS;
+            }
+            let rb = b.x * abs[i][0] + b.y * abs[i][1] + b.z * abs[i][2];
+            if t[i].abs() > a[i] + rb + margin {
                 return true;
             }
         }
+        // Box 2's face normals.
+        for j in 0..3 {
+            let ra = a.x * abs[0][j] + a.y * abs[1][j] + a.z * abs[2][j];
+            let tj = t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j];
+            if tj.abs() > ra + b[j] + margin {
+                return true;
+            }
+        }
+        // Edge cross products A_i × B_j (unnormalised: lengths sin θ_ij, the margin scaled alike).
+        for i in 0..3 {
+            let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
+            for j in 0..3 {
+                let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+                let ra = a[i1] * abs[i2][j] + a[i2] * abs[i1][j];
+                let rb = b[j1] * abs[i][j2] + b[j2] * abs[i][j1];
+                let tl = t[i2] * r[i1][j] - t[i1] * r[i2][j];
+                let length = (1.0 - r[i][j] * r[i][j]).max(0.0).sqrt();
+                if tl.abs() > ra + rb + margin * length + PARALLEL_EPS {
+                    return true;
+                }
+            }
+        }
+        false
     }
-    false
+}
+
+/// Whether boxes `b1` at pose `x1` and `b2` at pose `x2` are farther apart than `margin` (see
+/// [`WorldBox::apart`]).
+pub fn apart(b1: &LocalBox, x1: &Transform, b2: &LocalBox, x2: &Transform, margin: f64) -> bool {
+    WorldBox::new(b1, x1).apart(&WorldBox::new(b2, x2), margin)
 }
 
 #[cfg(test)]

@@ -292,7 +292,8 @@ pub struct SleepState {
     pub tree_awake: Vec<bool>,
     /// Number of awake trees (MuJoCo's `ntree_awake`).
     pub ntree_awake: usize,
-    /// The candidate geom pairs the last collision pass tested (after the sleep filter).
+    /// The candidate geom pairs the last collision pass tested (after the sleep filter; the
+    /// pairs of a run skipped at the body level, `collision::PairRun`, are not counted).
     pub pairs_tested: usize,
     /// Trees put to sleep and trees woken since `Data::new` or the last `reset`.
     pub slept: u64,
