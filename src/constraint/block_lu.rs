@@ -6,7 +6,7 @@
 //!
 //! The unknowns are grouped into the connected components of the matrix's pattern (i and j
 //! joined where `A[i][j]` or `A[j][i]` is not zero; a breadth-first search), and each block is
-//! solved by [`lu_solve`](super::dense::lu_solve)'s LU with complete pivoting, with the whole
+//! solved by the LU with complete pivoting of `dense.rs` ([`lu_kernel_dispatch`]), with the whole
 //! system's thresholds (rank tolerance from the largest entry of A, consistency from the largest
 //! entry of b). Complete pivoting on the whole matrix picks, at each step, the largest remaining
 //! entry, which lies in one block and eliminates within it (the other blocks' entries of its
@@ -55,8 +55,8 @@ impl BlockLu {
     }
 
     /// Solves `A x = b` for the top-left n × n block of `a`, n = `b.len()`, into `b`: the result
-    /// and the failures of [`lu_solve`](super::dense::lu_solve) with the same `floor`, block by
-    /// block. `a` is read (and overwritten with its factors when it is one block). Grows the
+    /// and the failures of the whole-matrix LU (`dense::lu_solve`, its tests' reference) with the
+    /// same `floor`, block by block. `a` is read (and overwritten with its factors when it is one block). Grows the
     /// buffers first when n is larger than every earlier system.
     pub fn solve(&mut self, a: &mut DMatrix<f64>, b: &mut [f64], floor: f64) -> bool {
         let n = b.len();

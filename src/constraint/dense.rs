@@ -62,8 +62,8 @@ pub(crate) fn lu_solve(a: &mut DMatrix<f64>, b: &mut [f64], piv: &mut [usize], f
         && (n == 0 || b.iter().all(|x| x.is_finite()))
 }
 
-/// The thresholds of [`lu_solve`] for a system (the whole system's, also when it is solved block
-/// by block).
+/// The thresholds of the LU solve with complete pivoting for a system (the whole system's, also
+/// when it is solved block by block).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LuBounds {
     /// Pivots at most this are zero: `RANK_TOLERANCE` times the matrix's largest entry.
@@ -115,9 +115,9 @@ unsafe fn lu_kernel_avx2(
     lu_kernel(m, stride, b, piv, bounds)
 }
 
-/// The elimination and solve of [`lu_solve`] on the top-left n × n block of `m` (column-major,
-/// `stride`), n = `b.len()`, with the given thresholds; true when the system is consistent (the
-/// caller checks finiteness).
+/// The elimination and back substitution of the LU solve with complete pivoting (`lu_solve`) on
+/// the top-left n × n block of `m` (column-major, `stride`), n = `b.len()`, with the given
+/// thresholds; true when the system is consistent (the caller checks finiteness).
 #[inline(always)]
 fn lu_kernel(m: &mut [f64], stride: usize, b: &mut [f64], piv: &mut [usize], bounds: LuBounds) -> bool {
     let n = b.len();
