@@ -133,12 +133,7 @@ impl PairRun {
     #[inline]
     pub fn apart(&self, x: &[Transform], reach: f64) -> bool {
         let (x1, x2) = (&x[self.anchor[0] as usize], &x[self.anchor[1] as usize]);
-        let d = x2.pos - x1.pos;
-        if self.plane {
-            x1.rot.column(2).dot(&d) > self.reach + reach
-        } else {
-            d.norm_squared() > (self.reach + reach) * (self.reach + reach)
-        }
+        spheres_apart(x1, x2, self.plane, self.reach + reach)
     }
 
     /// The runs of `model`'s candidate pairs, with the geoms' bounding radii `rbound`.
@@ -366,6 +361,20 @@ pub fn collide(model: &Model, cm: &CollisionModel, data: &mut Data, reach: f64) 
     }
 }
 
+/// Whether two bounding spheres centred at the origins of `x1` and `x2` are farther apart than
+/// `within` (the radii, margin and gap summed), or, with `plane`, whether `x2`'s origin is more
+/// than `within` above the plane of `x1` (its local z = 0): the test of one pair and of a run of
+/// pairs alike.
+#[inline(always)]
+fn spheres_apart(x1: &Transform, x2: &Transform, plane: bool, within: f64) -> bool {
+    let d = x2.pos - x1.pos;
+    if plane {
+        x1.rot.column(2).dot(&d) > within
+    } else {
+        d.norm_squared() > within * within
+    }
+}
+
 /// Candidate pair `idx` through the sleep filter and the bounding-sphere test (a plane: the other
 /// geom's sphere against the plane), then [`narrow_pair`]; whether it passed the sleep filter.
 #[inline(always)]
@@ -389,13 +398,7 @@ fn test_pair(
         return false;
     }
     let (x1, x2) = (&data.x_world_geom[b.geom[0] as usize], &data.x_world_geom[b.geom[1] as usize]);
-    let d = x2.pos - x1.pos;
-    let far = if b.plane {
-        x1.rot.column(2).dot(&d) > b.reach + reach
-    } else {
-        d.norm_squared() > (b.reach + reach) * (b.reach + reach)
-    };
-    if !far {
+    if !spheres_apart(x1, x2, b.plane, b.reach + reach) {
         narrow_pair(model, cm, data, idx, reach, budget);
     }
     true
