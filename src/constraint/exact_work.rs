@@ -140,8 +140,8 @@ impl ExactWork {
         }
     }
 
-    /// The dense matrices (M⁻¹Jᵀ, the Delassus matrix and its factors) for `nefc` rows, if
-    /// smaller: only the exact mode needs them (nefc² numbers each).
+    /// The dense matrices (M⁻¹Jᵀ, the Delassus matrix and its factors, the block LU's scratch)
+    /// for `nefc` rows, if smaller: only the exact mode needs them (nefc² numbers each).
     pub fn grow_matrices(&mut self, nv: usize, nefc: usize) {
         if self.motion.len() != 2 * nv {
             self.motion = DVector::zeros(2 * nv);
@@ -161,6 +161,7 @@ impl ExactWork {
         for m in [&mut self.delassus, &mut self.factor, &mut self.sub] {
             *m = DMatrix::zeros(nefc, nefc);
         }
+        self.lu.grow(nefc);
     }
 
     /// The per-row vectors for `nefc` rows.
@@ -179,7 +180,6 @@ impl ExactWork {
         self.warm.resize_vertically_mut(nefc, 0.0);
         self.pressing.resize(nefc, false);
         self.slipping.resize(nefc, false);
-        self.lu.grow(nefc);
         self.newton_pos.resize(nefc, usize::MAX);
         self.newton_rows.reserve(nefc.saturating_sub(self.newton_rows.len()));
         self.newton_normal.reserve(nefc.saturating_sub(self.newton_normal.len()));
