@@ -54,6 +54,11 @@ impl BlockLu {
         self.capacity = n;
     }
 
+    /// The largest system the buffers hold without growing.
+    pub fn capacity(&self) -> usize {
+        self.capacity
+    }
+
     /// Solves `A x = b` for the top-left n × n block of `a`, n = `b.len()`, into `b`: the result
     /// and the failures of the whole-matrix LU (`dense::lu_solve`, its tests' reference) with the
     /// same `floor`, block by block. `a` is read (and overwritten with its factors when it is one block). Grows the

@@ -190,3 +190,23 @@ impl ExactWork {
         self.warm_rows.reserve(nefc.saturating_sub(self.warm_rows.len()));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::ExactWork;
+
+    /// The per-row vectors every mode grows carry no nefc² buffer: a soft scene's rows never pay
+    /// for the exact mode's dense matrices (the block LU's scratch included); those grow with
+    /// `grow_matrices` only.
+    #[test]
+    fn per_row_vectors_allocate_no_matrix() {
+        let mut work = ExactWork::new(12, 0);
+        work.grow_vectors(2000);
+        assert_eq!(work.rhs.len(), 2000);
+        assert_eq!(work.delassus.len(), 0);
+        assert_eq!(work.lu.capacity(), 0);
+        work.grow_matrices(12, 300);
+        assert_eq!(work.delassus.nrows(), 300);
+        assert!(work.lu.capacity() >= 300);
+    }
+}
