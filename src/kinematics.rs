@@ -274,6 +274,7 @@ pub fn forward_velocities(model: &Model, data: &mut Data, v: &[f64]) -> Result<(
 
 /// [`forward_velocities`] without the argument checks.
 pub(crate) fn forward_velocities_unchecked(model: &Model, data: &mut Data, v: &[f64]) {
+    data.v_body[0] = Motion::zero();
     for b in 1..model.nbody() {
         let p = model.bodies[b].parent;
         let v_joint = joint_velocity(model, data, b, v);

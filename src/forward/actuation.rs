@@ -140,11 +140,14 @@ pub(crate) fn actuation_unchecked(
     }
     let zeroed = bad.is_some();
     let mut act_adr = 0;
-    // Every moment row from zero (one contiguous fill, not a strided one per row).
-    data.actuator_moment.as_mut_slice().fill(0.0);
     for (i, a) in model.actuators.iter().enumerate() {
         let act_index = (a.actnum() == 1).then_some(act_adr);
         act_adr += a.actnum();
+        // The moment row from zero over the entries its transmission can write (`moment_span`:
+        // a joint actuator's dofs); nothing writes the rest, zero since `Data::new`.
+        for k in moment_span(model, a) {
+            data.actuator_moment[(i, k)] = 0.0;
+        }
         if unsimulated_reason(model, a).is_some() {
             data.actuator_length[i] = 0.0;
             data.actuator_velocity[i] = 0.0;

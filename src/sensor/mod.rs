@@ -22,6 +22,7 @@ mod geometry;
 pub(crate) mod objects;
 mod position;
 mod subtree;
+mod touch;
 mod types;
 mod velocity;
 
@@ -99,6 +100,8 @@ pub(crate) struct SensorWork {
     pub time: f64,
     /// The contact sensor's matches.
     pub matches: Vec<contact_sensor::Match>,
+    /// The touch sensors, formed together in one pass over the contacts.
+    pub touch: touch::TouchSites,
 }
 
 impl SensorWork {
@@ -115,6 +118,7 @@ impl SensorWork {
             } else {
                 0
             }),
+            touch: touch::TouchSites::new(model),
         }
     }
 }
@@ -142,7 +146,8 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
         return;
     }
     forward_kinematics_unchecked(model, data, q);
-    if needs.velocities {
+    // Body velocities: for the velocity sensors, and the accelerations' velocity terms.
+    if needs.velocities || needs.rne_post {
         forward_velocities_unchecked(model, data, v);
     }
     let mut work = std::mem::take(&mut data.sensor_work);
@@ -158,7 +163,7 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
         subtree::subtree_velocities(model, data, &mut work.subtree, needs.subtree_angmom);
     }
     if needs.rne_post {
-        crate::dynamics::rne_post::rne_post_constraint_at(model, data, q, v, needs.rne_post_wrenches);
+        crate::dynamics::rne_post::rne_post_constraint_at(model, data, q, v, needs.rne_post_wrenches, true);
     }
     if needs.kinetic {
         let bodies: f64 =
@@ -166,6 +171,7 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
         let armature: f64 = model.dof_armature.iter().zip(v).map(|(a, vi)| 0.5 * a * vi * vi).sum();
         work.kinetic = bodies + armature;
     }
+    touch::touch_all(model, data, &work.touch, sensordata.as_mut_slice());
     let inside_site = |f: usize, p: &crate::spatial::Vec3| geometry::inside_site_zone(model, data, f, p);
     for s in model.sensors.iter().filter(|s| s.is_computed()) {
         let out = &mut sensordata.as_mut_slice()[s.adr..s.adr + s.dim];
@@ -173,6 +179,8 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
             (_, Some(spec)) => {
                 contact_sensor::compute(model, data, s, &spec, &inside_site, &mut work.matches, out)
             }
+            // Formed above, all together.
+            _ if touch::is_touch_site(s) => {}
             _ if matches!(
                 s.kind,
                 SensorType::Touch
