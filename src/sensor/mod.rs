@@ -31,7 +31,7 @@ pub use types::{
     RAY_FIELDS,
 };
 
-use crate::kinematics::{forward_kinematics_unchecked, forward_velocities_unchecked};
+use crate::kinematics::{forward_kinematics_sensed_unchecked, forward_velocities_unchecked};
 use crate::model::{Data, Model};
 use objects::Quat;
 use subtree::Subtree;
@@ -145,7 +145,8 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
     if !needs.any || data.forward_skip.sensors {
         return;
     }
-    forward_kinematics_unchecked(model, data, q);
+    // The link and site frames (the joint-anchor frames no sensor reads are left as they were).
+    forward_kinematics_sensed_unchecked(model, data, q);
     // Body velocities: for the velocity sensors, and the accelerations' velocity terms.
     if needs.velocities || needs.rne_post {
         forward_velocities_unchecked(model, data, v);
