@@ -173,7 +173,7 @@ pub fn rne_post_constraint(model: &Model, data: &mut Data) -> Result<(), InputEr
     let v = std::mem::take(&mut data.qvel);
     body_poses(model, data, q.as_slice());
     forward_velocities_unchecked(model, data, v.as_slice());
-    rne_post_constraint_at(model, data, q.as_slice(), v.as_slice(), true, false);
+    rne_post_constraint_at(model, data, q.as_slice(), v.as_slice(), true, false, None);
     data.qpos = q;
     data.qvel = v;
     Ok(())
@@ -186,7 +186,10 @@ pub fn rne_post_constraint(model: &Model, data: &mut Data) -> Result<(), InputEr
 /// `wrenches` (the sensor stage when no force or torque sensor reads them) `cfrc_ext` and
 /// `cfrc_int` are left zero and only the accelerations are formed. With `sensed_only` (the
 /// sensor stage) `cvel` and `cacc` are formed only for the bodies the model's acceleration sensors
-/// read (and mocap bodies), zero for the others.
+/// read (and mocap bodies), zero for the others. `centres`, when the caller has them at `q`
+/// (the sensor stage's subtree sensors), are each MuJoCo body's centre of mass, its subtree's mass
+/// and centre of mass (`xipos`, `body_subtreemass`, `subtree_com`), used instead of forming them
+/// again.
 pub(crate) fn rne_post_constraint_at(
     model: &Model,
     data: &mut Data,
@@ -194,11 +197,26 @@ pub(crate) fn rne_post_constraint_at(
     v: &[f64],
     wrenches: bool,
     sensed_only: bool,
+    centres: Option<(&[Vec3], &[f64], &[Vec3])>,
 ) {
     let mut w = std::mem::take(&mut data.rne_post);
     body_poses(model, data, q);
     compiled_motions(model, data, &mut w, v);
-    com_frames(model, data, &mut w);
+    // The caller's centres when they follow this file's rule (the world's own mass zero).
+    let world_massless = model.links.frame.first().is_none_or(|&f| model.frames[f].inertia.mass == 0.0);
+    match centres {
+        Some((xipos, mass, com))
+            if world_massless
+                && xipos.len() == w.xipos.len()
+                && mass.len() == w.subtree_mass.len()
+                && com.len() == w.subtree_com.len() =>
+        {
+            w.xipos.copy_from_slice(xipos);
+            w.subtree_mass.copy_from_slice(mass);
+            w.subtree_com.copy_from_slice(com);
+        }
+        _ => com_frames(model, data, &mut w),
+    }
     link_motions(model, data, &mut w, sensed_only);
     if wrenches {
         external_wrenches(model, data, &mut w);

@@ -164,7 +164,22 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
         subtree::subtree_velocities(model, data, &mut work.subtree, needs.subtree_angmom);
     }
     if needs.rne_post {
-        crate::dynamics::rne_post::rne_post_constraint_at(model, data, q, v, needs.rne_post_wrenches, true);
+        // The subtree centres of mass, when the subtree sensors formed them, are rne_post's too.
+        let subtree = &work.subtree;
+        let centres = needs.subtree_com.then_some((
+            subtree.xipos.as_slice(),
+            subtree.mass.as_slice(),
+            subtree.com.as_slice(),
+        ));
+        crate::dynamics::rne_post::rne_post_constraint_at(
+            model,
+            data,
+            q,
+            v,
+            needs.rne_post_wrenches,
+            true,
+            centres,
+        );
     }
     if needs.kinetic {
         let bodies: f64 =
