@@ -1,7 +1,7 @@
 //! Forward kinematics, body velocities and frame Jacobians (RBDA §4.1, §8.1).
 
 use crate::error::{check, InputError};
-use crate::model::{Data, HingeAxis, JointKind, Model};
+use crate::model::{Data, FrameKind, HingeAxis, JointKind, Model};
 #[cfg(target_arch = "x86_64")]
 use crate::spatial::fused::Fused;
 use crate::spatial::fused::{self, MulAdd, Separate};
@@ -228,31 +228,47 @@ pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) -> Result<(
 /// [`forward_kinematics`] without the argument checks. The body poses are formed only when they
 /// do not already hold `q` (`Data::poses_stamp`); the frames always are.
 pub(crate) fn forward_kinematics_unchecked(model: &Model, data: &mut Data, q: &[f64]) {
+    forward_kinematics_dispatch::<true>(model, data, q);
+}
+
+/// [`forward_kinematics_unchecked`] without the joint-anchor frames ([`FrameKind::Joint`]:
+/// no sensor reads them; their entries of `x_world_frame` are left as they were): the link and
+/// site frames the sensor stage reads, the same bits as [`forward_kinematics_unchecked`]'s.
+pub(crate) fn forward_kinematics_sensed_unchecked(model: &Model, data: &mut Data, q: &[f64]) {
+    forward_kinematics_dispatch::<false>(model, data, q);
+}
+
+/// [`forward_kinematics_with`] on the CPU's best path, with or without the joint-anchor frames.
+#[inline(always)]
+fn forward_kinematics_dispatch<const JOINT_FRAMES: bool>(model: &Model, data: &mut Data, q: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU has AVX2 and FMA (checked just above), all `forward_kinematics_fma`
         // requires.
-        unsafe { forward_kinematics_fma(model, data, q) };
+        unsafe { forward_kinematics_fma::<JOINT_FRAMES>(model, data, q) };
         return;
     }
-    forward_kinematics_with::<Separate>(model, data, q);
+    forward_kinematics_with::<Separate, JOINT_FRAMES>(model, data, q);
 }
 
 /// [`forward_kinematics_with`] compiled for AVX2 and FMA3, its multiply–adds fused.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn forward_kinematics_fma(model: &Model, data: &mut Data, q: &[f64]) {
-    forward_kinematics_with::<Fused>(model, data, q);
+unsafe fn forward_kinematics_fma<const JOINT_FRAMES: bool>(model: &Model, data: &mut Data, q: &[f64]) {
+    forward_kinematics_with::<Fused, JOINT_FRAMES>(model, data, q);
 }
 
 #[inline(always)]
-fn forward_kinematics_with<A: MulAdd>(model: &Model, data: &mut Data, q: &[f64]) {
+fn forward_kinematics_with<A: MulAdd, const JOINT_FRAMES: bool>(model: &Model, data: &mut Data, q: &[f64]) {
     if !data.poses_stamp.matches(q) {
         body_poses_with::<A>(model, data, q);
         data.poses_stamp.set(q);
     }
     // Frames rigidly attached to bodies.
     for (f, frame) in model.frames.iter().enumerate() {
+        if !JOINT_FRAMES && frame.kind == FrameKind::Joint {
+            continue;
+        }
         data.x_world_frame[f] = match frame.mocap {
             Some(m) => data.mocap_pose(m) * frame.x_body_frame,
             None => fused::compose::<A>(&data.x_world_body[frame.body], &frame.x_body_frame),
@@ -274,6 +290,7 @@ pub fn forward_velocities(model: &Model, data: &mut Data, v: &[f64]) -> Result<(
 
 /// [`forward_velocities`] without the argument checks.
 pub(crate) fn forward_velocities_unchecked(model: &Model, data: &mut Data, v: &[f64]) {
+    data.v_body[0] = Motion::zero();
     for b in 1..model.nbody() {
         let p = model.bodies[b].parent;
         let v_joint = joint_velocity(model, data, b, v);
@@ -500,10 +517,10 @@ mod tests {
         }
         for (file, model, q) in crate::kernel_test_states::robots() {
             let mut data = Data::new(&model);
-            forward_kinematics_with::<Separate>(&model, &mut data, &q);
+            forward_kinematics_with::<Separate, true>(&model, &mut data, &q);
             let (bodies, frames) = (data.x_world_body.clone(), data.x_world_frame.clone());
             // SAFETY: AVX2 and FMA are present (checked above).
-            unsafe { forward_kinematics_fma(&model, &mut data, &q) };
+            unsafe { forward_kinematics_fma::<true>(&model, &mut data, &q) };
             for (a, b) in
                 bodies.iter().chain(&frames).zip(data.x_world_body.iter().chain(&data.x_world_frame))
             {

@@ -43,9 +43,9 @@
 use crate::constraint::soft::rows::{conj, weld_quats, weld_rotation_map};
 use crate::constraint::{ConstraintMode, RowGeometry};
 use crate::error::{check, InputError};
-use crate::kinematics::body_poses;
+use crate::kinematics::{body_poses, forward_velocities_unchecked};
 use crate::model::{Data, EfcType, EqualityKind, Model};
-use crate::spatial::{Force, Motion, Transform, Vec3};
+use crate::spatial::{Force, Motion, RigidInertia, Transform, Vec3};
 
 /// MuJoCo's `mjMINVAL`: a subtree lighter than this has its centre of mass at the body's own.
 const MIN_MASS: f64 = 1e-15;
@@ -56,8 +56,15 @@ const MIN_MASS: f64 = 1e-15;
 pub(crate) struct RnePost {
     /// MuJoCo's `body_rootid`: the child of the world each body hangs from (0 for the world).
     pub(crate) rootid: Vec<usize>,
-    /// The world pose of each MuJoCo body's frame (MuJoCo's `xpos`, `xmat`).
-    pub(crate) x_world_link: Vec<Transform>,
+    /// Each MuJoCo body's own mass properties in its compiled body's coordinates (constant; a
+    /// mocap body's are formed at its pose instead).
+    inertia_body: Vec<RigidInertia>,
+    /// Each MuJoCo body's centre of mass in its compiled body's coordinates (constant).
+    com_body: Vec<Vec3>,
+    /// The MuJoCo bodies whose `cvel` and `cacc` the sensor stage forms: those its computed
+    /// accelerometers and frame accelerations read, and the mocap bodies (`cfrc_int` reads
+    /// theirs).
+    sensed: Vec<bool>,
     /// Each body's centre of mass, world (MuJoCo's `xipos`).
     pub(crate) xipos: Vec<Vec3>,
     /// The mass of each body's subtree (MuJoCo's `body_subtreemass`).
@@ -72,8 +79,6 @@ pub(crate) struct RnePost {
     pub(crate) cfrc_ext: Vec<Force>,
     /// Interaction wrench with the parent (MuJoCo's `cfrc_int`).
     pub(crate) cfrc_int: Vec<Force>,
-    /// Per compiled body: spatial velocity, body coordinates.
-    v_body: Vec<Motion>,
     /// Per compiled body: spatial acceleration with the gravity offset, body coordinates.
     a_body: Vec<Motion>,
 }
@@ -87,9 +92,12 @@ impl RnePost {
             rootid[b] = if parent[b] == 0 { b } else { rootid[parent[b]] };
         }
         let n = parent.len();
+        let frames = || model.links.frame.iter().map(|&f| &model.frames[f]);
         Self {
             rootid,
-            x_world_link: vec![Transform::identity(); n],
+            inertia_body: frames().map(|f| f.inertia.transformed(&f.x_body_frame)).collect(),
+            com_body: frames().map(|f| f.x_body_frame.act_point(&f.inertia.com())).collect(),
+            sensed: sensed_bodies(model),
             xipos: vec![Vec3::zeros(); n],
             subtree_mass: vec![0.0; n],
             subtree_com: vec![Vec3::zeros(); n],
@@ -97,10 +105,31 @@ impl RnePost {
             cacc: vec![Motion::zero(); n],
             cfrc_ext: vec![Force::zero(); n],
             cfrc_int: vec![Force::zero(); n],
-            v_body: vec![Motion::zero(); model.nbody()],
             a_body: vec![Motion::zero(); model.nbody()],
         }
     }
+}
+
+/// Per MuJoCo body, whether the sensor stage forms its `cvel` and `cacc` ([`RnePost::sensed`]).
+fn sensed_bodies(model: &Model) -> Vec<bool> {
+    use crate::sensor::{SensorObject, SensorType};
+    let links = &model.links;
+    let mut sensed: Vec<bool> = links.frame.iter().map(|&f| model.frames[f].mocap.is_some()).collect();
+    for s in model.sensors.iter().filter(|s| s.is_computed()) {
+        if !matches!(s.kind, SensorType::Accelerometer | SensorType::FrameLinAcc | SensorType::FrameAngAcc) {
+            continue;
+        }
+        let b = match s.object {
+            SensorObject::Body(b) | SensorObject::XBody(b) => Some(b),
+            SensorObject::Site(f) => links.of_frame.get(f).copied(),
+            SensorObject::Geom(g) => links.of_geom.get(g).copied(),
+            _ => None,
+        };
+        if let Some(flag) = b.and_then(|b| sensed.get_mut(b)) {
+            *flag = true;
+        }
+    }
+    sensed
 }
 
 /// MuJoCo's `mj_rnePostConstraint` at the state in `data` (`qpos`, `qvel`) with the outputs of
@@ -108,7 +137,7 @@ impl RnePost {
 /// forces `efc_force`): every MuJoCo body's `cacc`, `cfrc_ext` and `cfrc_int` (module
 /// documentation), read by [`body_acceleration`], [`object_acceleration`],
 /// [`interaction_wrench`] and [`external_wrench`]. Also forms the body poses at `qpos`
-/// (`x_world_body`). Allocates nothing.
+/// (`x_world_body`) and the body velocities at `qvel` (`v_body`). Allocates nothing.
 ///
 /// # Errors
 /// [`InputError::Length`] when `data` was made for another model or a state or input buffer
@@ -142,25 +171,56 @@ pub fn rne_post_constraint(model: &Model, data: &mut Data) -> Result<(), InputEr
     data.poses_stamp.clear();
     let q = std::mem::take(&mut data.qpos);
     let v = std::mem::take(&mut data.qvel);
-    rne_post_constraint_at(model, data, q.as_slice(), v.as_slice(), true);
+    body_poses(model, data, q.as_slice());
+    forward_velocities_unchecked(model, data, v.as_slice());
+    rne_post_constraint_at(model, data, q.as_slice(), v.as_slice(), true, false, None);
     data.qpos = q;
     data.qvel = v;
     Ok(())
 }
 
 /// [`rne_post_constraint`] at configuration `q` and velocity `v` (the state of the `forward_at`
-/// that left `qacc` and the constraint forces in `data`), without the argument checks. Without
+/// that left `qacc` and the constraint forces in `data`), without the argument checks, with the
+/// body velocities `v_body` already at `v` ([`forward_velocities`](crate::kinematics::forward_velocities)
+/// after the poses at `q`: the sensor stage forms them once for all its sensors). Without
 /// `wrenches` (the sensor stage when no force or torque sensor reads them) `cfrc_ext` and
-/// `cfrc_int` are left zero and only the accelerations are formed.
-pub(crate) fn rne_post_constraint_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], wrenches: bool) {
+/// `cfrc_int` are left zero and only the accelerations are formed. With `sensed_only` (the
+/// sensor stage) `cvel` and `cacc` are formed only for the bodies the model's acceleration sensors
+/// read (and mocap bodies), zero for the others. `centres`, when the caller has them at `q`
+/// (the sensor stage's subtree sensors), are each MuJoCo body's centre of mass, its subtree's mass
+/// and centre of mass (`xipos`, `body_subtreemass`, `subtree_com`), used instead of forming them
+/// again.
+pub(crate) fn rne_post_constraint_at(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    wrenches: bool,
+    sensed_only: bool,
+    centres: Option<(&[Vec3], &[f64], &[Vec3])>,
+) {
     let mut w = std::mem::take(&mut data.rne_post);
     body_poses(model, data, q);
     compiled_motions(model, data, &mut w, v);
-    com_frames(model, data, &mut w);
-    link_motions(model, data, &mut w);
+    // The caller's centres when they follow this file's rule (the world's own mass zero).
+    let world_massless = model.links.frame.first().is_none_or(|&f| model.frames[f].inertia.mass == 0.0);
+    match centres {
+        Some((xipos, mass, com))
+            if world_massless
+                && xipos.len() == w.xipos.len()
+                && mass.len() == w.subtree_mass.len()
+                && com.len() == w.subtree_com.len() =>
+        {
+            w.xipos.copy_from_slice(xipos);
+            w.subtree_mass.copy_from_slice(mass);
+            w.subtree_com.copy_from_slice(com);
+        }
+        _ => com_frames(model, data, &mut w),
+    }
+    link_motions(model, data, &mut w, sensed_only);
     if wrenches {
         external_wrenches(model, data, &mut w);
-        interaction_wrenches(model, &mut w);
+        interaction_wrenches(model, data, &mut w);
     } else {
         w.cfrc_ext.fill(Force::zero());
         w.cfrc_int.fill(Force::zero());
@@ -168,10 +228,10 @@ pub(crate) fn rne_post_constraint_at(model: &Model, data: &mut Data, q: &[f64], 
     data.rne_post = w;
 }
 
-/// Velocity and acceleration of every compiled body in its own coordinates at (`v`, `qacc`), the
-/// world accelerating at −gravity (RNEA's forward pass, RBDA Table 5.1). Needs `body_poses`.
+/// Acceleration of every compiled body in its own coordinates at (`v`, `qacc`), the world
+/// accelerating at −gravity (RNEA's forward pass, RBDA Table 5.1), with the velocities `v_body`
+/// at `v` (the same pass's, `forward_velocities`). Needs `body_poses`.
 fn compiled_motions(model: &Model, data: &Data, w: &mut RnePost, v: &[f64]) {
-    w.v_body[0] = Motion::zero();
     w.a_body[0] = Motion::new(Vec3::zeros(), -model.gravity);
     for b in 1..model.nbody() {
         let j = model.joint_of(b);
@@ -184,23 +244,23 @@ fn compiled_motions(model: &Model, data: &Data, w: &mut RnePost, v: &[f64]) {
         a_joint += j.kind.bias_motion(&v_joint);
         let x = &data.x_parent_body[b];
         let p = model.bodies[b].parent;
-        let v_b = x.inv_act_motion(&w.v_body[p]) + v_joint;
+        let v_b = &data.v_body[b];
         w.a_body[b] = x.inv_act_motion(&w.a_body[p]) + a_joint + v_b.cross_motion(&v_joint);
-        w.v_body[b] = v_b;
     }
 }
 
-/// Each MuJoCo body's frame pose, centre of mass, and its subtree's mass and centre of mass
-/// (MuJoCo's `xpos`/`xmat`, `xipos`, `body_subtreemass`, `subtree_com`; `mj_comPos`). The
-/// world's own mass is zero, as in MuJoCo.
+/// Each MuJoCo body's centre of mass, and its subtree's mass and centre of mass (MuJoCo's
+/// `xipos`, `body_subtreemass`, `subtree_com`; `mj_comPos`). The world's own mass is zero, as in
+/// MuJoCo.
 fn com_frames(model: &Model, data: &Data, w: &mut RnePost) {
     let links = &model.links;
     for b in 0..links.len() {
         let frame = &model.frames[links.frame[b]];
-        let x = data.attached_pose(frame.body, frame.mocap, &frame.x_body_frame);
         let mass = if b == 0 { 0.0 } else { frame.inertia.mass };
-        w.xipos[b] = x.act_point(&frame.inertia.com());
-        w.x_world_link[b] = x;
+        w.xipos[b] = match frame.mocap {
+            None => data.x_world_body[frame.body].act_point(&w.com_body[b]),
+            Some(m) => (data.mocap_pose(m) * frame.x_body_frame).act_point(&frame.inertia.com()),
+        };
         w.subtree_mass[b] = mass;
         w.subtree_com[b] = w.xipos[b] * mass;
     }
@@ -216,12 +276,18 @@ fn com_frames(model: &Model, data: &Data, w: &mut RnePost) {
     }
 }
 
-/// `cvel` and `cacc` of every MuJoCo body: its compiled body's, in world axes about the body's
-/// point `subtree_com[rootid]`. Bodies on the world (static and mocap bodies) have the world's:
-/// zero velocity and the acceleration (0, −g).
-fn link_motions(model: &Model, data: &Data, w: &mut RnePost) {
+/// `cvel` and `cacc` of every MuJoCo body (with `sensed_only`, of the [`RnePost::sensed`] ones;
+/// zero for the others): its compiled body's, in world axes about the body's point
+/// `subtree_com[rootid]`. Bodies on the world (static and mocap bodies) have the world's: zero
+/// velocity and the acceleration (0, −g).
+fn link_motions(model: &Model, data: &Data, w: &mut RnePost, sensed_only: bool) {
     let links = &model.links;
     for b in 0..links.len() {
+        if sensed_only && !w.sensed[b] {
+            w.cvel[b] = Motion::zero();
+            w.cacc[b] = Motion::zero();
+            continue;
+        }
         let cb = model.frames[links.frame[b]].body;
         let x = &data.x_world_body[cb];
         let offset = w.subtree_com[w.rootid[b]] - x.pos;
@@ -229,7 +295,7 @@ fn link_motions(model: &Model, data: &Data, w: &mut RnePost) {
             let ang = x.rot * m.ang;
             Motion::new(ang, x.rot * m.lin + ang.cross(&offset))
         };
-        w.cvel[b] = to_point(&w.v_body[cb]);
+        w.cvel[b] = to_point(&data.v_body[cb]);
         w.cacc[b] = to_point(&w.a_body[cb]);
     }
 }
@@ -340,19 +406,33 @@ fn add_equality(model: &Model, data: &Data, w: &mut RnePost, id: usize, r: usize
     add_ext(w, model.links.of_frame[frame2], -1.0, &torque, &force, &p_b);
 }
 
-/// `cfrc_int`: each body's inertial wrench I a + v ×* I v (its own inertia, about its point)
-/// minus `cfrc_ext`, summed over the subtree (leaves to root, MuJoCo's order; the world's entry
-/// sums its children's about their own points, as MuJoCo's does).
-fn interaction_wrenches(model: &Model, w: &mut RnePost) {
+/// `cfrc_int`: each body's inertial wrench I a + v ×* I v (its own inertia) minus `cfrc_ext`,
+/// summed over the subtree (leaves to root, MuJoCo's order; the world's entry sums its
+/// children's about their own points, as MuJoCo's does). The inertial wrench is formed in the
+/// compiled body's coordinates, where the body's inertia is constant, and moved to world axes
+/// about the body's point (one force transform instead of an inertia transform per body); a mocap
+/// body's, in world axes at its pose.
+fn interaction_wrenches(model: &Model, data: &Data, w: &mut RnePost) {
     let links = &model.links;
     w.cfrc_int[0] = Force::zero();
     for b in 1..links.len() {
         let frame = &model.frames[links.frame[b]];
-        let x = &w.x_world_link[b];
-        let about = Transform::new(x.rot, x.pos - w.subtree_com[w.rootid[b]]);
-        let inertia = frame.inertia.transformed(&about);
-        let (v, a) = (&w.cvel[b], &w.cacc[b]);
-        let f_body = inertia.mul_motion(a) + v.cross_force(&inertia.mul_motion(v));
+        let point = w.subtree_com[w.rootid[b]];
+        let f_body = match frame.mocap {
+            None => {
+                let (cb, inertia) = (frame.body, &w.inertia_body[b]);
+                let (v, a) = (&data.v_body[cb], &w.a_body[cb]);
+                let f = inertia.mul_motion(a) + v.cross_force(&inertia.mul_motion(v));
+                let x = &data.x_world_body[cb];
+                Transform::new(x.rot, x.pos - point).act_force(&f)
+            }
+            Some(m) => {
+                let x = data.mocap_pose(m) * frame.x_body_frame;
+                let inertia = frame.inertia.transformed(&Transform::new(x.rot, x.pos - point));
+                let (v, a) = (&w.cvel[b], &w.cacc[b]);
+                inertia.mul_motion(a) + v.cross_force(&inertia.mul_motion(v))
+            }
+        };
         w.cfrc_int[b] = f_body - w.cfrc_ext[b];
     }
     for b in (1..links.len()).rev() {

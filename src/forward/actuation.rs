@@ -134,17 +134,28 @@ pub(crate) fn actuation_unchecked(
     }
     // MuJoCo's mjWARN_BADCTRL (mj_fwdActuation): a control NaN, infinite or beyond ±MAX_CTRL
     // after its range clamp zeroes every control of this evaluation, with a warning.
-    let bad = (0..model.actuators.len()).find(|&i| is_bad(stage_ctrl(model, data, i)));
+    // The stage's controls, kept in `actuator_force` until each actuator's force replaces its own.
+    let mut bad = None;
+    for i in 0..model.actuators.len() {
+        let ctrl = stage_ctrl(model, data, i);
+        data.actuator_force[i] = ctrl;
+        if bad.is_none() && is_bad(ctrl) {
+            bad = Some(i);
+        }
+    }
     if let Some(i) = bad {
         data.warnings.bad_control(i);
     }
     let zeroed = bad.is_some();
     let mut act_adr = 0;
-    // Every moment row from zero (one contiguous fill, not a strided one per row).
-    data.actuator_moment.as_mut_slice().fill(0.0);
     for (i, a) in model.actuators.iter().enumerate() {
         let act_index = (a.actnum() == 1).then_some(act_adr);
         act_adr += a.actnum();
+        // The moment row from zero over the entries its transmission can write (`moment_span`:
+        // a joint actuator's dofs); nothing writes the rest, zero since `Data::new`.
+        for k in moment_span(model, a) {
+            data.actuator_moment[(i, k)] = 0.0;
+        }
         if unsimulated_reason(model, a).is_some() {
             data.actuator_length[i] = 0.0;
             data.actuator_velocity[i] = 0.0;
@@ -163,7 +174,7 @@ pub(crate) fn actuation_unchecked(
         }
         let actuator_moment = &data.actuator_moment;
         let velocity = moment_span(model, a).map(|k| actuator_moment[(i, k)] * v[k]).sum::<f64>();
-        let ctrl = if zeroed { 0.0 } else { stage_ctrl(model, data, i) };
+        let ctrl = if zeroed { 0.0 } else { data.actuator_force[i] };
         // The input of the gain: the control, or the activation (the next one with actearly).
         let input = match act_index {
             None => ctrl,

@@ -658,11 +658,11 @@ impl Data {
         if !matches!(kind, EfcType::ContactElliptic | EfcType::ContactPyramidal) {
             return 1;
         }
-        let mut k = i + 1;
-        while k < self.nefc && self.efc_type[k] == kind && self.efc_id[k] == self.efc_id[i] {
-            k += 1;
-        }
-        k - i
+        // The rows after i up to nefc, read as slices (no bounds check per row).
+        let id = self.efc_id[i];
+        let end = self.nefc.min(self.efc_type.len()).min(self.efc_id.len()).max(i + 1);
+        let (types, ids) = (&self.efc_type[i + 1..end], &self.efc_id[i + 1..end]);
+        1 + types.iter().zip(ids).take_while(|&(&t, &d)| t == kind && d == id).count()
     }
 }
 

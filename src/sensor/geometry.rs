@@ -1,8 +1,6 @@
 //! The sensors that ask a geometric question (MuJoCo's engine_sensor.c, through
 //! [`crate::collision`]'s ray casting, zone tests and geom distances):
 //!
-//! - `touch` (acceleration stage): the sum of the normal forces of the contacts on the site's body
-//!   whose normal ray, cast from the contact point, meets the site's zone (any contact inside it);
 //! - `rangefinder` on a site (position stage): the distance along the site's z axis to the nearest
 //!   geom not on the site's body (−1 when nothing is hit), with the `data` fields dist, dir,
 //!   origin, point, normal and depth;
@@ -16,8 +14,7 @@ use super::types::{Sensor, SensorObject, SensorType, RAY_FIELDS};
 use super::SensorWork;
 use crate::collision::geom_distance::geom_distance_unchecked;
 use crate::collision::inside::inside_primitive;
-use crate::collision::ray::{ray_primitive, ray_unchecked, RayFilter};
-use crate::constraint::contact_force::contact_force;
+use crate::collision::ray::{ray_unchecked, RayFilter};
 use crate::model::{Data, Model};
 use crate::spatial::Vec3;
 
@@ -28,34 +25,6 @@ const MINVAL: f64 = 1e-15;
 /// primitive shape).
 pub(crate) fn inside_site_zone(model: &Model, data: &Data, f: usize, p: &Vec3) -> bool {
     model.frames[f].site.is_some_and(|shape| inside_primitive(&data.x_world_frame[f], &shape, p))
-}
-
-/// The touch sensor of site frame `f`.
-fn touch(model: &Model, data: &Data, f: usize) -> f64 {
-    let Some(shape) = model.frames[f].site else { return 0.0 };
-    let body = model.links.of_frame[f];
-    let x_site = &data.x_world_frame[f];
-    let mut total = 0.0;
-    for (c, contact) in data.contacts.iter().enumerate() {
-        let bodies = contact.geom.map(|g| model.links.of_geom[g]);
-        if body != bodies[0] && body != bodies[1] {
-            continue;
-        }
-        let normal_force = contact_force(model, data, c).map_or(0.0, |w| w[0]);
-        if normal_force <= 0.0 {
-            continue;
-        }
-        // The normal's direction, pointing into the sensor's body.
-        let mut ray = contact.frame.row(0).transpose();
-        ray /= ray.norm().max(MINVAL);
-        if body == bodies[1] {
-            ray = -ray;
-        }
-        if ray_primitive(x_site, &shape, &contact.pos, &ray).is_some() {
-            total += normal_force;
-        }
-    }
-    total
 }
 
 /// The site rangefinder of frame `f` into `out` (its `data` fields in MuJoCo's order).
@@ -98,7 +67,6 @@ fn geoms_of(model: &Model, obj: SensorObject) -> impl Iterator<Item = usize> + '
 /// Writes the geometric sensor `s` into `out`.
 pub(crate) fn compute(model: &Model, data: &Data, work: &SensorWork, s: &Sensor, out: &mut [f64]) {
     match (s.kind, s.object) {
-        (SensorType::Touch, SensorObject::Site(f)) => out[0] = touch(model, data, f),
         (SensorType::Rangefinder, SensorObject::Site(f)) => rangefinder(model, data, s, f, out),
         (SensorType::InsideSite, obj) => {
             let SensorObject::Site(site) = s.reference else { return };

@@ -22,6 +22,7 @@ mod geometry;
 pub(crate) mod objects;
 mod position;
 mod subtree;
+mod touch;
 mod types;
 mod velocity;
 
@@ -30,7 +31,7 @@ pub use types::{
     RAY_FIELDS,
 };
 
-use crate::kinematics::{forward_kinematics_unchecked, forward_velocities_unchecked};
+use crate::kinematics::{forward_kinematics_sensed_unchecked, forward_velocities_unchecked};
 use crate::model::{Data, Model};
 use objects::Quat;
 use subtree::Subtree;
@@ -99,6 +100,8 @@ pub(crate) struct SensorWork {
     pub time: f64,
     /// The contact sensor's matches.
     pub matches: Vec<contact_sensor::Match>,
+    /// The touch sensors, formed together in one pass over the contacts.
+    pub touch: touch::TouchSites,
 }
 
 impl SensorWork {
@@ -115,6 +118,7 @@ impl SensorWork {
             } else {
                 0
             }),
+            touch: touch::TouchSites::new(model),
         }
     }
 }
@@ -141,8 +145,10 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
     if !needs.any || data.forward_skip.sensors {
         return;
     }
-    forward_kinematics_unchecked(model, data, q);
-    if needs.velocities {
+    // The link and site frames (the joint-anchor frames no sensor reads are left as they were).
+    forward_kinematics_sensed_unchecked(model, data, q);
+    // Body velocities: for the velocity sensors, and the accelerations' velocity terms.
+    if needs.velocities || needs.rne_post {
         forward_velocities_unchecked(model, data, v);
     }
     let mut work = std::mem::take(&mut data.sensor_work);
@@ -158,7 +164,22 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
         subtree::subtree_velocities(model, data, &mut work.subtree, needs.subtree_angmom);
     }
     if needs.rne_post {
-        crate::dynamics::rne_post::rne_post_constraint_at(model, data, q, v, needs.rne_post_wrenches);
+        // The subtree centres of mass, when the subtree sensors formed them, are rne_post's too.
+        let subtree = &work.subtree;
+        let centres = needs.subtree_com.then_some((
+            subtree.xipos.as_slice(),
+            subtree.mass.as_slice(),
+            subtree.com.as_slice(),
+        ));
+        crate::dynamics::rne_post::rne_post_constraint_at(
+            model,
+            data,
+            q,
+            v,
+            needs.rne_post_wrenches,
+            true,
+            centres,
+        );
     }
     if needs.kinetic {
         let bodies: f64 =
@@ -166,6 +187,7 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
         let armature: f64 = model.dof_armature.iter().zip(v).map(|(a, vi)| 0.5 * a * vi * vi).sum();
         work.kinetic = bodies + armature;
     }
+    touch::touch_all(model, data, &work.touch, sensordata.as_mut_slice());
     let inside_site = |f: usize, p: &crate::spatial::Vec3| geometry::inside_site_zone(model, data, f, p);
     for s in model.sensors.iter().filter(|s| s.is_computed()) {
         let out = &mut sensordata.as_mut_slice()[s.adr..s.adr + s.dim];
@@ -173,6 +195,8 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
             (_, Some(spec)) => {
                 contact_sensor::compute(model, data, s, &spec, &inside_site, &mut work.matches, out)
             }
+            // Formed above, all together.
+            _ if touch::is_touch_site(s) => {}
             _ if matches!(
                 s.kind,
                 SensorType::Touch
