@@ -57,43 +57,44 @@ struct Vertex {
     lines: u32,
 }
 
-/// Clips `poly` against the half-plane sign · v[coord] ≤ limit (side plane `plane`) into `out`;
-/// the clipped polygon's vertex count, or None (`out` untouched) when every vertex is inside.
+/// Clips `poly[..n]` against the half-plane sign · v[coord] ≤ limit (side plane `plane`), into
+/// `spare`, and swaps the two; left as it is when every vertex is inside. Returns the new count.
 fn clip(
-    poly: &[Vertex],
-    out: &mut [Vertex; MAX_VERTICES],
+    poly: &mut [Vertex; MAX_VERTICES],
+    spare: &mut [Vertex; MAX_VERTICES],
+    n: usize,
     coord: usize,
     sign: f64,
     limit: f64,
     plane: u32,
-) -> Option<usize> {
-    let n = poly.len().min(MAX_VERTICES);
+) -> usize {
     let mut d = [0.0; MAX_VERTICES];
     for k in 0..n {
         d[k] = sign * poly[k].p[coord] - limit;
     }
     if d[..n].iter().all(|&x| x <= 0.0) {
-        return None;
+        return n;
     }
     let mut m = 0;
     for k in 0..n {
         let k1 = if k + 1 == n { 0 } else { k + 1 };
         let (dp, dq) = (d[k], d[k1]);
         if dp <= 0.0 && m < MAX_VERTICES {
-            out[m] = poly[k];
+            spare[m] = poly[k];
             m += 1;
         }
         if ((dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0)) && m < MAX_VERTICES {
             let (p, q) = (poly[k].p, poly[k1].p);
             let t = dp / (dp - dq);
-            out[m] = Vertex {
+            spare[m] = Vertex {
                 p: [0, 1, 2].map(|r| p[r] + t * (q[r] - p[r])),
                 lines: (poly[k].lines & poly[k1].lines) | (1 << (4 + plane)),
             };
             m += 1;
         }
     }
-    Some(m)
+    std::mem::swap(poly, spare);
+    m
 }
 
 /// Boxes at poses `x1`, `x2` with half-extents `h1`, `h2`: the contacts no farther apart than
@@ -323,27 +324,20 @@ fn face_face(
     centre[2] = side * centre[2] - href[a];
     du[2] *= side;
     dv[2] *= side;
-    // The polygon is `bufs[cur][..n]`; each clip writes the other buffer (no copy back).
-    let mut bufs = [[Vertex::default(); MAX_VERTICES]; 2];
-    let mut cur = 0;
+    let mut poly = [Vertex::default(); MAX_VERTICES];
+    let mut spare = [Vertex::default(); MAX_VERTICES];
     // Corners in cyclic order; edge k joins corner k to corner k + 1.
     for (k, (su, sv)) in [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)].into_iter().enumerate() {
-        bufs[0][k] = Vertex {
+        poly[k] = Vertex {
             p: [0, 1, 2].map(|r| centre[r] + su * du[r] + sv * dv[r]),
             lines: (1 << k) | (1 << ((k + 3) % 4)),
         };
     }
     let mut n = 4;
-    for (coord, sign, limit, plane) in
-        [(0, 1.0, href[ax], 0), (0, -1.0, href[ax], 1), (1, 1.0, href[ay], 2), (1, -1.0, href[ay], 3)]
-    {
-        let [b0, b1] = &mut bufs;
-        let (src, dst) = if cur == 0 { (b0, b1) } else { (b1, b0) };
-        if let Some(m) = clip(&src[..n], dst, coord, sign, limit, plane) {
-            (n, cur) = (m, 1 - cur);
-        }
-    }
-    let poly = &bufs[cur];
+    n = clip(&mut poly, &mut spare, n, 0, 1.0, href[ax], 0);
+    n = clip(&mut poly, &mut spare, n, 0, -1.0, href[ax], 1);
+    n = clip(&mut poly, &mut spare, n, 1, 1.0, href[ay], 2);
+    n = clip(&mut poly, &mut spare, n, 1, -1.0, href[ay], 3);
 
     let normal = xref.rot.column(a) * if ref1 { side } else { -side };
     let face = ((code as u32) << 8)
