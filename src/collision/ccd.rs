@@ -62,6 +62,7 @@ impl<'a> CcdObj<'a> {
     }
 
     /// The support point along unit world direction `dir` (no margin).
+    #[inline(always)]
     fn support(&mut self, dir: &Vec3) -> Vec3 {
         let (rot, pos) = (&self.x.rot, &self.x.pos);
         match self.core {
@@ -132,19 +133,7 @@ impl<'a> CcdObj<'a> {
                 // MuJoCo climbs meshes of at least HILLCLIMB_MIN vertices (all of the mesh's,
                 // `mesh_vertnum`), and scans the others in their vertex-list order.
                 let i = if h.graph().nvert < HILLCLIMB_MIN {
-                    // Exhaustive, from the cached vertex (ties keep the earlier best).
-                    let (mut imax, mut max) = (0usize, f32::MIN as f64);
-                    if self.vertindex >= 0 {
-                        imax = self.vertindex as usize;
-                        max = d.dot(points[imax]);
-                    }
-                    for &i in h.scan_order() {
-                        let v = d.dot(points[i as usize]);
-                        if v > max {
-                            (max, imax) = (v, i as usize);
-                        }
-                    }
-                    imax
+                    h.support_index_scan(d, self.vertindex)
                 } else {
                     let i = h.support_index_warm(d, self.meshindex);
                     self.meshindex = i as i32;
@@ -201,6 +190,7 @@ fn det3(a: &Vec3, b: &Vec3, c: &Vec3) -> f64 {
     a.x * (b.y * c.z - b.z * c.y) + a.y * (b.z * c.x - b.x * c.z) + a.z * (b.x * c.y - b.y * c.x)
 }
 
+#[inline]
 fn lincomb(coef: &[f64], v: [&Vec3; 4]) -> Vec3 {
     let mut r = Vec3::zeros();
     for k in 0..3 {
@@ -350,12 +340,12 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
 
 /// The unit normal of face (v1, v2, v3) and the origin's signed distance along it (MAX when
 /// the face is degenerate).
-fn signed_distance(v1: &Vertex, v2: &Vertex, v3: &Vertex) -> (Vec3, f64) {
-    let normal = (v3.vert - v1.vert).cross(&(v2.vert - v1.vert));
+fn signed_distance(v1: &Vec3, v2: &Vec3, v3: &Vec3) -> (Vec3, f64) {
+    let normal = (v3 - v1).cross(&(v2 - v1));
     let norm2 = normal.dot(&normal);
     if norm2 > MINVAL * MINVAL && norm2 < MAXVAL * MAXVAL {
         let n = normal * (1.0 / norm2.sqrt());
-        return (n, n.dot(&v1.vert));
+        return (n, n.dot(v1));
     }
     (normal, MAX_LIMIT)
 }
@@ -364,14 +354,16 @@ fn signed_distance(v1: &Vertex, v2: &Vertex, v3: &Vertex) -> (Vec3, f64) {
 /// outside the difference, −1 if inconclusive (MuJoCo's `gjkIntersect`).
 fn gjk_intersect(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) -> i32 {
     let mut simplex = st.simplex;
+    // The simplex's order: entries are 0..4 (`& 3` below only tells the compiler so).
     let mut s = [0usize, 1, 2, 3];
     let mut k = st.gjk_iterations;
     while k < st.max_iterations {
+        let v = s.map(|i| simplex[i & 3].vert);
         let f = [
-            signed_distance(&simplex[s[2]], &simplex[s[1]], &simplex[s[3]]),
-            signed_distance(&simplex[s[0]], &simplex[s[2]], &simplex[s[3]]),
-            signed_distance(&simplex[s[1]], &simplex[s[0]], &simplex[s[3]]),
-            signed_distance(&simplex[s[0]], &simplex[s[1]], &simplex[s[2]]),
+            signed_distance(&v[2], &v[1], &v[3]),
+            signed_distance(&v[0], &v[2], &v[3]),
+            signed_distance(&v[1], &v[0], &v[3]),
+            signed_distance(&v[0], &v[1], &v[2]),
         ];
         if f.iter().any(|(_, d)| *d == 0.0) {
             st.gjk_iterations = k;
@@ -382,13 +374,14 @@ fn gjk_intersect(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) -> i32 {
         let index = if f[i].1 < f[j].1 { i } else { j };
         if f[index].1 > 0.0 {
             st.nsimplex = 4;
-            st.simplex = [simplex[s[0]], simplex[s[1]], simplex[s[2]], simplex[s[3]]];
+            st.simplex = s.map(|i| simplex[i & 3]);
             st.gjk_iterations = k;
             return 1;
         }
         let dir = f[index].0;
-        simplex[s[index]] = support(o1, o2, &dir, &-dir);
-        let reach = dir.dot(&simplex[s[index]].vert);
+        let w = support(o1, o2, &dir, &-dir);
+        simplex[s[index] & 3] = w;
+        let reach = dir.dot(&w.vert);
         if reach < 0.0 {
             st.nsimplex = 0;
             st.gjk_iterations = k;
@@ -623,6 +616,7 @@ impl Polytope {
     }
 
     /// Appends face (v1, v2, v3) with its adjacency; returns its squared distance (0: degenerate).
+    #[inline(always)]
     fn attach(&mut self, v1: usize, v2: usize, v3: usize, a1: usize, a2: usize, a3: usize) -> f64 {
         let mut face =
             Face { verts: [v1, v2, v3], adj: [a1, a2, a3], v: Vec3::zeros(), dist2: 0.0, index: -1 };

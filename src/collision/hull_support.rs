@@ -25,6 +25,9 @@ pub struct HullSupport {
     /// The hull vertices in the order of the mesh's vertex list (ascending `globalid`): the order
     /// MuJoCo's exhaustive support (`mjc_meshSupport`) scans them in, which decides ties.
     scan_order: Vec<u32>,
+    /// The hull's vertices in `scan_order` (`scan_points[k]` is `points[scan_order[k]]`): the
+    /// exhaustive scan reads them in a row, without an index per vertex.
+    scan_points: Vec<Vector>,
     /// Whether the hull has vertices and every edge of the graph joins two of them (`adj_start`
     /// ascending within `adj`, every entry of `adj` below the vertex count), checked once here:
     /// the climb then reads the vertices and edges without bounds checks (a quarter of its cost).
@@ -43,13 +46,14 @@ impl HullSupport {
         }
         let mut scan_order: Vec<u32> = (0..points.len() as u32).collect();
         scan_order.sort_by_key(|&i| graph.globalid[i as usize]);
+        let scan_points = scan_order.iter().map(|&i| points[i as usize]).collect();
         let n = points.len();
         let valid_graph = n > 0
             && graph.adj_start.len() == n + 1
             && graph.adj_start.windows(2).all(|w| w[0] <= w[1])
             && graph.adj_start[n] as usize <= graph.adj.len()
             && graph.adj.iter().all(|&j| (j as usize) < n);
-        Self { graph, points, extrema, scan_order, valid_graph }
+        Self { graph, points, extrema, scan_order, scan_points, valid_graph }
     }
 
     /// The hull's graph and face polygons.
@@ -65,6 +69,31 @@ impl HullSupport {
     /// The hull vertices in the mesh's vertex-list order (see the field).
     pub fn scan_order(&self) -> &[u32] {
         &self.scan_order
+    }
+
+    /// The index (in [`Self::points`]) of the vertex farthest along `dir` by MuJoCo's exhaustive
+    /// scan (`mjc_meshSupport`, for meshes too small to climb): from `cached` (the previous answer
+    /// of the same query sequence, −1 or out of range: none, the scan then starting below every
+    /// vertex at `f32::MIN`), every vertex in [`Self::scan_order`], a later one taken only when
+    /// strictly farther (ties keep the earlier best).
+    pub fn support_index_scan(&self, dir: Vector, cached: i32) -> usize {
+        let (mut imax, mut max) = (0usize, f32::MIN as f64);
+        if let Some(c) = usize::try_from(cached).ok().filter(|&c| c < self.points.len()) {
+            imax = c;
+            max = dir.dot(self.points[c]);
+        }
+        // The position in the scan of the best vertex so far (MAX: the start still is).
+        let mut kmax = usize::MAX;
+        for (k, p) in self.scan_points.iter().enumerate() {
+            let v = dir.dot(*p);
+            if v > max {
+                (max, kmax) = (v, k);
+            }
+        }
+        match self.scan_order.get(kmax) {
+            Some(&i) => i as usize,
+            None => imax,
+        }
     }
 
     /// The neighbours of vertex `v` along the hull's edges.

@@ -156,9 +156,15 @@ impl WorldBox {
                 let ra = a[i1] * abs[i2][j] + a[i2] * abs[i1][j];
                 let rb = b[j1] * abs[i][j2] + b[j2] * abs[i][j1];
                 let tl = t[i2] * r[i1][j] - t[i1] * r[i2][j];
-                let length = (1.0 - r[i][j] * r[i][j]).max(0.0).sqrt();
-                if tl.abs() > ra + rb + margin * length + PARALLEL_EPS {
-                    return true;
+                // The margin term is ≥ 0 (for a margin ≥ 0) and rounding is monotone, so the axis
+                // can separate only when |tl| exceeds ra + rb + ε: the length's square root is
+                // taken for those axes alone, the test itself unchanged.
+                let bound = ra + rb;
+                if margin < 0.0 || tl.abs() > bound + PARALLEL_EPS {
+                    let length = (1.0 - r[i][j] * r[i][j]).max(0.0).sqrt();
+                    if tl.abs() > bound + margin * length + PARALLEL_EPS {
+                        return true;
+                    }
                 }
             }
         }
