@@ -588,7 +588,7 @@ fn narrow_phase(model: &Model, cm: &CollisionModel, data: &mut Data, idx: usize,
         }
         _ => None,
     };
-    if let Some(p) = point {
+    if let Some((p, _face)) = point {
         if let (true, Some(s1), Some(s2)) = (pair.max_contacts > 1, &cm.shapes[g1], &cm.shapes[g2]) {
             // Feature ids: the order of the points (distinct within the pair).
             let mut k = 0;
