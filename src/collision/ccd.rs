@@ -1072,6 +1072,9 @@ fn penetration_with(
     o1.prism = prism1;
     let mut o2 = CcdObj::new(s2, x2, margin);
     let mut st = Status::start(x1, x2, tolerance, iterations);
+    // GJK starts from MuJoCo's geom centres (`mjc_center`).
+    let start = (if prism1.is_some() { x1.pos } else { centre(s1, x1) }, centre(s2, x2));
+    (st.x1, st.x2) = start;
     let core = |s: &ConvexShape| match s {
         ConvexShape::Ball(b) => Some((Core::Point, b.radius)),
         ConvexShape::Capsule(c) => Some((Core::Line, c.radius)),
@@ -1107,8 +1110,7 @@ fn penetration_with(
             return Some(contact(&st, margin, None));
         }
         st.gjk_iterations = 0;
-        st.x1 = x1.pos;
-        st.x2 = x2.pos;
+        (st.x1, st.x2) = start;
     }
     gjk(&mut st, &mut o1, &mut o2);
     if !(st.dist <= tolerance && st.nsimplex > 1 && !st.separated) {
