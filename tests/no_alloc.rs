@@ -101,13 +101,16 @@ fn kernels_and_integrators_do_not_allocate() {
 
 /// Contact scenes: the collision pass, the contact rows, the Gauss–Seidel Coulomb solve, the frozen
 /// rows of a step and the projections allocate nothing either (a box resting on an incline with
-/// four sticking corners; go1 standing on its floor from its home keyframe).
+/// four sticking corners; go1 standing on its floor from its home keyframe; convex meshes resting
+/// on a table box and on each other, the multi-point contacts of box–mesh and mesh–mesh pairs).
 #[test]
 fn contact_scenes_do_not_allocate() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for (file, keyframe) in
-        [("models/textbook/incline_box.xml", None), ("models/mjcf/unitree_go1/scene.xml", Some("home"))]
-    {
+    for (file, keyframe) in [
+        ("models/textbook/incline_box.xml", None),
+        ("models/mjcf/unitree_go1/scene.xml", Some("home")),
+        ("validation/scenes/mesh_pile.xml", None),
+    ] {
         let model = load(&root.join(file), &LoadOptions::default()).unwrap();
         let _data = Data::new(&model);
         let q = match keyframe {

@@ -8,9 +8,10 @@
 //! the pair's margin (MuJoCo's `support`); spheres and capsules are first shrunk to their centre
 //! and segment (a shallow contact is then the distance of the cores less the radii).
 //!
-//! The result is the EPA face's witness points, normal and distance ([`super::multiccd`] finds
-//! the other points of a multi-point contact from that normal). No allocation once the thread's
-//! workspace has grown.
+//! The result is the EPA face's witness points, normal and distance, and the face's three
+//! polytope vertices as the geom features their support points came from ([`EpaFace`]: from
+//! which [`super::multiccd`] finds the other points of a multi-point contact, as MuJoCo's
+//! `multicontact` does). No allocation once the thread's workspace has grown.
 
 use super::convex::ConvexShape;
 use crate::spatial::{Transform, Vec3};
@@ -895,6 +896,12 @@ impl Polytope {
         face
     }
 
+    /// The geom features of face `f`'s vertices.
+    fn face_features(&self, f: usize) -> EpaFace {
+        let v = self.faces[f].verts.map(|i| &self.verts[i]);
+        EpaFace { index1: v.map(|x| x.index1), index2: v.map(|x| x.index2) }
+    }
+
     /// The witness points of face `f` and its signed distance (MuJoCo's `epaWitness`).
     fn witness(&self, f: usize) -> (Vec3, Vec3, f64) {
         let face = &self.faces[f];
@@ -980,6 +987,18 @@ fn tri_point_intersect(v1: &Vec3, v2: &Vec3, v3: &Vec3, p: &Vec3) -> bool {
     (pr - p).norm() < MINVAL
 }
 
+/// The face EPA ended on, by where its three vertices' support points lie on each geom: per
+/// vertex (the face's order), the box corner (bit 0 +x, bit 1 +y, bit 2 +z) or hull vertex
+/// index on geom 1 (`index1`) and geom 2 (`index2`), −1 on a curved geom (MuJoCo's
+/// `Vertex.index1`, `index2`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct EpaFace {
+    /// Geom 1's feature index of each face vertex.
+    pub index1: [i32; 3],
+    /// Geom 2's feature index of each face vertex.
+    pub index2: [i32; 3],
+}
+
 /// A contact from the solver: the witness points (of the geoms inflated by half the margin
 /// each; their midpoint is the contact position), the unit normal from geom 1 to geom 2, the
 /// contact distance (the margin plus the inflated geoms' signed distance).
@@ -993,6 +1012,9 @@ pub(crate) struct CcdContact {
     pub normal: Vec3,
     /// Contact distance (m).
     pub dist: f64,
+    /// The EPA face the contact comes from (None: a shallow contact of a sphere's or capsule's
+    /// core, found by GJK alone).
+    pub face: Option<EpaFace>,
 }
 
 /// MuJoCo's `mjc_penetration` with one contact: the penetration of the two geoms inflated by
@@ -1044,6 +1066,9 @@ fn penetration_with(
     o1.prism = prism1;
     let mut o2 = CcdObj::new(s2, x2, margin);
     let mut st = Status::start(x1, x2, tolerance, iterations);
+    // GJK starts from MuJoCo's geom centres (`mjc_center`).
+    let start = (if prism1.is_some() { x1.pos } else { centre(s1, x1) }, centre(s2, x2));
+    (st.x1, st.x2) = start;
     let core = |s: &ConvexShape| match s {
         ConvexShape::Ball(b) => Some((Core::Point, b.radius)),
         ConvexShape::Capsule(c) => Some((Core::Line, c.radius)),
@@ -1076,11 +1101,10 @@ fn penetration_with(
             if st.dist > st.dist_cutoff || st.dist >= 0.0 {
                 return None;
             }
-            return Some(contact(&st, margin));
+            return Some(contact(&st, margin, None));
         }
         st.gjk_iterations = 0;
-        st.x1 = x1.pos;
-        st.x2 = x2.pos;
+        (st.x1, st.x2) = start;
     }
     gjk(&mut st, &mut o1, &mut o2);
     if !(st.dist <= tolerance && st.nsimplex > 1 && !st.separated) {
@@ -1102,7 +1126,7 @@ fn penetration_with(
         if st.dist >= 0.0 {
             return None;
         }
-        Some(contact(&st, margin))
+        Some(contact(&st, margin, Some(pt.face_features(f))))
     })
 }
 
@@ -1166,6 +1190,6 @@ fn centre(s: &ConvexShape, x: &Transform) -> Vec3 {
     }
 }
 
-fn contact(st: &Status, margin: f64) -> CcdContact {
-    CcdContact { x1: st.x1, x2: st.x2, normal: normalize3(&(st.x1 - st.x2)), dist: margin + st.dist }
+fn contact(st: &Status, margin: f64, face: Option<EpaFace>) -> CcdContact {
+    CcdContact { x1: st.x1, x2: st.x2, normal: normalize3(&(st.x1 - st.x2)), dist: margin + st.dist, face }
 }

@@ -217,11 +217,13 @@ pub fn mujoco_pair(
     touching: bool,
 ) -> Option<PairPoint> {
     mujoco_pair_warm(x1, s1, x2, s2, margin, options, touching, &mut super::ccd::SeparationWarm::none())
+        .map(|(p, _)| p)
 }
 
 /// [`mujoco_pair`] with the separation test started from `warm` and what it found written back
 /// (its last support vertices and separating direction, see [`super::ccd::separated`]): the
-/// collision pass keeps them per pair from one pass to the next.
+/// collision pass keeps them per pair from one pass to the next. With the point, the EPA face
+/// it comes from (None when the point is not EPA's: parry's, or a shallow sphere or capsule).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn mujoco_pair_warm(
     x1: &Transform,
@@ -232,7 +234,7 @@ pub(crate) fn mujoco_pair_warm(
     options: &crate::model::Options,
     touching: bool,
     warm: &mut super::ccd::SeparationWarm,
-) -> Option<PairPoint> {
+) -> Option<(PairPoint, Option<super::ccd::EpaFace>)> {
     let polytope = |s: &ConvexShape| matches!(s, ConvexShape::Cuboid(_) | ConvexShape::Hull(_));
     if polytope(s1) && polytope(s2) {
         // MuJoCo's GJK dismisses most candidate pairs after a few support points (a pair
@@ -257,7 +259,7 @@ pub(crate) fn mujoco_pair_warm(
         // margin-inflated geoms stops at ccd_tolerance, and 3 of the margin box–mesh cases of
         // tests/convex_mujoco.rs match MuJoCo's contacts only from parry's points.
         if margin > 0.0 {
-            return support_pair(x1, s1, x2, s2, margin);
+            return support_pair(x1, s1, x2, s2, margin).map(|p| (p, None));
         }
     }
     let c = super::ccd::penetration(
@@ -269,7 +271,7 @@ pub(crate) fn mujoco_pair_warm(
         options.ccd_tolerance,
         options.ccd_iterations as usize,
     )?;
-    Some(PairPoint { p1: c.x1, p2: c.x2, normal: c.normal, dist: c.dist })
+    Some((PairPoint { p1: c.x1, p2: c.x2, normal: c.normal, dist: c.dist }, c.face))
 }
 
 /// The signed distance of two support-map shapes to f64 round-off, if closer than `reach`: when

@@ -38,6 +38,7 @@ pub mod broadphase;
 pub mod capsule;
 mod ccd;
 pub mod convex;
+mod epa_face;
 mod frame;
 pub mod geom_distance;
 mod gjk;
@@ -588,7 +589,7 @@ fn narrow_phase(model: &Model, cm: &CollisionModel, data: &mut Data, idx: usize,
         }
         _ => None,
     };
-    if let Some(p) = point {
+    if let Some((p, face)) = point {
         if let (true, Some(s1), Some(s2)) = (pair.max_contacts > 1, &cm.shapes[g1], &cm.shapes[g2]) {
             // Feature ids: the order of the points (distinct within the pair).
             let mut k = 0;
@@ -596,7 +597,7 @@ fn narrow_phase(model: &Model, cm: &CollisionModel, data: &mut Data, idx: usize,
                 push(q.p1, q.p2, q.normal, q.dist, None, k);
                 k += 1;
             };
-            multiccd::convex_contacts(&x1, s1, &x2, s2, p, pair.margin + pair.gap, &mut out);
+            multiccd::convex_contacts(&x1, s1, &x2, s2, p, face.as_ref(), pair.margin + pair.gap, &mut out);
             return;
         }
         push(p.p1, p.p2, p.normal, p.dist, None, 0);

@@ -11,15 +11,16 @@
 //! half the pair's margin + gap) and then, with `multiccd` on:
 //!
 //! - **box and mesh against box and mesh** (`mj_maxContact` 4, 5 with a margin): the polytope
-//!   path. From EPA's penetration direction MuJoCo finds the faces of both
-//!   geoms at their contact features; two faces within ~5.1° of opposite (normals' dot below
-//!   −0.996) clip one another: the face of geom 1 clips geom 2's face polygon (Sutherland–
-//!   Hodgman), the clipped vertices farther than the margin + gap above geom 1's face plane are
-//!   dropped (MuJoCo 4.0 clips margin pairs too; its older source turned them), more than four are
-//!   pruned to a quadrilateral of largest area. Failing that, an edge of the lower-dimensional
-//!   feature within ~5.1° of parallel to a face of the other (|dot| below 0.0888) is clipped
-//!   against that face (its two farthest points). Otherwise the single EPA point stays. Each point
-//!   has its own depth (below the clipping face), its normal along the clipped face's normal.
+//!   path. MuJoCo reads each geom's contact feature (vertex, edge or face) off the face EPA ends
+//!   on and gathers the faces around it ([`super::epa_face`]); two faces within ~5.1° of opposite
+//!   (normals' dot below −0.996) clip one another: the face of geom 1 clips geom 2's face polygon
+//!   (Sutherland–Hodgman), the clipped vertices farther than the margin + gap above geom 1's face
+//!   plane are dropped (MuJoCo 4.0 clips margin pairs too; its older source turned them), more
+//!   than four are pruned to a quadrilateral. Failing that, an edge of the lower-dimensional
+//!   feature (then one of geom 2's) within ~5.1° of parallel to a face of the other (|dot| below
+//!   0.0888) is clipped against that face (its two farthest points). Otherwise the single EPA
+//!   point stays. Each point has its own depth (below the clipping face), its normal along the
+//!   clipped face's normal.
 //! - **a capsule or a cylinder against a box or a mesh** (`mj_maxContact` 5): MuJoCo's source
 //!   snapshot turns both geoms by ±1e-3 rad about the contact's tangents and reruns the solver;
 //!   the live 4.0.0 does not (its contacts show it): a capsule's segment, or a cylinder's side
@@ -32,22 +33,26 @@
 //!   measured (lagrange gives one).
 //! - **a sphere or an ellipsoid**: one contact.
 //!
-//! With `multiccd` off every convex pair gives one contact. lagrange reproduces these on its own
-//! GJK/EPA ([`super::convex`]): the contact features are the vertices of each geom within a small
-//! tolerance of its support plane along the EPA normal (MuJoCo reads them off EPA's final face),
-//! and when several face pairs are within the tolerance the most nearly opposite is taken (MuJoCo
-//! takes the first in its polygon order). The witness points follow the live 4.0.0, not the
-//! snapshot (see [`polytope_contacts`]' clipping).
+//! With `multiccd` off every convex pair gives one contact. lagrange reproduces these on its port
+//! of MuJoCo's GJK/EPA ([`super::ccd`]), the features read off its final face as MuJoCo does
+//! ([`super::epa_face`], where the live 4.0.0's choice among aligned features is set out: it
+//! differs from the source snapshot). Box and mesh pairs with a margin take their first point
+//! from parry instead ([`super::convex::mujoco_pair`]), with no EPA face: their features are the
+//! vertices of each geom within a small tolerance of its support plane along the contact normal
+//! ([`support_plane_features`]). The witness points follow the live 4.0.0, not the snapshot (see
+//! [`polytope_contacts`]' clipping).
 
+use super::ccd::EpaFace;
 use super::convex::{ConvexShape, PairPoint};
+use super::epa_face::Feature;
 use crate::spatial::{Transform, Vec3};
 use parry3d_f64::math::Vector;
 use std::cell::RefCell;
 
 /// Cosine above which two face normals count as opposite (MuJoCo's `mjFACE_TOL`, ~5.1°).
-const FACE_TOL: f64 = 0.996;
+pub(crate) const FACE_TOL: f64 = 0.996;
 /// |cosine| below which an edge counts as parallel to a face (MuJoCo's `mjEDGE_TOL`, ~5.1°).
-const EDGE_TOL: f64 = 0.0888;
+pub(crate) const EDGE_TOL: f64 = 0.0888;
 
 /// Scratch buffers of the clipping, reused per thread (no allocation once grown).
 #[derive(Default)]
@@ -62,6 +67,7 @@ struct Scratch {
     feature2: Vec<u32>,
     tmp: Vec<u32>,
     faces: Vec<u32>,
+    epa: super::epa_face::FaceScratch,
 }
 
 thread_local! {
@@ -69,7 +75,7 @@ thread_local! {
 }
 
 /// A polytope geom: a box (half-extents) or a mesh's hull.
-enum Poly<'a> {
+pub(crate) enum Poly<'a> {
     Cuboid(Vec3),
     Hull(&'a super::hull_support::HullSupport),
 }
@@ -86,15 +92,25 @@ impl<'a> Poly<'a> {
         }
     }
 
-    fn nvert(&self) -> usize {
+    /// The number of vertices.
+    pub(crate) fn nvert(&self) -> usize {
         match self {
             Poly::Cuboid(_) => 8,
             Poly::Hull(s) => s.points().len(),
         }
     }
 
+    /// Whether the geom has face polygons (a box always; a hull unless MuJoCo's polygon merge
+    /// left none).
+    pub(crate) fn has_faces(&self) -> bool {
+        match self {
+            Poly::Cuboid(_) => true,
+            Poly::Hull(s) => s.graph().npoly() > 0,
+        }
+    }
+
     /// Vertex `i` in the geom frame (box corner i: bit 0 +x, bit 1 +y, bit 2 +z).
-    fn vertex(&self, i: u32) -> Vec3 {
+    pub(crate) fn vertex(&self, i: u32) -> Vec3 {
         match self {
             Poly::Cuboid(h) => Vec3::new(
                 if i & 1 != 0 { h.x } else { -h.x },
@@ -260,15 +276,19 @@ fn feature_edges(
     }
 }
 
-/// The contacts of two polytopes (boxes, mesh hulls) from EPA's penetrating point `first`, by
-/// MuJoCo's face and edge clipping (module documentation); `emit` receives each (the single
-/// `first` when no faces or edges line up). Returns the number emitted.
-pub fn polytope_contacts(
+/// The contacts of two polytopes (boxes, mesh hulls) from the penetrating point `first`, by
+/// MuJoCo's face and edge clipping (module documentation): the features from EPA's final face
+/// `face` when the point is EPA's ([`super::epa_face`]), else from the support planes along its
+/// normal ([`support_plane_features`]); `emit` receives each (the single `first` when no faces
+/// or edges line up). Returns the number emitted.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn polytope_contacts(
     x1: &Transform,
     s1: &ConvexShape,
     x2: &Transform,
     s2: &ConvexShape,
     first: PairPoint,
+    face: Option<&EpaFace>,
     margin: f64,
     emit: &mut dyn FnMut(PairPoint),
 ) -> usize {
@@ -278,25 +298,12 @@ pub fn polytope_contacts(
     };
     SCRATCH.with(|s| {
         let s = &mut *s.borrow_mut();
-        let n = first.normal;
-        let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
-        let tol = 1e-9 * scale;
-        let mut tmp = std::mem::take(&mut s.tmp);
-        support_feature(&p1, x1, &n, tol, &mut s.feature1);
-        support_feature(&p2, x2, &-n, tol, &mut s.feature2);
-        feature_faces(&p1, x1, &s.feature1, &n, &mut s.faces, &mut s.normals1);
-        feature_faces(&p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
-        let (dim1, dim2) = (s.feature1.len().min(3), s.feature2.len().min(3));
-        // The most nearly opposite face pair within the tolerance.
-        let mut aligned: Option<(f64, usize, usize)> = None;
-        for (i, (a, _)) in s.normals1.iter().enumerate() {
-            for (j, (b, _)) in s.normals2.iter().enumerate() {
-                let c = a.dot(b);
-                if c < -FACE_TOL && aligned.is_none_or(|(best, ..)| c < best) {
-                    aligned = Some((c, i, j));
-                }
+        let chosen = match face {
+            Some(f) => {
+                super::epa_face::aligned_features(&p1, x1, &p2, x2, f, &first.p1, &first.p2, &mut s.epa)
             }
-        }
+            None => support_plane_features(&p1, x1, &p2, x2, &first, s),
+        };
         let mut count = 0;
         // The normal is the clipped face's reversed (face–face), the face's (an edge of geom 2)
         // or the face's reversed (an edge of geom 1): the direction from w1 to w2 of a penetrating
@@ -306,26 +313,29 @@ pub fn polytope_contacts(
             emit(PairPoint { p1: w1, p2: w2, normal, dist });
             count += 1;
         };
-        if let Some((_, i, j)) = aligned {
-            let (n1, f1) = s.normals1[i];
-            let (n2, f2) = s.normals2[j];
-            face_polygon(&p1, x1, f1, &mut tmp, &mut s.face1);
-            face_polygon(&p2, x2, f2, &mut tmp, &mut s.face2);
-            clip(&s.face1, &s.face2, &n1, &n2, margin, false, &mut s.poly, &mut s.clip, &mut |w1, w2, d| {
-                out(w1, w2, d, false, -n2)
-            });
-        } else if dim1 < 3 && dim1 <= dim2 {
-            // An edge of geom 1 against a face of geom 2.
-            feature_edges(&p1, x1, &s.feature1, &mut tmp, &mut s.faces, &mut s.face1);
-            if let Some((e, j)) = edge_face(&s.face1, &s.normals2) {
-                let (n2, f2) = s.normals2[j];
+        let mut tmp = std::mem::take(&mut s.tmp);
+        match chosen {
+            Some((Feature::Face { index: f1, normal: n1 }, Feature::Face { index: f2, normal: n2 })) => {
+                face_polygon(&p1, x1, f1, &mut tmp, &mut s.face1);
                 face_polygon(&p2, x2, f2, &mut tmp, &mut s.face2);
-                let edge = [s.face1[2 * e], s.face1[2 * e + 1]];
-                s.face1.clear();
-                s.face1.extend_from_slice(&edge);
+                clip(
+                    &s.face1,
+                    &s.face2,
+                    &n1,
+                    &n2,
+                    margin,
+                    false,
+                    &mut s.poly,
+                    &mut s.clip,
+                    &mut |w1, w2, d| out(w1, w2, d, false, -n2),
+                );
+            }
+            // An edge of geom 1 against a face of geom 2.
+            Some((Feature::Edge(edge), Feature::Face { index: f2, normal: n2 })) => {
+                face_polygon(&p2, x2, f2, &mut tmp, &mut s.face2);
                 clip(
                     &s.face2,
-                    &s.face1,
+                    &edge,
                     &n2,
                     &-n2,
                     margin,
@@ -335,18 +345,12 @@ pub fn polytope_contacts(
                     &mut |w1, w2, d| out(w1, w2, d, true, -n2),
                 );
             }
-        } else if dim2 < 3 {
             // An edge of geom 2 against a face of geom 1.
-            feature_edges(&p2, x2, &s.feature2, &mut tmp, &mut s.faces, &mut s.face2);
-            if let Some((e, i)) = edge_face(&s.face2, &s.normals1) {
-                let (n1, f1) = s.normals1[i];
+            Some((Feature::Face { index: f1, normal: n1 }, Feature::Edge(edge))) => {
                 face_polygon(&p1, x1, f1, &mut tmp, &mut s.face1);
-                let edge = [s.face2[2 * e], s.face2[2 * e + 1]];
-                s.face2.clear();
-                s.face2.extend_from_slice(&edge);
                 clip(
                     &s.face1,
-                    &s.face2,
+                    &edge,
                     &n1,
                     &-n1,
                     margin,
@@ -356,6 +360,7 @@ pub fn polytope_contacts(
                     &mut |w1, w2, d| out(w1, w2, d, false, n1),
                 );
             }
+            Some((Feature::Edge(_), Feature::Edge(_))) | None => {}
         }
         s.tmp = tmp;
         if count == 0 {
@@ -364,6 +369,53 @@ pub fn polytope_contacts(
         }
         count
     })
+}
+
+/// The features to clip when no EPA face is at hand (a pair with a margin, whose first point is
+/// parry's): the vertices of each geom within a small tolerance of its support plane along the
+/// normal of `first`, their faces and edges; the most nearly opposite face pair, else the edge of
+/// the lower-dimensional feature most nearly parallel to a face of the other.
+fn support_plane_features(
+    p1: &Poly,
+    x1: &Transform,
+    p2: &Poly,
+    x2: &Transform,
+    first: &PairPoint,
+    s: &mut Scratch,
+) -> Option<(Feature, Feature)> {
+    let n = first.normal;
+    let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
+    let tol = 1e-9 * scale;
+    support_feature(p1, x1, &n, tol, &mut s.feature1);
+    support_feature(p2, x2, &-n, tol, &mut s.feature2);
+    feature_faces(p1, x1, &s.feature1, &n, &mut s.faces, &mut s.normals1);
+    feature_faces(p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
+    let (dim1, dim2) = (s.feature1.len().min(3), s.feature2.len().min(3));
+    let face_of = |(normal, index): (Vec3, u32)| Feature::Face { index, normal };
+    // The most nearly opposite face pair within the tolerance.
+    let mut aligned: Option<(f64, usize, usize)> = None;
+    for (i, (a, _)) in s.normals1.iter().enumerate() {
+        for (j, (b, _)) in s.normals2.iter().enumerate() {
+            let c = a.dot(b);
+            if c < -FACE_TOL && aligned.is_none_or(|(best, ..)| c < best) {
+                aligned = Some((c, i, j));
+            }
+        }
+    }
+    if let Some((_, i, j)) = aligned {
+        return Some((face_of(s.normals1[i]), face_of(s.normals2[j])));
+    }
+    if dim1 < 3 && dim1 <= dim2 {
+        feature_edges(p1, x1, &s.feature1, &mut s.tmp, &mut s.faces, &mut s.face1);
+        let (e, j) = edge_face(&s.face1, &s.normals2)?;
+        Some((Feature::Edge([s.face1[2 * e], s.face1[2 * e + 1]]), face_of(s.normals2[j])))
+    } else if dim2 < 3 {
+        feature_edges(p2, x2, &s.feature2, &mut s.tmp, &mut s.faces, &mut s.face2);
+        let (e, i) = edge_face(&s.face2, &s.normals1)?;
+        Some((face_of(s.normals1[i]), Feature::Edge([s.face2[2 * e], s.face2[2 * e + 1]])))
+    } else {
+        None
+    }
 }
 
 /// The edge (index into `edges`' pairs) most nearly parallel to one of the faces (index into
@@ -520,19 +572,20 @@ fn largest_quad(p: &[Vec3]) -> [usize; 4] {
 /// ([`polytope_contacts`]), a capsule or a cylinder's side against a polytope face by segment
 /// clipping, a cylinder's cap against a polytope face as an octagon; `first` alone otherwise.
 #[allow(clippy::too_many_arguments)]
-pub fn convex_contacts(
+pub(crate) fn convex_contacts(
     x1: &Transform,
     s1: &ConvexShape,
     x2: &Transform,
     s2: &ConvexShape,
     first: PairPoint,
+    face: Option<&EpaFace>,
     margin_gap: f64,
     emit: &mut dyn FnMut(PairPoint),
 ) {
     let polytopes = Poly::of(s1).is_some() && Poly::of(s2).is_some();
     if polytopes {
         if first.dist < margin_gap {
-            polytope_contacts(x1, s1, x2, s2, first, margin_gap, emit);
+            polytope_contacts(x1, s1, x2, s2, first, face, margin_gap, emit);
         } else {
             emit(first);
         }

@@ -16,6 +16,10 @@
 //!   outside, walks from it to the two ends of the run — the other points are inside. Otherwise
 //!   (no such point outside, or a polygon not certified convex) every point is tested.
 //!
+//! Small clips (face sides × polygon points up to 64: box and mesh faces of a few vertices, most
+//! clips) run the passes as written, each point's side test shared by its two edges: there the
+//! savings above cost more in bookkeeping than they save.
+//!
 //! A pad's face of 76 vertices clipping a box face (the Robotiq 2F-85's finger on a block) cuts
 //! on most of its sides, each against a polygon of up to 76 points: the test of every point in
 //! every pass was half of that scene's collision pass.
@@ -84,6 +88,9 @@ fn strictly_convex_about(poly: &[Vec3], n: &Vec3) -> bool {
 /// ```
 pub fn clip_by_face_sides(face: &[Vec3], n: &Vec3, poly: &mut Vec<Vec3>, scratch: &mut ClipScratch) {
     let m = face.len();
+    if m * poly.len() <= SMALL {
+        return clip_small(face, n, poly, &mut scratch.next);
+    }
     let ClipScratch { next, flags } = scratch;
     // Whether the polygon is strictly convex, found when first needed (a clipped convex polygon
     // stays convex).
@@ -224,6 +231,51 @@ pub fn clip_by_face_sides(face: &[Vec3], n: &Vec3, poly: &mut Vec<Vec3>, scratch
     if !poly.is_empty() {
         let np = poly.len();
         poly.rotate_left(turns % np);
+    }
+}
+
+/// Face sides × polygon points up to which [`clip_by_face_sides`] runs the passes as written
+/// ([`clip_small`]): on a box face clipping a box face the run walk's bookkeeping costs more
+/// than the tests it saves.
+const SMALL: usize = 64;
+
+/// [`clip_by_face_sides`] pass by pass, every point through every side (each point's side test
+/// taken once per pass and shared by the two edges it ends): the same points in the same order.
+fn clip_small(face: &[Vec3], n: &Vec3, poly: &mut Vec<Vec3>, next: &mut Vec<Vec3>) {
+    let m = face.len();
+    for k in 0..m {
+        let np = poly.len();
+        if np == 0 {
+            return;
+        }
+        let (a, b) = (face[k], face[if k + 1 == m { 0 } else { k + 1 }]);
+        let pn = (b - a).cross(n).normalize();
+        let pd = pn.dot(&a);
+        let inside = |p: &Vec3| (p - a).dot(&pn) > -MINVAL;
+        next.clear();
+        let first_inside = inside(&poly[0]);
+        let mut ip = first_inside;
+        for i in 0..np {
+            let (p, q) = (poly[i], if i + 1 == np { poly[0] } else { poly[i + 1] });
+            let iq = if i + 1 == np { first_inside } else { inside(&q) };
+            if ip && iq {
+                next.push(q);
+            } else if ip || iq {
+                let pq = q - p;
+                let den = pn.dot(&pq);
+                if den != 0.0 {
+                    let t = (pd - pn.dot(&p)) / den;
+                    if (0.0..=1.0).contains(&t) {
+                        next.push(p + pq * t);
+                    }
+                }
+                if iq {
+                    next.push(q);
+                }
+            }
+            ip = iq;
+        }
+        std::mem::swap(poly, next);
     }
 }
 
