@@ -12,7 +12,7 @@
 //!
 //! - **box and mesh against box and mesh** (`mj_maxContact` 4, 5 with a margin): the polytope
 //!   path. MuJoCo reads each geom's contact feature (vertex, edge or face) off the face EPA ends
-//!   on and gathers the faces around it ([`super::epa_face`]); two faces within ~5.1° of opposite
+//!   on and gathers the faces around it (`collision/epa_face.rs`); two faces within ~5.1° of opposite
 //!   (normals' dot below −0.996) clip one another: the face of geom 1 clips geom 2's face polygon
 //!   (Sutherland–Hodgman), the clipped vertices farther than the margin + gap above geom 1's face
 //!   plane are dropped (MuJoCo 4.0 clips margin pairs too; its older source turned them), more
@@ -34,13 +34,13 @@
 //! - **a sphere or an ellipsoid**: one contact.
 //!
 //! With `multiccd` off every convex pair gives one contact. lagrange reproduces these on its port
-//! of MuJoCo's GJK/EPA ([`super::ccd`]), the features read off its final face as MuJoCo does
-//! ([`super::epa_face`], where the live 4.0.0's choice among aligned features is set out: it
+//! of MuJoCo's GJK/EPA (`collision/ccd.rs`), the features read off its final face as MuJoCo does
+//! (`collision/epa_face.rs`, where the live 4.0.0's choice among aligned features is set out: it
 //! differs from the source snapshot). Box and mesh pairs with a margin take their first point
 //! from parry instead ([`super::convex::mujoco_pair`]), with no EPA face: their features are the
 //! vertices of each geom within a small tolerance of its support plane along the contact normal
-//! ([`support_plane_features`]). The witness points follow the live 4.0.0, not the snapshot (see
-//! [`polytope_contacts`]' clipping).
+//! (`support_plane_features`). The witness points follow the live 4.0.0, not the snapshot (see
+//! `polytope_contacts`' clipping).
 
 use super::ccd::EpaFace;
 use super::convex::{ConvexShape, PairPoint};
@@ -278,8 +278,8 @@ fn feature_edges(
 
 /// The contacts of two polytopes (boxes, mesh hulls) from the penetrating point `first`, by
 /// MuJoCo's face and edge clipping (module documentation): the features from EPA's final face
-/// `face` when the point is EPA's ([`super::epa_face`]), else from the support planes along its
-/// normal ([`support_plane_features`]); `emit` receives each (the single `first` when no faces
+/// `face` when the point is EPA's (`collision/epa_face.rs`), else from the support planes along its
+/// normal (`support_plane_features`); `emit` receives each (the single `first` when no faces
 /// or edges line up). Returns the number emitted.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn polytope_contacts(

@@ -54,7 +54,8 @@ impl BlockLu {
         self.capacity = n;
     }
 
-    /// The largest system the buffers hold without growing.
+    /// The largest system the buffers hold without growing (for tests).
+    #[cfg(test)]
     pub fn capacity(&self) -> usize {
         self.capacity
     }
