@@ -19,6 +19,7 @@
 
 mod activation;
 mod actuation;
+mod actuator_layout;
 pub(crate) mod adhesion;
 pub mod history;
 pub mod muscle;
@@ -37,6 +38,7 @@ pub(crate) use actuation::{actuation_unchecked, add_actuator_length_derivative};
 pub(crate) use history::{record_controls, reset_actuator_buffers};
 
 pub use crate::constraint::DriftCorrection;
+pub use actuator_layout::{ActuatorEntry, ActuatorLayout};
 pub use plan::{Plan, Stage, StageKind, Status};
 pub(crate) use skip::{ForwardSkip, SkipStage};
 pub(crate) use xfrc::accumulate_xfrc;
