@@ -109,6 +109,7 @@ pub fn actuation(
     check::v("actuation", "v", model, v)?;
     InputError::check_len("actuation", "bias_velocity", bias_velocity.len(), model.actuators.len(), "nu")?;
     data.poses_stamp.clear();
+    data.velocity_stamp.clear();
     crate::tendon::compute(model, data, q, v);
     actuation_unchecked(model, data, q, v, bias_velocity);
     Ok(())

@@ -80,6 +80,7 @@ pub fn forward(model: &Model, data: &mut Data) {
 pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     // Every evaluation forms its body poses afresh, once (`Data::poses_stamp`).
     data.poses_stamp.clear();
+    data.velocity_stamp.clear();
     let plan = &model.plan;
     let (rows, solver) = (&plan.constraints, &plan.solver);
     // Tendon lengths, Jacobians and velocities first: limits, passive forces, actuators and
