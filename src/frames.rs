@@ -30,6 +30,7 @@ fn frame_index(model: &Model, function: &'static str, name: &str) -> Result<usiz
 fn kinematics_at_state(model: &Model, data: &mut Data, velocities: bool) {
     let q = std::mem::take(&mut data.qpos);
     data.poses_stamp.clear();
+    data.velocity_stamp.clear();
     forward_kinematics_unchecked(model, data, q.as_slice());
     data.qpos = q;
     if velocities {

@@ -221,6 +221,7 @@ pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) -> Result<(
     check::data("forward_kinematics", model, data)?;
     check::q("forward_kinematics", model, q)?;
     data.poses_stamp.clear();
+    data.velocity_stamp.clear();
     forward_kinematics_unchecked(model, data, q);
     Ok(())
 }
@@ -290,6 +291,7 @@ pub fn forward_velocities(model: &Model, data: &mut Data, v: &[f64]) -> Result<(
 
 /// [`forward_velocities`] without the argument checks.
 pub(crate) fn forward_velocities_unchecked(model: &Model, data: &mut Data, v: &[f64]) {
+    data.velocity_stamp.clear();
     data.v_body[0] = Motion::zero();
     for b in 1..model.nbody() {
         let p = model.bodies[b].parent;

@@ -428,6 +428,7 @@ impl Simulation {
     pub fn kinematics(&mut self) {
         let q = std::mem::take(&mut self.data.qpos);
         self.data.poses_stamp.clear();
+        self.data.velocity_stamp.clear();
         forward_kinematics_unchecked(&self.model, &mut self.data, q.as_slice());
         self.data.qpos = q;
     }

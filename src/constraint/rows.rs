@@ -351,6 +351,7 @@ impl ConstraintModel {
         check::data("ConstraintModel::collide", model, data)?;
         check::q("ConstraintModel::collide", model, q)?;
         data.poses_stamp.clear();
+        data.velocity_stamp.clear();
         Ok(self.collide_unchecked(model, data, q))
     }
 
@@ -564,6 +565,7 @@ impl ConstraintModel {
         check::q("ConstraintModel::evaluate", model, q)?;
         check::v("ConstraintModel::evaluate", "v", model, v)?;
         data.poses_stamp.clear();
+        data.velocity_stamp.clear();
         self.evaluate_unchecked(model, data, q, v);
         Ok(())
     }

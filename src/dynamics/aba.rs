@@ -119,6 +119,8 @@ fn aba_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], tau: &[f64])
         data.f_body[b] = v_body.cross_force(&inertia.mul_motion(&v_body));
         data.v_body[b] = v_body;
     }
+    // The body velocities at (q, v), as RNEA's and `forward_velocities`' (the same expression).
+    data.velocity_stamp.set(q, v);
     // Pass 2, leaves to root: U = Iᴬ S, D = Sᵀ U, u = τ − Sᵀ pᴬ; hand the articulated inertia
     // Iᵃ = Iᴬ − U D⁻¹ Uᵀ and bias pᵃ = pᴬ + Iᵃ c + U D⁻¹ u to the parent (RBDA eq. 7.42–7.43).
     for b in (1..nb).rev() {

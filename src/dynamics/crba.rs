@@ -48,6 +48,7 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMat
     check::data("crba", model, data)?;
     check::q("crba", model, q)?;
     data.poses_stamp.clear();
+    data.velocity_stamp.clear();
     Ok(crba_unchecked(model, data, q))
 }
 
@@ -67,6 +68,7 @@ pub fn crba_upper<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'
     check::data("crba_upper", model, data)?;
     check::q("crba_upper", model, q)?;
     data.poses_stamp.clear();
+    data.velocity_stamp.clear();
     crba_dispatch::<false>(model, data, q);
     Ok(&data.mass_matrix)
 }
@@ -104,6 +106,7 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
             data.x_world_body[b] = Transform::new(x.rot, x.pos + data.p_world_tree[b]);
         }
         data.poses_stamp.clear();
+        data.velocity_stamp.clear();
     }
 }
 

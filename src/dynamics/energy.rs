@@ -19,6 +19,7 @@ pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> R
     check::q("kinetic_energy", model, q)?;
     check::v("kinetic_energy", "v", model, v)?;
     data.poses_stamp.clear();
+    data.velocity_stamp.clear();
     Ok(kinetic_energy_unchecked(model, data, q, v))
 }
 

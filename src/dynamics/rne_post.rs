@@ -169,6 +169,7 @@ pub fn rne_post_constraint(model: &Model, data: &mut Data) -> Result<(), InputEr
     InputError::check_len(F, "data.mocap_pos", data.mocap_pos.len(), nmocap, "mocap bodies")?;
     InputError::check_len(F, "data.mocap_quat", data.mocap_quat.len(), nmocap, "mocap bodies")?;
     data.poses_stamp.clear();
+    data.velocity_stamp.clear();
     let q = std::mem::take(&mut data.qpos);
     let v = std::mem::take(&mut data.qvel);
     body_poses(model, data, q.as_slice());

@@ -66,6 +66,7 @@ pub(crate) fn rnea_unchecked<'d>(
         data.v_body[b] = v_body;
         data.a_body[b] = a_body;
     }
+    data.velocity_stamp.set(q, v);
     // Pass 2, leaves to root: project forces on the joint axes, pass the rest to the parent.
     for b in (1..model.nbody()).rev() {
         let j = model.joint_of(b);

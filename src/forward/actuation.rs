@@ -23,7 +23,7 @@
 use super::activation::{activation_rate, next_activation};
 use super::adhesion::body_moment;
 use super::muscle::{muscle_bias, muscle_gain};
-use super::transmission::{moment_span, needs_poses, transmission, Poses};
+use super::transmission::{transmission, Poses};
 use crate::error::{check, InputError};
 use crate::kinematics::forward_kinematics_unchecked;
 pub use crate::model::actuator::unsimulated_reason;
@@ -83,12 +83,6 @@ fn clamp_ctrl(model: &Model, i: usize, ctrl: f64) -> f64 {
     }
 }
 
-/// The control the actuation stage uses: actuator i's control, or with a `delay` its recorded
-/// control at `data.time` − delay (`forward::history`), clamped as [`clamped_ctrl`].
-fn stage_ctrl(model: &Model, data: &Data, i: usize) -> f64 {
-    clamp_ctrl(model, i, super::history::delayed_ctrl(model, data, i))
-}
-
 /// MuJoCo's `mju_isBad`: NaN or beyond ±mjMAXVAL.
 fn is_bad(x: f64) -> bool {
     x.is_nan() || x.abs() > MAX_CTRL
@@ -115,12 +109,15 @@ pub fn actuation(
     check::v("actuation", "v", model, v)?;
     InputError::check_len("actuation", "bias_velocity", bias_velocity.len(), model.actuators.len(), "nu")?;
     data.poses_stamp.clear();
+    data.velocity_stamp.clear();
     crate::tendon::compute(model, data, q, v);
     actuation_unchecked(model, data, q, v, bias_velocity);
     Ok(())
 }
 
-/// [`actuation`] without the argument checks.
+/// [`actuation`] without the argument checks. Reads the plan's
+/// [`ActuatorLayout`](super::ActuatorLayout) (worked out here when the plan is not built for
+/// this model's actuators).
 pub(crate) fn actuation_unchecked(
     model: &Model,
     data: &mut Data,
@@ -128,17 +125,34 @@ pub(crate) fn actuation_unchecked(
     v: &[f64],
     bias_velocity: &[f64],
 ) {
+    let built;
+    let layout = if model.plan.actuators.fits(model) {
+        &model.plan.actuators
+    } else {
+        built = super::ActuatorLayout::new(model);
+        &built
+    };
     data.qfrc_actuator.fill(0.0);
-    if model.actuators.iter().any(|a| needs_poses(a) && unsimulated_reason(model, a).is_none()) {
+    if layout.needs_poses {
         forward_kinematics_unchecked(model, data, q);
     }
     // MuJoCo's mjWARN_BADCTRL (mj_fwdActuation): a control NaN, infinite or beyond ±MAX_CTRL
     // after its range clamp zeroes every control of this evaluation, with a warning.
-    // The stage's controls, kept in `actuator_force` until each actuator's force replaces its own.
+    // The stage's controls: each actuator's control, or with a `delay` its recorded control at
+    // `data.time` − delay (`forward::history`), clamped as [`clamp_ctrl`]; kept in
+    // `actuator_force` until each actuator's force replaces its own.
+    let clampctrl = model.options.flags.clampctrl;
     let mut bad = None;
-    for i in 0..model.actuators.len() {
-        let ctrl = stage_ctrl(model, data, i);
-        data.actuator_force[i] = ctrl;
+    for (i, a) in model.actuators.iter().enumerate() {
+        let raw = match a.history {
+            Some(h) if h.delay != 0.0 => super::history::delayed_ctrl(model, data, i),
+            _ => data.ctrl.as_slice()[i],
+        };
+        let ctrl = match (clampctrl, a.ctrlrange) {
+            (true, Some([lo, hi])) => raw.clamp(lo, hi),
+            _ => raw,
+        };
+        data.actuator_force.as_mut_slice()[i] = ctrl;
         if bad.is_none() && is_bad(ctrl) {
             bad = Some(i);
         }
@@ -147,44 +161,75 @@ pub(crate) fn actuation_unchecked(
         data.warnings.bad_control(i);
     }
     let zeroed = bad.is_some();
-    let mut act_adr = 0;
-    for (i, a) in model.actuators.iter().enumerate() {
-        let act_index = (a.actnum() == 1).then_some(act_adr);
-        act_adr += a.actnum();
-        // The moment row from zero over the entries its transmission can write (`moment_span`:
-        // a joint actuator's dofs); nothing writes the rest, zero since `Data::new`.
-        for k in moment_span(model, a) {
-            data.actuator_moment[(i, k)] = 0.0;
-        }
-        if unsimulated_reason(model, a).is_some() {
-            data.actuator_length[i] = 0.0;
-            data.actuator_velocity[i] = 0.0;
-            data.actuator_force[i] = 0.0;
-            if let Some(j) = act_index {
-                data.act_dot[j] = 0.0;
+    let Data {
+        act,
+        act_dot,
+        actuator_moment,
+        actuator_length,
+        actuator_velocity,
+        actuator_force,
+        qfrc_actuator,
+        x_world_body,
+        s_body,
+        x_world_frame,
+        ten_length,
+        ten_j,
+        contacts,
+        ..
+    } = data;
+    let (x_world_body, s_body, x_world_frame) = (&x_world_body[..], &s_body[..], &x_world_frame[..]);
+    let (ten_length, ten_j, contacts) = (&*ten_length, &*ten_j, &contacts[..]);
+    let (act, act_dot) = (act.as_slice(), act_dot.as_mut_slice());
+    let (lengths, velocities) = (actuator_length.as_mut_slice(), actuator_velocity.as_mut_slice());
+    let forces = actuator_force.as_mut_slice();
+    let nu = actuator_moment.nrows();
+    for ((i, a), e) in model.actuators.iter().enumerate().zip(&layout.entries) {
+        if !e.simulated {
+            // The moment row from zero over its span; nothing writes the rest, zero since
+            // `Data::new`.
+            for k in e.span() {
+                actuator_moment[(i, k)] = 0.0;
+            }
+            lengths[i] = 0.0;
+            velocities[i] = 0.0;
+            forces[i] = 0.0;
+            if let Some(j) = e.act {
+                act_dot[j] = 0.0;
             }
             continue;
         }
-        let Data { actuator_moment, x_world_body, s_body, x_world_frame, ten_length, ten_j, .. } = data;
-        let poses = Poses { x_world_body, s_body, x_world_frame, ten_length, ten_j };
-        let length = transmission(model, a, q, poses, actuator_moment, i);
-        if let Transmission::Body(b) = a.transmission {
-            let Data { actuator_moment, x_world_body, s_body, contacts, .. } = data;
-            body_moment(model, contacts, x_world_body, s_body, b, actuator_moment, i);
-        }
-        let actuator_moment = &data.actuator_moment;
-        let velocity = moment_span(model, a).map(|k| actuator_moment[(i, k)] * v[k]).sum::<f64>();
-        let ctrl = if zeroed { 0.0 } else { data.actuator_force[i] };
+        let (length, velocity) = if let Some((qa, da)) = e.one_dof {
+            // A hinge or slide joint transmission: the moment row is gear₀ at the joint's dof
+            // (0 + gear₀, as added to the zeroed row), the length gear₀ · q, the velocity the
+            // one product of the row with v.
+            let gear = a.gear[0];
+            let moment = 0.0 + gear;
+            actuator_moment.as_mut_slice()[i + da * nu] = moment;
+            (gear * q[qa], moment * v[da])
+        } else {
+            // The moment row from zero over the entries its transmission can write.
+            for k in e.span() {
+                actuator_moment[(i, k)] = 0.0;
+            }
+            let poses = Poses { x_world_body, s_body, x_world_frame, ten_length, ten_j };
+            let length = transmission(model, a, q, poses, actuator_moment, i);
+            if let Transmission::Body(b) = a.transmission {
+                body_moment(model, contacts, x_world_body, s_body, b, actuator_moment, i);
+            }
+            let actuator_moment = &*actuator_moment;
+            (length, e.span().map(|k| actuator_moment[(i, k)] * v[k]).sum::<f64>())
+        };
+        let ctrl = if zeroed { 0.0 } else { forces[i] };
         // The input of the gain: the control, or the activation (the next one with actearly).
-        let input = match act_index {
+        let input = match e.act {
             None => ctrl,
             Some(j) => {
-                let act_dot = activation_rate(a, ctrl, data.act[j]);
-                data.act_dot[j] = act_dot;
+                let rate = activation_rate(a, ctrl, act[j]);
+                act_dot[j] = rate;
                 if a.actearly {
-                    next_activation(a, data.act[j], act_dot, model.options.timestep)
+                    next_activation(a, act[j], rate, model.options.timestep)
                 } else {
-                    data.act[j]
+                    act[j]
                 }
             }
         };
@@ -198,60 +243,56 @@ pub(crate) fn actuation_unchecked(
             BiasType::Muscle => muscle_bias(length, a.lengthrange, a.acc0, &a.biasprm),
             _ => 0.0,
         };
-        data.actuator_length[i] = length;
-        data.actuator_velocity[i] = velocity;
-        data.actuator_force[i] = gain * input + bias;
+        lengths[i] = length;
+        velocities[i] = velocity;
+        forces[i] = gain * input + bias;
     }
-    scale_tendon_forces(model, data);
-    for (i, a) in model.actuators.iter().enumerate() {
-        let mut force = data.actuator_force[i];
+    if layout.tendon_force_range {
+        scale_tendon_forces(model, forces);
+    }
+    let qfrc = qfrc_actuator.as_mut_slice();
+    for ((i, a), e) in model.actuators.iter().enumerate().zip(&layout.entries) {
+        let mut force = forces[i];
         if let Some([lo, hi]) = a.forcerange {
             force = force.clamp(lo, hi);
         }
-        data.actuator_force[i] = force;
+        forces[i] = force;
         if force == 0.0 {
             continue;
         }
-        let Data { qfrc_actuator, actuator_moment, .. } = data;
-        for k in moment_span(model, a) {
-            qfrc_actuator[k] += actuator_moment[(i, k)] * force;
+        if let Some((_, da)) = e.one_dof {
+            qfrc[da] += actuator_moment.as_slice()[i + da * nu] * force;
+        } else {
+            for k in e.span() {
+                qfrc[k] += actuator_moment[(i, k)] * force;
+            }
         }
     }
     // `actuatorgravcomp` joints: their gravity compensation (the passive stage's
     // `qfrc_gravcomp`) is an actuator force, inside the clamp below (MuJoCo's mj_fwdActuation).
     if crate::dynamics::gravcomp::active(model) {
-        let Data { qfrc_gravcomp, qfrc_actuator, .. } = data;
-        crate::dynamics::gravcomp::add_gravcomp(
-            model,
-            qfrc_gravcomp.as_slice(),
-            qfrc_actuator.as_mut_slice(),
-            true,
-        );
+        crate::dynamics::gravcomp::add_gravcomp(model, data.qfrc_gravcomp.as_slice(), qfrc, true);
     }
     // Joints' `actuatorfrcrange`: the total actuator force on each of their dofs is clamped.
-    for j in &model.joints {
+    for &j in &layout.force_range_joints {
+        let j = &model.joints[j];
         if let Some([lo, hi]) = j.actuator_force_range {
             for dof in j.dof_adr..j.dof_adr + j.kind.nv() {
-                data.qfrc_actuator[dof] = data.qfrc_actuator[dof].clamp(lo, hi);
+                qfrc[dof] = qfrc[dof].clamp(lo, hi);
             }
         }
     }
 }
 
 /// Tendons' `actuatorfrcrange`: when the total force of the actuators on a limited tendon is
-/// outside its range, each of their forces is scaled by bound / total (MuJoCo's
+/// outside its range, each of their `forces` is scaled by bound / total (MuJoCo's
 /// `mj_fwdActuation`, before the actuators' own `forcerange`).
-fn scale_tendon_forces(model: &Model, data: &mut Data) {
+fn scale_tendon_forces(model: &Model, forces: &mut [f64]) {
     for (t, tendon) in model.tendons.iter().enumerate() {
         let Some([lo, hi]) = tendon.actuator_force_range else { continue };
         let on_tendon = |a: &crate::model::Actuator| a.transmission == Transmission::Tendon(t);
-        let total: f64 = model
-            .actuators
-            .iter()
-            .zip(data.actuator_force.iter())
-            .filter(|(a, _)| on_tendon(a))
-            .map(|(_, f)| f)
-            .sum();
+        let total: f64 =
+            model.actuators.iter().zip(forces.iter()).filter(|(a, _)| on_tendon(a)).map(|(_, f)| f).sum();
         let scale = if total == 0.0 {
             continue;
         } else if total < lo {
@@ -261,7 +302,7 @@ fn scale_tendon_forces(model: &Model, data: &mut Data) {
         } else {
             continue;
         };
-        for (a, f) in model.actuators.iter().zip(data.actuator_force.iter_mut()) {
+        for (a, f) in model.actuators.iter().zip(forces.iter_mut()) {
             if on_tendon(a) {
                 *f *= scale;
             }

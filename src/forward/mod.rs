@@ -19,6 +19,7 @@
 
 mod activation;
 mod actuation;
+mod actuator_layout;
 pub(crate) mod adhesion;
 pub mod history;
 pub mod muscle;
@@ -37,6 +38,7 @@ pub(crate) use actuation::{actuation_unchecked, add_actuator_length_derivative};
 pub(crate) use history::{record_controls, reset_actuator_buffers};
 
 pub use crate::constraint::DriftCorrection;
+pub use actuator_layout::{ActuatorEntry, ActuatorLayout};
 pub use plan::{Plan, Stage, StageKind, Status};
 pub(crate) use skip::{ForwardSkip, SkipStage};
 pub(crate) use xfrc::accumulate_xfrc;
@@ -78,6 +80,7 @@ pub fn forward(model: &Model, data: &mut Data) {
 pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     // Every evaluation forms its body poses afresh, once (`Data::poses_stamp`).
     data.poses_stamp.clear();
+    data.velocity_stamp.clear();
     let plan = &model.plan;
     let (rows, solver) = (&plan.constraints, &plan.solver);
     // Tendon lengths, Jacobians and velocities first: limits, passive forces, actuators and

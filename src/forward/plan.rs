@@ -96,6 +96,9 @@ pub struct Plan {
     /// Each actuator's velocity bias coefficient with `dampratio` resolved at `qpos0`
     /// ([`super::resolved_bias_velocity`]).
     pub actuator_bias_velocity: Vec<f64>,
+    /// The actuators' layout for the actuation stage (simulated or not, activation, moment span,
+    /// one-dof joint transmissions).
+    pub actuators: super::ActuatorLayout,
     /// What the sensor stage computes beside the sensors (body velocities, subtree momenta, …).
     pub sensor_needs: crate::sensor::SensorNeeds,
     /// The fluid forces' bodies and coefficients (None without `<option density>` or `viscosity`).
@@ -125,6 +128,7 @@ impl Plan {
             constraints,
             solver,
             actuator_bias_velocity: super::resolved_bias_velocity(model),
+            actuators: super::ActuatorLayout::new(model),
             sensor_needs: crate::sensor::SensorNeeds::of(model),
             fluid: crate::dynamics::fluid::FluidModel::new(model),
             max_dof_depth: model.max_dof_depth(),

@@ -156,6 +156,8 @@ pub struct Data {
     /// The configuration `x_parent_body`, `x_world_body` and `s_body` were last formed at, while
     /// they hold (one pose pass per evaluation).
     pub(crate) poses_stamp: super::poses_stamp::PosesStamp,
+    /// The state (q, v) `v_body` was last formed at by RNEA or ABA, while it holds.
+    pub(crate) velocity_stamp: super::velocity_stamp::VelocityStamp,
     /// Spatial velocity of each body, body coordinates.
     pub v_body: Vec<Motion>,
     /// Spatial acceleration of each body (including the gravity offset in RNEA/ABA), body coords.
@@ -438,6 +440,7 @@ impl Data {
             p_world_tree: vec![Vec3::zeros(); nb],
             x_tree_body: vec![Transform::identity(); nb],
             poses_stamp: super::poses_stamp::PosesStamp::with_capacity(model.nq),
+            velocity_stamp: super::velocity_stamp::VelocityStamp::with_capacity(model.nq, model.nv),
             v_body: vec![Motion::zero(); nb],
             a_body: vec![Motion::zero(); nb],
             c_body: vec![Motion::zero(); nb],

@@ -21,6 +21,7 @@ pub mod reset;
 pub mod sleep;
 pub mod spec;
 pub mod tendon;
+pub(crate) mod velocity_stamp;
 pub mod warning;
 
 pub use actuator::{Actuator, ActuatorHistory, Interp};

@@ -147,8 +147,9 @@ pub(crate) fn compute_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64], t
     }
     // The link and site frames (the joint-anchor frames no sensor reads are left as they were).
     forward_kinematics_sensed_unchecked(model, data, q);
-    // Body velocities: for the velocity sensors, and the accelerations' velocity terms.
-    if needs.velocities || needs.rne_post {
+    // Body velocities: for the velocity sensors, and the accelerations' velocity terms (RNEA's or
+    // ABA's of the same evaluation when they are still those of (q, v): `Data::velocity_stamp`).
+    if (needs.velocities || needs.rne_post) && !data.velocity_stamp.matches(q, v) {
         forward_velocities_unchecked(model, data, v);
     }
     let mut work = std::mem::take(&mut data.sensor_work);
