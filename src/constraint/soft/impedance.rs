@@ -208,6 +208,7 @@ fn violation(model: &Model, data: &Data, i: usize) -> (f64, usize) {
 
 /// `efc_diag_a`, `efc_kbip`, `efc_r`, `efc_d`, `contact_mu` and `efc_aref` of the rows of
 /// `soft_positions` with `efc_vel` and `efc_jdotv`.
+#[inline(never)]
 pub(crate) fn make_impedance(model: &Model, w: &InverseWeights, data: &mut Data) {
     diag_approx(model, w, data);
     let mut i = 0;
