@@ -9,6 +9,14 @@
 //! buffers at another configuration clears the stamp, and every evaluation starts with it clear
 //! (a model edited between two calls is never read through stale poses).
 
+/// Whether two states are the same to the bit (their lengths included): what "the buffers hold
+/// this state" means for the stamps (−0.0 and 0.0 differ, a NaN never matches a NaN of
+/// another payload).
+#[inline]
+pub(super) fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
 /// The configuration the body poses were last formed at, when they still hold.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct PosesStamp {
@@ -25,7 +33,7 @@ impl PosesStamp {
     /// Whether the body poses are those of configuration `q` (bit for bit).
     #[inline]
     pub fn matches(&self, q: &[f64]) -> bool {
-        self.valid && self.q.len() == q.len() && self.q.iter().zip(q).all(|(a, b)| a.to_bits() == b.to_bits())
+        self.valid && same_bits(&self.q, q)
     }
 
     /// The body poses now hold configuration `q`.

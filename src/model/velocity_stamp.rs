@@ -12,6 +12,8 @@
 //! clears the stamp, and so does every evaluation's start (with the poses stamp: a model edited
 //! between two calls is never read through stale velocities).
 
+use super::poses_stamp::same_bits;
+
 /// The state (q, v) the body velocities were last formed at by a pass that records it.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct VelocityStamp {
@@ -30,10 +32,7 @@ impl VelocityStamp {
     /// Whether the body velocities are those of the state (`q`, `v`) (bit for bit).
     #[inline]
     pub fn matches(&self, q: &[f64], v: &[f64]) -> bool {
-        let same = |a: &[f64], b: &[f64]| {
-            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
-        };
-        self.valid && same(&self.q, q) && same(&self.v, v)
+        self.valid && same_bits(&self.q, q) && same_bits(&self.v, v)
     }
 
     /// The body velocities now hold the state (`q`, `v`).
