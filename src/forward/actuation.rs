@@ -76,6 +76,7 @@ fn clamped_ctrl(model: &Model, data: &Data, i: usize) -> f64 {
 }
 
 /// `ctrl` of actuator i clamped to its `ctrlrange` unless `clampctrl` is disabled.
+#[inline]
 fn clamp_ctrl(model: &Model, i: usize, ctrl: f64) -> f64 {
     match (model.options.flags.clampctrl, model.actuators[i].ctrlrange) {
         (true, Some([lo, hi])) => ctrl.clamp(lo, hi),
@@ -141,17 +142,9 @@ pub(crate) fn actuation_unchecked(
     // The stage's controls: each actuator's control, or with a `delay` its recorded control at
     // `data.time` − delay (`forward::history`), clamped as [`clamp_ctrl`]; kept in
     // `actuator_force` until each actuator's force replaces its own.
-    let clampctrl = model.options.flags.clampctrl;
     let mut bad = None;
-    for (i, a) in model.actuators.iter().enumerate() {
-        let raw = match a.history {
-            Some(h) if h.delay != 0.0 => super::history::delayed_ctrl(model, data, i),
-            _ => data.ctrl.as_slice()[i],
-        };
-        let ctrl = match (clampctrl, a.ctrlrange) {
-            (true, Some([lo, hi])) => raw.clamp(lo, hi),
-            _ => raw,
-        };
+    for i in 0..model.actuators.len() {
+        let ctrl = clamp_ctrl(model, i, super::history::delayed_ctrl(model, data, i));
         data.actuator_force.as_mut_slice()[i] = ctrl;
         if bad.is_none() && is_bad(ctrl) {
             bad = Some(i);

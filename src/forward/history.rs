@@ -150,6 +150,7 @@ pub fn read(buffer: &[f64], n: usize, t: f64, interp: Interp) -> f64 {
 /// Actuator `i`'s control input to the actuation stage: `ctrl[i]`, or for an actuator with a
 /// history and a nonzero `delay` its recorded control at `data.time` − delay (MuJoCo's
 /// `mj_readCtrl`). Not clamped.
+#[inline]
 pub(crate) fn delayed_ctrl(model: &Model, data: &Data, i: usize) -> f64 {
     match &model.actuators[i].history {
         Some(h) if h.delay != 0.0 => {
