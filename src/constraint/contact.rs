@@ -27,7 +27,7 @@
 use crate::kinematics::{for_each_ancestor_dof_at, point_bias_acceleration};
 use crate::model::spec::Shape;
 use crate::model::{Contact, Data, EfcType, Model};
-use crate::spatial::{Motion, Transform, Vec3};
+use crate::spatial::Vec3;
 
 /// Distance (m) up to which a contact carries a row in exact mode: touching, up to the round-off
 /// the position projection leaves (as for joint limits).
@@ -98,60 +98,6 @@ pub(crate) fn add_contact_jacobian(model: &Model, data: &mut Data, contact: &Con
             }
         });
     }
-}
-
-/// The nonzero columns of `contact`'s contact-frame Jacobian (the rows of
-/// [`add_contact_jacobian`], `dim` of them), compactly: the dofs that move one of the two bodies
-/// and not the other — both paths to the root below their lowest common ancestor (a common
-/// ancestor's columns cancel to exact zeros) — ascending into `cols`, and each one's `dim` row
-/// values into `vals` (the same bits as `add_contact_jacobian` writes). Columns whose values are
-/// all zero are dropped. Needs body poses and motion subspaces; `cols` and `vals` are cleared
-/// first and need capacity nv to stay without allocation.
-pub(crate) fn contact_jacobian_columns(
-    model: &Model,
-    x_world_body: &[Transform],
-    s_body: &[Motion],
-    contact: &Contact,
-    dim: usize,
-    cols: &mut Vec<usize>,
-    vals: &mut Vec<[f64; 6]>,
-) {
-    cols.clear();
-    vals.clear();
-    let p = contact.pos;
-    let f = contact.frame;
-    let dirs = [f.row(0).transpose(), f.row(1).transpose(), f.row(2).transpose()];
-    let [mut a, mut b] = contact.geom.map(|g| model.geoms[g].body);
-    // Bodies are numbered parents first: the path with the larger body index steps up until the
-    // two meet (the bodies visited strictly descend). Geom 1's body counts negative, geom 2's
-    // positive.
-    while a != b {
-        let (step, sign) = if a > b { (&mut a, -1.0) } else { (&mut b, 1.0) };
-        let body = *step;
-        let j = model.joint_of(body);
-        let x = &x_world_body[body];
-        let r = p - x.pos;
-        for k in (j.dof_adr..j.dof_adr + j.kind.nv()).rev() {
-            let ang = x.rot * s_body[k].ang;
-            let lin = x.rot * s_body[k].lin + ang.cross(&r);
-            let mut v = [0.0; 6];
-            for (i, v) in v.iter_mut().enumerate().take(dim) {
-                *v = sign * if i < 3 { dirs[i].dot(&lin) } else { dirs[i - 3].dot(&ang) };
-            }
-            if v[..dim].iter().any(|&x| x != 0.0) {
-                cols.push(k);
-                vals.push(v);
-            }
-        }
-        let parent = model.bodies[body].parent;
-        debug_assert!(parent < body, "bodies are numbered parents first");
-        *step = parent;
-    }
-    // The bodies came in descending order (each step leaves the larger index), so with each
-    // joint's dofs taken last to first the columns are descending: reversed, ascending.
-    cols.reverse();
-    vals.reverse();
-    debug_assert!(cols.windows(2).all(|w| w[0] < w[1]), "dofs are numbered in body order");
 }
 
 /// `efc_jdotv` of the contact rows r..r+dim of contact `c` (needs `bias_accelerations` at the

@@ -233,9 +233,10 @@ pub(crate) fn make_impedance(model: &Model, w: &InverseWeights, data: &mut Data)
         } else {
             b
         };
+        let (efc_r, efc_diag_a) = (data.efc_r.as_mut_slice(), data.efc_diag_a.as_slice());
         for j in 0..dim {
             let r = i + j;
-            data.efc_r[r] = ((1.0 - imp) * data.efc_diag_a[r] / imp).max(MINVAL);
+            efc_r[r] = ((1.0 - imp) * efc_diag_a[r] / imp).max(MINVAL);
             data.efc_kbip[r] = if kind == EfcType::ContactElliptic && j > 0 {
                 [0.0, friction_b, imp, imp_d]
             } else {
@@ -267,12 +268,28 @@ pub(crate) fn make_impedance(model: &Model, w: &InverseWeights, data: &mut Data)
         }
         i += len;
     }
-    for i in 0..data.nefc {
-        data.efc_d[i] = 1.0 / data.efc_r[i];
-        let [k, b, imp, _] = data.efc_kbip[i];
-        data.efc_diag_a[i] = data.efc_r[i] * imp / (1.0 - imp);
-        data.efc_aref[i] =
-            -b * data.efc_vel[i] - k * imp * (data.efc_pos[i] - data.efc_margin[i]) - data.efc_jdotv[i];
+    // Over slices: a `DVector`'s own indexing checks its shape at every access.
+    let n = data.nefc;
+    let Data {
+        efc_d, efc_r, efc_kbip, efc_diag_a, efc_aref, efc_vel, efc_pos, efc_margin, efc_jdotv, ..
+    } = &mut *data;
+    let (efc_vel, efc_pos, efc_margin, efc_jdotv) = (
+        &efc_vel.as_slice()[..n],
+        &efc_pos.as_slice()[..n],
+        &efc_margin.as_slice()[..n],
+        &efc_jdotv.as_slice()[..n],
+    );
+    let (efc_d, efc_diag_a, efc_aref) = (
+        &mut efc_d.as_mut_slice()[..n],
+        &mut efc_diag_a.as_mut_slice()[..n],
+        &mut efc_aref.as_mut_slice()[..n],
+    );
+    let (efc_r, efc_kbip) = (&efc_r.as_slice()[..n], &efc_kbip[..n]);
+    for i in 0..n {
+        efc_d[i] = 1.0 / efc_r[i];
+        let [k, b, imp, _] = efc_kbip[i];
+        efc_diag_a[i] = efc_r[i] * imp / (1.0 - imp);
+        efc_aref[i] = -b * efc_vel[i] - k * imp * (efc_pos[i] - efc_margin[i]) - efc_jdotv[i];
     }
 }
 

@@ -11,6 +11,7 @@
 //! `efc_diagA`, `efc_state` as `efc_r`, `efc_d`, `efc_aref`, `efc_kbip`, `efc_diag_a`,
 //! `efc_state`). Nothing is projected after a step: drift is what the soft model allows.
 
+mod contact_columns;
 pub mod cost;
 mod hessian;
 pub mod impedance;

@@ -17,7 +17,7 @@
 //! `efc_vel` = J v for every row; `efc_jdotv` is J̇ v of connect and weld rows (MuJoCo 4
 //! subtracts it from their reference acceleration), 0 elsewhere.
 
-use crate::constraint::contact::contact_jacobian_columns;
+use super::contact_columns::contact_jacobian_columns;
 use crate::constraint::limits::{quat_angle_axis, LimitKind, LimitRow};
 use crate::constraint::rows::EqualityRows;
 use crate::constraint::rows::{point_motion, RowGeometry};
@@ -278,6 +278,9 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
     } = &mut *data;
     let stride = efc_j.nrows();
     let j = efc_j.as_mut_slice();
+    let (efc_pos, efc_margin, efc_frictionloss) =
+        (efc_pos.as_mut_slice(), efc_margin.as_mut_slice(), efc_frictionloss.as_mut_slice());
+    soft.dof_axes.forget();
     for (c, contact) in contacts.iter().enumerate() {
         if contact.dist >= contact.includemargin {
             continue;
@@ -292,14 +295,25 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
             (dim, EfcType::ContactElliptic)
         };
         let (columns, values) = (&mut soft.columns, &mut soft.column_values);
-        contact_jacobian_columns(model, x_world_body, s_body, contact, dim, columns, values);
+        contact_jacobian_columns(
+            model,
+            x_world_body,
+            s_body,
+            &mut soft.dof_axes,
+            contact,
+            dim,
+            columns,
+            values,
+        );
         if pyramidal {
             // The edges J_n ± μ_k J_k (pair k − 1 in rows 2k − 2, 2k − 1) in place of the frame
             // rows, and only the columns where an edge is nonzero.
+            // Each column's edges are written in the next free slot, which moves on only when
+            // one of them is nonzero.
             let mut kept = 0;
             for t in 0..columns.len() {
-                let v = values[t];
-                let mut e = [0.0; 10];
+                let v = &values[t];
+                let e = &mut soft.edge_values[kept];
                 for k in 1..dim {
                     let mu = contact.friction[k - 1];
                     e[2 * k - 2] = v[0] + mu * v[k];
@@ -307,23 +321,29 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
                 }
                 if e[..rows].iter().any(|&x| x != 0.0) {
                     columns[kept] = columns[t];
-                    soft.edge_values[kept] = e;
                     kept += 1;
                 }
             }
             columns.truncate(kept);
         }
+        // J is stored by columns: each column's rows r..r + rows are contiguous.
+        let n = columns.len();
+        for t in 0..n {
+            let column = &mut j[columns[t] * stride + r..][..rows];
+            if pyramidal {
+                column.copy_from_slice(&soft.edge_values[t][..rows]);
+            } else {
+                column.copy_from_slice(&soft.column_values[t][..rows]);
+            }
+        }
+        // The record: each row over the same columns (exact-size extends, one capacity check
+        // per row).
         for i in 0..rows {
-            // Exact-size extends: one capacity check per row, not per entry.
             soft.nz_index.extend_from_slice(columns);
             if pyramidal {
-                soft.nz_value.extend(soft.edge_values[..columns.len()].iter().map(|e| e[i]));
+                soft.nz_value.extend(soft.edge_values[..n].iter().map(|e| e[i]));
             } else {
                 soft.nz_value.extend(soft.column_values.iter().map(|v| v[i]));
-            }
-            let row_values = &soft.nz_value[soft.nz_value.len() - columns.len()..];
-            for (&k, &v) in columns.iter().zip(row_values) {
-                j[k * stride + r + i] = v;
             }
             soft.nz_start.push(soft.nz_index.len());
             let row = r + i;

@@ -55,6 +55,8 @@ pub(crate) struct SoftWork {
     pub column_values: Vec<[f64; 6]>,
     /// Their values in a pyramidal contact's edge rows (nv).
     pub edge_values: Vec<[f64; 10]>,
+    /// Each dof's world axes at its body's origin, shared by the contacts of a position stage.
+    pub dof_axes: super::contact_columns::DofAxes,
     /// (row, column) of J's nonzeros in column order, while `nz_start`/`nz_index` are built.
     pub nz_scratch: Vec<(usize, usize)>,
     /// Scratch of a row group's Hessian term while H is assembled (`hessian::scratch_len`).
@@ -100,6 +102,7 @@ impl SoftWork {
             columns: Vec::with_capacity(nv),
             column_values: Vec::with_capacity(nv),
             edge_values: vec![[0.0; 10]; nv],
+            dof_axes: super::contact_columns::DofAxes::new(nv),
             nz_scratch: Vec::new(),
             hessian_column: vec![0.0; super::hessian::scratch_len(nv)],
             islands: super::island::Islands::with_capacity(nv, nefc),
