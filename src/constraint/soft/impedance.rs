@@ -87,75 +87,73 @@ fn stiffness_damping(solref: &[f64; 2], dmax: f64) -> (f64, f64) {
     (k, b)
 }
 
-/// `efc_diag_a`: MuJoCo's diagonal approximation of J M⁻¹ Jᵀ per row (`mj_diagApprox`).
-fn diag_approx(model: &Model, w: &InverseWeights, data: &mut Data) {
-    let mut i = 0;
-    while i < data.nefc {
-        let id = data.efc_id[i];
-        let len = data.efc_block_len(i);
-        match data.efc_type[i] {
-            EfcType::Equality => {
-                let eq = &model.equalities[id];
-                let n = eq.kind.nrow();
-                let frames = |f1: usize, f2: usize| (w.of_frame(model, f1), w.of_frame(model, f2));
-                for k in 0..n {
-                    data.efc_diag_a[i + k] = match &eq.kind {
-                        EqualityKind::Connect { frame1, frame2, .. } => {
-                            let (a, b) = frames(*frame1, *frame2);
-                            a[0] + b[0]
-                        }
-                        EqualityKind::Weld { frame1, frame2, .. } => {
-                            let (a, b) = frames(*frame1, *frame2);
-                            let rot = usize::from(k > 2);
-                            a[rot] + b[rot]
-                        }
-                        EqualityKind::Joint { joint1, joint2, .. } => {
-                            let dof = |j: usize| w.dof_invweight0[model.joints[j].dof_adr];
-                            dof(*joint1) + joint2.map_or(0.0, dof)
-                        }
-                        EqualityKind::Mimic { joint, leader, .. } => {
-                            let dof = |j: usize| w.dof_invweight0[model.joints[j].dof_adr];
-                            dof(*joint) + dof(*leader)
-                        }
-                        EqualityKind::Tendon { tendon1, tendon2, .. } => {
-                            w.tendon_invweight0[*tendon1] + tendon2.map_or(0.0, |t| w.tendon_invweight0[t])
-                        }
-                    };
-                }
-                i += n;
-                continue;
-            }
-            EfcType::FrictionDof => data.efc_diag_a[i] = w.dof_invweight0[id],
-            EfcType::LimitJoint => data.efc_diag_a[i] = w.dof_invweight0[model.joints[id].dof_adr],
-            EfcType::LimitTendon | EfcType::FrictionTendon => data.efc_diag_a[i] = w.tendon_invweight0[id],
-            kind => {
-                let c = &data.contacts[id];
-                let (mut tran, mut rot) = (0.0, 0.0);
-                for g in c.geom {
-                    let iw = w.frame_invweight0[w.geom_frame[g]];
-                    tran += iw[0];
-                    rot += iw[1];
-                }
-                let dim = c.condim.clamp(1, 6) as usize;
-                match kind {
-                    EfcType::ContactFrictionless => data.efc_diag_a[i] = tran,
-                    EfcType::ContactElliptic => {
-                        for j in 0..dim {
-                            data.efc_diag_a[i + j] = if j < 3 { tran } else { rot };
-                        }
+/// `efc_diag_a` of the block at row `i` (`len` = `Data::efc_block_len(i)`): MuJoCo's diagonal
+/// approximation of J M⁻¹ Jᵀ per row (`mj_diagApprox`); an equality's block is its `nrow` rows.
+fn diag_approx(model: &Model, w: &InverseWeights, data: &mut Data, i: usize, len: usize) {
+    let id = data.efc_id[i];
+    let kind = data.efc_type[i];
+    let diag_a = data.efc_diag_a.as_mut_slice();
+    match kind {
+        EfcType::Equality => {
+            let eq = &model.equalities[id];
+            let n = eq.kind.nrow();
+            let frames = |f1: usize, f2: usize| (w.of_frame(model, f1), w.of_frame(model, f2));
+            for k in 0..n {
+                diag_a[i + k] = match &eq.kind {
+                    EqualityKind::Connect { frame1, frame2, .. } => {
+                        let (a, b) = frames(*frame1, *frame2);
+                        a[0] + b[0]
                     }
-                    _ => {
-                        for j in 0..dim - 1 {
-                            let f = c.friction[j];
-                            let v = tran + f * f * if j < 2 { tran } else { rot };
-                            data.efc_diag_a[i + 2 * j] = v;
-                            data.efc_diag_a[i + 2 * j + 1] = v;
-                        }
+                    EqualityKind::Weld { frame1, frame2, .. } => {
+                        let (a, b) = frames(*frame1, *frame2);
+                        let rot = usize::from(k > 2);
+                        a[rot] + b[rot]
+                    }
+                    EqualityKind::Joint { joint1, joint2, .. } => {
+                        let dof = |j: usize| w.dof_invweight0[model.joints[j].dof_adr];
+                        dof(*joint1) + joint2.map_or(0.0, dof)
+                    }
+                    EqualityKind::Mimic { joint, leader, .. } => {
+                        let dof = |j: usize| w.dof_invweight0[model.joints[j].dof_adr];
+                        dof(*joint) + dof(*leader)
+                    }
+                    EqualityKind::Tendon { tendon1, tendon2, .. } => {
+                        w.tendon_invweight0[*tendon1] + tendon2.map_or(0.0, |t| w.tendon_invweight0[t])
+                    }
+                };
+            }
+        }
+        EfcType::FrictionDof => diag_a[i] = w.dof_invweight0[id],
+        EfcType::LimitJoint => diag_a[i] = w.dof_invweight0[model.joints[id].dof_adr],
+        EfcType::LimitTendon | EfcType::FrictionTendon => diag_a[i] = w.tendon_invweight0[id],
+        kind => {
+            let c = &data.contacts[id];
+            let (mut tran, mut rot) = (0.0, 0.0);
+            for g in c.geom {
+                let iw = w.frame_invweight0[w.geom_frame[g]];
+                tran += iw[0];
+                rot += iw[1];
+            }
+            let dim = c.condim.clamp(1, 6) as usize;
+            match kind {
+                EfcType::ContactFrictionless => diag_a[i] = tran,
+                EfcType::ContactElliptic => {
+                    for j in 0..dim {
+                        diag_a[i + j] = if j < 3 { tran } else { rot };
+                    }
+                }
+                _ => {
+                    // A pyramidal contact's `len` = 2 (dim − 1) rows, in pairs.
+                    debug_assert_eq!(len, 2 * (dim - 1));
+                    for j in 0..dim - 1 {
+                        let f = c.friction[j];
+                        let v = tran + f * f * if j < 2 { tran } else { rot };
+                        diag_a[i + 2 * j] = v;
+                        diag_a[i + 2 * j + 1] = v;
                     }
                 }
             }
         }
-        i += len;
     }
 }
 
@@ -191,8 +189,7 @@ fn parameters(model: &Model, data: &Data, i: usize) -> ([f64; 2], [f64; 2], [f64
 }
 
 /// The row's violation for the impedance and the number of rows sharing it (module doc).
-fn violation(model: &Model, data: &Data, i: usize) -> (f64, usize) {
-    let len = data.efc_block_len(i);
+fn violation(model: &Model, data: &Data, i: usize, len: usize) -> (f64, usize) {
     match data.efc_type[i] {
         EfcType::Equality => match model.equalities[data.efc_id[i]].kind {
             EqualityKind::Connect { .. } => (data.efc_pos.rows(i, 3).norm(), 3),
@@ -210,14 +207,16 @@ fn violation(model: &Model, data: &Data, i: usize) -> (f64, usize) {
 /// `soft_positions` with `efc_vel` and `efc_jdotv`.
 #[inline(never)]
 pub(crate) fn make_impedance(model: &Model, w: &InverseWeights, data: &mut Data) {
-    diag_approx(model, w, data);
+    // One pass over the blocks (a row, an equality's rows, a contact's rows).
     let mut i = 0;
     while i < data.nefc {
+        let len = data.efc_block_len(i);
+        diag_approx(model, w, data, i, len);
         let kind = data.efc_type[i];
         let frictional_dof = matches!(kind, EfcType::FrictionDof | EfcType::FrictionTendon);
         let (solref, solreffriction, solimp) = parameters(model, data, i);
         let (solref, solimp) = sanitize(model, solref, solimp, false);
-        let (x, dim) = violation(model, data, i);
+        let (x, dim) = violation(model, data, i, len);
         let (imp, imp_d) = impedance(&solimp, x - data.efc_margin[i]);
         // (k, b) of the block's first row, and of an elliptic contact's friction rows (k = 0,
         // b from `solreffriction` when it is given, else from `solref`).
@@ -243,30 +242,24 @@ pub(crate) fn make_impedance(model: &Model, w: &InverseWeights, data: &mut Data)
                 [k, b, imp, imp_d]
             };
         }
-        i += dim;
-    }
-    // Frictional contacts: R of the friction rows and the regularized cone's μ.
-    let mut i = data.ne + data.nf;
-    while i < data.nefc {
-        let kind = data.efc_type[i];
-        let len = data.efc_block_len(i);
+        // Frictional contacts: R of the friction rows and the regularized cone's μ.
         if matches!(kind, EfcType::ContactElliptic | EfcType::ContactPyramidal) {
-            let c = data.contacts[data.efc_id[i]];
-            let r1 = data.efc_r[i] / model.options.impratio.max(MINVAL);
-            let mu = c.friction[0] * (r1 / data.efc_r[i]).sqrt();
-            data.contact_mu[data.efc_id[i]] = mu;
+            let c = &data.contacts[data.efc_id[i]];
+            let efc_r = data.efc_r.as_mut_slice();
+            let r1 = efc_r[i] / model.options.impratio.max(MINVAL);
+            let mu = c.friction[0] * (r1 / efc_r[i]).sqrt();
             if kind == EfcType::ContactElliptic {
-                data.efc_r[i + 1] = r1;
+                efc_r[i + 1] = r1;
                 for j in 1..len - 1 {
-                    data.efc_r[i + j + 1] =
-                        r1 * c.friction[0] * c.friction[0] / (c.friction[j] * c.friction[j]);
+                    efc_r[i + j + 1] = r1 * c.friction[0] * c.friction[0] / (c.friction[j] * c.friction[j]);
                 }
             } else {
-                let rpy = 2.0 * mu * mu * data.efc_r[i];
-                data.efc_r.rows_mut(i, len).fill(rpy);
+                let rpy = 2.0 * mu * mu * efc_r[i];
+                efc_r[i..i + len].fill(rpy);
             }
+            data.contact_mu[data.efc_id[i]] = mu;
         }
-        i += len;
+        i += dim;
     }
     // Over slices: a `DVector`'s own indexing checks its shape at every access.
     let n = data.nefc;
