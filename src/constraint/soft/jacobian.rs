@@ -69,13 +69,41 @@ pub(crate) fn record(
 
 /// Zeroes rows `first..` of `j` that the record (`start`, `index`, rows 0..start.len() − 1)
 /// lists as nonzero: with the record current, every row of `j` from `first` on is zero after.
-pub(crate) fn clear_recorded(j: &mut DMatrix<f64>, first: usize, start: &[usize], index: &[usize]) {
+/// `blocks` (first row, rows), ascending, are runs of rows recorded over the same columns (a
+/// contact's rows): those are cleared column by column, each column's run contiguous in J's
+/// storage.
+pub(crate) fn clear_recorded(
+    j: &mut DMatrix<f64>,
+    first: usize,
+    start: &[usize],
+    index: &[usize],
+    blocks: &[(usize, usize)],
+) {
     let rows = j.nrows();
     let data = j.as_mut_slice();
-    for i in first..start.len().saturating_sub(1) {
+    let recorded = start.len().saturating_sub(1);
+    let clear_row = |data: &mut [f64], i: usize| {
         for &k in &index[start[i]..start[i + 1]] {
             data[k * rows + i] = 0.0;
         }
+    };
+    let mut i = first;
+    for &(b0, n) in blocks {
+        while i < b0.min(recorded) {
+            clear_row(data, i);
+            i += 1;
+        }
+        let (lo, end) = (i.max(b0), (b0 + n).min(recorded));
+        if lo < end {
+            for &k in &index[start[b0]..start[b0 + 1]] {
+                data[k * rows + lo..k * rows + end].fill(0.0);
+            }
+        }
+        i = i.max(end);
+    }
+    while i < recorded {
+        clear_row(data, i);
+        i += 1;
     }
 }
 
@@ -94,9 +122,26 @@ mod tests {
         assert_eq!(start, [0, 2, 3, 5]);
         assert_eq!(index, [1, 3, 0, 2, 3]);
         assert_eq!(value, [2.0, -1.0, 0.5, 3.0, 4.0]);
-        clear_recorded(&mut j, 1, &start, &index);
+        clear_recorded(&mut j, 1, &start, &index, &[]);
         assert_eq!(j[(0, 1)], 2.0);
         assert_eq!(j[(0, 3)], -1.0);
         assert_eq!(j.rows(1, 4).iter().filter(|&&x| x != 0.0).count(), 0);
+    }
+
+    #[test]
+    fn blocks_of_rows_on_the_same_columns_are_cleared_as_runs() {
+        // Row 0 alone, rows 1–3 a block on columns 0 and 2, row 4 alone; cleared from row 2 on.
+        let mut j = DMatrix::zeros(6, 3);
+        for (i, k, v) in [(0, 1, 1.0), (1, 0, 2.0), (1, 2, 3.0), (2, 0, 4.0), (2, 2, 5.0), (3, 0, 6.0)] {
+            j[(i, k)] = v;
+        }
+        j[(3, 2)] = 7.0;
+        j[(4, 1)] = 8.0;
+        let (mut start, mut index, mut value, mut scratch) = (vec![], vec![], vec![], vec![]);
+        record(&j, 5, &mut start, &mut index, &mut value, &mut scratch);
+        clear_recorded(&mut j, 2, &start, &index, &[(1, 3)]);
+        assert_eq!(j[(0, 1)], 1.0);
+        assert_eq!((j[(1, 0)], j[(1, 2)]), (2.0, 3.0));
+        assert_eq!(j.rows(2, 4).iter().filter(|&&x| x != 0.0).count(), 0);
     }
 }

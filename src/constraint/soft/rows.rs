@@ -102,7 +102,7 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
     // column by column (contiguous in J's storage) rather than row by row (strided).
     if data.soft.j_recorded {
         let Data { efc_j, soft, .. } = &mut *data;
-        super::jacobian::clear_recorded(efc_j, ne, &soft.nz_start, &soft.nz_index);
+        super::jacobian::clear_recorded(efc_j, ne, &soft.nz_start, &soft.nz_index, &soft.contact_blocks);
     } else {
         let stride = data.efc_j.nrows();
         let nv = model.nv;
@@ -281,6 +281,7 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
     let (efc_pos, efc_margin, efc_frictionloss) =
         (efc_pos.as_mut_slice(), efc_margin.as_mut_slice(), efc_frictionloss.as_mut_slice());
     soft.dof_axes.forget();
+    soft.contact_blocks.clear();
     for (c, contact) in contacts.iter().enumerate() {
         if contact.dist >= contact.includemargin {
             continue;
@@ -337,7 +338,8 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
             }
         }
         // The record: each row over the same columns (exact-size extends, one capacity check
-        // per row).
+        // per row), and the rows as one block for the next clear.
+        soft.contact_blocks.push((r, rows));
         for i in 0..rows {
             soft.nz_index.extend_from_slice(columns);
             if pyramidal {

@@ -57,6 +57,8 @@ pub(crate) struct SoftWork {
     pub edge_values: Vec<[f64; 10]>,
     /// Each dof's world axes at its body's origin, shared by the contacts of a position stage.
     pub dof_axes: super::contact_columns::DofAxes,
+    /// The contacts' rows as recorded, (first row, rows): each contact's rows share their columns.
+    pub contact_blocks: Vec<(usize, usize)>,
     /// (row, column) of J's nonzeros in column order, while `nz_start`/`nz_index` are built.
     pub nz_scratch: Vec<(usize, usize)>,
     /// Scratch of a row group's Hessian term while H is assembled (`hessian::scratch_len`).
@@ -103,6 +105,7 @@ impl SoftWork {
             column_values: Vec::with_capacity(nv),
             edge_values: vec![[0.0; 10]; nv],
             dof_axes: super::contact_columns::DofAxes::new(nv),
+            contact_blocks: Vec::with_capacity(nefc),
             nz_scratch: Vec::new(),
             hessian_column: vec![0.0; super::hessian::scratch_len(nv)],
             islands: super::island::Islands::with_capacity(nv, nefc),
