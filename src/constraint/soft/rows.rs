@@ -370,12 +370,40 @@ pub(crate) fn soft_velocities(cm: &ConstraintModel, model: &Model, data: &mut Da
     if data.soft.j_recorded {
         let Data { efc_vel, soft, .. } = &mut *data;
         let (start, index, value) = (&soft.nz_start, &soft.nz_index, &soft.nz_value);
-        for (i, vel) in efc_vel.as_mut_slice()[..nefc].iter_mut().enumerate() {
+        let vel = &mut efc_vel.as_mut_slice()[..nefc];
+        let row = |i: usize| {
             let mut s = 0.0;
             for (&k, &j_ik) in index[start[i]..start[i + 1]].iter().zip(&value[start[i]..start[i + 1]]) {
                 s += j_ik * v[k];
             }
-            *vel = s;
+            s
+        };
+        // A contact's rows share their columns (`contact_blocks`): v is gathered on them once
+        // and each row's sum runs over two contiguous vectors, in the same order.
+        let gathered = &mut soft.gathered;
+        let mut i = 0;
+        for &(first, rows) in &soft.contact_blocks {
+            while i < first.min(nefc) {
+                vel[i] = row(i);
+                i += 1;
+            }
+            let columns = &index[start[first]..start[first + 1]];
+            let m = columns.len();
+            for (g, &k) in gathered.iter_mut().zip(columns) {
+                *g = v[k];
+            }
+            for r in first..(first + rows).min(nefc) {
+                let mut s = 0.0;
+                for (&j_rk, &v_k) in value[start[r]..start[r] + m].iter().zip(&gathered[..m]) {
+                    s += j_rk * v_k;
+                }
+                vel[r] = s;
+            }
+            i = i.max(first + rows);
+        }
+        while i < nefc {
+            vel[i] = row(i);
+            i += 1;
         }
     } else {
         let stride = data.efc_j.nrows();

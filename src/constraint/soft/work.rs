@@ -59,6 +59,8 @@ pub(crate) struct SoftWork {
     pub dof_axes: super::contact_columns::DofAxes,
     /// The contacts' rows as recorded, (first row, rows): each contact's rows share their columns.
     pub contact_blocks: Vec<(usize, usize)>,
+    /// A vector's entries on one block's columns (nv; the velocity stage's J v).
+    pub gathered: Vec<f64>,
     /// (row, column) of J's nonzeros in column order, while `nz_start`/`nz_index` are built.
     pub nz_scratch: Vec<(usize, usize)>,
     /// Scratch of a row group's Hessian term while H is assembled (`hessian::scratch_len`).
@@ -106,6 +108,7 @@ impl SoftWork {
             edge_values: vec![[0.0; 10]; nv],
             dof_axes: super::contact_columns::DofAxes::new(nv),
             contact_blocks: Vec::with_capacity(nefc),
+            gathered: vec![0.0; nv],
             nz_scratch: Vec::new(),
             hessian_column: vec![0.0; super::hessian::scratch_len(nv)],
             islands: super::island::Islands::with_capacity(nv, nefc),
