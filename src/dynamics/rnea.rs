@@ -44,12 +44,19 @@ pub(crate) fn rnea_unchecked<'d>(
     v: &[f64],
     qacc: &[f64],
 ) -> &'d DVector<f64> {
-    data.poses_stamp.keep_if(q);
+    // The joint transforms and subspaces of an earlier pass at this q (the position stage's, the
+    // same bits) are not formed again (`Data::poses_stamp`).
+    let posed = data.poses_stamp.matches(q);
+    if !posed {
+        data.poses_stamp.clear();
+    }
     data.v_body[0] = Motion::zero();
     data.a_body[0] = Motion::new(Vec3::zeros(), -model.gravity);
     // Pass 1, root to leaves: body velocities, accelerations and the net force each needs.
     for b in 1..model.nbody() {
-        update_joint(model, data, b, q);
+        if !posed {
+            update_joint(model, data, b, q);
+        }
         let p = model.bodies[b].parent;
         let x = data.x_parent_body[b];
         let v_joint = joint_velocity(model, data, b, v);
