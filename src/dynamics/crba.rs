@@ -343,19 +343,22 @@ fn factorize_shifted(model: &Model, data: &mut Data, shift: Option<(f64, &[f64])
         unsafe { factorize_avx2(model, data, shift) };
         return;
     }
-    factorize_kernel(model, data, shift);
+    factorize_kernel::<false>(model, data, shift);
 }
 
-/// [`factorize_kernel`] compiled for AVX2: its updates four entries wide. Rust never fuses a
-/// product and a sum unasked, so the factor has the same bits as the portable kernel's.
+/// [`factorize_kernel`] compiled for AVX2: its updates four entries wide ([`sub_scaled`]). Rust
+/// never fuses a product and a sum unasked, so the factor has the same bits as the portable
+/// kernel's.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn factorize_avx2(model: &Model, data: &mut Data, shift: Option<(f64, &[f64])>) {
-    factorize_kernel(model, data, shift);
+    factorize_kernel::<true>(model, data, shift);
 }
 
+/// The factorization; `AVX2`: the caller is compiled for AVX2 (its updates through
+/// [`sub_scaled`]'s vector arm).
 #[inline(always)]
-fn factorize_kernel(model: &Model, data: &mut Data, shift: Option<(f64, &[f64])>) {
+fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Option<(f64, &[f64])>) {
     let lambda = &model.dof_parent[..model.nv];
     let nv = model.nv;
     let Data { mass_matrix, mass_factor, warnings, .. } = data;
@@ -392,19 +395,58 @@ fn factorize_kernel(model: &Model, data: &mut Data, shift: Option<(f64, &[f64])>
         let mut i = lambda[k];
         while i != NO_DOF {
             let a = col_k[i] / d_k;
-            let col_i = &mut before[i * nv..i * nv + i + 1];
             // Column k is nonzero only on k's chain, whose rows up to i are i's chain: the
             // update runs over i's span from its chain's first dof (the same bits on the chain
             // as the whole column, without the products with zeros of other trees).
-            for (x, y) in col_i[lo..].iter_mut().zip(&col_k[lo..=i]) {
-                *x -= a * y;
-            }
+            sub_scaled::<AVX2>(&mut before[i * nv + lo..=i * nv + i], &col_k[lo..=i], a);
             col_k[i] = a;
             i = lambda[i];
         }
     }
     if let Some(first) = singular {
         warnings.singular_factor(first);
+    }
+}
+
+/// `x −= a · y` entry by entry over the shorter of the two. With `AVX2` (only in code compiled
+/// for AVX2) four entries per instruction, the last one to three through a masked load and
+/// store: the factorization's updates are short (a few entries on each of a few hundred pairs
+/// for a humanoid), where the compiler's own loop spends more on its set-up (a run-time check
+/// that the slices do not overlap, a scalar remainder) than on the arithmetic. Each entry gets
+/// the same two operations, a product then a difference, rounded once each: the same bits
+/// either way.
+#[inline(always)]
+fn sub_scaled<const AVX2: bool>(x: &mut [f64], y: &[f64], a: f64) {
+    let n = x.len().min(y.len());
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        use std::arch::x86_64::{
+            _mm256_cmpgt_epi64, _mm256_loadu_pd, _mm256_maskload_pd, _mm256_maskstore_pd, _mm256_mul_pd,
+            _mm256_set1_epi64x, _mm256_set1_pd, _mm256_setr_epi64x, _mm256_storeu_pd, _mm256_sub_pd,
+        };
+        let (xp, yp) = (x.as_mut_ptr(), y.as_ptr());
+        // SAFETY: `AVX2` is set only where the caller is compiled for AVX2 (`factorize_avx2`);
+        // every load and store stays within the first n entries of both slices (the masked
+        // lanes past n are neither read nor written), and `x` and `y` are distinct borrows.
+        unsafe {
+            let av = _mm256_set1_pd(a);
+            let mut j = 0;
+            while j + 4 <= n {
+                let (xv, yv) = (_mm256_loadu_pd(xp.add(j)), _mm256_loadu_pd(yp.add(j)));
+                _mm256_storeu_pd(xp.add(j), _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
+                j += 4;
+            }
+            if j < n {
+                let left = _mm256_set1_epi64x((n - j) as i64);
+                let mask = _mm256_cmpgt_epi64(left, _mm256_setr_epi64x(0, 1, 2, 3));
+                let (xv, yv) = (_mm256_maskload_pd(xp.add(j), mask), _mm256_maskload_pd(yp.add(j), mask));
+                _mm256_maskstore_pd(xp.add(j), mask, _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
+            }
+        }
+        return;
+    }
+    for (xj, yj) in x[..n].iter_mut().zip(&y[..n]) {
+        *xj -= a * yj;
     }
 }
 
