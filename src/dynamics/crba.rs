@@ -2,7 +2,7 @@
 //! factorization and solve (RBDA §6.3, Tables 6.3–6.4).
 
 use crate::error::{check, InputError};
-use crate::kinematics::body_world_pose;
+use crate::kinematics::{body_world_pose, posed_world_pose};
 use crate::model::warning::MIN_PIVOT;
 use crate::model::{Data, HingeAxis, JointKind, Model, NO_DOF};
 #[cfg(target_arch = "x86_64")]
@@ -97,7 +97,7 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
     // for `x_world_body`, whose world poses of this q, if it holds them, survive).
     let world_current = data.poses_stamp.matches(q);
     std::mem::swap(&mut data.x_world_body, &mut data.x_tree_body);
-    crba_passes::<A, MIRROR>(model, data, q);
+    crba_passes::<A, MIRROR>(model, data, q, world_current);
     std::mem::swap(&mut data.x_world_body, &mut data.x_tree_body);
     if !world_current {
         // The world poses: the tree's origin added back.
@@ -110,8 +110,10 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
     }
 }
 
+/// `posed`: the joint transforms and subspaces (`x_parent_body`, `s_body`) are already q's
+/// (`Data::poses_stamp`), so pass 1 composes the poses from them instead of forming them again.
 #[inline(always)]
-fn crba_passes<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64]) {
+fn crba_passes<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64], posed: bool) {
     // A floating base (a free joint on the world, numbered first, with an unrotated placement):
     // its six columns are (0, eᵢ) and (R eᵢ, p × R eᵢ) in world coordinates (R, p its pose), so
     // the six entries of a descendant's F are F_lin and Rᵀ (F_ang − p × F_lin), the moment about
@@ -127,9 +129,9 @@ fn crba_passes<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
         // Hinges apart, each arm with its own copy of the body's work: a shared body with a
         // branch in the middle spills the pose to the stack.
         if model.hinge_axis[b] != HingeAxis::Other {
-            body_pass::<A, true>(model, data, b, q, false);
+            body_pass::<A, true>(model, data, b, q, false, posed);
         } else {
-            body_pass::<A, false>(model, data, b, q, floating_base && b == 1);
+            body_pass::<A, false>(model, data, b, q, floating_base && b == 1, posed);
         }
     }
     let nv = model.nv;
@@ -179,7 +181,8 @@ fn crba_passes<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
 /// a tree's root body is placed at zero and its world position kept in `data.p_world_tree`), the
 /// columns of its degrees of freedom in those coordinates (none for a floating base,
 /// `no_columns`) and its inertia in them. `HINGE`: b's joint is a hinge about a coordinate axis,
-/// whose column is (R a, p × R a).
+/// whose column is (R a, p × R a). `posed`: b's joint transform is already q's
+/// ([`posed_world_pose`]).
 #[inline(always)]
 fn body_pass<A: MulAdd, const HINGE: bool>(
     model: &Model,
@@ -187,8 +190,13 @@ fn body_pass<A: MulAdd, const HINGE: bool>(
     b: usize,
     q: &[f64],
     no_columns: bool,
+    posed: bool,
 ) {
-    let mut x_world_body = body_world_pose::<A, HINGE>(model, data, b, q);
+    let mut x_world_body = if posed {
+        posed_world_pose::<A, HINGE>(model, data, b)
+    } else {
+        body_world_pose::<A, HINGE>(model, data, b, q)
+    };
     let parent = model.bodies[b].parent;
     if parent == 0 {
         data.p_world_tree[b] = x_world_body.pos;
