@@ -240,8 +240,23 @@ pub(crate) fn body_poses(model: &Model, data: &mut Data, q: &[f64]) {
     if data.poses_stamp.matches(q) {
         return;
     }
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `body_poses_avx2` requires.
+        unsafe { body_poses_avx2(model, data, q) };
+        data.poses_stamp.set(q);
+        return;
+    }
     body_poses_with::<Separate>(model, data, q);
     data.poses_stamp.set(q);
+}
+
+/// [`body_poses`]' pass compiled for AVX2, as ABA's: separate multiplies and adds (no fused
+/// multiply–add), so the bits of the baseline build.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn body_poses_avx2(model: &Model, data: &mut Data, q: &[f64]) {
+    body_poses_with::<Separate>(model, data, q);
 }
 
 #[inline(always)]
