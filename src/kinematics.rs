@@ -77,25 +77,48 @@ pub(crate) fn revolute_placement(
 /// s' = ±s by the axis's sign; the third is kept.
 #[inline(always)]
 fn turn_columns<A: MulAdd>(r: &Mat3, axis: &Vec3, principal: HingeAxis, s: f64, c: f64) -> Mat3 {
+    let signed = match principal {
+        HingeAxis::X => s * axis.x,
+        HingeAxis::Y => s * axis.y,
+        _ => s * axis.z,
+    };
+    turn_columns_signed::<A>(r, principal, signed, c)
+}
+
+/// [`turn_columns`] from s' = ±s (the sine times the axis's sign, as [`principal_rotation`]
+/// stores it) and c.
+#[inline(always)]
+fn turn_columns_signed<A: MulAdd>(r: &Mat3, principal: HingeAxis, s: f64, c: f64) -> Mat3 {
     let col = |i: usize| r.column(i).into_owned();
-    let turn = |u: Vec3, w: Vec3, s: f64| {
+    let turn = |u: Vec3, w: Vec3| {
         let f = |k: usize| (A::madd(w[k], s, u[k] * c), A::madd(-u[k], s, w[k] * c));
         let (a, b, d) = (f(0), f(1), f(2));
         (Vec3::new(a.0, b.0, d.0), Vec3::new(a.1, b.1, d.1))
     };
     match principal {
         HingeAxis::X => {
-            let (n1, n2) = turn(col(1), col(2), s * axis.x);
+            let (n1, n2) = turn(col(1), col(2));
             Mat3::from_columns(&[col(0), n1, n2])
         }
         HingeAxis::Y => {
-            let (n2, n0) = turn(col(2), col(0), s * axis.y);
+            let (n2, n0) = turn(col(2), col(0));
             Mat3::from_columns(&[n0, col(1), n2])
         }
         _ => {
-            let (n0, n1) = turn(col(0), col(1), s * axis.z);
+            let (n0, n1) = turn(col(0), col(1));
             Mat3::from_columns(&[n0, n1, col(2)])
         }
+    }
+}
+
+/// (s', c) back from a [`principal_rotation`] `rot` about `principal`: the entries it stored,
+/// the same bits.
+#[inline(always)]
+fn principal_sin_cos(rot: &Mat3, principal: HingeAxis) -> (f64, f64) {
+    match principal {
+        HingeAxis::X => (rot[(2, 1)], rot[(1, 1)]),
+        HingeAxis::Y => (rot[(0, 2)], rot[(0, 0)]),
+        _ => (rot[(1, 0)], rot[(0, 0)]),
     }
 }
 
@@ -156,6 +179,29 @@ fn set_hinge_column(data: &mut Data, dof: usize, axis: &Vec3) {
     s.lin = Vec3::zeros();
 }
 
+/// [`body_world_pose`] of a body whose joint transform and subspace are already those of the
+/// configuration (`x_parent_body[b]`, `s_body`: an earlier pass at the same q,
+/// `Data::poses_stamp`): the same bits, without forming the joint again (no sine or cosine: a
+/// hinge on an unrotated placement reads them back from its `x_parent_body` rotation).
+#[inline(always)]
+pub(crate) fn posed_world_pose<A: MulAdd, const HINGE: bool>(
+    model: &Model,
+    data: &Data,
+    b: usize,
+) -> Transform {
+    let body = &model.bodies[b];
+    let x_world_parent = &data.x_world_body[body.parent];
+    let x_parent_body = &data.x_parent_body[b];
+    if HINGE && model.placement_unrotated[b] {
+        let principal = model.hinge_axis[b];
+        let (s, c) = principal_sin_cos(&x_parent_body.rot, principal);
+        let rot = turn_columns_signed::<A>(&x_world_parent.rot, principal, s, c);
+        let pos = fused::mat_vec_add::<A>(&x_world_parent.rot, &body.x_parent_joint.pos, &x_world_parent.pos);
+        return Transform::new(rot, pos);
+    }
+    fused::compose::<A>(x_world_parent, x_parent_body)
+}
+
 /// Body b's world pose `x_world_parent · x_parent_body` (returned, not stored), after its joint's
 /// update ([`update_joint`]); `HINGE` (the body's hinge turns about a coordinate axis, checked by
 /// the caller against `Model::hinge_axis`) takes [`hinge_world_pose`]. A constant, so that a
@@ -194,8 +240,23 @@ pub(crate) fn body_poses(model: &Model, data: &mut Data, q: &[f64]) {
     if data.poses_stamp.matches(q) {
         return;
     }
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `body_poses_avx2` requires.
+        unsafe { body_poses_avx2(model, data, q) };
+        data.poses_stamp.set(q);
+        return;
+    }
     body_poses_with::<Separate>(model, data, q);
     data.poses_stamp.set(q);
+}
+
+/// [`body_poses`]' pass compiled for AVX2, as ABA's: separate multiplies and adds (no fused
+/// multiply–add), so the bits of the baseline build.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn body_poses_avx2(model: &Model, data: &mut Data, q: &[f64]) {
+    body_poses_with::<Separate>(model, data, q);
 }
 
 #[inline(always)]

@@ -103,12 +103,19 @@ unsafe fn aba_avx2(model: &Model, data: &mut Data, q: &[f64], v: &[f64], tau: &[
 #[inline(always)]
 fn aba_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], tau: &[f64]) {
     let nb = model.nbody();
-    data.poses_stamp.keep_if(q);
+    // The joint transforms and subspaces of an earlier pass at this q (the collision pass's,
+    // the same bits) are not formed again (`Data::poses_stamp`).
+    let posed = data.poses_stamp.matches(q);
+    if !posed {
+        data.poses_stamp.clear();
+    }
     data.v_body[0] = Motion::zero();
     // Pass 1, root to leaves: velocities, velocity-product accelerations c, and the rigid-body
     // inertias and bias forces pᴬ = v ×* I v that start the articulated quantities.
     for b in 1..nb {
-        update_joint(model, data, b, q);
+        if !posed {
+            update_joint(model, data, b, q);
+        }
         let p = model.bodies[b].parent;
         let v_joint = joint_velocity(model, data, b, v);
         let v_body = data.x_parent_body[b].inv_act_motion(&data.v_body[p]) + v_joint;

@@ -2,7 +2,7 @@
 //! factorization and solve (RBDA §6.3, Tables 6.3–6.4).
 
 use crate::error::{check, InputError};
-use crate::kinematics::body_world_pose;
+use crate::kinematics::{body_world_pose, posed_world_pose};
 use crate::model::warning::MIN_PIVOT;
 use crate::model::{Data, HingeAxis, JointKind, Model, NO_DOF};
 #[cfg(target_arch = "x86_64")]
@@ -97,7 +97,7 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
     // for `x_world_body`, whose world poses of this q, if it holds them, survive).
     let world_current = data.poses_stamp.matches(q);
     std::mem::swap(&mut data.x_world_body, &mut data.x_tree_body);
-    crba_passes::<A, MIRROR>(model, data, q);
+    crba_passes::<A, MIRROR>(model, data, q, world_current);
     std::mem::swap(&mut data.x_world_body, &mut data.x_tree_body);
     if !world_current {
         // The world poses: the tree's origin added back.
@@ -110,8 +110,10 @@ fn crba_kernel<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
     }
 }
 
+/// `posed`: the joint transforms and subspaces (`x_parent_body`, `s_body`) are already q's
+/// (`Data::poses_stamp`), so pass 1 composes the poses from them instead of forming them again.
 #[inline(always)]
-fn crba_passes<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64]) {
+fn crba_passes<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q: &[f64], posed: bool) {
     // A floating base (a free joint on the world, numbered first, with an unrotated placement):
     // its six columns are (0, eᵢ) and (R eᵢ, p × R eᵢ) in world coordinates (R, p its pose), so
     // the six entries of a descendant's F are F_lin and Rᵀ (F_ang − p × F_lin), the moment about
@@ -127,9 +129,9 @@ fn crba_passes<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
         // Hinges apart, each arm with its own copy of the body's work: a shared body with a
         // branch in the middle spills the pose to the stack.
         if model.hinge_axis[b] != HingeAxis::Other {
-            body_pass::<A, true>(model, data, b, q, false);
+            body_pass::<A, true>(model, data, b, q, false, posed);
         } else {
-            body_pass::<A, false>(model, data, b, q, floating_base && b == 1);
+            body_pass::<A, false>(model, data, b, q, floating_base && b == 1, posed);
         }
     }
     let nv = model.nv;
@@ -179,7 +181,8 @@ fn crba_passes<A: MulAdd, const MIRROR: bool>(model: &Model, data: &mut Data, q:
 /// a tree's root body is placed at zero and its world position kept in `data.p_world_tree`), the
 /// columns of its degrees of freedom in those coordinates (none for a floating base,
 /// `no_columns`) and its inertia in them. `HINGE`: b's joint is a hinge about a coordinate axis,
-/// whose column is (R a, p × R a).
+/// whose column is (R a, p × R a). `posed`: b's joint transform is already q's
+/// ([`posed_world_pose`]).
 #[inline(always)]
 fn body_pass<A: MulAdd, const HINGE: bool>(
     model: &Model,
@@ -187,8 +190,13 @@ fn body_pass<A: MulAdd, const HINGE: bool>(
     b: usize,
     q: &[f64],
     no_columns: bool,
+    posed: bool,
 ) {
-    let mut x_world_body = body_world_pose::<A, HINGE>(model, data, b, q);
+    let mut x_world_body = if posed {
+        posed_world_pose::<A, HINGE>(model, data, b)
+    } else {
+        body_world_pose::<A, HINGE>(model, data, b, q)
+    };
     let parent = model.bodies[b].parent;
     if parent == 0 {
         data.p_world_tree[b] = x_world_body.pos;
@@ -343,19 +351,22 @@ fn factorize_shifted(model: &Model, data: &mut Data, shift: Option<(f64, &[f64])
         unsafe { factorize_avx2(model, data, shift) };
         return;
     }
-    factorize_kernel(model, data, shift);
+    factorize_kernel::<false>(model, data, shift);
 }
 
-/// [`factorize_kernel`] compiled for AVX2: its updates four entries wide. Rust never fuses a
-/// product and a sum unasked, so the factor has the same bits as the portable kernel's.
+/// [`factorize_kernel`] compiled for AVX2: its updates four entries wide ([`sub_scaled`]). Rust
+/// never fuses a product and a sum unasked, so the factor has the same bits as the portable
+/// kernel's.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn factorize_avx2(model: &Model, data: &mut Data, shift: Option<(f64, &[f64])>) {
-    factorize_kernel(model, data, shift);
+    factorize_kernel::<true>(model, data, shift);
 }
 
+/// The factorization; `AVX2`: the caller is compiled for AVX2 (its updates through
+/// [`sub_scaled`]'s vector arm).
 #[inline(always)]
-fn factorize_kernel(model: &Model, data: &mut Data, shift: Option<(f64, &[f64])>) {
+fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Option<(f64, &[f64])>) {
     let lambda = &model.dof_parent[..model.nv];
     let nv = model.nv;
     let Data { mass_matrix, mass_factor, warnings, .. } = data;
@@ -392,19 +403,58 @@ fn factorize_kernel(model: &Model, data: &mut Data, shift: Option<(f64, &[f64])>
         let mut i = lambda[k];
         while i != NO_DOF {
             let a = col_k[i] / d_k;
-            let col_i = &mut before[i * nv..i * nv + i + 1];
             // Column k is nonzero only on k's chain, whose rows up to i are i's chain: the
             // update runs over i's span from its chain's first dof (the same bits on the chain
             // as the whole column, without the products with zeros of other trees).
-            for (x, y) in col_i[lo..].iter_mut().zip(&col_k[lo..=i]) {
-                *x -= a * y;
-            }
+            sub_scaled::<AVX2>(&mut before[i * nv + lo..=i * nv + i], &col_k[lo..=i], a);
             col_k[i] = a;
             i = lambda[i];
         }
     }
     if let Some(first) = singular {
         warnings.singular_factor(first);
+    }
+}
+
+/// `x −= a · y` entry by entry over the shorter of the two. With `AVX2` (only in code compiled
+/// for AVX2) four entries per instruction, the last one to three through a masked load and
+/// store: the factorization's updates are short (a few entries on each of a few hundred pairs
+/// for a humanoid), where the compiler's own loop spends more on its set-up (a run-time check
+/// that the slices do not overlap, a scalar remainder) than on the arithmetic. Each entry gets
+/// the same two operations, a product then a difference, rounded once each: the same bits
+/// either way.
+#[inline(always)]
+fn sub_scaled<const AVX2: bool>(x: &mut [f64], y: &[f64], a: f64) {
+    let n = x.len().min(y.len());
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        use std::arch::x86_64::{
+            _mm256_cmpgt_epi64, _mm256_loadu_pd, _mm256_maskload_pd, _mm256_maskstore_pd, _mm256_mul_pd,
+            _mm256_set1_epi64x, _mm256_set1_pd, _mm256_setr_epi64x, _mm256_storeu_pd, _mm256_sub_pd,
+        };
+        let (xp, yp) = (x.as_mut_ptr(), y.as_ptr());
+        // SAFETY: `AVX2` is set only where the caller is compiled for AVX2 (`factorize_avx2`);
+        // every load and store stays within the first n entries of both slices (the masked
+        // lanes past n are neither read nor written), and `x` and `y` are distinct borrows.
+        unsafe {
+            let av = _mm256_set1_pd(a);
+            let mut j = 0;
+            while j + 4 <= n {
+                let (xv, yv) = (_mm256_loadu_pd(xp.add(j)), _mm256_loadu_pd(yp.add(j)));
+                _mm256_storeu_pd(xp.add(j), _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
+                j += 4;
+            }
+            if j < n {
+                let left = _mm256_set1_epi64x((n - j) as i64);
+                let mask = _mm256_cmpgt_epi64(left, _mm256_setr_epi64x(0, 1, 2, 3));
+                let (xv, yv) = (_mm256_maskload_pd(xp.add(j), mask), _mm256_maskload_pd(yp.add(j), mask));
+                _mm256_maskstore_pd(xp.add(j), mask, _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
+            }
+        }
+        return;
+    }
+    for (xj, yj) in x[..n].iter_mut().zip(&y[..n]) {
+        *xj -= a * yj;
     }
 }
 
@@ -464,6 +514,31 @@ pub(crate) fn solve_with_factor_span_unchecked(
     model: &Model,
     factor: &DMatrix<f64>,
     x: &mut [f64],
+    span: (usize, usize),
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `solve_span_avx2` requires.
+        unsafe { solve_span_avx2(model, factor, x, span) };
+        return;
+    }
+    solve_span_kernel::<false>(model, factor, x, span);
+}
+
+/// [`solve_span_kernel`] compiled for AVX2: the updates of Lᵀ z = b four entries wide
+/// ([`sub_scaled`]), the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn solve_span_avx2(model: &Model, factor: &DMatrix<f64>, x: &mut [f64], span: (usize, usize)) {
+    solve_span_kernel::<true>(model, factor, x, span);
+}
+
+/// [`solve_with_factor_span_unchecked`]; `AVX2`: the caller is compiled for AVX2.
+#[inline(always)]
+fn solve_span_kernel<const AVX2: bool>(
+    model: &Model,
+    factor: &DMatrix<f64>,
+    x: &mut [f64],
     (lo, hi): (usize, usize),
 ) {
     let lambda = &model.dof_parent[..model.nv];
@@ -473,11 +548,7 @@ pub(crate) fn solve_with_factor_span_unchecked(
     for i in (lo..hi).rev() {
         let (col_i, x_i) = (&h[i * nv..(i + 1) * nv], x[i]);
         if lambda[i] != NO_DOF {
-            for_each_run(model, lambda[i], |s, e| {
-                for (xj, l) in x[s..=e].iter_mut().zip(&col_i[s..=e]) {
-                    *xj -= l * x_i;
-                }
-            });
+            for_each_run(model, lambda[i], |s, e| sub_scaled::<AVX2>(&mut x[s..=e], &col_i[s..=e], x_i));
         }
     }
     for i in lo..hi {

@@ -65,6 +65,13 @@ pub(crate) struct RnePost {
     /// accelerometers and frame accelerations read, and the mocap bodies (`cfrc_int` reads
     /// theirs).
     sensed: Vec<bool>,
+    /// The MuJoCo bodies whose `cfrc_int` the sensor stage forms: the subtrees of the bodies its
+    /// computed force and torque sensors read (a body's `cfrc_int` carries its whole subtree).
+    wrench_sensed: Vec<bool>,
+    /// Per compiled body, whether the sensor stage forms its acceleration: the compiled bodies of
+    /// the [`sensed`](Self::sensed) and [`wrench_sensed`](Self::wrench_sensed) MuJoCo bodies and
+    /// their ancestors (an acceleration is formed from its parent's).
+    accelerated: Vec<bool>,
     /// Each body's centre of mass, world (MuJoCo's `xipos`).
     pub(crate) xipos: Vec<Vec3>,
     /// The mass of each body's subtree (MuJoCo's `body_subtreemass`).
@@ -93,11 +100,15 @@ impl RnePost {
         }
         let n = parent.len();
         let frames = || model.links.frame.iter().map(|&f| &model.frames[f]);
+        let (sensed, wrench_sensed) = (sensed_bodies(model), wrench_sensed_bodies(model));
+        let accelerated = accelerated_bodies(model, &sensed, &wrench_sensed);
         Self {
             rootid,
             inertia_body: frames().map(|f| f.inertia.transformed(&f.x_body_frame)).collect(),
             com_body: frames().map(|f| f.x_body_frame.act_point(&f.inertia.com())).collect(),
-            sensed: sensed_bodies(model),
+            sensed,
+            wrench_sensed,
+            accelerated,
             xipos: vec![Vec3::zeros(); n],
             subtree_mass: vec![0.0; n],
             subtree_com: vec![Vec3::zeros(); n],
@@ -130,6 +141,46 @@ fn sensed_bodies(model: &Model) -> Vec<bool> {
         }
     }
     sensed
+}
+
+/// Per MuJoCo body, whether the sensor stage forms its `cfrc_int` ([`RnePost::wrench_sensed`]):
+/// the bodies of the sites of the computed force and torque sensors and their descendants (MuJoCo
+/// numbers a parent before its children).
+fn wrench_sensed_bodies(model: &Model) -> Vec<bool> {
+    use crate::sensor::{SensorObject, SensorType};
+    let links = &model.links;
+    let mut sensed = vec![false; links.len()];
+    for s in model.sensors.iter().filter(|s| s.is_computed()) {
+        if let (SensorType::Force | SensorType::Torque, SensorObject::Site(f)) = (s.kind, s.object) {
+            if let Some(flag) = links.of_frame.get(f).and_then(|&b| sensed.get_mut(b)) {
+                *flag = true;
+            }
+        }
+    }
+    for b in 1..links.len() {
+        if sensed[links.parent[b]] {
+            sensed[b] = true;
+        }
+    }
+    sensed
+}
+
+/// Per compiled body, whether the sensor stage forms its acceleration ([`RnePost::accelerated`]):
+/// those of the MuJoCo bodies in `sensed` or `wrench_sensed`, and their ancestors (a compiled
+/// body's parent comes before it).
+fn accelerated_bodies(model: &Model, sensed: &[bool], wrench_sensed: &[bool]) -> Vec<bool> {
+    let mut accelerated = vec![false; model.nbody()];
+    for (b, &f) in model.links.frame.iter().enumerate() {
+        if sensed[b] || wrench_sensed[b] {
+            accelerated[model.frames[f].body] = true;
+        }
+    }
+    for b in (1..model.nbody()).rev() {
+        if accelerated[b] {
+            accelerated[model.bodies[b].parent] = true;
+        }
+    }
+    accelerated
 }
 
 /// MuJoCo's `mj_rnePostConstraint` at the state in `data` (`qpos`, `qvel`) with the outputs of
@@ -187,7 +238,8 @@ pub fn rne_post_constraint(model: &Model, data: &mut Data) -> Result<(), InputEr
 /// `wrenches` (the sensor stage when no force or torque sensor reads them) `cfrc_ext` and
 /// `cfrc_int` are left zero and only the accelerations are formed. With `sensed_only` (the
 /// sensor stage) `cvel` and `cacc` are formed only for the bodies the model's acceleration sensors
-/// read (and mocap bodies), zero for the others. `centres`, when the caller has them at `q`
+/// read (and mocap bodies), zero for the others, and `cfrc_int` only for the subtrees its force and
+/// torque sensors read, zero for the other bodies (the world's too, unless a sensor reads it). `centres`, when the caller has them at `q`
 /// (the sensor stage's subtree sensors), are each MuJoCo body's centre of mass, its subtree's mass
 /// and centre of mass (`xipos`, `body_subtreemass`, `subtree_com`), used instead of forming them
 /// again.
@@ -202,7 +254,7 @@ pub(crate) fn rne_post_constraint_at(
 ) {
     let mut w = std::mem::take(&mut data.rne_post);
     body_poses(model, data, q);
-    compiled_motions(model, data, &mut w, v);
+    compiled_motions(model, data, &mut w, v, sensed_only);
     // The caller's centres when they follow this file's rule (the world's own mass zero).
     let world_massless = model.links.frame.first().is_none_or(|&f| model.frames[f].inertia.mass == 0.0);
     match centres {
@@ -221,7 +273,7 @@ pub(crate) fn rne_post_constraint_at(
     link_motions(model, data, &mut w, sensed_only);
     if wrenches {
         external_wrenches(model, data, &mut w);
-        interaction_wrenches(model, data, &mut w);
+        interaction_wrenches(model, data, &mut w, sensed_only);
     } else {
         w.cfrc_ext.fill(Force::zero());
         w.cfrc_int.fill(Force::zero());
@@ -231,10 +283,14 @@ pub(crate) fn rne_post_constraint_at(
 
 /// Acceleration of every compiled body in its own coordinates at (`v`, `qacc`), the world
 /// accelerating at −gravity (RNEA's forward pass, RBDA Table 5.1), with the velocities `v_body`
-/// at `v` (the same pass's, `forward_velocities`). Needs `body_poses`.
-fn compiled_motions(model: &Model, data: &Data, w: &mut RnePost, v: &[f64]) {
+/// at `v` (the same pass's, `forward_velocities`). Needs `body_poses`. With `sensed_only`, only
+/// of the [`RnePost::accelerated`] bodies (the others' are left as they were: nothing reads them).
+fn compiled_motions(model: &Model, data: &Data, w: &mut RnePost, v: &[f64], sensed_only: bool) {
     w.a_body[0] = Motion::new(Vec3::zeros(), -model.gravity);
     for b in 1..model.nbody() {
+        if sensed_only && !w.accelerated[b] {
+            continue;
+        }
         let j = model.joint_of(b);
         let mut v_joint = Motion::zero();
         let mut a_joint = Motion::zero();
@@ -412,11 +468,17 @@ fn add_equality(model: &Model, data: &Data, w: &mut RnePost, id: usize, r: usize
 /// children's about their own points, as MuJoCo's does). The inertial wrench is formed in the
 /// compiled body's coordinates, where the body's inertia is constant, and moved to world axes
 /// about the body's point (one force transform instead of an inertia transform per body); a mocap
-/// body's, in world axes at its pose.
-fn interaction_wrenches(model: &Model, data: &Data, w: &mut RnePost) {
+/// body's, in world axes at its pose. With `sensed_only`, only of the
+/// [`RnePost::wrench_sensed`] bodies, zero for the others: a sensed body's subtree is sensed, so
+/// its sum is the same.
+fn interaction_wrenches(model: &Model, data: &Data, w: &mut RnePost, sensed_only: bool) {
     let links = &model.links;
     w.cfrc_int[0] = Force::zero();
     for b in 1..links.len() {
+        if sensed_only && !w.wrench_sensed[b] {
+            w.cfrc_int[b] = Force::zero();
+            continue;
+        }
         let frame = &model.frames[links.frame[b]];
         let point = w.subtree_com[w.rootid[b]];
         let f_body = match frame.mocap {
@@ -437,8 +499,12 @@ fn interaction_wrenches(model: &Model, data: &Data, w: &mut RnePost) {
         w.cfrc_int[b] = f_body - w.cfrc_ext[b];
     }
     for b in (1..links.len()).rev() {
+        let p = links.parent[b];
+        if sensed_only && !w.wrench_sensed[p] {
+            continue;
+        }
         let f = w.cfrc_int[b];
-        w.cfrc_int[links.parent[b]] += f;
+        w.cfrc_int[p] += f;
     }
 }
 

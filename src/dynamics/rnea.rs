@@ -44,12 +44,39 @@ pub(crate) fn rnea_unchecked<'d>(
     v: &[f64],
     qacc: &[f64],
 ) -> &'d DVector<f64> {
-    data.poses_stamp.keep_if(q);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `rnea_avx2` requires.
+        unsafe { rnea_avx2(model, data, q, v, qacc) };
+        return &data.tau;
+    }
+    rnea_kernel(model, data, q, v, qacc);
+    &data.tau
+}
+
+/// [`rnea_kernel`] compiled for AVX2, as ABA's: no fused multiply–add (Rust fuses none unasked),
+/// so the bits of the baseline build.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn rnea_avx2(model: &Model, data: &mut Data, q: &[f64], v: &[f64], qacc: &[f64]) {
+    rnea_kernel(model, data, q, v, qacc);
+}
+
+#[inline(always)]
+fn rnea_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], qacc: &[f64]) {
+    // The joint transforms and subspaces of an earlier pass at this q (the position stage's, the
+    // same bits) are not formed again (`Data::poses_stamp`).
+    let posed = data.poses_stamp.matches(q);
+    if !posed {
+        data.poses_stamp.clear();
+    }
     data.v_body[0] = Motion::zero();
     data.a_body[0] = Motion::new(Vec3::zeros(), -model.gravity);
     // Pass 1, root to leaves: body velocities, accelerations and the net force each needs.
     for b in 1..model.nbody() {
-        update_joint(model, data, b, q);
+        if !posed {
+            update_joint(model, data, b, q);
+        }
         let p = model.bodies[b].parent;
         let x = data.x_parent_body[b];
         let v_joint = joint_velocity(model, data, b, v);
@@ -79,7 +106,6 @@ pub(crate) fn rnea_unchecked<'d>(
             data.f_body[p] += f_parent;
         }
     }
-    &data.tau
 }
 
 /// Bias forces c(q, v) = RNEA(q, v, 0): Coriolis, centrifugal and gravity (MuJoCo's
