@@ -103,15 +103,30 @@ impl<'a> Assembler<'a> {
     /// Rows i..i + dim with the same columns and a dense block B: with G the rows' values,
     /// H[p][q] += Σ_a G_a[p] (B G)_a[q], p ≥ q.
     fn add_block(&mut self, i: usize, dim: usize, block: &[[f64; 6]; 6]) {
+        // The block's size a compile-time constant: its products unrolled whatever the
+        // surrounding code's inlining.
+        match dim {
+            1 => self.add_block_of::<1>(i, block),
+            2 => self.add_block_of::<2>(i, block),
+            3 => self.add_block_of::<3>(i, block),
+            4 => self.add_block_of::<4>(i, block),
+            5 => self.add_block_of::<5>(i, block),
+            _ => self.add_block_of::<BLOCK>(i, block),
+        }
+    }
+
+    /// [`Self::add_block`] of a `D` × `D` block: each column's coefficients B g_q summed over
+    /// b = 0 … D − 1 in order.
+    fn add_block_of<const D: usize>(&mut self, i: usize, block: &[[f64; 6]; 6]) {
         let cols = self.nz.columns(i);
-        let mut g: [&[f64]; BLOCK] = [&[]; BLOCK];
-        for (a, g) in g.iter_mut().enumerate().take(dim) {
+        let mut g: [&[f64]; D] = [&[]; D];
+        for (a, g) in g.iter_mut().enumerate() {
             *g = self.nz.row_values(i + a).1;
         }
-        add_columns(self.h, cols, &g[..dim], self.column, |g_q, c| {
+        add_columns(self.h, cols, &g, self.column, |g_q, c| {
             for (c, row) in c.iter_mut().zip(block) {
                 let mut s = 0.0;
-                for (&b_ab, &g_b) in row.iter().zip(g_q) {
+                for (&b_ab, &g_b) in row[..D].iter().zip(&g_q[..D]) {
                     s += b_ab * g_b;
                 }
                 *c = s;
