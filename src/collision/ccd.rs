@@ -2,9 +2,25 @@
 //! functions and `mjc_penetration` in engine_collision_convex.c), read for its semantics and
 //! written anew, so that the convex pairs stop where MuJoCo's stop: GJK with the signed-volume
 //! distance subalgorithm (Montanari et al., ToG 2017) and MuJoCo's Frank–Wolfe duality-gap stop
-//! (`ccd_tolerance`, exact on boxes and meshes without margin), its fallback intersection test on
-//! a tetrahedron, the initial polytope built from GJK's 1-, 2- or 3-simplex, and EPA with MuJoCo's
-//! face map, horizon and bounds (`ccd_tolerance`, `ccd_iterations`). Each geom is inflated by half
+//! (`ccd_tolerance`, exact on boxes and meshes without margin), the initial polytope built from
+//! GJK's 1-, 2- or 3-simplex, and EPA with MuJoCo's face map, horizon and bounds
+//! (`ccd_tolerance`, `ccd_iterations`).
+//!
+//! The C source read is a snapshot of 2026-08; the live MuJoCo 4.0.0 (the reference) differs from
+//! it in GJK, as its GPU port MuJoCo Warp 4.0.0 (same team, released with it; its Python source
+//! `collision_gjk.py`, read for semantics) shows and the goldens confirm (`tests/convex_mujoco.rs`,
+//! `docs/multiccd.md`):
+//! - on the contact path GJK runs until its simplex holds the origin: no hand-over of the first
+//!   tetrahedron to the snapshot's intersection test (`gjkIntersect`; Warp has none). With that
+//!   test, 25 golden cases of curved pairs parted from MuJoCo (cylinder–box 18 → 21 of 32,
+//!   cylinder–cylinder 14 → 19, cylinder–mesh 19 → 22, ellipsoid pairs +1 to +3 each; none
+//!   fewer). [`separated`], lagrange's own early-out, keeps the test (a proof of separation
+//!   either way);
+//! - the first step's norm is no stall (the starting x_k is no simplex point);
+//! - two discrete geoms search, once |x_k| < 1e-4, along the simplex's edge-orthogonal or
+//!   triangle-normal direction ([`gjk_direction`]), and the stopping tests read x_k along it.
+//!
+//! The last two change no golden case (kept as 4.0.0's semantics). Each geom is inflated by half
 //! the pair's margin (MuJoCo's `support`); spheres and capsules are first shrunk to their centre
 //! and segment (a shallow contact is then the distance of the cores less the radii).
 //!
@@ -187,6 +203,54 @@ fn gjk_support(o1: &mut CcdObj, o2: &mut CcdObj, x_k: &Vec3, x_norm: f64) -> Ver
     support(o1, o2, &dir, &dir_neg)
 }
 
+/// |x_k| below which GJK on two discrete geoms searches along a direction set by its simplex
+/// rather than x_k's own (MuJoCo 4.0's direction tuning).
+const TUNE_NORM: f64 = 1e-4;
+
+/// MuJoCo 4.0's search direction for GJK's next support point: x_k's, or, for two discrete geoms
+/// (boxes, meshes, prisms without margin) once |x_k| < [`TUNE_NORM`] — where x_k, the
+/// difference of nearly equal points, has lost its direction — the simplex's: with an edge
+/// (`n` = 2), x_k with the edge's component projected out; with a triangle (`n` = 3), the
+/// triangle's normal on x_k's side. Returns x_k along that direction (|x_k| kept), which the
+/// stopping tests read.
+fn gjk_direction(x_k: &Vec3, x_norm: f64, simplex: &[Vertex; 4], n: usize, discrete: bool) -> Vec3 {
+    if !discrete || x_norm >= TUNE_NORM {
+        return *x_k;
+    }
+    let dir = x_k * (1.0 / x_norm);
+    match n {
+        2 => {
+            let edge = simplex[1].vert - simplex[0].vert;
+            let len2 = edge.dot(&edge);
+            if len2 > MINVAL * MINVAL {
+                let d = dir - edge * (dir.dot(&edge) / len2);
+                let dnorm = d.norm();
+                if dnorm > MINVAL {
+                    return d * (x_norm / dnorm);
+                }
+            }
+            *x_k
+        }
+        3 => {
+            let normal = (simplex[1].vert - simplex[0].vert).cross(&(simplex[2].vert - simplex[0].vert));
+            let nnorm = normal.norm();
+            if nnorm > MINVAL {
+                let side = dir.dot(&normal);
+                let sign = if side > 0.0 {
+                    1.0
+                } else if side < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                };
+                return normal * (sign * x_norm / nnorm);
+            }
+            *x_k
+        }
+        _ => *x_k,
+    }
+}
+
 fn det3(a: &Vec3, b: &Vec3, c: &Vec3) -> f64 {
     a.x * (b.y * c.z - b.z * c.y) + a.y * (b.z * c.x - b.x * c.z) + a.z * (b.x * c.y - b.y * c.x)
 }
@@ -231,6 +295,10 @@ struct Status {
     /// When GJK proves the geoms apart by a support plane: the plane's normal direction x_k
     /// (zero otherwise).
     axis: Vec3,
+    /// Whether GJK, with no distance wanted, hands a tetrahedron to the intersection test
+    /// (`gjk_intersect`, the source snapshot's fallback). The live MuJoCo 4.0.0 does not on its
+    /// contact path (see [`penetration`]); [`separated`] does, as a faster proof of separation.
+    intersect_fallback: bool,
 }
 
 impl Status {
@@ -249,13 +317,14 @@ impl Status {
             simplex: [ZERO_VERTEX; 4],
             nsimplex: 0,
             axis: Vec3::zeros(),
+            intersect_fallback: false,
         }
     }
 }
 
 fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
     let get_dist = st.dist_cutoff > 0.0;
-    let mut backup = !get_dist;
+    let mut backup = !get_dist && st.intersect_fallback;
     let (mut n, mut k) = (0usize, 0usize);
     let kmax = st.max_iterations;
     let mut lambda = [0.0f64; 4];
@@ -276,19 +345,20 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
         if x_norm < min_norm || (x_norm_prev - x_norm).abs() < MINVAL {
             break;
         }
-        st.simplex[n] = gjk_support(o1, o2, &x_k, x_norm);
+        let x_dir = gjk_direction(&x_k, x_norm, &st.simplex, n, discrete);
+        st.simplex[n] = gjk_support(o1, o2, &x_dir, x_norm);
         let s_k = st.simplex[n].vert;
-        if x_k.dot(&(x_k - s_k)) < epsilon {
+        if x_dir.dot(&(x_dir - s_k)) < epsilon {
             break;
         }
-        let lower = x_k.dot(&s_k);
+        let lower = x_dir.dot(&s_k);
         if !get_dist {
             if lower > 0.0 {
-                st.axis = x_k;
+                st.axis = x_dir;
                 return separated(st, k);
             }
         } else if st.dist_cutoff < MAX_LIMIT && lower > 0.0 && lower >= st.dist_cutoff * x_norm {
-            st.axis = x_k;
+            st.axis = x_dir;
             return separated(st, k);
         }
         if n == 3 && backup {
@@ -317,7 +387,9 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
         }
         let s = &st.simplex;
         x_k = lincomb(&lambda[..n], [&s[0].vert, &s[1].vert, &s[2].vert, &s[3].vert]);
-        x_norm_prev = x_norm;
+        // MuJoCo 4.0: the first x_k is no simplex point, so a first step of the same norm is
+        // no stall (its source snapshot stopped there).
+        x_norm_prev = if k == 0 { 0.0 } else { x_norm };
         x_norm = x_k.norm();
         if n == 4 {
             break;
@@ -1172,6 +1244,7 @@ pub(crate) fn separated(
     let mut o2 = CcdObj::new(s2, x2, margin);
     (o1.meshindex, o2.meshindex) = (warm.index[0], warm.index[1]);
     let mut st = Status::start(x1, x2, tolerance, iterations);
+    st.intersect_fallback = true;
     let c1 = centre(s1, x1);
     // GJK's first direction is st.x1 − st.x2.
     (st.x1, st.x2) = if warm.axis != Vec3::zeros() { (c1, c1 - warm.axis) } else { (c1, centre(s2, x2)) };

@@ -24,6 +24,11 @@
 //!   faces, the first (faces outermost) within ~5.1° of parallel, and when none is, geom 2's
 //!   edges against geom 1's faces (the snapshot stops at the first test). With faces on both
 //!   geoms and none opposite, no choice (one contact).
+//!
+//! MuJoCo Warp 4.0.0 (the GPU port released with MuJoCo 4.0.0; its `collision_gjk.py` read for
+//! semantics, docs/multiccd.md) agrees on the most opposite pair, but stops after geom 1's edges
+//! and skips faces not facing the contact direction; tried against the goldens, its edge rule
+//! loses 1 box–mesh and 3 mesh–mesh cases and its facing test changes none, so neither is taken.
 
 use super::ccd::EpaFace;
 use super::multiccd::{Poly, EDGE_TOL, FACE_TOL};

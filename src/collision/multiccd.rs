@@ -27,8 +27,9 @@
 //!   line, within ~5.1° of parallel to a face of the polytope is clipped by the face (points on
 //!   the surface and on the face's plane, normal the face's reversed: a capsule lying on a face
 //!   gets its two ends); a cylinder's cap within ~5.1° of facing a face is clipped as a polygon
-//!   (four rim points at 22.5° + k·90° for a cylinder standing on a face — lagrange takes the cap
-//!   as a regular octagon at 22.5° + k·45°, which reproduces that); otherwise one contact.
+//!   (the cap as MuJoCo 4.0's regular 16-gon, vertex k at k·22.5° about the cylinder's x axis,
+//!   clockwise seen from outside the cap: MuJoCo Warp 4.0.0's `_cylinder_face`, and every
+//!   contact of the golden resting poses lies at a multiple of 22.5°); otherwise one contact.
 //! - **capsule–cylinder, cylinder–cylinder** (`mj_maxContact` 5): one contact at every pose
 //!   measured (lagrange gives one).
 //! - **a sphere or an ellipsoid**: one contact.
@@ -53,6 +54,8 @@ use std::cell::RefCell;
 pub(crate) const FACE_TOL: f64 = 0.996;
 /// |cosine| below which an edge counts as parallel to a face (MuJoCo's `mjEDGE_TOL`, ~5.1°).
 pub(crate) const EDGE_TOL: f64 = 0.0888;
+/// The sides of the regular polygon standing in for a cylinder's cap (MuJoCo 4.0's 16-gon).
+const CAP_SIDES: usize = 16;
 
 /// Scratch buffers of the clipping, reused per thread (no allocation once grown).
 #[derive(Default)]
@@ -441,8 +444,8 @@ fn edge_face(edges: &[Vec3], faces: &[(Vec3, u32)]) -> Option<(usize, usize)> {
 /// and of an edge to its two farthest points. The quadrilateral is MuJoCo 4.0's (the clipped
 /// polygon's first point fixed, [`super::plane_mesh::quad_from_first`]: measured black-box on 40
 /// box–prism faces, 38 the same points in the same order, the 2 others misread by the
-/// measurement); with `octagon` (a cylinder's cap, itself an octagon fitted to MuJoCo's cap
-/// contacts with this pruning) its 2026-08 source snapshot's `polygonQuad`, which that fit used.
+/// measurement); with `cap` (a cylinder's cap clipping a face) the rule fitted to MuJoCo 4.0's
+/// cap contacts ([`cap_quad`]).
 #[allow(clippy::too_many_arguments)]
 fn clip(
     face: &[Vec3],
@@ -450,7 +453,7 @@ fn clip(
     n: &Vec3,
     wit_dir: &Vec3,
     margin: f64,
-    octagon: bool,
+    cap: bool,
     poly: &mut Vec<Vec3>,
     scratch: &mut super::polygon_clip::ClipScratch,
     out: &mut dyn FnMut(Vec3, Vec3, f64),
@@ -481,11 +484,8 @@ fn clip(
         out(w1, w2, d);
     };
     if poly.len() > 4 {
-        let q = if octagon {
-            largest_quad(poly)
-        } else {
-            super::plane_mesh::quad_from_first(poly.len(), |i| poly[i])
-        };
+        let q =
+            if cap { cap_quad(poly) } else { super::plane_mesh::quad_from_first(poly.len(), |i| poly[i]) };
         for i in q {
             report(&poly[i]);
         }
@@ -510,67 +510,51 @@ fn clip(
     }
 }
 
-/// Area of quadrilateral abcd (half the norm of the sum of its two diagonal-split cross products).
-fn area4(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> f64 {
-    0.5 * ((d - a).cross(&(b - d)) + (c - b).cross(&(a - c))).norm()
+/// Area of the quadrilateral abcd (half the norm of its diagonals' cross product).
+fn area4d(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> f64 {
+    0.5 * (a - c).cross(&(b - d)).norm()
 }
 
-/// Four vertices of a convex polygon (more than four vertices) spanning a quadrilateral of
-/// large area: the `polygonQuad` search of MuJoCo's 2026-08 source snapshot (each corner advanced
-/// while its area formula grows, every vertex tried as the first), which depends on where the
-/// polygon starts (not always the largest). MuJoCo 4.0.0 fixes the first vertex instead.
-fn largest_quad(p: &[Vec3]) -> [usize; 4] {
+/// Four vertices of a cylinder cap's clipped polygon (more than four), the first fixed: the
+/// other three start a quarter, a half and three quarters along the polygon and each moves, in
+/// turn, either way while the quadrilateral's area grows, until none moves. A rule fitted to the
+/// live MuJoCo 4.0.0's contacts of a cylinder resting on a box (its source is not at hand): 6 of
+/// the 8 golden resting poses give MuJoCo's four points; the rule of polytope faces
+/// ([`super::plane_mesh::quad_from_first`]) gives 2.
+fn cap_quad(p: &[Vec3]) -> [usize; 4] {
     let n = p.len();
-    let next = |i: usize| (i + 1) % n;
-    let (mut b, mut c, mut d) = (1, 2, 3);
-    let mut res = [0, 1, 2, 3];
-    let mut m = area4(&p[0], &p[1], &p[2], &p[3]);
-    for a in 0..n {
-        loop {
-            let m_next = area4(&p[a], &p[b], &p[c], &p[next(d)]);
-            if m_next <= m {
-                break;
-            }
-            m = m_next;
-            d = next(d);
-            res = [a, b, c, d];
-            loop {
-                let m_next = area4(&p[a], &p[b], &p[next(c)], &p[d]);
-                if m_next <= m {
-                    break;
+    let mut q = [0, n / 4, n / 2, 3 * n / 4];
+    let area = |q: &[usize; 4]| area4d(&p[q[0]], &p[q[1]], &p[q[2]], &p[q[3]]);
+    let mut m = area(&q);
+    loop {
+        let mut moved = false;
+        for k in 1..4 {
+            for step in [1, n - 1] {
+                loop {
+                    let mut r = q;
+                    r[k] = (r[k] + step) % n;
+                    let a = area(&r);
+                    if a <= m {
+                        break;
+                    }
+                    q = r;
+                    m = a;
+                    moved = true;
                 }
-                m = m_next;
-                c = next(c);
-                res = [a, b, c, d];
-            }
-            loop {
-                let m_next = area4(&p[a], &p[next(b)], &p[c], &p[d]);
-                if m_next <= m {
-                    break;
-                }
-                m = m_next;
-                b = next(b);
-                res = [a, b, c, d];
             }
         }
-        if b == a {
-            b = next(b);
-            if c == b {
-                c = next(c);
-                if d == c {
-                    d = next(d);
-                }
-            }
+        if !moved {
+            break;
         }
     }
-    res
+    q
 }
 
 /// The contacts of a convex pair from GJK/EPA's first point `first` (penetrating or within the
 /// margin + gap), as MuJoCo 4.0 gives them with `multiccd` on (the caller asks only for pairs
 /// whose contact limit exceeds one; module documentation): polytopes by face and edge clipping
 /// ([`polytope_contacts`]), a capsule or a cylinder's side against a polytope face by segment
-/// clipping, a cylinder's cap against a polytope face as an octagon; `first` alone otherwise.
+/// clipping, a cylinder's cap against a polytope face as a 16-gon; `first` alone otherwise.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn convex_contacts(
     x1: &Transform,
@@ -599,7 +583,7 @@ pub(crate) fn convex_contacts(
         }
         (ConvexShape::Cylinder(c), Some(p2)) => {
             // The side's line at the contact when the axis is within ~5.1° of the contact plane;
-            // the cap as an octagon when it is within ~5.1° of the normal; else one contact.
+            // the cap as a 16-gon when it is within ~5.1° of the normal; else one contact.
             let axis = x1.rot.column(2).into_owned();
             let along = axis.dot(&first.normal);
             if along.abs() < EDGE_TOL {
@@ -620,10 +604,12 @@ pub(crate) fn convex_contacts(
 }
 
 /// A cylinder's cap (geom 1; `side` +1 the top, −1 the bottom) against a box or mesh hull: the
-/// cap as a regular octagon (vertices at 22.5° + k·45° about the cylinder's x axis, on the rim),
-/// clipped against the polytope's face opposite it like two polytope faces (MuJoCo 4.0's contacts
-/// of a cylinder standing on a face are four rim points at such angles: read from its contacts,
-/// its source snapshot turned the geoms). `first` alone when no face is opposite.
+/// cap as MuJoCo 4.0's regular 16-gon (vertex k at k·22.5° about the cylinder's x axis, on the
+/// rim, clockwise seen from outside the cap: MuJoCo Warp 4.0.0's `_cylinder_face`; its source
+/// snapshot turned the geoms instead) clipping the polytope's face opposite it like two polytope
+/// faces. With it the first contact of all 8 golden resting poses is MuJoCo's (the octagon at
+/// 22.5° + k·45° used before could not give MuJoCo's points at 0°, 45°, 90°…). `first` alone
+/// when no face is opposite.
 #[allow(clippy::too_many_arguments)]
 fn cap_polytope(
     x1: &Transform,
@@ -657,9 +643,10 @@ fn cap_polytope(
         if let Some((n2, f2)) = opposite {
             // Clockwise seen from outside the cap.
             s.face1.clear();
-            for k in 0..8 {
-                let t = (22.5 + 45.0 * k as f64).to_radians() * -side;
-                s.face1.push(centre + (e1 * t.cos() + e2 * t.sin()) * r);
+            let (col0, col1) = (e1 * r, e2 * (r * side));
+            for k in 0..CAP_SIDES {
+                let t = k as f64 * std::f64::consts::PI / (CAP_SIDES / 2) as f64;
+                s.face1.push(col0 * t.cos() - col1 * t.sin() + centre);
             }
             face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
             clip(&s.face1, &s.face2, &n1, &n2, margin, true, &mut s.poly, &mut s.clip, &mut |w1, w2, d| {
