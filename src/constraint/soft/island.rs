@@ -296,14 +296,15 @@ pub(super) fn newton(
     // H is zero outside the rows the last solve wrote: its islands' dofs, on the pattern it
     // was analyzed with (still the current one). Those rows are cleared here, so that H is zero
     // before this solve's pattern is analyzed and its islands' rows are formed.
+    // (H and M are column-major: entry (k, j) at j · nv + k.)
     {
         let isl = &soft.islands;
-        let h = &mut soft.hessian;
+        let h = soft.hessian.as_mut_slice();
         for &k in &isl.dofs {
             for &j in soft.factor.pattern_row(k) {
-                h[(k, j)] = 0.0;
+                h[j * nv + k] = 0.0;
             }
-            h[(k, k)] = 0.0;
+            h[k * nv + k] = 0.0;
         }
     }
     let isl = &mut soft.islands;
@@ -327,8 +328,9 @@ pub(super) fn newton(
                        state: &mut [EfcState]|
      -> f64 {
         let mut c = 0.0;
+        let (x, a0, ma, f0) = (qacc.as_slice(), p.a0.as_slice(), ma.as_slice(), p.f0.as_slice());
         for &k in isl.dofs_of(i) {
-            c += 0.5 * (qacc[k] - p.a0[k]) * (ma[k] - p.f0[k]);
+            c += 0.5 * (x[k] - a0[k]) * (ma[k] - f0[k]);
         }
         rows.update_rows(jar, force, state, isl.rows_of(i), |_, t| c += t);
         c
@@ -342,6 +344,7 @@ pub(super) fn newton(
     loop {
         // g = M a − qfrc_smooth − Jᵀ f on each iterating island, and its scaled norm.
         let grad = soft.grad.as_mut_slice();
+        let (ma, f0, forces) = (soft.ma.as_slice(), p.f0.as_slice(), force.as_slice());
         let mut any = false;
         for i in 0..n {
             if !isl.active[i] {
@@ -349,10 +352,10 @@ pub(super) fn newton(
             }
             let dofs = isl.dofs_of(i);
             for &k in dofs {
-                grad[k] = soft.ma[k] - p.f0[k];
+                grad[k] = ma[k] - f0[k];
             }
             for &r in isl.rows_of(i) {
-                let f = force[r];
+                let f = forces[r];
                 if f != 0.0 {
                     let (cols, vals) = nz.row_values(r);
                     for (&k, &j_rk) in cols.iter().zip(vals) {
@@ -429,18 +432,19 @@ pub(super) fn newton(
         // A new factor: H = M + Jᵀ (∂²s) J on those islands' dofs, factored.
         let mut factored = true;
         if !isl.fresh_dofs.is_empty() {
-            let h = &mut soft.hessian;
+            let (h, m) = (soft.hessian.as_mut_slice(), p.m.as_slice());
             for &k in &isl.fresh_dofs {
                 for &j in soft.factor.pattern_row(k) {
-                    h[(k, j)] = 0.0;
+                    h[j * nv + k] = 0.0;
                 }
-                h[(k, k)] = p.m[(k, k)];
+                h[k * nv + k] = m[k * nv + k];
                 let mut l = model.dof_parent[k];
                 while l != NO_DOF {
-                    h[(k, l)] = p.m[(k, l)];
+                    h[l * nv + k] = m[l * nv + k];
                     l = model.dof_parent[l];
                 }
             }
+            let h = &mut soft.hessian;
             {
                 let mut rows_h = Assembler::new(h, nz, &mut soft.hessian_column);
                 let (row_island, fresh) = (&isl.row, &isl.fresh);
@@ -462,8 +466,9 @@ pub(super) fn newton(
             }
         }
         let dir = soft.dir.as_mut_slice();
+        let grad = soft.grad.as_slice();
         for &k in &isl.active_dofs {
-            dir[k] = soft.grad[k];
+            dir[k] = grad[k];
         }
         if factored {
             soft.factor.solve_rows(dir, &isl.active_dofs);
@@ -490,16 +495,23 @@ pub(super) fn newton(
                 continue;
             }
             let (mut g0, mut dmd) = (0.0, 0.0);
-            for &k in isl.dofs_of(i) {
-                g0 += (soft.ma[k] - p.f0[k]) * soft.dir[k];
-                dmd += soft.dir[k] * soft.mdir[k];
+            {
+                let (ma, f0, dir, mdir) =
+                    (soft.ma.as_slice(), p.f0.as_slice(), soft.dir.as_slice(), soft.mdir.as_slice());
+                for &k in isl.dofs_of(i) {
+                    g0 += (ma[k] - f0[k]) * dir[k];
+                    dmd += dir[k] * mdir[k];
+                }
             }
             let list = &isl.rows[isl.row_start[i]..isl.row_start[i + 1]];
             let (jar, jv, trial) = (&soft.jar, &soft.jv, &mut soft.jar_trial);
             let alpha = line_search_with(
                 |alpha| {
-                    for &r in list {
-                        trial[r] = jar[r] + alpha * jv[r];
+                    {
+                        let (t, jar, jv) = (trial.as_mut_slice(), jar.as_slice(), jv.as_slice());
+                        for &r in list {
+                            t[r] = jar[r] + alpha * jv[r];
+                        }
                     }
                     let (d1, d2) = rows.directional_rows(trial, jv, list);
                     (g0 + alpha * dmd + d1, dmd + d2)
@@ -514,12 +526,17 @@ pub(super) fn newton(
             }
             isl.alpha[i] = alpha;
             // The move, and the island's new cost.
-            for &k in isl.dofs_of(i) {
-                qacc[k] += alpha * soft.dir[k];
-                soft.ma[k] += alpha * soft.mdir[k];
-            }
-            for &r in list {
-                soft.jar[r] += alpha * soft.jv[r];
+            {
+                let (x, ma) = (qacc.as_mut_slice(), soft.ma.as_mut_slice());
+                let (dir, mdir) = (soft.dir.as_slice(), soft.mdir.as_slice());
+                for &k in isl.dofs_of(i) {
+                    x[k] += alpha * dir[k];
+                    ma[k] += alpha * mdir[k];
+                }
+                let (jar, jv) = (soft.jar.as_mut_slice(), soft.jv.as_slice());
+                for &r in list {
+                    jar[r] += alpha * jv[r];
+                }
             }
             let new_cost = island_cost(isl, i, qacc, &soft.ma, &soft.jar, force, state);
             isl.improvement[i] = isl.scale[i] * (cost[i] - new_cost);

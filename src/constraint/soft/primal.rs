@@ -173,13 +173,15 @@ pub(super) fn mul_m_on(
     x: &[f64],
     r: &mut [f64],
 ) {
+    // (M column-major: entry (l, k) at k · nv + l.)
+    let (nv, m) = (m.nrows(), m.as_slice());
     for k in dofs.clone() {
-        r[k] = m[(k, k)] * x[k];
+        r[k] = m[k * nv + k] * x[k];
     }
     for k in dofs {
         let mut l = dof_parent[k];
         while l != crate::model::NO_DOF {
-            let m_lk = m[(l, k)];
+            let m_lk = m[k * nv + l];
             r[l] += m_lk * x[k];
             r[k] += m_lk * x[l];
             l = dof_parent[l];

@@ -80,6 +80,9 @@ pub(crate) struct SparseCholesky {
     stamp: usize,
     /// Whether the symbolic structure (H's and L's patterns, the elimination tree) is set.
     analyzed: bool,
+    /// Whether the analyzed pattern is one kept for cliques it covers (`covers_cliques`): it may
+    /// then couple dofs that no row couples now (other groups, `numeric`'s `group`).
+    kept_wider: bool,
     /// Symbolic analyses done (a pattern changed), for tests and profiles.
     analyses: usize,
 }
@@ -115,6 +118,7 @@ impl SparseCholesky {
             cover: Vec::with_capacity(n),
             stamp: 0,
             analyzed: false,
+            kept_wider: false,
             analyses: 0,
         }
     }
@@ -156,33 +160,34 @@ impl SparseCholesky {
         // one before it (one contact after another on the same bodies) is taken once.
         self.mark.clear();
         self.mark.resize(n, NONE);
-        self.clique_start.clear();
-        self.clique_start.push(0);
-        self.clique_cols.clear();
+        // (Owned locals and slices: their lengths and addresses stay in registers.)
+        let (mut clique_start, mut clique_cols) =
+            (std::mem::take(&mut self.clique_start), std::mem::take(&mut self.clique_cols));
+        clique_start.clear();
+        clique_start.push(0);
+        clique_cols.clear();
+        let mark = self.mark.as_mut_slice();
         for (c, &(first, last)) in groups.iter().enumerate() {
-            let begin = self.clique_cols.len();
+            let begin = clique_cols.len();
             let row = |r: usize| &nz_index[nz_start[r]..nz_start[r + 1]];
             if (first + 1..=last).all(|r| row(r) == row(first)) {
                 // The usual group: a contact's rows over one shared column list (ascending).
-                self.clique_cols.extend_from_slice(row(first));
+                clique_cols.extend_from_slice(row(first));
             } else {
                 for &p in &nz_index[nz_start[first]..nz_start[last + 1]] {
-                    if self.mark[p] != c {
-                        self.mark[p] = c;
-                        self.clique_cols.push(p);
+                    if mark[p] != c {
+                        mark[p] = c;
+                        clique_cols.push(p);
                     }
                 }
-                self.clique_cols[begin..].sort_unstable();
+                clique_cols[begin..].sort_unstable();
             }
-            let nc = self.clique_start.len() - 1;
-            let repeat = nc > 0 && {
-                let prev = &self.clique_cols[self.clique_start[nc - 1]..begin];
-                prev == &self.clique_cols[begin..]
-            };
+            let nc = clique_start.len() - 1;
+            let repeat = nc > 0 && clique_cols[clique_start[nc - 1]..begin] == clique_cols[begin..];
             // A clique of one dof couples nothing, nor one whose dofs lie on one chain of a tree
             // (each an ancestor of the next: a body's contact with the world) — M's pattern holds
             // it already. Left out, such rows appearing and leaving do not change the key.
-            let chain = self.clique_cols[begin..].windows(2).all(|w| {
+            let chain = clique_cols[begin..].windows(2).all(|w| {
                 let mut l = dof_parent[w[1]];
                 while l != NONE && l > w[0] {
                     l = dof_parent[l];
@@ -190,19 +195,26 @@ impl SparseCholesky {
                 l == w[0]
             });
             if repeat || chain {
-                self.clique_cols.truncate(begin);
+                clique_cols.truncate(begin);
             } else {
-                self.clique_start.push(self.clique_cols.len());
+                clique_start.push(clique_cols.len());
             }
         }
-        if self.analyzed
-            && self.key_n == n
-            && ((self.key_start == self.clique_start && self.key_cols == self.clique_cols)
-                || self.covers_cliques())
-        {
-            return;
+        self.clique_start = clique_start;
+        self.clique_cols = clique_cols;
+        if self.analyzed && self.key_n == n {
+            if self.key_start == self.clique_start && self.key_cols == self.clique_cols {
+                // The pattern of exactly these cliques: no coupling beyond theirs.
+                self.kept_wider = false;
+                return;
+            }
+            if self.covers_cliques() {
+                self.kept_wider = true;
+                return;
+            }
         }
         self.analyses += 1;
+        self.kept_wider = false;
         std::mem::swap(&mut self.key_start, &mut self.clique_start);
         std::mem::swap(&mut self.key_cols, &mut self.clique_cols);
         self.key_n = n;
@@ -218,46 +230,59 @@ impl SparseCholesky {
         }
         self.h_count.clear();
         self.h_count.extend_from_slice(&self.d_start[..n]);
-        self.d_cliques.clear();
-        self.d_cliques.resize(self.d_start[n], 0);
-        for c in 0..ncliques {
-            for &p in &self.key_cols[self.key_start[c]..self.key_start[c + 1]] {
-                self.d_cliques[self.h_count[p]] = c;
-                self.h_count[p] += 1;
+        overwrite_len(&mut self.d_cliques, self.d_start[n]);
+        {
+            let (next, d_cliques) = (self.h_count.as_mut_slice(), self.d_cliques.as_mut_slice());
+            let (key_start, key_cols) = (self.key_start.as_slice(), self.key_cols.as_slice());
+            for c in 0..ncliques {
+                for &p in &key_cols[key_start[c]..key_start[c + 1]] {
+                    d_cliques[next[p]] = c;
+                    next[p] += 1;
+                }
             }
         }
         // Row k of H's strict lower pattern: k's ancestors and the dofs below k of its cliques.
         self.mark.clear();
         self.mark.resize(n, NONE);
-        self.h_start.clear();
-        self.h_start.push(0);
-        self.h_cols.clear();
-        for k in 0..n {
-            self.mark[k] = k;
-            let mut l = dof_parent[k];
-            while l != NONE {
-                if self.mark[l] != k {
-                    self.mark[l] = k;
-                    self.h_cols.push(l);
-                }
-                l = dof_parent[l];
-            }
-            for &c in &self.d_cliques[self.d_start[k]..self.d_start[k + 1]] {
-                for &q in &self.key_cols[self.key_start[c]..self.key_start[c + 1]] {
-                    // A clique's dofs ascend: those below k come first.
-                    if q >= k {
-                        break;
+        // (The lists built here are owned locals and the others slices, so that their lengths
+        // and addresses stay in registers across the stores.)
+        let (mut h_start, mut h_cols) = (std::mem::take(&mut self.h_start), std::mem::take(&mut self.h_cols));
+        h_start.clear();
+        h_start.push(0);
+        h_cols.clear();
+        {
+            let mark = self.mark.as_mut_slice();
+            let (d_start, d_cliques) = (self.d_start.as_slice(), self.d_cliques.as_slice());
+            let (key_start, key_cols) = (self.key_start.as_slice(), self.key_cols.as_slice());
+            for k in 0..n {
+                mark[k] = k;
+                let mut l = dof_parent[k];
+                while l != NONE {
+                    if mark[l] != k {
+                        mark[l] = k;
+                        h_cols.push(l);
                     }
-                    if self.mark[q] != k {
-                        self.mark[q] = k;
-                        self.h_cols.push(q);
+                    l = dof_parent[l];
+                }
+                for &c in &d_cliques[d_start[k]..d_start[k + 1]] {
+                    for &q in &key_cols[key_start[c]..key_start[c + 1]] {
+                        // A clique's dofs ascend: those below k come first.
+                        if q >= k {
+                            break;
+                        }
+                        if mark[q] != k {
+                            mark[q] = k;
+                            h_cols.push(q);
+                        }
                     }
                 }
+                // (In any order: the elimination tree, the row patterns and the numeric scatter
+                // do not depend on it.)
+                h_start.push(h_cols.len());
             }
-            // (In any order: the elimination tree, the row patterns and the numeric scatter
-            // do not depend on it.)
-            self.h_start.push(self.h_cols.len());
         }
+        self.h_start = h_start;
+        self.h_cols = h_cols;
         self.symbolic(n);
     }
 
@@ -287,6 +312,7 @@ impl SparseCholesky {
     pub fn factor(&mut self, h: &DMatrix<f64>, n: usize, tol: f64) -> bool {
         self.pattern_of_h(h, n);
         self.analyzed = false;
+        self.kept_wider = false;
         self.symbolic(n);
         self.numeric(h, tol, None)
     }
@@ -350,6 +376,18 @@ impl SparseCholesky {
         true
     }
 
+    /// Whether a clique of the analyzed pattern holds dofs of two groups (`group` by dof; false
+    /// when it is empty).
+    fn cliques_span(&self, group: &[usize]) -> bool {
+        if group.is_empty() {
+            return false;
+        }
+        self.key_start.windows(2).any(|w| {
+            let clique = &self.key_cols[w[0]..w[1]];
+            clique.split_first().is_some_and(|(&first, rest)| rest.iter().any(|&q| group[q] != group[first]))
+        })
+    }
+
     /// From H's pattern: P H P's (its transpose, reindexed), the elimination tree, L's pattern
     /// by rows (each row's `ereach`, ascending) and by columns, and where each entry of the one
     /// sits in the other.
@@ -366,35 +404,45 @@ impl SparseCholesky {
         }
         self.h_count.clear();
         self.h_count.extend_from_slice(&self.p_start[..n]);
-        self.p_cols.clear();
-        self.p_cols.resize(self.p_start[n], 0);
-        for j in 0..n {
-            for &k in &self.h_cols[self.h_start[j]..self.h_start[j + 1]] {
-                let p = n - 1 - k;
-                self.p_cols[self.h_count[p]] = n - 1 - j;
-                self.h_count[p] += 1;
+        overwrite_len(&mut self.p_cols, self.p_start[n]);
+        {
+            let (next, p_cols) = (self.h_count.as_mut_slice(), self.p_cols.as_mut_slice());
+            let (h_start, h_cols) = (self.h_start.as_slice(), self.h_cols.as_slice());
+            for j in 0..n {
+                for &k in &h_cols[h_start[j]..h_start[j + 1]] {
+                    let p = n - 1 - k;
+                    p_cols[next[p]] = n - 1 - j;
+                    next[p] += 1;
+                }
             }
         }
         self.elimination_tree(n);
         self.mark.clear();
         self.mark.resize(n, NONE);
-        self.l_start.clear();
-        self.l_start.push(0);
-        self.l_cols.clear();
-        for k in 0..n {
-            // Row k's pattern: every dof reached from H's row k up the tree (all below k), in
-            // the order reached (sorted below).
-            self.mark[k] = k;
-            for &j in &self.p_cols[self.p_start[k]..self.p_start[k + 1]] {
-                let mut i = j;
-                while self.mark[i] != k {
-                    self.mark[i] = k;
-                    self.l_cols.push(i);
-                    i = self.parent[i];
+        let (mut l_start, mut l_cols) = (std::mem::take(&mut self.l_start), std::mem::take(&mut self.l_cols));
+        l_start.clear();
+        l_start.push(0);
+        l_cols.clear();
+        {
+            let (mark, parent) = (self.mark.as_mut_slice(), self.parent.as_slice());
+            let (p_start, p_cols) = (self.p_start.as_slice(), self.p_cols.as_slice());
+            for k in 0..n {
+                // Row k's pattern: every dof reached from H's row k up the tree (all below k),
+                // in the order reached (sorted below).
+                mark[k] = k;
+                for &j in &p_cols[p_start[k]..p_start[k + 1]] {
+                    let mut i = j;
+                    while mark[i] != k {
+                        mark[i] = k;
+                        l_cols.push(i);
+                        i = parent[i];
+                    }
                 }
+                l_start.push(l_cols.len());
             }
-            self.l_start.push(self.l_cols.len());
         }
+        self.l_start = l_start;
+        self.l_cols = l_cols;
         let nnz = self.l_cols.len();
         self.c_start.clear();
         self.c_start.resize(n + 1, 0);
@@ -406,33 +454,39 @@ impl SparseCholesky {
         }
         self.h_count.clear();
         self.h_count.extend_from_slice(&self.c_start[..n]);
-        self.c_rows.clear();
-        self.c_rows.resize(nnz, 0);
-        self.c_vals.clear();
-        self.c_vals.resize(nnz, 0.0);
-        self.c_slot.clear();
-        self.c_slot.resize(nnz, 0);
+        // (Every entry of c_rows and c_slot is written below; c_vals is written by `numeric`
+        // before any read: a solve factors every island of a new pattern first.)
+        overwrite_len(&mut self.c_rows, nnz);
+        overwrite_len(&mut self.c_vals, nnz);
+        overwrite_len(&mut self.c_slot, nnz);
         // L by columns: rows taken in ascending order, so each column's rows ascend.
-        for k in 0..n {
-            for u in self.l_start[k]..self.l_start[k + 1] {
-                let j = self.l_cols[u];
-                self.c_rows[self.h_count[j]] = k;
-                self.h_count[j] += 1;
+        {
+            let (next, c_rows) = (self.h_count.as_mut_slice(), self.c_rows.as_mut_slice());
+            let (l_start, l_cols) = (self.l_start.as_slice(), self.l_cols.as_slice());
+            for k in 0..n {
+                for &j in &l_cols[l_start[k]..l_start[k + 1]] {
+                    c_rows[next[j]] = k;
+                    next[j] += 1;
+                }
             }
         }
         // L by rows again from its columns, taken in ascending order: each row's columns ascend
         // (two counting passes instead of a sort per row); and where each entry sits in the
         // column storage. (`ancestor` is free scratch after the elimination tree.)
-        let next = &mut self.ancestor;
-        next.clear();
-        next.extend_from_slice(&self.l_start[..n]);
-        for j in 0..n {
-            for slot in self.c_start[j]..self.c_start[j + 1] {
-                let k = self.c_rows[slot];
-                let u = next[k];
-                next[k] += 1;
-                self.l_cols[u] = j;
-                self.c_slot[u] = slot;
+        self.ancestor.clear();
+        self.ancestor.extend_from_slice(&self.l_start[..n]);
+        {
+            let next = self.ancestor.as_mut_slice();
+            let (l_cols, c_slot) = (self.l_cols.as_mut_slice(), self.c_slot.as_mut_slice());
+            let (c_start, c_rows) = (self.c_start.as_slice(), self.c_rows.as_slice());
+            for j in 0..n {
+                for slot in c_start[j]..c_start[j + 1] {
+                    let k = c_rows[slot];
+                    let u = next[k];
+                    next[k] += 1;
+                    l_cols[u] = j;
+                    c_slot[u] = slot;
+                }
             }
         }
         self.x.clear();
@@ -450,14 +504,16 @@ impl SparseCholesky {
         self.parent.resize(n, NONE);
         self.ancestor.clear();
         self.ancestor.resize(n, NONE);
+        let (parent, ancestor) = (self.parent.as_mut_slice(), self.ancestor.as_mut_slice());
+        let (p_start, p_cols) = (self.p_start.as_slice(), self.p_cols.as_slice());
         for k in 0..n {
-            for &j in &self.p_cols[self.p_start[k]..self.p_start[k + 1]] {
+            for &j in &p_cols[p_start[k]..p_start[k + 1]] {
                 let mut i = j;
                 while i != NONE && i < k {
-                    let next = self.ancestor[i];
-                    self.ancestor[i] = k;
+                    let next = ancestor[i];
+                    ancestor[i] = k;
                     if next == NONE {
-                        self.parent[i] = k;
+                        parent[i] = k;
                     }
                     i = next;
                 }
@@ -473,17 +529,22 @@ impl SparseCholesky {
     /// another group's rows or columns (`group`, by dof) are set to zero.
     fn numeric(&mut self, h: &DMatrix<f64>, tol: f64, rows: Option<(&[usize], &[usize])>) -> bool {
         let n = self.diag.len();
-        let x = &mut self.x;
         let all = (0..if rows.is_some() { 0 } else { n }).map(|p| n - 1 - p);
         let (listed, group) = rows.unwrap_or((&[], &[]));
+        // Entries across groups exist only in a kept wider pattern or where a clique spans
+        // groups (a contact whose rows' columns differ): else no entry needs the test.
+        let group = if self.kept_wider || self.cliques_span(group) { group } else { &[] };
+        let x = &mut self.x;
         let other = |a: usize, b: usize| !group.is_empty() && group[n - 1 - a] != group[n - 1 - b];
+        // H column-major: H[k, j] at j · ld + k.
+        let (h, ld) = (h.as_slice(), h.nrows());
         for k in all.chain(listed.iter().rev().copied()) {
             let p = n - 1 - k;
             // H's column k below the diagonal (its row k left of it), at positions.
             for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
-                x[n - 1 - j] = h[(k, j)];
+                x[n - 1 - j] = h[j * ld + k];
             }
-            let mut d = h[(k, k)];
+            let mut d = h[k * ld + k];
             for u in self.l_start[p]..self.l_start[p + 1] {
                 let (c, slot) = (self.l_cols[u], self.c_slot[u]);
                 if other(c, p) {
@@ -610,6 +671,17 @@ impl SparseCholesky {
             }
             b[k] = s / self.diag[p];
         }
+    }
+}
+
+/// Sets `v`'s length to `len` for a pass that writes every entry before any is read: only
+/// entries beyond its old length are filled (a symbolic analysis reuses its buffers without
+/// clearing them first).
+fn overwrite_len<T: Copy + Default>(v: &mut Vec<T>, len: usize) {
+    if v.len() < len {
+        v.resize(len, T::default());
+    } else {
+        v.truncate(len);
     }
 }
 
