@@ -80,6 +80,30 @@ pub(crate) fn contact_rows(model: &Model, data: &mut Data, mut r: usize, frictio
     r
 }
 
+/// The `dim` frame-row values (normal, tangents, torsion, rolling) of a column with linear part
+/// `lin` at the contact point and angular part `ang`, times `sign`; zero past `dim`.
+#[inline]
+pub(crate) fn frame_values(dirs: &[Vec3; 3], lin: &Vec3, ang: &Vec3, dim: usize, sign: f64) -> [f64; 6] {
+    let mut v = [0.0; 6];
+    v[0] = sign * dirs[0].dot(lin);
+    if dim >= 3 {
+        v[1] = sign * dirs[1].dot(lin);
+        v[2] = sign * dirs[2].dot(lin);
+        if dim >= 4 {
+            v[3] = sign * dirs[0].dot(ang);
+            if dim >= 6 {
+                v[4] = sign * dirs[1].dot(ang);
+                v[5] = sign * dirs[2].dot(ang);
+            } else if dim == 5 {
+                v[4] = sign * dirs[1].dot(ang);
+            }
+        }
+    } else if dim == 2 {
+        v[1] = sign * dirs[1].dot(lin);
+    }
+    v
+}
+
 /// Adds the contact-frame Jacobian of `contact` (normal, tangents, then torsion and rolling: the
 /// relative velocity of geom 2's body over geom 1's at the contact point, in the contact frame)
 /// to rows r..r+dim of `efc_j` (MuJoCo's `mj_contactJacobian`). Needs body poses and motion
@@ -92,9 +116,9 @@ pub(crate) fn add_contact_jacobian(model: &Model, data: &mut Data, contact: &Con
     let Data { efc_j, x_world_body, s_body, .. } = data;
     for (body, sign) in bodies.into_iter().zip([-1.0, 1.0]) {
         for_each_ancestor_dof_at(model, x_world_body, s_body, body, &p, |k, lin, ang| {
-            for i in 0..dim {
-                let value = if i < 3 { dirs[i].dot(&lin) } else { dirs[i - 3].dot(&ang) };
-                efc_j[(r + i, k)] += sign * value;
+            let v = frame_values(&dirs, &lin, &ang, dim, sign);
+            for (i, &v_i) in v[..dim].iter().enumerate() {
+                efc_j[(r + i, k)] += v_i;
             }
         });
     }

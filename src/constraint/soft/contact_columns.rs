@@ -10,6 +10,7 @@
 //! moves — a box resting on four corners, a foot on its sole's contacts — so [`DofAxes`] forms it
 //! once per position stage, for the dofs a contact reaches, and the contacts read it.
 
+use crate::constraint::contact::frame_values;
 use crate::model::{Contact, Model};
 use crate::spatial::{Motion, Transform, Vec3};
 
@@ -47,30 +48,6 @@ impl DofAxes {
         }
         self.axes[k]
     }
-}
-
-/// The `dim` frame-row values (normal, tangents, torsion, rolling) of a column with linear part
-/// `lin` at the contact point and angular part `ang`, times `sign`; zero past `dim`.
-#[inline]
-fn frame_values(dirs: &[Vec3; 3], lin: &Vec3, ang: &Vec3, dim: usize, sign: f64) -> [f64; 6] {
-    let mut v = [0.0; 6];
-    v[0] = sign * dirs[0].dot(lin);
-    if dim >= 3 {
-        v[1] = sign * dirs[1].dot(lin);
-        v[2] = sign * dirs[2].dot(lin);
-        if dim >= 4 {
-            v[3] = sign * dirs[0].dot(ang);
-            if dim >= 6 {
-                v[4] = sign * dirs[1].dot(ang);
-                v[5] = sign * dirs[2].dot(ang);
-            } else if dim == 5 {
-                v[4] = sign * dirs[1].dot(ang);
-            }
-        }
-    } else if dim == 2 {
-        v[1] = sign * dirs[1].dot(lin);
-    }
-    v
 }
 
 /// The nonzero columns of `contact`'s frame rows (`dim` of them), compactly: the dofs that move

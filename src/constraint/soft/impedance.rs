@@ -87,9 +87,10 @@ fn stiffness_damping(solref: &[f64; 2], dmax: f64) -> (f64, f64) {
     (k, b)
 }
 
-/// `efc_diag_a` of the block at row `i` (`len` = `Data::efc_block_len(i)`): MuJoCo's diagonal
-/// approximation of J M⁻¹ Jᵀ per row (`mj_diagApprox`); an equality's block is its `nrow` rows.
-fn diag_approx(model: &Model, w: &InverseWeights, data: &mut Data, i: usize, len: usize) {
+/// `efc_diag_a` of the block at row `i`: MuJoCo's diagonal approximation of J M⁻¹ Jᵀ per row
+/// (`mj_diagApprox`); an equality's block is its `nrow` rows, a pyramidal contact's its
+/// 2 (dim − 1) edges in pairs.
+fn diag_approx(model: &Model, w: &InverseWeights, data: &mut Data, i: usize) {
     let id = data.efc_id[i];
     let kind = data.efc_type[i];
     let diag_a = data.efc_diag_a.as_mut_slice();
@@ -143,8 +144,6 @@ fn diag_approx(model: &Model, w: &InverseWeights, data: &mut Data, i: usize, len
                     }
                 }
                 _ => {
-                    // A pyramidal contact's `len` = 2 (dim − 1) rows, in pairs.
-                    debug_assert_eq!(len, 2 * (dim - 1));
                     for j in 0..dim - 1 {
                         let f = c.friction[j];
                         let v = tran + f * f * if j < 2 { tran } else { rot };
@@ -211,7 +210,7 @@ pub(crate) fn make_impedance(model: &Model, w: &InverseWeights, data: &mut Data)
     let mut i = 0;
     while i < data.nefc {
         let len = data.efc_block_len(i);
-        diag_approx(model, w, data, i, len);
+        diag_approx(model, w, data, i);
         let kind = data.efc_type[i];
         let frictional_dof = matches!(kind, EfcType::FrictionDof | EfcType::FrictionTendon);
         let (solref, solreffriction, solimp) = parameters(model, data, i);
