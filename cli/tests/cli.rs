@@ -428,3 +428,43 @@ fn simulate_and_eval_report_mujocos_run_time_warnings() {
     let w = doc["results"][0]["warnings"][0].as_str().unwrap();
     assert!(w.contains("singular") && w.contains("'a'"), "{w}");
 }
+
+/// A full contact buffer is reported with the budget of the mode that ran: `--constraints exact`
+/// keeps at most `MAX_CONTACTS` (its Delassus matrix is rows × rows), which the summary's warning
+/// quotes, not the soft mode's larger budget of the file's own model.
+#[test]
+fn simulate_quotes_the_contact_budget_of_the_mode_it_ran() {
+    // 140 boxes pressed 1 mm into a plane, four corner contacts each: 560 > 500.
+    let mut bodies = String::new();
+    for k in 0..140 {
+        let (x, y) = ((k % 12) as f64 * 0.2, (k / 12) as f64 * 0.2);
+        bodies += &format!(
+            "<body pos='{x} {y} 0.039'><freejoint/><geom type='box' size='0.04 0.04 0.04' mass='0.5'/></body>"
+        );
+    }
+    let xml = format!(
+        "<mujoco><default><geom condim='1'/></default><worldbody><geom type='plane' size='0 0 1'/>{bodies}</worldbody></mujoco>"
+    );
+    let path = temp_file("budget.xml", &xml);
+    let (ok, out, err) = lagrange(&[
+        "simulate",
+        path.to_str().unwrap(),
+        "--constraints",
+        "exact",
+        "--duration",
+        "0.002",
+        "--json",
+    ]);
+    std::fs::remove_file(&path).ok();
+    assert!(ok, "{err}");
+    let summary: Value = serde_json::from_str(&out).unwrap();
+    // Each collision pass (the start's and the step's) drops the 60 beyond the budget.
+    let dropped = summary["contacts_dropped"].as_u64().unwrap();
+    let per_pass = 560 - lagrange::model::MAX_CONTACTS as u64;
+    assert!(dropped > 0 && dropped % per_pass == 0, "{dropped} dropped");
+    let warnings = summary["warnings"].as_array().unwrap();
+    let full = warnings.iter().filter_map(|w| w.as_str()).find(|w| w.contains("collision pass"));
+    let full = full.unwrap_or_else(|| panic!("no contact-full warning: {warnings:?}"));
+    assert!(full.contains(&format!("than the {} kept", lagrange::model::MAX_CONTACTS)), "{full}");
+    assert!(full.contains("560 found"), "{full}");
+}

@@ -483,7 +483,9 @@ pub fn simulate(model: &Model, request: &Request) -> Result<Summary, CliError> {
     };
     Ok(Summary {
         sensors,
-        warnings: sim.data.warnings.messages(model),
+        // The simulation's model: `--constraints` may have changed its mode, and with it the
+        // contact budget the warnings quote.
+        warnings: sim.data.warnings.messages(&sim.model),
         passive,
         contacts_dropped: sim.data.contacts_dropped,
         sleep: sim.model.options.flags.sleep.then(|| {
