@@ -19,7 +19,7 @@ pub(crate) use aba::aba_unchecked;
 pub use crba::{crba, crba_upper, factorize_mass_matrix, solve_mass_matrix, solve_with_factor};
 pub(crate) use crba::{
     crba_unchecked, factorize_mass_matrix_damped, solve_transposed_with_factor_unchecked,
-    solve_with_factor_unchecked, tree_span,
+    solve_with_factor_span_unchecked, solve_with_factor_unchecked, tree_span,
 };
 pub(crate) use energy::kinetic_energy_unchecked;
 pub use energy::{center_of_mass, kinetic_energy, potential_energy, spatial_momentum};

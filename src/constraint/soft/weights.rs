@@ -11,7 +11,7 @@
 //! - `tendon_invweight0`: J_t M⁻¹ J_tᵀ of a tendon (J_t its `ten_J` row at `qpos0`);
 //! - `meaninertia`: the mean of M's diagonal at `qpos0`, which scales the solvers' tolerance.
 
-use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked};
+use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_span_unchecked, tree_span};
 use crate::kinematics::{for_each_ancestor_dof, forward_kinematics_unchecked};
 use crate::model::{Data, FrameKind, JointKind, Model};
 use crate::spatial::Vec3;
@@ -46,19 +46,11 @@ impl InverseWeights {
             (0..model.tendons.len()).map(|t| data.ten_j.row(t).iter().copied().collect()).collect();
         let meaninertia =
             if nv > 0 { (0..nv).map(|k| data.mass_matrix[(k, k)]).sum::<f64>() / nv as f64 } else { 1.0 };
-        // x ↦ M⁻¹ x with the factor at qpos0.
-        let solve = |x: &mut [f64]| solve_with_factor_unchecked(model, &data.mass_factor, x);
-        let quadratic = |rows: &[Vec<f64>]| -> Vec<f64> {
-            rows.iter()
-                .map(|r| {
-                    let mut y = r.clone();
-                    solve(&mut y);
-                    r.iter().zip(&y).map(|(a, b)| a * b).sum()
-                })
-                .collect()
-        };
+        let mut form = QuadraticForm { model, factor: &data.mass_factor, y: vec![0.0; nv] };
         let mut frame_invweight0 = vec![[0.0; 2]; model.frames.len()];
         let mut simple_dofs: Vec<(usize, f64)> = Vec::new();
+        // A body's 6 Jacobian rows, zero outside the dofs written last.
+        let mut rows = vec![vec![0.0; nv]; 6];
         for (f, frame) in model.frames.iter().enumerate() {
             if frame.kind != FrameKind::Link || frame.body == 0 {
                 continue;
@@ -72,26 +64,36 @@ impl InverseWeights {
             }
             let x = data.x_world_frame[f];
             let com = if frame.inertia.mass > 0.0 { x.act_point(&frame.inertia.com()) } else { x.pos };
-            let mut rows = vec![vec![0.0; nv]; 6];
+            let (mut first, mut last) = (usize::MAX, 0);
             for_each_ancestor_dof(model, &data.x_world_body, &data.s_body, frame.body, |k, s| {
                 let lin: Vec3 = s.lin + s.ang.cross(&com);
                 for i in 0..3 {
                     rows[i][k] = lin[i];
                     rows[3 + i][k] = s.ang[i];
                 }
+                (first, last) = (first.min(k), last.max(k));
             });
-            let a = quadratic(&rows);
+            if first > last {
+                continue;
+            }
+            let a: [f64; 6] = std::array::from_fn(|i| form.of(&rows[i], first, last));
             frame_invweight0[f] = [(a[0] + a[1] + a[2]) / 3.0, (a[3] + a[4] + a[5]) / 3.0];
+            for r in &mut rows {
+                r[first..=last].fill(0.0);
+            }
         }
-        let unit = |k: usize| {
-            let mut r = vec![0.0; nv];
-            r[k] = 1.0;
-            r
-        };
+        let mut unit = vec![0.0; nv];
         let mut dof_invweight0 = vec![0.0; nv];
         for j in &model.joints {
             let d = j.dof_adr;
-            let a = quadratic(&(d..d + j.kind.nv()).map(unit).collect::<Vec<_>>());
+            let a: Vec<f64> = (d..d + j.kind.nv())
+                .map(|k| {
+                    unit[k] = 1.0;
+                    let w = form.of(&unit, k, k);
+                    unit[k] = 0.0;
+                    w
+                })
+                .collect();
             match j.kind {
                 JointKind::Free => {
                     let (t, r) = ((a[0] + a[1] + a[2]) / 3.0, (a[3] + a[4] + a[5]) / 3.0);
@@ -105,7 +107,13 @@ impl InverseWeights {
         for (d, w) in simple_dofs {
             dof_invweight0[d] = w;
         }
-        let tendon_invweight0 = tendon_rows.iter().map(|r| quadratic(std::slice::from_ref(r))[0]).collect();
+        let tendon_invweight0 = tendon_rows
+            .iter()
+            .map(|r| match (r.iter().position(|&a| a != 0.0), r.iter().rposition(|&a| a != 0.0)) {
+                (Some(first), Some(last)) => form.of(r, first, last),
+                _ => 0.0,
+            })
+            .collect();
         let geom_frame = model.geoms.iter().map(|g| body_frame(model, g.body, Some(&g.link))).collect();
         Self { frame_invweight0, geom_frame, dof_invweight0, tendon_invweight0, meaninertia }
     }
@@ -168,4 +176,27 @@ fn simple_slider(model: &Model, data: &Data, f: usize) -> Option<Vec<usize>> {
         dofs.push(j.dof_adr);
     }
     Some(dofs)
+}
+
+/// r M⁻¹ rᵀ with the mass matrix factor at `qpos0`, for rows that are zero outside dofs
+/// `first ..= last`: solved on the span of the trees those dofs belong to (M⁻¹ rᵀ is zero
+/// outside it), the full solve's arithmetic on those dofs in time proportional to the span, so
+/// that a scene of many free bodies compiles in time linear in them.
+struct QuadraticForm<'a> {
+    model: &'a Model,
+    factor: &'a nalgebra::DMatrix<f64>,
+    /// nv numbers, zero between calls.
+    y: Vec<f64>,
+}
+
+impl QuadraticForm<'_> {
+    fn of(&mut self, r: &[f64], first: usize, last: usize) -> f64 {
+        let (lo, hi) = tree_span(self.model, first, last);
+        let y = &mut self.y;
+        y[lo..hi].copy_from_slice(&r[lo..hi]);
+        solve_with_factor_span_unchecked(self.model, self.factor, y, (lo, hi));
+        let q = r[lo..hi].iter().zip(&y[lo..hi]).map(|(a, b)| a * b).sum();
+        y[lo..hi].fill(0.0);
+        q
+    }
 }
