@@ -176,7 +176,15 @@ fn mimic_of(model: &Model, j: usize) -> Option<(&str, f64, f64, &str)> {
 /// `com` is in the body frame, `inertia` is the 3×3 tensor about the centre of mass in body axes.
 /// Body 0 is `world` (with any links welded to it); `total_mass` counts the moving bodies only.
 pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
-    let plan = Plan::new(model, mode);
+    let rebuilt;
+    let plan = match mode {
+        Some(m) => {
+            rebuilt = Plan::new(model, Some(m));
+            &rebuilt
+        }
+        // The model's own plan (its inverse weights take a pass over the bodies at compile).
+        None => &model.plan,
+    };
     let bodies: Vec<Value> = model
         .bodies
         .iter()
@@ -268,7 +276,15 @@ pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
 
 /// Human-readable summary of a model.
 pub fn to_text(model: &Model, mode: Option<ConstraintMode>) -> String {
-    let plan = Plan::new(model, mode);
+    let rebuilt;
+    let plan = match mode {
+        Some(m) => {
+            rebuilt = Plan::new(model, Some(m));
+            &rebuilt
+        }
+        // The model's own plan (its inverse weights take a pass over the bodies at compile).
+        None => &model.plan,
+    };
     use std::fmt::Write;
     let mut s = String::new();
     let src = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "(embedded)".into());
