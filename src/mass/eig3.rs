@@ -14,8 +14,8 @@
 //! (`mesh_quat` within 5e-14 on 224 Menagerie meshes and scales, the Robotiq 2F-85's among them,
 //! where an earlier rule — stopping at a rotation closer than 1e-12 to none, sorting by an
 //! absolute 1e-12 — left 1e-7 to 3e-6 rad between them on many, and small meshes with their
-//! moments unsorted; tests/mujoco_meshframe.rs). The half-angle of each rotation comes from its tangent
-//! (√((1 − cos)/2) cancels to zero below 1e-8 rad).
+//! moments unsorted; tests/mujoco_sameframe.rs). The half-angle of each rotation comes from its
+//! tangent (√((1 − cos)/2) cancels to zero below 1e-8 rad).
 
 use crate::spatial::{quat_to_matrix, Mat3};
 
