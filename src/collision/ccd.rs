@@ -401,10 +401,15 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
         st.x1 = lincomb(&lambda[..n], [&s[0].vert1, &s[1].vert1, &s[2].vert1, &s[3].vert1]);
         st.x2 = lincomb(&lambda[..n], [&s[0].vert2, &s[1].vert2, &s[2].vert2, &s[3].vert2]);
     }
-    let tmp = gjk_support(o1, o2, &x_k, x_norm);
-    if x_k.dot(&tmp.vert) > 0.0 {
-        st.separated = true;
-        st.axis = x_k;
+    // MuJoCo 4.0.0 checks the separation once more along x_k unless the simplex is a
+    // tetrahedron, which holds the origin (its support counts show it: the source snapshot checks
+    // every time, one support call more per penetrating pair).
+    if n != 4 {
+        let tmp = gjk_support(o1, o2, &x_k, x_norm);
+        if x_k.dot(&tmp.vert) > 0.0 {
+            st.separated = true;
+            st.axis = x_k;
+        }
     }
     st.gjk_iterations = k;
     st.nsimplex = n;

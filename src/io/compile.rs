@@ -89,6 +89,10 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let (mut nq, mut nv) = (0, 0);
     // The spec link each frame and geom is made from (MuJoCo's body table, `Links`).
     let (mut frame_spec_link, mut geom_spec_link) = (Vec::new(), Vec::new());
+    // MuJoCo's frame of each geom in its body (a mesh's moved to the mesh's inertial frame; None
+    // for a mesh whose frame is not computed, one that does not collide) and of each site.
+    let (mut geom_local, mut site_local): (Vec<Option<Transform>>, Vec<Option<Transform>>) =
+        (Vec::new(), Vec::new());
 
     // Pass 1, links in depth-first order: create a body per movable joint, fuse fixed ones.
     for (li, link) in spec.links.iter().enumerate() {
@@ -189,7 +193,9 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
             mocap,
             site: None,
         });
+        site_local.push(None);
         for f in &link.frames {
+            site_local.push((f.kind == FrameKind::Site).then_some(f.x_link_frame));
             frames.push(Frame {
                 name: f.name.clone(),
                 kind: f.kind,
@@ -203,6 +209,10 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
         for (g, &mass) in link.geoms.iter().zip(&geom_masses[li]) {
             let hull_graph = crate::io::geom_hull::geom_hull(g, word, &link.name, &mut hulls, &mut warnings)?;
             let unreadable = matches!(g.shape, Shape::Mesh { .. }) && hull_graph.is_none();
+            geom_local.push(match (&g.shape, &hull_graph) {
+                (Shape::Mesh { .. }, None) => None,
+                (_, h) => Some(g.x_link_geom * mesh_frame(h.as_ref())),
+            });
             geoms.push(Geom {
                 name: g.name.clone(),
                 link: link.name.clone(),
@@ -332,8 +342,22 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
     let spec_parent: Vec<Option<usize>> = spec.links.iter().map(|l| l.parent).collect();
     let mut links =
         crate::model::Links::build(&kind_is_link, &spec_parent, &frame_spec_link, &geom_spec_link);
-    // MuJoCo's body_iquat: an explicit diagonal <inertial> keeps its frame; otherwise the
-    // principal axes of the body's inertia as MuJoCo's compiler finds them.
+    // Per spec link: MuJoCo's frame of its geom when exactly one of its geoms has mass (and that
+    // frame is known), which a body whose inertia comes from its geoms copies as its inertial frame.
+    let mut single_massive: Vec<Option<Transform>> = vec![None; spec.links.len()];
+    {
+        let mut first_geom = 0;
+        for (li, masses) in geom_masses.iter().enumerate() {
+            let mut massive = masses.iter().enumerate().filter(|&(_, &m)| m > 0.0);
+            if let (Some((k, _)), None) = (massive.next(), massive.next()) {
+                single_massive[li] = geom_local[first_geom + k];
+            }
+            first_geom += masses.len();
+        }
+    }
+    // MuJoCo's body_iquat: an explicit diagonal <inertial> keeps its frame; a single geom's frame
+    // when the inertia comes from it alone; otherwise the principal axes of the body's inertia as
+    // MuJoCo's compiler finds them.
     links.iquat = links
         .frame
         .iter()
@@ -356,11 +380,23 @@ pub fn compile(spec: &ModelSpec) -> Result<Model, LoadError> {
                         )
                     }
                 }
+                // A single geom with mass: its frame, as MuJoCo copies it.
+                _ if link.inertia_from_geoms && single_massive[li].is_some() => single_massive[li]
+                    .map_or([1.0, 0.0, 0.0, 0.0], |s| crate::sensor::objects::rot_quat(&s.rot)),
                 _ if frames[f].inertia.mass > 0.0 => crate::sensor::objects::principal_quat(&i_com),
                 _ => [1.0, 0.0, 0.0, 0.0],
             }
         })
         .collect();
+    place_same_frames(
+        &mut geoms,
+        &mut frames,
+        &mut links,
+        &geom_local,
+        &site_local,
+        &single_massive,
+        &geom_spec_link,
+    );
     let mut model = Model {
         gravcomp,
         name: spec.name.clone(),
@@ -997,4 +1033,59 @@ fn negative_moment(i: &InertialSpec, moments: &Vec3) -> Option<String> {
         e.sort_by(f64::total_cmp);
         format!("principal moments {e:?} include a negative one")
     })
+}
+
+/// A mesh's MuJoCo frame in its geom frame (`MeshGraph::box_frame`), the identity for other geoms.
+fn mesh_frame(hull: Option<&crate::io::geom_hull::GeomHull>) -> Transform {
+    hull.map_or(Transform::identity(), |h| Transform::new(h.box_frame.1, h.box_frame.0))
+}
+
+/// Places geoms and sites as MuJoCo's `geom_sameframe` and `site_sameframe` do
+/// ([`crate::io::sameframe`]) and records the flags in `links`. `geom_local` and `site_local`
+/// are MuJoCo's frames of the geoms and sites in their bodies (None: not a site, or a mesh whose
+/// frame is not computed, which keeps its own pose); `single_massive` is, per spec link, the
+/// frame of the one geom its inertia was copied from. That geom keeps its pose exactly when it is
+/// the inertial frame (MuJoCo's placement is then its own composition).
+fn place_same_frames(
+    geoms: &mut [Geom],
+    frames: &mut [Frame],
+    links: &mut crate::model::Links,
+    geom_local: &[Option<Transform>],
+    site_local: &[Option<Transform>],
+    single_massive: &[Option<Transform>],
+    geom_spec_link: &[usize],
+) {
+    use crate::io::sameframe::{classify, placed, SameFrame};
+    let inertial = |frames: &[Frame], b: usize| {
+        let i = &frames[links.frame[b]].inertia;
+        (if i.mass > 0.0 { i.com() } else { Vec3::zeros() }, links.iquat[b])
+    };
+    links.geom_sameframe = vec![SameFrame::None; geoms.len()];
+    for (g, geom) in geoms.iter_mut().enumerate() {
+        let Some(local) = geom_local[g] else { continue };
+        let b = links.of_geom[g];
+        let (ipos, iquat) = inertial(frames, b);
+        let flag = classify(&local, &ipos, &iquat);
+        links.geom_sameframe[g] = flag;
+        let copied = single_massive[geom_spec_link[g]].is_some_and(|s| s == local);
+        if flag == SameFrame::None || (flag == SameFrame::Inertia && copied) {
+            continue;
+        }
+        let x_body_link = frames[links.frame[b]].x_body_frame;
+        geom.x_body_geom = x_body_link
+            * placed(flag, &local, &ipos, &iquat)
+            * mesh_frame(geom.hull_graph.as_ref()).inverse();
+    }
+    links.site_sameframe = vec![SameFrame::None; frames.len()];
+    for f in 0..frames.len() {
+        let Some(local) = site_local[f] else { continue };
+        let b = links.of_frame[f];
+        let (ipos, iquat) = inertial(frames, b);
+        let flag = classify(&local, &ipos, &iquat);
+        links.site_sameframe[f] = flag;
+        if flag != SameFrame::None {
+            frames[f].x_body_frame =
+                frames[links.frame[b]].x_body_frame * placed(flag, &local, &ipos, &iquat);
+        }
+    }
 }

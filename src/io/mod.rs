@@ -11,6 +11,7 @@ mod lines;
 pub mod mjcf;
 pub mod package;
 pub mod plausibility;
+pub mod sameframe;
 mod singular;
 pub mod urdf;
 

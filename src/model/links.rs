@@ -24,6 +24,12 @@ pub struct Links {
     /// (MuJoCo's `body_iquat`: an `<inertial>`'s own `quat` with `diaginertia`, else the principal
     /// axes MuJoCo's compiler finds, moments in decreasing order).
     pub iquat: Vec<[f64; 4]>,
+    /// For each geom of `Model::geoms`: MuJoCo's `geom_sameframe`, the frame of its body it takes
+    /// its pose from (placed by `io::sameframe`); `None` for a mesh that does not collide (its
+    /// MuJoCo frame is not computed: it keeps its own pose).
+    pub geom_sameframe: Vec<SameFrame>,
+    /// For each frame of `Model::frames`: MuJoCo's `site_sameframe` for sites, `None` for others.
+    pub site_sameframe: Vec<SameFrame>,
 }
 
 impl Links {
@@ -93,7 +99,32 @@ impl Links {
             of_frame: frame_spec_link.iter().map(|&l| id[l]).collect(),
             of_geom: geom_spec_link.iter().map(|&l| id[l]).collect(),
             iquat: Vec::new(),
+            geom_sameframe: Vec::new(),
+            site_sameframe: Vec::new(),
         }
+    }
+}
+
+/// Which frame of its body a geom or site shares (MuJoCo's `mjtSameFrame`, same numbering).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SameFrame {
+    /// Its own pose in the body (`mjSAMEFRAME_NONE`, 0).
+    #[default]
+    None = 0,
+    /// The body's frame (`mjSAMEFRAME_BODY`, 1).
+    Body = 1,
+    /// The body frame's rotation at its own position (`mjSAMEFRAME_BODYROT`, 3).
+    BodyRot = 3,
+    /// The body's inertial frame (`mjSAMEFRAME_INERTIA`, 2).
+    Inertia = 2,
+    /// The inertial frame's rotation at its own position (`mjSAMEFRAME_INERTIAROT`, 4).
+    InertiaRot = 4,
+}
+
+impl SameFrame {
+    /// MuJoCo's number for the flag (`geom_sameframe`, `site_sameframe`).
+    pub fn mujoco_code(self) -> u8 {
+        self as u8
     }
 }
 

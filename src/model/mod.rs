@@ -32,7 +32,7 @@ pub use elements::{Element, Keyframe};
 pub use equality::{Equality, EqualityKind};
 pub use hfield::HeightField;
 pub use joint::{axis_angle, HingeAxis, JointKind};
-pub use links::Links;
+pub use links::{Links, SameFrame};
 pub use options::{Flags, Options};
 pub use tendon::{PathElement, Tendon, TendonKind, WrapShape};
 pub use warning::{WarningStat, Warnings};
