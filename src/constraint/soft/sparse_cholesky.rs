@@ -44,6 +44,11 @@ pub(crate) struct SparseCholesky {
     h_start: Vec<usize>,
     h_cols: Vec<usize>,
     h_count: Vec<usize>,
+    /// H's values on its analyzed pattern: the strictly lower entries beside `h_cols` (row k's
+    /// columns ascending) and the diagonal — the only copy of H the sparse path keeps (no nv²
+    /// storage: assembled in place by `hessian.rs`, read by the factorization row by row).
+    h_vals: Vec<f64>,
+    h_diag: Vec<f64>,
     /// The same of P H P (positions: dof k at n − 1 − k), the transpose of H's.
     p_start: Vec<usize>,
     p_cols: Vec<usize>,
@@ -95,6 +100,8 @@ impl SparseCholesky {
             h_start: Vec::with_capacity(n + 1),
             h_cols: Vec::with_capacity(nnz),
             h_count: Vec::with_capacity(n + 1),
+            h_vals: Vec::with_capacity(nnz),
+            h_diag: Vec::with_capacity(n),
             p_start: Vec::with_capacity(n + 1),
             p_cols: Vec::with_capacity(nnz),
             parent: Vec::with_capacity(n),
@@ -123,15 +130,53 @@ impl SparseCholesky {
         }
     }
 
-    /// The strictly lower nonzeros of H by rows, of the analyzed pattern: the entries a caller
-    /// that assembles H in place must clear before the next assembly (and before a new
-    /// [`Self::analyze`] replaces the pattern).
-    pub fn pattern_row(&self, k: usize) -> &[usize] {
-        if k + 1 < self.h_start.len() {
-            &self.h_cols[self.h_start[k]..self.h_start[k + 1]]
-        } else {
-            &[]
+    /// H's values on the analyzed pattern, to assemble in place ([`SparseH`]).
+    pub fn h_mut(&mut self) -> SparseH<'_> {
+        SparseH { start: &self.h_start, cols: &self.h_cols, vals: &mut self.h_vals, diag: &mut self.h_diag }
+    }
+
+    /// Sets H's rows `dofs` (strictly lower entries and diagonal) to M's: the diagonal, each
+    /// dof's ancestors (`dof_parent`) from `m` (column-major, entry (k, l) at l · nv + k), zero
+    /// elsewhere on the pattern — the start of a Hessian's assembly on those dofs.
+    pub fn set_rows_to_m(&mut self, dofs: &[usize], m: &DMatrix<f64>, dof_parent: &[usize]) {
+        let (ld, m) = (m.nrows(), m.as_slice());
+        for &k in dofs {
+            let (a, b) = (self.h_start[k], self.h_start[k + 1]);
+            let (cols, vals) = (&self.h_cols[a..b], &mut self.h_vals[a..b]);
+            vals.fill(0.0);
+            self.h_diag[k] = m[k * ld + k];
+            // The ancestors descend, the row's columns ascend: one backward walk.
+            let mut u = cols.len();
+            let mut l = dof_parent[k];
+            while l != NONE {
+                while u > 0 && cols[u - 1] > l {
+                    u -= 1;
+                }
+                debug_assert!(u > 0 && cols[u - 1] == l, "an ancestor outside H's pattern");
+                if u > 0 {
+                    vals[u - 1] = m[l * ld + k];
+                }
+                l = dof_parent[l];
+            }
         }
+    }
+
+    /// Copies the lower triangle of the dense `h` on the analyzed pattern into H's values.
+    #[cfg(test)]
+    pub fn load(&mut self, h: &DMatrix<f64>) {
+        let n = self.h_start.len() - 1;
+        for k in 0..n {
+            for u in self.h_start[k]..self.h_start[k + 1] {
+                self.h_vals[u] = h[(k, self.h_cols[u])];
+            }
+            self.h_diag[k] = h[(k, k)];
+        }
+    }
+
+    /// The strictly lower nonzeros of H's row k on the analyzed pattern (ascending).
+    #[cfg(test)]
+    pub fn pattern_row(&self, k: usize) -> &[usize] {
+        &self.h_cols[self.h_start[k]..self.h_start[k + 1]]
     }
 
     /// How many symbolic analyses were done (each pattern change costs one).
@@ -276,8 +321,10 @@ impl SparseCholesky {
                         }
                     }
                 }
-                // (In any order: the elimination tree, the row patterns and the numeric scatter
-                // do not depend on it.)
+                // Ascending (the elimination tree, the row patterns and the numeric scatter do
+                // not depend on the order; the in-place assembly walks the rows in it).
+                let begin = *h_start.last().unwrap_or(&0);
+                h_cols[begin..].sort_unstable();
                 h_start.push(h_cols.len());
             }
         }
@@ -291,19 +338,20 @@ impl SparseCholesky {
     /// Returns false if a pivot is not positive.
     #[cfg(test)]
     pub fn factor_analyzed(&mut self, h: &DMatrix<f64>) -> bool {
-        self.numeric(h, 0.0, None)
+        self.load(h);
+        self.numeric(0.0, None)
     }
 
-    /// Factors `h` (lower triangle read) with the symbolic structure of the last
-    /// [`Self::analyze`], at the dofs `rows` only: the dofs of independent groups (constraint
+    /// Factors H (its values as assembled on the analyzed pattern, [`Self::h_mut`]) with the
+    /// symbolic structure of the last [`Self::analyze`], at the dofs `rows` only: the dofs of independent groups (constraint
     /// islands, `island.rs`), each group's ascending, that no other dof of L' couples to
     /// (factored from the list's end: children before parents); the other columns of L' keep
     /// stale values, which [`Self::solve_rows`] does not read. The work is that of the listed
     /// columns' nonzeros. `group` gives each dof's group: a listed dof's entries in another
     /// group's rows and columns (a kept pattern's coupling that no row makes now,
     /// [`Self::analyze`]) are set to zero, as the factor of H has them.
-    pub fn factor_rows(&mut self, h: &DMatrix<f64>, rows: &[usize], group: &[usize]) -> bool {
-        self.numeric(h, 0.0, Some((rows, group)))
+    pub fn factor_rows(&mut self, rows: &[usize], group: &[usize]) -> bool {
+        self.numeric(0.0, Some((rows, group)))
     }
 
     /// Factors the symmetric `h` (its lower triangle is read; n × n at the top left) into L.
@@ -314,7 +362,8 @@ impl SparseCholesky {
         self.analyzed = false;
         self.kept_wider = false;
         self.symbolic(n);
-        self.numeric(h, tol, None)
+        self.load(h);
+        self.numeric(tol, None)
     }
 
     /// Row lists of H's strictly lower nonzeros, from its lower triangle read by columns
@@ -493,6 +542,9 @@ impl SparseCholesky {
         self.x.resize(n, 0.0);
         self.diag.clear();
         self.diag.resize(n, 0.0);
+        // (H's values are written row by row before a factorization reads them.)
+        overwrite_len(&mut self.h_vals, self.h_cols.len());
+        overwrite_len(&mut self.h_diag, n);
         self.cover.clear();
         self.cover.resize(n, 0);
         self.analyzed = true;
@@ -527,7 +579,7 @@ impl SparseCholesky {
     /// reindexed). Every position in order, or (`rows`) the listed dofs' positions only, in the
     /// reverse of the list's order: islands whose dofs are listed ascending each; entries in
     /// another group's rows or columns (`group`, by dof) are set to zero.
-    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64, rows: Option<(&[usize], &[usize])>) -> bool {
+    fn numeric(&mut self, tol: f64, rows: Option<(&[usize], &[usize])>) -> bool {
         let n = self.diag.len();
         let all = (0..if rows.is_some() { 0 } else { n }).map(|p| n - 1 - p);
         let (listed, group) = rows.unwrap_or((&[], &[]));
@@ -536,15 +588,14 @@ impl SparseCholesky {
         let group = if self.kept_wider || self.cliques_span(group) { group } else { &[] };
         let x = &mut self.x;
         let other = |a: usize, b: usize| !group.is_empty() && group[n - 1 - a] != group[n - 1 - b];
-        // H column-major: H[k, j] at j · ld + k.
-        let (h, ld) = (h.as_slice(), h.nrows());
         for k in all.chain(listed.iter().rev().copied()) {
             let p = n - 1 - k;
             // H's column k below the diagonal (its row k left of it), at positions.
-            for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
-                x[n - 1 - j] = h[j * ld + k];
+            let (a, b) = (self.h_start[k], self.h_start[k + 1]);
+            for (&j, &h_kj) in self.h_cols[a..b].iter().zip(&self.h_vals[a..b]) {
+                x[n - 1 - j] = h_kj;
             }
-            let mut d = h[k * ld + k];
+            let mut d = self.h_diag[k];
             for u in self.l_start[p]..self.l_start[p + 1] {
                 let (c, slot) = (self.l_cols[u], self.c_slot[u]);
                 if other(c, p) {
@@ -672,6 +723,16 @@ impl SparseCholesky {
             b[k] = s / self.diag[p];
         }
     }
+}
+
+/// H's values on the analyzed pattern, borrowed for assembly in place: row k's strictly lower
+/// entries at columns `cols[start[k]..start[k + 1]]` (ascending) hold `vals` there, the
+/// diagonal `diag[k]`.
+pub(crate) struct SparseH<'a> {
+    pub start: &'a [usize],
+    pub cols: &'a [usize],
+    pub vals: &'a mut [f64],
+    pub diag: &'a mut [f64],
 }
 
 /// Sets `v`'s length to `len` for a pass that writes every entry before any is read: only
@@ -812,7 +873,8 @@ mod tests {
         let first_tree = [0, 1, 2];
         let mut g = SparseCholesky::default();
         g.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
-        assert!(g.factor_rows(&h, &first_tree, &[0, 0, 0, 1, 1]));
+        g.load(&h);
+        assert!(g.factor_rows(&first_tree, &[0, 0, 0, 1, 1]));
         let mut kept = rhs;
         g.solve_rows(&mut kept, &first_tree);
         assert_eq!(&kept[..3], &whole[..3]);
@@ -885,7 +947,8 @@ mod tests {
         f.analyze(n, &dof_parent, &[], &nz_start, &nz_index);
         assert_eq!(f.analyses(), 1);
         let (first_tree, group) = ([0, 1, 2], [0, 0, 0, 1, 1]);
-        assert!(f.factor_rows(&h, &first_tree, &group));
+        f.load(&h);
+        assert!(f.factor_rows(&first_tree, &group));
         let rhs = [1.0, -2.0, 0.5, 3.0, -1.0];
         let mut kept = rhs;
         f.solve_rows(&mut kept, &first_tree);
