@@ -19,6 +19,7 @@
 use super::cost::Rows;
 use super::hessian::{Assembler, Target};
 use super::primal::{line_search_with, mul_m_on, term_change, Settings, Sparsity, TermChange};
+use super::sparse_cholesky::{SparseCholesky, RANK};
 use super::work::SoftWork;
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{EfcState, Model, NO_DOF};
@@ -379,20 +380,45 @@ pub(super) fn newton(
             let (d0, d1) = (isl.dof_start[i], isl.dof_start[i + 1]);
             isl.active_dofs.extend_from_slice(&isl.dofs[d0..d1]);
             if isl.factored[i] {
+                // Rows that changed, batched while they share their columns (a contact's rows:
+                // one walk of the factor for them all, `rank_update`), applied in row order.
+                let mut batch = ([0usize; RANK], 0);
+                let update = |factor: &mut SparseCholesky, batch: &[usize]| {
+                    let (mut vals, mut scale, mut add) = ([&[][..]; RANK], [0.0; RANK], [false; RANK]);
+                    for (v, &r) in batch.iter().enumerate() {
+                        vals[v] = nz.row_values(r).1;
+                        scale[v] = rows.d[r].sqrt();
+                        add[v] = state[r] == EfcState::Quadratic;
+                    }
+                    let k = batch.len();
+                    factor.rank_update(nz.columns(batch[0]), &vals[..k], &scale[..k], &add[..k])
+                };
+                let mut ok = true;
                 for &r in &isl.rows[isl.row_start[i]..isl.row_start[i + 1]] {
                     let change = term_change(isl.factor_state[r], state[r]);
                     if change == TermChange::Block {
-                        isl.factored[i] = false;
+                        ok = false;
                         break;
                     }
                     if change != TermChange::Same {
                         isl.factor_state[r] = state[r];
-                        let (cols, vals) = nz.row_values(r);
-                        if !soft.factor.rank_one(cols, vals, rows.d[r].sqrt(), change == TermChange::Enters) {
-                            isl.factored[i] = false;
-                            break;
+                        let (b, len) = &mut batch;
+                        if *len == RANK || (*len > 0 && nz.columns(b[0]) != nz.columns(r)) {
+                            ok = update(&mut soft.factor, &b[..*len]);
+                            *len = 0;
+                            if !ok {
+                                break;
+                            }
                         }
+                        b[*len] = r;
+                        *len += 1;
                     }
+                }
+                if ok && batch.1 > 0 {
+                    ok = update(&mut soft.factor, &batch.0[..batch.1]);
+                }
+                if !ok {
+                    isl.factored[i] = false;
                 }
             }
             if !isl.factored[i] {

@@ -36,6 +36,10 @@ use nalgebra::DMatrix;
 
 const NONE: usize = usize::MAX;
 
+/// The most vectors of one rank update ([`SparseCholesky::rank_update`]: a pyramidal contact of
+/// condim 3 has four rows).
+pub(crate) const RANK: usize = 4;
+
 /// The factor L (H = L Lᵀ), its symbolic structure (kept while the pattern is unchanged) and the
 /// scratch of its computation.
 #[derive(Clone, Debug, Default)]
@@ -70,6 +74,8 @@ pub(crate) struct SparseCholesky {
     c_slot: Vec<usize>,
     /// Dense scratch row of L (zero between calls).
     x: Vec<f64>,
+    /// The vectors of a rank update, interleaved (`RANK` per position; zero between calls).
+    xb: Vec<f64>,
     /// The cliques of the pattern being analyzed (clique c's dofs are
     /// `clique_cols[clique_start[c]..clique_start[c + 1]]`, ascending) and each dof's cliques.
     clique_start: Vec<usize>,
@@ -115,6 +121,7 @@ impl SparseCholesky {
             c_vals: Vec::with_capacity(nnz),
             c_slot: Vec::with_capacity(nnz),
             x: Vec::with_capacity(n),
+            xb: Vec::with_capacity(RANK * n),
             clique_start: Vec::with_capacity(n + 1),
             clique_cols: Vec::with_capacity(nnz),
             d_start: Vec::with_capacity(n + 1),
@@ -410,16 +417,19 @@ impl SparseCholesky {
         if kept > 2 * new + 8 {
             return false;
         }
-        for c in 0..new {
-            let clique = &self.clique_cols[self.clique_start[c]..self.clique_start[c + 1]];
-            for (t, &p) in clique.iter().enumerate().skip(1) {
-                self.stamp += 1;
-                for &q in &self.h_cols[self.h_start[p]..self.h_start[p + 1]] {
-                    self.cover[q] = self.stamp;
-                }
-                if clique[..t].iter().any(|&q| self.cover[q] != self.stamp) {
-                    return false;
-                }
+        (0..new).all(|c| self.clique_covered(c))
+    }
+
+    /// Whether the analyzed H pattern holds every pair of new clique c.
+    fn clique_covered(&mut self, c: usize) -> bool {
+        let clique = &self.clique_cols[self.clique_start[c]..self.clique_start[c + 1]];
+        for (t, &p) in clique.iter().enumerate().skip(1) {
+            self.stamp += 1;
+            for &q in &self.h_cols[self.h_start[p]..self.h_start[p + 1]] {
+                self.cover[q] = self.stamp;
+            }
+            if clique[..t].iter().any(|&q| self.cover[q] != self.stamp) {
+                return false;
             }
         }
         true
@@ -540,6 +550,8 @@ impl SparseCholesky {
         }
         self.x.clear();
         self.x.resize(n, 0.0);
+        self.xb.clear();
+        self.xb.resize(RANK * n, 0.0);
         self.diag.clear();
         self.diag.resize(n, 0.0);
         // (H's values are written row by row before a factorization reads them.)
@@ -638,40 +650,91 @@ impl SparseCholesky {
     /// engine_solver.c). w's pattern must lie in the analyzed one (a row of the analyzed
     /// cliques). Returns false if a downdate leaves a pivot at or below 1e-10 of its square
     /// before: the factor is then spoiled and the caller factors H afresh.
+    #[cfg(test)]
     pub fn rank_one(&mut self, cols: &[usize], vals: &[f64], scale: f64, add: bool) -> bool {
+        self.rank_update(cols, &[vals], &[scale], &[add])
+    }
+
+    /// [`Self::rank_one`] for up to [`RANK`] vectors on the same dofs `cols` (a contact's rows
+    /// entering or leaving together: `vals[v]`, `scale[v]`, `add[v]` each), applied one after
+    /// the other — to the same bits as that many calls of `rank_one` in order — in one walk of
+    /// their common elimination-tree path: at each column the vectors' rotations in turn, then
+    /// each entry of the column rotated by them in turn (each of L's entries read and written
+    /// once for all of them).
+    pub fn rank_update(&mut self, cols: &[usize], vals: &[&[f64]], scale: &[f64], add: &[bool]) -> bool {
+        match vals.len() {
+            0 => true,
+            1 => self.rank_update_of::<1>(cols, vals, scale, add),
+            2 => self.rank_update_of::<2>(cols, vals, scale, add),
+            3 => self.rank_update_of::<3>(cols, vals, scale, add),
+            _ => self.rank_update_of::<RANK>(cols, vals, scale, add),
+        }
+    }
+
+    fn rank_update_of<const K: usize>(
+        &mut self,
+        cols: &[usize],
+        vals: &[&[f64]],
+        scale: &[f64],
+        add: &[bool],
+    ) -> bool {
         let Some(&last) = cols.last() else {
             return true;
         };
         let n = self.diag.len();
         let first = n - 1 - last;
-        let sign = if add { 1.0 } else { -1.0 };
-        let x = &mut self.x;
-        for (&k, &v) in cols.iter().zip(vals) {
-            x[n - 1 - k] = scale * v;
+        let mut sign = [0.0; K];
+        for v in 0..K {
+            sign[v] = if add[v] { 1.0 } else { -1.0 };
         }
-        // x is nonzero only on the path (a column's rows are its ancestors): each entry is
-        // cleared as its column is passed, so x is zero again at the end.
+        // The vectors interleaved: vector v's entry at position p in xb[RANK p + v].
+        let xb = &mut self.xb;
+        for (t, &k) in cols.iter().enumerate() {
+            let p = n - 1 - k;
+            for v in 0..K {
+                xb[RANK * p + v] = scale[v] * vals[v][t];
+            }
+        }
+        // xb is nonzero only on the path (a column's rows are its ancestors): each entry is
+        // cleared as its column is passed, so xb is zero again at the end.
         let mut k = first;
         let mut ok = true;
         while k != NONE {
-            let (l_kk, w_k) = (self.diag[k], x[k]);
-            x[k] = 0.0;
-            if ok && w_k != 0.0 {
-                let r2 = l_kk * l_kk + sign * w_k * w_k;
-                if r2 <= 1e-10 * l_kk * l_kk {
-                    ok = false;
-                } else {
-                    let r = r2.sqrt();
-                    let (c, s, inv_c) = (r / l_kk, w_k / l_kk, l_kk / r);
-                    let signed_s = sign * s;
-                    self.diag[k] = r;
-                    let (a, b) = (self.c_start[k], self.c_start[k + 1]);
-                    for (&i, l_ik) in self.c_rows[a..b].iter().zip(&mut self.c_vals[a..b]) {
-                        let x_i = x[i];
-                        let l = (*l_ik + signed_s * x_i) * inv_c;
-                        x[i] = c * x_i - s * l;
-                        *l_ik = l;
+            // Each vector's rotation (c, s, sign · s, 1 / c) at column k, in order (each from
+            // the pivot the one before left); `live` where one applies.
+            let mut rot = [[0.0; 4]; K];
+            let mut live = [false; K];
+            for v in 0..K {
+                let w_k = xb[RANK * k + v];
+                xb[RANK * k + v] = 0.0;
+                if ok && w_k != 0.0 {
+                    let l_kk = self.diag[k];
+                    let r2 = l_kk * l_kk + sign[v] * w_k * w_k;
+                    if r2 <= 1e-10 * l_kk * l_kk {
+                        ok = false;
+                    } else {
+                        let r = r2.sqrt();
+                        let (c, s, inv_c) = (r / l_kk, w_k / l_kk, l_kk / r);
+                        rot[v] = [c, s, sign[v] * s, inv_c];
+                        live[v] = true;
+                        self.diag[k] = r;
                     }
+                }
+            }
+            if ok && live.iter().any(|&l| l) {
+                let (a, b) = (self.c_start[k], self.c_start[k + 1]);
+                for (&i, l_ik) in self.c_rows[a..b].iter().zip(&mut self.c_vals[a..b]) {
+                    let x = &mut xb[RANK * i..RANK * i + K];
+                    let mut l = *l_ik;
+                    for v in 0..K {
+                        if live[v] {
+                            let [c, s, signed_s, inv_c] = rot[v];
+                            let x_i = x[v];
+                            l = (l + signed_s * x_i) * inv_c;
+                            x[v] = c * x_i - s * l;
+                        }
+                    }
+                    *l_ik = l;
                 }
             }
             k = self.parent[k];
@@ -912,7 +975,7 @@ mod tests {
             assert!((f.diag[k] - g.diag[k]).abs() <= 1e-13 * g.diag[k]);
         }
         // The scratch is clean, and the downdate returns H's factor.
-        assert!(f.x.iter().all(|&v| v == 0.0));
+        assert!(f.xb.iter().all(|&v| v == 0.0));
         assert!(f.rank_one(&cols, &vals, scale, false));
         let mut h_factor = SparseCholesky::default();
         h_factor.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
@@ -925,7 +988,31 @@ mod tests {
         }
         // A downdate that would leave H indefinite is refused.
         assert!(!f.rank_one(&cols, &vals, 10.0, false));
-        assert!(f.x.iter().all(|&v| v == 0.0));
+        assert!(f.xb.iter().all(|&v| v == 0.0));
+    }
+
+    #[test]
+    fn a_rank_update_of_several_vectors_is_their_rank_one_updates_in_order_to_the_bit() {
+        // Two trees and a row group on dofs 1, 2 and 4: three vectors (two updates and a
+        // downdate) at once against one after the other.
+        let n = 5;
+        let dof_parent = [NONE, 0, 1, NONE, 3];
+        let h = tree_matrix(&dof_parent);
+        let (nz_start, nz_index) = ([0, 3], [1, 2, 4]);
+        let cols = [1, 2, 4];
+        let vals: [&[f64]; 3] = [&[0.5, -1.5, 2.0], &[1.0, 0.25, -0.5], &[0.3, 0.2, 0.1]];
+        let (scale, add) = ([1.7, 0.9, 0.8], [true, true, false]);
+        let mut one = SparseCholesky::default();
+        one.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(one.factor_analyzed(&h));
+        let mut all = one.clone();
+        for v in 0..3 {
+            assert!(one.rank_one(&cols, vals[v], scale[v], add[v]));
+        }
+        assert!(all.rank_update(&cols, &vals, &scale, &add));
+        assert_eq!(one.diag, all.diag);
+        assert_eq!(one.c_vals, all.c_vals);
+        assert!(all.xb.iter().all(|&v| v == 0.0));
     }
 
     #[test]
