@@ -270,7 +270,9 @@ fn add_columns(
 /// (p, q), p ≥ q, added once, in the same order over the rows. The coefficients of every
 /// column are formed first (in `scratch`), then H is walked row by row (each row's pattern
 /// ascending, as the group's columns are: one merge per row).
-#[inline(always)]
+// (Kept out of line: the dense path's assembly, inlined into its callers, stays as compact as
+// it was without it.)
+#[inline(never)]
 fn add_columns_sparse(
     h: &mut SparseH,
     cols: &[usize],
