@@ -623,7 +623,9 @@ impl Data {
         }
         let new = n.max(2 * cap);
         let nv = self.efc_j.ncols();
-        self.efc_j = DMatrix::zeros(new, nv);
+        // A zeroed allocation (`vec!` of zeros): the pages that no row is written to are never
+        // touched, where `DMatrix::zeros` writes every entry of rows × nv.
+        self.efc_j = DMatrix::from_vec(new, nv, vec![0.0; new * nv]);
         self.exact.grow_vectors(new);
         for v in [
             &mut self.efc_pos,

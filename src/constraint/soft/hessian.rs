@@ -14,6 +14,7 @@
 //! added pair by pair.
 
 use super::primal::Sparsity;
+use super::sparse_cholesky::SparseH;
 use nalgebra::DMatrix;
 
 /// The most scalar rows summed as one group (a pyramidal contact of condim 6 has 10; a box
@@ -28,13 +29,22 @@ pub(super) const fn scratch_len(nv: usize) -> usize {
     2 * GROUP.div_ceil(4) * 4 * nv
 }
 
+/// Where the rows' terms are added: a dense nv × nv H (the dense Newton path, `primal.rs`), or
+/// H's values on the analyzed pattern of its sparse factor (the islands' path: no nv² storage,
+/// each row of H contiguous; `sparse_cholesky.rs`). Both receive the same sums in the same
+/// order, entry by entry.
+pub(super) enum Target<'a> {
+    Dense(&'a mut DMatrix<f64>),
+    Sparse(SparseH<'a>),
+}
+
 /// Adds the rows' Hessian blocks to H's lower triangle (see the module doc). Scalar rows are
 /// held in a pending group until a row with other columns (or a block) arrives; [`finish`]
 /// adds the last group.
 ///
 /// [`finish`]: Assembler::finish
 pub(super) struct Assembler<'a> {
-    h: &'a mut DMatrix<f64>,
+    h: Target<'a>,
     nz: &'a Sparsity<'a>,
     /// Scratch for a group's values laid out transposed, 2 · GROUP · nv long (`add_columns`).
     column: &'a mut [f64],
@@ -45,9 +55,9 @@ pub(super) struct Assembler<'a> {
 }
 
 impl<'a> Assembler<'a> {
-    /// An assembler adding to `h` (nv × nv) the rows of `nz`; `column` is scratch of
+    /// An assembler adding to `h` (over nv dofs) the rows of `nz`; `column` is scratch of
     /// [`scratch_len`]`(nv)`.
-    pub fn new(h: &'a mut DMatrix<f64>, nz: &'a Sparsity<'a>, column: &'a mut [f64]) -> Self {
+    pub fn new(h: Target<'a>, nz: &'a Sparsity<'a>, column: &'a mut [f64]) -> Self {
         Self { h, nz, column, rows: [0; GROUP], weights: [0.0; GROUP], len: 0 }
     }
 
@@ -93,11 +103,15 @@ impl<'a> Assembler<'a> {
             *g = self.nz.row_values(row).1;
         }
         let weights = self.weights;
-        add_columns(self.h, cols, &g[..k], self.column, |g_q, c| {
+        let coefficients = |g_q: &[f64], c: &mut [f64]| {
             for ((c, &w), &g) in c.iter_mut().zip(&weights[..k]).zip(g_q) {
                 *c = w * g;
             }
-        });
+        };
+        match &mut self.h {
+            Target::Dense(h) => add_columns(h, cols, &g[..k], self.column, coefficients),
+            Target::Sparse(h) => add_columns_sparse(h, cols, &g[..k], self.column, coefficients),
+        }
     }
 
     /// Rows i..i + dim with the same columns and a dense block B: with G the rows' values,
@@ -123,7 +137,7 @@ impl<'a> Assembler<'a> {
         for (a, g) in g.iter_mut().enumerate() {
             *g = self.nz.row_values(i + a).1;
         }
-        add_columns(self.h, cols, &g, self.column, |g_q, c| {
+        let coefficients = |g_q: &[f64], c: &mut [f64]| {
             for (c, row) in c.iter_mut().zip(block) {
                 let mut s = 0.0;
                 for (&b_ab, &g_b) in row[..D].iter().zip(&g_q[..D]) {
@@ -131,14 +145,34 @@ impl<'a> Assembler<'a> {
                 }
                 *c = s;
             }
-        });
+        };
+        match &mut self.h {
+            Target::Dense(h) => add_columns(h, cols, &g, self.column, coefficients),
+            Target::Sparse(h) => add_columns_sparse(h, cols, &g, self.column, coefficients),
+        }
     }
 
     /// H[p][q] += w J[a][p] J[b][q] over the nonzero columns p ≥ q of rows a and b.
     fn add_pair(&mut self, a: usize, b: usize, w: f64) {
         let ((row_a, j_a), (row_b, j_b)) = (self.nz.row_values(a), self.nz.row_values(b));
-        let nv = self.h.nrows();
-        let h = self.h.as_mut_slice();
+        let h = match &mut self.h {
+            Target::Dense(h) => h,
+            Target::Sparse(h) => {
+                for (&q, &j_bq) in row_b.iter().zip(j_b) {
+                    let c = w * j_bq;
+                    for (&p, &j_ap) in row_a.iter().zip(j_a) {
+                        if p >= q {
+                            if let Some(entry) = h.entry(p, q) {
+                                *entry += j_ap * c;
+                            }
+                        }
+                    }
+                }
+                return;
+            }
+        };
+        let nv = h.nrows();
+        let h = h.as_mut_slice();
         for (&q, &j_bq) in row_b.iter().zip(j_b) {
             let column = &mut h[q * nv..(q + 1) * nv];
             let c = w * j_bq;
@@ -232,6 +266,146 @@ fn add_columns(
     }
 }
 
+/// [`add_columns`] into H's values on the sparse factor's pattern: the same sum for each entry
+/// (p, q), p ≥ q, added once, in the same order over the rows. The coefficients of every
+/// column are formed first (in `scratch`), then H is walked row by row (each row's pattern
+/// ascending, as the group's columns are: one merge per row).
+// (Kept out of line: the dense path's assembly, inlined into its callers, stays as compact as
+// it was without it.)
+#[inline(never)]
+fn add_columns_sparse(
+    h: &mut SparseH,
+    cols: &[usize],
+    g: &[&[f64]],
+    scratch: &mut [f64],
+    mut coefficients: impl FnMut(&[f64], &mut [f64]),
+) {
+    let (n, k) = (cols.len(), g.len());
+    if k <= 8 {
+        // Each column's coefficients c(q) at c[8q..8q + k] (from the rows' values there, as
+        // `add_columns` forms them), then each entry's sum over (up to) four rows at a time.
+        let c = &mut scratch[..8 * n];
+        let mut g_q = [0.0; 8];
+        for (q, c_q) in c.chunks_exact_mut(8).enumerate() {
+            for (x, g) in g_q.iter_mut().zip(g) {
+                *x = g[q];
+            }
+            coefficients(&g_q[..k], &mut c_q[..k]);
+        }
+        // (The group's size a compile-time constant: the sums unrolled.)
+        match k {
+            1 => add_rows_sparse::<1>(h, cols, g, c),
+            2 => add_rows_sparse::<2>(h, cols, g, c),
+            3 => add_rows_sparse::<3>(h, cols, g, c),
+            4 => add_rows_sparse::<4>(h, cols, g, c),
+            5 => add_rows_sparse::<5>(h, cols, g, c),
+            6 => add_rows_sparse::<6>(h, cols, g, c),
+            7 => add_rows_sparse::<7>(h, cols, g, c),
+            _ => add_rows_sparse::<8>(h, cols, g, c),
+        }
+        return;
+    }
+    let kp = k.div_ceil(4) * 4;
+    let (gt, rest) = scratch.split_at_mut(n * kp);
+    let c = &mut rest[..n * kp];
+    for (p, gt_p) in gt.chunks_exact_mut(kp).enumerate() {
+        for (r, g) in g.iter().enumerate() {
+            gt_p[r] = g[p];
+        }
+        gt_p[k..].fill(0.0);
+    }
+    for (g_q, c_q) in gt.chunks_exact(kp).zip(c.chunks_exact_mut(kp)) {
+        coefficients(&g_q[..k], &mut c_q[..k]);
+        c_q[k..].fill(0.0);
+    }
+    for (t, &p) in cols.iter().enumerate() {
+        let gt_p = &gt[t * kp..(t + 1) * kp];
+        let (row, vals) = h.row_mut(p);
+        let mut u = 0;
+        for (s, &q) in cols[..t].iter().enumerate() {
+            u = find_from(row, u, q);
+            if u < row.len() {
+                vals[u] += dot4(gt_p, &c[s * kp..(s + 1) * kp]);
+            }
+        }
+        h.diag[p] += dot4(gt_p, &c[t * kp..(t + 1) * kp]);
+    }
+}
+
+/// The k ≤ 8 rows' sums of [`add_columns_sparse`] with `K` rows: entry (p, q) gets
+/// Σ_r c_r(q) G_r[p] four rows at a time (one addition per four), as `add_columns` forms it.
+#[inline(always)]
+fn add_rows_sparse<const K: usize>(h: &mut SparseH, cols: &[usize], g: &[&[f64]], c: &[f64]) {
+    // The sum of the rows lo..hi (at most four) in order, left to right.
+    #[inline(always)]
+    fn chunk<const K: usize>(c: &[f64], g_p: &[f64; 8], lo: usize) -> f64 {
+        let hi = (lo + 4).min(K);
+        let mut v = c[lo] * g_p[lo];
+        for r in lo + 1..hi {
+            v += c[r] * g_p[r];
+        }
+        v
+    }
+    for (t, &p) in cols.iter().enumerate() {
+        // The rows' values at p, once per row of H.
+        let mut g_p = [0.0; 8];
+        for (x, g) in g_p.iter_mut().zip(g) {
+            *x = g[t];
+        }
+        let (row, vals) = h.row_mut(p);
+        let mut u = 0;
+        for (s, &q) in cols[..t].iter().enumerate() {
+            u = find_from(row, u, q);
+            if u < row.len() {
+                let c_s = &c[8 * s..8 * s + 8];
+                vals[u] += chunk::<K>(c_s, &g_p, 0);
+                if K > 4 {
+                    vals[u] += chunk::<K>(c_s, &g_p, 4);
+                }
+            }
+        }
+        let c_t = &c[8 * t..8 * t + 8];
+        h.diag[p] += chunk::<K>(c_t, &g_p, 0);
+        if K > 4 {
+            h.diag[p] += chunk::<K>(c_t, &g_p, 4);
+        }
+    }
+}
+
+/// The position of `q` in the ascending `row` from position `u` on (`row.len()` if absent,
+/// which a pattern that covers the rows' pairs never has).
+#[inline(always)]
+fn find_from(row: &[usize], mut u: usize, q: usize) -> usize {
+    while u < row.len() && row[u] < q {
+        u += 1;
+    }
+    debug_assert!(u < row.len() && row[u] == q, "a row pair outside H's pattern");
+    if u < row.len() && row[u] == q {
+        u
+    } else {
+        row.len()
+    }
+}
+
+impl SparseH<'_> {
+    /// The stored entry (p, q), p ≥ q, of H's lower triangle (None outside the pattern).
+    fn entry(&mut self, p: usize, q: usize) -> Option<&mut f64> {
+        if p == q {
+            return Some(&mut self.diag[p]);
+        }
+        let (a, b) = (self.start[p], self.start[p + 1]);
+        let u = self.cols[a..b].binary_search(&q).ok()?;
+        Some(&mut self.vals[a + u])
+    }
+
+    /// Row p's strictly lower columns (ascending) and its values there.
+    #[inline(always)]
+    fn row_mut(&mut self, p: usize) -> (&[usize], &mut [f64]) {
+        let (a, b) = (self.start[p], self.start[p + 1]);
+        (&self.cols[a..b], &mut self.vals[a..b])
+    }
+}
+
 /// Σ a_i b_i of two equally long vectors whose length is a multiple of four: four partial
 /// sums (the lanes of a vector register) combined at the end.
 #[inline]
@@ -249,6 +423,7 @@ fn dot4(a: &[f64], b: &[f64]) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::sparse_cholesky::SparseCholesky;
     use super::*;
 
     /// Jᵀ B J (lower triangle) by the definition.
@@ -311,11 +486,27 @@ mod tests {
         blocks.extend((8..26).map(|i| (i, 1, scalar(0.2 + 0.1 * i as f64))));
         let mut h = DMatrix::zeros(nv, nv);
         let mut column = vec![0.0; scratch_len(nv)];
-        let mut asm = Assembler::new(&mut h, &nz, &mut column);
+        let mut asm = Assembler::new(Target::Dense(&mut h), &nz, &mut column);
         for &(i, dim, b) in &blocks {
             asm.add(i, dim, &b);
         }
         asm.finish();
+        // The same into H's values on a sparse factor's (full) pattern: the same bits.
+        let full = DMatrix::from_fn(nv, nv, |p, q| if p == q { nv as f64 } else { 1.0 });
+        let mut factor = SparseCholesky::default();
+        assert!(factor.factor(&full, nv, 0.0));
+        factor.load(&DMatrix::zeros(nv, nv));
+        let mut asm = Assembler::new(Target::Sparse(factor.h_mut()), &nz, &mut column);
+        for &(i, dim, b) in &blocks {
+            asm.add(i, dim, &b);
+        }
+        asm.finish();
+        let mut sparse = factor.h_mut();
+        for p in 0..nv {
+            for q in 0..=p {
+                assert_eq!(sparse.entry(p, q).map(|x| *x), Some(h[(p, q)]), "H[{p}][{q}]");
+            }
+        }
         let want = reference(&j, &blocks, nv);
         for p in 0..nv {
             for q in 0..nv {

@@ -17,8 +17,9 @@
 //! keep `qacc_smooth` (MuJoCo does the same).
 
 use super::cost::Rows;
-use super::hessian::Assembler;
+use super::hessian::{Assembler, Target};
 use super::primal::{line_search_with, mul_m_on, term_change, Settings, Sparsity, TermChange};
+use super::sparse_cholesky::{SparseCholesky, RANK};
 use super::work::SoftWork;
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{EfcState, Model, NO_DOF};
@@ -293,20 +294,6 @@ pub(super) fn newton(
 ) -> Outcome {
     let (model, rows, nz, s) = (p.model, p.rows, p.nz, p.settings);
     let (nv, nefc) = (model.nv, rows.nefc);
-    // H is zero outside the rows the last solve wrote: its islands' dofs, on the pattern it
-    // was analyzed with (still the current one). Those rows are cleared here, so that H is zero
-    // before this solve's pattern is analyzed and its islands' rows are formed.
-    // (H and M are column-major: entry (k, j) at j · nv + k.)
-    {
-        let isl = &soft.islands;
-        let h = soft.hessian.as_mut_slice();
-        for &k in &isl.dofs {
-            for &j in soft.factor.pattern_row(k) {
-                h[j * nv + k] = 0.0;
-            }
-            h[k * nv + k] = 0.0;
-        }
-    }
     let isl = &mut soft.islands;
     isl.discover(nv, &model.dof_parent, nefc, nz, p.m);
     let n = isl.n;
@@ -393,20 +380,45 @@ pub(super) fn newton(
             let (d0, d1) = (isl.dof_start[i], isl.dof_start[i + 1]);
             isl.active_dofs.extend_from_slice(&isl.dofs[d0..d1]);
             if isl.factored[i] {
+                // Rows that changed, batched while they share their columns (a contact's rows:
+                // one walk of the factor for them all, `rank_update`), applied in row order.
+                let mut batch = ([0usize; RANK], 0);
+                let update = |factor: &mut SparseCholesky, batch: &[usize]| {
+                    let (mut vals, mut scale, mut add) = ([&[][..]; RANK], [0.0; RANK], [false; RANK]);
+                    for (v, &r) in batch.iter().enumerate() {
+                        vals[v] = nz.row_values(r).1;
+                        scale[v] = rows.d[r].sqrt();
+                        add[v] = state[r] == EfcState::Quadratic;
+                    }
+                    let k = batch.len();
+                    factor.rank_update(nz.columns(batch[0]), &vals[..k], &scale[..k], &add[..k])
+                };
+                let mut ok = true;
                 for &r in &isl.rows[isl.row_start[i]..isl.row_start[i + 1]] {
                     let change = term_change(isl.factor_state[r], state[r]);
                     if change == TermChange::Block {
-                        isl.factored[i] = false;
+                        ok = false;
                         break;
                     }
                     if change != TermChange::Same {
                         isl.factor_state[r] = state[r];
-                        let (cols, vals) = nz.row_values(r);
-                        if !soft.factor.rank_one(cols, vals, rows.d[r].sqrt(), change == TermChange::Enters) {
-                            isl.factored[i] = false;
-                            break;
+                        let (b, len) = &mut batch;
+                        if *len == RANK || (*len > 0 && nz.columns(b[0]) != nz.columns(r)) {
+                            ok = update(&mut soft.factor, &b[..*len]);
+                            *len = 0;
+                            if !ok {
+                                break;
+                            }
                         }
+                        b[*len] = r;
+                        *len += 1;
                     }
+                }
+                if ok && batch.1 > 0 {
+                    ok = update(&mut soft.factor, &batch.0[..batch.1]);
+                }
+                if !ok {
+                    isl.factored[i] = false;
                 }
             }
             if !isl.factored[i] {
@@ -432,21 +444,10 @@ pub(super) fn newton(
         // A new factor: H = M + Jᵀ (∂²s) J on those islands' dofs, factored.
         let mut factored = true;
         if !isl.fresh_dofs.is_empty() {
-            let (h, m) = (soft.hessian.as_mut_slice(), p.m.as_slice());
-            for &k in &isl.fresh_dofs {
-                for &j in soft.factor.pattern_row(k) {
-                    h[j * nv + k] = 0.0;
-                }
-                h[k * nv + k] = m[k * nv + k];
-                let mut l = model.dof_parent[k];
-                while l != NO_DOF {
-                    h[l * nv + k] = m[l * nv + k];
-                    l = model.dof_parent[l];
-                }
-            }
-            let h = &mut soft.hessian;
+            soft.factor.set_rows_to_m(&isl.fresh_dofs, p.m, &model.dof_parent);
             {
-                let mut rows_h = Assembler::new(h, nz, &mut soft.hessian_column);
+                let mut rows_h =
+                    Assembler::new(Target::Sparse(soft.factor.h_mut()), nz, &mut soft.hessian_column);
                 let (row_island, fresh) = (&isl.row, &isl.fresh);
                 rows.hessian(&soft.jar, state, |i, dim, block| {
                     if row_island[i] != NONE && fresh[row_island[i]] {
@@ -455,7 +456,7 @@ pub(super) fn newton(
                 });
                 rows_h.finish();
             }
-            factored = soft.factor.factor_rows(&soft.hessian, &isl.fresh_dofs, &isl.dof);
+            factored = soft.factor.factor_rows(&isl.fresh_dofs, &isl.dof);
             for i in 0..n {
                 if isl.fresh[i] {
                     isl.factored[i] = factored;

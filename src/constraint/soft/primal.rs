@@ -15,7 +15,7 @@
 //! `tolerance`, the scale being 1 / (meaninertia · max(1, nv)).
 
 use super::cost::Rows;
-use super::hessian::Assembler;
+use super::hessian::{Assembler, Target};
 use crate::constraint::dense::{cholesky, cholesky_rank_one, cholesky_solve};
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, EfcState, Model};
@@ -397,7 +397,8 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                         );
                     factor_valid = updated || {
                         soft.hessian.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
-                        let mut rows_h = Assembler::new(&mut soft.hessian, &nz, &mut soft.hessian_column);
+                        let mut rows_h =
+                            Assembler::new(Target::Dense(&mut soft.hessian), &nz, &mut soft.hessian_column);
                         rows.hessian(&soft.jar, efc_state, |i, dim, block| rows_h.add(i, dim, block));
                         rows_h.finish();
                         let ok = cholesky(&soft.hessian, nv, &mut soft.dense_factor, 0.0);

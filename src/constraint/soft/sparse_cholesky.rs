@@ -36,6 +36,10 @@ use nalgebra::DMatrix;
 
 const NONE: usize = usize::MAX;
 
+/// The most vectors of one rank update ([`SparseCholesky::rank_update`]: a pyramidal contact of
+/// condim 3 has four rows).
+pub(crate) const RANK: usize = 4;
+
 /// The factor L (H = L Lᵀ), its symbolic structure (kept while the pattern is unchanged) and the
 /// scratch of its computation.
 #[derive(Clone, Debug, Default)]
@@ -44,6 +48,11 @@ pub(crate) struct SparseCholesky {
     h_start: Vec<usize>,
     h_cols: Vec<usize>,
     h_count: Vec<usize>,
+    /// H's values on its analyzed pattern: the strictly lower entries beside `h_cols` (row k's
+    /// columns ascending) and the diagonal — the only copy of H the sparse path keeps (no nv²
+    /// storage: assembled in place by `hessian.rs`, read by the factorization row by row).
+    h_vals: Vec<f64>,
+    h_diag: Vec<f64>,
     /// The same of P H P (positions: dof k at n − 1 − k), the transpose of H's.
     p_start: Vec<usize>,
     p_cols: Vec<usize>,
@@ -65,6 +74,8 @@ pub(crate) struct SparseCholesky {
     c_slot: Vec<usize>,
     /// Dense scratch row of L (zero between calls).
     x: Vec<f64>,
+    /// The vectors of a rank update, interleaved (`RANK` per position; zero between calls).
+    xb: Vec<f64>,
     /// The cliques of the pattern being analyzed (clique c's dofs are
     /// `clique_cols[clique_start[c]..clique_start[c + 1]]`, ascending) and each dof's cliques.
     clique_start: Vec<usize>,
@@ -95,6 +106,8 @@ impl SparseCholesky {
             h_start: Vec::with_capacity(n + 1),
             h_cols: Vec::with_capacity(nnz),
             h_count: Vec::with_capacity(n + 1),
+            h_vals: Vec::with_capacity(nnz),
+            h_diag: Vec::with_capacity(n),
             p_start: Vec::with_capacity(n + 1),
             p_cols: Vec::with_capacity(nnz),
             parent: Vec::with_capacity(n),
@@ -108,6 +121,7 @@ impl SparseCholesky {
             c_vals: Vec::with_capacity(nnz),
             c_slot: Vec::with_capacity(nnz),
             x: Vec::with_capacity(n),
+            xb: Vec::with_capacity(RANK * n),
             clique_start: Vec::with_capacity(n + 1),
             clique_cols: Vec::with_capacity(nnz),
             d_start: Vec::with_capacity(n + 1),
@@ -123,15 +137,53 @@ impl SparseCholesky {
         }
     }
 
-    /// The strictly lower nonzeros of H by rows, of the analyzed pattern: the entries a caller
-    /// that assembles H in place must clear before the next assembly (and before a new
-    /// [`Self::analyze`] replaces the pattern).
-    pub fn pattern_row(&self, k: usize) -> &[usize] {
-        if k + 1 < self.h_start.len() {
-            &self.h_cols[self.h_start[k]..self.h_start[k + 1]]
-        } else {
-            &[]
+    /// H's values on the analyzed pattern, to assemble in place ([`SparseH`]).
+    pub fn h_mut(&mut self) -> SparseH<'_> {
+        SparseH { start: &self.h_start, cols: &self.h_cols, vals: &mut self.h_vals, diag: &mut self.h_diag }
+    }
+
+    /// Sets H's rows `dofs` (strictly lower entries and diagonal) to M's: the diagonal, each
+    /// dof's ancestors (`dof_parent`) from `m` (column-major, entry (k, l) at l · nv + k), zero
+    /// elsewhere on the pattern — the start of a Hessian's assembly on those dofs.
+    pub fn set_rows_to_m(&mut self, dofs: &[usize], m: &DMatrix<f64>, dof_parent: &[usize]) {
+        let (ld, m) = (m.nrows(), m.as_slice());
+        for &k in dofs {
+            let (a, b) = (self.h_start[k], self.h_start[k + 1]);
+            let (cols, vals) = (&self.h_cols[a..b], &mut self.h_vals[a..b]);
+            vals.fill(0.0);
+            self.h_diag[k] = m[k * ld + k];
+            // The ancestors descend, the row's columns ascend: one backward walk.
+            let mut u = cols.len();
+            let mut l = dof_parent[k];
+            while l != NONE {
+                while u > 0 && cols[u - 1] > l {
+                    u -= 1;
+                }
+                debug_assert!(u > 0 && cols[u - 1] == l, "an ancestor outside H's pattern");
+                if u > 0 {
+                    vals[u - 1] = m[l * ld + k];
+                }
+                l = dof_parent[l];
+            }
         }
+    }
+
+    /// Copies the lower triangle of the dense `h` on the analyzed pattern into H's values.
+    #[cfg(test)]
+    pub fn load(&mut self, h: &DMatrix<f64>) {
+        let n = self.h_start.len() - 1;
+        for k in 0..n {
+            for u in self.h_start[k]..self.h_start[k + 1] {
+                self.h_vals[u] = h[(k, self.h_cols[u])];
+            }
+            self.h_diag[k] = h[(k, k)];
+        }
+    }
+
+    /// The strictly lower nonzeros of H's row k on the analyzed pattern (ascending).
+    #[cfg(test)]
+    pub fn pattern_row(&self, k: usize) -> &[usize] {
+        &self.h_cols[self.h_start[k]..self.h_start[k + 1]]
     }
 
     /// How many symbolic analyses were done (each pattern change costs one).
@@ -276,8 +328,10 @@ impl SparseCholesky {
                         }
                     }
                 }
-                // (In any order: the elimination tree, the row patterns and the numeric scatter
-                // do not depend on it.)
+                // Ascending (the elimination tree, the row patterns and the numeric scatter do
+                // not depend on the order; the in-place assembly walks the rows in it).
+                let begin = *h_start.last().unwrap_or(&0);
+                h_cols[begin..].sort_unstable();
                 h_start.push(h_cols.len());
             }
         }
@@ -291,19 +345,20 @@ impl SparseCholesky {
     /// Returns false if a pivot is not positive.
     #[cfg(test)]
     pub fn factor_analyzed(&mut self, h: &DMatrix<f64>) -> bool {
-        self.numeric(h, 0.0, None)
+        self.load(h);
+        self.numeric(0.0, None)
     }
 
-    /// Factors `h` (lower triangle read) with the symbolic structure of the last
-    /// [`Self::analyze`], at the dofs `rows` only: the dofs of independent groups (constraint
+    /// Factors H (its values as assembled on the analyzed pattern, [`Self::h_mut`]) with the
+    /// symbolic structure of the last [`Self::analyze`], at the dofs `rows` only: the dofs of independent groups (constraint
     /// islands, `island.rs`), each group's ascending, that no other dof of L' couples to
     /// (factored from the list's end: children before parents); the other columns of L' keep
     /// stale values, which [`Self::solve_rows`] does not read. The work is that of the listed
     /// columns' nonzeros. `group` gives each dof's group: a listed dof's entries in another
     /// group's rows and columns (a kept pattern's coupling that no row makes now,
     /// [`Self::analyze`]) are set to zero, as the factor of H has them.
-    pub fn factor_rows(&mut self, h: &DMatrix<f64>, rows: &[usize], group: &[usize]) -> bool {
-        self.numeric(h, 0.0, Some((rows, group)))
+    pub fn factor_rows(&mut self, rows: &[usize], group: &[usize]) -> bool {
+        self.numeric(0.0, Some((rows, group)))
     }
 
     /// Factors the symmetric `h` (its lower triangle is read; n × n at the top left) into L.
@@ -314,7 +369,8 @@ impl SparseCholesky {
         self.analyzed = false;
         self.kept_wider = false;
         self.symbolic(n);
-        self.numeric(h, tol, None)
+        self.load(h);
+        self.numeric(tol, None)
     }
 
     /// Row lists of H's strictly lower nonzeros, from its lower triangle read by columns
@@ -361,16 +417,19 @@ impl SparseCholesky {
         if kept > 2 * new + 8 {
             return false;
         }
-        for c in 0..new {
-            let clique = &self.clique_cols[self.clique_start[c]..self.clique_start[c + 1]];
-            for (t, &p) in clique.iter().enumerate().skip(1) {
-                self.stamp += 1;
-                for &q in &self.h_cols[self.h_start[p]..self.h_start[p + 1]] {
-                    self.cover[q] = self.stamp;
-                }
-                if clique[..t].iter().any(|&q| self.cover[q] != self.stamp) {
-                    return false;
-                }
+        (0..new).all(|c| self.clique_covered(c))
+    }
+
+    /// Whether the analyzed H pattern holds every pair of new clique c.
+    fn clique_covered(&mut self, c: usize) -> bool {
+        let clique = &self.clique_cols[self.clique_start[c]..self.clique_start[c + 1]];
+        for (t, &p) in clique.iter().enumerate().skip(1) {
+            self.stamp += 1;
+            for &q in &self.h_cols[self.h_start[p]..self.h_start[p + 1]] {
+                self.cover[q] = self.stamp;
+            }
+            if clique[..t].iter().any(|&q| self.cover[q] != self.stamp) {
+                return false;
             }
         }
         true
@@ -491,8 +550,13 @@ impl SparseCholesky {
         }
         self.x.clear();
         self.x.resize(n, 0.0);
+        self.xb.clear();
+        self.xb.resize(RANK * n, 0.0);
         self.diag.clear();
         self.diag.resize(n, 0.0);
+        // (H's values are written row by row before a factorization reads them.)
+        overwrite_len(&mut self.h_vals, self.h_cols.len());
+        overwrite_len(&mut self.h_diag, n);
         self.cover.clear();
         self.cover.resize(n, 0);
         self.analyzed = true;
@@ -527,7 +591,7 @@ impl SparseCholesky {
     /// reindexed). Every position in order, or (`rows`) the listed dofs' positions only, in the
     /// reverse of the list's order: islands whose dofs are listed ascending each; entries in
     /// another group's rows or columns (`group`, by dof) are set to zero.
-    fn numeric(&mut self, h: &DMatrix<f64>, tol: f64, rows: Option<(&[usize], &[usize])>) -> bool {
+    fn numeric(&mut self, tol: f64, rows: Option<(&[usize], &[usize])>) -> bool {
         let n = self.diag.len();
         let all = (0..if rows.is_some() { 0 } else { n }).map(|p| n - 1 - p);
         let (listed, group) = rows.unwrap_or((&[], &[]));
@@ -536,15 +600,14 @@ impl SparseCholesky {
         let group = if self.kept_wider || self.cliques_span(group) { group } else { &[] };
         let x = &mut self.x;
         let other = |a: usize, b: usize| !group.is_empty() && group[n - 1 - a] != group[n - 1 - b];
-        // H column-major: H[k, j] at j · ld + k.
-        let (h, ld) = (h.as_slice(), h.nrows());
         for k in all.chain(listed.iter().rev().copied()) {
             let p = n - 1 - k;
             // H's column k below the diagonal (its row k left of it), at positions.
-            for &j in &self.h_cols[self.h_start[k]..self.h_start[k + 1]] {
-                x[n - 1 - j] = h[j * ld + k];
+            let (a, b) = (self.h_start[k], self.h_start[k + 1]);
+            for (&j, &h_kj) in self.h_cols[a..b].iter().zip(&self.h_vals[a..b]) {
+                x[n - 1 - j] = h_kj;
             }
-            let mut d = h[k * ld + k];
+            let mut d = self.h_diag[k];
             for u in self.l_start[p]..self.l_start[p + 1] {
                 let (c, slot) = (self.l_cols[u], self.c_slot[u]);
                 if other(c, p) {
@@ -587,40 +650,91 @@ impl SparseCholesky {
     /// engine_solver.c). w's pattern must lie in the analyzed one (a row of the analyzed
     /// cliques). Returns false if a downdate leaves a pivot at or below 1e-10 of its square
     /// before: the factor is then spoiled and the caller factors H afresh.
+    #[cfg(test)]
     pub fn rank_one(&mut self, cols: &[usize], vals: &[f64], scale: f64, add: bool) -> bool {
+        self.rank_update(cols, &[vals], &[scale], &[add])
+    }
+
+    /// [`Self::rank_one`] for up to [`RANK`] vectors on the same dofs `cols` (a contact's rows
+    /// entering or leaving together: `vals[v]`, `scale[v]`, `add[v]` each), applied one after
+    /// the other — to the same bits as that many calls of `rank_one` in order — in one walk of
+    /// their common elimination-tree path: at each column the vectors' rotations in turn, then
+    /// each entry of the column rotated by them in turn (each of L's entries read and written
+    /// once for all of them).
+    pub fn rank_update(&mut self, cols: &[usize], vals: &[&[f64]], scale: &[f64], add: &[bool]) -> bool {
+        match vals.len() {
+            0 => true,
+            1 => self.rank_update_of::<1>(cols, vals, scale, add),
+            2 => self.rank_update_of::<2>(cols, vals, scale, add),
+            3 => self.rank_update_of::<3>(cols, vals, scale, add),
+            _ => self.rank_update_of::<RANK>(cols, vals, scale, add),
+        }
+    }
+
+    fn rank_update_of<const K: usize>(
+        &mut self,
+        cols: &[usize],
+        vals: &[&[f64]],
+        scale: &[f64],
+        add: &[bool],
+    ) -> bool {
         let Some(&last) = cols.last() else {
             return true;
         };
         let n = self.diag.len();
         let first = n - 1 - last;
-        let sign = if add { 1.0 } else { -1.0 };
-        let x = &mut self.x;
-        for (&k, &v) in cols.iter().zip(vals) {
-            x[n - 1 - k] = scale * v;
+        let mut sign = [0.0; K];
+        for v in 0..K {
+            sign[v] = if add[v] { 1.0 } else { -1.0 };
         }
-        // x is nonzero only on the path (a column's rows are its ancestors): each entry is
-        // cleared as its column is passed, so x is zero again at the end.
+        // The vectors interleaved: vector v's entry at position p in xb[RANK p + v].
+        let xb = &mut self.xb;
+        for (t, &k) in cols.iter().enumerate() {
+            let p = n - 1 - k;
+            for v in 0..K {
+                xb[RANK * p + v] = scale[v] * vals[v][t];
+            }
+        }
+        // xb is nonzero only on the path (a column's rows are its ancestors): each entry is
+        // cleared as its column is passed, so xb is zero again at the end.
         let mut k = first;
         let mut ok = true;
         while k != NONE {
-            let (l_kk, w_k) = (self.diag[k], x[k]);
-            x[k] = 0.0;
-            if ok && w_k != 0.0 {
-                let r2 = l_kk * l_kk + sign * w_k * w_k;
-                if r2 <= 1e-10 * l_kk * l_kk {
-                    ok = false;
-                } else {
-                    let r = r2.sqrt();
-                    let (c, s, inv_c) = (r / l_kk, w_k / l_kk, l_kk / r);
-                    let signed_s = sign * s;
-                    self.diag[k] = r;
-                    let (a, b) = (self.c_start[k], self.c_start[k + 1]);
-                    for (&i, l_ik) in self.c_rows[a..b].iter().zip(&mut self.c_vals[a..b]) {
-                        let x_i = x[i];
-                        let l = (*l_ik + signed_s * x_i) * inv_c;
-                        x[i] = c * x_i - s * l;
-                        *l_ik = l;
+            // Each vector's rotation (c, s, sign · s, 1 / c) at column k, in order (each from
+            // the pivot the one before left); `live` where one applies.
+            let mut rot = [[0.0; 4]; K];
+            let mut live = [false; K];
+            for v in 0..K {
+                let w_k = xb[RANK * k + v];
+                xb[RANK * k + v] = 0.0;
+                if ok && w_k != 0.0 {
+                    let l_kk = self.diag[k];
+                    let r2 = l_kk * l_kk + sign[v] * w_k * w_k;
+                    if r2 <= 1e-10 * l_kk * l_kk {
+                        ok = false;
+                    } else {
+                        let r = r2.sqrt();
+                        let (c, s, inv_c) = (r / l_kk, w_k / l_kk, l_kk / r);
+                        rot[v] = [c, s, sign[v] * s, inv_c];
+                        live[v] = true;
+                        self.diag[k] = r;
                     }
+                }
+            }
+            if ok && live.iter().any(|&l| l) {
+                let (a, b) = (self.c_start[k], self.c_start[k + 1]);
+                for (&i, l_ik) in self.c_rows[a..b].iter().zip(&mut self.c_vals[a..b]) {
+                    let x = &mut xb[RANK * i..RANK * i + K];
+                    let mut l = *l_ik;
+                    for v in 0..K {
+                        if live[v] {
+                            let [c, s, signed_s, inv_c] = rot[v];
+                            let x_i = x[v];
+                            l = (l + signed_s * x_i) * inv_c;
+                            x[v] = c * x_i - s * l;
+                        }
+                    }
+                    *l_ik = l;
                 }
             }
             k = self.parent[k];
@@ -672,6 +786,16 @@ impl SparseCholesky {
             b[k] = s / self.diag[p];
         }
     }
+}
+
+/// H's values on the analyzed pattern, borrowed for assembly in place: row k's strictly lower
+/// entries at columns `cols[start[k]..start[k + 1]]` (ascending) hold `vals` there, the
+/// diagonal `diag[k]`.
+pub(crate) struct SparseH<'a> {
+    pub start: &'a [usize],
+    pub cols: &'a [usize],
+    pub vals: &'a mut [f64],
+    pub diag: &'a mut [f64],
 }
 
 /// Sets `v`'s length to `len` for a pass that writes every entry before any is read: only
@@ -812,7 +936,8 @@ mod tests {
         let first_tree = [0, 1, 2];
         let mut g = SparseCholesky::default();
         g.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
-        assert!(g.factor_rows(&h, &first_tree, &[0, 0, 0, 1, 1]));
+        g.load(&h);
+        assert!(g.factor_rows(&first_tree, &[0, 0, 0, 1, 1]));
         let mut kept = rhs;
         g.solve_rows(&mut kept, &first_tree);
         assert_eq!(&kept[..3], &whole[..3]);
@@ -850,7 +975,7 @@ mod tests {
             assert!((f.diag[k] - g.diag[k]).abs() <= 1e-13 * g.diag[k]);
         }
         // The scratch is clean, and the downdate returns H's factor.
-        assert!(f.x.iter().all(|&v| v == 0.0));
+        assert!(f.xb.iter().all(|&v| v == 0.0));
         assert!(f.rank_one(&cols, &vals, scale, false));
         let mut h_factor = SparseCholesky::default();
         h_factor.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
@@ -863,7 +988,31 @@ mod tests {
         }
         // A downdate that would leave H indefinite is refused.
         assert!(!f.rank_one(&cols, &vals, 10.0, false));
-        assert!(f.x.iter().all(|&v| v == 0.0));
+        assert!(f.xb.iter().all(|&v| v == 0.0));
+    }
+
+    #[test]
+    fn a_rank_update_of_several_vectors_is_their_rank_one_updates_in_order_to_the_bit() {
+        // Two trees and a row group on dofs 1, 2 and 4: three vectors (two updates and a
+        // downdate) at once against one after the other.
+        let n = 5;
+        let dof_parent = [NONE, 0, 1, NONE, 3];
+        let h = tree_matrix(&dof_parent);
+        let (nz_start, nz_index) = ([0, 3], [1, 2, 4]);
+        let cols = [1, 2, 4];
+        let vals: [&[f64]; 3] = [&[0.5, -1.5, 2.0], &[1.0, 0.25, -0.5], &[0.3, 0.2, 0.1]];
+        let (scale, add) = ([1.7, 0.9, 0.8], [true, true, false]);
+        let mut one = SparseCholesky::default();
+        one.analyze(n, &dof_parent, &[(0, 0)], &nz_start, &nz_index);
+        assert!(one.factor_analyzed(&h));
+        let mut all = one.clone();
+        for v in 0..3 {
+            assert!(one.rank_one(&cols, vals[v], scale[v], add[v]));
+        }
+        assert!(all.rank_update(&cols, &vals, &scale, &add));
+        assert_eq!(one.diag, all.diag);
+        assert_eq!(one.c_vals, all.c_vals);
+        assert!(all.xb.iter().all(|&v| v == 0.0));
     }
 
     #[test]
@@ -885,7 +1034,8 @@ mod tests {
         f.analyze(n, &dof_parent, &[], &nz_start, &nz_index);
         assert_eq!(f.analyses(), 1);
         let (first_tree, group) = ([0, 1, 2], [0, 0, 0, 1, 1]);
-        assert!(f.factor_rows(&h, &first_tree, &group));
+        f.load(&h);
+        assert!(f.factor_rows(&first_tree, &group));
         let rhs = [1.0, -2.0, 0.5, 3.0, -1.0];
         let mut kept = rhs;
         f.solve_rows(&mut kept, &first_tree);

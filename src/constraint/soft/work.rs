@@ -23,8 +23,8 @@ pub(crate) struct SoftWork {
     pub mdir: DVector<f64>,
     pub grad_prev: DVector<f64>,
     pub mgrad_prev: DVector<f64>,
-    /// The cost's Hessian M + Jᵀ D J (+ cone blocks), nv × nv (lower triangle, nonzero only on
-    /// its factor's pattern), and its sparse Cholesky factor.
+    /// The dense path's Hessian M + Jᵀ D J (+ cone blocks), nv × nv (empty on the islands' path,
+    /// whose Hessian lives on its factor's pattern), and the islands' sparse Cholesky factor.
     pub hessian: DMatrix<f64>,
     pub factor: super::sparse_cholesky::SparseCholesky,
     /// Whether the model's Newton solves take the dense path (`primal::dense_newton`).
@@ -88,7 +88,7 @@ impl SoftWork {
             mdir: DVector::zeros(nv),
             grad_prev: DVector::zeros(nv),
             mgrad_prev: DVector::zeros(nv),
-            hessian: DMatrix::zeros(nv, nv),
+            hessian: if dense { DMatrix::zeros(nv, nv) } else { DMatrix::zeros(0, 0) },
             factor: super::sparse_cholesky::SparseCholesky::with_capacity(nv),
             dense,
             dense_factor: if dense { DMatrix::zeros(nv, nv) } else { DMatrix::zeros(0, 0) },
