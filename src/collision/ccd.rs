@@ -23,13 +23,15 @@
 //!   origin, divided by their sum; `S1D` returns the second vertex for a segment shorter than
 //!   1e-15;
 //! - the ellipsoid's support scales each component by (1/|s|)·size;
+//! - the first GJK runs on the cores for every pair with a sphere, a capsule or a margin: spheres
+//!   and capsules shrunk to their centre and segment, every geom without the margin (the source
+//!   shrinks only spheres and capsules, keeping the margin of the others);
 //! - EPA stops when this iteration's upper bound (not the running minimum) is within the
 //!   tolerance of the lower one, and drops a first-iteration face whose bound is below it by
 //!   the tolerance.
 //!
-//! Each geom is inflated by half the pair's margin (MuJoCo's `support`); spheres and capsules are
-//! first shrunk to their centre and segment (a shallow contact is then the distance of the cores
-//! less the radii).
+//! Each geom is inflated by half the pair's margin (MuJoCo's `support`); a shallow contact found
+//! on the cores is their distance less the radii and the margin.
 //!
 //! The result is the EPA face's witness points, normal and distance, and the face's three
 //! polytope vertices as the geom features their support points came from ([`EpaFace`]: from
@@ -1157,19 +1159,25 @@ fn penetration_with(
         _ => None,
     };
     let (c1, c2) = (core(s1), core(s2));
-    if c1.is_some() || c2.is_some() {
+    // MuJoCo 4.0.0 (its `mjc_ccd`'s machine code) first runs GJK on the cores: spheres and
+    // capsules shrunk to their centre and segment, and every geom without the pair's margin.
+    if c1.is_some() || c2.is_some() || margin > 0.0 {
         let mut full = [0.0; 2];
         for (k, (o, c)) in [(&mut o1, c1), (&mut o2, c2)].into_iter().enumerate() {
+            full[k] = 0.5 * margin;
+            o.margin = 0.0;
             if let Some((kind, radius)) = c {
-                full[k] = radius + 0.5 * margin;
+                full[k] += radius;
                 o.core = kind;
             }
         }
         st.dist_cutoff = full[0] + full[1];
         gjk(&mut st, &mut o1, &mut o2);
         st.dist_cutoff = 0.0;
-        o1.core = Core::Shape;
-        o2.core = Core::Shape;
+        for o in [&mut o1, &mut o2] {
+            o.core = Core::Shape;
+            o.margin = margin;
+        }
         if st.dist > st.tolerance {
             // Shallow: the cores' witness points moved out by the radii.
             let n = normalize3(&(st.x2 - st.x1));
