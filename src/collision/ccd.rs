@@ -983,7 +983,7 @@ impl Polytope {
     /// The geom features of face `f`'s vertices.
     fn face_features(&self, f: usize) -> EpaFace {
         let v = self.faces[f].verts.map(|i| &self.verts[i]);
-        EpaFace { index1: v.map(|x| x.index1), index2: v.map(|x| x.index2) }
+        EpaFace { index1: v.map(|x| x.index1), index2: v.map(|x| x.index2), vert1: v.map(|x| x.vert1) }
     }
 
     /// The witness points of face `f` and its signed distance (MuJoCo's `epaWitness`).
@@ -1075,12 +1075,14 @@ fn tri_point_intersect(v1: &Vec3, v2: &Vec3, v3: &Vec3, p: &Vec3) -> bool {
 /// vertex (the face's order), the box corner (bit 0 +x, bit 1 +y, bit 2 +z) or hull vertex
 /// index on geom 1 (`index1`) and geom 2 (`index2`), −1 on a curved geom (MuJoCo's
 /// `Vertex.index1`, `index2`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct EpaFace {
     /// Geom 1's feature index of each face vertex.
     pub index1: [i32; 3],
     /// Geom 2's feature index of each face vertex.
     pub index2: [i32; 3],
+    /// Geom 1's support point of each face vertex (world; inflated by half the margin).
+    pub vert1: [Vec3; 3],
 }
 
 /// A contact from the solver: the witness points (of the geoms inflated by half the margin
@@ -1191,7 +1193,18 @@ fn penetration_with(
             if st.dist > st.dist_cutoff || st.dist >= 0.0 {
                 return None;
             }
-            return Some(contact(&st, margin, None));
+            // MuJoCo 4.0.0 reads a shallow contact's features off GJK's simplex as off an EPA
+            // face (its first, second and third vertices, the first repeated when fewer).
+            let face = (st.nsimplex > 0).then(|| {
+                let k = [0, usize::from(st.nsimplex > 1), if st.nsimplex > 2 { 2 } else { 0 }];
+                let v = k.map(|i| &st.simplex[i]);
+                EpaFace {
+                    index1: v.map(|x| x.index1),
+                    index2: v.map(|x| x.index2),
+                    vert1: v.map(|x| x.vert1),
+                }
+            });
+            return Some(contact(&st, margin, face));
         }
         st.gjk_iterations = 0;
         (st.x1, st.x2) = start;

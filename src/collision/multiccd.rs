@@ -23,10 +23,12 @@
 //!   clipped face's normal.
 //! - **a capsule or a cylinder against a box or a mesh** (`mj_maxContact` 5): MuJoCo's source
 //!   snapshot turns both geoms by ±1e-3 rad about the contact's tangents and reruns the solver;
-//!   the live 4.0.0 does not (its contacts show it): a capsule's segment, or a cylinder's side
-//!   line, within ~5.1° of parallel to a face of the polytope is clipped by the face (points on
-//!   the surface and on the face's plane, normal the face's reversed: a capsule lying on a face
-//!   gets its two ends); a cylinder's cap within ~5.1° of facing a face is clipped as a polygon
+//!   the live 4.0.0 does not (its contacts show it): a capsule's surface line through its
+//!   witness point, or a cylinder's side line through the support point of the first vertex of
+//!   EPA's final face (of GJK's simplex for a shallow contact), clipped by the first face of the
+//!   polytope's feature on that face within ~5.1° of parallel (points on the line and on the
+//!   face's plane, normal the face's reversed: a capsule lying on a face gets its two ends; the
+//!   faces at the support plane when no face is at hand); a cylinder's cap within ~5.1° of facing a face is clipped as a polygon
 //!   (the cap as MuJoCo 4.0's regular 16-gon, vertex k at k·22.5° about the cylinder's x axis,
 //!   clockwise seen from outside the cap: MuJoCo Warp 4.0.0's `_cylinder_face`, and every
 //!   contact of the golden resting poses lies at a multiple of 22.5°); otherwise one contact.
@@ -577,9 +579,14 @@ pub(crate) fn convex_contacts(
     }
     match (s1, Poly::of(s2)) {
         (ConvexShape::Capsule(c), Some(p2)) => {
-            let (a, b) = (c.segment.a, c.segment.b);
-            let seg = [x1.act_point(&Vec3::new(a.x, a.y, a.z)), x1.act_point(&Vec3::new(b.x, b.y, b.z))];
-            segment_polytope(x1, seg, c.radius, x2, &p2, first, margin_gap, emit);
+            // MuJoCo 4.0.0: the capsule's surface line through its witness point, parallel to
+            // the axis, as long as the segment; already inflated by half the margin.
+            let axis = x1.rot.column(2).into_owned();
+            let w = first.p1;
+            let pr = (w - x1.pos).dot(&axis);
+            let len = c.segment.b.z;
+            let seg = [w + axis * (-pr - len), w + axis * (-pr + len)];
+            segment_polytope(x1, seg, 0.5 * margin_gap, x2, &p2, first, face, margin_gap, emit);
         }
         (ConvexShape::Cylinder(c), Some(p2)) => {
             // The side's line at the contact when the axis is within ~5.1° of the contact plane;
@@ -587,10 +594,31 @@ pub(crate) fn convex_contacts(
             let axis = x1.rot.column(2).into_owned();
             let along = axis.dot(&first.normal);
             if along.abs() < EDGE_TOL {
-                let radial = (first.normal - axis * along).normalize();
-                let centre = x1.pos + radial * c.radius;
-                let h = axis * c.half_height;
-                segment_polytope(x1, [centre - h, centre + h], 0.0, x2, &p2, first, margin_gap, emit);
+                // MuJoCo 4.0.0: the side line through the support point of EPA's face's first
+                // vertex on the cylinder (on a rim; moved back onto it from the margin), to the
+                // other cap.
+                let seg = match face {
+                    Some(f) => {
+                        let mut v = f.vert1[0];
+                        let up = (v - x1.pos).dot(&axis) < 0.0;
+                        let sgn = if up { 1.0 } else { -1.0 };
+                        if margin_gap > 0.0 {
+                            let d = v - x1.pos;
+                            let (l0, l1) = (x1.rot.column(0).dot(&d), x1.rot.column(1).dot(&d));
+                            let n2 = l0 * l0 + l1 * l1;
+                            let scl = if n2 >= 1e-30 { c.radius / n2.sqrt() } else { 0.0 };
+                            v = x1.rot * Vec3::new(scl * l0, scl * l1, -sgn * c.half_height) + x1.pos;
+                        }
+                        [v, v + axis * (sgn * 2.0 * c.half_height)]
+                    }
+                    None => {
+                        let radial = (first.normal - axis * along).normalize();
+                        let centre = x1.pos + radial * c.radius;
+                        let h = axis * c.half_height;
+                        [centre - h, centre + h]
+                    }
+                };
+                segment_polytope(x1, seg, 0.0, x2, &p2, first, face, margin_gap, emit);
             } else if along.abs() > FACE_TOL {
                 cap_polytope(x1, c.radius, c.half_height, along.signum(), x2, &p2, first, margin_gap, emit);
             } else {
@@ -662,21 +690,22 @@ fn cap_polytope(
     }
 }
 
-/// A segment of geom 1 (a capsule's, radius `r`; a cylinder's side line, radius 0) against a box
-/// or mesh hull from the first contact `first`, as MuJoCo 4.0 gives it (read from its contacts:
-/// its source snapshot turned the geoms instead): when the segment lies within ~5.1° of parallel
-/// to a face of the polytope at the contact, the segment clipped by that face's sides, each point
-/// within `margin` of the face (less the radius) a contact — on geom 1's surface and on the face's
-/// plane, normal the face's reversed, distance to the face less the radius (the two farthest when
-/// more). Otherwise `first` alone.
-#[allow(clippy::too_many_arguments)]
+/// A segment of geom 1 (a capsule's surface line, inflated by `inflated` = half the margin; a
+/// cylinder's side line, `inflated` 0) against a box or mesh hull from the first contact `first`,
+/// as MuJoCo 4.0.0 gives it (its `multicontact`'s edge–face case, read from Warp 4.0.0 and the
+/// live contacts): when the segment lies within ~5.1° of parallel to a face of the polytope at
+/// the contact, the segment clipped by that face's sides, each point within `margin` (less
+/// `inflated`) above the face a contact — witness on the segment and on the face's plane (moved
+/// out by `inflated`), normal the face's reversed (the two farthest when more). Otherwise
+/// `first` alone.
 fn segment_polytope(
     x1: &Transform,
     seg: [Vec3; 2],
-    r: f64,
+    inflated: f64,
     x2: &Transform,
     p2: &Poly,
     first: PairPoint,
+    face: Option<&EpaFace>,
     margin: f64,
     emit: &mut dyn FnMut(PairPoint),
 ) {
@@ -684,13 +713,27 @@ fn segment_polytope(
     let emitted = SCRATCH.with(|s| {
         let s = &mut *s.borrow_mut();
         let mut tmp = std::mem::take(&mut s.tmp);
-        let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
-        support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
-        feature_faces(p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
         s.face1.clear();
         s.face1.extend_from_slice(&seg);
+        // MuJoCo 4.0.0: the faces of geom 2's feature on EPA's final face, the first (in their
+        // order) within ~5.1° of parallel to the segment; without a face, the faces at geom 2's
+        // support plane, the most nearly parallel.
+        if let Some(f) = face {
+            super::epa_face::geom2_faces(p2, x2, f, &(first.p2 - first.p1), &mut s.normals2);
+        } else {
+            s.normals2.clear();
+        }
+        let chosen = if s.normals2.is_empty() {
+            let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
+            support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
+            feature_faces(p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
+            edge_face(&s.face1, &s.normals2)
+        } else {
+            let d = (seg[1] - seg[0]).normalize();
+            s.normals2.iter().position(|(m, _)| d.dot(m).abs() < EDGE_TOL).map(|j| (0, j))
+        };
         let mut count = 0;
-        if let Some((_, j)) = edge_face(&s.face1, &s.normals2) {
+        if let Some((_, j)) = chosen {
             let (n2, f2) = s.normals2[j];
             face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
             clip(
@@ -698,13 +741,13 @@ fn segment_polytope(
                 &s.face1,
                 &n2,
                 &-n2,
-                margin + r,
+                margin - inflated,
                 false,
                 &mut s.poly,
                 &mut s.clip,
-                &mut |_, v, _| {
-                    let d = (v - s.face2[0]).dot(&n2);
-                    emit(PairPoint { p1: v - n2 * r, p2: v - n2 * d, normal: -n2, dist: d - r });
+                &mut |w1, w2, d| {
+                    let p2 = if inflated != 0.0 { w1 + n2 * inflated } else { w1 };
+                    emit(PairPoint { p1: w2, p2, normal: -n2, dist: d + inflated });
                     count += 1;
                 },
             );
