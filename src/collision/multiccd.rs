@@ -698,6 +698,7 @@ fn cap_polytope(
 /// `inflated`) above the face a contact — witness on the segment and on the face's plane (moved
 /// out by `inflated`), normal the face's reversed (the two farthest when more). Otherwise
 /// `first` alone.
+#[allow(clippy::too_many_arguments)]
 fn segment_polytope(
     x1: &Transform,
     seg: [Vec3; 2],
