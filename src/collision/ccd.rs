@@ -68,7 +68,8 @@ pub(crate) struct CcdObj<'a> {
     /// The pair's margin: the support adds half of it along the direction.
     margin: f64,
     core: Core,
-    /// The last support vertex (box corner bits, hull vertex index; −1 for curved shapes).
+    /// The last support vertex (box corner bits, hull vertex index, a cylinder's cap: 0 top, 1
+    /// bottom; −1 for the other curved shapes).
     vertindex: i32,
     /// The hill climb's warm start (−1: none yet).
     meshindex: i32,
@@ -138,6 +139,8 @@ impl<'a> CcdObj<'a> {
                 Vec3::new(s.x * (inv * size.x), s.y * (inv * size.y), s.z * (inv * size.z))
             }
             ConvexShape::Cylinder(c) => {
+                // MuJoCo 4.0.0 marks the cap: 0 the top, 1 the bottom.
+                self.vertindex = (local.z < 0.0) as i32;
                 let n2 = local.x * local.x + local.y * local.y;
                 let scl = if n2 >= MINVAL * MINVAL { c.radius / n2.sqrt() } else { 0.0 };
                 Vec3::new(

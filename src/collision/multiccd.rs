@@ -32,8 +32,10 @@
 //!   (the cap as MuJoCo 4.0's regular 16-gon, vertex k at k·22.5° about the cylinder's x axis,
 //!   clockwise seen from outside the cap: MuJoCo Warp 4.0.0's `_cylinder_face`, and every
 //!   contact of the golden resting poses lies at a multiple of 22.5°); otherwise one contact.
-//! - **capsule–cylinder, cylinder–cylinder** (`mj_maxContact` 5): one contact at every pose
-//!   measured (lagrange gives one).
+//! - **capsule–cylinder, cylinder–cylinder** (`mj_maxContact` 5): geom 1's edge (as against a
+//!   polytope) within ~5.1° of parallel to geom 2's cap, when the final face's feature on geom 2
+//!   is that cap (the cylinder support marks the cap), clipped by the cap's 16-gon; otherwise
+//!   one contact.
 //! - **a sphere or an ellipsoid**: one contact.
 //!
 //! With `multiccd` off every convex pair gives one contact. lagrange reproduces these on its port
@@ -598,19 +600,7 @@ pub(crate) fn convex_contacts(
                 // vertex on the cylinder (on a rim; moved back onto it from the margin), to the
                 // other cap.
                 let seg = match face {
-                    Some(f) => {
-                        let mut v = f.vert1[0];
-                        let up = (v - x1.pos).dot(&axis) < 0.0;
-                        let sgn = if up { 1.0 } else { -1.0 };
-                        if margin_gap > 0.0 {
-                            let d = v - x1.pos;
-                            let (l0, l1) = (x1.rot.column(0).dot(&d), x1.rot.column(1).dot(&d));
-                            let n2 = l0 * l0 + l1 * l1;
-                            let scl = if n2 >= 1e-30 { c.radius / n2.sqrt() } else { 0.0 };
-                            v = x1.rot * Vec3::new(scl * l0, scl * l1, -sgn * c.half_height) + x1.pos;
-                        }
-                        [v, v + axis * (sgn * 2.0 * c.half_height)]
-                    }
+                    Some(f) => cylinder_side(x1, c, f, margin_gap),
                     None => {
                         let radial = (first.normal - axis * along).normalize();
                         let centre = x1.pos + radial * c.radius;
@@ -625,10 +615,114 @@ pub(crate) fn convex_contacts(
                 emit(first);
             }
         }
-        // Capsule–cylinder, cylinder–cylinder: MuJoCo 4.0 gives these one contact at the poses
-        // measured (its source snapshot turned the geoms).
+        // Capsule–cylinder, cylinder–cylinder: geom 1's edge against geom 2's cap.
+        (ConvexShape::Capsule(_) | ConvexShape::Cylinder(_), None) => match s2 {
+            ConvexShape::Cylinder(c2) if edge_cap(x1, s1, x2, c2, &first, face, margin_gap, emit) > 0 => {}
+            _ => emit(first),
+        },
         _ => emit(first),
     }
+}
+
+/// A capsule's or a cylinder's edge (geom 1) against a cylinder's cap (geom 2), as MuJoCo 4.0.0's
+/// `multicontact` takes it (Warp 4.0.0's `_cylinder_normals`, `_cylinder_face`, and the live
+/// contacts): when geom 2's feature on EPA's final face (or GJK's simplex) is one cap, geom 1's
+/// edge (a capsule's surface line through its witness point; a cylinder's side line through the
+/// support point of the face's first vertex) within ~5.1° of parallel to that cap is clipped by
+/// the cap's 16-gon. Returns the number of contacts emitted (0: none, the caller keeps `first`);
+/// two caps facing each other are left to `first`.
+#[allow(clippy::too_many_arguments)]
+fn edge_cap(
+    x1: &Transform,
+    s1: &ConvexShape,
+    x2: &Transform,
+    c2: &parry3d_f64::shape::Cylinder,
+    first: &PairPoint,
+    face: Option<&EpaFace>,
+    margin: f64,
+    emit: &mut dyn FnMut(PairPoint),
+) -> usize {
+    let Some(f) = face else { return 0 };
+    let idx = f.index2[0];
+    if idx < 0 || f.index2.iter().any(|&i| i != idx) {
+        return 0;
+    }
+    let z2 = x2.rot.column(2).into_owned();
+    let n2 = if idx != 0 { -z2 } else { z2 };
+    let axis = x1.rot.column(2).into_owned();
+    let (seg, inflated) = match s1 {
+        ConvexShape::Capsule(c) => {
+            let w = first.p1;
+            let pr = (w - x1.pos).dot(&axis);
+            let len = c.segment.b.z;
+            ([w + axis * (-pr - len), w + axis * (-pr + len)], 0.5 * margin)
+        }
+        ConvexShape::Cylinder(c) => {
+            // Geom 1's own cap facing geom 2's: MuJoCo clips the two caps (not here).
+            let i1 = f.index1[0];
+            if f.index1.iter().all(|&i| i == i1) {
+                let n1 = if i1 != 0 { -axis } else { axis };
+                if n1.dot(&n2) < -FACE_TOL {
+                    return 0;
+                }
+            }
+            (cylinder_side(x1, c, f, margin), 0.0)
+        }
+        _ => return 0,
+    };
+    let d = (seg[1] - seg[0]).normalize();
+    if d.dot(&n2).abs() >= EDGE_TOL {
+        return 0;
+    }
+    SCRATCH.with(|s| {
+        let s = &mut *s.borrow_mut();
+        let sgn = if idx != 0 { -1.0 } else { 1.0 };
+        let centre = z2 * (sgn * c2.half_height) + x2.pos;
+        let (e1, e2) = (x2.rot.column(0).into_owned(), x2.rot.column(1).into_owned());
+        let (col0, col1) = (e1 * c2.radius, e2 * (c2.radius * sgn));
+        s.face2.clear();
+        for k in 0..CAP_SIDES {
+            let t = k as f64 * std::f64::consts::PI / (CAP_SIDES / 2) as f64;
+            s.face2.push(col0 * t.cos() - col1 * t.sin() + centre);
+        }
+        s.face1.clear();
+        s.face1.extend_from_slice(&seg);
+        let mut count = 0;
+        clip(
+            &s.face2,
+            &s.face1,
+            &n2,
+            &-n2,
+            margin - inflated,
+            false,
+            &mut s.poly,
+            &mut s.clip,
+            &mut |w1, w2, d| {
+                let p2 = if inflated != 0.0 { w1 + n2 * inflated } else { w1 };
+                emit(PairPoint { p1: w2, p2, normal: -n2, dist: d + inflated });
+                count += 1;
+            },
+        );
+        count
+    })
+}
+
+/// A cylinder's side line (geom 1) as MuJoCo 4.0.0's `multicontact` takes it: through the
+/// support point of EPA's face's first vertex on the cylinder (on a rim; moved back onto it from
+/// the margin), to the other cap.
+fn cylinder_side(x1: &Transform, c: &parry3d_f64::shape::Cylinder, f: &EpaFace, margin: f64) -> [Vec3; 2] {
+    let axis = x1.rot.column(2).into_owned();
+    let mut v = f.vert1[0];
+    let up = (v - x1.pos).dot(&axis) < 0.0;
+    let sgn = if up { 1.0 } else { -1.0 };
+    if margin > 0.0 {
+        let d = v - x1.pos;
+        let (l0, l1) = (x1.rot.column(0).dot(&d), x1.rot.column(1).dot(&d));
+        let n2 = l0 * l0 + l1 * l1;
+        let scl = if n2 >= 1e-30 { c.radius / n2.sqrt() } else { 0.0 };
+        v = x1.rot * Vec3::new(scl * l0, scl * l1, -sgn * c.half_height) + x1.pos;
+    }
+    [v, v + axis * (sgn * 2.0 * c.half_height)]
 }
 
 /// A cylinder's cap (geom 1; `side` +1 the top, −1 the bottom) against a box or mesh hull: the
