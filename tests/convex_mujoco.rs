@@ -65,8 +65,9 @@ const SEGMENT: &str = "the single contact is the live MuJoCo 4.0.0's GJK/EPA (se
     surface line through the witness point and a cylinder's side line runs through the support point of the final \
     face's (or, for a shallow contact, GJK simplex's) first vertex, clipped by the first face of the polytope's \
     feature on that face within ~5.1 deg of parallel, as MuJoCo 4.0's multicontact does (capsule-mesh 17 -> 32: every \
-    case, cylinder-box 25 -> 30); a cylinder's cap (a 16-gon) clipping a face is pruned to 4 points by a rule fitted \
-    to the goldens (cylinder_box resting2 and resting3 differ); a capsule's or a cylinder's edge within ~5.1 deg of \
+    case, cylinder-box 25 -> 30); a cylinder's cap (the live library's 16-gon table) clipping a face is pruned to 4 \
+    points by the live library's quadrilateral rule, but the clipped points still differ from the live ones in the \
+    last bits, which decides between equal-area quadrilaterals (cylinder_box resting2 and resting5 differ); a capsule's or a cylinder's edge within ~5.1 deg of \
     parallel to a cylinder's cap on the final face is clipped by the cap's 16-gon (capsule-cylinder and \
     cylinder-cylinder: every case); cylinder_mesh_margin/random5 differs by 1.2e-7: the mesh's second support point \
     already differs in the last bit (the mesh's frame or vertices, not the solver)";

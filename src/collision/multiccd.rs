@@ -58,8 +58,36 @@ use std::cell::RefCell;
 pub(crate) const FACE_TOL: f64 = 0.996;
 /// |cosine| below which an edge counts as parallel to a face (MuJoCo's `mjEDGE_TOL`, ~5.1°).
 pub(crate) const EDGE_TOL: f64 = 0.0888;
-/// The sides of the regular polygon standing in for a cylinder's cap (MuJoCo 4.0's 16-gon).
-const CAP_SIDES: usize = 16;
+/// Cosine and sine of k·22.5° (k = 0..16), the vertices of the regular 16-gon standing in for a
+/// cylinder's cap, as the live MuJoCo 4.0.0's table holds them (its cap polygons dumped under gdb:
+/// exact 0 and ±1, the others to 15 significant digits, cos 45° = 0.707106781186548 and
+/// sin 45° = 0.707106781186547).
+// MuJoCo's table values, not the correctly rounded constants: the approximation is the point.
+#[allow(clippy::approx_constant)]
+const CAP_COS_SIN: [(f64, f64); 16] = {
+    const C1: f64 = 0.923879532511287;
+    const S1: f64 = 0.38268343236509;
+    const C2: f64 = 0.707106781186548;
+    const S2: f64 = 0.707106781186547;
+    [
+        (1.0, 0.0),
+        (C1, S1),
+        (C2, S2),
+        (S1, C1),
+        (0.0, 1.0),
+        (-S1, C1),
+        (-S2, C2),
+        (-C1, S1),
+        (-1.0, 0.0),
+        (-C1, -S1),
+        (-C2, -S2),
+        (-S1, -C1),
+        (0.0, -1.0),
+        (S1, -C1),
+        (S2, -C2),
+        (C1, -S1),
+    ]
+};
 
 /// Scratch buffers of the clipping, reused per thread (no allocation once grown).
 #[derive(Default)]
@@ -448,8 +476,8 @@ fn edge_face(edges: &[Vec3], faces: &[(Vec3, u32)]) -> Option<(usize, usize)> {
 /// and of an edge to its two farthest points. The quadrilateral is MuJoCo 4.0's (the clipped
 /// polygon's first point fixed, [`super::plane_mesh::quad_from_first`]: measured black-box on 40
 /// box–prism faces, 38 the same points in the same order, the 2 others misread by the
-/// measurement); with `cap` (a cylinder's cap clipping a face) the rule fitted to MuJoCo 4.0's
-/// cap contacts ([`cap_quad`]).
+/// measurement); with `cap` (a cylinder's cap clipping a face) the live
+/// MuJoCo 4.0.0's own rule ([`cap_quad`]).
 #[allow(clippy::too_many_arguments)]
 fn clip(
     face: &[Vec3],
@@ -519,39 +547,56 @@ fn area4d(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> f64 {
     0.5 * (a - c).cross(&(b - d)).norm()
 }
 
-/// Four vertices of a cylinder cap's clipped polygon (more than four), the first fixed: the
-/// other three start a quarter, a half and three quarters along the polygon and each moves, in
-/// turn, either way while the quadrilateral's area grows, until none moves. A rule fitted to the
-/// live MuJoCo 4.0.0's contacts of a cylinder resting on a box (its source is not at hand): 6 of
-/// the 8 golden resting poses give MuJoCo's four points; the rule of polytope faces
-/// ([`super::plane_mesh::quad_from_first`]) gives 2.
+/// Four vertices of a cylinder cap's clipped polygon (more than four) enclosing a large area, as
+/// the live MuJoCo 4.0.0's `polygonClip` picks them (read from its machine code; Warp 4.0.0's
+/// `_polygon_quad` is the same): from (0, 1, 2, 3), for each first vertex a in turn, the fourth
+/// advances while the area grows, and after each advance the third, then the second, advance
+/// while it grows; the second (third, fourth) steps off a when they coincide.
 fn cap_quad(p: &[Vec3]) -> [usize; 4] {
     let n = p.len();
-    let mut q = [0, n / 4, n / 2, 3 * n / 4];
-    let area = |q: &[usize; 4]| area4d(&p[q[0]], &p[q[1]], &p[q[2]], &p[q[3]]);
-    let mut m = area(&q);
-    loop {
-        let mut moved = false;
-        for k in 1..4 {
-            for step in [1, n - 1] {
-                loop {
-                    let mut r = q;
-                    r[k] = (r[k] + step) % n;
-                    let a = area(&r);
-                    if a <= m {
-                        break;
-                    }
-                    q = r;
-                    m = a;
-                    moved = true;
+    let area = |a: usize, b: usize, c: usize, d: usize| area4d(&p[a], &p[b], &p[c], &p[d]);
+    let (mut b, mut c, mut d) = (1, 2, 3);
+    let mut res = [0, b, c, d];
+    let mut m = area(0, b, c, d);
+    for a in 0..n {
+        loop {
+            let next = area(a, b, c, (d + 1) % n);
+            if next <= m {
+                break;
+            }
+            m = next;
+            d = (d + 1) % n;
+            res = [a, b, c, d];
+            loop {
+                let next = area(a, b, (c + 1) % n, d);
+                if next <= m {
+                    break;
+                }
+                m = next;
+                c = (c + 1) % n;
+                res = [a, b, c, d];
+            }
+            loop {
+                let next = area(a, (b + 1) % n, c, d);
+                if next <= m {
+                    break;
+                }
+                m = next;
+                b = (b + 1) % n;
+                res = [a, b, c, d];
+            }
+        }
+        if b == a {
+            b = (b + 1) % n;
+            if c == b {
+                c = (c + 1) % n;
+                if d == c {
+                    d = (d + 1) % n;
                 }
             }
         }
-        if !moved {
-            break;
-        }
     }
-    q
+    res
 }
 
 /// The contacts of a convex pair from GJK/EPA's first point `first` (penetrating or within the
@@ -681,9 +726,8 @@ fn edge_cap(
         let (e1, e2) = (x2.rot.column(0).into_owned(), x2.rot.column(1).into_owned());
         let (col0, col1) = (e1 * c2.radius, e2 * (c2.radius * sgn));
         s.face2.clear();
-        for k in 0..CAP_SIDES {
-            let t = k as f64 * std::f64::consts::PI / (CAP_SIDES / 2) as f64;
-            s.face2.push(col0 * t.cos() - col1 * t.sin() + centre);
+        for (c, sn) in CAP_COS_SIN {
+            s.face2.push(col0 * c - col1 * sn + centre);
         }
         s.face1.clear();
         s.face1.extend_from_slice(&seg);
@@ -766,9 +810,8 @@ fn cap_polytope(
             // Clockwise seen from outside the cap.
             s.face1.clear();
             let (col0, col1) = (e1 * r, e2 * (r * side));
-            for k in 0..CAP_SIDES {
-                let t = k as f64 * std::f64::consts::PI / (CAP_SIDES / 2) as f64;
-                s.face1.push(col0 * t.cos() - col1 * t.sin() + centre);
+            for (c, sn) in CAP_COS_SIN {
+                s.face1.push(col0 * c - col1 * sn + centre);
             }
             face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
             clip(&s.face1, &s.face2, &n1, &n2, margin, true, &mut s.poly, &mut s.clip, &mut |w1, w2, d| {
