@@ -7,22 +7,31 @@
 //! (`ccd_tolerance`, `ccd_iterations`).
 //!
 //! The C source read is a snapshot of 2026-08; the live MuJoCo 4.0.0 (the reference) differs from
-//! it in GJK, as its GPU port MuJoCo Warp 4.0.0 (same team, released with it; its Python source
-//! `collision_gjk.py`, read for semantics) shows and the goldens confirm (`tests/convex_mujoco.rs`,
-//! `docs/multiccd.md`):
-//! - on the contact path GJK runs until its simplex holds the origin: no hand-over of the first
-//!   tetrahedron to the snapshot's intersection test (`gjkIntersect`; Warp has none). With that
-//!   test, 25 golden cases of curved pairs parted from MuJoCo (cylinder–box 18 → 21 of 32,
-//!   cylinder–cylinder 14 → 19, cylinder–mesh 19 → 22, ellipsoid pairs +1 to +3 each; none
-//!   fewer). [`separated`], lagrange's own early-out, keeps the test (a proof of separation
-//!   either way);
-//! - the first step's norm is no stall (the starting x_k is no simplex point);
-//! - two discrete geoms search, once |x_k| < 1e-4, along the simplex's edge-orthogonal or
-//!   triangle-normal direction ([`gjk_direction`]), and the stopping tests read x_k along it.
+//! it. Its library `libmujoco.so.4.0.0` (the Python wheel's) is not stripped and has no fused
+//! multiply-adds, so its `gjk`, `S2D`, `S1D`, `epa` and support functions were read from their
+//! machine code (`objdump -d`) and their support calls traced under `gdb` against this module's
+//! on the goldens (`docs/multiccd.md`, "Reading the live library"); this module follows that code
+//! operation for operation where they differ:
+//! - GJK's next x_k is the origin's projection on the line or plane of the reduced simplex (the
+//!   barycentric combination only when it is degenerate); the separation test comes before the
+//!   duality-gap test, which the first iteration skips; |x_k| is tested after each update;
+//!   there is no hand-over of a tetrahedron to an intersection test on the contact path
+//!   ([`separated`], lagrange's own early-out, keeps the snapshot's `gjkIntersect`: a proof of
+//!   separation either way) and no direction tuning for discrete geoms (the projection is
+//!   already orthogonal to the simplex);
+//! - `S2D`'s barycentric coordinates are signed areas from the vertices relative to the projected
+//!   origin, divided by their sum; `S1D` returns the second vertex for a segment shorter than
+//!   1e-15;
+//! - the ellipsoid's support scales each component by (1/|s|)·size;
+//! - the first GJK runs on the cores for every pair with a sphere, a capsule or a margin: spheres
+//!   and capsules shrunk to their centre and segment, every geom without the margin (the source
+//!   shrinks only spheres and capsules, keeping the margin of the others);
+//! - EPA stops when this iteration's upper bound (not the running minimum) is within the
+//!   tolerance of the lower one, and drops a first-iteration face whose bound is below it by
+//!   the tolerance.
 //!
-//! The last two change no golden case (kept as 4.0.0's semantics). Each geom is inflated by half
-//! the pair's margin (MuJoCo's `support`); spheres and capsules are first shrunk to their centre
-//! and segment (a shallow contact is then the distance of the cores less the radii).
+//! Each geom is inflated by half the pair's margin (MuJoCo's `support`); a shallow contact found
+//! on the cores is their distance less the radii and the margin.
 //!
 //! The result is the EPA face's witness points, normal and distance, and the face's three
 //! polytope vertices as the geom features their support points came from ([`EpaFace`]: from
@@ -59,7 +68,8 @@ pub(crate) struct CcdObj<'a> {
     /// The pair's margin: the support adds half of it along the direction.
     margin: f64,
     core: Core,
-    /// The last support vertex (box corner bits, hull vertex index; −1 for curved shapes).
+    /// The last support vertex (box corner bits, hull vertex index, a cylinder's cap: 0 top, 1
+    /// bottom; −1 for the other curved shapes).
     vertindex: i32,
     /// The hill climb's warm start (−1: none yet).
     meshindex: i32,
@@ -123,9 +133,14 @@ impl<'a> CcdObj<'a> {
                 if norm2 < MINVAL * MINVAL {
                     return rot.column(0) * size.x + pos;
                 }
-                (s * (1.0 / norm2.sqrt())).component_mul(&size)
+                // MuJoCo scales each component by (1/|s|)·size, not (s/|s|)·size: the
+                // product of the two factors is rounded first (the live 4.0.0's code).
+                let inv = 1.0 / norm2.sqrt();
+                Vec3::new(s.x * (inv * size.x), s.y * (inv * size.y), s.z * (inv * size.z))
             }
             ConvexShape::Cylinder(c) => {
+                // MuJoCo 4.0.0 marks the cap: 0 the top, 1 the bottom.
+                self.vertindex = (local.z < 0.0) as i32;
                 let n2 = local.x * local.x + local.y * local.y;
                 let scl = if n2 >= MINVAL * MINVAL { c.radius / n2.sqrt() } else { 0.0 };
                 Vec3::new(
@@ -203,54 +218,6 @@ fn gjk_support(o1: &mut CcdObj, o2: &mut CcdObj, x_k: &Vec3, x_norm: f64) -> Ver
     support(o1, o2, &dir, &dir_neg)
 }
 
-/// |x_k| below which GJK on two discrete geoms searches along a direction set by its simplex
-/// rather than x_k's own (MuJoCo 4.0's direction tuning).
-const TUNE_NORM: f64 = 1e-4;
-
-/// MuJoCo 4.0's search direction for GJK's next support point: x_k's, or, for two discrete geoms
-/// (boxes, meshes, prisms without margin) once |x_k| < [`TUNE_NORM`] — where x_k, the
-/// difference of nearly equal points, has lost its direction — the simplex's: with an edge
-/// (`n` = 2), x_k with the edge's component projected out; with a triangle (`n` = 3), the
-/// triangle's normal on x_k's side. Returns x_k along that direction (|x_k| kept), which the
-/// stopping tests read.
-fn gjk_direction(x_k: &Vec3, x_norm: f64, simplex: &[Vertex; 4], n: usize, discrete: bool) -> Vec3 {
-    if !discrete || x_norm >= TUNE_NORM {
-        return *x_k;
-    }
-    let dir = x_k * (1.0 / x_norm);
-    match n {
-        2 => {
-            let edge = simplex[1].vert - simplex[0].vert;
-            let len2 = edge.dot(&edge);
-            if len2 > MINVAL * MINVAL {
-                let d = dir - edge * (dir.dot(&edge) / len2);
-                let dnorm = d.norm();
-                if dnorm > MINVAL {
-                    return d * (x_norm / dnorm);
-                }
-            }
-            *x_k
-        }
-        3 => {
-            let normal = (simplex[1].vert - simplex[0].vert).cross(&(simplex[2].vert - simplex[0].vert));
-            let nnorm = normal.norm();
-            if nnorm > MINVAL {
-                let side = dir.dot(&normal);
-                let sign = if side > 0.0 {
-                    1.0
-                } else if side < 0.0 {
-                    -1.0
-                } else {
-                    0.0
-                };
-                return normal * (sign * x_norm / nnorm);
-            }
-            *x_k
-        }
-        _ => *x_k,
-    }
-}
-
 fn det3(a: &Vec3, b: &Vec3, c: &Vec3) -> f64 {
     a.x * (b.y * c.z - b.z * c.y) + a.y * (b.z * c.x - b.x * c.z) + a.z * (b.x * c.y - b.y * c.x)
 }
@@ -322,6 +289,13 @@ impl Status {
     }
 }
 
+/// GJK as the live MuJoCo 4.0.0 runs it (its `gjk`, read from the library's machine code; it
+/// differs from the C source snapshot): the next x_k is the origin's projection on the affine hull
+/// of the reduced simplex (its line or plane; the barycentric combination only when that hull is
+/// degenerate, and the single vertex itself), the separation test comes before the duality-gap
+/// test, which is skipped on the first iteration, and the stopping tests on |x_k| follow each
+/// update (MINVAL for a single vertex or when a distance is wanted, `tolerance` otherwise for
+/// curved geoms).
 fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
     let get_dist = st.dist_cutoff > 0.0;
     let mut backup = !get_dist && st.intersect_fallback;
@@ -332,9 +306,13 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
     st.separated = false;
     let discrete = o1.discrete() && o2.discrete() && o1.margin == 0.0 && o2.margin == 0.0;
     let epsilon = if discrete { 0.0 } else { 0.5 * tol2 };
-    let min_norm = if discrete { MINVAL } else { st.tolerance };
+    let min_norm = if discrete || get_dist { MINVAL } else { st.tolerance };
     let mut x_k = st.x1 - st.x2;
-    let (mut x_norm, mut x_norm_prev) = (x_k.norm(), 0.0);
+    let mut x_norm = x_k.norm();
+    if x_norm < MINVAL {
+        x_k = Vec3::x();
+        x_norm = 1.0;
+    }
     let separated = |st: &mut Status, k| {
         st.separated = true;
         st.gjk_iterations = k;
@@ -342,24 +320,24 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
         st.dist = MAX_LIMIT;
     };
     while k < kmax {
-        if x_norm < min_norm || (x_norm_prev - x_norm).abs() < MINVAL {
-            break;
-        }
-        let x_dir = gjk_direction(&x_k, x_norm, &st.simplex, n, discrete);
-        st.simplex[n] = gjk_support(o1, o2, &x_dir, x_norm);
+        st.simplex[n] = gjk_support(o1, o2, &x_k, x_norm);
         let s_k = st.simplex[n].vert;
-        if x_dir.dot(&(x_dir - s_k)) < epsilon {
-            break;
-        }
-        let lower = x_dir.dot(&s_k);
-        if !get_dist {
+        let lower = x_k.dot(&s_k);
+        if get_dist {
             if lower > 0.0 {
-                st.axis = x_dir;
-                return separated(st, k);
+                // MuJoCo 4.0.0 marks the pair apart here even when it goes on.
+                st.separated = true;
+                if st.dist_cutoff < MAX_LIMIT && lower >= st.dist_cutoff * x_norm {
+                    st.axis = x_k;
+                    return separated(st, k);
+                }
             }
-        } else if st.dist_cutoff < MAX_LIMIT && lower > 0.0 && lower >= st.dist_cutoff * x_norm {
-            st.axis = x_dir;
+        } else if lower > 0.0 {
+            st.axis = x_k;
             return separated(st, k);
+        }
+        if k != 0 && x_k.dot(&(x_k - s_k)) < epsilon {
+            break;
         }
         if n == 3 && backup {
             st.gjk_iterations = k;
@@ -385,13 +363,31 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
         if n < 1 {
             return separated(st, k);
         }
-        let s = &st.simplex;
-        x_k = lincomb(&lambda[..n], [&s[0].vert, &s[1].vert, &s[2].vert, &s[3].vert]);
-        // MuJoCo 4.0: the first x_k is no simplex point, so a first step of the same norm is
-        // no stall (its source snapshot stopped there).
-        x_norm_prev = if k == 0 { 0.0 } else { x_norm };
-        x_norm = x_k.norm();
         if n == 4 {
+            break;
+        }
+        let s = &st.simplex;
+        x_k = match n {
+            1 => s[0].vert * lambda[0],
+            2 => {
+                let diff = s[1].vert - s[0].vert;
+                let dd = diff.dot(&diff);
+                if dd < MINVAL * MINVAL {
+                    lincomb(&lambda[..2], [&s[0].vert, &s[1].vert, &s[1].vert, &s[1].vert])
+                } else {
+                    let scl = -(s[1].vert.dot(&diff) / dd);
+                    s[1].vert + diff * scl
+                }
+            }
+            _ => project_origin_plane(&s[0].vert, &s[1].vert, &s[2].vert)
+                .unwrap_or_else(|| lincomb(&lambda[..3], [&s[0].vert, &s[1].vert, &s[2].vert, &s[2].vert])),
+        };
+        let x_norm_prev = x_norm;
+        x_norm = x_k.norm();
+        if x_norm < if n == 1 { MINVAL } else { min_norm } {
+            break;
+        }
+        if k != 0 && (x_norm - x_norm_prev).abs() < MINVAL {
             break;
         }
         k += 1;
@@ -402,9 +398,9 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
         st.x2 = lincomb(&lambda[..n], [&s[0].vert2, &s[1].vert2, &s[2].vert2, &s[3].vert2]);
     }
     // MuJoCo 4.0.0 checks the separation once more along x_k unless the simplex is a
-    // tetrahedron, which holds the origin (its support counts show it: the source snapshot checks
-    // every time, one support call more per penetrating pair).
-    if n != 4 {
+    // tetrahedron, which holds the origin (its machine code and support counts show it: the source
+    // snapshot checks every time, one support call more per penetrating pair).
+    if n <= 3 && !st.separated && x_norm >= MINVAL {
         let tmp = gjk_support(o1, o2, &x_k, x_norm);
         if x_k.dot(&tmp.vert) > 0.0 {
             st.separated = true;
@@ -557,31 +553,40 @@ fn s3d(lambda: &mut [f64; 4], s1: &Vec3, s2: &Vec3, s3: &Vec3, s4: &Vec3) {
     }
 }
 
+/// The origin's closest point on triangle (s1, s2, s3) as barycentric coordinates, as the live
+/// MuJoCo 4.0.0's `S2D` computes them (read from its machine code; its C source snapshot
+/// differs): the dropped axis by the largest component of (s2 − s1) × (s3 − s1), the signed
+/// areas of the sub-triangles with the projected origin from vertex coordinates relative to it,
+/// the coordinates normalised by the areas' sum; every edge searched when the plane is
+/// degenerate.
 fn s2d(lambda: &mut [f64; 3], s1: &Vec3, s2: &Vec3, s3: &Vec3) {
-    let Some(p_o) = project_origin_plane(s1, s2, s3) else {
-        let l = s1d(s1, s2);
-        *lambda = [l[0], l[1], 0.0];
-        return;
-    };
-    let m14 = s2[1] * s3[2] - s2[2] * s3[1] - s1[1] * s3[2] + s1[2] * s3[1] + s1[1] * s2[2] - s1[2] * s2[1];
-    let m24 = s2[0] * s3[2] - s2[2] * s3[0] - s1[0] * s3[2] + s1[2] * s3[0] + s1[0] * s2[2] - s1[2] * s2[0];
-    let m34 = s2[0] * s3[1] - s2[1] * s3[0] - s1[0] * s3[1] + s1[1] * s3[0] + s1[0] * s2[1] - s1[1] * s2[0];
-    let (mu1, mu2, mu3) = (m14.abs(), m24.abs(), m34.abs());
-    let (m_max, x, y) = if mu1 >= mu2 && mu1 >= mu3 {
-        (m14, 1, 2)
-    } else if mu2 >= mu3 {
-        (m24, 0, 2)
-    } else {
-        (m34, 0, 1)
-    };
-    let (s1x, s1y, s2x, s2y, s3x, s3y, px, py) = (s1[x], s1[y], s2[x], s2[y], s3[x], s3[y], p_o[x], p_o[y]);
-    let c31 = px * s2y + py * s3x + s2x * s3y - px * s3y - py * s2x - s3x * s2y;
-    let c32 = px * s3y + py * s1x + s3x * s1y - px * s1y - py * s3x - s1x * s3y;
-    let c33 = px * s1y + py * s2x + s1x * s2y - px * s2y - py * s1x - s2x * s1y;
-    let comp = [same_sign(m_max, c31), same_sign(m_max, c32), same_sign(m_max, c33)];
-    if comp.iter().all(|&c| c) {
-        *lambda = [c31 / m_max, c32 / m_max, c33 / m_max];
-        return;
+    let mut comp = [false; 3];
+    if let Some(p_o) = project_origin_plane(s1, s2, s3) {
+        let (a, b) = (s2 - s1, s3 - s1);
+        let m14 = a[1] * b[2] - a[2] * b[1];
+        let m24 = a[0] * b[2] - a[2] * b[0];
+        let m34 = a[0] * b[1] - a[1] * b[0];
+        let (mu1, mu2, mu3) = (m14.abs(), m24.abs(), m34.abs());
+        let (m_max, x, y) = if mu1 >= mu2 && mu1 >= mu3 {
+            (m14, 1, 2)
+        } else if mu2 >= mu3 {
+            (m24, 0, 2)
+        } else {
+            (m34, 0, 1)
+        };
+        // The three vertices relative to the projected origin, in the kept axes.
+        let (a0, a1) = (s1[x] - p_o[x], s1[y] - p_o[y]);
+        let (b0, b1) = (s2[x] - p_o[x], s2[y] - p_o[y]);
+        let (c0, c1) = (s3[x] - p_o[x], s3[y] - p_o[y]);
+        let c31 = c1 * b0 - c0 * b1;
+        let c32 = c0 * a1 - a0 * c1;
+        let c33 = a0 * b1 - b0 * a1;
+        comp = [same_sign(m_max, c31), same_sign(m_max, c32), same_sign(m_max, c33)];
+        if comp.iter().all(|&c| c) {
+            let sum = c31 + c32 + c33;
+            *lambda = [c31 / sum, c32 / sum, c33 / sum];
+            return;
+        }
     }
     let mut dmin = MAX_LIMIT;
     let edges: [([&Vec3; 2], [usize; 2]); 3] = [([s2, s3], [1, 2]), ([s1, s3], [0, 2]), ([s1, s2], [0, 1])];
@@ -602,10 +607,16 @@ fn s2d(lambda: &mut [f64; 3], s1: &Vec3, s2: &Vec3, s3: &Vec3) {
     }
 }
 
+/// The origin's closest point on segment (s1, s2) as barycentric coordinates (MuJoCo 4.0.0's
+/// `S1D`: the second vertex alone when the segment is shorter than 1e-15).
 fn s1d(s1: &Vec3, s2: &Vec3) -> [f64; 2] {
     // The origin projected on the line.
     let diff = s2 - s1;
-    let scl = -(s2.dot(&diff) / diff.dot(&diff));
+    let dd = diff.dot(&diff);
+    if dd < MINVAL * MINVAL {
+        return [0.0, 1.0];
+    }
+    let scl = -(s2.dot(&diff) / dd);
     let p_o = s2 + diff * scl;
     let mut mu_max = s1[0] - s2[0];
     let mut index = 0;
@@ -926,8 +937,10 @@ impl Polytope {
                 upper = upper_k;
                 upper2 = upper * upper;
             }
-            if upper - lower < tolerance {
-                if k == 0 && upper < lower - 1e-10 {
+            // MuJoCo 4.0.0 (its machine code) stops on this iteration's bound, not the running
+            // minimum, and drops a first-iteration face whose bound is below by the tolerance.
+            if upper_k - lower < tolerance {
+                if k == 0 && upper < lower - tolerance {
                     face = None;
                 }
                 break;
@@ -976,7 +989,7 @@ impl Polytope {
     /// The geom features of face `f`'s vertices.
     fn face_features(&self, f: usize) -> EpaFace {
         let v = self.faces[f].verts.map(|i| &self.verts[i]);
-        EpaFace { index1: v.map(|x| x.index1), index2: v.map(|x| x.index2) }
+        EpaFace { index1: v.map(|x| x.index1), index2: v.map(|x| x.index2), vert1: v.map(|x| x.vert1) }
     }
 
     /// The witness points of face `f` and its signed distance (MuJoCo's `epaWitness`).
@@ -1068,12 +1081,14 @@ fn tri_point_intersect(v1: &Vec3, v2: &Vec3, v3: &Vec3, p: &Vec3) -> bool {
 /// vertex (the face's order), the box corner (bit 0 +x, bit 1 +y, bit 2 +z) or hull vertex
 /// index on geom 1 (`index1`) and geom 2 (`index2`), −1 on a curved geom (MuJoCo's
 /// `Vertex.index1`, `index2`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct EpaFace {
     /// Geom 1's feature index of each face vertex.
     pub index1: [i32; 3],
     /// Geom 2's feature index of each face vertex.
     pub index2: [i32; 3],
+    /// Geom 1's support point of each face vertex (world; inflated by half the margin).
+    pub vert1: [Vec3; 3],
 }
 
 /// A contact from the solver: the witness points (of the geoms inflated by half the margin
@@ -1152,19 +1167,25 @@ fn penetration_with(
         _ => None,
     };
     let (c1, c2) = (core(s1), core(s2));
-    if c1.is_some() || c2.is_some() {
+    // MuJoCo 4.0.0 (its `mjc_ccd`'s machine code) first runs GJK on the cores: spheres and
+    // capsules shrunk to their centre and segment, and every geom without the pair's margin.
+    if c1.is_some() || c2.is_some() || margin > 0.0 {
         let mut full = [0.0; 2];
         for (k, (o, c)) in [(&mut o1, c1), (&mut o2, c2)].into_iter().enumerate() {
+            full[k] = 0.5 * margin;
+            o.margin = 0.0;
             if let Some((kind, radius)) = c {
-                full[k] = radius + 0.5 * margin;
+                full[k] += radius;
                 o.core = kind;
             }
         }
         st.dist_cutoff = full[0] + full[1];
         gjk(&mut st, &mut o1, &mut o2);
         st.dist_cutoff = 0.0;
-        o1.core = Core::Shape;
-        o2.core = Core::Shape;
+        for o in [&mut o1, &mut o2] {
+            o.core = Core::Shape;
+            o.margin = margin;
+        }
         if st.dist > st.tolerance {
             // Shallow: the cores' witness points moved out by the radii.
             let n = normalize3(&(st.x2 - st.x1));
@@ -1178,7 +1199,18 @@ fn penetration_with(
             if st.dist > st.dist_cutoff || st.dist >= 0.0 {
                 return None;
             }
-            return Some(contact(&st, margin, None));
+            // MuJoCo 4.0.0 reads a shallow contact's features off GJK's simplex as off an EPA
+            // face (its first, second and third vertices, the first repeated when fewer).
+            let face = (st.nsimplex > 0).then(|| {
+                let k = [0, usize::from(st.nsimplex > 1), if st.nsimplex > 2 { 2 } else { 0 }];
+                let v = k.map(|i| &st.simplex[i]);
+                EpaFace {
+                    index1: v.map(|x| x.index1),
+                    index2: v.map(|x| x.index2),
+                    vert1: v.map(|x| x.vert1),
+                }
+            });
+            return Some(contact(&st, margin, face));
         }
         st.gjk_iterations = 0;
         (st.x1, st.x2) = start;

@@ -296,3 +296,18 @@ pub(crate) fn aligned_features(
     }
     None
 }
+
+/// The candidate faces of geom 2 (polytope `p2` at `x2`) named by EPA's final face `face` (its
+/// feature's faces, as MuJoCo 4.0's `multicontact` gathers them for a capsule's or a cylinder's
+/// edge against a polytope), `dir` the contact direction from geom 1 to geom 2 (a box's
+/// fallback); empty when the face names no vertex of `p2` or a hull has no polygons.
+pub(crate) fn geom2_faces(p2: &Poly, x2: &Transform, face: &EpaFace, dir: &Vec3, out: &mut Vec<(Vec3, u32)>) {
+    out.clear();
+    let mut vi2 = face.index2;
+    if !valid(p2, &vi2) || !p2.has_faces() {
+        return;
+    }
+    let mut v2 = vi2.map(|i| x2.act_point(&p2.vertex(i as u32)));
+    let dim2 = simplex_dim(&mut vi2, &mut v2);
+    candidate_faces(p2, x2, dim2, &vi2, dir, out);
+}

@@ -23,15 +23,19 @@
 //!   clipped face's normal.
 //! - **a capsule or a cylinder against a box or a mesh** (`mj_maxContact` 5): MuJoCo's source
 //!   snapshot turns both geoms by ±1e-3 rad about the contact's tangents and reruns the solver;
-//!   the live 4.0.0 does not (its contacts show it): a capsule's segment, or a cylinder's side
-//!   line, within ~5.1° of parallel to a face of the polytope is clipped by the face (points on
-//!   the surface and on the face's plane, normal the face's reversed: a capsule lying on a face
-//!   gets its two ends); a cylinder's cap within ~5.1° of facing a face is clipped as a polygon
+//!   the live 4.0.0 does not (its contacts show it): a capsule's surface line through its
+//!   witness point, or a cylinder's side line through the support point of the first vertex of
+//!   EPA's final face (of GJK's simplex for a shallow contact), clipped by the first face of the
+//!   polytope's feature on that face within ~5.1° of parallel (points on the line and on the
+//!   face's plane, normal the face's reversed: a capsule lying on a face gets its two ends; the
+//!   faces at the support plane when no face is at hand); a cylinder's cap within ~5.1° of facing a face is clipped as a polygon
 //!   (the cap as MuJoCo 4.0's regular 16-gon, vertex k at k·22.5° about the cylinder's x axis,
 //!   clockwise seen from outside the cap: MuJoCo Warp 4.0.0's `_cylinder_face`, and every
 //!   contact of the golden resting poses lies at a multiple of 22.5°); otherwise one contact.
-//! - **capsule–cylinder, cylinder–cylinder** (`mj_maxContact` 5): one contact at every pose
-//!   measured (lagrange gives one).
+//! - **capsule–cylinder, cylinder–cylinder** (`mj_maxContact` 5): geom 1's edge (as against a
+//!   polytope) within ~5.1° of parallel to geom 2's cap, when the final face's feature on geom 2
+//!   is that cap (the cylinder support marks the cap), clipped by the cap's 16-gon; otherwise
+//!   one contact.
 //! - **a sphere or an ellipsoid**: one contact.
 //!
 //! With `multiccd` off every convex pair gives one contact. lagrange reproduces these on its port
@@ -54,8 +58,36 @@ use std::cell::RefCell;
 pub(crate) const FACE_TOL: f64 = 0.996;
 /// |cosine| below which an edge counts as parallel to a face (MuJoCo's `mjEDGE_TOL`, ~5.1°).
 pub(crate) const EDGE_TOL: f64 = 0.0888;
-/// The sides of the regular polygon standing in for a cylinder's cap (MuJoCo 4.0's 16-gon).
-const CAP_SIDES: usize = 16;
+/// Cosine and sine of k·22.5° (k = 0..16), the vertices of the regular 16-gon standing in for a
+/// cylinder's cap, as the live MuJoCo 4.0.0's table holds them (its cap polygons dumped under gdb:
+/// exact 0 and ±1, the others to 15 significant digits, cos 45° = 0.707106781186548 and
+/// sin 45° = 0.707106781186547).
+// MuJoCo's table values, not the correctly rounded constants: the approximation is the point.
+#[allow(clippy::approx_constant)]
+const CAP_COS_SIN: [(f64, f64); 16] = {
+    const C1: f64 = 0.923879532511287;
+    const S1: f64 = 0.38268343236509;
+    const C2: f64 = 0.707106781186548;
+    const S2: f64 = 0.707106781186547;
+    [
+        (1.0, 0.0),
+        (C1, S1),
+        (C2, S2),
+        (S1, C1),
+        (0.0, 1.0),
+        (-S1, C1),
+        (-S2, C2),
+        (-C1, S1),
+        (-1.0, 0.0),
+        (-C1, -S1),
+        (-C2, -S2),
+        (-S1, -C1),
+        (0.0, -1.0),
+        (S1, -C1),
+        (S2, -C2),
+        (C1, -S1),
+    ]
+};
 
 /// Scratch buffers of the clipping, reused per thread (no allocation once grown).
 #[derive(Default)]
@@ -444,8 +476,8 @@ fn edge_face(edges: &[Vec3], faces: &[(Vec3, u32)]) -> Option<(usize, usize)> {
 /// and of an edge to its two farthest points. The quadrilateral is MuJoCo 4.0's (the clipped
 /// polygon's first point fixed, [`super::plane_mesh::quad_from_first`]: measured black-box on 40
 /// box–prism faces, 38 the same points in the same order, the 2 others misread by the
-/// measurement); with `cap` (a cylinder's cap clipping a face) the rule fitted to MuJoCo 4.0's
-/// cap contacts ([`cap_quad`]).
+/// measurement); with `cap` (a cylinder's cap clipping a face) the live
+/// MuJoCo 4.0.0's own rule ([`cap_quad`]).
 #[allow(clippy::too_many_arguments)]
 fn clip(
     face: &[Vec3],
@@ -515,39 +547,56 @@ fn area4d(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> f64 {
     0.5 * (a - c).cross(&(b - d)).norm()
 }
 
-/// Four vertices of a cylinder cap's clipped polygon (more than four), the first fixed: the
-/// other three start a quarter, a half and three quarters along the polygon and each moves, in
-/// turn, either way while the quadrilateral's area grows, until none moves. A rule fitted to the
-/// live MuJoCo 4.0.0's contacts of a cylinder resting on a box (its source is not at hand): 6 of
-/// the 8 golden resting poses give MuJoCo's four points; the rule of polytope faces
-/// ([`super::plane_mesh::quad_from_first`]) gives 2.
+/// Four vertices of a cylinder cap's clipped polygon (more than four) enclosing a large area, as
+/// the live MuJoCo 4.0.0's `polygonClip` picks them (read from its machine code; Warp 4.0.0's
+/// `_polygon_quad` is the same): from (0, 1, 2, 3), for each first vertex a in turn, the fourth
+/// advances while the area grows, and after each advance the third, then the second, advance
+/// while it grows; the second (third, fourth) steps off a when they coincide.
 fn cap_quad(p: &[Vec3]) -> [usize; 4] {
     let n = p.len();
-    let mut q = [0, n / 4, n / 2, 3 * n / 4];
-    let area = |q: &[usize; 4]| area4d(&p[q[0]], &p[q[1]], &p[q[2]], &p[q[3]]);
-    let mut m = area(&q);
-    loop {
-        let mut moved = false;
-        for k in 1..4 {
-            for step in [1, n - 1] {
-                loop {
-                    let mut r = q;
-                    r[k] = (r[k] + step) % n;
-                    let a = area(&r);
-                    if a <= m {
-                        break;
-                    }
-                    q = r;
-                    m = a;
-                    moved = true;
+    let area = |a: usize, b: usize, c: usize, d: usize| area4d(&p[a], &p[b], &p[c], &p[d]);
+    let (mut b, mut c, mut d) = (1, 2, 3);
+    let mut res = [0, b, c, d];
+    let mut m = area(0, b, c, d);
+    for a in 0..n {
+        loop {
+            let next = area(a, b, c, (d + 1) % n);
+            if next <= m {
+                break;
+            }
+            m = next;
+            d = (d + 1) % n;
+            res = [a, b, c, d];
+            loop {
+                let next = area(a, b, (c + 1) % n, d);
+                if next <= m {
+                    break;
+                }
+                m = next;
+                c = (c + 1) % n;
+                res = [a, b, c, d];
+            }
+            loop {
+                let next = area(a, (b + 1) % n, c, d);
+                if next <= m {
+                    break;
+                }
+                m = next;
+                b = (b + 1) % n;
+                res = [a, b, c, d];
+            }
+        }
+        if b == a {
+            b = (b + 1) % n;
+            if c == b {
+                c = (c + 1) % n;
+                if d == c {
+                    d = (d + 1) % n;
                 }
             }
         }
-        if !moved {
-            break;
-        }
     }
-    q
+    res
 }
 
 /// The contacts of a convex pair from GJK/EPA's first point `first` (penetrating or within the
@@ -577,9 +626,14 @@ pub(crate) fn convex_contacts(
     }
     match (s1, Poly::of(s2)) {
         (ConvexShape::Capsule(c), Some(p2)) => {
-            let (a, b) = (c.segment.a, c.segment.b);
-            let seg = [x1.act_point(&Vec3::new(a.x, a.y, a.z)), x1.act_point(&Vec3::new(b.x, b.y, b.z))];
-            segment_polytope(x1, seg, c.radius, x2, &p2, first, margin_gap, emit);
+            // MuJoCo 4.0.0: the capsule's surface line through its witness point, parallel to
+            // the axis, as long as the segment; already inflated by half the margin.
+            let axis = x1.rot.column(2).into_owned();
+            let w = first.p1;
+            let pr = (w - x1.pos).dot(&axis);
+            let len = c.segment.b.z;
+            let seg = [w + axis * (-pr - len), w + axis * (-pr + len)];
+            segment_polytope(x1, seg, 0.5 * margin_gap, x2, &p2, first, face, margin_gap, emit);
         }
         (ConvexShape::Cylinder(c), Some(p2)) => {
             // The side's line at the contact when the axis is within ~5.1° of the contact plane;
@@ -587,20 +641,132 @@ pub(crate) fn convex_contacts(
             let axis = x1.rot.column(2).into_owned();
             let along = axis.dot(&first.normal);
             if along.abs() < EDGE_TOL {
-                let radial = (first.normal - axis * along).normalize();
-                let centre = x1.pos + radial * c.radius;
-                let h = axis * c.half_height;
-                segment_polytope(x1, [centre - h, centre + h], 0.0, x2, &p2, first, margin_gap, emit);
+                // MuJoCo 4.0.0: the side line through the support point of EPA's face's first
+                // vertex on the cylinder (on a rim; moved back onto it from the margin), to the
+                // other cap.
+                let seg = match face {
+                    Some(f) => cylinder_side(x1, c, f, margin_gap),
+                    None => {
+                        let radial = (first.normal - axis * along).normalize();
+                        let centre = x1.pos + radial * c.radius;
+                        let h = axis * c.half_height;
+                        [centre - h, centre + h]
+                    }
+                };
+                segment_polytope(x1, seg, 0.0, x2, &p2, first, face, margin_gap, emit);
             } else if along.abs() > FACE_TOL {
                 cap_polytope(x1, c.radius, c.half_height, along.signum(), x2, &p2, first, margin_gap, emit);
             } else {
                 emit(first);
             }
         }
-        // Capsule–cylinder, cylinder–cylinder: MuJoCo 4.0 gives these one contact at the poses
-        // measured (its source snapshot turned the geoms).
+        // Capsule–cylinder, cylinder–cylinder: geom 1's edge against geom 2's cap.
+        (ConvexShape::Capsule(_) | ConvexShape::Cylinder(_), None) => match s2 {
+            ConvexShape::Cylinder(c2) if edge_cap(x1, s1, x2, c2, &first, face, margin_gap, emit) > 0 => {}
+            _ => emit(first),
+        },
         _ => emit(first),
     }
+}
+
+/// A capsule's or a cylinder's edge (geom 1) against a cylinder's cap (geom 2), as MuJoCo 4.0.0's
+/// `multicontact` takes it (Warp 4.0.0's `_cylinder_normals`, `_cylinder_face`, and the live
+/// contacts): when geom 2's feature on EPA's final face (or GJK's simplex) is one cap, geom 1's
+/// edge (a capsule's surface line through its witness point; a cylinder's side line through the
+/// support point of the face's first vertex) within ~5.1° of parallel to that cap is clipped by
+/// the cap's 16-gon. Returns the number of contacts emitted (0: none, the caller keeps `first`);
+/// two caps facing each other are left to `first`.
+#[allow(clippy::too_many_arguments)]
+fn edge_cap(
+    x1: &Transform,
+    s1: &ConvexShape,
+    x2: &Transform,
+    c2: &parry3d_f64::shape::Cylinder,
+    first: &PairPoint,
+    face: Option<&EpaFace>,
+    margin: f64,
+    emit: &mut dyn FnMut(PairPoint),
+) -> usize {
+    let Some(f) = face else { return 0 };
+    let idx = f.index2[0];
+    if idx < 0 || f.index2.iter().any(|&i| i != idx) {
+        return 0;
+    }
+    let z2 = x2.rot.column(2).into_owned();
+    let n2 = if idx != 0 { -z2 } else { z2 };
+    let axis = x1.rot.column(2).into_owned();
+    let (seg, inflated) = match s1 {
+        ConvexShape::Capsule(c) => {
+            let w = first.p1;
+            let pr = (w - x1.pos).dot(&axis);
+            let len = c.segment.b.z;
+            ([w + axis * (-pr - len), w + axis * (-pr + len)], 0.5 * margin)
+        }
+        ConvexShape::Cylinder(c) => {
+            // Geom 1's own cap facing geom 2's: MuJoCo clips the two caps (not here).
+            let i1 = f.index1[0];
+            if f.index1.iter().all(|&i| i == i1) {
+                let n1 = if i1 != 0 { -axis } else { axis };
+                if n1.dot(&n2) < -FACE_TOL {
+                    return 0;
+                }
+            }
+            (cylinder_side(x1, c, f, margin), 0.0)
+        }
+        _ => return 0,
+    };
+    let d = (seg[1] - seg[0]).normalize();
+    if d.dot(&n2).abs() >= EDGE_TOL {
+        return 0;
+    }
+    SCRATCH.with(|s| {
+        let s = &mut *s.borrow_mut();
+        let sgn = if idx != 0 { -1.0 } else { 1.0 };
+        let centre = z2 * (sgn * c2.half_height) + x2.pos;
+        let (e1, e2) = (x2.rot.column(0).into_owned(), x2.rot.column(1).into_owned());
+        let (col0, col1) = (e1 * c2.radius, e2 * (c2.radius * sgn));
+        s.face2.clear();
+        for (c, sn) in CAP_COS_SIN {
+            s.face2.push(col0 * c - col1 * sn + centre);
+        }
+        s.face1.clear();
+        s.face1.extend_from_slice(&seg);
+        let mut count = 0;
+        clip(
+            &s.face2,
+            &s.face1,
+            &n2,
+            &-n2,
+            margin - inflated,
+            false,
+            &mut s.poly,
+            &mut s.clip,
+            &mut |w1, w2, d| {
+                let p2 = if inflated != 0.0 { w1 + n2 * inflated } else { w1 };
+                emit(PairPoint { p1: w2, p2, normal: -n2, dist: d + inflated });
+                count += 1;
+            },
+        );
+        count
+    })
+}
+
+/// A cylinder's side line (geom 1) as MuJoCo 4.0.0's `multicontact` takes it: through the
+/// support point of EPA's face's first vertex on the cylinder (on a rim; moved back onto it from
+/// the margin), to the other cap.
+fn cylinder_side(x1: &Transform, c: &parry3d_f64::shape::Cylinder, f: &EpaFace, margin: f64) -> [Vec3; 2] {
+    let axis = x1.rot.column(2).into_owned();
+    let mut v = f.vert1[0];
+    let up = (v - x1.pos).dot(&axis) < 0.0;
+    let sgn = if up { 1.0 } else { -1.0 };
+    if margin > 0.0 {
+        let d = v - x1.pos;
+        let (l0, l1) = (x1.rot.column(0).dot(&d), x1.rot.column(1).dot(&d));
+        let n2 = l0 * l0 + l1 * l1;
+        let scl = if n2 >= 1e-30 { c.radius / n2.sqrt() } else { 0.0 };
+        v = x1.rot * Vec3::new(scl * l0, scl * l1, -sgn * c.half_height) + x1.pos;
+    }
+    [v, v + axis * (sgn * 2.0 * c.half_height)]
 }
 
 /// A cylinder's cap (geom 1; `side` +1 the top, −1 the bottom) against a box or mesh hull: the
@@ -644,9 +810,8 @@ fn cap_polytope(
             // Clockwise seen from outside the cap.
             s.face1.clear();
             let (col0, col1) = (e1 * r, e2 * (r * side));
-            for k in 0..CAP_SIDES {
-                let t = k as f64 * std::f64::consts::PI / (CAP_SIDES / 2) as f64;
-                s.face1.push(col0 * t.cos() - col1 * t.sin() + centre);
+            for (c, sn) in CAP_COS_SIN {
+                s.face1.push(col0 * c - col1 * sn + centre);
             }
             face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
             clip(&s.face1, &s.face2, &n1, &n2, margin, true, &mut s.poly, &mut s.clip, &mut |w1, w2, d| {
@@ -662,21 +827,23 @@ fn cap_polytope(
     }
 }
 
-/// A segment of geom 1 (a capsule's, radius `r`; a cylinder's side line, radius 0) against a box
-/// or mesh hull from the first contact `first`, as MuJoCo 4.0 gives it (read from its contacts:
-/// its source snapshot turned the geoms instead): when the segment lies within ~5.1° of parallel
-/// to a face of the polytope at the contact, the segment clipped by that face's sides, each point
-/// within `margin` of the face (less the radius) a contact — on geom 1's surface and on the face's
-/// plane, normal the face's reversed, distance to the face less the radius (the two farthest when
-/// more). Otherwise `first` alone.
+/// A segment of geom 1 (a capsule's surface line, inflated by `inflated` = half the margin; a
+/// cylinder's side line, `inflated` 0) against a box or mesh hull from the first contact `first`,
+/// as MuJoCo 4.0.0 gives it (its `multicontact`'s edge–face case, read from Warp 4.0.0 and the
+/// live contacts): when the segment lies within ~5.1° of parallel to a face of the polytope at
+/// the contact, the segment clipped by that face's sides, each point within `margin` (less
+/// `inflated`) above the face a contact — witness on the segment and on the face's plane (moved
+/// out by `inflated`), normal the face's reversed (the two farthest when more). Otherwise
+/// `first` alone.
 #[allow(clippy::too_many_arguments)]
 fn segment_polytope(
     x1: &Transform,
     seg: [Vec3; 2],
-    r: f64,
+    inflated: f64,
     x2: &Transform,
     p2: &Poly,
     first: PairPoint,
+    face: Option<&EpaFace>,
     margin: f64,
     emit: &mut dyn FnMut(PairPoint),
 ) {
@@ -684,13 +851,27 @@ fn segment_polytope(
     let emitted = SCRATCH.with(|s| {
         let s = &mut *s.borrow_mut();
         let mut tmp = std::mem::take(&mut s.tmp);
-        let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
-        support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
-        feature_faces(p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
         s.face1.clear();
         s.face1.extend_from_slice(&seg);
+        // MuJoCo 4.0.0: the faces of geom 2's feature on EPA's final face, the first (in their
+        // order) within ~5.1° of parallel to the segment; without a face, the faces at geom 2's
+        // support plane, the most nearly parallel.
+        if let Some(f) = face {
+            super::epa_face::geom2_faces(p2, x2, f, &(first.p2 - first.p1), &mut s.normals2);
+        } else {
+            s.normals2.clear();
+        }
+        let chosen = if s.normals2.is_empty() {
+            let scale = (x1.pos - x2.pos).norm().max(first.dist.abs()).max(1e-3);
+            support_feature(p2, x2, &-n, 1e-9 * scale, &mut s.feature2);
+            feature_faces(p2, x2, &s.feature2, &-n, &mut s.faces, &mut s.normals2);
+            edge_face(&s.face1, &s.normals2)
+        } else {
+            let d = (seg[1] - seg[0]).normalize();
+            s.normals2.iter().position(|(m, _)| d.dot(m).abs() < EDGE_TOL).map(|j| (0, j))
+        };
         let mut count = 0;
-        if let Some((_, j)) = edge_face(&s.face1, &s.normals2) {
+        if let Some((_, j)) = chosen {
             let (n2, f2) = s.normals2[j];
             face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
             clip(
@@ -698,13 +879,13 @@ fn segment_polytope(
                 &s.face1,
                 &n2,
                 &-n2,
-                margin + r,
+                margin - inflated,
                 false,
                 &mut s.poly,
                 &mut s.clip,
-                &mut |_, v, _| {
-                    let d = (v - s.face2[0]).dot(&n2);
-                    emit(PairPoint { p1: v - n2 * r, p2: v - n2 * d, normal: -n2, dist: d - r });
+                &mut |w1, w2, d| {
+                    let p2 = if inflated != 0.0 { w1 + n2 * inflated } else { w1 };
+                    emit(PairPoint { p1: w2, p2, normal: -n2, dist: d + inflated });
                     count += 1;
                 },
             );

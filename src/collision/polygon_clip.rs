@@ -45,6 +45,19 @@ pub struct ClipScratch {
 }
 
 /// Whether `poly` (3 points or more; fewer are convex) turns the same way at every vertex about
+/// The unit inward normal of the side plane through edge a→b of a face with normal `n`, as the
+/// live MuJoCo 4.0.0's `planeNormal` rounds it (read from its machine code): (b − a) × ((a + n)
+/// − a), scaled by the reciprocal of its norm ((1, 0, 0) below 1e-15).
+fn side_normal(a: &Vec3, b: &Vec3, n: &Vec3) -> Vec3 {
+    let c = (b - a).cross(&((a + n) - a));
+    let norm = c.norm();
+    if norm < MINVAL {
+        Vec3::x()
+    } else {
+        c * (1.0 / norm)
+    }
+}
+
 /// `n`, each turn's sine above [`CONVEX_SINE`] (no repeated or collinear points).
 fn strictly_convex_about(poly: &[Vec3], n: &Vec3) -> bool {
     let np = poly.len();
@@ -106,7 +119,7 @@ pub fn clip_by_face_sides(face: &[Vec3], n: &Vec3, poly: &mut Vec<Vec3>, scratch
         }
         let (a, b) = (face[k], face[(k + 1) % m]);
         // Inward normal of the side plane through edge a→b (clockwise about n).
-        let pn = (b - a).cross(n).normalize();
+        let pn = side_normal(&a, &b, n);
         let inside = |p: &Vec3| (p - a).dot(&pn) > -MINVAL;
         let pd = pn.dot(&a);
         let side = b - a;
@@ -249,7 +262,7 @@ fn clip_small(face: &[Vec3], n: &Vec3, poly: &mut Vec<Vec3>, next: &mut Vec<Vec3
             return;
         }
         let (a, b) = (face[k], face[if k + 1 == m { 0 } else { k + 1 }]);
-        let pn = (b - a).cross(n).normalize();
+        let pn = side_normal(&a, &b, n);
         let pd = pn.dot(&a);
         let inside = |p: &Vec3| (p - a).dot(&pn) > -MINVAL;
         next.clear();
@@ -298,7 +311,7 @@ mod tests {
         let m = face.len();
         for k in 0..m {
             let (a, b) = (face[k], face[(k + 1) % m]);
-            let pn = (b - a).cross(n).normalize();
+            let pn = side_normal(&a, &b, n);
             let pd = pn.dot(&a);
             let inside = |p: &Vec3| (p - a).dot(&pn) > -MINVAL;
             let np = poly.len();
