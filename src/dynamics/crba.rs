@@ -401,6 +401,27 @@ fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Opt
         // Every ancestor of k starts its chain where k's does (the tree's root dof).
         let lo = model.dof_tree_start[k];
         let mut i = lambda[k];
+        #[cfg(target_arch = "x86_64")]
+        if AVX2 {
+            // The loop below through raw pointers: for a humanoid the pairs (k, ancestor i)
+            // are many and their updates short, and the slices' bounds checks and the
+            // remainder's mask set-up cost more than the arithmetic.
+            assert!(k < nv && lo <= k && before.len() == k * nv);
+            let (hp, yk) = (before.as_mut_ptr(), col_k.as_mut_ptr());
+            while i != NO_DOF {
+                assert!(i < k && lo <= i);
+                // SAFETY: i < k (checked), so column i lies in `before` (k · nv entries) and
+                // rows lo ..= i < nv of it, and rows lo ..= i of column k (`col_k`, nv long),
+                // are inside their slices, which are disjoint; the caller is compiled for AVX2.
+                unsafe {
+                    let a = *yk.add(i) / d_k;
+                    sub_scaled_avx2(hp.add(i * nv + lo), yk.add(lo), i + 1 - lo, a);
+                    *yk.add(i) = a;
+                }
+                i = lambda[i];
+            }
+            continue;
+        }
         while i != NO_DOF {
             let a = col_k[i] / d_k;
             // Column k is nonzero only on k's chain, whose rows up to i are i's chain: the
@@ -455,6 +476,42 @@ fn sub_scaled<const AVX2: bool>(x: &mut [f64], y: &[f64], a: f64) {
     }
     for (xj, yj) in x[..n].iter_mut().zip(&y[..n]) {
         *xj -= a * yj;
+    }
+}
+
+/// Lanes to keep of a vector whose last 1, 2 or 3 entries are past a span's end (index: how
+/// many lanes are kept).
+#[cfg(target_arch = "x86_64")]
+static TAIL_MASK: [[i64; 4]; 4] = [[0, 0, 0, 0], [-1, 0, 0, 0], [-1, -1, 0, 0], [-1, -1, -1, 0]];
+
+/// [`sub_scaled`]'s vector arm on raw pointers: x[0..n] −= a · y[0..n], four entries per
+/// instruction, the last one to three through a masked load and store (the same product then
+/// difference per entry, the same bits).
+///
+/// # Safety
+/// The CPU has AVX2; x and y point to n valid entries each, not overlapping.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn sub_scaled_avx2(x: *mut f64, y: *const f64, n: usize, a: f64) {
+    use std::arch::x86_64::{
+        __m256i, _mm256_loadu_pd, _mm256_loadu_si256, _mm256_maskload_pd, _mm256_maskstore_pd, _mm256_mul_pd,
+        _mm256_set1_pd, _mm256_storeu_pd, _mm256_sub_pd,
+    };
+    // SAFETY: the caller's contract (n valid entries at x and y, AVX2); the masked lanes past
+    // n are neither read nor written.
+    unsafe {
+        let av = _mm256_set1_pd(a);
+        let mut j = 0;
+        while j + 4 <= n {
+            let (xv, yv) = (_mm256_loadu_pd(x.add(j)), _mm256_loadu_pd(y.add(j)));
+            _mm256_storeu_pd(x.add(j), _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
+            j += 4;
+        }
+        if j < n {
+            let mask = _mm256_loadu_si256(TAIL_MASK[n - j].as_ptr().cast::<__m256i>());
+            let (xv, yv) = (_mm256_maskload_pd(x.add(j), mask), _mm256_maskload_pd(y.add(j), mask));
+            _mm256_maskstore_pd(x.add(j), mask, _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
+        }
     }
 }
 
