@@ -376,6 +376,25 @@ fn cholesky_kernel(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f64) -
 /// rotate nothing). Returns false, leaving `l` unusable, when a downdate leaves a pivot not
 /// positive (A − x xᵀ not positive definite to working precision) or a value is not finite.
 pub(crate) fn cholesky_rank_one(l: &mut DMatrix<f64>, n: usize, x: &mut [f64], sign: f64) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `cholesky_rank_one_avx2` requires.
+        return unsafe { cholesky_rank_one_avx2(l, n, x, sign) };
+    }
+    cholesky_rank_one_kernel(l, n, x, sign)
+}
+
+/// [`cholesky_rank_one`] compiled for AVX2: the rotation of each entry pair is independent of
+/// the others', four at a time, the same operations in the same order (no fused
+/// multiply–adds), so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn cholesky_rank_one_avx2(l: &mut DMatrix<f64>, n: usize, x: &mut [f64], sign: f64) -> bool {
+    cholesky_rank_one_kernel(l, n, x, sign)
+}
+
+#[inline(always)]
+fn cholesky_rank_one_kernel(l: &mut DMatrix<f64>, n: usize, x: &mut [f64], sign: f64) -> bool {
     let stride = l.nrows();
     let ls = l.as_mut_slice();
     let x = &mut x[..n];
@@ -408,6 +427,26 @@ pub(crate) fn cholesky_rank_one(l: &mut DMatrix<f64>, n: usize, x: &mut [f64], s
 /// column, per entry in the same order as the row form; back substitution by rows of Lᵀ, which
 /// are L's columns).
 pub(crate) fn cholesky_solve(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `cholesky_solve_avx2` requires.
+        unsafe { cholesky_solve_avx2(l, n, b) };
+        return;
+    }
+    cholesky_solve_kernel(l, n, b);
+}
+
+/// [`cholesky_solve`] compiled for AVX2: the same operations in the same order (the forward
+/// substitution's column updates four entries at a time; the back substitution's sums stay
+/// sequential), so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn cholesky_solve_avx2(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
+    cholesky_solve_kernel(l, n, b);
+}
+
+#[inline(always)]
+fn cholesky_solve_kernel(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
     let stride = l.nrows();
     let ls = l.as_slice();
     let b = &mut b[..n];
