@@ -602,6 +602,11 @@ fn solve_span_kernel<const AVX2: bool>(
     let nv = model.nv;
     let h = factor.as_slice();
     let x = &mut x[..nv];
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        solve_span_runs_avx2(model, h, x, (lo, hi));
+        return;
+    }
     for i in (lo..hi).rev() {
         let (col_i, x_i) = (&h[i * nv..(i + 1) * nv], x[i]);
         if lambda[i] != NO_DOF {
@@ -618,6 +623,52 @@ fn solve_span_kernel<const AVX2: bool>(
             for_each_run(model, lambda[i], |s, e| {
                 acc += x[s..=e].iter().zip(&col_i[s..=e]).map(|(xj, l)| xj * l).sum::<f64>();
             });
+        }
+        x[i] -= acc;
+    }
+}
+
+/// [`solve_span_kernel`]'s AVX2 arm: the same runs, products, differences and sums in the same
+/// order (the same bits), with the runs walked through raw pointers — for a humanoid a solve is
+/// a few hundred short runs, where the slices' bounds checks cost more than the arithmetic.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn solve_span_runs_avx2(model: &Model, h: &[f64], x: &mut [f64], (lo, hi): (usize, usize)) {
+    let nv = model.nv;
+    let (lambda, run_start) = (&model.dof_parent[..nv], &model.dof_run_start[..nv]);
+    assert!(h.len() >= nv * nv && x.len() == nv && hi <= nv);
+    let (hp, xp) = (h.as_ptr(), x.as_mut_ptr());
+    // The run s ..= e that ends at dof e, checked inside x and a factor column.
+    let run = |e: usize| {
+        let s = run_start[e];
+        assert!(s <= e && e < nv);
+        s
+    };
+    for i in (lo..hi).rev() {
+        // SAFETY: i < hi ≤ nv, so x[i] and column i (nv entries from i · nv) are inside x and h.
+        let (col, x_i) = unsafe { (hp.add(i * nv), *xp.add(i)) };
+        let mut e = lambda[i];
+        while e != NO_DOF {
+            let s = run(e);
+            // SAFETY: s ≤ e < nv (checked): entries s ..= e of x and of column i, which do not
+            // overlap (x and h are distinct borrows); the caller is compiled for AVX2.
+            unsafe { sub_scaled_avx2(xp.add(s), col.add(s), e + 1 - s, x_i) };
+            e = lambda[s];
+        }
+    }
+    for i in lo..hi {
+        x[i] /= h[i + i * nv];
+    }
+    for i in lo..hi {
+        let col = &h[i * nv..(i + 1) * nv];
+        let mut acc = 0.0;
+        let mut e = lambda[i];
+        while e != NO_DOF {
+            let s = run(e);
+            // SAFETY: s ≤ e < nv (checked), inside both slices of nv entries.
+            let (xs, ls) = unsafe { (x.get_unchecked(s..=e), col.get_unchecked(s..=e)) };
+            acc += xs.iter().zip(ls).map(|(xj, l)| xj * l).sum::<f64>();
+            e = lambda[s];
         }
         x[i] -= acc;
     }
