@@ -154,91 +154,12 @@ impl<'a> Assembler<'a> {
 /// H[p][q] += Σ_r c_r(q) G_r[p] over columns q of `cols` and p ≥ q (rows `g`, all on `cols`;
 /// `coefficients(g_q, c)` writes c_r(q) from the rows' values g_q = (G_0[q], …) at column
 /// position q). Up to eight rows, each entry's sum is formed in registers from the rows' values,
-/// four rows at a time (an elliptic contact of condim 6 is two such passes), along the runs of
-/// consecutive columns (a contact's columns are its bodies' dof chains: a few runs), where H's
-/// entries are contiguous and the sums vectorize; more rows are first
+/// four rows at a time (an elliptic contact of condim 6 is two such passes); more rows are first
 /// laid out transposed in `scratch` — Gᵀ[p] = (G_0[p], …, G_{k−1}[p]) and
 /// C[q] = (c_0(q), …) contiguous, zero-padded to a multiple of four — so that each entry is one
-/// dot product of two contiguous vectors (`dot4`). Either way it is added to H once. Compiled
-/// for AVX2 where the CPU has it (the same products and sums in the same order: the same bits).
+/// dot product of two contiguous vectors (`dot4`). Either way it is added to H once.
 #[inline(always)]
 fn add_columns(
-    h: &mut DMatrix<f64>,
-    cols: &[usize],
-    g: &[&[f64]],
-    scratch: &mut [f64],
-    coefficients: impl FnMut(&[f64], &mut [f64]),
-) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2 (checked just above), all `add_columns_avx2` requires.
-        unsafe { add_columns_avx2(h, cols, g, scratch, coefficients) };
-        return;
-    }
-    add_columns_kernel::<false>(h, cols, g, scratch, coefficients);
-}
-
-/// [`add_columns`] compiled for AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn add_columns_avx2(
-    h: &mut DMatrix<f64>,
-    cols: &[usize],
-    g: &[&[f64]],
-    scratch: &mut [f64],
-    coefficients: impl FnMut(&[f64], &mut [f64]),
-) {
-    add_columns_kernel::<true>(h, cols, g, scratch, coefficients);
-}
-
-/// The most columns whose runs [`add_columns`] lists up front (more: found entry by entry).
-const RUNS: usize = 64;
-
-/// `column[cols[p]] += Σ_r c[r] · g[r][p]` for p in `from..n`, the sum left to right
-/// (c₀ g₀ + c₁ g₁ + …, as written out term by term), over the runs of consecutive columns:
-/// `ends[p]` is the last position of the run holding p (`None`: runs found as they come).
-#[inline(always)]
-fn add_runs<const R: usize>(
-    column: &mut [f64],
-    cols: &[usize],
-    ends: Option<&[usize; RUNS]>,
-    from: usize,
-    g: &[&[f64]],
-    c: &[f64],
-) {
-    let n = cols.len();
-    let g: [&[f64]; R] = std::array::from_fn(|r| &g[r][..n]);
-    let c: [f64; R] = std::array::from_fn(|r| c[r]);
-    let mut p = from;
-    while p < n {
-        let e = match ends {
-            Some(ends) => ends[p],
-            None => {
-                let mut e = p;
-                while e + 1 < n && cols[e + 1] == cols[e] + 1 {
-                    e += 1;
-                }
-                e
-            }
-        };
-        let base = cols[p];
-        let dst = &mut column[base..=base + (e - p)];
-        let g: [&[f64]; R] = std::array::from_fn(|r| &g[r][p..=e]);
-        for (t, d) in dst.iter_mut().enumerate() {
-            let mut s = c[0] * g[0][t];
-            for r in 1..R {
-                s += c[r] * g[r][t];
-            }
-            *d += s;
-        }
-        p = e + 1;
-    }
-}
-
-/// [`add_columns`]; `AVX2`: the caller is compiled for AVX2 (the dot products through
-/// [`dot4_avx2`]).
-#[inline(always)]
-fn add_columns_kernel<const AVX2: bool>(
     h: &mut DMatrix<f64>,
     cols: &[usize],
     g: &[&[f64]],
@@ -250,14 +171,7 @@ fn add_columns_kernel<const AVX2: bool>(
     let h = h.as_mut_slice();
     if k <= 8 {
         // Up to eight rows: each entry's sum over (up to) four rows at a time in a register,
-        // straight from the rows' values, run by run.
-        let mut ends = [0; RUNS];
-        let ends = (n <= RUNS).then(|| {
-            for p in (0..n).rev() {
-                ends[p] = if p + 1 < n && cols[p + 1] == cols[p] + 1 { ends[p + 1] } else { p };
-            }
-            &ends
-        });
+        // straight from the rows' values.
         let (mut g_q, mut c) = ([0.0; 8], [0.0; 8]);
         for q in 0..n {
             for (x, g) in g_q.iter_mut().zip(g) {
@@ -265,12 +179,33 @@ fn add_columns_kernel<const AVX2: bool>(
             }
             coefficients(&g_q[..k], &mut c[..k]);
             let column = &mut h[cols[q] * nv..(cols[q] + 1) * nv];
+            let rows = &cols[q..];
             for (g, c) in g.chunks(4).zip(c[..k].chunks(4)) {
                 match g.len() {
-                    1 => add_runs::<1>(column, cols, ends, q, g, c),
-                    2 => add_runs::<2>(column, cols, ends, q, g, c),
-                    3 => add_runs::<3>(column, cols, ends, q, g, c),
-                    _ => add_runs::<4>(column, cols, ends, q, g, c),
+                    1 => {
+                        for (&p, &g0) in rows.iter().zip(&g[0][q..n]) {
+                            column[p] += c[0] * g0;
+                        }
+                    }
+                    2 => {
+                        for ((&p, &g0), &g1) in rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]) {
+                            column[p] += c[0] * g0 + c[1] * g1;
+                        }
+                    }
+                    3 => {
+                        for (((&p, &g0), &g1), &g2) in
+                            rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n])
+                        {
+                            column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2;
+                        }
+                    }
+                    _ => {
+                        for ((((&p, &g0), &g1), &g2), &g3) in
+                            rows.iter().zip(&g[0][q..n]).zip(&g[1][q..n]).zip(&g[2][q..n]).zip(&g[3][q..n])
+                        {
+                            column[p] += c[0] * g0 + c[1] * g1 + c[2] * g2 + c[3] * g3;
+                        }
+                    }
                 }
             }
         }
@@ -292,45 +227,8 @@ fn add_columns_kernel<const AVX2: bool>(
     for (q, (&col_q, c_q)) in cols.iter().zip(c.chunks_exact(kp)).enumerate() {
         let column = &mut h[col_q * nv..(col_q + 1) * nv];
         for (&p, g_p) in cols[q..].iter().zip(gt[q * kp..].chunks_exact(kp)) {
-            #[cfg(target_arch = "x86_64")]
-            if AVX2 {
-                // SAFETY: `AVX2` is set only in code compiled for AVX2 (`add_columns_avx2`).
-                column[p] += unsafe { dot4_avx2(g_p, c_q) };
-                continue;
-            }
             column[p] += dot4(g_p, c_q);
         }
-    }
-}
-
-/// [`dot4`] with its four partial sums in one AVX2 register: per lane the same products and
-/// sums in the same order, combined as (s₀ + s₂) + (s₁ + s₃): the same bits.
-///
-/// # Safety
-/// The CPU has AVX2.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn dot4_avx2(a: &[f64], b: &[f64]) -> f64 {
-    use std::arch::x86_64::{
-        _mm256_add_pd, _mm256_castpd256_pd128, _mm256_extractf128_pd, _mm256_loadu_pd, _mm256_mul_pd,
-        _mm256_setzero_pd, _mm_add_pd, _mm_cvtsd_f64, _mm_unpackhi_pd,
-    };
-    let n = a.len().min(b.len()) / 4 * 4;
-    // SAFETY: every load reads four entries below n, inside both slices; the CPU has AVX2 (the
-    // caller's contract).
-    unsafe {
-        let mut s = _mm256_setzero_pd();
-        let mut i = 0;
-        while i < n {
-            s = _mm256_add_pd(
-                s,
-                _mm256_mul_pd(_mm256_loadu_pd(a.as_ptr().add(i)), _mm256_loadu_pd(b.as_ptr().add(i))),
-            );
-            i += 4;
-        }
-        // (s0 + s2, s1 + s3), then their sum.
-        let t = _mm_add_pd(_mm256_castpd256_pd128(s), _mm256_extractf128_pd::<1>(s));
-        _mm_cvtsd_f64(t) + _mm_cvtsd_f64(_mm_unpackhi_pd(t, t))
     }
 }
 
