@@ -401,6 +401,27 @@ fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Opt
         // Every ancestor of k starts its chain where k's does (the tree's root dof).
         let lo = model.dof_tree_start[k];
         let mut i = lambda[k];
+        #[cfg(target_arch = "x86_64")]
+        if AVX2 {
+            // The loop below through raw pointers: for a humanoid the pairs (k, ancestor i)
+            // are many and their updates short, and the slices' bounds checks and the
+            // remainder's mask set-up cost more than the arithmetic.
+            assert!(k < nv && lo <= k && before.len() == k * nv);
+            let (hp, yk) = (before.as_mut_ptr(), col_k.as_mut_ptr());
+            while i != NO_DOF {
+                assert!(i < k && lo <= i);
+                // SAFETY: i < k (checked), so column i lies in `before` (k · nv entries) and
+                // rows lo ..= i < nv of it, and rows lo ..= i of column k (`col_k`, nv long),
+                // are inside their slices, which are disjoint; the caller is compiled for AVX2.
+                unsafe {
+                    let a = *yk.add(i) / d_k;
+                    sub_scaled_avx2(hp.add(i * nv + lo), yk.add(lo), i + 1 - lo, a);
+                    *yk.add(i) = a;
+                }
+                i = lambda[i];
+            }
+            continue;
+        }
         while i != NO_DOF {
             let a = col_k[i] / d_k;
             // Column k is nonzero only on k's chain, whose rows up to i are i's chain: the
@@ -455,6 +476,42 @@ fn sub_scaled<const AVX2: bool>(x: &mut [f64], y: &[f64], a: f64) {
     }
     for (xj, yj) in x[..n].iter_mut().zip(&y[..n]) {
         *xj -= a * yj;
+    }
+}
+
+/// Lanes to keep of a vector whose last 1, 2 or 3 entries are past a span's end (index: how
+/// many lanes are kept).
+#[cfg(target_arch = "x86_64")]
+static TAIL_MASK: [[i64; 4]; 4] = [[0, 0, 0, 0], [-1, 0, 0, 0], [-1, -1, 0, 0], [-1, -1, -1, 0]];
+
+/// [`sub_scaled`]'s vector arm on raw pointers: x[0..n] −= a · y[0..n], four entries per
+/// instruction, the last one to three through a masked load and store (the same product then
+/// difference per entry, the same bits).
+///
+/// # Safety
+/// The CPU has AVX2; x and y point to n valid entries each, not overlapping.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn sub_scaled_avx2(x: *mut f64, y: *const f64, n: usize, a: f64) {
+    use std::arch::x86_64::{
+        __m256i, _mm256_loadu_pd, _mm256_loadu_si256, _mm256_maskload_pd, _mm256_maskstore_pd, _mm256_mul_pd,
+        _mm256_set1_pd, _mm256_storeu_pd, _mm256_sub_pd,
+    };
+    // SAFETY: the caller's contract (n valid entries at x and y, AVX2); the masked lanes past
+    // n are neither read nor written.
+    unsafe {
+        let av = _mm256_set1_pd(a);
+        let mut j = 0;
+        while j + 4 <= n {
+            let (xv, yv) = (_mm256_loadu_pd(x.add(j)), _mm256_loadu_pd(y.add(j)));
+            _mm256_storeu_pd(x.add(j), _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
+            j += 4;
+        }
+        if j < n {
+            let mask = _mm256_loadu_si256(TAIL_MASK[n - j].as_ptr().cast::<__m256i>());
+            let (xv, yv) = (_mm256_maskload_pd(x.add(j), mask), _mm256_maskload_pd(y.add(j), mask));
+            _mm256_maskstore_pd(x.add(j), mask, _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
+        }
     }
 }
 
@@ -545,6 +602,11 @@ fn solve_span_kernel<const AVX2: bool>(
     let nv = model.nv;
     let h = factor.as_slice();
     let x = &mut x[..nv];
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        solve_span_runs_avx2(model, h, x, (lo, hi));
+        return;
+    }
     for i in (lo..hi).rev() {
         let (col_i, x_i) = (&h[i * nv..(i + 1) * nv], x[i]);
         if lambda[i] != NO_DOF {
@@ -561,6 +623,52 @@ fn solve_span_kernel<const AVX2: bool>(
             for_each_run(model, lambda[i], |s, e| {
                 acc += x[s..=e].iter().zip(&col_i[s..=e]).map(|(xj, l)| xj * l).sum::<f64>();
             });
+        }
+        x[i] -= acc;
+    }
+}
+
+/// [`solve_span_kernel`]'s AVX2 arm: the same runs, products, differences and sums in the same
+/// order (the same bits), with the runs walked through raw pointers — for a humanoid a solve is
+/// a few hundred short runs, where the slices' bounds checks cost more than the arithmetic.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn solve_span_runs_avx2(model: &Model, h: &[f64], x: &mut [f64], (lo, hi): (usize, usize)) {
+    let nv = model.nv;
+    let (lambda, run_start) = (&model.dof_parent[..nv], &model.dof_run_start[..nv]);
+    assert!(h.len() >= nv * nv && x.len() == nv && hi <= nv);
+    let (hp, xp) = (h.as_ptr(), x.as_mut_ptr());
+    // The run s ..= e that ends at dof e, checked inside x and a factor column.
+    let run = |e: usize| {
+        let s = run_start[e];
+        assert!(s <= e && e < nv);
+        s
+    };
+    for i in (lo..hi).rev() {
+        // SAFETY: i < hi ≤ nv, so x[i] and column i (nv entries from i · nv) are inside x and h.
+        let (col, x_i) = unsafe { (hp.add(i * nv), *xp.add(i)) };
+        let mut e = lambda[i];
+        while e != NO_DOF {
+            let s = run(e);
+            // SAFETY: s ≤ e < nv (checked): entries s ..= e of x and of column i, which do not
+            // overlap (x and h are distinct borrows); the caller is compiled for AVX2.
+            unsafe { sub_scaled_avx2(xp.add(s), col.add(s), e + 1 - s, x_i) };
+            e = lambda[s];
+        }
+    }
+    for i in lo..hi {
+        x[i] /= h[i + i * nv];
+    }
+    for i in lo..hi {
+        let col = &h[i * nv..(i + 1) * nv];
+        let mut acc = 0.0;
+        let mut e = lambda[i];
+        while e != NO_DOF {
+            let s = run(e);
+            // SAFETY: s ≤ e < nv (checked), inside both slices of nv entries.
+            let (xs, ls) = unsafe { (x.get_unchecked(s..=e), col.get_unchecked(s..=e)) };
+            acc += xs.iter().zip(ls).map(|(xj, l)| xj * l).sum::<f64>();
+            e = lambda[s];
         }
         x[i] -= acc;
     }

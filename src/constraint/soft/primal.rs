@@ -80,6 +80,37 @@ pub(super) fn mul_j(
     x: &DVector<f64>,
     r: &mut DVector<f64>,
 ) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `mul_j_avx2` requires.
+        unsafe { mul_j_avx2(s, dense, nefc, x, r) };
+        return;
+    }
+    mul_j_kernel(s, dense, nefc, x, r);
+}
+
+/// [`mul_j`] compiled for AVX2: the same products and sums in the same order (no fused
+/// multiply–adds), four entries per instruction, so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn mul_j_avx2(
+    s: &Sparsity,
+    dense: Option<&DMatrix<f64>>,
+    nefc: usize,
+    x: &DVector<f64>,
+    r: &mut DVector<f64>,
+) {
+    mul_j_kernel(s, dense, nefc, x, r);
+}
+
+#[inline(always)]
+fn mul_j_kernel(
+    s: &Sparsity,
+    dense: Option<&DMatrix<f64>>,
+    nefc: usize,
+    x: &DVector<f64>,
+    r: &mut DVector<f64>,
+) {
     let x = x.as_slice();
     let r = &mut r.as_mut_slice()[..nefc];
     if let Some(j) = dense {
@@ -109,6 +140,31 @@ pub(super) fn mul_jt(
     f: &DVector<f64>,
     out: &mut [f64],
 ) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `mul_jt_avx2` requires.
+        unsafe { mul_jt_avx2(s, dense, nefc, f, out) };
+        return;
+    }
+    mul_jt_kernel(s, dense, nefc, f, out);
+}
+
+/// [`mul_jt`] compiled for AVX2: the four partial sums of [`dot`] are one vector register's
+/// lanes, the same sums in the same order, so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn mul_jt_avx2(
+    s: &Sparsity,
+    dense: Option<&DMatrix<f64>>,
+    nefc: usize,
+    f: &DVector<f64>,
+    out: &mut [f64],
+) {
+    mul_jt_kernel(s, dense, nefc, f, out);
+}
+
+#[inline(always)]
+fn mul_jt_kernel(s: &Sparsity, dense: Option<&DMatrix<f64>>, nefc: usize, f: &DVector<f64>, out: &mut [f64]) {
     let f = &f.as_slice()[..nefc];
     if let Some(j) = dense {
         let (stride, j) = (j.nrows(), j.as_slice());
@@ -129,6 +185,7 @@ pub(super) fn mul_jt(
 }
 
 /// Σ a_i b_i in four partial sums (the lanes of a vector register), then the remainder.
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let mut s = [0.0; 4];
     let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
@@ -157,10 +214,25 @@ pub(super) fn mul_m(
 ) {
     let nv = x.len();
     if dense {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above), all `dense_mul_avx2` requires.
+            unsafe { dense_mul_avx2(m, x, r) };
+            return;
+        }
         m.mul_to(x, r);
         return;
     }
     mul_m_on(dof_parent, m, 0..nv, x.as_slice(), r.as_mut_slice());
+}
+
+/// r ← M x (nalgebra's product) compiled for AVX2: the same products and sums in the same
+/// order, four entries per instruction instead of two (Rust fuses no multiply–add unasked), so
+/// the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn dense_mul_avx2(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
+    m.mul_to(x, r);
 }
 
 /// r ← M x on the dofs `dofs` (whole trees, each tree's dofs ascending; M couples a dof only to
