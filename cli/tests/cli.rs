@@ -461,7 +461,7 @@ fn simulate_quotes_the_contact_budget_of_the_mode_it_ran() {
     // Each collision pass (the start's and the step's) drops the 60 beyond the budget.
     let dropped = summary["contacts_dropped"].as_u64().unwrap();
     let per_pass = 560 - lagrange::model::MAX_CONTACTS as u64;
-    assert!(dropped > 0 && dropped % per_pass == 0, "{dropped} dropped");
+    assert!(dropped > 0 && dropped.is_multiple_of(per_pass), "{dropped} dropped");
     let warnings = summary["warnings"].as_array().unwrap();
     let full = warnings.iter().filter_map(|w| w.as_str()).find(|w| w.contains("collision pass"));
     let full = full.unwrap_or_else(|| panic!("no contact-full warning: {warnings:?}"));
