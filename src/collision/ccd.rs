@@ -566,14 +566,7 @@ fn s2d(lambda: &mut [f64; 3], s1: &Vec3, s2: &Vec3, s3: &Vec3) {
         let m14 = a[1] * b[2] - a[2] * b[1];
         let m24 = a[0] * b[2] - a[2] * b[0];
         let m34 = a[0] * b[1] - a[1] * b[0];
-        let (mu1, mu2, mu3) = (m14.abs(), m24.abs(), m34.abs());
-        let (m_max, x, y) = if mu1 >= mu2 && mu1 >= mu3 {
-            (m14, 1, 2)
-        } else if mu2 >= mu3 {
-            (m24, 0, 2)
-        } else {
-            (m34, 0, 1)
-        };
+        let (m_max, x, y) = projection_axes(m14, m24, m34);
         // The three vertices relative to the projected origin, in the kept axes.
         let (a0, a1) = (s1[x] - p_o[x], s1[y] - p_o[y]);
         let (b0, b1) = (s2[x] - p_o[x], s2[y] - p_o[y]);
@@ -1050,18 +1043,24 @@ fn ray_triangle(v1: &Vec3, v2: &Vec3, v3: &Vec3, v4: &Vec3, v5: &Vec3) -> i32 {
     0
 }
 
-fn tri_affine_coord(v1: &Vec3, v2: &Vec3, v3: &Vec3, p: &Vec3) -> [f64; 3] {
-    let m14 = v2[1] * v3[2] - v2[2] * v3[1] - v1[1] * v3[2] + v1[2] * v3[1] + v1[1] * v2[2] - v1[2] * v2[1];
-    let m24 = v2[0] * v3[2] - v2[2] * v3[0] - v1[0] * v3[2] + v1[2] * v3[0] + v1[0] * v2[2] - v1[2] * v2[0];
-    let m34 = v2[0] * v3[1] - v2[1] * v3[0] - v1[0] * v3[1] + v1[1] * v3[0] + v1[0] * v2[1] - v1[1] * v2[0];
+/// The plane a triangle is projected on for its 2-D areas: from the components (m14, m24, m34) of
+/// its normal (x, y, z), the largest in magnitude and the two axes kept (dropping x, y or z).
+fn projection_axes(m14: f64, m24: f64, m34: f64) -> (f64, usize, usize) {
     let (mu1, mu2, mu3) = (m14.abs(), m24.abs(), m34.abs());
-    let (m_max, x, y) = if mu1 >= mu2 && mu1 >= mu3 {
+    if mu1 >= mu2 && mu1 >= mu3 {
         (m14, 1, 2)
     } else if mu2 >= mu3 {
         (m24, 0, 2)
     } else {
         (m34, 0, 1)
-    };
+    }
+}
+
+fn tri_affine_coord(v1: &Vec3, v2: &Vec3, v3: &Vec3, p: &Vec3) -> [f64; 3] {
+    let m14 = v2[1] * v3[2] - v2[2] * v3[1] - v1[1] * v3[2] + v1[2] * v3[1] + v1[1] * v2[2] - v1[2] * v2[1];
+    let m24 = v2[0] * v3[2] - v2[2] * v3[0] - v1[0] * v3[2] + v1[2] * v3[0] + v1[0] * v2[2] - v1[2] * v2[0];
+    let m34 = v2[0] * v3[1] - v2[1] * v3[0] - v1[0] * v3[1] + v1[1] * v3[0] + v1[0] * v2[1] - v1[1] * v2[0];
+    let (m_max, x, y) = projection_axes(m14, m24, m34);
     let c31 = p[x] * v2[y] + p[y] * v3[x] + v2[x] * v3[y] - p[x] * v3[y] - p[y] * v2[x] - v3[x] * v2[y];
     let c32 = p[x] * v3[y] + p[y] * v1[x] + v3[x] * v1[y] - p[x] * v1[y] - p[y] * v3[x] - v1[x] * v3[y];
     let c33 = p[x] * v1[y] + p[y] * v2[x] + v1[x] * v2[y] - p[x] * v2[y] - p[y] * v1[x] - v2[x] * v1[y];

@@ -469,6 +469,36 @@ fn edge_face(edges: &[Vec3], faces: &[(Vec3, u32)]) -> Option<(usize, usize)> {
     best.map(|(_, e, j)| (e, j))
 }
 
+/// Geom 1's segment (`s.face1`) clipped against geom 2's face polygon (`s.face2`, outward normal
+/// `n2`), each clipped point emitted as a contact with normal −`n2` (geom 2's point moved out by
+/// `inflated`, the margin share a core was shrunk by, and the depth with it); how many.
+fn clip_segment_on_face(
+    s: &mut Scratch,
+    n2: &Vec3,
+    margin: f64,
+    inflated: f64,
+    emit: &mut dyn FnMut(PairPoint),
+) -> usize {
+    let mut count = 0;
+    let n2 = *n2;
+    clip(
+        &s.face2,
+        &s.face1,
+        &n2,
+        &-n2,
+        margin - inflated,
+        false,
+        &mut s.poly,
+        &mut s.clip,
+        &mut |w1, w2, d| {
+            let p2 = if inflated != 0.0 { w1 + n2 * inflated } else { w1 };
+            emit(PairPoint { p1: w2, p2, normal: -n2, dist: d + inflated });
+            count += 1;
+        },
+    );
+    count
+}
+
 /// Clips polygon (or edge) `clipped_in` by face polygon `face` (outward normal `n`, vertices
 /// clockwise about it), keeps the points not above the face's plane and reports each as
 /// witness points (on `face`'s plane along `wit_dir`, on `clipped_in`) and signed distance below
@@ -731,23 +761,7 @@ fn edge_cap(
         }
         s.face1.clear();
         s.face1.extend_from_slice(&seg);
-        let mut count = 0;
-        clip(
-            &s.face2,
-            &s.face1,
-            &n2,
-            &-n2,
-            margin - inflated,
-            false,
-            &mut s.poly,
-            &mut s.clip,
-            &mut |w1, w2, d| {
-                let p2 = if inflated != 0.0 { w1 + n2 * inflated } else { w1 };
-                emit(PairPoint { p1: w2, p2, normal: -n2, dist: d + inflated });
-                count += 1;
-            },
-        );
-        count
+        clip_segment_on_face(s, &n2, margin, inflated, emit)
     })
 }
 
@@ -874,21 +888,7 @@ fn segment_polytope(
         if let Some((_, j)) = chosen {
             let (n2, f2) = s.normals2[j];
             face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
-            clip(
-                &s.face2,
-                &s.face1,
-                &n2,
-                &-n2,
-                margin - inflated,
-                false,
-                &mut s.poly,
-                &mut s.clip,
-                &mut |w1, w2, d| {
-                    let p2 = if inflated != 0.0 { w1 + n2 * inflated } else { w1 };
-                    emit(PairPoint { p1: w2, p2, normal: -n2, dist: d + inflated });
-                    count += 1;
-                },
-            );
+            count = clip_segment_on_face(s, &n2, margin, inflated, emit);
         }
         s.tmp = tmp;
         count

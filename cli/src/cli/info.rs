@@ -172,19 +172,20 @@ fn mimic_of(model: &Model, j: usize) -> Option<(&str, f64, f64, &str)> {
     })
 }
 
+/// The plan `info` describes: the model's own (its inverse weights took a pass over the bodies
+/// at compile), or a new one when `--constraints` asks for a mode.
+fn plan_of(model: &Model, mode: Option<ConstraintMode>) -> std::borrow::Cow<'_, Plan> {
+    match mode {
+        Some(m) => std::borrow::Cow::Owned(Plan::new(model, Some(m))),
+        None => std::borrow::Cow::Borrowed(&model.plan),
+    }
+}
+
 /// The `info` JSON document: keys `nq`, `nv`, `total_mass`, `bodies`, `joints`, `stages`.
 /// `com` is in the body frame, `inertia` is the 3×3 tensor about the centre of mass in body axes.
 /// Body 0 is `world` (with any links welded to it); `total_mass` counts the moving bodies only.
 pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
-    let rebuilt;
-    let plan = match mode {
-        Some(m) => {
-            rebuilt = Plan::new(model, Some(m));
-            &rebuilt
-        }
-        // The model's own plan (its inverse weights take a pass over the bodies at compile).
-        None => &model.plan,
-    };
+    let plan = plan_of(model, mode);
     let bodies: Vec<Value> = model
         .bodies
         .iter()
@@ -276,15 +277,7 @@ pub fn to_json(model: &Model, mode: Option<ConstraintMode>) -> Value {
 
 /// Human-readable summary of a model.
 pub fn to_text(model: &Model, mode: Option<ConstraintMode>) -> String {
-    let rebuilt;
-    let plan = match mode {
-        Some(m) => {
-            rebuilt = Plan::new(model, Some(m));
-            &rebuilt
-        }
-        // The model's own plan (its inverse weights take a pass over the bodies at compile).
-        None => &model.plan,
-    };
+    let plan = plan_of(model, mode);
     use std::fmt::Write;
     let mut s = String::new();
     let src = model.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "(embedded)".into());
