@@ -245,6 +245,27 @@ fn add_columns(
         }
         return;
     }
+    let (gt, c, kp) = transposed_with_coefficients(scratch, g, n, &mut coefficients);
+    for (q, (&col_q, c_q)) in cols.iter().zip(c.chunks_exact(kp)).enumerate() {
+        let column = &mut h[col_q * nv..(col_q + 1) * nv];
+        for (&p, g_p) in cols[q..].iter().zip(gt[q * kp..].chunks_exact(kp)) {
+            column[p] += dot4(g_p, c_q);
+        }
+    }
+}
+
+/// For more than eight rows (`add_columns`, `add_columns_sparse`): the rows' values transposed,
+/// per column q its k values padded with zeros to kp (a multiple of 4), and each column's
+/// coefficients beside them, both in `scratch`; (Gᵀ, C, kp). (Out of line: large groups are
+/// rare, and the callers' common paths stay compact.)
+#[inline(never)]
+fn transposed_with_coefficients<'a>(
+    scratch: &'a mut [f64],
+    g: &[&[f64]],
+    n: usize,
+    coefficients: &mut impl FnMut(&[f64], &mut [f64]),
+) -> (&'a [f64], &'a [f64], usize) {
+    let k = g.len();
     let kp = k.div_ceil(4) * 4;
     let (gt, rest) = scratch.split_at_mut(n * kp);
     let c = &mut rest[..n * kp];
@@ -258,12 +279,7 @@ fn add_columns(
         coefficients(&g_q[..k], &mut c_q[..k]);
         c_q[k..].fill(0.0);
     }
-    for (q, (&col_q, c_q)) in cols.iter().zip(c.chunks_exact(kp)).enumerate() {
-        let column = &mut h[col_q * nv..(col_q + 1) * nv];
-        for (&p, g_p) in cols[q..].iter().zip(gt[q * kp..].chunks_exact(kp)) {
-            column[p] += dot4(g_p, c_q);
-        }
-    }
+    (gt, c, kp)
 }
 
 /// [`add_columns`] into H's values on the sparse factor's pattern: the same sum for each entry
@@ -305,19 +321,7 @@ fn add_columns_sparse(
         }
         return;
     }
-    let kp = k.div_ceil(4) * 4;
-    let (gt, rest) = scratch.split_at_mut(n * kp);
-    let c = &mut rest[..n * kp];
-    for (p, gt_p) in gt.chunks_exact_mut(kp).enumerate() {
-        for (r, g) in g.iter().enumerate() {
-            gt_p[r] = g[p];
-        }
-        gt_p[k..].fill(0.0);
-    }
-    for (g_q, c_q) in gt.chunks_exact(kp).zip(c.chunks_exact_mut(kp)) {
-        coefficients(&g_q[..k], &mut c_q[..k]);
-        c_q[k..].fill(0.0);
-    }
+    let (gt, c, kp) = transposed_with_coefficients(scratch, g, n, &mut coefficients);
     for (t, &p) in cols.iter().enumerate() {
         let gt_p = &gt[t * kp..(t + 1) * kp];
         let (row, vals) = h.row_mut(p);
