@@ -97,3 +97,22 @@ fn attach_a_whole_world_body() {
 fn replicate_ring_nested_and_frames() {
     check("compose_replicate");
 }
+
+/// A hostile `sep` (every name of every copy carries it) is refused with the limit and the fix,
+/// before any copy is made; a separator at the limit loads.
+#[test]
+fn replicate_refuses_a_separator_beyond_the_limit() {
+    use lagrange::io::mjcf::MAX_SEP;
+    let scene = |sep: &str| {
+        format!(
+            "<mujoco><worldbody><replicate count='3' offset='0.3 0 0' sep='{sep}'><body name='b'><freejoint/><geom size='.1'/></body></replicate></worldbody></mujoco>"
+        )
+    };
+    let path = std::path::Path::new("sep.xml");
+    let long = "x".repeat(MAX_SEP + 1);
+    let err = lagrange::io::load_str(&scene(&long), path, &LoadOptions::default()).unwrap_err().to_string();
+    assert!(err.contains("sep") && err.contains(&format!("{} characters", MAX_SEP + 1)), "{err}");
+    assert!(err.contains("give a short separator"), "{err}");
+    let ok = lagrange::io::load_str(&scene(&"x".repeat(MAX_SEP)), path, &LoadOptions::default()).unwrap();
+    assert_eq!(ok.bodies.len(), 4);
+}

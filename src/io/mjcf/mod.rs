@@ -34,6 +34,8 @@ mod sections;
 mod tendon;
 mod xml;
 
+pub use replicate::{MAX_COPIES, MAX_SEP};
+
 use super::{LoadError, LoadOptions};
 use crate::model::spec::{MassRules, ModelSpec};
 use orientation::AngleConvention;

@@ -19,6 +19,11 @@ const BODY_TREE: [&str; 4] = ["worldbody", "body", "frame", "replicate"];
 /// Resource limit: copies one model may create (a hostile `count` cannot exhaust memory).
 pub const MAX_COPIES: usize = 100_000;
 
+/// Resource limit: the longest `sep` (characters). Every named element of every copy carries it,
+/// so a hostile separator of hundreds of kilobytes made gigabytes of names (a fuzzer's input
+/// took 35 s to load); real separators are a character or a few.
+pub const MAX_SEP: usize = 256;
+
 /// Expands every `<replicate>` below the `<worldbody>`s of `root`.
 pub(crate) fn expand(root: &mut Element, angles: &AngleConvention) -> Result<(), LoadError> {
     let mut budget = MAX_COPIES;
@@ -78,6 +83,15 @@ fn copies(r: &Element, angles: &AngleConvention, budget: &mut usize) -> Result<V
     let offset = a.vec3("offset")?.unwrap_or_default();
     let euler = a.array::<3>("euler")?.unwrap_or_default();
     let sep = a.text("sep").unwrap_or("");
+    if sep.chars().count() > MAX_SEP {
+        return Err(a.error(
+            "sep",
+            format!(
+                "is {} characters long, beyond {MAX_SEP} (a resource limit: every name of every copy carries it); give a short separator",
+                sep.chars().count()
+            ),
+        ));
+    }
     let digits = count.to_string().len();
     let mut pos = Vec3::zeros();
     let mut out = Vec::with_capacity(count);
