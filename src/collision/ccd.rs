@@ -116,7 +116,8 @@ impl<'a> CcdObj<'a> {
                     (ibest, best) = (i, d);
                 }
             }
-            self.vertindex = ibest as i32;
+            // MuJoCo's prism support leaves the vertex index alone (−1): EPA's repeated-vertex
+            // test then compares the other geom's features only.
             return rot * prism[ibest] + pos;
         }
         let supp = match self.shape {
@@ -1124,6 +1125,22 @@ pub(crate) fn penetration(
     penetration_with(s1, None, x1, s2, x2, margin, tolerance, iterations)
 }
 
+/// The box of geom `s` at pose `x` along the axes of `x`'s parent frame: the lowest and highest
+/// coordinate of its support points along −e_k and +e_k (MuJoCo's six support calls at the start
+/// of `mjc_ConvexHField`, no margin).
+pub(crate) fn support_box(s: &ConvexShape, x: &Transform) -> (Vec3, Vec3) {
+    let mut o = CcdObj::new(s, x, 0.0);
+    let (mut lo, mut hi) = (Vec3::zeros(), Vec3::zeros());
+    for k in 0..3 {
+        let mut dir = Vec3::zeros();
+        dir[k] = 1.0;
+        hi[k] = o.support(&dir)[k];
+        dir[k] = -1.0;
+        lo[k] = o.support(&dir)[k];
+    }
+    (lo, hi)
+}
+
 /// [`penetration`] of a height-field prism (`prism`: base then top vertices in the frame `x1`)
 /// and geom `s2`: MuJoCo's `mjc_penetration` call in `mjc_ConvexHField`.
 #[allow(clippy::too_many_arguments)]
@@ -1158,7 +1175,16 @@ fn penetration_with(
     let mut o2 = CcdObj::new(s2, x2, margin);
     let mut st = Status::start(x1, x2, tolerance, iterations);
     // GJK starts from MuJoCo's geom centres (`mjc_center`).
-    let start = (if prism1.is_some() { x1.pos } else { centre(s1, x1) }, centre(s2, x2));
+    // A prism's centre is the mean of its six vertices (MuJoCo's `mjc_center`: summed in order,
+    // then scaled by 1/6).
+    let centre1 = match prism1 {
+        Some(prism) => {
+            let sum = prism.iter().fold(Vec3::zeros(), |acc, v| acc + v);
+            x1.act_point(&(sum * (1.0 / 6.0)))
+        }
+        None => centre(s1, x1),
+    };
+    let start = (centre1, centre(s2, x2));
     (st.x1, st.x2) = start;
     let core = |s: &ConvexShape| match s {
         ConvexShape::Ball(b) => Some((Core::Point, b.radius)),

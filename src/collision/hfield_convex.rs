@@ -1,15 +1,18 @@
-//! Height-field contacts with capsules, boxes, cylinders, ellipsoids and meshes as MuJoCo 4.0 makes
-//! them (`mjc_ConvexHField`, engine_collision_convex.c): the other geom's box in the height field's
-//! frame (its support points along ±x, ±y, ±z) grown by the margin selects the grid cells; each
-//! cell is cut into two triangular prisms (diagonal from column c−1, row r+1 to column c, row r;
-//! base at z = −`size[3]`), visited row by row, then column, then the cell's two prisms. A prism
-//! whose three tops plus the margin lie below the geom's lowest point is skipped; every other is a
-//! convex solid collided with the geom by MuJoCo's native GJK/EPA (`collision::ccd`, the prism's
-//! support as MuJoCo's `mjc_prism_support`), one contact per prism closer than the margin, at most
-//! [`super::hfield::MAX_CONTACTS`]. Spheres keep their exact closed form
-//! ([`super::hfield::sphere`]).
+//! Height-field contacts as MuJoCo 4.0 makes them (`mjc_ConvexHField`, engine_collision_convex.c),
+//! for every geom it collides with a height field (spheres, capsules, boxes, cylinders, ellipsoids,
+//! meshes), computed in the height field's frame as MuJoCo computes them: the geom's pose relative
+//! to the field (its position difference rotated into the field, its rotation Rᵀ_field R_geom), its
+//! box in that frame (support points along ±x, ±y, ±z) grown by the margin selecting the grid cells
+//! ([`super::hfield::Cells`]); each cell cut into two triangular prisms (base at z = −`size[3]`),
+//! visited row by row, then column, then the cell's two prisms. A prism whose three tops plus the
+//! margin lie below the geom's lowest point is skipped; every other is a convex solid collided with
+//! the geom by MuJoCo's native GJK/EPA (`collision::ccd`: the prism's support as `mjc_prism_support`,
+//! which leaves the vertex index at −1, GJK started from the prism's centre — the mean of its six
+//! vertices — and the geom's), one contact per prism closer than the margin, at most
+//! [`super::hfield::MAX_CONTACTS`]: the witnesses' midpoint and normal turned back to world. Read
+//! from the live 4.0.0 library's support calls (docs/multiccd.md, "Reading the live library").
 
-use super::ccd::penetration_prism;
+use super::ccd::{penetration_prism, support_box};
 use super::convex::ConvexShape;
 use super::hfield::{Cells, HfieldPoint, MAX_CONTACTS};
 use crate::model::{HeightField, Options};
@@ -33,14 +36,12 @@ pub fn convex(
     }
     let s = field.size;
     let rot = &x_hfield.rot;
+    // Everything below in the height field's frame, as MuJoCo computes it: the geom's pose
+    // relative to the field (position difference, then rotated) and the prisms in field
+    // coordinates; contacts are turned back to world at the end.
+    let x_local = Transform::new(rot.tr_mul(&x_geom.rot), rot.tr_mul(&(x_geom.pos - x_hfield.pos)));
     // The geom's box in the height-field frame: its support points along the frame's axes.
-    let (mut lo, mut hi) = (Vec3::zeros(), Vec3::zeros());
-    for k in 0..3 {
-        let axis = rot.column(k).into_owned();
-        let local = |p: Vec3| (rot.transpose() * (p - x_hfield.pos))[k];
-        hi[k] = local(shape.world_support(x_geom, &axis));
-        lo[k] = local(shape.world_support(x_geom, &-axis));
-    }
+    let (lo, hi) = support_box(shape, &x_local);
     let Some(cells) = Cells::under(field, &lo, &hi, margin) else { return };
     let mut n = 0;
     for r in cells.rows.clone() {
@@ -53,16 +54,19 @@ pub fn convex(
                 let prism = [base[0], base[1], base[2], top[0], top[1], top[2]];
                 let Some(con) = penetration_prism(
                     &prism,
-                    x_hfield,
+                    &Transform::identity(),
                     shape,
-                    x_geom,
+                    &x_local,
                     margin,
                     options.ccd_tolerance,
                     options.ccd_iterations as usize,
                 ) else {
                     continue;
                 };
-                out(HfieldPoint { p1: con.x1, p2: con.x2, normal: con.normal, dist: con.dist });
+                // MuJoCo's contact: the witnesses' midpoint and the normal, rotated and moved
+                // back to world.
+                let pos = rot * ((con.x1 + con.x2) * 0.5) + x_hfield.pos;
+                out(HfieldPoint { pos, normal: rot * con.normal, dist: con.dist });
                 n += 1;
                 if n >= MAX_CONTACTS {
                     return;

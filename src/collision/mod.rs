@@ -17,8 +17,8 @@
 //! capsules ([`box_primitive`]) and boxes ([`box_box`]) with MuJoCo's multi-point manifolds, and
 //! GJK/EPA on support maps for the other convex pairs ([`convex`]). Meshes collide by their
 //! convex hulls, whose support points are found by hill climbing on the hull's edges
-//! ([`hull_support`], as MuJoCo's mesh graph); height fields collide with spheres exactly ([`hfield`], MuJoCo's
-//! prisms) and with the other geoms by GJK/EPA on the prisms ([`hfield_convex`]).
+//! ([`hull_support`], as MuJoCo's mesh graph); height fields collide with every convex geom by GJK/EPA on
+//! MuJoCo's prisms, in the field's frame ([`hfield`], [`hfield_convex`]).
 //!
 //! `collide` reports the contacts closer than the pair's margin + gap plus `reach`: MuJoCo's rule
 //! with `reach` = 0 (contacts in the gap are reported without rows: rows exist below the margin,
@@ -477,16 +477,10 @@ fn narrow_phase(model: &Model, cm: &CollisionModel, data: &mut Data, idx: usize,
             feature,
         });
     };
-    // Height fields against spheres: MuJoCo's prisms ([`hfield`]).
-    if let (Shape::Hfield { field, .. }, Shape::Sphere { radius }) = (&geom1.shape, &geom2.shape) {
-        let mut out = |p: hfield::HfieldPoint| push(p.p1, p.p2, p.normal, p.dist, None, 0);
-        hfield::sphere(&x1, field, &x2.pos, *radius, pair.margin, &mut out);
-        return;
-    }
-    // Height fields against the other convex geoms: MuJoCo's prisms by GJK/EPA ([`hfield_convex`]).
+    // Height fields against every convex geom: MuJoCo's prisms by GJK/EPA ([`hfield_convex`]).
     if let Shape::Hfield { field, .. } = &geom1.shape {
         if let Some(s2) = &cm.shapes[g2] {
-            let mut out = |p: hfield::HfieldPoint| push(p.p1, p.p2, p.normal, p.dist, None, 0);
+            let mut out = |p: hfield::HfieldPoint| push(p.pos, p.pos, p.normal, p.dist, None, 0);
             hfield_convex::convex(&x1, field, s2, &x2, pair.margin, &model.options, &mut out);
         }
         return;

@@ -792,11 +792,6 @@ pub const VIEW_F32_REL: f64 = 1e-7;
 /// spreads an edge by a pixel; 3 allows for it and for the arrows' and grid's rasterization.
 pub const VIEW_BOX_MARGIN_PX: f64 = 3.0;
 
-/// Distance of a height-field contact whose sphere centre lies inside the prism, against MuJoCo
-/// (m): MuJoCo's EPA stops within its `ccd_tolerance` (1e-6) of the exact depth lagrange computes,
-/// off by up to 7.2e-6 on tests/hfield_mujoco.rs's terrain.
-pub const HFIELD_EPA_DIST: f64 = 1e-5;
-
 /// The compiler's lengthrange simulation against MuJoCo's (tests/lengthrange_mujoco.rs), relative
 /// to the range's width: the same 1000-step soft simulations, agreeing to round-off (7.5e-11 at
 /// worst on MyoSuite's 86 muscle models, validation/mujoco_lengthrange_golden.py) — far below
