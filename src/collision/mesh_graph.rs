@@ -129,11 +129,7 @@ impl MeshGraph {
         poly_start.push(0);
         let mut per_vertex: Vec<Vec<u32>> = vec![Vec::new(); nv];
         for (p, path) in polygons.iter().enumerate() {
-            poly_normal.push(make_normal(
-                &scaled[path[0] as usize],
-                &scaled[path[1] as usize],
-                &scaled[path[2] as usize],
-            ));
+            poly_normal.push(polygon_normal(scaled, path));
             for &v in path {
                 let l = local[v as usize];
                 poly.push(l);
@@ -228,9 +224,18 @@ fn degenerate(points: &[Vec3]) -> Option<String> {
     None
 }
 
-/// The unit normal of triangle (a, b, c) (`mjuu_makenormal`: (1, 0, 0) when degenerate).
-fn make_normal(a: &Vec3, b: &Vec3, c: &Vec3) -> Vec3 {
-    let n = (b - a).cross(&(c - a));
+/// A polygon's unit normal as MuJoCo 4.0.0 has it (`mesh_polynormal`): its vector area, the sum
+/// of the fan triangles' cross products from its first vertex (equal to the sum over the hull
+/// triangles merged into it), normalised. The live library's normals are not its first three
+/// vertices' (its source snapshot's `MakePolygonNormals`): on a merged, slightly curved polygon
+/// whose first vertices lie nearly on a line the two differ by degrees (a G1 palm mesh's
+/// 10-vertex polygon: 0.77°), and the face clipped against another geom with them. (1, 0, 0) when degenerate.
+fn polygon_normal(vertices: &[Vec3], path: &[u32]) -> Vec3 {
+    let v0 = vertices[path[0] as usize];
+    let mut n = Vec3::zeros();
+    for w in path[1..].windows(2) {
+        n += (vertices[w[0] as usize] - v0).cross(&(vertices[w[1] as usize] - v0));
+    }
     let norm = n.dot(&n).sqrt();
     if norm < 1e-14 {
         return Vec3::x();
