@@ -378,15 +378,7 @@ fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Opt
     // copying them, O(nv²) over many bodies, is not needed.
     for k in 0..nv {
         let lo = model.dof_tree_start[k];
-        let (dst, src) = (&mut h[k * nv + lo..=k * nv + k], &m[k * nv + lo..=k * nv + k]);
-        #[cfg(target_arch = "x86_64")]
-        if AVX2 {
-            // SAFETY: both spans are k + 1 − lo entries long and distinct borrows; `AVX2` is set
-            // only where the caller is compiled for AVX2 (`factorize_avx2`).
-            unsafe { copy_avx2(dst.as_mut_ptr(), src.as_ptr(), dst.len()) };
-            continue;
-        }
-        dst.copy_from_slice(src);
+        h[k * nv + lo..=k * nv + k].copy_from_slice(&m[k * nv + lo..=k * nv + k]);
     }
     if let Some((step, damping)) = shift {
         for (k, d) in damping[..nv].iter().enumerate() {
@@ -500,35 +492,6 @@ unsafe fn sub_scaled_avx2(x: *mut f64, y: *const f64, n: usize, a: f64) {
         }
         if j < n {
             *x.add(j) -= a * *y.add(j);
-        }
-    }
-}
-
-/// Copies n entries from y to x in the groups [`sub_scaled_avx2`] updates them in (four, then
-/// two, then one): a factor column is copied from M and then rewritten by those updates and
-/// read back four at a time, and a load is forwarded from the store buffer only when it lies
-/// within one store (`copy_from_slice`'s `memcpy` stores a short span as overlapping pairs of
-/// 32-byte blocks, and is a call per column).
-///
-/// # Safety
-/// The CPU has AVX2; x and y point to n valid entries each, not overlapping.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn copy_avx2(x: *mut f64, y: *const f64, n: usize) {
-    use std::arch::x86_64::{_mm256_loadu_pd, _mm256_storeu_pd, _mm_loadu_pd, _mm_storeu_pd};
-    // SAFETY: the caller's contract (n valid entries at x and y, AVX2).
-    unsafe {
-        let mut j = 0;
-        while j + 4 <= n {
-            _mm256_storeu_pd(x.add(j), _mm256_loadu_pd(y.add(j)));
-            j += 4;
-        }
-        if j + 2 <= n {
-            _mm_storeu_pd(x.add(j), _mm_loadu_pd(y.add(j)));
-            j += 2;
-        }
-        if j < n {
-            *x.add(j) = *y.add(j);
         }
     }
 }
