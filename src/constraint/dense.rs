@@ -217,16 +217,20 @@ const BLOCKED_N: usize = 256;
 /// registers across all earlier columns, instead of updating the whole column in memory once per
 /// earlier column: for the Newton Hessian of a 27-dof humanoid the set-up of the many short
 /// column updates cost more than their arithmetic. The earlier columns with l_jk ≠ 0 are listed
-/// once per column. Rows left over at the end of a column (fewer than four) are formed again by
-/// the last block of four, which ends at row n − 1 (the same values stored twice); in the last
-/// three columns that block starts above the diagonal and stores only its lanes from row j on
-/// (the upper triangle of `l` is left as it was).
+/// once per column. Each block is divided by the pivot's root in registers, before its one store
+/// (a division pass over the stored column would read each group of four across two stores, which
+/// the store buffer cannot forward: a stall per group). Rows left over at the end of a column
+/// (fewer than four) are formed again by the last block of four, which ends at row n − 1 (the
+/// same values stored twice); in the last three columns that block starts above the diagonal and
+/// stores only its lanes from row j on (the upper triangle of `l` is left as it was).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn cholesky_avx2(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f64) -> bool {
     use std::arch::x86_64::{
-        _mm256_cmpgt_epi64, _mm256_div_pd, _mm256_loadu_pd, _mm256_maskstore_pd, _mm256_mul_pd,
-        _mm256_set1_epi64x, _mm256_set1_pd, _mm256_setr_epi64x, _mm256_storeu_pd, _mm256_sub_pd,
+        _mm256_blend_pd, _mm256_blendv_pd, _mm256_castsi256_pd, _mm256_cmpeq_epi64, _mm256_cmpgt_epi64,
+        _mm256_cvtsd_f64, _mm256_div_pd, _mm256_loadu_pd, _mm256_maskstore_pd, _mm256_mul_pd,
+        _mm256_set1_epi64x, _mm256_set1_pd, _mm256_setr_epi64x, _mm256_setzero_pd, _mm256_storeu_pd,
+        _mm256_sub_pd,
     };
     if n > BLOCKED_N {
         return cholesky_kernel(a, n, l, tol);
@@ -263,7 +267,22 @@ unsafe fn cholesky_avx2(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f
                 }
                 ls[l_col + i] = x;
             }
+            let d = ls[l_col + j];
+            if d <= tol {
+                return false;
+            }
+            let d = d.sqrt();
+            ls[l_col + j] = d;
+            for x in &mut ls[l_col + j + 1..l_col + n] {
+                *x /= d;
+            }
         } else {
+            // The pivot l_jj is in the first block formed (lane j − b of the block at row b);
+            // every block is divided by √l_jj in registers before it is stored (the pivot's lane
+            // replaced by √l_jj), so that no entry is stored twice and nothing is read back
+            // across two stores, which the store buffer cannot forward.
+            let mut dv = _mm256_setzero_pd();
+            let mut first = true;
             // SAFETY: every block of four rows starts at a row b with b + 4 ≤ n ≤ both strides (the assert above), so the loads from column j of A and
             // from the earlier columns of L (offsets k · stride, k < j ≤ n − 1 < both column
             // counts) and the stores into column j of L stay inside both matrices' storage; the
@@ -281,8 +300,19 @@ unsafe fn cholesky_avx2(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f
                         x0 = _mm256_sub_pd(x0, _mm256_mul_pd(_mm256_loadu_pd(lp.add(o + i)), v));
                         x1 = _mm256_sub_pd(x1, _mm256_mul_pd(_mm256_loadu_pd(lp.add(o + i + 4)), v));
                     }
+                    if first {
+                        // i = j: the pivot is lane 0.
+                        let Some(d) = pivot_root(_mm256_cvtsd_f64(x0), tol) else {
+                            return column_failed(a_s, ls, offs, vals, a_col, l_col, j, n);
+                        };
+                        dv = _mm256_set1_pd(d);
+                        x0 = _mm256_blend_pd::<1>(_mm256_div_pd(x0, dv), dv);
+                        first = false;
+                    } else {
+                        x0 = _mm256_div_pd(x0, dv);
+                    }
                     _mm256_storeu_pd(lp.add(l_col + i), x0);
-                    _mm256_storeu_pd(lp.add(l_col + i + 4), x1);
+                    _mm256_storeu_pd(lp.add(l_col + i + 4), _mm256_div_pd(x1, dv));
                     i += 8;
                 }
                 while i < n {
@@ -296,6 +326,23 @@ unsafe fn cholesky_avx2(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f
                             _mm256_mul_pd(_mm256_loadu_pd(lp.add(o + b)), _mm256_set1_pd(v)),
                         );
                     }
+                    if first {
+                        // The pivot is lane j − b (0 when b = j, up to 3 in the last columns).
+                        let mut lanes = [0.0; 4];
+                        _mm256_storeu_pd(lanes.as_mut_ptr(), x0);
+                        let Some(d) = pivot_root(lanes[j - b], tol) else {
+                            return column_failed(a_s, ls, offs, vals, a_col, l_col, j, n);
+                        };
+                        dv = _mm256_set1_pd(d);
+                        let at_pivot = _mm256_cmpeq_epi64(
+                            _mm256_setr_epi64x(0, 1, 2, 3),
+                            _mm256_set1_epi64x((j - b) as i64),
+                        );
+                        x0 = _mm256_blendv_pd(_mm256_div_pd(x0, dv), dv, _mm256_castsi256_pd(at_pivot));
+                        first = false;
+                    } else {
+                        x0 = _mm256_div_pd(x0, dv);
+                    }
                     if b >= j {
                         _mm256_storeu_pd(lp.add(l_col + b), x0);
                     } else {
@@ -308,28 +355,45 @@ unsafe fn cholesky_avx2(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f
                 }
             }
         }
-        let d = ls[l_col + j];
-        if d <= tol {
-            return false;
-        }
-        let d = d.sqrt();
-        ls[l_col + j] = d;
-        let col = &mut ls[l_col + j + 1..l_col + n];
-        let mut chunks = col.chunks_exact_mut(4);
-        // SAFETY: each chunk is four entries long; the CPU has AVX2. Division is exact-rounded
-        // lane by lane: the scalar quotient's bits.
-        unsafe {
-            let dv = _mm256_set1_pd(d);
-            for c in &mut chunks {
-                let p = c.as_mut_ptr();
-                _mm256_storeu_pd(p, _mm256_div_pd(_mm256_loadu_pd(p), dv));
-            }
-        }
-        for x in chunks.into_remainder() {
-            *x /= d;
-        }
     }
     true
+}
+
+/// √p for a pivot p above `tol` (NaN passes, as in [`cholesky_kernel`]'s test), else None.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn pivot_root(p: f64, tol: f64) -> Option<f64> {
+    if p <= tol {
+        None
+    } else {
+        Some(p.sqrt())
+    }
+}
+
+/// [`cholesky_avx2`]'s column j when its pivot is not above the tolerance: the column's entries
+/// from row j on stored undivided, as [`cholesky_kernel`] leaves them (the same products and
+/// differences in the same order, one entry at a time), and false.
+#[cfg(target_arch = "x86_64")]
+#[allow(clippy::too_many_arguments)]
+#[cold]
+fn column_failed(
+    a_s: &[f64],
+    ls: &mut [f64],
+    offs: &[usize],
+    vals: &[f64],
+    a_col: usize,
+    l_col: usize,
+    j: usize,
+    n: usize,
+) -> bool {
+    for i in j..n {
+        let mut x = a_s[a_col + i];
+        for (&o, &v) in offs.iter().zip(vals) {
+            x -= ls[o + i] * v;
+        }
+        ls[l_col + i] = x;
+    }
+    false
 }
 
 #[inline(always)]
@@ -772,10 +836,16 @@ mod tests {
                     1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
                 ],
             );
-            let mut l = DMatrix::zeros(5, 5);
+            let (mut l, mut want) = (DMatrix::zeros(5, 5), DMatrix::zeros(5, 5));
             // SAFETY: as above.
             assert!(!unsafe { cholesky_avx2(&a, 5, &mut l, 0.0) });
-            assert!(!cholesky_kernel(&a, 5, &mut l, 0.0));
+            assert!(!cholesky_kernel(&a, 5, &mut want, 0.0));
+            // The failed column (1, pivot 1 − 2² < 0) is left undivided by both, the same bits.
+            for k in 0..2 {
+                for i in k..5 {
+                    assert_eq!(l[(i, k)].to_bits(), want[(i, k)].to_bits(), "failed factor ({i}, {k})");
+                }
+            }
         }
     }
 

@@ -438,40 +438,20 @@ fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Opt
 }
 
 /// `x −= a · y` entry by entry over the shorter of the two. With `AVX2` (only in code compiled
-/// for AVX2) four entries per instruction, the last one to three through a masked load and
-/// store: the factorization's updates are short (a few entries on each of a few hundred pairs
-/// for a humanoid), where the compiler's own loop spends more on its set-up (a run-time check
-/// that the slices do not overlap, a scalar remainder) than on the arithmetic. Each entry gets
-/// the same two operations, a product then a difference, rounded once each: the same bits
-/// either way.
+/// for AVX2) four entries per instruction and the last one to three one at a time
+/// ([`sub_scaled_avx2`]): the factorization's updates are short (a few entries on each of a few
+/// hundred pairs for a humanoid), where the compiler's own loop spends more on its set-up (a
+/// run-time check that the slices do not overlap, a scalar remainder) than on the arithmetic.
+/// Each entry gets the same two operations, a product then a difference, rounded once each: the
+/// same bits either way.
 #[inline(always)]
 fn sub_scaled<const AVX2: bool>(x: &mut [f64], y: &[f64], a: f64) {
     let n = x.len().min(y.len());
     #[cfg(target_arch = "x86_64")]
     if AVX2 {
-        use std::arch::x86_64::{
-            _mm256_cmpgt_epi64, _mm256_loadu_pd, _mm256_maskload_pd, _mm256_maskstore_pd, _mm256_mul_pd,
-            _mm256_set1_epi64x, _mm256_set1_pd, _mm256_setr_epi64x, _mm256_storeu_pd, _mm256_sub_pd,
-        };
-        let (xp, yp) = (x.as_mut_ptr(), y.as_ptr());
-        // SAFETY: `AVX2` is set only where the caller is compiled for AVX2 (`factorize_avx2`);
-        // every load and store stays within the first n entries of both slices (the masked
-        // lanes past n are neither read nor written), and `x` and `y` are distinct borrows.
-        unsafe {
-            let av = _mm256_set1_pd(a);
-            let mut j = 0;
-            while j + 4 <= n {
-                let (xv, yv) = (_mm256_loadu_pd(xp.add(j)), _mm256_loadu_pd(yp.add(j)));
-                _mm256_storeu_pd(xp.add(j), _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
-                j += 4;
-            }
-            if j < n {
-                let left = _mm256_set1_epi64x((n - j) as i64);
-                let mask = _mm256_cmpgt_epi64(left, _mm256_setr_epi64x(0, 1, 2, 3));
-                let (xv, yv) = (_mm256_maskload_pd(xp.add(j), mask), _mm256_maskload_pd(yp.add(j), mask));
-                _mm256_maskstore_pd(xp.add(j), mask, _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
-            }
-        }
+        // SAFETY: `AVX2` is set only where the caller is compiled for AVX2 (`factorize_avx2`,
+        // `solve_span_avx2`); x and y hold at least n entries each and are distinct borrows.
+        unsafe { sub_scaled_avx2(x.as_mut_ptr(), y.as_ptr(), n, a) };
         return;
     }
     for (xj, yj) in x[..n].iter_mut().zip(&y[..n]) {
@@ -479,14 +459,13 @@ fn sub_scaled<const AVX2: bool>(x: &mut [f64], y: &[f64], a: f64) {
     }
 }
 
-/// Lanes to keep of a vector whose last 1, 2 or 3 entries are past a span's end (index: how
-/// many lanes are kept).
-#[cfg(target_arch = "x86_64")]
-static TAIL_MASK: [[i64; 4]; 4] = [[0, 0, 0, 0], [-1, 0, 0, 0], [-1, -1, 0, 0], [-1, -1, -1, 0]];
-
 /// [`sub_scaled`]'s vector arm on raw pointers: x[0..n] −= a · y[0..n], four entries per
-/// instruction, the last one to three through a masked load and store (the same product then
-/// difference per entry, the same bits).
+/// instruction, the last two two-wide and the last one alone (the same product then difference per
+/// entry, the same bits). Not through a masked load and store: on AMD Zen a masked store is
+/// several times slower than a plain one, and a masked load of entries a masked store has just
+/// written is not forwarded from the store buffer (it waits for the store to reach the cache,
+/// about 25 cycles) — and these updates rewrite the same few entries again and again (a
+/// factor column once per descendant dof, the solve's x once per dof below it).
 ///
 /// # Safety
 /// The CPU has AVX2; x and y point to n valid entries each, not overlapping.
@@ -494,11 +473,10 @@ static TAIL_MASK: [[i64; 4]; 4] = [[0, 0, 0, 0], [-1, 0, 0, 0], [-1, -1, 0, 0], 
 #[inline(always)]
 unsafe fn sub_scaled_avx2(x: *mut f64, y: *const f64, n: usize, a: f64) {
     use std::arch::x86_64::{
-        __m256i, _mm256_loadu_pd, _mm256_loadu_si256, _mm256_maskload_pd, _mm256_maskstore_pd, _mm256_mul_pd,
-        _mm256_set1_pd, _mm256_storeu_pd, _mm256_sub_pd,
+        _mm256_castpd256_pd128, _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_storeu_pd,
+        _mm256_sub_pd, _mm_loadu_pd, _mm_mul_pd, _mm_storeu_pd, _mm_sub_pd,
     };
-    // SAFETY: the caller's contract (n valid entries at x and y, AVX2); the masked lanes past
-    // n are neither read nor written.
+    // SAFETY: the caller's contract (n valid entries at x and y, AVX2).
     unsafe {
         let av = _mm256_set1_pd(a);
         let mut j = 0;
@@ -507,10 +485,13 @@ unsafe fn sub_scaled_avx2(x: *mut f64, y: *const f64, n: usize, a: f64) {
             _mm256_storeu_pd(x.add(j), _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
             j += 4;
         }
+        if j + 2 <= n {
+            let (xv, yv) = (_mm_loadu_pd(x.add(j)), _mm_loadu_pd(y.add(j)));
+            _mm_storeu_pd(x.add(j), _mm_sub_pd(xv, _mm_mul_pd(_mm256_castpd256_pd128(av), yv)));
+            j += 2;
+        }
         if j < n {
-            let mask = _mm256_loadu_si256(TAIL_MASK[n - j].as_ptr().cast::<__m256i>());
-            let (xv, yv) = (_mm256_maskload_pd(x.add(j), mask), _mm256_maskload_pd(y.add(j), mask));
-            _mm256_maskstore_pd(x.add(j), mask, _mm256_sub_pd(xv, _mm256_mul_pd(av, yv)));
+            *x.add(j) -= a * *y.add(j);
         }
     }
 }
