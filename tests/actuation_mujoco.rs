@@ -66,6 +66,15 @@ fn gravity_compensation_follows_mujoco() {
     check_scene("gravcomp.xml", &golden["scenes"]["gravcomp.xml"]);
 }
 
+/// A joint's and a tendon's `actuatorfrcrange` reached under implicitfast: the clamped actuators
+/// are left out of the velocity derivative, as MuJoCo 4.0 does (before, 8.5e-5 rad apart after one
+/// step).
+#[test]
+fn actuator_force_ranges_reached_under_implicitfast_follow_mujoco() {
+    let golden = golden();
+    check_scene("actfrcrange_implicitfast.xml", &golden["scenes"]["actfrcrange_implicitfast.xml"]);
+}
+
 /// The compile-time muscle constants of `scene`: `actuator_lengthrange` (exact: copied from the
 /// file or a joint's or tendon's range) and `actuator_acc0` (to 1e-9 relative).
 fn check_muscle_constants(name: &str, scene: &Value) {

@@ -1,5 +1,6 @@
 """Reference data for the actuation features of issue 30 (gravity compensation with and without
-`actuatorgravcomp`, muscles, adhesion, `<flag override>`): for each scene of tests/data/mjcf/actuation,
+`actuatorgravcomp`, muscles, adhesion, `<flag override>`, joint and tendon `actuatorfrcrange`
+reached under implicitfast): for each scene of tests/data/mjcf/actuation,
 MuJoCo's mj_forward at random states (qpos from qpos0 moved by a random velocity through
 mj_integratePos, random qvel, act and ctrl) — qfrc_gravcomp, qfrc_passive, qfrc_actuator,
 actuator_length, actuator_velocity, actuator_force, act_dot, qacc — the model's
@@ -30,6 +31,7 @@ CONTROLS = {
     "gravcomp.xml": [0.3, 0.1],
     "muscle_limits.xml": [0.8, 0.2, 1.3, 0.5],
     "muscle_written.xml": [0.6, 1.0, 0.05, 0.9],
+    "actfrcrange_implicitfast.xml": [1.0, 0.7, 0.5],
 }
 NSTATES = 4
 SAMPLES = [1, 50, 100, 200]

@@ -341,6 +341,35 @@ pub(crate) fn add_actuator_length_derivative(model: &Model, data: &Data, matrix:
     })
 }
 
+/// Whether the total actuator force on actuator `a`'s joint or tendon sits at that joint's or
+/// tendon's `actuatorfrcrange` bound (the joint's clamped `qfrc_actuator`; the tendon's summed
+/// actuator forces within 1e-5 of a bound, relative): MuJoCo 4.0 then leaves the actuator out of
+/// the velocity derivative (`mjd_actuator_vel`; MuJoCo Warp 4.0.0's `_jnt_actfrc_clamped`,
+/// `_tendon_actfrc_clamped`), as it does at the actuator's own `forcerange`.
+fn total_force_clamped(model: &Model, data: &Data, a: &crate::model::Actuator) -> bool {
+    match a.transmission {
+        Transmission::Joint(j) | Transmission::JointInParent(j) => {
+            let joint = &model.joints[j];
+            joint.actuator_force_range.is_some_and(|[lo, hi]| {
+                let f = data.qfrc_actuator[joint.dof_adr];
+                f <= lo || f >= hi
+            })
+        }
+        Transmission::Tendon(t) => model.tendons[t].actuator_force_range.is_some_and(|[lo, hi]| {
+            let total: f64 = model
+                .actuators
+                .iter()
+                .zip(data.actuator_force.iter())
+                .filter(|(b, _)| b.transmission == Transmission::Tendon(t))
+                .map(|(_, f)| f)
+                .sum();
+            const TOL: f64 = 1e-5;
+            total <= lo + TOL * lo.abs() || total >= hi - TOL * hi.abs()
+        }),
+        _ => false,
+    }
+}
+
 /// Adds −h · Σᵢ momentᵢᵀ dᵢ momentᵢ to `matrix`, dᵢ = `d(actuator, i, x)` with x the gain's input
 /// (control — clamped to its range with `clamp`, as given otherwise, which is what MuJoCo's
 /// `mjd_actuator_vel` reads — or activation), for the simulated actuators whose force is inside
@@ -372,6 +401,9 @@ fn add_actuator_derivative(
             if f <= lo || f >= hi {
                 continue;
             }
+        }
+        if !clamp && total_force_clamped(model, data, a) {
+            continue;
         }
         let x = match act_index {
             None if zeroed => 0.0,
