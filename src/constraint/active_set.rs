@@ -7,14 +7,15 @@ use super::dense::solve_psd;
 use super::ExactWork;
 use crate::model::Data;
 
-/// Solves A μ = `efc_rhs` (first nefc entries) in place; returns the rank of A.
+/// Solves A μ = `efc_rhs` (first nefc entries) in place, island by island of A's pattern
+/// (`BlockLu::solve_psd`: the minimum-norm solution where redundant); returns the rank of A.
 pub(crate) fn solve_delassus(data: &mut Data) -> usize {
     let n = data.nefc;
     let Data {
-        exact: ExactWork { delassus: efc_delassus, rhs: efc_rhs, factor: efc_factor, eig: efc_eig, .. },
+        exact: ExactWork { delassus: efc_delassus, rhs: efc_rhs, factor: efc_factor, eig: efc_eig, lu, .. },
         ..
     } = data;
-    solve_psd(efc_delassus, &mut efc_rhs.as_mut_slice()[..n], efc_factor, efc_eig)
+    lu.solve_psd(efc_delassus, &mut efc_rhs.as_mut_slice()[..n], efc_factor, efc_eig)
 }
 
 /// The mixed complementarity problem of bilateral and unilateral rows on A = J M⁻¹ Jᵀ (in

@@ -266,22 +266,26 @@ pub(crate) fn solve_coulomb(
 }
 
 /// max |M⁻¹Jᵀ Δλ| (the sweep's change, Δλ = λ − `lambda_prev`) and max |M⁻¹Jᵀ λ|. Column by
-/// column of M⁻¹Jᵀ, over each row's tree span (`exact.spans`; the column is zero outside it):
+/// column of M⁻¹Jᵀ, over each row's trees (`exact.trees`) or tree span (`exact.spans`; the
+/// column is zero outside them):
 /// per dof the same sum, in the same order, as the dense product.
 fn sweep_motion(nv: usize, data: &mut Data) -> (f64, f64) {
     let n = data.nefc;
-    let ExactWork { minv_jt, rhs, lambda_prev, spans, motion, .. } = &mut data.exact;
+    let ExactWork { minv_jt, rhs, lambda_prev, spans, motion, trees, trees_valid, .. } = &mut data.exact;
     let (change, whole) = motion.as_mut_slice()[..2 * nv].split_at_mut(nv);
     change.fill(0.0);
     whole.fill(0.0);
     let y = minv_jt.as_slice();
     for i in 0..n {
-        let (lo, hi) = spans[i];
         let (l, dl) = (rhs[i], rhs[i] - lambda_prev[i]);
-        for k in lo..hi {
-            let yk = y[k + i * nv];
-            change[k] += yk * dl;
-            whole[k] += yk * l;
+        // Over the row's trees when known (between them its column is zero), else its span.
+        let ranges = if *trees_valid { trees[i] } else { [spans[i], (0, 0)] };
+        for (lo, hi) in ranges {
+            for k in lo..hi {
+                let yk = y[k + i * nv];
+                change[k] += yk * dl;
+                whole[k] += yk * l;
+            }
         }
     }
     let moved = change.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -301,10 +305,18 @@ fn delassus_column(data: &Data, i: usize) -> &[f64] {
     &data.exact.delassus.as_slice()[i * stride..i * stride + data.nefc]
 }
 
-/// Σ_j A_ji x_j over the rows (down column i: contiguous; the same sum, in the same order, as
-/// the indexed form).
+/// Σ_j A_ji x_j over the rows (down column i: contiguous), over the Delassus matrix's nonzero
+/// pattern (`ExactWork::pattern_rows`) when [`delassus`](super::exact) built one for these rows:
+/// the same sum, in the same order, as the indexed form without its exact-zero terms.
 pub(super) fn column_dot(data: &Data, i: usize, x: &[f64]) -> f64 {
-    delassus_column(data, i).iter().zip(x).map(|(a, x)| a * x).sum()
+    let col = delassus_column(data, i);
+    let w = &data.exact;
+    if w.pattern_full || w.pattern_n != data.nefc {
+        return col.iter().zip(x).map(|(a, x)| a * x).sum();
+    }
+    // Over the column's pattern only: the terms left out are exact zeros (rows whose trees do
+    // not meet row i's), the others summed in the same, ascending, order.
+    w.pattern_rows[w.pattern_ptr[i]..w.pattern_ptr[i + 1]].iter().map(|&r| col[r] * x[r]).sum()
 }
 
 /// Sets λ of rows i..i+len to 0; returns the change (times A_ii).

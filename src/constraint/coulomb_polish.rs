@@ -10,7 +10,6 @@
 use super::coulomb::{
     column_dot, max_dissipation, mu, separating, Level, MAX_DIM, POLISH_ROUNDS, SLIP_VELOCITY,
 };
-use super::dense::solve_psd;
 use super::ExactWork;
 use crate::model::{Data, EfcType, Model};
 
@@ -308,19 +307,35 @@ fn solve_active_set(
                     factor: efc_factor,
                     eig: efc_eig,
                     polish_work,
+                    lu,
+                    pattern_ptr,
+                    pattern_rows,
+                    pattern_n,
+                    pattern_full,
                     ..
                 },
             ..
         } = &mut *data;
+        let sparse = !*pattern_full && *pattern_n == n;
         // A_FF λ_F = b_F − A_F,X λ_X, the fixed forces λ_X the candidate's; minimum-norm for
         // redundant rows (a box's corners share its load evenly). From the candidate: the
         // correction δ_F of its free forces, A_FF δ_F = −w_F (w = A λ − b), minimum-norm.
         for (a, &r) in efc_active.iter().enumerate() {
             let col = &efc_delassus.as_slice()[r * efc_delassus.nrows()..r * efc_delassus.nrows() + n];
             let mut rhs = efc_force[r];
-            for j in 0..n {
+            // Over the Delassus pattern when there is one (the other terms are exact zeros).
+            let subtract = |rhs: &mut f64, j: usize| {
                 if from_candidate || !in_active[j] {
-                    rhs -= col[j] * efc_lambda_prev[j];
+                    *rhs -= col[j] * efc_lambda_prev[j];
+                }
+            };
+            if sparse {
+                for &j in &pattern_rows[pattern_ptr[r]..pattern_ptr[r + 1]] {
+                    subtract(&mut rhs, j);
+                }
+            } else {
+                for j in 0..n {
+                    subtract(&mut rhs, j);
                 }
             }
             efc_sub_rhs[a] = rhs;
@@ -329,7 +344,8 @@ fn solve_active_set(
             }
         }
         *polish_work += (k * k * k) as f64 / 3.0;
-        redundant |= solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..k], efc_factor, efc_eig) < k;
+        // Block by block over the islands of the active rows (a pile's separate groups).
+        redundant |= lu.solve_psd(efc_sub, &mut efc_sub_rhs.as_mut_slice()[..k], efc_factor, efc_eig) < k;
         for (a, &r) in efc_active.iter().enumerate() {
             if from_candidate {
                 efc_lambda_prev[r] += efc_sub_rhs[a];

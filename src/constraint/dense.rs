@@ -30,11 +30,25 @@ pub(crate) fn solve_psd(
         b.fill(0.0);
         return 0;
     }
-    if cholesky(a, n, work, scale * RANK_TOLERANCE) {
+    solve_psd_tol(a, b, work, vec, scale * RANK_TOLERANCE)
+}
+
+/// [`solve_psd`] with the rank tolerance `tol` given (the pivots of the pivoted Cholesky factor
+/// above it count): for a block of a larger system, judged by the whole system's tolerance
+/// ([`super::block_lu::BlockLu::solve_psd`]).
+pub(crate) fn solve_psd_tol(
+    a: &mut DMatrix<f64>,
+    b: &mut [f64],
+    work: &mut DMatrix<f64>,
+    vec: &mut DVector<f64>,
+    tol: f64,
+) -> usize {
+    let n = b.len();
+    if cholesky(a, n, work, tol) {
         cholesky_solve(work, n, b);
         return n;
     }
-    min_norm_solve(a, n, b, work, vec, scale * RANK_TOLERANCE)
+    min_norm_solve(a, n, b, work, vec, tol)
 }
 
 /// Solves the general (non-symmetric) `A x = b` for the top-left n × n block of `a`, n =

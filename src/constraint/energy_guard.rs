@@ -12,7 +12,8 @@
 //! every cone and box that contains 0), scaled to take out as much energy as they can, and never
 //! to add any. Only unconverged solves are guarded: a converged solve is the law itself.
 
-use crate::model::{Data, Model};
+use super::coulomb::column_dot;
+use crate::model::Data;
 
 /// Scales the forces of an unconverged solve (λ in `exact.rhs`, first nefc entries) so that
 /// they do not add kinetic energy. `jv_free[i]` is J_i v′, the row velocity the step reaches
@@ -27,7 +28,8 @@ pub(crate) fn limit_energy(data: &mut Data, h: f64, jv_free: impl Fn(&Data, usiz
         if lambda[j] == 0.0 {
             continue;
         }
-        let a_lambda: f64 = (0..n).map(|i| data.exact.delassus[(i, j)] * lambda[i]).sum();
+        // (A λ)_j down column j, over the Delassus pattern (the same sum without exact zeros).
+        let a_lambda = column_dot(data, j, lambda);
         quadratic += lambda[j] * a_lambda;
     }
     let linear: f64 = (0..n).map(|i| lambda[i] * jv_free(data, i)).sum();
@@ -45,12 +47,4 @@ pub(crate) fn limit_energy(data: &mut Data, h: f64, jv_free: impl Fn(&Data, usiz
     }
     data.efc_energy_limited += 1;
     s
-}
-
-/// J_i v′ at the acceleration level: the row velocity after a step `h` of the motion without
-/// constraint forces, J_i (v + h q̈_smooth).
-pub(crate) fn free_row_velocity(model: &Model, data: &Data, h: f64, i: usize) -> f64 {
-    let nv = model.nv;
-    let jq: f64 = (0..nv).map(|k| data.efc_j[(i, k)] * data.qacc_smooth[k]).sum();
-    data.efc_vel[i] + h * jq
 }

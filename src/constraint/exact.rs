@@ -11,7 +11,7 @@
 use super::active_set::{solve_delassus, solve_mixed};
 use super::admm::{solve_admm, ExactContactSolver};
 use super::coulomb::{has_friction, solve_coulomb, Level, SolverSettings, SEPARATING_VELOCITY};
-use super::energy_guard::{free_row_velocity, limit_energy};
+use super::energy_guard::limit_energy;
 use super::ConstraintModel;
 use super::ExactWork;
 use crate::collision::{collide, EXACT_REACH};
@@ -47,6 +47,14 @@ fn delassus(model: &Model, data: &mut Data) {
                 yt_run,
                 order,
                 dof_rows,
+                pattern_ptr,
+                pattern_rows,
+                pattern_n,
+                pattern_full,
+                trees,
+                trees_valid,
+                tree_ptr,
+                tree_rows,
                 ..
             },
         ..
@@ -89,10 +97,199 @@ fn delassus(model: &Model, data: &mut Data) {
     let stride = efc_delassus.nrows();
     let a = efc_delassus.as_mut_slice();
     let width = spans[..n].iter().map(|&(lo, hi)| hi - lo).max().unwrap_or(0);
-    if 2 * width >= nv {
-        delassus_all_pairs(a, stride, n, nv, jt, y, spans);
-    } else {
+    // Each row's trees: when none touches more than two (contacts, a connect between two
+    // bodies), the products and the pattern go tree by tree.
+    *trees_valid = row_trees(model, &jt[..nv * n], &spans[..n], &mut trees[..n]);
+    if *trees_valid {
+        tree_lists(&trees[..n], tree_ptr, tree_rows);
+        delassus_by_trees(a, stride, nv, jt, y, &trees[..n], tree_ptr, tree_rows, pattern_ptr, pattern_rows);
+        *pattern_n = n;
+        *pattern_full = pattern_rows.len() == n * n;
+        return;
+    }
+    let sorted = 2 * width < nv;
+    if sorted {
         delassus_meeting_pairs(a, stride, n, nv, jt, y, spans, &mut order[..n], width);
+    } else {
+        delassus_all_pairs(a, stride, n, nv, jt, y, spans);
+    }
+    delassus_pattern(&spans[..n], sorted.then_some(&order[..n]), width, pattern_ptr, pattern_rows);
+    *pattern_n = n;
+    *pattern_full = pattern_rows.len() == n * n;
+}
+
+/// Per row, the dof ranges of the kinematic trees its J row (in `jt`, rows of nv) touches, the
+/// tree of its first nonzero and that of its last (`[first, (0, 0)]` when they are one tree;
+/// both empty for a zero row). False when some row touches a third tree between them (a tendon
+/// or an equality over several trees): the caller then pairs rows by their spans.
+fn row_trees(model: &Model, jt: &[f64], spans: &[(usize, usize)], trees: &mut [[(usize, usize); 2]]) -> bool {
+    let nv = model.nv;
+    for (i, (&(lo, hi), t)) in spans.iter().zip(trees.iter_mut()).enumerate() {
+        if lo >= hi {
+            *t = [(0, 0); 2];
+            continue;
+        }
+        let first = tree_span(model, lo, lo);
+        let last = tree_span(model, hi - 1, hi - 1);
+        if first == last {
+            *t = [first, (0, 0)];
+            continue;
+        }
+        if jt[i * nv + first.1..i * nv + last.0].iter().any(|&x| x != 0.0) {
+            return false;
+        }
+        *t = [first, last];
+    }
+    true
+}
+
+/// The rows touching each tree (`trees` of [`row_trees`]), in compressed form keyed by the
+/// tree's first dof (`ptr`, nv + 1 offsets into `rows`), each tree's rows ascending.
+fn tree_lists(trees: &[[(usize, usize); 2]], ptr: &mut [usize], rows: &mut [usize]) {
+    ptr.fill(0);
+    let touched = |t: &[(usize, usize); 2]| t.map(|r| (r.0 < r.1).then_some(r.0));
+    for t in trees {
+        for root in touched(t).into_iter().flatten() {
+            ptr[root + 1] += 1;
+        }
+    }
+    for k in 1..ptr.len() {
+        ptr[k] += ptr[k - 1];
+    }
+    // Filled with ptr[t] as the cursor (ending at the start of the next tree), then shifted back.
+    for (i, t) in trees.iter().enumerate() {
+        for root in touched(t).into_iter().flatten() {
+            rows[ptr[root]] = i;
+            ptr[root] += 1;
+        }
+    }
+    for k in (1..ptr.len()).rev() {
+        ptr[k] = ptr[k - 1];
+    }
+    ptr[0] = 0;
+}
+
+/// The Delassus matrix A_ij = J_i · Y_j and its nonzero pattern for rows that each touch at
+/// most two trees (`trees`, listed per tree in `tree_ptr`/`tree_rows`): rows i and j meet when
+/// they share a tree, and A_ij is the sum over the shared trees' dofs, ascending — the dense sum's
+/// terms without its exact zeros (elsewhere J_i or Y_j is zero), in its order. The pattern of
+/// column j is the union of its trees' rows (ascending); every other entry is zero. Work: the
+/// pattern's size times a tree's dofs, where the span pairing pays n² pairs once a row's trees
+/// lie far apart (a pile: a contact between the first and the last body spans every dof).
+#[allow(clippy::too_many_arguments)]
+fn delassus_by_trees(
+    a: &mut [f64],
+    stride: usize,
+    nv: usize,
+    jt: &[f64],
+    y: &[f64],
+    trees: &[[(usize, usize); 2]],
+    tree_ptr: &[usize],
+    tree_rows: &[usize],
+    pattern_ptr: &mut Vec<usize>,
+    pattern_rows: &mut Vec<usize>,
+) {
+    let n = trees.len();
+    for j in 0..n {
+        a[j * stride..j * stride + n].fill(0.0);
+    }
+    pattern_ptr.clear();
+    pattern_rows.clear();
+    pattern_ptr.push(0);
+    let list = |t: (usize, usize)| -> &[usize] {
+        if t.0 < t.1 {
+            &tree_rows[tree_ptr[t.0]..tree_ptr[t.0 + 1]]
+        } else {
+            &[]
+        }
+    };
+    for j in 0..n {
+        let [tj0, tj1] = trees[j];
+        let (p, q) = (list(tj0), list(tj1));
+        // The union of the two ascending lists, ascending, each row once.
+        let (mut u, mut v) = (0, 0);
+        loop {
+            let i = match (p.get(u), q.get(v)) {
+                (Some(&x), Some(&z)) => {
+                    u += usize::from(x <= z);
+                    v += usize::from(z <= x);
+                    x.min(z)
+                }
+                (Some(&x), None) => {
+                    u += 1;
+                    x
+                }
+                (None, Some(&z)) => {
+                    v += 1;
+                    z
+                }
+                (None, None) => break,
+            };
+            pattern_rows.push(i);
+            if i > j {
+                continue;
+            }
+            let y_j = &y[j * nv..(j + 1) * nv];
+            let j_i = &jt[i * nv..(i + 1) * nv];
+            let mut sum: f64 = std::iter::empty::<f64>().sum();
+            for t in trees[i] {
+                if t.0 < t.1 && (t == tj0 || t == tj1) {
+                    for k in t.0..t.1 {
+                        sum += j_i[k] * y_j[k];
+                    }
+                }
+            }
+            a[i + j * stride] = sum;
+            a[j + i * stride] = sum;
+        }
+        pattern_ptr.push(pattern_rows.len());
+    }
+}
+
+/// The nonzero pattern of the Delassus matrix of the rows with tree spans `spans`: per column j,
+/// ascending, the rows i whose span meets j's (A_ij is zero otherwise), in compressed columns
+/// (`ptr` n + 1 offsets into `rows`). With `order` (the rows sorted by their span's first dof,
+/// `width` the widest span) only the rows that can meet j are visited, as in
+/// [`delassus_meeting_pairs`]; without it every pair is checked. The gather–scatter work of a
+/// Gauss–Seidel sweep on the pattern is its size, the Delassus matrix's nonzeros, rather than n²
+/// (a pile: each contact meets only the contacts of its two bodies). `rows` grows only when a
+/// pattern is larger than any before it.
+fn delassus_pattern(
+    spans: &[(usize, usize)],
+    order: Option<&[usize]>,
+    width: usize,
+    ptr: &mut Vec<usize>,
+    rows: &mut Vec<usize>,
+) {
+    let n = spans.len();
+    ptr.clear();
+    rows.clear();
+    ptr.push(0);
+    let meets = |i: usize, (lo_j, hi_j): (usize, usize)| {
+        let (lo_i, hi_i) = spans[i];
+        lo_i.max(lo_j) < hi_i.min(hi_j)
+    };
+    for j in 0..n {
+        let (lo_j, hi_j) = spans[j];
+        if lo_j < hi_j {
+            match order {
+                Some(order) => {
+                    let start = rows.len();
+                    let first = order.partition_point(|&i| spans[i].0 + width <= lo_j);
+                    for &i in &order[first..] {
+                        if spans[i].0 >= hi_j {
+                            break;
+                        }
+                        if meets(i, spans[j]) {
+                            rows.push(i);
+                        }
+                    }
+                    rows[start..].sort_unstable();
+                }
+                None => rows.extend((0..n).filter(|&i| meets(i, spans[j]))),
+            }
+        }
+        ptr.push(rows.len());
     }
 }
 
@@ -305,24 +502,41 @@ fn solve_rows_kernel(
     }
 }
 
-/// J_i · x for row `i` of the current rows, over its trees' dofs (`exact.spans`; J_i is zero
+/// J_i · x for row `i` of the current rows, over its trees' dofs ([`row_ranges`]; J_i is zero
 /// outside them): the dense sum's terms in its order, without its exact zeros. Needs the rows'
-/// Jᵀ and spans of [`delassus`] at the current J.
+/// Jᵀ and trees of [`delassus`] at the current J.
 fn row_dot(data: &Data, nv: usize, i: usize, x: &[f64]) -> f64 {
-    let (lo, hi) = data.exact.spans[i];
     let row = &data.exact.jt.as_slice()[i * nv..(i + 1) * nv];
-    row[lo..hi].iter().zip(&x[lo..hi]).map(|(j, x)| j * x).sum()
+    let mut sum: f64 = std::iter::empty::<f64>().sum();
+    for (lo, hi) in row_ranges(data, i) {
+        for (j, x) in row[lo..hi].iter().zip(&x[lo..hi]) {
+            sum += j * x;
+        }
+    }
+    sum
+}
+
+/// The dofs of row i's trees, ascending, as two ranges (`exact.trees`; the second may be
+/// empty), or its span and an empty range when the trees are not known: J_i and M⁻¹J_iᵀ are
+/// zero outside them. Needs [`delassus`] at the current rows.
+fn row_ranges(data: &Data, i: usize) -> [(usize, usize); 2] {
+    if data.exact.trees_valid {
+        data.exact.trees[i]
+    } else {
+        [data.exact.spans[i], (0, 0)]
+    }
 }
 
 /// x += s · M⁻¹Jᵀ μ with μ the first nefc entries of `efc_rhs` (the result of a Delassus solve),
-/// each row's column over its trees' dofs (zero outside them).
+/// each row's column over its trees' dofs ([`row_ranges`]; zero outside them).
 fn add_minv_jt_mu(data: &Data, nv: usize, s: f64, x: &mut [f64]) {
     let y = data.exact.minv_jt.as_slice();
     for i in 0..data.nefc {
         let mu = s * data.exact.rhs[i];
-        let (lo, hi) = data.exact.spans[i];
-        for (x, y) in x[lo..hi].iter_mut().zip(&y[i * nv + lo..i * nv + hi]) {
-            *x += y * mu;
+        for (lo, hi) in row_ranges(data, i) {
+            for (x, y) in x[lo..hi].iter_mut().zip(&y[i * nv + lo..i * nv + hi]) {
+                *x += y * mu;
+            }
         }
     }
 }
@@ -355,7 +569,9 @@ pub(crate) fn solve_exact(
         }
         if !data.efc_converged {
             let h = model.options.timestep;
-            limit_energy(data, h, |d, i| free_row_velocity(model, d, h, i));
+            // J_i v′, the row velocity after a step h of the motion without constraint forces:
+            // J_i (v + h q̈_smooth).
+            limit_energy(data, h, |d, i| d.efc_vel[i] + h * row_dot(d, nv, i, d.qacc_smooth.as_slice()));
         }
         // No rank to report: the iterative solve gives one of the equivalent force distributions.
         data.exact.active.clear();
@@ -377,10 +593,11 @@ pub(crate) fn solve_exact(
         data.efc_force[i] = lambda;
         data.exact.warm[i] = lambda;
         data.exact.warm_rows.push((data.efc_type[i], data.efc_id[i]));
-        let (lo, hi) = data.exact.spans[i];
-        let row = &data.exact.jt.as_slice()[i * nv + lo..i * nv + hi];
-        for (f, j) in data.qfrc_constraint.as_mut_slice()[lo..hi].iter_mut().zip(row) {
-            *f += j * lambda;
+        for (lo, hi) in row_ranges(data, i) {
+            let row = &data.exact.jt.as_slice()[i * nv + lo..i * nv + hi];
+            for (f, j) in data.qfrc_constraint.as_mut_slice()[lo..hi].iter_mut().zip(row) {
+                *f += j * lambda;
+            }
         }
     }
 }
@@ -517,7 +734,7 @@ mod tests {
     use crate::dynamics::solve_with_factor_unchecked;
 
     /// The tree-restricted Delassus products equal the dense J M⁻¹ Jᵀ (each entry the same sum
-    /// without its exact zeros) on a scene with several trees: two stacked boxes, a hinged
+    /// without its exact zeros), and the nonzero pattern holds every nonzero, on a scene with several trees: two stacked boxes, a hinged
     /// pendulum touching the floor, a free capsule.
     #[test]
     fn delassus_equals_the_dense_products() {
@@ -566,6 +783,11 @@ mod tests {
                 let (r, s) = (i.min(c), i.max(c));
                 let dense_upper: f64 = (0..nv).map(|k| j[(r, k)] * y[(k, s)]).sum();
                 assert_eq!(data.exact.delassus[(i, c)], dense_upper, "({i}, {c})");
+                // Every nonzero lies in the pattern (the Gauss–Seidel gathers read only it).
+                let w = &data.exact;
+                assert_eq!(w.pattern_n, n);
+                let column = &w.pattern_rows[w.pattern_ptr[c]..w.pattern_ptr[c + 1]];
+                assert!(dense_upper == 0.0 || column.contains(&i), "({i}, {c}) outside the pattern");
                 assert!((dense - dense_upper).abs() <= 1e-12 * (1.0 + dense.abs()));
                 let (lo, hi) = data.exact.spans[c];
                 if (lo..hi).contains(&(i % nv)) {

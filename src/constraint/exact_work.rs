@@ -83,6 +83,26 @@ pub(crate) struct ExactWork {
     /// Per row, the dofs [lo, hi) of the kinematic trees it touches (`dynamics::tree_span`):
     /// M⁻¹ J_iᵀ is zero outside them, and A_ij = 0 when two rows' spans are disjoint.
     pub spans: Vec<(usize, usize)>,
+    /// The nonzero pattern of the Delassus matrix (`super::delassus_pattern`), column by column
+    /// in compressed form: column j's rows that may be nonzero (their spans meet j's) are
+    /// `pattern_rows[pattern_ptr[j]..pattern_ptr[j + 1]]`, ascending. Valid for `pattern_n` rows
+    /// (0 when none was built: the columns are then read whole); `pattern_full` when every pair
+    /// meets (one robot), where the columns are read whole too.
+    pub pattern_ptr: Vec<usize>,
+    pub pattern_rows: Vec<usize>,
+    pub pattern_n: usize,
+    pub pattern_full: bool,
+    /// Per row, the dof ranges of the (at most two) kinematic trees its J row touches (the second
+    /// empty when it touches one), when every row touches at most two (`delassus_by_trees`).
+    pub trees: Vec<[(usize, usize); 2]>,
+    /// Whether `trees` holds the current rows' trees (false when some row touches more than two:
+    /// their spans are read instead).
+    pub trees_valid: bool,
+    /// The rows touching each tree, in compressed form keyed by the tree's first dof: tree
+    /// rooted at dof t has rows `tree_rows[tree_ptr[t]..tree_ptr[t + 1]]`, ascending (nv + 1
+    /// offsets; at most two entries per row).
+    pub tree_ptr: Vec<usize>,
+    pub tree_rows: Vec<usize>,
     /// Per row, during a velocity-level Coulomb solve: its force in the last acceleration-level
     /// solve (`Data::efc_previous_force`, looked up once per solve rather than per sweep).
     pub previous: DVector<f64>,
@@ -133,6 +153,14 @@ impl ExactWork {
             order: vec![0; nefc],
             dof_rows: vec![(0, 0); nv],
             spans: vec![(0, 0); nefc],
+            pattern_ptr: Vec::with_capacity(nefc + 1),
+            pattern_rows: Vec::with_capacity(nefc * nefc),
+            pattern_n: 0,
+            pattern_full: false,
+            trees: vec![[(0, 0); 2]; nefc],
+            trees_valid: false,
+            tree_ptr: vec![0; nv + 1],
+            tree_rows: vec![0; 2 * nefc],
             previous: DVector::zeros(nefc),
             polish_set: 0,
             polish_work: 0.0,
@@ -141,13 +169,15 @@ impl ExactWork {
     }
 
     /// The dense matrices (M⁻¹Jᵀ, the Delassus matrix and its factors, the block LU's scratch)
-    /// for `nefc` rows, if smaller: only the exact mode needs them (nefc² numbers each).
+    /// for `nefc` rows, if smaller, and the Delassus pattern's room: only the exact mode needs them
+    /// (nefc² numbers each).
     pub fn grow_matrices(&mut self, nv: usize, nefc: usize) {
         if self.motion.len() != 2 * nv {
             self.motion = DVector::zeros(2 * nv);
         }
         if self.dof_rows.len() != nv {
             self.dof_rows = vec![(0, 0); nv];
+            self.tree_ptr = vec![0; nv + 1];
         }
         if self.delassus.nrows() >= nefc && self.minv_jt.nrows() == nv {
             return;
@@ -158,6 +188,12 @@ impl ExactWork {
         self.yt_acc = vec![0.0; nefc];
         self.yt_run = vec![0.0; nefc];
         self.order = vec![0; nefc];
+        self.tree_rows = vec![0; 2 * nefc];
+        // The pattern's room for every pair, so that it never grows inside a step (its size is
+        // the rows' meeting pairs: at most the Delassus matrix's entries).
+        self.pattern_ptr = Vec::with_capacity(nefc + 1);
+        self.pattern_rows = Vec::with_capacity(nefc * nefc);
+        self.pattern_n = 0;
         for m in [&mut self.delassus, &mut self.factor, &mut self.sub] {
             *m = DMatrix::zeros(nefc, nefc);
         }
@@ -185,6 +221,7 @@ impl ExactWork {
         self.newton_normal.reserve(nefc.saturating_sub(self.newton_normal.len()));
         self.in_active.resize(nefc, false);
         self.spans.resize(nefc, (0, 0));
+        self.trees.resize(nefc, [(0, 0); 2]);
         self.admm.grow(nefc);
         self.active.reserve(nefc.saturating_sub(self.active.len()));
         self.warm_rows.reserve(nefc.saturating_sub(self.warm_rows.len()));
