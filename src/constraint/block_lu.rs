@@ -24,7 +24,7 @@
 //! The buffers grow with the largest system solved ([`BlockLu::grow`]); a solve allocates
 //! nothing.
 
-use super::dense::{largest_entry, lu_kernel_dispatch, solve_psd_tol, LuBounds};
+use super::dense::{largest_entry, lu_kernel_dispatch, psd_rank_tolerance, solve_psd_tol, LuBounds};
 use super::RANK_TOLERANCE;
 use nalgebra::{DMatrix, DVector};
 
@@ -99,24 +99,36 @@ impl BlockLu {
         }
         let cap = self.capacity;
         for c in 0..blocks {
-            let members = &self.order[self.start[c]..self.start[c + 1]];
-            let s = members.len();
-            for (jl, &j) in members.iter().enumerate() {
-                let col = &m[j * stride..j * stride + n];
-                for (il, &i) in members.iter().enumerate() {
-                    self.block[(il, jl)] = col[i];
-                }
-                self.rhs[jl] = b[j];
-            }
+            let s = self.gather(c, m, stride, n, b);
             if !lu_kernel_dispatch(self.block.as_mut_slice(), cap, &mut self.rhs[..s], &mut self.piv, bounds)
             {
                 return false;
             }
-            for (il, &i) in members.iter().enumerate() {
-                b[i] = self.rhs[il];
-            }
+            self.scatter(c, b);
         }
         b.iter().all(|x| x.is_finite())
+    }
+
+    /// Copies component `c`'s rows and columns of the n × n matrix `m` (column stride `stride`)
+    /// into `block` and its entries of `b` into `rhs`, in the component's order; returns its size.
+    fn gather(&mut self, c: usize, m: &[f64], stride: usize, n: usize, b: &[f64]) -> usize {
+        let (lo, hi) = (self.start[c], self.start[c + 1]);
+        for jl in 0..hi - lo {
+            let j = self.order[lo + jl];
+            let col = &m[j * stride..j * stride + n];
+            for il in 0..hi - lo {
+                self.block[(il, jl)] = col[self.order[lo + il]];
+            }
+            self.rhs[jl] = b[j];
+        }
+        hi - lo
+    }
+
+    /// Writes component `c`'s solution (in `rhs`) back to its entries of `b`.
+    fn scatter(&self, c: usize, b: &mut [f64]) {
+        for (il, &i) in self.order[self.start[c]..self.start[c + 1]].iter().enumerate() {
+            b[i] = self.rhs[il];
+        }
     }
 
     /// Solves `A x = b` for the symmetric positive semi-definite top-left n × n block of `a`,
@@ -135,41 +147,23 @@ impl BlockLu {
         vec: &mut DVector<f64>,
     ) -> usize {
         let n = b.len();
-        if n == 0 {
-            return 0;
+        let Some(tol) = psd_rank_tolerance(a, b) else { return 0 };
+        if n < PSD_SPLIT_SIZE {
+            return solve_psd_tol(a, b, work, vec, tol);
         }
         let stride = a.nrows();
-        let scale = (0..n).map(|i| a[(i, i)].abs()).fold(0.0, f64::max);
-        if scale == 0.0 || !scale.is_finite() {
-            b.fill(0.0);
-            return 0;
-        }
-        if n < PSD_SPLIT_SIZE {
-            return solve_psd_tol(a, b, work, vec, scale * RANK_TOLERANCE);
-        }
         self.grow(n);
         let blocks = match self.components(a.as_slice(), stride, n) {
             Some((blocks, _)) if blocks > 1 => blocks,
-            _ => return solve_psd_tol(a, b, work, vec, scale * RANK_TOLERANCE),
+            _ => return solve_psd_tol(a, b, work, vec, tol),
         };
-        let m = a.as_slice();
         let mut rank = 0;
         for c in 0..blocks {
-            let members = &mut self.order[self.start[c]..self.start[c + 1]];
             // Ascending, as in the whole system: the block's factor is the whole one's rows.
-            members.sort_unstable();
-            let s = members.len();
-            for (jl, &j) in members.iter().enumerate() {
-                let col = &m[j * stride..j * stride + n];
-                for (il, &i) in members.iter().enumerate() {
-                    self.block[(il, jl)] = col[i];
-                }
-                self.rhs[jl] = b[j];
-            }
-            rank += solve_psd_tol(&mut self.block, &mut self.rhs[..s], work, vec, scale * RANK_TOLERANCE);
-            for (il, &i) in members.iter().enumerate() {
-                b[i] = self.rhs[il];
-            }
+            self.order[self.start[c]..self.start[c + 1]].sort_unstable();
+            let s = self.gather(c, a.as_slice(), stride, n, b);
+            rank += solve_psd_tol(&mut self.block, &mut self.rhs[..s], work, vec, tol);
+            self.scatter(c, b);
         }
         rank
     }

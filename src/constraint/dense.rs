@@ -21,16 +21,23 @@ pub(crate) fn solve_psd(
     work: &mut DMatrix<f64>,
     vec: &mut DVector<f64>,
 ) -> usize {
+    match psd_rank_tolerance(a, b) {
+        Some(tol) => solve_psd_tol(a, b, work, vec, tol),
+        None => 0,
+    }
+}
+
+/// The rank tolerance of the PSD system `A x = b` (A the top-left n × n block of `a`, n =
+/// `b.len()`): `RANK_TOLERANCE` times A's largest diagonal entry; None (and `b` zeroed: the
+/// solution is x = 0, rank 0) when there are no unknowns or that entry is zero or not finite.
+pub(crate) fn psd_rank_tolerance(a: &DMatrix<f64>, b: &mut [f64]) -> Option<f64> {
     let n = b.len();
-    if n == 0 {
-        return 0;
-    }
     let scale = (0..n).map(|i| a[(i, i)].abs()).fold(0.0, f64::max);
-    if scale == 0.0 || !scale.is_finite() {
+    if n == 0 || scale == 0.0 || !scale.is_finite() {
         b.fill(0.0);
-        return 0;
+        return None;
     }
-    solve_psd_tol(a, b, work, vec, scale * RANK_TOLERANCE)
+    Some(scale * RANK_TOLERANCE)
 }
 
 /// [`solve_psd`] with the rank tolerance `tol` given (the pivots of the pivoted Cholesky factor
