@@ -2,7 +2,7 @@
 //! grid cells under the other geom's box (its support points along the height field's axes, in
 //! the field's frame) are cut into two triangular prisms each, diagonal from (column c−1, row
 //! r+1) to (c, r), bottoms at z = −`size[3]`, visited row by row, then column, then the two prisms
-//! of the cell. [`Cells`] is that grid; `hfield_convex` collides each prism with the geom.
+//! of the cell. `Cells` is that grid; `hfield_convex` collides each prism with the geom.
 
 use crate::model::HeightField;
 use crate::spatial::Vec3;

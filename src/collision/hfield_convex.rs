@@ -3,7 +3,7 @@
 //! meshes), computed in the height field's frame as MuJoCo computes them: the geom's pose relative
 //! to the field (its position difference rotated into the field, its rotation Rᵀ_field R_geom), its
 //! box in that frame (support points along ±x, ±y, ±z) grown by the margin selecting the grid cells
-//! ([`super::hfield::Cells`]); each cell cut into two triangular prisms (base at z = −`size[3]`),
+//! (`hfield::Cells`); each cell cut into two triangular prisms (base at z = −`size[3]`),
 //! visited row by row, then column, then the cell's two prisms. A prism whose three tops plus the
 //! margin lie below the geom's lowest point is skipped; every other is a convex solid collided with
 //! the geom by MuJoCo's native GJK/EPA (`collision::ccd`: the prism's support as `mjc_prism_support`,
