@@ -283,9 +283,7 @@ pub(crate) fn actuation_unchecked(
 fn scale_tendon_forces(model: &Model, forces: &mut [f64]) {
     for (t, tendon) in model.tendons.iter().enumerate() {
         let Some([lo, hi]) = tendon.actuator_force_range else { continue };
-        let on_tendon = |a: &crate::model::Actuator| a.transmission == Transmission::Tendon(t);
-        let total: f64 =
-            model.actuators.iter().zip(forces.iter()).filter(|(a, _)| on_tendon(a)).map(|(_, f)| f).sum();
+        let total = tendon_total_force(model, forces, t);
         let scale = if total == 0.0 {
             continue;
         } else if total < lo {
@@ -296,7 +294,7 @@ fn scale_tendon_forces(model: &Model, forces: &mut [f64]) {
             continue;
         };
         for (a, f) in model.actuators.iter().zip(forces.iter_mut()) {
-            if on_tendon(a) {
+            if a.transmission == Transmission::Tendon(t) {
                 *f *= scale;
             }
         }
@@ -317,6 +315,9 @@ pub fn add_actuator_velocity_derivative(
     h: f64,
 ) -> bool {
     add_actuator_derivative(model, data, matrix, h, false, |a, i, x| {
+        if total_force_clamped(model, data, a) {
+            return 0.0;
+        }
         let mut d = if a.biastype == BiasType::Affine { bias_velocity[i] } else { 0.0 };
         if a.gaintype == GainType::Affine {
             d += a.gainprm[2] * x;
@@ -341,6 +342,18 @@ pub(crate) fn add_actuator_length_derivative(model: &Model, data: &Data, matrix:
     })
 }
 
+/// The sum of `forces` (one per actuator) over the actuators pulling on tendon `t`, in actuator
+/// order.
+fn tendon_total_force(model: &Model, forces: &[f64], t: usize) -> f64 {
+    model
+        .actuators
+        .iter()
+        .zip(forces)
+        .filter(|(a, _)| a.transmission == Transmission::Tendon(t))
+        .map(|(_, f)| f)
+        .sum()
+}
+
 /// Whether the total actuator force on actuator `a`'s joint or tendon sits at that joint's or
 /// tendon's `actuatorfrcrange` bound (the joint's clamped `qfrc_actuator`; the tendon's summed
 /// actuator forces within 1e-5 of a bound, relative): MuJoCo 4.0 then leaves the actuator out of
@@ -356,13 +369,7 @@ fn total_force_clamped(model: &Model, data: &Data, a: &crate::model::Actuator) -
             })
         }
         Transmission::Tendon(t) => model.tendons[t].actuator_force_range.is_some_and(|[lo, hi]| {
-            let total: f64 = model
-                .actuators
-                .iter()
-                .zip(data.actuator_force.iter())
-                .filter(|(b, _)| b.transmission == Transmission::Tendon(t))
-                .map(|(_, f)| f)
-                .sum();
+            let total = tendon_total_force(model, data.actuator_force.as_slice(), t);
             const TOL: f64 = 1e-5;
             total <= lo + TOL * lo.abs() || total >= hi - TOL * hi.abs()
         }),
@@ -401,9 +408,6 @@ fn add_actuator_derivative(
             if f <= lo || f >= hi {
                 continue;
             }
-        }
-        if !clamp && total_force_clamped(model, data, a) {
-            continue;
         }
         let x = match act_index {
             None if zeroed => 0.0,
