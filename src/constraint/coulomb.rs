@@ -160,6 +160,8 @@ pub(crate) fn solve_coulomb(
     // and the solve counts as unconverged (reported), never NaN.
     let mut first_total = 0.0f64;
     let mut last_polish = 0.0;
+    // The smallest sweep change so far and its iterate (`exact.best`).
+    let mut best_moved = f64::INFINITY;
     // A sweep costs about n² + n·nv: large problems get fewer sweeps (a work budget), so that a
     // pile of contacts cannot stall a step; a solve stopped early is counted as unconverged.
     let sweep = (n * n + n * model.nv).max(1) as f64;
@@ -212,9 +214,15 @@ pub(crate) fn solve_coulomb(
             data.efc_safe_friction = true;
             first_total = 0.0;
             iterations = 0;
+            best_moved = f64::INFINITY;
             continue;
         }
         change = moved;
+        if moved < best_moved {
+            best_moved = moved;
+            let ExactWork { rhs, best, .. } = &mut data.exact;
+            best.as_mut_slice()[..n].copy_from_slice(&rhs.as_slice()[..n]);
+        }
         if moved <= settings.tolerance * total.max(motion_scale)
             || moved <= ROUND_OFF_FLOOR
             || !moved.is_finite()
@@ -256,6 +264,12 @@ pub(crate) fn solve_coulomb(
             exact.warm_sweep_work =
                 if warm { f64::from(iterations) * sweep + exact.polish_work } else { 0.0 };
         }
+    }
+    // An unconverged solve returns its best iterate, not wherever the last sweep swung to.
+    if !data.efc_converged && best_moved < change {
+        let ExactWork { rhs, best, .. } = &mut data.exact;
+        rhs.as_mut_slice()[..n].copy_from_slice(&best.as_slice()[..n]);
+        change = best_moved;
     }
     data.efc_iterations = iterations;
     data.efc_residual = change;

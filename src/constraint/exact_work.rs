@@ -44,6 +44,9 @@ pub(crate) struct ExactWork {
     pub warm_sweep_work: f64,
     /// λ at the start of a Gauss–Seidel sweep.
     pub lambda_prev: DVector<f64>,
+    /// The iterate whose sweep changed the motion least so far: what an unconverged solve
+    /// returns (a pile's sweeps can swing far from it before the iteration limit).
+    pub best: DVector<f64>,
     /// Per row, during the velocity projection: a limit or contact row that carried a compressive
     /// force in the last acceleration-level solve. Its velocity is held at 0 (the row stays
     /// closed) rather than allowed to grow: a small separating J v left by the integrator's error
@@ -137,6 +140,7 @@ impl ExactWork {
             warm_polish_work: 0.0,
             warm_sweep_work: 0.0,
             lambda_prev: DVector::zeros(nefc),
+            best: DVector::zeros(nefc),
             pressing: vec![false; nefc],
             slipping: vec![false; nefc],
             slip_dir: DVector::zeros(nefc),
@@ -207,6 +211,7 @@ impl ExactWork {
             &mut self.eig,
             &mut self.sub_rhs,
             &mut self.lambda_prev,
+            &mut self.best,
             &mut self.previous,
             &mut self.slip_dir,
             &mut self.nu,
