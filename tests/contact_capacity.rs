@@ -78,3 +78,39 @@ fn a_pass_with_more_contacts_than_the_budget_counts_what_it_drops() {
     assert_eq!(data.contacts.len(), budget);
     assert_eq!(data.warnings.contact_full.number, 3);
 }
+
+/// The budget as an option (`Options::max_contacts`, CLI `--max-contacts`): the exact mode keeps
+/// every contact of a scene beyond its default budget of 500 when asked, and a budget set below
+/// the scene's contacts drops the rest with the warning naming the count, as the default does.
+#[test]
+fn the_contact_budget_is_an_option() {
+    let n = 140;
+    let text = boxes_on_plane(n, "Newton", 3);
+    let mut model = common::load_mjcf_text("contact_capacity", "boxes_exact", &text);
+    model.set_constraint_mode(lagrange::constraint::ConstraintMode::Exact);
+    let default_budget = model.contact_budget();
+    assert!(default_budget < 4 * n, "the scene must exceed the exact mode's default budget {default_budget}");
+    model.options.max_contacts = Some(4 * n);
+    assert_eq!(model.contact_budget(), 4 * n);
+    let mut data = Data::new(&model);
+    forward(&model, &mut data);
+    assert_eq!(data.contacts.len(), 4 * n, "every contact is kept");
+    assert_eq!(data.contacts_dropped, 0);
+    assert!(data.qacc.iter().all(|a| a.is_finite()));
+    let again = allocations(|| forward(&model, &mut data));
+    assert_eq!(again, 0, "a pass at the same size allocated {again} times");
+    // Below the scene's contacts: the option's worth kept, the rest counted and warned about.
+    model.options.max_contacts = Some(100);
+    let mut data = Data::new(&model);
+    forward(&model, &mut data);
+    assert_eq!((data.contacts.len(), data.contacts_dropped), (100, (4 * n - 100) as u64));
+    let message = data.warnings.messages(&model).join("\n");
+    assert!(message.contains("than the 100 kept") && message.contains("--max-contacts"), "{message}");
+    // Through the loader (what the CLI's --max-contacts sets).
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact_capacity_option.xml");
+    std::fs::write(&path, &text).unwrap();
+    let options = lagrange::io::LoadOptions { max_contacts: Some(7), ..Default::default() };
+    let loaded = lagrange::io::load(&path, &options).unwrap();
+    let _ = std::fs::remove_file(&path);
+    assert_eq!((loaded.options.max_contacts, loaded.contact_budget()), (Some(7), 7));
+}

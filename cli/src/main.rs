@@ -48,6 +48,11 @@ struct Cli {
     /// controller's) to its `<limit effort>`; MJCF models use `actuatorfrcrange` instead.
     #[arg(long, global = true)]
     clamp_effort: bool,
+    /// The most contacts one collision pass keeps, instead of the default budget (500 with the
+    /// exact mode, PGS or no-slip, whose rows × rows matrices grow with its square), within
+    /// memory; contacts beyond it are dropped, counted and warned about.
+    #[arg(long, global = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    max_contacts: Option<u32>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -326,6 +331,7 @@ fn main() -> ExitCode {
         accept_nonphysical_inertia: cli.accept_nonphysical_inertia,
         disabled_flags: cli.disabled_flags,
         clamp_effort: cli.clamp_effort,
+        max_contacts: cli.max_contacts.map(|n| n as usize),
     };
     let mode = cli.constraints.map(ConstraintMode::from);
     let result = match cli.command {

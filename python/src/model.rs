@@ -41,6 +41,7 @@ impl Options {
             accept_nonphysical_inertia: self.accept_nonphysical_inertia,
             disabled_flags: self.disable.clone(),
             clamp_effort: self.clamp_effort,
+            ..Default::default()
         }
     }
 }

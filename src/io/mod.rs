@@ -41,12 +41,16 @@ pub struct LoadOptions {
     /// Clamp the joint torques applied to each URDF joint (actuator plus applied forces) to its
     /// `<limit effort>` (CLI `--clamp-effort`). MJCF models say it with `actuatorfrcrange`.
     pub clamp_effort: bool,
+    /// The most contacts one collision pass keeps ([`Options::max_contacts`](crate::model::Options::max_contacts);
+    /// CLI `--max-contacts N`): None keeps the model's default budget.
+    pub max_contacts: Option<usize>,
 }
 
 /// Loads a model file, choosing the loader by extension (`.urdf`, or `.xml` for MJCF).
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Model, LoadError> {
     let mut spec = load_spec(path, options)?;
     disable_flags(&mut spec, &options.disabled_flags)?;
+    spec.options.max_contacts = options.max_contacts.or(spec.options.max_contacts);
     compile(&spec)
 }
 
@@ -121,6 +125,7 @@ pub fn load_str(text: &str, path: &Path, options: &LoadOptions) -> Result<Model,
         None => return Err(LoadError::UnsupportedFormat { file: path.display().to_string() }),
     };
     disable_flags(&mut spec, &options.disabled_flags)?;
+    spec.options.max_contacts = options.max_contacts.or(spec.options.max_contacts);
     compile(&spec)
 }
 

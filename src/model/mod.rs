@@ -445,12 +445,18 @@ impl Model {
     /// [`MAX_SOFT_CONTACTS`], as many as keep one Newton iteration's Hessian work bounded (rows ×
     /// (2 · [`Model::max_dof_depth`])² below about 5·10⁸). Never fewer than [`INITIAL_CONTACTS`]. Contacts beyond it are
     /// dropped, counted in [`Data::contacts_dropped`] and raise the `contact_full` warning
-    /// (`Data::warnings`, with the count and the time of the pass).
+    /// (`Data::warnings`, with the count and the time of the pass). [`Options::max_contacts`],
+    /// when set, replaces this default, within the memory bounds alone.
     pub fn contact_budget(&self) -> usize {
         let numbers = (CONTACT_MEMORY / 8) as f64;
         // Each row: its J row (nv numbers) and about 20 per-row numbers (efc_* vectors).
         let by_jacobian = numbers / (6.0 * (self.nv + 20) as f64);
         let dense_rows = self.dense_contact_rows();
+        if let Some(most) = self.options.max_contacts {
+            // One rows × rows matrix within the memory too, where a solver forms one.
+            let by_memory = if dense_rows { by_jacobian.min(numbers.sqrt() / 6.0) } else { by_jacobian };
+            return most.min(by_memory as usize);
+        }
         // Newton's Hessian takes about (nonzeros per row)² per row and iteration; a row touches at
         // most the ancestor dofs of its two bodies.
         let depth = self.plan.max_dof_depth.max(1) as f64;

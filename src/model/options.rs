@@ -278,6 +278,14 @@ pub struct Options {
     /// The velocity (m/s, each dof's speed scaled by its `dof_length`) below which a tree may
     /// fall asleep (MuJoCo's `sleep_tolerance`, default 1e-3; read with `<flag sleep>`).
     pub sleep_tolerance: f64,
+    /// The most contacts one collision pass keeps, when set: replaces the default budget of
+    /// [`Model::contact_budget`](crate::Model::contact_budget) (500 with the solvers that form
+    /// rows × rows matrices: the exact mode, PGS, no-slip), bounded only by memory (the rows'
+    /// Jacobian and, for those solvers, one rows × rows matrix within 1 GiB). Contacts beyond it
+    /// are dropped, counted and warned about as beyond the default budget. None (the default):
+    /// the default budget. CLI `--max-contacts N`, [`LoadOptions::max_contacts`](crate::io::LoadOptions).
+    /// (MJCF's `<size nconmax>` is a legacy attribute MuJoCo 4.0 ignores, and so does lagrange.)
+    pub max_contacts: Option<usize>,
     /// The `<flag>` switches.
     pub flags: Flags,
     /// Contact margin under `<flag override>` (m; MuJoCo's `o_margin`, default 0).
@@ -313,6 +321,7 @@ impl Default for Options {
             ccd_tolerance: 1e-6,
             ccd_iterations: 35,
             sleep_tolerance: 1e-3,
+            max_contacts: None,
             flags: Flags::default(),
             o_margin: 0.0,
             o_solref: [0.02, 1.0],

@@ -168,7 +168,8 @@ impl Warnings {
                 "{} collision pass(es) found more contacts than the {} kept (last at t = {} s: {} \
                  found), as MuJoCo's mjWARN_CONTACTFULL: the rest were dropped, so bodies may sink \
                  into each other; exclude pairs that need not touch (<contact><exclude>, \
-                 contype/conaffinity){}",
+                 contype/conaffinity), raise the budget (--max-contacts, Options::max_contacts; \
+                 memory grows with it){}",
                 self.contact_full.number,
                 model.contact_budget(),
                 self.contact_full_time,
