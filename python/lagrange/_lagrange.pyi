@@ -47,6 +47,7 @@ class Model:
         disable: Optional[Sequence[str]] = None,
         clamp_effort: bool = False,
         constraints: Optional[str] = None,
+        max_contacts: Optional[int] = None,
     ) -> Model: ...
     @staticmethod
     def from_string(
@@ -59,6 +60,7 @@ class Model:
         disable: Optional[Sequence[str]] = None,
         clamp_effort: bool = False,
         constraints: Optional[str] = None,
+        max_contacts: Optional[int] = None,
     ) -> Model: ...
     @staticmethod
     def _restore(kind: str, text: str, path: Union[str, PathLike], opts: Dict[str, Any]) -> Model: ...

@@ -31,6 +31,7 @@ pub struct Options {
     disable: Vec<String>,
     clamp_effort: bool,
     constraints: Option<String>,
+    max_contacts: Option<usize>,
 }
 
 impl Options {
@@ -41,7 +42,7 @@ impl Options {
             accept_nonphysical_inertia: self.accept_nonphysical_inertia,
             disabled_flags: self.disable.clone(),
             clamp_effort: self.clamp_effort,
-            ..Default::default()
+            max_contacts: self.max_contacts,
         }
     }
 }
@@ -51,7 +52,8 @@ impl Options {
 /// Load with `Model.from_file(path, **options)` or `Model.from_string(xml, **options)`; the
 /// options are `package_dirs` (folders for `package://` URIs), `floating` (a URDF root on a free
 /// joint), `accept_nonphysical_inertia`, `disable` (MJCF `<flag>` names to turn off),
-/// `clamp_effort` and `constraints` ('soft' or 'exact').
+/// `clamp_effort`, `constraints` ('soft' or 'exact') and `max_contacts` (the most contacts one
+/// collision pass keeps, instead of the default budget; the CLI's `--max-contacts`).
 #[pyclass(name = "Model", module = "lagrange", frozen)]
 pub struct PyModel {
     /// The model, shared with rollouts' worker threads.
@@ -68,6 +70,7 @@ fn options_of(
     disable: Option<Vec<String>>,
     clamp_effort: bool,
     constraints: Option<String>,
+    max_contacts: Option<usize>,
 ) -> Options {
     Options {
         package_dirs: package_dirs.unwrap_or_default(),
@@ -76,6 +79,7 @@ fn options_of(
         disable: disable.unwrap_or_default(),
         clamp_effort,
         constraints,
+        max_contacts,
     }
 }
 
@@ -128,7 +132,7 @@ impl PyModel {
     /// are found beside the file. Raises `lagrange.LoadError` with file:line on a bad file.
     #[staticmethod]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (path, *, package_dirs=None, floating=false, accept_nonphysical_inertia=false, disable=None, clamp_effort=false, constraints=None))]
+    #[pyo3(signature = (path, *, package_dirs=None, floating=false, accept_nonphysical_inertia=false, disable=None, clamp_effort=false, constraints=None, max_contacts=None))]
     fn from_file(
         py: Python<'_>,
         path: PathBuf,
@@ -138,6 +142,7 @@ impl PyModel {
         disable: Option<Vec<String>>,
         clamp_effort: bool,
         constraints: Option<String>,
+        max_contacts: Option<usize>,
     ) -> PyResult<Self> {
         let path = std::path::absolute(&path).unwrap_or(path);
         let options = options_of(
@@ -147,6 +152,7 @@ impl PyModel {
             disable,
             clamp_effort,
             constraints,
+            max_contacts,
         );
         Self::load(py, Source::File(path), options)
     }
@@ -154,7 +160,7 @@ impl PyModel {
     /// Loads a URDF or MJCF model from text; `base` (default: the current directory) anchors
     /// relative includes and meshes.
     #[staticmethod]
-    #[pyo3(signature = (xml, *, base=None, package_dirs=None, floating=false, accept_nonphysical_inertia=false, disable=None, clamp_effort=false, constraints=None))]
+    #[pyo3(signature = (xml, *, base=None, package_dirs=None, floating=false, accept_nonphysical_inertia=false, disable=None, clamp_effort=false, constraints=None, max_contacts=None))]
     #[allow(clippy::too_many_arguments)]
     fn from_string(
         py: Python<'_>,
@@ -166,6 +172,7 @@ impl PyModel {
         disable: Option<Vec<String>>,
         clamp_effort: bool,
         constraints: Option<String>,
+        max_contacts: Option<usize>,
     ) -> PyResult<Self> {
         let dir = base.unwrap_or_else(|| PathBuf::from("."));
         let dir = std::path::absolute(&dir).unwrap_or(dir);
@@ -177,6 +184,7 @@ impl PyModel {
             disable,
             clamp_effort,
             constraints,
+            max_contacts,
         );
         Self::load(py, Source::Text(xml, dir.join(name)), options)
     }
@@ -201,6 +209,7 @@ impl PyModel {
             disable: get("disable")?.map(|v| v.extract()).transpose()?.unwrap_or_default(),
             clamp_effort: get("clamp_effort")?.map(|v| v.extract()).transpose()?.unwrap_or(false),
             constraints: get("constraints")?.map(|v| v.extract()).transpose()?.flatten(),
+            max_contacts: get("max_contacts")?.map(|v| v.extract()).transpose()?.flatten(),
         };
         let source = if kind == "file" { Source::File(path) } else { Source::Text(text, path) };
         Self::load(py, source, options)
@@ -216,6 +225,7 @@ impl PyModel {
         opts.set_item("disable", this.options.disable.clone())?;
         opts.set_item("clamp_effort", this.options.clamp_effort)?;
         opts.set_item("constraints", this.options.constraints.clone())?;
+        opts.set_item("max_contacts", this.options.max_contacts)?;
         let (kind, text, path) = match &this.source {
             Source::File(path) => ("file", String::new(), path.clone()),
             Source::Text(text, path) => ("text", text.clone(), path.clone()),

@@ -216,3 +216,23 @@ def test_buffers_never_move(integrator):
     assert views["qpos"][0] == d.qpos[0] != 1.5 and views["sensordata"][1] == d.sensordata[1]
     lagrange.reset(m, d)
     assert all(getattr(d, n).__array_interface__["data"][0] == address[n] for n in names)
+
+
+def test_max_contacts_is_a_load_option():
+    # Three boxes resting on a plane: 4 corner contacts each (MuJoCo's box-plane points).
+    boxes = "".join(
+        f"<body pos='{0.3 * k} 0 0.039'><freejoint/><geom type='box' size='0.04 0.04 0.04'/></body>"
+        for k in range(3)
+    )
+    xml = f"<mujoco><worldbody><geom type='plane' size='0 0 1'/>{boxes}</worldbody></mujoco>"
+    for budget, kept in ((None, 12), (5, 5)):
+        m = lagrange.Model.from_string(xml, max_contacts=budget)
+        d = lagrange.Data(m)
+        lagrange.forward(m, d)
+        assert d.ncon == kept
+        # The option travels with the model (pickle reloads it with its options).
+        again = pickle.loads(pickle.dumps(m))
+        d2 = lagrange.Data(again)
+        lagrange.forward(again, d2)
+        assert d2.ncon == kept
+    assert "contact_full" in d.warnings, d.warnings
