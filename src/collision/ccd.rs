@@ -654,6 +654,12 @@ struct Polytope {
     maxfaces: usize,
     center: Vec3,
     map: Vec<usize>,
+    /// `map_dist2[k]` is `faces[map[k]].dist2`: the search for the nearest face reads the
+    /// distances in a row.
+    map_dist2: Vec<f64>,
+    /// `keys[i]` is vertex i's two feature indices in one word ([`feature_key`]): the repeated
+    /// support test of discrete geoms reads them in a row.
+    keys: Vec<u64>,
     h_indices: Vec<usize>,
     h_edges: Vec<usize>,
     h_w: Vec3,
@@ -677,17 +683,22 @@ enum PolytopeError {
 impl Polytope {
     fn reset(&mut self) {
         self.verts.clear();
+        self.keys.clear();
         self.faces.clear();
         self.map.clear();
+        self.map_dist2.clear();
         self.h_indices.clear();
         self.h_edges.clear();
     }
 
+    #[inline(always)]
     fn insert(&mut self, v: Vertex) -> usize {
+        self.keys.push(feature_key(&v));
         self.verts.push(v);
         self.verts.len() - 1
     }
 
+    #[inline(always)]
     fn epa_support(&mut self, o1: &mut CcdObj, o2: &mut CcdObj, d: &Vec3, dnorm: f64) -> usize {
         let (mut dir, mut dir_neg) = (Vec3::x(), -Vec3::x());
         if dnorm > MINVAL {
@@ -718,26 +729,41 @@ impl Polytope {
         face.dist2
     }
 
+    #[inline(always)]
     fn populate_map(&mut self) {
         self.map.clear();
+        self.map_dist2.clear();
         for i in 0..self.faces.len() {
             self.map.push(i);
+            self.map_dist2.push(self.faces[i].dist2);
             self.faces[i].index = i as i64;
         }
     }
 
+    /// Puts face `f` at the end of the map.
+    #[inline(always)]
+    fn map_push(&mut self, f: usize) {
+        self.faces[f].index = self.map.len() as i64;
+        self.map.push(f);
+        self.map_dist2.push(self.faces[f].dist2);
+    }
+
+    #[inline(always)]
     fn delete_face(&mut self, f: usize) {
         let idx = self.faces[f].index;
         if idx >= 0 {
             let last = self.map.pop().expect("a face in the map");
+            let last_dist2 = self.map_dist2.pop().expect("a distance per face in the map");
             if (idx as usize) < self.map.len() {
                 self.map[idx as usize] = last;
+                self.map_dist2[idx as usize] = last_dist2;
                 self.faces[last].index = idx;
             }
         }
         self.faces[f].index = -2;
     }
 
+    #[inline(always)]
     fn get_edge(&self, f: usize, vertex: usize) -> usize {
         let v = self.faces[f].verts;
         if v[0] == vertex {
@@ -909,10 +935,10 @@ impl Polytope {
         for k in 0..kmax {
             let pface = face;
             let mut lower2 = MAX_LIMIT;
-            for &f in &self.map {
-                if self.faces[f].dist2 < lower2 {
+            for (&f, &dist2) in self.map.iter().zip(&self.map_dist2) {
+                if dist2 < lower2 {
                     face = Some(f);
-                    lower2 = self.faces[f].dist2;
+                    lower2 = dist2;
                 }
             }
             let Some(f) = face.filter(|_| lower2 <= upper2) else {
@@ -939,7 +965,7 @@ impl Polytope {
                 }
                 break;
             }
-            if discrete && self.verts[..wi].iter().any(|v| v.index1 == w.index1 && v.index2 == w.index2) {
+            if discrete && self.keys[..wi].contains(&self.keys[wi]) {
                 break;
             }
             self.h_w = w.vert;
@@ -969,8 +995,7 @@ impl Polytope {
                     break;
                 }
                 if dist2 >= lower2 && dist2 <= upper2 {
-                    self.faces[cur].index = self.map.len() as i64;
-                    self.map.push(cur);
+                    self.map_push(cur);
                 }
             }
             if self.map.is_empty() || face.is_none() {
@@ -995,6 +1020,12 @@ impl Polytope {
         let x2 = lincomb(&l, [&a.vert2, &b.vert2, &c.vert2, &c.vert2]);
         (x1, x2, -face.dist2.sqrt())
     }
+}
+
+/// A vertex's two feature indices (geom 1's, geom 2's) in one word: equal keys, equal pairs.
+#[inline(always)]
+fn feature_key(v: &Vertex) -> u64 {
+    (u64::from(v.index1 as u32) << 32) | u64::from(v.index2 as u32)
 }
 
 /// The rotation by 120° about `axis` (row-major as MuJoCo's `rotmat`).
