@@ -776,14 +776,17 @@ impl Polytope {
     }
 
     fn horizon_rec(&mut self, f: usize, e: usize) -> bool {
-        let face = self.faces[f];
-        if face.v.dot(&self.h_w) - face.dist2 > MINVAL {
+        // Only the face's projection and distance for the test; its edges once it is deleted.
+        let (v, dist2) = (self.faces[f].v, self.faces[f].dist2);
+        if v.dot(&self.h_w) - dist2 > MINVAL {
+            let (adjs, verts) = (self.faces[f].adj, self.faces[f].verts);
             self.delete_face(f);
-            for k in 1..3 {
-                let i = (e + k) % 3;
-                let adj = face.adj[i];
+            // Edges e + 1 and e + 2 (mod 3), in that order.
+            let i1 = NEXT3[e];
+            for i in [i1, NEXT3[i1]] {
+                let adj = adjs[i];
                 if self.faces[adj].index > -2 {
-                    let adj_edge = self.get_edge(adj, face.verts[(i + 1) % 3]);
+                    let adj_edge = self.get_edge(adj, verts[NEXT3[i]]);
                     if !self.horizon_rec(adj, adj_edge) {
                         self.h_indices.push(adj);
                         self.h_edges.push(adj_edge);
@@ -951,8 +954,8 @@ impl Polytope {
             let lower = lower2.sqrt();
             let fv = self.faces[f].v;
             let wi = self.epa_support(o1, o2, &fv, lower);
-            let w = self.verts[wi];
-            let upper_k = fv.dot(&w.vert) / lower;
+            let w_vert = self.verts[wi].vert;
+            let upper_k = fv.dot(&w_vert) / lower;
             if upper_k < upper {
                 upper = upper_k;
                 upper2 = upper * upper;
@@ -968,7 +971,7 @@ impl Polytope {
             if discrete && self.keys[..wi].contains(&self.keys[wi]) {
                 break;
             }
-            self.h_w = w.vert;
+            self.h_w = w_vert;
             self.h_indices.clear();
             self.h_edges.clear();
             self.horizon(f);
@@ -985,10 +988,10 @@ impl Polytope {
                 let cur = nfaces + i;
                 let (hi, he) = (self.h_indices[i], self.h_edges[i]);
                 let hv = self.faces[hi].verts;
-                let (v1, v2) = (hv[he], hv[(he + 1) % 3]);
+                let (v1, v2) = (hv[he], hv[NEXT3[he]]);
                 self.faces[hi].adj[he] = cur;
                 let prev = if i == 0 { nfaces + nedges - 1 } else { cur - 1 };
-                let next = nfaces + (i + 1) % nedges;
+                let next = if i + 1 == nedges { nfaces } else { cur + 1 };
                 let dist2 = self.attach(wi, v2, v1, prev, hi, next);
                 if dist2 == 0.0 {
                     face = None;
@@ -1021,6 +1024,9 @@ impl Polytope {
         (x1, x2, -face.dist2.sqrt())
     }
 }
+
+/// The next corner of a triangle: `NEXT3[i]` is (i + 1) mod 3 (a table, not a division).
+const NEXT3: [usize; 3] = [1, 2, 0];
 
 /// A vertex's two feature indices (geom 1's, geom 2's) in one word: equal keys, equal pairs.
 #[inline(always)]
