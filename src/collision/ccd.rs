@@ -357,8 +357,11 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
             if lambda[i] == 0.0 {
                 continue;
             }
-            st.simplex[n] = st.simplex[i];
-            lambda[n] = lambda[i];
+            // A vertex already in its place is not copied onto itself.
+            if n != i {
+                st.simplex[n] = st.simplex[i];
+                lambda[n] = lambda[i];
+            }
             n += 1;
         }
         if n < 1 {
@@ -712,14 +715,21 @@ impl Polytope {
     /// Appends face (v1, v2, v3) with its adjacency; returns its squared distance (0: degenerate).
     #[inline(always)]
     fn attach(&mut self, v1: usize, v2: usize, v3: usize, a1: usize, a2: usize, a3: usize) -> f64 {
-        let mut face =
-            Face { verts: [v1, v2, v3], adj: [a1, a2, a3], v: Vec3::zeros(), dist2: 0.0, index: -1 };
-        let ret = project_origin_plane(&self.verts[v3].vert, &self.verts[v2].vert, &self.verts[v1].vert);
+        let (p1, p2, p3) = (self.verts[v1].vert, self.verts[v2].vert, self.verts[v3].vert);
+        self.attach_at([v1, v2, v3], [&p1, &p2, &p3], [a1, a2, a3])
+    }
+
+    /// [`Self::attach`] of face `verts` whose vertices' points `pts` the caller holds (no
+    /// look-ups), adjacency `adj`.
+    #[inline(always)]
+    fn attach_at(&mut self, verts: [usize; 3], pts: [&Vec3; 3], adj: [usize; 3]) -> f64 {
+        let mut face = Face { verts, adj, v: Vec3::zeros(), dist2: 0.0, index: -1 };
+        let ret = project_origin_plane(pts[2], pts[1], pts[0]);
         let Some(mut v) = ret else {
             self.faces.push(face);
             return 0.0;
         };
-        let outward = self.verts[v1].vert - self.center;
+        let outward = pts[0] - self.center;
         if v.dot(&outward) < 0.0 {
             v *= -1.0;
         }
@@ -905,22 +915,24 @@ impl Polytope {
     }
 
     fn polytope4(&mut self, st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) -> Result<(), PolytopeError> {
-        let v1 = self.insert(st.simplex[0]);
-        let v2 = self.insert(st.simplex[1]);
-        let v3 = self.insert(st.simplex[2]);
-        let v4 = self.insert(st.simplex[3]);
-        let p = |i: usize| self.verts[i].vert;
-        self.center = (p(v1) + p(v2) + p(v3) + p(v4)) * 0.25;
+        // The four simplex vertices appended at once (indices v1..v4 in order).
+        let v1 = self.verts.len();
+        self.verts.extend_from_slice(&st.simplex);
+        self.keys.extend(st.simplex.iter().map(feature_key));
+        // The points held here, not looked up in the polytope.
+        let q = st.simplex.map(|v| v.vert);
+        self.center = (q[0] + q[1] + q[2] + q[3]) * 0.25;
+        // Faces (1, 2, 3), (1, 4, 2), (1, 3, 4), (4, 3, 2) of the simplex, with their adjacency.
         let faces =
-            [(v1, v2, v3, 1, 3, 2), (v1, v4, v2, 2, 3, 0), (v1, v3, v4, 0, 3, 1), (v4, v3, v2, 2, 0, 1)];
-        for (a, b, c, x, y, z) in faces {
-            if self.attach(a, b, c, x, y, z) < MINVAL * MINVAL {
-                self.replace_simplex3(st, a, b, c);
+            [([0, 1, 2], [1, 3, 2]), ([0, 3, 1], [2, 3, 0]), ([0, 2, 3], [0, 3, 1]), ([3, 2, 1], [2, 0, 1])];
+        for (f, adj) in faces {
+            let verts = f.map(|i| v1 + i);
+            if self.attach_at(verts, f.map(|i| &q[i]), adj) < MINVAL * MINVAL {
+                self.replace_simplex3(st, verts[0], verts[1], verts[2]);
                 return self.polytope3(st, o1, o2);
             }
         }
-        let p = |i: usize| self.verts[i].vert;
-        if !test_tetra(&p(v1), &p(v2), &p(v3), &p(v4)) {
+        if !test_tetra(&q[0], &q[1], &q[2], &q[3]) {
             return Err(PolytopeError::MissingOrigin);
         }
         self.populate_map();
@@ -992,7 +1004,8 @@ impl Polytope {
                 self.faces[hi].adj[he] = cur;
                 let prev = if i == 0 { nfaces + nedges - 1 } else { cur - 1 };
                 let next = if i + 1 == nedges { nfaces } else { cur + 1 };
-                let dist2 = self.attach(wi, v2, v1, prev, hi, next);
+                let (p2, p1) = (self.verts[v2].vert, self.verts[v1].vert);
+                let dist2 = self.attach_at([wi, v2, v1], [&w_vert, &p2, &p1], [prev, hi, next]);
                 if dist2 == 0.0 {
                     face = None;
                     break;
