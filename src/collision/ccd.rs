@@ -663,8 +663,8 @@ struct Polytope {
     /// `keys[i]` is vertex i's two feature indices in one word ([`feature_key`]): the repeated
     /// support test of discrete geoms reads them in a row.
     keys: Vec<u64>,
-    h_indices: Vec<usize>,
-    h_edges: Vec<usize>,
+    /// The horizon found by [`Self::horizon`]: (face, edge) pairs, one push per edge.
+    rim: Vec<(usize, usize)>,
     h_w: Vec3,
 }
 
@@ -690,8 +690,7 @@ impl Polytope {
         self.faces.clear();
         self.map.clear();
         self.map_dist2.clear();
-        self.h_indices.clear();
-        self.h_edges.clear();
+        self.rim.clear();
     }
 
     #[inline(always)]
@@ -798,8 +797,7 @@ impl Polytope {
                 if self.faces[adj].index > -2 {
                     let adj_edge = self.get_edge(adj, verts[NEXT3[i]]);
                     if !self.horizon_rec(adj, adj_edge) {
-                        self.h_indices.push(adj);
-                        self.h_edges.push(adj_edge);
+                        self.rim.push((adj, adj_edge));
                     }
                 }
             }
@@ -815,8 +813,7 @@ impl Polytope {
             let adj = face.adj[a];
             let adj_edge = self.get_edge(adj, face.verts[vert]);
             if (a == 0 || self.faces[adj].index > -2) && !self.horizon_rec(adj, adj_edge) {
-                self.h_indices.push(adj);
-                self.h_edges.push(adj_edge);
+                self.rim.push((adj, adj_edge));
             }
         }
     }
@@ -984,10 +981,9 @@ impl Polytope {
                 break;
             }
             self.h_w = w_vert;
-            self.h_indices.clear();
-            self.h_edges.clear();
+            self.rim.clear();
             self.horizon(f);
-            let nedges = self.h_indices.len();
+            let nedges = self.rim.len();
             if nedges < 3 {
                 face = None;
                 break;
@@ -998,7 +994,7 @@ impl Polytope {
             }
             for i in 0..nedges {
                 let cur = nfaces + i;
-                let (hi, he) = (self.h_indices[i], self.h_edges[i]);
+                let (hi, he) = self.rim[i];
                 let hv = self.faces[hi].verts;
                 let (v1, v2) = (hv[he], hv[NEXT3[he]]);
                 self.faces[hi].adj[he] = cur;
