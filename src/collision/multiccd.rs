@@ -276,9 +276,21 @@ fn feature_faces(
 
 /// The world polygon of face `f` (clockwise seen from outside) into `out`.
 fn face_polygon(poly: &Poly, x: &Transform, f: u32, tmp: &mut Vec<u32>, out: &mut Vec<Vec3>) {
-    poly.face_vertices(f, tmp);
     out.clear();
-    out.extend(tmp.iter().map(|&v| x.act_point(&poly.vertex(v))));
+    match poly {
+        // A hull's polygon read backwards straight into world points (no index list first).
+        Poly::Hull(s) => {
+            let points = s.points();
+            out.extend(s.graph().polygon(f as usize).iter().rev().map(|&v| {
+                let p = points[v as usize];
+                x.act_point(&Vec3::new(p.x, p.y, p.z))
+            }));
+        }
+        Poly::Cuboid(_) => {
+            poly.face_vertices(f, tmp);
+            out.extend(tmp.iter().map(|&v| x.act_point(&poly.vertex(v))));
+        }
+    }
 }
 
 /// The edges of a feature of one or two vertices as (start, end) world points: the edge itself,
