@@ -357,8 +357,11 @@ fn gjk(st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) {
             if lambda[i] == 0.0 {
                 continue;
             }
-            st.simplex[n] = st.simplex[i];
-            lambda[n] = lambda[i];
+            // A vertex already in its place is not copied onto itself.
+            if n != i {
+                st.simplex[n] = st.simplex[i];
+                lambda[n] = lambda[i];
+            }
             n += 1;
         }
         if n < 1 {
@@ -654,8 +657,14 @@ struct Polytope {
     maxfaces: usize,
     center: Vec3,
     map: Vec<usize>,
-    h_indices: Vec<usize>,
-    h_edges: Vec<usize>,
+    /// `map_dist2[k]` is `faces[map[k]].dist2`: the search for the nearest face reads the
+    /// distances in a row.
+    map_dist2: Vec<f64>,
+    /// `keys[i]` is vertex i's two feature indices in one word ([`feature_key`]): the repeated
+    /// support test of discrete geoms reads them in a row.
+    keys: Vec<u64>,
+    /// The horizon found by [`Self::horizon`]: (face, edge) pairs, one push per edge.
+    rim: Vec<(usize, usize)>,
     h_w: Vec3,
 }
 
@@ -677,17 +686,21 @@ enum PolytopeError {
 impl Polytope {
     fn reset(&mut self) {
         self.verts.clear();
+        self.keys.clear();
         self.faces.clear();
         self.map.clear();
-        self.h_indices.clear();
-        self.h_edges.clear();
+        self.map_dist2.clear();
+        self.rim.clear();
     }
 
+    #[inline(always)]
     fn insert(&mut self, v: Vertex) -> usize {
+        self.keys.push(feature_key(&v));
         self.verts.push(v);
         self.verts.len() - 1
     }
 
+    #[inline(always)]
     fn epa_support(&mut self, o1: &mut CcdObj, o2: &mut CcdObj, d: &Vec3, dnorm: f64) -> usize {
         let (mut dir, mut dir_neg) = (Vec3::x(), -Vec3::x());
         if dnorm > MINVAL {
@@ -701,14 +714,21 @@ impl Polytope {
     /// Appends face (v1, v2, v3) with its adjacency; returns its squared distance (0: degenerate).
     #[inline(always)]
     fn attach(&mut self, v1: usize, v2: usize, v3: usize, a1: usize, a2: usize, a3: usize) -> f64 {
-        let mut face =
-            Face { verts: [v1, v2, v3], adj: [a1, a2, a3], v: Vec3::zeros(), dist2: 0.0, index: -1 };
-        let ret = project_origin_plane(&self.verts[v3].vert, &self.verts[v2].vert, &self.verts[v1].vert);
+        let (p1, p2, p3) = (self.verts[v1].vert, self.verts[v2].vert, self.verts[v3].vert);
+        self.attach_at([v1, v2, v3], [&p1, &p2, &p3], [a1, a2, a3])
+    }
+
+    /// [`Self::attach`] of face `verts` whose vertices' points `pts` the caller holds (no
+    /// look-ups), adjacency `adj`.
+    #[inline(always)]
+    fn attach_at(&mut self, verts: [usize; 3], pts: [&Vec3; 3], adj: [usize; 3]) -> f64 {
+        let mut face = Face { verts, adj, v: Vec3::zeros(), dist2: 0.0, index: -1 };
+        let ret = project_origin_plane(pts[2], pts[1], pts[0]);
         let Some(mut v) = ret else {
             self.faces.push(face);
             return 0.0;
         };
-        let outward = self.verts[v1].vert - self.center;
+        let outward = pts[0] - self.center;
         if v.dot(&outward) < 0.0 {
             v *= -1.0;
         }
@@ -718,26 +738,41 @@ impl Polytope {
         face.dist2
     }
 
+    #[inline(always)]
     fn populate_map(&mut self) {
         self.map.clear();
+        self.map_dist2.clear();
         for i in 0..self.faces.len() {
             self.map.push(i);
+            self.map_dist2.push(self.faces[i].dist2);
             self.faces[i].index = i as i64;
         }
     }
 
+    /// Puts face `f` at the end of the map.
+    #[inline(always)]
+    fn map_push(&mut self, f: usize) {
+        self.faces[f].index = self.map.len() as i64;
+        self.map.push(f);
+        self.map_dist2.push(self.faces[f].dist2);
+    }
+
+    #[inline(always)]
     fn delete_face(&mut self, f: usize) {
         let idx = self.faces[f].index;
         if idx >= 0 {
             let last = self.map.pop().expect("a face in the map");
+            let last_dist2 = self.map_dist2.pop().expect("a distance per face in the map");
             if (idx as usize) < self.map.len() {
                 self.map[idx as usize] = last;
+                self.map_dist2[idx as usize] = last_dist2;
                 self.faces[last].index = idx;
             }
         }
         self.faces[f].index = -2;
     }
 
+    #[inline(always)]
     fn get_edge(&self, f: usize, vertex: usize) -> usize {
         let v = self.faces[f].verts;
         if v[0] == vertex {
@@ -750,17 +785,19 @@ impl Polytope {
     }
 
     fn horizon_rec(&mut self, f: usize, e: usize) -> bool {
-        let face = self.faces[f];
-        if face.v.dot(&self.h_w) - face.dist2 > MINVAL {
+        // Only the face's projection and distance for the test; its edges once it is deleted.
+        let (v, dist2) = (self.faces[f].v, self.faces[f].dist2);
+        if v.dot(&self.h_w) - dist2 > MINVAL {
+            let (adjs, verts) = (self.faces[f].adj, self.faces[f].verts);
             self.delete_face(f);
-            for k in 1..3 {
-                let i = (e + k) % 3;
-                let adj = face.adj[i];
+            // Edges e + 1 and e + 2 (mod 3), in that order.
+            let i1 = NEXT3[e];
+            for i in [i1, NEXT3[i1]] {
+                let adj = adjs[i];
                 if self.faces[adj].index > -2 {
-                    let adj_edge = self.get_edge(adj, face.verts[(i + 1) % 3]);
+                    let adj_edge = self.get_edge(adj, verts[NEXT3[i]]);
                     if !self.horizon_rec(adj, adj_edge) {
-                        self.h_indices.push(adj);
-                        self.h_edges.push(adj_edge);
+                        self.rim.push((adj, adj_edge));
                     }
                 }
             }
@@ -776,8 +813,7 @@ impl Polytope {
             let adj = face.adj[a];
             let adj_edge = self.get_edge(adj, face.verts[vert]);
             if (a == 0 || self.faces[adj].index > -2) && !self.horizon_rec(adj, adj_edge) {
-                self.h_indices.push(adj);
-                self.h_edges.push(adj_edge);
+                self.rim.push((adj, adj_edge));
             }
         }
     }
@@ -876,22 +912,24 @@ impl Polytope {
     }
 
     fn polytope4(&mut self, st: &mut Status, o1: &mut CcdObj, o2: &mut CcdObj) -> Result<(), PolytopeError> {
-        let v1 = self.insert(st.simplex[0]);
-        let v2 = self.insert(st.simplex[1]);
-        let v3 = self.insert(st.simplex[2]);
-        let v4 = self.insert(st.simplex[3]);
-        let p = |i: usize| self.verts[i].vert;
-        self.center = (p(v1) + p(v2) + p(v3) + p(v4)) * 0.25;
+        // The four simplex vertices appended at once (indices v1..v4 in order).
+        let v1 = self.verts.len();
+        self.verts.extend_from_slice(&st.simplex);
+        self.keys.extend(st.simplex.iter().map(feature_key));
+        // The points held here, not looked up in the polytope.
+        let q = st.simplex.map(|v| v.vert);
+        self.center = (q[0] + q[1] + q[2] + q[3]) * 0.25;
+        // Faces (1, 2, 3), (1, 4, 2), (1, 3, 4), (4, 3, 2) of the simplex, with their adjacency.
         let faces =
-            [(v1, v2, v3, 1, 3, 2), (v1, v4, v2, 2, 3, 0), (v1, v3, v4, 0, 3, 1), (v4, v3, v2, 2, 0, 1)];
-        for (a, b, c, x, y, z) in faces {
-            if self.attach(a, b, c, x, y, z) < MINVAL * MINVAL {
-                self.replace_simplex3(st, a, b, c);
+            [([0, 1, 2], [1, 3, 2]), ([0, 3, 1], [2, 3, 0]), ([0, 2, 3], [0, 3, 1]), ([3, 2, 1], [2, 0, 1])];
+        for (f, adj) in faces {
+            let verts = f.map(|i| v1 + i);
+            if self.attach_at(verts, f.map(|i| &q[i]), adj) < MINVAL * MINVAL {
+                self.replace_simplex3(st, verts[0], verts[1], verts[2]);
                 return self.polytope3(st, o1, o2);
             }
         }
-        let p = |i: usize| self.verts[i].vert;
-        if !test_tetra(&p(v1), &p(v2), &p(v3), &p(v4)) {
+        if !test_tetra(&q[0], &q[1], &q[2], &q[3]) {
             return Err(PolytopeError::MissingOrigin);
         }
         self.populate_map();
@@ -909,10 +947,10 @@ impl Polytope {
         for k in 0..kmax {
             let pface = face;
             let mut lower2 = MAX_LIMIT;
-            for &f in &self.map {
-                if self.faces[f].dist2 < lower2 {
+            for (&f, &dist2) in self.map.iter().zip(&self.map_dist2) {
+                if dist2 < lower2 {
                     face = Some(f);
-                    lower2 = self.faces[f].dist2;
+                    lower2 = dist2;
                 }
             }
             let Some(f) = face.filter(|_| lower2 <= upper2) else {
@@ -925,8 +963,8 @@ impl Polytope {
             let lower = lower2.sqrt();
             let fv = self.faces[f].v;
             let wi = self.epa_support(o1, o2, &fv, lower);
-            let w = self.verts[wi];
-            let upper_k = fv.dot(&w.vert) / lower;
+            let w_vert = self.verts[wi].vert;
+            let upper_k = fv.dot(&w_vert) / lower;
             if upper_k < upper {
                 upper = upper_k;
                 upper2 = upper * upper;
@@ -939,14 +977,13 @@ impl Polytope {
                 }
                 break;
             }
-            if discrete && self.verts[..wi].iter().any(|v| v.index1 == w.index1 && v.index2 == w.index2) {
+            if discrete && self.keys[..wi].contains(&self.keys[wi]) {
                 break;
             }
-            self.h_w = w.vert;
-            self.h_indices.clear();
-            self.h_edges.clear();
+            self.h_w = w_vert;
+            self.rim.clear();
             self.horizon(f);
-            let nedges = self.h_indices.len();
+            let nedges = self.rim.len();
             if nedges < 3 {
                 face = None;
                 break;
@@ -957,20 +994,20 @@ impl Polytope {
             }
             for i in 0..nedges {
                 let cur = nfaces + i;
-                let (hi, he) = (self.h_indices[i], self.h_edges[i]);
+                let (hi, he) = self.rim[i];
                 let hv = self.faces[hi].verts;
-                let (v1, v2) = (hv[he], hv[(he + 1) % 3]);
+                let (v1, v2) = (hv[he], hv[NEXT3[he]]);
                 self.faces[hi].adj[he] = cur;
                 let prev = if i == 0 { nfaces + nedges - 1 } else { cur - 1 };
-                let next = nfaces + (i + 1) % nedges;
-                let dist2 = self.attach(wi, v2, v1, prev, hi, next);
+                let next = if i + 1 == nedges { nfaces } else { cur + 1 };
+                let (p2, p1) = (self.verts[v2].vert, self.verts[v1].vert);
+                let dist2 = self.attach_at([wi, v2, v1], [&w_vert, &p2, &p1], [prev, hi, next]);
                 if dist2 == 0.0 {
                     face = None;
                     break;
                 }
                 if dist2 >= lower2 && dist2 <= upper2 {
-                    self.faces[cur].index = self.map.len() as i64;
-                    self.map.push(cur);
+                    self.map_push(cur);
                 }
             }
             if self.map.is_empty() || face.is_none() {
@@ -995,6 +1032,15 @@ impl Polytope {
         let x2 = lincomb(&l, [&a.vert2, &b.vert2, &c.vert2, &c.vert2]);
         (x1, x2, -face.dist2.sqrt())
     }
+}
+
+/// The next corner of a triangle: `NEXT3[i]` is (i + 1) mod 3 (a table, not a division).
+const NEXT3: [usize; 3] = [1, 2, 0];
+
+/// A vertex's two feature indices (geom 1's, geom 2's) in one word: equal keys, equal pairs.
+#[inline(always)]
+fn feature_key(v: &Vertex) -> u64 {
+    (u64::from(v.index1 as u32) << 32) | u64::from(v.index2 as u32)
 }
 
 /// The rotation by 120° about `axis` (row-major as MuJoCo's `rotmat`).

@@ -69,14 +69,14 @@ fn normalize3(v: Vec3) -> Vec3 {
 }
 
 /// The dimension (1, 2, 3) of a geom's feature from its three indices, the second distinct one
-/// moved into the second place (with its point) as MuJoCo's `simplexDim` does.
-fn simplex_dim(vi: &mut [i32; 3], v: &mut [Vec3; 3]) -> usize {
+/// moved into the second place as MuJoCo's `simplexDim` does (the vertices' points, formed from
+/// the indices after it, follow them).
+fn simplex_dim(vi: &mut [i32; 3]) -> usize {
     if vi[0] == vi[1] {
         if vi[0] == vi[2] {
             return 1;
         }
         vi[1] = vi[2];
-        v[1] = v[2];
         return 2;
     }
     if vi[2] == vi[0] || vi[2] == vi[1] {
@@ -238,8 +238,17 @@ fn edge_face(edges: &[(Vec3, Vec3)], faces: &[(Vec3, u32)]) -> Option<(usize, us
 }
 
 /// Whether every index of `vi` names a vertex of `poly`.
+#[inline]
 fn valid(poly: &Poly, vi: &[i32; 3]) -> bool {
-    vi.iter().all(|&v| v >= 0 && (v as usize) < poly.nvert())
+    let n = poly.nvert();
+    let ok = |v: i32| usize::try_from(v).is_ok_and(|v| v < n);
+    ok(vi[0]) && ok(vi[1]) && ok(vi[2])
+}
+
+/// The world points of the vertices `vi` of `poly` at pose `x`.
+#[inline]
+fn world_points(poly: &Poly, x: &Transform, vi: &[i32; 3]) -> [Vec3; 3] {
+    vi.map(|i| x.act_point(&poly.vertex(i as u32)))
 }
 
 /// The features of geoms 1 (`p1` at `x1`) and 2 to clip against each other, from EPA's final
@@ -260,10 +269,8 @@ pub(crate) fn aligned_features(
     if !valid(p1, &vi1) || !valid(p2, &vi2) || !p1.has_faces() || !p2.has_faces() {
         return None;
     }
-    let mut v1 = vi1.map(|i| x1.act_point(&p1.vertex(i as u32)));
-    let mut v2 = vi2.map(|i| x2.act_point(&p2.vertex(i as u32)));
-    let dim1 = simplex_dim(&mut vi1, &mut v1);
-    let dim2 = simplex_dim(&mut vi2, &mut v2);
+    let dim1 = simplex_dim(&mut vi1);
+    let dim2 = simplex_dim(&mut vi2);
     let (dir, dir_neg) = (w2 - w1, w1 - w2);
     candidate_faces(p1, x1, dim1, &vi1, &dir_neg, &mut s.normals1);
     candidate_faces(p2, x2, dim2, &vi2, &dir, &mut s.normals2);
@@ -283,13 +290,16 @@ pub(crate) fn aligned_features(
     }
     // An edge of the lower-dimensional feature (geom 1's of equals) against a face of the other,
     // then, failing that, an edge of geom 2 against a face of geom 1.
+    // The vertices' world points, formed only for the edges.
     if dim1 < 3 && dim1 <= dim2 {
+        let v1 = world_points(p1, x1, &vi1);
         candidate_edges(p1, x1, dim1, &v1, vi1[0], &mut s.edges);
         if let Some((e, j)) = edge_face(&s.edges, &s.normals2) {
             return Some((Feature::Edge([v1[0], s.edges[e].1]), face_of(s.normals2[j])));
         }
     }
     if dim2 < 3 {
+        let v2 = world_points(p2, x2, &vi2);
         candidate_edges(p2, x2, dim2, &v2, vi2[0], &mut s.edges);
         let (e, i) = edge_face(&s.edges, &s.normals1)?;
         return Some((face_of(s.normals1[i]), Feature::Edge([v2[0], s.edges[e].1])));
@@ -307,7 +317,6 @@ pub(crate) fn geom2_faces(p2: &Poly, x2: &Transform, face: &EpaFace, dir: &Vec3,
     if !valid(p2, &vi2) || !p2.has_faces() {
         return;
     }
-    let mut v2 = vi2.map(|i| x2.act_point(&p2.vertex(i as u32)));
-    let dim2 = simplex_dim(&mut vi2, &mut v2);
+    let dim2 = simplex_dim(&mut vi2);
     candidate_faces(p2, x2, dim2, &vi2, dir, out);
 }

@@ -276,9 +276,21 @@ fn feature_faces(
 
 /// The world polygon of face `f` (clockwise seen from outside) into `out`.
 fn face_polygon(poly: &Poly, x: &Transform, f: u32, tmp: &mut Vec<u32>, out: &mut Vec<Vec3>) {
-    poly.face_vertices(f, tmp);
     out.clear();
-    out.extend(tmp.iter().map(|&v| x.act_point(&poly.vertex(v))));
+    match poly {
+        // A hull's polygon read backwards straight into world points (no index list first).
+        Poly::Hull(s) => {
+            let points = s.points();
+            out.extend(s.graph().polygon(f as usize).iter().rev().map(|&v| {
+                let p = points[v as usize];
+                x.act_point(&Vec3::new(p.x, p.y, p.z))
+            }));
+        }
+        Poly::Cuboid(_) => {
+            poly.face_vertices(f, tmp);
+            out.extend(tmp.iter().map(|&v| x.act_point(&poly.vertex(v))));
+        }
+    }
 }
 
 /// The edges of a feature of one or two vertices as (start, end) world points: the edge itself,
@@ -325,7 +337,7 @@ pub(crate) fn polytope_contacts(
     first: PairPoint,
     face: Option<&EpaFace>,
     margin: f64,
-    emit: &mut dyn FnMut(PairPoint),
+    emit: &mut impl FnMut(PairPoint),
 ) -> usize {
     let (Some(p1), Some(p2)) = (Poly::of(s1), Poly::of(s2)) else {
         emit(first);
@@ -477,7 +489,7 @@ fn clip_segment_on_face(
     n2: &Vec3,
     margin: f64,
     inflated: f64,
-    emit: &mut dyn FnMut(PairPoint),
+    emit: &mut impl FnMut(PairPoint),
 ) -> usize {
     let mut count = 0;
     let n2 = *n2;
@@ -518,7 +530,7 @@ fn clip(
     cap: bool,
     poly: &mut Vec<Vec3>,
     scratch: &mut super::polygon_clip::ClipScratch,
-    out: &mut dyn FnMut(Vec3, Vec3, f64),
+    out: &mut impl FnMut(Vec3, Vec3, f64),
 ) {
     if face.len() < 3 {
         return;
@@ -643,7 +655,7 @@ pub(crate) fn convex_contacts(
     first: PairPoint,
     face: Option<&EpaFace>,
     margin_gap: f64,
-    emit: &mut dyn FnMut(PairPoint),
+    emit: &mut impl FnMut(PairPoint),
 ) {
     let polytopes = Poly::of(s1).is_some() && Poly::of(s2).is_some();
     if polytopes {
@@ -715,7 +727,7 @@ fn edge_cap(
     first: &PairPoint,
     face: Option<&EpaFace>,
     margin: f64,
-    emit: &mut dyn FnMut(PairPoint),
+    emit: &mut impl FnMut(PairPoint),
 ) -> usize {
     let Some(f) = face else { return 0 };
     let idx = f.index2[0];
@@ -800,7 +812,7 @@ fn cap_polytope(
     p2: &Poly,
     first: PairPoint,
     margin: f64,
-    emit: &mut dyn FnMut(PairPoint),
+    emit: &mut impl FnMut(PairPoint),
 ) {
     let axis = x1.rot.column(2).into_owned();
     let (e1, e2) = (x1.rot.column(0).into_owned(), x1.rot.column(1).into_owned());
@@ -859,7 +871,7 @@ fn segment_polytope(
     first: PairPoint,
     face: Option<&EpaFace>,
     margin: f64,
-    emit: &mut dyn FnMut(PairPoint),
+    emit: &mut impl FnMut(PairPoint),
 ) {
     let n = first.normal;
     let emitted = SCRATCH.with(|s| {
