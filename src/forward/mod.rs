@@ -14,7 +14,9 @@
 //! Which stages run is decided once by the [`Plan`]; [`forward`] walks it. Without constraint rows
 //! the position and velocity stages are skipped and ABA gives `qacc_smooth` directly (M is never
 //! built); `qacc` = `qacc_smooth` then. A model whose only rows are joint limits takes the same
-//! ABA path at every state where no joint is at a limit. `qfrc_applied`, `ctrl` and `act` are
+//! ABA path at every state where no joint is at a limit, unless the stepper asks for M
+//! (`ForwardSkip::mass_wanted`: the implicitly damped Euler step, which factors M anyway), when
+//! the position and velocity stages form M, its factor and the bias without rows. `qfrc_applied`, `ctrl` and `act` are
 //! inputs set by the caller (`act` by the integrators, from their state).
 
 mod activation;
@@ -107,6 +109,15 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         data.forward_skip.m_path
     };
     data.forward_skip.m_path = m_path;
+    // M formed without rows, at a stepper's request (`ForwardSkip::mass_wanted`): the position
+    // and velocity stages' smooth parts and the acceleration by the factor, no solver (a model
+    // without constraints skips those stages: ABA there).
+    let mass = if skip == SkipStage::None {
+        m_path || (data.forward_skip.mass_wanted && plan.has_constraints())
+    } else {
+        data.forward_skip.mass_formed
+    };
+    data.forward_skip.mass_formed = mass;
     for stage in &plan.stages {
         if stage.status != Status::Runs {
             continue;
@@ -115,23 +126,27 @@ pub(crate) fn forward_at(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
             StageKind::Position | StageKind::Velocity | StageKind::Passive if skip == SkipStage::Velocity => {
             }
             StageKind::Position if skip == SkipStage::Position => {}
-            StageKind::Position if m_path => {
+            StageKind::Position if mass => {
                 crba_unchecked(model, data, q);
                 factorize_mass_matrix(model, data);
-                solver.positions(rows, model, data, q);
+                if m_path {
+                    solver.positions(rows, model, data, q);
+                }
             }
-            StageKind::Velocity if m_path => {
+            StageKind::Velocity if mass => {
                 bias_forces_unchecked(model, data, q, v);
                 data.qfrc_bias.copy_from(&data.tau);
                 // RNEA left the body velocities at v in `v_body`.
-                solver.velocities(rows, model, data, q, v);
+                if m_path {
+                    solver.velocities(rows, model, data, q, v);
+                }
             }
             StageKind::Passive => passive(model, data, q, v),
             StageKind::Actuation => actuation_unchecked(model, data, q, v, &plan.actuator_bias_velocity),
             // Sleeping islands: with every tree asleep nothing accelerates (MuJoCo skips the
             // sleeping dofs' smooth dynamics).
             StageKind::Acceleration if !m_path && data.sleep.all_asleep(model) => data.qacc_smooth.fill(0.0),
-            StageKind::Acceleration => acceleration(model, data, q, v, m_path),
+            StageKind::Acceleration => acceleration(model, data, q, v, mass),
             StageKind::Constraint if m_path => solver.solve(model, data),
             // Row sources are built by the position stage; the rest are listings.
             _ => {}

@@ -29,4 +29,12 @@ pub(crate) struct ForwardSkip {
     /// Whether the last `forward_at` took the M path (rows existed): a skipped position stage
     /// keeps its answer.
     pub m_path: bool,
+    /// A stepper's request that the next `forward_at` form M and its factor even where no row
+    /// exists (the M path without the solver) instead of ABA: the implicitly damped Euler step
+    /// factors M again anyway, and CRBA, the factor and RNEA cost less than ABA followed by
+    /// CRBA. Set and cleared around the call by the stepper (`integrate::euler`).
+    pub mass_wanted: bool,
+    /// Whether the last `forward_at` formed M and its factor at its q (rows existed, or
+    /// [`mass_wanted`](Self::mass_wanted)): a skipped position stage keeps this answer too.
+    pub mass_formed: bool,
 }

@@ -1,7 +1,9 @@
 //! Semi-implicit (symplectic) Euler: v ← v + h·v̇(q, v); q ← q ⊕ h·v (first order; MuJoCo's
 //! default `Euler`). As MuJoCo's (`<flag eulerdamp>`, on by default; MuJoCo documentation,
 //! "Computation → Numerical integration"), joint damping is integrated implicitly:
-//! v ← v + h (M + h·diag(damping))⁻¹ M v̇, which keeps strongly damped joints stable.
+//! v ← v + h (M + h·diag(damping))⁻¹ M v̇, which keeps strongly damped joints stable. As
+//! MuJoCo's `mj_forward` does, the evaluation then forms M and its factor also where no
+//! constraint row exists (the M path instead of ABA), since the step needs M anyway.
 
 use super::{correct_drift, Advance, State, StepReport, Stepper};
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix_damped, solve_with_factor_unchecked};
@@ -43,14 +45,19 @@ impl Advance for SemiImplicitEuler {
 
     fn advance(&mut self, model: &Model, data: &mut Data, state: &mut State, h: f64) -> StepReport {
         data.act.copy_from(&state.act);
+        let flags = &model.options.flags;
+        let damped = flags.eulerdamp && flags.damper && model.has_damping();
+        // The damped step factors M at q anyway: `forward` forms it (and RNEA's bias) where no
+        // row exists too, instead of ABA and CRBA again below (`ForwardSkip::mass_wanted`).
+        data.forward_skip.mass_wanted = damped;
         forward_at(model, data, state.q.as_slice(), state.v.as_slice());
+        data.forward_skip.mass_wanted = false;
         // MuJoCo's mj_step: the sensors of the state the step starts from.
         crate::sensor::compute_at(model, data, state.q.as_slice(), state.v.as_slice(), state.time);
         advance_activations(model, state.act.as_mut_slice(), data.act_dot.as_slice(), h);
         // MuJoCo's mj_advance: islands at rest fall asleep (their v zeroed) before v advances.
         crate::forward::sleep::sleep_islands(model, data, state.q.as_slice(), state.v.as_mut_slice());
-        let flags = &model.options.flags;
-        if flags.eulerdamp && flags.damper && model.has_damping() {
+        if damped {
             damped_acceleration(model, data, state.q.as_slice(), &mut self.damped, h);
             state.v.axpy(h, &self.damped, 1.0);
         } else {
@@ -68,9 +75,9 @@ impl Advance for SemiImplicitEuler {
 /// the factor's storage (`factorize_mass_matrix_damped`), so M itself stays as CRBA gave it and
 /// `data.mass_factor` holds the factor of the damped matrix afterwards.
 fn damped_acceleration(model: &Model, data: &mut Data, q: &[f64], out: &mut DVector<f64>, h: f64) {
-    // M at q: the position stage's own when `forward` took the M path there (CRBA again would
-    // give the same bits), else formed here.
-    if !data.forward_skip.m_path {
+    // M at q: the position stage's own when `forward` formed it there (CRBA again would give the
+    // same bits), else formed here.
+    if !data.forward_skip.mass_formed {
         crba_unchecked(model, data, q);
     }
     mass_times(out, &data.mass_matrix, &data.qacc);

@@ -66,9 +66,9 @@ pub(super) fn implicit_acceleration(
     if !damped && actuator_bias_velocity.is_none() {
         return false;
     }
-    // M at q: the position stage's own when `forward` took the M path there (CRBA again would
+    // M at q: the position stage's own when `forward` formed it there (CRBA again would
     // give the same bits), else formed here.
-    if !data.forward_skip.m_path {
+    if !data.forward_skip.mass_formed {
         crba_unchecked(model, data, q);
     }
     out.gemv(1.0, &data.mass_matrix, &data.qacc, 0.0);
