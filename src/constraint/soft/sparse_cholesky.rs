@@ -588,8 +588,13 @@ impl SparseCholesky {
         // positions n − 1 − j (counting sort; a row's order does not matter below).
         self.p_start.clear();
         self.p_start.resize(n + 1, 0);
-        for &k in &self.h_cols {
-            self.p_start[n - k] += 1;
+        // (An unchanged component's rows are left out: only the rows analyzed anew read P H P.)
+        for j in 0..n {
+            if !self.same[j] {
+                for &k in &self.h_cols[self.h_start[j]..self.h_start[j + 1]] {
+                    self.p_start[n - k] += 1;
+                }
+            }
         }
         for p in 0..n {
             self.p_start[p + 1] += self.p_start[p];
@@ -600,7 +605,7 @@ impl SparseCholesky {
         {
             let (next, p_cols) = (self.h_count.as_mut_slice(), self.p_cols.as_mut_slice());
             let (h_start, h_cols) = (self.h_start.as_slice(), self.h_cols.as_slice());
-            for j in 0..n {
+            for j in (0..n).filter(|&j| !self.same[j]) {
                 for &k in &h_cols[h_start[j]..h_start[j + 1]] {
                     let p = n - 1 - k;
                     p_cols[next[p]] = n - 1 - j;
@@ -872,7 +877,22 @@ impl SparseCholesky {
                     }
                 }
             }
-            if ok && live.iter().any(|&l| l) {
+            if ok && live.iter().all(|&l| l) {
+                // Every vector rotates this column (the usual case): the same products in the
+                // same order without the per-vector test.
+                let (a, b) = (self.c_start[k], self.c_start[k + 1]);
+                for (&i, l_ik) in self.c_rows[a..b].iter().zip(&mut self.c_vals[a..b]) {
+                    let x = &mut xb[RANK * i..RANK * i + K];
+                    let mut l = *l_ik;
+                    for v in 0..K {
+                        let [c, s, signed_s, inv_c] = rot[v];
+                        let x_i = x[v];
+                        l = (l + signed_s * x_i) * inv_c;
+                        x[v] = c * x_i - s * l;
+                    }
+                    *l_ik = l;
+                }
+            } else if ok && live.iter().any(|&l| l) {
                 let (a, b) = (self.c_start[k], self.c_start[k + 1]);
                 for (&i, l_ik) in self.c_rows[a..b].iter().zip(&mut self.c_vals[a..b]) {
                     let x = &mut xb[RANK * i..RANK * i + K];
