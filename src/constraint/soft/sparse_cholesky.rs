@@ -110,6 +110,10 @@ pub(crate) struct SparseCholesky {
     old_parent: Vec<usize>,
     old_l_start: Vec<usize>,
     old_l_cols: Vec<usize>,
+    /// The analysis before's L by columns and each row entry's slot there.
+    old_c_start: Vec<usize>,
+    old_c_rows: Vec<usize>,
+    old_c_slot: Vec<usize>,
     /// Whether the symbolic structure (H's and L's patterns, the elimination tree) is set.
     analyzed: bool,
     /// Whether the analyzed pattern is one kept for cliques it covers (`covers_cliques`): it may
@@ -164,6 +168,9 @@ impl SparseCholesky {
             old_parent: Vec::with_capacity(n),
             old_l_start: Vec::with_capacity(n + 1),
             old_l_cols: Vec::with_capacity(nnz),
+            old_c_start: Vec::with_capacity(n + 1),
+            old_c_rows: Vec::with_capacity(nnz),
+            old_c_slot: Vec::with_capacity(nnz),
             analyzed: false,
             kept_wider: false,
             analyses: 0,
@@ -652,10 +659,23 @@ impl SparseCholesky {
         self.l_start = l_start;
         self.l_cols = l_cols;
         let nnz = self.l_cols.len();
+        // (The last analysis's columns: an unchanged component's are copied. Its positions'
+        // entries lie in its own rows and columns only.)
+        std::mem::swap(&mut self.c_start, &mut self.old_c_start);
+        std::mem::swap(&mut self.c_rows, &mut self.old_c_rows);
+        std::mem::swap(&mut self.c_slot, &mut self.old_c_slot);
+        let same_at = |same: &[bool], p: usize| same[n - 1 - p];
         self.c_start.clear();
         self.c_start.resize(n + 1, 0);
-        for &j in &self.l_cols {
-            self.c_start[j + 1] += 1;
+        for k in 0..n {
+            if same_at(&self.same, k) {
+                // Column k's count as before.
+                self.c_start[k + 1] += self.old_c_start[k + 1] - self.old_c_start[k];
+            } else {
+                for &j in &self.l_cols[self.l_start[k]..self.l_start[k + 1]] {
+                    self.c_start[j + 1] += 1;
+                }
+            }
         }
         for j in 0..n {
             self.c_start[j + 1] += self.c_start[j];
@@ -667,11 +687,19 @@ impl SparseCholesky {
         overwrite_len(&mut self.c_rows, nnz);
         overwrite_len(&mut self.c_vals, nnz);
         overwrite_len(&mut self.c_slot, nnz);
-        // L by columns: rows taken in ascending order, so each column's rows ascend.
+        // L by columns: rows taken in ascending order, so each column's rows ascend (an
+        // unchanged column's rows as before).
         {
             let (next, c_rows) = (self.h_count.as_mut_slice(), self.c_rows.as_mut_slice());
             let (l_start, l_cols) = (self.l_start.as_slice(), self.l_cols.as_slice());
+            let (same, old_start, old_rows) =
+                (self.same.as_slice(), self.old_c_start.as_slice(), self.old_c_rows.as_slice());
             for k in 0..n {
+                if same_at(same, k) {
+                    let old = &old_rows[old_start[k]..old_start[k + 1]];
+                    c_rows[next[k]..next[k] + old.len()].copy_from_slice(old);
+                    continue;
+                }
                 for &j in &l_cols[l_start[k]..l_start[k + 1]] {
                     c_rows[next[j]] = k;
                     next[j] += 1;
@@ -680,14 +708,29 @@ impl SparseCholesky {
         }
         // L by rows again from its columns, taken in ascending order: each row's columns ascend
         // (two counting passes instead of a sort per row); and where each entry sits in the
-        // column storage. (`ancestor` is free scratch after the elimination tree.)
+        // column storage. (`ancestor` is free scratch after the elimination tree.) An unchanged
+        // row's columns ascend already (copied): its entries' slots are the old ones moved with
+        // their columns.
         self.ancestor.clear();
         self.ancestor.extend_from_slice(&self.l_start[..n]);
         {
             let next = self.ancestor.as_mut_slice();
+            let (l_start, old_l_start) = (self.l_start.as_slice(), self.old_l_start.as_slice());
             let (l_cols, c_slot) = (self.l_cols.as_mut_slice(), self.c_slot.as_mut_slice());
             let (c_start, c_rows) = (self.c_start.as_slice(), self.c_rows.as_slice());
+            let (same, old_c_start, old_slot) =
+                (self.same.as_slice(), self.old_c_start.as_slice(), self.old_c_slot.as_slice());
             for j in 0..n {
+                if same_at(same, j) {
+                    // Row j (unchanged): each entry's slot in its column, moved.
+                    let (a, b) = (l_start[j], l_start[j + 1]);
+                    let old = old_l_start[j];
+                    for u in a..b {
+                        let c = l_cols[u];
+                        c_slot[u] = old_slot[old + (u - a)] - old_c_start[c] + c_start[c];
+                    }
+                    continue;
+                }
                 for slot in c_start[j]..c_start[j + 1] {
                     let k = c_rows[slot];
                     let u = next[k];
@@ -697,17 +740,21 @@ impl SparseCholesky {
                 }
             }
         }
-        self.x.clear();
-        self.x.resize(n, 0.0);
-        self.xb.clear();
-        self.xb.resize(RANK * n, 0.0);
-        self.diag.clear();
-        self.diag.resize(n, 0.0);
-        // (H's values are written row by row before a factorization reads them.)
+        // The scratch rows are zero between calls: set only when the size changes.
+        if self.x.len() != n {
+            self.x.clear();
+            self.x.resize(n, 0.0);
+        }
+        if self.xb.len() != RANK * n {
+            self.xb.clear();
+            self.xb.resize(RANK * n, 0.0);
+        }
+        // (The diagonal and H's values are written before a factorization or solve reads them;
+        // the coverage stamps are all below the next one.)
+        overwrite_len(&mut self.diag, n);
         overwrite_len(&mut self.h_vals, self.h_cols.len());
         overwrite_len(&mut self.h_diag, n);
-        self.cover.clear();
-        self.cover.resize(n, 0);
+        overwrite_len(&mut self.cover, n);
         self.analyzed = true;
     }
 
