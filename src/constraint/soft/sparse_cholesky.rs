@@ -25,7 +25,10 @@
 //! the iterations of a Newton solve, whose pattern covers every row that can press, and across
 //! steps while the contacts touch the same dofs; [`SparseCholesky::factor_kept`] is then
 //! only the numeric factorization (MuJoCo likewise keeps its sparse Hessian's structure,
-//! engine_solver.c).
+//! engine_solver.c). When the cliques do change, the structure of every component of H's pattern
+//! (trees joined by cliques: the constraint islands) whose cliques are those of the last analysis
+//! is copied from it, and only the components whose contacts changed are analyzed — as MuJoCo's
+//! island solves analyze each island on its own.
 //!
 //! The arithmetic is the dense factorization's ([`crate::constraint::dense::cholesky`]) of
 //! P H P minus its products with structural zeros, in the same order: factor and solves agree
@@ -89,6 +92,28 @@ pub(crate) struct SparseCholesky {
     /// Stamps of the coverage test (`covers_cliques`): per dof, and the last one given.
     cover: Vec<usize>,
     stamp: usize,
+    /// The components of the analyzed pattern (the trees M couples, joined by the cliques): each
+    /// dof's component by its smallest dof, and each component's cliques (component r's are
+    /// `comp_cliques[comp_start[r]..comp_start[r + 1]]`, indices into the key, in order); the
+    /// same of the analysis before, and per dof whether its component is one of that analysis
+    /// unchanged (its structure is then copied: [`Self::analyze`]).
+    comp: Vec<usize>,
+    comp_start: Vec<usize>,
+    comp_cliques: Vec<usize>,
+    old_comp: Vec<usize>,
+    old_comp_start: Vec<usize>,
+    old_comp_cliques: Vec<usize>,
+    same: Vec<bool>,
+    /// The analysis before's H rows, elimination tree and L rows (read for unchanged components).
+    old_h_start: Vec<usize>,
+    old_h_cols: Vec<usize>,
+    old_parent: Vec<usize>,
+    old_l_start: Vec<usize>,
+    old_l_cols: Vec<usize>,
+    /// The analysis before's L by columns and each row entry's slot there.
+    old_c_start: Vec<usize>,
+    old_c_rows: Vec<usize>,
+    old_c_slot: Vec<usize>,
     /// Whether the symbolic structure (H's and L's patterns, the elimination tree) is set.
     analyzed: bool,
     /// Whether the analyzed pattern is one kept for cliques it covers (`covers_cliques`): it may
@@ -131,6 +156,21 @@ impl SparseCholesky {
             key_n: 0,
             cover: Vec::with_capacity(n),
             stamp: 0,
+            comp: Vec::with_capacity(n),
+            comp_start: Vec::with_capacity(n + 1),
+            comp_cliques: Vec::with_capacity(n),
+            old_comp: Vec::with_capacity(n),
+            old_comp_start: Vec::with_capacity(n + 1),
+            old_comp_cliques: Vec::with_capacity(n),
+            same: Vec::with_capacity(n),
+            old_h_start: Vec::with_capacity(n + 1),
+            old_h_cols: Vec::with_capacity(nnz),
+            old_parent: Vec::with_capacity(n),
+            old_l_start: Vec::with_capacity(n + 1),
+            old_l_cols: Vec::with_capacity(nnz),
+            old_c_start: Vec::with_capacity(n + 1),
+            old_c_rows: Vec::with_capacity(nnz),
+            old_c_slot: Vec::with_capacity(nnz),
             analyzed: false,
             kept_wider: false,
             analyses: 0,
@@ -267,9 +307,12 @@ impl SparseCholesky {
         }
         self.analyses += 1;
         self.kept_wider = false;
+        let incremental = self.analyzed && self.key_n == n;
+        // (The last analysis's cliques stay in `clique_start`/`clique_cols`.)
         std::mem::swap(&mut self.key_start, &mut self.clique_start);
         std::mem::swap(&mut self.key_cols, &mut self.clique_cols);
         self.key_n = n;
+        self.components(n, dof_parent, incremental);
         let ncliques = self.key_start.len() - 1;
         // Each dof's cliques (counting sort).
         self.d_start.clear();
@@ -298,6 +341,8 @@ impl SparseCholesky {
         self.mark.resize(n, NONE);
         // (The lists built here are owned locals and the others slices, so that their lengths
         // and addresses stay in registers across the stores.)
+        std::mem::swap(&mut self.h_start, &mut self.old_h_start);
+        std::mem::swap(&mut self.h_cols, &mut self.old_h_cols);
         let (mut h_start, mut h_cols) = (std::mem::take(&mut self.h_start), std::mem::take(&mut self.h_cols));
         h_start.clear();
         h_start.push(0);
@@ -306,7 +351,15 @@ impl SparseCholesky {
             let mark = self.mark.as_mut_slice();
             let (d_start, d_cliques) = (self.d_start.as_slice(), self.d_cliques.as_slice());
             let (key_start, key_cols) = (self.key_start.as_slice(), self.key_cols.as_slice());
+            let (same, old_start, old_cols) =
+                (self.same.as_slice(), self.old_h_start.as_slice(), self.old_h_cols.as_slice());
             for k in 0..n {
+                if same[k] {
+                    // An unchanged component's row: the last analysis's.
+                    h_cols.extend_from_slice(&old_cols[old_start[k]..old_start[k + 1]]);
+                    h_start.push(h_cols.len());
+                    continue;
+                }
                 mark[k] = k;
                 let mut l = dof_parent[k];
                 while l != NONE {
@@ -368,6 +421,8 @@ impl SparseCholesky {
         self.pattern_of_h(h, n);
         self.analyzed = false;
         self.kept_wider = false;
+        self.same.clear();
+        self.same.resize(n, false);
         self.symbolic(n);
         self.load(h);
         self.numeric(tol, None)
@@ -403,6 +458,91 @@ impl SparseCholesky {
                     self.h_count[i] += 1;
                 }
             }
+        }
+    }
+
+    /// The components of the pattern of the key's cliques (`comp`, `comp_start`,
+    /// `comp_cliques`: union–find over dofs, each tree's dofs joined from the start, each
+    /// clique's dofs joined; a component is named by its smallest dof) and, when `incremental`
+    /// (the analysis before was of n dofs too; its cliques in `clique_start`/`clique_cols`), which
+    /// dofs lie in a component of that analysis unchanged (`same`): one with the same smallest
+    /// dof and the same cliques in the same order — the same trees, so the same rows of H, the
+    /// same elimination subtree and the same rows of L, which are copied instead of computed.
+    fn components(&mut self, n: usize, dof_parent: &[usize], incremental: bool) {
+        std::mem::swap(&mut self.comp, &mut self.old_comp);
+        std::mem::swap(&mut self.comp_start, &mut self.old_comp_start);
+        std::mem::swap(&mut self.comp_cliques, &mut self.old_comp_cliques);
+        let comp = &mut self.comp;
+        comp.clear();
+        for k in 0..n {
+            // Parents come first: each dof points at its tree's root (itself at a root).
+            let t = if dof_parent[k] == NONE { k } else { comp[dof_parent[k]] };
+            comp.push(t);
+        }
+        fn find(comp: &mut [usize], mut x: usize) -> usize {
+            while comp[x] != x {
+                comp[x] = comp[comp[x]];
+                x = comp[x];
+            }
+            x
+        }
+        let (key_start, key_cols) = (self.key_start.as_slice(), self.key_cols.as_slice());
+        let ncliques = key_start.len() - 1;
+        for c in 0..ncliques {
+            let clique = &key_cols[key_start[c]..key_start[c + 1]];
+            let mut a = find(comp, clique[0]);
+            for &q in &clique[1..] {
+                let b = find(comp, q);
+                if a != b {
+                    // The smaller root stays: a component is named by its smallest dof.
+                    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                    comp[hi] = lo;
+                    a = lo;
+                }
+            }
+        }
+        for k in 0..n {
+            let r = find(comp, k);
+            comp[k] = r;
+        }
+        // Each component's cliques, in order (counting sort by component).
+        let starts = &mut self.comp_start;
+        starts.clear();
+        starts.resize(n + 1, 0);
+        for c in 0..ncliques {
+            starts[comp[key_cols[key_start[c]]] + 1] += 1;
+        }
+        for k in 0..n {
+            starts[k + 1] += starts[k];
+        }
+        self.h_count.clear();
+        self.h_count.extend_from_slice(&starts[..n]);
+        overwrite_len(&mut self.comp_cliques, ncliques);
+        for c in 0..ncliques {
+            let r = comp[key_cols[key_start[c]]];
+            self.comp_cliques[self.h_count[r]] = c;
+            self.h_count[r] += 1;
+        }
+        self.same.clear();
+        self.same.resize(n, false);
+        if !incremental || self.old_comp.len() != n {
+            return;
+        }
+        let (old_start, old_cols) = (self.clique_start.as_slice(), self.clique_cols.as_slice());
+        for k in 0..n {
+            let r = comp[k];
+            if r != k {
+                // (r < k: its flag is set.)
+                self.same[k] = self.same[r];
+                continue;
+            }
+            let new = &self.comp_cliques[starts[r]..starts[r + 1]];
+            let old = &self.old_comp_cliques[self.old_comp_start[r]..self.old_comp_start[r + 1]];
+            self.same[r] = self.old_comp[r] == r
+                && new.len() == old.len()
+                && new.iter().zip(old).all(|(&a, &b)| {
+                    key_cols[key_start[a]..key_start[a + 1]] == old_cols[old_start[b]..old_start[b + 1]]
+                });
         }
     }
 
@@ -455,8 +595,13 @@ impl SparseCholesky {
         // positions n − 1 − j (counting sort; a row's order does not matter below).
         self.p_start.clear();
         self.p_start.resize(n + 1, 0);
-        for &k in &self.h_cols {
-            self.p_start[n - k] += 1;
+        // (An unchanged component's rows are left out: only the rows analyzed anew read P H P.)
+        for j in 0..n {
+            if !self.same[j] {
+                for &k in &self.h_cols[self.h_start[j]..self.h_start[j + 1]] {
+                    self.p_start[n - k] += 1;
+                }
+            }
         }
         for p in 0..n {
             self.p_start[p + 1] += self.p_start[p];
@@ -467,7 +612,7 @@ impl SparseCholesky {
         {
             let (next, p_cols) = (self.h_count.as_mut_slice(), self.p_cols.as_mut_slice());
             let (h_start, h_cols) = (self.h_start.as_slice(), self.h_cols.as_slice());
-            for j in 0..n {
+            for j in (0..n).filter(|&j| !self.same[j]) {
                 for &k in &h_cols[h_start[j]..h_start[j + 1]] {
                     let p = n - 1 - k;
                     p_cols[next[p]] = n - 1 - j;
@@ -478,6 +623,8 @@ impl SparseCholesky {
         self.elimination_tree(n);
         self.mark.clear();
         self.mark.resize(n, NONE);
+        std::mem::swap(&mut self.l_start, &mut self.old_l_start);
+        std::mem::swap(&mut self.l_cols, &mut self.old_l_cols);
         let (mut l_start, mut l_cols) = (std::mem::take(&mut self.l_start), std::mem::take(&mut self.l_cols));
         l_start.clear();
         l_start.push(0);
@@ -485,7 +632,16 @@ impl SparseCholesky {
         {
             let (mark, parent) = (self.mark.as_mut_slice(), self.parent.as_slice());
             let (p_start, p_cols) = (self.p_start.as_slice(), self.p_cols.as_slice());
+            let (same, old_start, old_cols) =
+                (self.same.as_slice(), self.old_l_start.as_slice(), self.old_l_cols.as_slice());
             for k in 0..n {
+                if same[n - 1 - k] {
+                    // An unchanged component's row of L: the last analysis's (ascending; the
+                    // order does not matter here).
+                    l_cols.extend_from_slice(&old_cols[old_start[k]..old_start[k + 1]]);
+                    l_start.push(l_cols.len());
+                    continue;
+                }
                 // Row k's pattern: every dof reached from H's row k up the tree (all below k),
                 // in the order reached (sorted below).
                 mark[k] = k;
@@ -503,10 +659,23 @@ impl SparseCholesky {
         self.l_start = l_start;
         self.l_cols = l_cols;
         let nnz = self.l_cols.len();
+        // (The last analysis's columns: an unchanged component's are copied. Its positions'
+        // entries lie in its own rows and columns only.)
+        std::mem::swap(&mut self.c_start, &mut self.old_c_start);
+        std::mem::swap(&mut self.c_rows, &mut self.old_c_rows);
+        std::mem::swap(&mut self.c_slot, &mut self.old_c_slot);
+        let same_at = |same: &[bool], p: usize| same[n - 1 - p];
         self.c_start.clear();
         self.c_start.resize(n + 1, 0);
-        for &j in &self.l_cols {
-            self.c_start[j + 1] += 1;
+        for k in 0..n {
+            if same_at(&self.same, k) {
+                // Column k's count as before.
+                self.c_start[k + 1] += self.old_c_start[k + 1] - self.old_c_start[k];
+            } else {
+                for &j in &self.l_cols[self.l_start[k]..self.l_start[k + 1]] {
+                    self.c_start[j + 1] += 1;
+                }
+            }
         }
         for j in 0..n {
             self.c_start[j + 1] += self.c_start[j];
@@ -518,11 +687,19 @@ impl SparseCholesky {
         overwrite_len(&mut self.c_rows, nnz);
         overwrite_len(&mut self.c_vals, nnz);
         overwrite_len(&mut self.c_slot, nnz);
-        // L by columns: rows taken in ascending order, so each column's rows ascend.
+        // L by columns: rows taken in ascending order, so each column's rows ascend (an
+        // unchanged column's rows as before).
         {
             let (next, c_rows) = (self.h_count.as_mut_slice(), self.c_rows.as_mut_slice());
             let (l_start, l_cols) = (self.l_start.as_slice(), self.l_cols.as_slice());
+            let (same, old_start, old_rows) =
+                (self.same.as_slice(), self.old_c_start.as_slice(), self.old_c_rows.as_slice());
             for k in 0..n {
+                if same_at(same, k) {
+                    let old = &old_rows[old_start[k]..old_start[k + 1]];
+                    c_rows[next[k]..next[k] + old.len()].copy_from_slice(old);
+                    continue;
+                }
                 for &j in &l_cols[l_start[k]..l_start[k + 1]] {
                     c_rows[next[j]] = k;
                     next[j] += 1;
@@ -531,14 +708,29 @@ impl SparseCholesky {
         }
         // L by rows again from its columns, taken in ascending order: each row's columns ascend
         // (two counting passes instead of a sort per row); and where each entry sits in the
-        // column storage. (`ancestor` is free scratch after the elimination tree.)
+        // column storage. (`ancestor` is free scratch after the elimination tree.) An unchanged
+        // row's columns ascend already (copied): its entries' slots are the old ones moved with
+        // their columns.
         self.ancestor.clear();
         self.ancestor.extend_from_slice(&self.l_start[..n]);
         {
             let next = self.ancestor.as_mut_slice();
+            let (l_start, old_l_start) = (self.l_start.as_slice(), self.old_l_start.as_slice());
             let (l_cols, c_slot) = (self.l_cols.as_mut_slice(), self.c_slot.as_mut_slice());
             let (c_start, c_rows) = (self.c_start.as_slice(), self.c_rows.as_slice());
+            let (same, old_c_start, old_slot) =
+                (self.same.as_slice(), self.old_c_start.as_slice(), self.old_c_slot.as_slice());
             for j in 0..n {
+                if same_at(same, j) {
+                    // Row j (unchanged): each entry's slot in its column, moved.
+                    let (a, b) = (l_start[j], l_start[j + 1]);
+                    let old = old_l_start[j];
+                    for u in a..b {
+                        let c = l_cols[u];
+                        c_slot[u] = old_slot[old + (u - a)] - old_c_start[c] + c_start[c];
+                    }
+                    continue;
+                }
                 for slot in c_start[j]..c_start[j + 1] {
                     let k = c_rows[slot];
                     let u = next[k];
@@ -548,29 +740,40 @@ impl SparseCholesky {
                 }
             }
         }
-        self.x.clear();
-        self.x.resize(n, 0.0);
-        self.xb.clear();
-        self.xb.resize(RANK * n, 0.0);
-        self.diag.clear();
-        self.diag.resize(n, 0.0);
-        // (H's values are written row by row before a factorization reads them.)
+        // The scratch rows are zero between calls: set only when the size changes.
+        if self.x.len() != n {
+            self.x.clear();
+            self.x.resize(n, 0.0);
+        }
+        if self.xb.len() != RANK * n {
+            self.xb.clear();
+            self.xb.resize(RANK * n, 0.0);
+        }
+        // (The diagonal and H's values are written before a factorization or solve reads them;
+        // the coverage stamps are all below the next one.)
+        overwrite_len(&mut self.diag, n);
         overwrite_len(&mut self.h_vals, self.h_cols.len());
         overwrite_len(&mut self.h_diag, n);
-        self.cover.clear();
-        self.cover.resize(n, 0);
+        overwrite_len(&mut self.cover, n);
         self.analyzed = true;
     }
 
     /// Liu's algorithm: parent[i] = the first row k > i with L[k, i] ≠ 0.
     fn elimination_tree(&mut self, n: usize) {
+        std::mem::swap(&mut self.parent, &mut self.old_parent);
         self.parent.clear();
         self.parent.resize(n, NONE);
         self.ancestor.clear();
         self.ancestor.resize(n, NONE);
         let (parent, ancestor) = (self.parent.as_mut_slice(), self.ancestor.as_mut_slice());
         let (p_start, p_cols) = (self.p_start.as_slice(), self.p_cols.as_slice());
+        let (same, old_parent) = (self.same.as_slice(), self.old_parent.as_slice());
         for k in 0..n {
+            if same[n - 1 - k] {
+                // An unchanged component's positions: their parents (in the component) as before.
+                parent[k] = old_parent[k];
+                continue;
+            }
             for &j in &p_cols[p_start[k]..p_start[k + 1]] {
                 let mut i = j;
                 while i != NONE && i < k {
@@ -721,7 +924,22 @@ impl SparseCholesky {
                     }
                 }
             }
-            if ok && live.iter().any(|&l| l) {
+            if ok && live.iter().all(|&l| l) {
+                // Every vector rotates this column (the usual case): the same products in the
+                // same order without the per-vector test.
+                let (a, b) = (self.c_start[k], self.c_start[k + 1]);
+                for (&i, l_ik) in self.c_rows[a..b].iter().zip(&mut self.c_vals[a..b]) {
+                    let x = &mut xb[RANK * i..RANK * i + K];
+                    let mut l = *l_ik;
+                    for v in 0..K {
+                        let [c, s, signed_s, inv_c] = rot[v];
+                        let x_i = x[v];
+                        l = (l + signed_s * x_i) * inv_c;
+                        x[v] = c * x_i - s * l;
+                    }
+                    *l_ik = l;
+                }
+            } else if ok && live.iter().any(|&l| l) {
                 let (a, b) = (self.c_start[k], self.c_start[k + 1]);
                 for (&i, l_ik) in self.c_rows[a..b].iter().zip(&mut self.c_vals[a..b]) {
                     let x = &mut xb[RANK * i..RANK * i + K];
@@ -1046,6 +1264,45 @@ mod tests {
         own.solve(&mut want);
         assert_eq!(&kept[..3], &want[..3]);
         assert_eq!(&kept[3..], &rhs[3..]);
+    }
+
+    #[test]
+    fn an_analysis_that_copies_unchanged_components_equals_a_fresh_one() {
+        // Three trees 0 → 1 → 2, 3 → 4, 5 → 6 → 7 and dof 8 alone. First rows couple {2, 4} and
+        // {6, 8}; then {2, 4} stays and {6, 8} becomes {7, 8}: the component of trees 0 and 3
+        // is copied, the other analyzed, and the structure is the fresh analysis's.
+        let n = 9;
+        let dof_parent = [NONE, 0, 1, NONE, 3, NONE, 5, 6, NONE];
+        let (start_a, index_a) = ([0, 2, 4], [2, 4, 6, 8]);
+        let (start_b, index_b) = ([0, 2, 4], [2, 4, 7, 8]);
+        let groups = [(0, 0), (1, 1)];
+        let mut kept = SparseCholesky::default();
+        kept.analyze(n, &dof_parent, &groups, &start_a, &index_a);
+        kept.analyze(n, &dof_parent, &groups, &start_b, &index_b);
+        assert_eq!(kept.analyses(), 2);
+        assert_eq!(kept.same, [true, true, true, true, true, false, false, false, false]);
+        let mut fresh = SparseCholesky::default();
+        fresh.analyze(n, &dof_parent, &groups, &start_b, &index_b);
+        assert_eq!(fresh.same, [false; 9]);
+        assert_eq!((&kept.h_start, &kept.h_cols), (&fresh.h_start, &fresh.h_cols));
+        assert_eq!(kept.parent, fresh.parent);
+        assert_eq!((&kept.l_start, &kept.l_cols), (&fresh.l_start, &fresh.l_cols));
+        assert_eq!(
+            (&kept.c_start, &kept.c_rows, &kept.c_slot),
+            (&fresh.c_start, &fresh.c_rows, &fresh.c_slot)
+        );
+        // And it factors and solves as the fresh one.
+        let mut h = tree_matrix(&dof_parent);
+        for (a, b, v) in [(4, 2, 0.5), (8, 7, -0.3)] {
+            h[(a, b)] = v;
+            h[(b, a)] = v;
+        }
+        assert!(kept.factor_analyzed(&h) && fresh.factor_analyzed(&h));
+        let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).cos()).collect();
+        let (mut x1, mut x2) = (rhs.clone(), rhs);
+        kept.solve(&mut x1);
+        fresh.solve(&mut x2);
+        assert_eq!(x1, x2);
     }
 
     #[test]
