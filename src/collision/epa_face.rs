@@ -312,11 +312,33 @@ pub(crate) fn aligned_features(
 /// edge against a polytope), `dir` the contact direction from geom 1 to geom 2 (a box's
 /// fallback); empty when the face names no vertex of `p2` or a hull has no polygons.
 pub(crate) fn geom2_faces(p2: &Poly, x2: &Transform, face: &EpaFace, dir: &Vec3, out: &mut Vec<(Vec3, u32)>) {
+    geom2_feature(p2, x2, face, dir, out, None);
+}
+
+/// [`geom2_faces`], and with `edges` geom 2's feature edges (unit directions from its first
+/// vertex and far ends, MuJoCo's order; none for a face) with that first vertex. Returns the
+/// feature's dimension (0 when the face names no vertex of `p2` or a hull has no polygons).
+pub(crate) fn geom2_feature(
+    p2: &Poly,
+    x2: &Transform,
+    face: &EpaFace,
+    dir: &Vec3,
+    out: &mut Vec<(Vec3, u32)>,
+    edges: Option<(&mut Vec<(Vec3, Vec3)>, &mut Vec3)>,
+) -> usize {
     out.clear();
     let mut vi2 = face.index2;
     if !valid(p2, &vi2) || !p2.has_faces() {
-        return;
+        return 0;
     }
     let dim2 = simplex_dim(&mut vi2);
     candidate_faces(p2, x2, dim2, &vi2, dir, out);
+    if let Some((e, start)) = edges {
+        e.clear();
+        if dim2 < 3 {
+            candidate_edges(p2, x2, dim2, &v2, vi2[0], e);
+        }
+        *start = v2[0];
+    }
+    dim2
 }

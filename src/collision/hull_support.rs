@@ -6,7 +6,14 @@
 //! the result is the exhaustive scan's (vertices exactly as far apart along the direction may give
 //! another of them) at a cost that grows with the number of edges walked instead of the number of
 //! vertices. The hull, its vertex order and its edges' order are MuJoCo's mesh graph (qhull's,
-//! [`super::mesh_graph`]), so ties and warm starts walk as MuJoCo's climb does.
+//! [`super::mesh_graph`]), and the climb runs where MuJoCo's does — in MuJoCo's mesh frame (the
+//! mesh's centre of mass and principal axes), on the vertices' `f32` copies, from the grid seeds
+//! MuJoCo's compiler finds in that frame (`mesh_extrema`) — so ties, warm starts and the local
+//! maxima of a hull made slightly non-convex by the `f32` rounding walk as MuJoCo's climb does.
+//! (With the seeds and grid cells taken in the geom's file frame, the Robotiq 2F-85's spring link
+//! climbed from another seed across its flat face to a vertex 4.5e-10 m farther than MuJoCo's
+//! local maximum; EPA then ended on another face, one contact 6 mm from MuJoCo's:
+//! docs/multiccd.md.)
 
 use super::mesh_graph::MeshGraph;
 use parry3d_f64::math::Vector;
@@ -17,10 +24,17 @@ use std::sync::Arc;
 #[derive(Clone, Debug)]
 pub struct HullSupport {
     graph: Arc<MeshGraph>,
-    /// The hull's vertices (the graph's, as parry vectors: what the climbs read).
+    /// The hull's vertices (the graph's, geom frame, as parry vectors): the support points.
     points: Vec<Vector>,
-    /// Per grid direction (x, y, z in {−1, 0, 1}, index 9x + 3y + z after adding 1 to each), the
-    /// vertex farthest along it: the climb's start.
+    /// The hull's vertices as MuJoCo stores them (`f32` in its mesh frame,
+    /// [`MeshGraph::mujoco_vertices`]): what the climb compares, as MuJoCo's does.
+    mj_points: Vec<Vector>,
+    /// The transpose of the mesh frame's axes in the geom frame (`box_frame`): a geom-frame
+    /// direction into the mesh frame; None when the two frames' axes are the same.
+    mj_axes_t: Option<crate::spatial::Mat3>,
+    /// Per grid direction of the mesh frame (x, y, z in {−1, 0, 1}, index 9x + 3y + z after
+    /// adding 1 to each), the first vertex farthest along it in `f32` arithmetic on
+    /// `mj_points` (MuJoCo's `mesh_extrema`): the climb's start.
     extrema: [u32; 27],
     /// The hull vertices in the order of the mesh's vertex list (ascending `globalid`): the order
     /// MuJoCo's exhaustive support (`mjc_meshSupport`) scans them in, which decides ties.
@@ -39,11 +53,14 @@ impl HullSupport {
     /// vertices.
     pub fn new(graph: Arc<MeshGraph>) -> Self {
         let points: Vec<Vector> = graph.vertices.iter().map(|v| Vector::new(v.x, v.y, v.z)).collect();
-        let mut extrema = [0u32; 27];
-        for (k, slot) in extrema.iter_mut().enumerate() {
-            let dir = Vector::new((k / 9) as f64 - 1.0, ((k / 3) % 3) as f64 - 1.0, (k % 3) as f64 - 1.0);
-            *slot = scan(&points, dir) as u32;
-        }
+        let mj_points: Vec<Vector> = if graph.mujoco_vertices.len() == points.len() {
+            graph.mujoco_vertices.iter().map(|v| Vector::new(v.x, v.y, v.z)).collect()
+        } else {
+            points.clone()
+        };
+        let axes = graph.box_frame.1;
+        let mj_axes_t = (axes != crate::spatial::Mat3::identity()).then(|| axes.transpose());
+        let extrema = grid_extrema(&mj_points);
         let mut scan_order: Vec<u32> = (0..points.len() as u32).collect();
         scan_order.sort_by_key(|&i| graph.globalid[i as usize]);
         let scan_points = scan_order.iter().map(|&i| points[i as usize]).collect();
@@ -53,7 +70,7 @@ impl HullSupport {
             && graph.adj_start.windows(2).all(|w| w[0] <= w[1])
             && graph.adj_start[n] as usize <= graph.adj.len()
             && graph.adj.iter().all(|&j| (j as usize) < n);
-        Self { graph, points, extrema, scan_order, scan_points, valid_graph }
+        Self { graph, points, mj_points, mj_axes_t, extrema, scan_order, scan_points, valid_graph }
     }
 
     /// The hull's graph and face polygons.
@@ -111,7 +128,15 @@ impl HullSupport {
     /// [`Self::support_index`] warm-started as MuJoCo's `mjc_hillclimbSupport`: from the better of
     /// the grid seed and `cached` (the previous answer of the same query sequence; −1: none).
     pub fn support_index_warm(&self, dir: Vector, cached: i32) -> usize {
-        let points = &self.points;
+        // MuJoCo climbs in its mesh frame, on the vertices as it stores them.
+        let dir = match &self.mj_axes_t {
+            Some(t) => {
+                let v = t * crate::spatial::Vec3::new(dir.x, dir.y, dir.z);
+                Vector::new(v.x, v.y, v.z)
+            }
+            None => dir,
+        };
+        let points = &self.mj_points;
         let cell = |a: f64| (a > 0.4) as usize + 1 - (a < -0.4) as usize;
         let seed = self.extrema[9 * cell(dir.x) + 3 * cell(dir.y) + cell(dir.z)] as usize;
         let mut best = seed;
@@ -165,18 +190,24 @@ impl HullSupport {
     }
 }
 
-/// The first vertex of `points` farthest along `dir` (the exhaustive scan).
-pub(crate) fn scan(points: &[Vector], dir: Vector) -> usize {
-    let mut best = 0;
-    let mut best_dot = f64::NEG_INFINITY;
+/// MuJoCo's grid seeds (`mesh_extrema`, user_model.cc): per direction (cx, cy, cz) of
+/// {−1, 0, 1}³ (index 9(cx + 1) + 3(cy + 1) + cz + 1), the first vertex with the largest
+/// x·cx + y·cy + z·cz, computed in `f32` on the stored vertices `points`.
+fn grid_extrema(points: &[Vector]) -> [u32; 27] {
+    let mut extrema = [0u32; 27];
+    let mut max = [f32::MIN; 27];
     for (i, p) in points.iter().enumerate() {
-        let dot = p.dot(dir);
-        if dot > best_dot {
-            best_dot = dot;
-            best = i;
+        let (x, y, z) = (p.x as f32, p.y as f32, p.z as f32);
+        for (k, (slot, m)) in extrema.iter_mut().zip(max.iter_mut()).enumerate() {
+            let c = |j: usize| j as f32 - 1.0;
+            let dot = x * c(k / 9) + y * c((k / 3) % 3) + z * c(k % 3);
+            if dot > *m {
+                *m = dot;
+                *slot = i as u32;
+            }
         }
     }
-    best
+    extrema
 }
 
 impl SupportMap for HullSupport {

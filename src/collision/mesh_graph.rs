@@ -59,6 +59,10 @@ pub struct MeshGraph {
     /// (`mjCMesh::Process`) — in which MuJoCo's bounding box of the geom (`geom_aabb`) is
     /// axis-aligned (`obb::LocalBox`); the geom frame itself (identity) when it is not known.
     pub box_frame: (Vec3, Mat3),
+    /// The hull vertices as MuJoCo's compiler stores them (`mesh_vert`: `f32` coordinates in its
+    /// mesh frame, `box_frame`), qhull's order: what MuJoCo's hill climb compares and its grid
+    /// seeds (`mesh_extrema`) are found from. `vertices` when that frame is not known.
+    pub mujoco_vertices: Vec<Vec3>,
 }
 
 /// Why a mesh has no hull graph.
@@ -144,8 +148,9 @@ impl MeshGraph {
             vpolys.extend_from_slice(&l);
             vpoly_start.push(vpolys.len() as u32);
         }
-        let vertices = g.vert_globalid.iter().map(|&gid| placed[gid as usize]).collect();
+        let vertices: Vec<Vec3> = g.vert_globalid.iter().map(|&gid| placed[gid as usize]).collect();
         Ok(Self {
+            mujoco_vertices: vertices.clone(),
             vertices,
             globalid: g.vert_globalid,
             nvert: n,

@@ -103,6 +103,7 @@ struct Scratch {
     tmp: Vec<u32>,
     faces: Vec<u32>,
     epa: super::epa_face::FaceScratch,
+    edges: Vec<(Vec3, Vec3)>,
 }
 
 thread_local! {
@@ -697,8 +698,8 @@ pub(crate) fn convex_contacts(
                 };
                 segment_polytope(x1, seg, 0.0, x2, &p2, first, face, margin_gap, emit);
             } else if along.abs() > FACE_TOL {
-                cap_polytope(x1, c.radius, c.half_height, along.signum(), x2, &p2, first, margin_gap, emit);
-            } else {
+                cap_polytope(x1, c, along.signum(), x2, &p2, first, face, margin_gap, emit);
+            } else if cap_features(x1, c, x2, &p2, &first, face, margin_gap, false, emit) == 0 {
                 emit(first);
             }
         }
@@ -805,15 +806,16 @@ fn cylinder_side(x1: &Transform, c: &parry3d_f64::shape::Cylinder, f: &EpaFace, 
 #[allow(clippy::too_many_arguments)]
 fn cap_polytope(
     x1: &Transform,
-    r: f64,
-    h: f64,
+    c: &parry3d_f64::shape::Cylinder,
     side: f64,
     x2: &Transform,
     p2: &Poly,
     first: PairPoint,
+    face: Option<&EpaFace>,
     margin: f64,
     emit: &mut impl FnMut(PairPoint),
 ) {
+    let (r, h) = (c.radius, c.half_height);
     let axis = x1.rot.column(2).into_owned();
     let (e1, e2) = (x1.rot.column(0).into_owned(), x1.rot.column(1).into_owned());
     let n1 = axis * side;
@@ -848,9 +850,124 @@ fn cap_polytope(
         s.tmp = tmp;
         count
     });
-    if emitted == 0 {
+    if emitted == 0 && cap_features(x1, c, x2, p2, &first, face, margin, true, emit) == 0 {
         emit(first);
     }
+}
+
+/// The cap (16-gon) of a cylinder (geom 1) against a polytope's edge, as MuJoCo 4.0.0's
+/// `multicontact` reads the features off EPA's final face (Warp 4.0.0's `multicontact`, and the
+/// live library's contacts): when the cylinder's feature is one cap (every face vertex's support
+/// marks the same cap), the cylinder's side line is tried first against the polytope's feature's
+/// faces (the first within ~5.1° of parallel: clipped by it, nothing else tried), then the first
+/// of the polytope's feature edges (an edge, or a vertex's edges) within ~5.1° of parallel to
+/// the cap is clipped by the cap's 16-gon (points on the cap's plane and along its normal, the
+/// contact normal the cap's). With `skip_opposite`
+/// the cap against an opposite face was tried already; else such a face is clipped by the cap.
+/// Returns the number of contacts emitted (0: none).
+#[allow(clippy::too_many_arguments)]
+fn cap_features(
+    x1: &Transform,
+    c: &parry3d_f64::shape::Cylinder,
+    x2: &Transform,
+    p2: &Poly,
+    first: &PairPoint,
+    face: Option<&EpaFace>,
+    margin: f64,
+    skip_opposite: bool,
+    emit: &mut dyn FnMut(PairPoint),
+) -> usize {
+    let Some(f) = face else { return 0 };
+    let idx = f.index1[0];
+    if idx < 0 || f.index1.iter().any(|&i| i != idx) {
+        return 0;
+    }
+    let side = if idx != 0 { -1.0 } else { 1.0 };
+    let axis = x1.rot.column(2).into_owned();
+    let n1 = axis * side;
+    SCRATCH.with(|s| {
+        let s = &mut *s.borrow_mut();
+        let mut start = Vec3::zeros();
+        let mut edges = std::mem::take(&mut s.edges);
+        let dim2 = super::epa_face::geom2_feature(
+            p2,
+            x2,
+            f,
+            &(first.p2 - first.p1),
+            &mut s.normals2,
+            Some((&mut edges, &mut start)),
+        );
+        let mut count = 0;
+        let mut tmp = std::mem::take(&mut s.tmp);
+        let cap = |s: &mut Scratch| {
+            s.face1.clear();
+            let centre = x1.pos + n1 * c.half_height;
+            let (col0, col1) = (x1.rot.column(0) * c.radius, x1.rot.column(1) * (c.radius * side));
+            for (cs, sn) in CAP_COS_SIN {
+                s.face1.push(col0 * cs - col1 * sn + centre);
+            }
+        };
+        if dim2 > 0 {
+            let opposite = s
+                .normals2
+                .iter()
+                .copied()
+                .filter(|(m, _)| !skip_opposite && m.dot(&n1) < -FACE_TOL)
+                .min_by(|a, b| a.0.dot(&n1).total_cmp(&b.0.dot(&n1)));
+            if let Some((n2, f2)) = opposite {
+                cap(s);
+                face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
+                clip(
+                    &s.face1,
+                    &s.face2,
+                    &n1,
+                    &n2,
+                    margin,
+                    true,
+                    &mut s.poly,
+                    &mut s.clip,
+                    &mut |w1, w2, d| {
+                        emit(PairPoint { p1: w1, p2: w2, normal: -n2, dist: d });
+                        count += 1;
+                    },
+                );
+            } else {
+                // The side line against the polytope's faces ...
+                let seg = cylinder_side(x1, c, f, margin);
+                let d = (seg[1] - seg[0]).normalize();
+                let parallel = s.normals2.iter().find(|(m, _)| d.dot(m).abs() < EDGE_TOL).copied();
+                if let Some((n2, f2)) = parallel {
+                    // A clip that keeps no point leaves the single contact (no edge tried: drop
+                    // scene d2_13).
+                    s.face1.clear();
+                    s.face1.extend_from_slice(&seg);
+                    face_polygon(p2, x2, f2, &mut tmp, &mut s.face2);
+                    count = clip_segment_on_face(s, &n2, margin, 0.0, emit);
+                } else if let Some(&(_, end)) = edges.iter().find(|(e, _)| e.dot(&n1).abs() < EDGE_TOL) {
+                    // ... then the polytope's edges against the cap.
+                    cap(s);
+                    let edge = [start, end];
+                    clip(
+                        &s.face1,
+                        &edge,
+                        &n1,
+                        &-n1,
+                        margin,
+                        false,
+                        &mut s.poly,
+                        &mut s.clip,
+                        &mut |w1, w2, d| {
+                            emit(PairPoint { p1: w1, p2: w2, normal: n1, dist: d });
+                            count += 1;
+                        },
+                    );
+                }
+            }
+        }
+        s.tmp = tmp;
+        s.edges = edges;
+        count
+    })
 }
 
 /// A segment of geom 1 (a capsule's surface line, inflated by `inflated` = half the margin; a

@@ -105,6 +105,9 @@ pub fn geom_hull(
     let mut graph = MeshGraph::new(&unscaled, &scaled, &placed, -1).map_err(|e| err(e.to_string()))?;
     if let Some(frame) = frame {
         graph.box_frame = frame;
+        let (com, r) = frame;
+        graph.mujoco_vertices =
+            graph.globalid.iter().map(|&gid| mujoco_stored(&scaled[gid as usize], &com, &r)).collect();
     }
     let entry = Arc::new(graph);
     cache.entries.insert(key, entry.clone());
@@ -116,10 +119,13 @@ pub fn geom_hull(
 /// axes as MuJoCo's compiler finds them ([`mujoco_mesh_frame`]).
 pub(crate) fn round_as_mujoco(vertices: &mut [Vec3], com: &Vec3, r: &Mat3) {
     for v in vertices {
-        let local = r.transpose() * (*v - com);
-        let stored = local.map(|a| f64::from(a as f32));
-        *v = com + r * stored;
+        *v = com + r * mujoco_stored(v, com, r);
     }
+}
+
+/// Where MuJoCo's compiler stores vertex `v` (file frame): `f32(Rᵀ (v − c))`, in its mesh frame.
+fn mujoco_stored(v: &Vec3, com: &Vec3, r: &Mat3) -> Vec3 {
+    (r.transpose() * (v - com)).map(|a| f64::from(a as f32))
 }
 
 /// Area (0 below 1e-15 of twice it, as MuJoCo ignores such faces), unit normal and centre of a
