@@ -335,6 +335,7 @@ pub(crate) fn geom2_feature(
     candidate_faces(p2, x2, dim2, &vi2, dir, out);
     if let Some((e, start)) = edges {
         e.clear();
+        let v2 = world_points(p2, x2, &vi2);
         if dim2 < 3 {
             candidate_edges(p2, x2, dim2, &v2, vi2[0], e);
         }

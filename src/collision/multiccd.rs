@@ -875,7 +875,7 @@ fn cap_features(
     face: Option<&EpaFace>,
     margin: f64,
     skip_opposite: bool,
-    emit: &mut dyn FnMut(PairPoint),
+    emit: &mut impl FnMut(PairPoint),
 ) -> usize {
     let Some(f) = face else { return 0 };
     let idx = f.index1[0];
