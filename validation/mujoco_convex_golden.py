@@ -181,6 +181,28 @@ def simple(name, g1, g2, n=16, margin=True, extra=None):
     return make
 
 
+# A cylinder's cap against a cube's edge with no cube face opposite the cap, as met in a drop test
+# (five objects falling on a table, step 164): MuJoCo clips the cube's edge by the cap's 16-gon
+# (two contacts), choosing by the features of EPA's final face. Bodies (pos, quat): the
+# cylinder, then the cube (the drop scene's own centred cube at scale 0.6).
+DROP_CYLINDER = 'type="cylinder" size="0.0393 0.0235"'
+DROP_CUBE = 'type="mesh" mesh="cube_drop"'
+DROP_ASSET = '<mesh name="cube_drop" file="cube_centred.obj" scale="0.6 0.6 0.6"/>'
+DROP_CASES = {
+    "cap_on_edge": (((-0.09470551076524246, 0.018934415479995772, 0.28036984620245564),
+                     (0.4594776752331524, 0.14626725362377335, 0.688224240914168, 0.5420641573631428)),
+                    ((-0.05422868656163417, 0.04281432714488902, 0.22840014621754512),
+                     (0.383822723536361, -0.021310260232116775, 0.024181686214831404, -0.9228441015457474))),
+}
+
+
+def cylinder_mesh():
+    out = simple("cylinder_mesh", CYLINDER_B, CUBE_MESH)()
+    s = ConvexScene("cylinder_cube_drop", DROP_CYLINDER, DROP_CUBE, NO_MARGIN, assets=DROP_ASSET)
+    out.append((s, [s.record(name, "penetrating", q1, q2) for name, (q1, q2) in DROP_CASES.items()], 0))
+    return out
+
+
 PAIRS = {
     "box_mesh": box_mesh,
     "mesh_mesh": mesh_mesh,
@@ -192,7 +214,7 @@ PAIRS = {
                            extra=lambda s, r: resting_cases(s, r, 8, lambda q: Q_I, lambda q: yaw_tilt(q, 0.05),
                                                             (0.1, 0.1))),
     "cylinder_cylinder": simple("cylinder_cylinder", CYLINDER, CYLINDER_B),
-    "cylinder_mesh": simple("cylinder_mesh", CYLINDER_B, CUBE_MESH),
+    "cylinder_mesh": cylinder_mesh,
     "sphere_mesh": simple("sphere_mesh", SPHERE, LINK5),
     "sphere_ellipsoid": simple("sphere_ellipsoid", SPHERE, ELLIPSOID, n=8),
     "capsule_ellipsoid": simple("capsule_ellipsoid", CAPSULE, ELLIPSOID, n=8),
