@@ -160,8 +160,11 @@ pub(crate) fn solve_coulomb(
     // and the solve counts as unconverged (reported), never NaN.
     let mut first_total = 0.0f64;
     let mut last_polish = 0.0;
-    // The smallest sweep change so far and its iterate (`exact.best`).
+    // The smallest sweep change so far, and whether its iterate is the current one (then not
+    // copied: it is saved in `exact.best`, from `lambda_prev`, only once a later sweep changes
+    // the motion more — in a converging solve, never).
     let mut best_moved = f64::INFINITY;
+    let mut best_is_last = false;
     // A sweep costs about n² + n·nv: large problems get fewer sweeps (a work budget), so that a
     // pile of contacts cannot stall a step; a solve stopped early is counted as unconverged.
     let sweep = (n * n + n * model.nv).max(1) as f64;
@@ -215,13 +218,18 @@ pub(crate) fn solve_coulomb(
             first_total = 0.0;
             iterations = 0;
             best_moved = f64::INFINITY;
+            best_is_last = false;
             continue;
         }
         change = moved;
         if moved < best_moved {
             best_moved = moved;
-            let ExactWork { rhs, best, .. } = &mut data.exact;
-            best.as_mut_slice()[..n].copy_from_slice(&rhs.as_slice()[..n]);
+            best_is_last = true;
+        } else if best_is_last {
+            // The best iterate is the one this sweep started from.
+            let ExactWork { lambda_prev, best, .. } = &mut data.exact;
+            best.as_mut_slice()[..n].copy_from_slice(&lambda_prev.as_slice()[..n]);
+            best_is_last = false;
         }
         if moved <= settings.tolerance * total.max(motion_scale)
             || moved <= ROUND_OFF_FLOOR
@@ -266,7 +274,7 @@ pub(crate) fn solve_coulomb(
         }
     }
     // An unconverged solve returns its best iterate, not wherever the last sweep swung to.
-    if !data.efc_converged && best_moved < change {
+    if !data.efc_converged && !best_is_last && best_moved < change {
         let ExactWork { rhs, best, .. } = &mut data.exact;
         rhs.as_mut_slice()[..n].copy_from_slice(&best.as_slice()[..n]);
         change = best_moved;
