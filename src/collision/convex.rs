@@ -13,8 +13,26 @@ use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
 use std::cell::{Cell, RefCell};
 
 thread_local! {
-    /// The EPA workspace of this thread, reused so that overlapping pairs do not allocate.
-    static EPA_WORK: RefCell<EPA> = RefCell::new(EPA::new());
+    /// The EPA workspace of this thread, reused so that overlapping pairs do not allocate
+    /// ([`primed_epa`]).
+    static EPA_WORK: RefCell<EPA> = RefCell::new(primed_epa());
+}
+
+/// A fresh EPA workspace whose buffers (polytope vertices, faces, the silhouette, the face heap)
+/// have grown as far as one query can take them: EPA between two deeply overlapping balls, a
+/// smooth pair, runs to its iteration limit. Its buffers grow only when a query needs more than
+/// any before it, so that a workspace that has only met easy pairs would allocate at the first
+/// harder one, inside a step; primed, it does so when the thread first needs EPA.
+fn primed_epa() -> EPA {
+    let mut epa = EPA::new();
+    let ball = Ball::new(1.0);
+    let pos12 = Pose::from_translation(Vector::new(0.3, 0.2, 0.1));
+    let mut simplex = VoronoiSimplex::new();
+    simplex.reset(CsoPoint::from_shapes(&pos12, &ball, &ball, Vector::X));
+    if let GJKResult::Intersection = gjk::closest_points(&pos12, &ball, &ball, 0.0, true, &mut simplex) {
+        std::hint::black_box(epa.closest_points(&pos12, &ball, &ball, &simplex));
+    }
+    epa
 }
 use parry3d_f64::shape::{Ball, Capsule, Cuboid, Cylinder, SupportMap};
 
