@@ -36,7 +36,9 @@
 pub(crate) use super::coulomb_polish::polish;
 use super::coulomb_polish::{any_contact_moving, cone_of};
 use super::dense::solve_psd;
+use super::exact::form_minv_jt;
 use super::ExactWork;
+use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, EfcType, Model};
 
 /// Iteration limit and tolerance of the Gauss–Seidel solve.
@@ -204,7 +206,7 @@ pub(crate) fn solve_coulomb(
         // The change of the motion this sweep made, M⁻¹Jᵀ Δλ, against the constraint's whole
         // correction M⁻¹Jᵀ λ: redundant rows may still trade force between them (a box's corners),
         // which moves nothing.
-        let (moved, total) = sweep_motion(model.nv, data);
+        let (moved, total) = sweep_motion(model, data, iterations);
         if iterations == 1 {
             first_total = total;
         }
@@ -287,31 +289,53 @@ pub(crate) fn solve_coulomb(
     }
 }
 
-/// max |M⁻¹Jᵀ Δλ| (the sweep's change, Δλ = λ − `lambda_prev`) and max |M⁻¹Jᵀ λ|. Column by
-/// column of M⁻¹Jᵀ, over each row's trees (`exact.trees`) or tree span (`exact.spans`; the
-/// column is zero outside them):
-/// per dof the same sum, in the same order, as the dense product.
-fn sweep_motion(nv: usize, data: &mut Data) -> (f64, f64) {
-    let n = data.nefc;
-    let ExactWork { minv_jt, rhs, lambda_prev, spans, motion, trees, trees_valid, .. } = &mut data.exact;
+/// max |M⁻¹Jᵀ Δλ| (the sweep's change, Δλ = λ − `lambda_prev`) and max |M⁻¹Jᵀ λ|, by one of two
+/// routes: Jᵀ Δλ and Jᵀ λ over each row's nonzeros (`ExactWork::row_ranges`) and a solve of each
+/// with the factor of M; or, once the sweeps of this solve (`sweeps`, this one included) have
+/// cost in solves what forming M⁻¹Jᵀ costs (`ExactWork::minv_jt_work`: cheap for many small
+/// trees, a pile; dear for a long chain), M⁻¹Jᵀ formed ([`form_minv_jt`]) and its columns summed
+/// over each row's trees.
+fn sweep_motion(model: &Model, data: &mut Data, sweeps: u32) -> (f64, f64) {
+    let (n, nv) = (data.nefc, model.nv);
+    let w = &data.exact;
+    if !w.minv_jt_ready && f64::from(sweeps) * 2.0 * w.solve_work >= w.minv_jt_work {
+        form_minv_jt(model, data);
+    }
+    let Data { mass_factor, exact, .. } = data;
+    let mut motion = std::mem::take(&mut exact.motion);
     let (change, whole) = motion.as_mut_slice()[..2 * nv].split_at_mut(nv);
     change.fill(0.0);
     whole.fill(0.0);
-    let y = minv_jt.as_slice();
-    for i in 0..n {
-        let (l, dl) = (rhs[i], rhs[i] - lambda_prev[i]);
-        // Over the row's trees when known (between them its column is zero), else its span.
-        let ranges = if *trees_valid { trees[i] } else { [spans[i], (0, 0)] };
-        for (lo, hi) in ranges {
-            for k in lo..hi {
-                let yk = y[k + i * nv];
-                change[k] += yk * dl;
-                whole[k] += yk * l;
+    if exact.minv_jt_ready {
+        let y = exact.minv_jt.as_slice();
+        for i in 0..n {
+            let (l, dl) = (exact.rhs[i], exact.rhs[i] - exact.lambda_prev[i]);
+            for (lo, hi) in exact.tree_ranges(i) {
+                for k in lo..hi {
+                    let yk = y[k + i * nv];
+                    change[k] += yk * dl;
+                    whole[k] += yk * l;
+                }
             }
         }
+    } else {
+        let jt = exact.jt.as_slice();
+        for i in 0..n {
+            let (l, dl) = (exact.rhs[i], exact.rhs[i] - exact.lambda_prev[i]);
+            for (lo, hi) in exact.row_ranges(i) {
+                for k in lo..hi {
+                    let jk = jt[k + i * nv];
+                    change[k] += jk * dl;
+                    whole[k] += jk * l;
+                }
+            }
+        }
+        solve_with_factor_unchecked(model, mass_factor, change);
+        solve_with_factor_unchecked(model, mass_factor, whole);
     }
     let moved = change.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let total = whole.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    exact.motion = motion;
     (moved, total)
 }
 

@@ -1,8 +1,10 @@
 //! The exact (rigid) constraint solver: the KKT system of Lagrangian mechanics with multipliers
 //! (docs/physics.md §1.6, eq. 20: M q̈ + c − τ = Jᵀλ together with the acceleration form of the constraints,
 //! J q̈ + J̇v = 0), solved by the range-space method with the tree-sparse LᵀDL factor of M
-//! (RBDA §6.3): Y = M⁻¹Jᵀ, the Delassus matrix A = J Y, then A λ = −(J q̈_smooth + J̇v) and
-//! q̈ = q̈_smooth + Y λ. Redundant rows give the minimum-norm multipliers ([`solve_psd`]).
+//! (RBDA §6.3): the Delassus matrix A = J M⁻¹ Jᵀ = (L⁻ᵀJᵀ)ᵀ D⁻¹ (L⁻ᵀJᵀ) (RBDA §6.5: L⁻ᵀ keeps
+//! the sparsity of Jᵀ — a row's column of L⁻ᵀJᵀ is zero outside its bodies' ancestor dofs), then
+//! A λ = −(J q̈_smooth + J̇v) and q̈ = q̈_smooth + M⁻¹Jᵀλ. Redundant rows give the minimum-norm
+//! multipliers ([`solve_psd`]).
 //!
 //! Drift correction for steppers: [`project_positions`] (Gauss–Newton onto φ(q) = 0 along
 //! M⁻¹Jᵀ, on the configuration manifold) and [`project_velocities`] (the M-orthogonal projection
@@ -15,17 +17,18 @@ use super::energy_guard::limit_energy;
 use super::ConstraintModel;
 use super::ExactWork;
 use crate::collision::{collide, EXACT_REACH};
-use crate::dynamics::{crba_unchecked, factorize_mass_matrix, tree_span};
+use crate::dynamics::{crba_unchecked, factorize_mass_matrix, solve_with_factor_unchecked, tree_span};
 use crate::error::{check, InputError};
 use crate::kinematics::body_poses;
 use crate::model::{integrate_configuration_unchecked, Data, EfcType, Model, NO_DOF};
 
-/// Y = M⁻¹Jᵀ into `efc_minv_jt` (each row's column over its span only: zero outside it, and not
-/// written there) and A = J M⁻¹ Jᵀ into `efc_delassus` for the current rows (needs
-/// the factor of M in `mass_factor`). Each row touches the dofs of at most two kinematic trees,
-/// and M is block-diagonal over trees: Y_i is solved over its row's trees only and A_ij is
-/// J_i · Y_j over the dofs both rows' trees share (zero when there are none) — the dense
-/// products' arithmetic, in the same order, without their exact-zero terms.
+/// The Delassus matrix A = J M⁻¹ Jᵀ of the current rows into `exact.delassus` (needs the factor
+/// of M in `mass_factor`), with Jᵀ (`exact.jt`), each row's support, spans and trees, and A's
+/// nonzero pattern. M = LᵀDL is block-diagonal over kinematic trees, so A is a sum over trees:
+/// for each tree, the rows touching it ([`tree_lists`]) form a block whose products
+/// [`gram_block`] adds — X = L⁻ᵀJᵀ over the tree's dofs, then A += Xᵀ D⁻¹ X — and rows whose
+/// trees are disjoint have A_ij = 0. When some row touches more than two trees (a tendon over
+/// several), all rows form one block over all dofs.
 fn delassus(model: &Model, data: &mut Data) {
     let n = data.nefc;
     let nv = model.nv;
@@ -38,13 +41,11 @@ fn delassus(model: &Model, data: &mut Data) {
         mass_factor,
         exact:
             ExactWork {
-                minv_jt: efc_minv_jt,
                 delassus: efc_delassus,
                 jt,
+                ljt,
                 spans,
-                yt,
-                yt_acc,
-                yt_run,
+                support,
                 order,
                 dof_rows,
                 pattern_ptr,
@@ -55,73 +56,150 @@ fn delassus(model: &Model, data: &mut Data) {
                 trees_valid,
                 tree_ptr,
                 tree_rows,
+                minv_jt_ready,
+                minv_jt_work,
+                solve_work,
                 ..
             },
         ..
     } = data;
-    // Jᵀ, read down J's columns (contiguous in its storage), and each row's span.
+    // Jᵀ, read down J's columns (contiguous in its storage), and each row's support and span.
+    let j_stride = efc_j.nrows();
+    let j_cols = efc_j.as_slice();
     let jt = &mut jt.as_mut_slice()[..nv * n];
-    let yt = &mut yt[..n * nv];
     for k in 0..nv {
-        let col = &efc_j.as_slice()[k * efc_j.nrows()..k * efc_j.nrows() + n];
-        yt[k * n..(k + 1) * n].copy_from_slice(col);
-        for (i, &jik) in col.iter().enumerate() {
+        for (i, &jik) in j_cols[k * j_stride..k * j_stride + n].iter().enumerate() {
             jt[k + i * nv] = jik;
         }
     }
     for i in 0..n {
         let row = &jt[i * nv..(i + 1) * nv];
-        spans[i] = match (row.iter().position(|&x| x != 0.0), row.iter().rposition(|&x| x != 0.0)) {
-            (Some(first), Some(last)) => tree_span(model, first, last),
-            _ => (0, 0),
-        };
+        (support[i], spans[i]) =
+            match (row.iter().position(|&x| x != 0.0), row.iter().rposition(|&x| x != 0.0)) {
+                (Some(first), Some(last)) => ((first, last + 1), tree_span(model, first, last)),
+                _ => ((0, 0), (0, 0)),
+            };
     }
-    // Per dof, the rows that may touch it (its tree's: the spans are whole trees).
-    dof_rows.fill((n, 0));
-    for (i, &(lo, hi)) in spans[..n].iter().enumerate() {
-        for r in &mut dof_rows[lo..hi] {
-            *r = (r.0.min(i), r.1.max(i + 1));
-        }
-    }
-    // Y = M⁻¹Jᵀ for all rows at once, on its transpose.
-    solve_rows(model, mass_factor.as_slice(), yt, n, dof_rows, &mut yt_acc[..n], &mut yt_run[..n]);
-    // Each row's column of M⁻¹Jᵀ over its span (zero outside it, where no reader looks).
-    let y = &mut efc_minv_jt.as_mut_slice()[..nv * n];
-    for (i, &(lo, hi)) in spans[..n].iter().enumerate() {
-        for (k, x) in (lo..hi).zip(&mut y[i * nv + lo..i * nv + hi]) {
-            *x = yt[k * n + i];
-        }
-    }
-    // A_ij = J_i · Y_j over the dofs of both rows' trees, ascending (outside them a term of the
-    // dense sum is an exact zero), for i ≤ j, mirrored to A_ji; zero when the trees are disjoint.
     let stride = efc_delassus.nrows();
     let a = efc_delassus.as_mut_slice();
-    let width = spans[..n].iter().map(|&(lo, hi)| hi - lo).max().unwrap_or(0);
+    for j in 0..n {
+        a[j * stride..j * stride + n].fill(0.0);
+    }
+    let h = mass_factor.as_slice();
     // Each row's trees: when none touches more than two (contacts, a connect between two
     // bodies), the products and the pattern go tree by tree.
     *trees_valid = row_trees(model, &jt[..nv * n], &spans[..n], &mut trees[..n]);
+    *pattern_n = n;
+    *minv_jt_ready = false;
+    // What forming M⁻¹Jᵀ would cost and what one solve with M costs (`sweep_motion`'s choice).
+    *solve_work = SOLVE_PAIR_WORK * ancestor_pairs(model, (0, nv)) as f64 + SOLVE_DOF_WORK * nv as f64;
+    *minv_jt_work = 0.0;
+    let mut block = |rows: &[usize], dofs: (usize, usize), a: &mut [f64]| {
+        let pairs = ancestor_pairs(model, dofs) as f64;
+        *minv_jt_work += MINV_JT_WORK * rows.len() as f64 * (2.0 * pairs + (dofs.1 - dofs.0) as f64);
+        let block = Block { model, h, j_cols, j_stride, rows, dofs };
+        block.add_gram(ljt, dof_rows, a, stride);
+    };
     if *trees_valid {
         tree_lists(&trees[..n], tree_ptr, tree_rows);
-        delassus_by_trees(a, stride, nv, jt, y, &trees[..n], tree_ptr, tree_rows, pattern_ptr, pattern_rows);
-        *pattern_n = n;
-        *pattern_full = pattern_rows.len() == n * n;
+        let mut root = 0;
+        while root < nv {
+            let end = tree_span(model, root, root).1;
+            let rows = &tree_rows[tree_ptr[root]..tree_ptr[root + 1]];
+            if !rows.is_empty() {
+                block(rows, (root, end), a);
+            }
+            root = end;
+        }
+        *pattern_full = (0..nv).any(|t| tree_ptr[t + 1] - tree_ptr[t] == n);
+        if *pattern_full {
+            pattern_ptr.clear();
+            pattern_rows.clear();
+        } else {
+            pattern_by_trees(&trees[..n], tree_ptr, tree_rows, pattern_ptr, pattern_rows);
+        }
         return;
     }
+    for (i, o) in order[..n].iter_mut().enumerate() {
+        *o = i;
+    }
+    if n > 0 {
+        block(&order[..n], (0, nv), a);
+    }
+    let width = spans[..n].iter().map(|&(lo, hi)| hi - lo).max().unwrap_or(0);
     let sorted = 2 * width < nv;
     if sorted {
-        delassus_meeting_pairs(a, stride, n, nv, jt, y, spans, &mut order[..n], width);
-    } else {
-        delassus_all_pairs(a, stride, n, nv, jt, y, spans);
+        sort_by_span_start(&spans[..n], &mut order[..n]);
     }
     delassus_pattern(&spans[..n], sorted.then_some(&order[..n]), width, pattern_ptr, pattern_rows);
-    *pattern_n = n;
     *pattern_full = pattern_rows.len() == n * n;
 }
 
-/// Per row, the dof ranges of the kinematic trees its J row (in `jt`, rows of nv) touches, the
-/// tree of its first nonzero and that of its last (`[first, (0, 0)]` when they are one tree;
-/// both empty for a zero row). False when some row touches a third tree between them (a tendon
-/// or an equality over several trees): the caller then pairs rows by their spans.
+/// Work estimates (instructions, measured with callgrind on chain_30 and bin_10) of a solve with
+/// M's factor (`dynamics::solve_with_factor_span_unchecked`: per ancestor pair of dofs, and per
+/// dof), and of forming M⁻¹Jᵀ per row and multiply-add ([`Block::minv_jt`], vectorized across
+/// rows).
+const SOLVE_PAIR_WORK: f64 = 8.0;
+const SOLVE_DOF_WORK: f64 = 100.0;
+const MINV_JT_WORK: f64 = 1.5;
+
+/// The pairs (dof, ancestor dof) among the dofs [lo, hi): the multiply-adds of each half of a
+/// solve with M's tree-sparse factor.
+fn ancestor_pairs(model: &Model, (lo, hi): (usize, usize)) -> usize {
+    let mut pairs = 0;
+    for k in lo..hi {
+        let mut e = model.dof_parent[k];
+        while e != NO_DOF {
+            let s = model.dof_run_start[e];
+            pairs += e + 1 - s;
+            e = model.dof_parent[s];
+        }
+    }
+    pairs
+}
+
+/// M⁻¹Jᵀ of the current rows into `exact.minv_jt` (each row's column over its trees, or its
+/// span when the trees are not known; not written elsewhere), block by block as [`delassus`]
+/// formed the products (needs its tree lists, at the same rows). Formed only when the
+/// Gauss–Seidel sweeps have cost more in solves with M than this costs (`sweep_motion`).
+pub(super) fn form_minv_jt(model: &Model, data: &mut Data) {
+    let n = data.nefc;
+    let nv = model.nv;
+    let Data {
+        efc_j,
+        mass_factor,
+        exact:
+            ExactWork { minv_jt, minv_jt_ready, ljt, order, dof_rows, trees_valid, tree_ptr, tree_rows, .. },
+        ..
+    } = data;
+    let (j_stride, j_cols, h) = (efc_j.nrows(), efc_j.as_slice(), mass_factor.as_slice());
+    let y = minv_jt.as_mut_slice();
+    let mut block = |rows: &[usize], dofs: (usize, usize), y: &mut [f64]| {
+        Block { model, h, j_cols, j_stride, rows, dofs }.minv_jt(ljt, dof_rows, y);
+    };
+    if *trees_valid {
+        let mut root = 0;
+        while root < nv {
+            let end = tree_span(model, root, root).1;
+            let rows = &tree_rows[tree_ptr[root]..tree_ptr[root + 1]];
+            if !rows.is_empty() {
+                block(rows, (root, end), y);
+            }
+            root = end;
+        }
+    } else if n > 0 {
+        for (i, o) in order[..n].iter_mut().enumerate() {
+            *o = i;
+        }
+        block(&order[..n], (0, nv), y);
+    }
+    *minv_jt_ready = true;
+}
+
+/// Per row, the dof ranges of the (at most two) kinematic trees its J row (in `jt`, rows of nv)
+/// touches, the tree of its first nonzero and that of its last (`[first, (0, 0)]` when they are
+/// one tree; both empty for a zero row). False when some row touches a third tree between them
+/// (a tendon or an equality over several trees): the caller then pairs rows by their spans.
 fn row_trees(model: &Model, jt: &[f64], spans: &[(usize, usize)], trees: &mut [[(usize, usize); 2]]) -> bool {
     let nv = model.nv;
     for (i, (&(lo, hi), t)) in spans.iter().zip(trees.iter_mut()).enumerate() {
@@ -169,30 +247,18 @@ fn tree_lists(trees: &[[(usize, usize); 2]], ptr: &mut [usize], rows: &mut [usiz
     ptr[0] = 0;
 }
 
-/// The Delassus matrix A_ij = J_i · Y_j and its nonzero pattern for rows that each touch at
-/// most two trees (`trees`, listed per tree in `tree_ptr`/`tree_rows`): rows i and j meet when
-/// they share a tree, and A_ij is the sum over the shared trees' dofs, ascending — the dense sum's
-/// terms without its exact zeros (elsewhere J_i or Y_j is zero), in its order. The pattern of
-/// column j is the union of its trees' rows (ascending); every other entry is zero. Work: the
-/// pattern's size times a tree's dofs, where the span pairing pays n² pairs once a row's trees
-/// lie far apart (a pile: a contact between the first and the last body spans every dof).
-#[allow(clippy::too_many_arguments)]
-fn delassus_by_trees(
-    a: &mut [f64],
-    stride: usize,
-    nv: usize,
-    jt: &[f64],
-    y: &[f64],
+/// The nonzero pattern of the Delassus matrix for rows that each touch at most two trees
+/// (`trees`, listed per tree in `tree_ptr`/`tree_rows`): rows i and j meet when they share a
+/// tree, so the pattern of column j is the union of its trees' rows (ascending); every other
+/// entry is zero. Its size is the work of a Gauss–Seidel sweep's gathers (a pile: each contact
+/// meets only the contacts of its two bodies).
+fn pattern_by_trees(
     trees: &[[(usize, usize); 2]],
     tree_ptr: &[usize],
     tree_rows: &[usize],
     pattern_ptr: &mut Vec<usize>,
     pattern_rows: &mut Vec<usize>,
 ) {
-    let n = trees.len();
-    for j in 0..n {
-        a[j * stride..j * stride + n].fill(0.0);
-    }
     pattern_ptr.clear();
     pattern_rows.clear();
     pattern_ptr.push(0);
@@ -203,8 +269,7 @@ fn delassus_by_trees(
             &[]
         }
     };
-    for j in 0..n {
-        let [tj0, tj1] = trees[j];
+    for &[tj0, tj1] in trees {
         let (p, q) = (list(tj0), list(tj1));
         // The union of the two ascending lists, ascending, each row once.
         let (mut u, mut v) = (0, 0);
@@ -226,21 +291,6 @@ fn delassus_by_trees(
                 (None, None) => break,
             };
             pattern_rows.push(i);
-            if i > j {
-                continue;
-            }
-            let y_j = &y[j * nv..(j + 1) * nv];
-            let j_i = &jt[i * nv..(i + 1) * nv];
-            let mut sum: f64 = std::iter::empty::<f64>().sum();
-            for t in trees[i] {
-                if t.0 < t.1 && (t == tj0 || t == tj1) {
-                    for k in t.0..t.1 {
-                        sum += j_i[k] * y_j[k];
-                    }
-                }
-            }
-            a[i + j * stride] = sum;
-            a[j + i * stride] = sum;
         }
         pattern_ptr.push(pattern_rows.len());
     }
@@ -249,11 +299,9 @@ fn delassus_by_trees(
 /// The nonzero pattern of the Delassus matrix of the rows with tree spans `spans`: per column j,
 /// ascending, the rows i whose span meets j's (A_ij is zero otherwise), in compressed columns
 /// (`ptr` n + 1 offsets into `rows`). With `order` (the rows sorted by their span's first dof,
-/// `width` the widest span) only the rows that can meet j are visited, as in
-/// [`delassus_meeting_pairs`]; without it every pair is checked. The gather–scatter work of a
-/// Gauss–Seidel sweep on the pattern is its size, the Delassus matrix's nonzeros, rather than n²
-/// (a pile: each contact meets only the contacts of its two bodies). `rows` grows only when a
-/// pattern is larger than any before it.
+/// [`sort_by_span_start`]; `width` the widest span) only the rows that can meet j are visited —
+/// row i can meet row j only if lo_j − `width` < lo_i < hi_j; without it every pair is checked.
+/// `rows` grows only when a pattern is larger than any before it.
 fn delassus_pattern(
     spans: &[(usize, usize)],
     order: Option<&[usize]>,
@@ -293,64 +341,10 @@ fn delassus_pattern(
     }
 }
 
-/// A_ij = J_i · Y_j (over both rows' spans) for every pair i ≤ j, column by column (contiguous
-/// writes), and the lower triangle by symmetry: when most rows' trees meet (one robot, a pair of
-/// boxes).
-fn delassus_all_pairs(
-    a: &mut [f64],
-    stride: usize,
-    n: usize,
-    nv: usize,
-    jt: &[f64],
-    y: &[f64],
-    spans: &[(usize, usize)],
-) {
-    for j in 0..n {
-        let (lo_j, hi_j) = spans[j];
-        let y_j = &y[j * nv..(j + 1) * nv];
-        for i in 0..=j {
-            let (lo_i, hi_i) = spans[i];
-            let (lo, hi) = (lo_i.max(lo_j), hi_i.min(hi_j));
-            a[i + j * stride] = if lo >= hi {
-                0.0
-            } else {
-                jt[i * nv + lo..i * nv + hi].iter().zip(&y_j[lo..hi]).map(|(x, y)| x * y).sum()
-            };
-        }
-    }
-    // The lower triangle in 8 × 8 tiles (each tile's reads and writes stay in a few cache lines
-    // of the capacity-strided matrix).
-    const TILE: usize = 8;
-    for ib in (0..n).step_by(TILE) {
-        for jb in (ib..n).step_by(TILE) {
-            for i in ib..(ib + TILE).min(n) {
-                for j in jb.max(i + 1)..(jb + TILE).min(n) {
-                    a[j + i * stride] = a[i + j * stride];
-                }
-            }
-        }
-    }
-}
-
-/// [`delassus_all_pairs`] visiting only the pairs whose spans meet, for rows on many separate
-/// trees (a stack, a bin: each row touches one or two of them): the rest is zero. The rows in
-/// order of their span's first dof (`order`); row i can meet row j only if
-/// lo_j − `width` < lo_i < hi_j (`width` the widest span).
-#[allow(clippy::too_many_arguments)]
-fn delassus_meeting_pairs(
-    a: &mut [f64],
-    stride: usize,
-    n: usize,
-    nv: usize,
-    jt: &[f64],
-    y: &[f64],
-    spans: &[(usize, usize)],
-    order: &mut [usize],
-    width: usize,
-) {
-    // Insertion sort, stable: the rows come mostly in order already (a contact's rows together,
-    // contacts by body).
-    for k in 0..n {
+/// The rows in order of their span's first dof (`order`: 0..n on entry), by a stable insertion
+/// sort: the rows come mostly in order already (a contact's rows together, contacts by body).
+fn sort_by_span_start(spans: &[(usize, usize)], order: &mut [usize]) {
+    for k in 0..order.len() {
         let lo = spans[k].0;
         let mut p = k;
         while p > 0 && spans[order[p - 1]].0 > lo {
@@ -359,156 +353,217 @@ fn delassus_meeting_pairs(
         }
         order[p] = k;
     }
-    for j in 0..n {
-        a[j * stride..j * stride + n].fill(0.0);
-    }
-    for j in 0..n {
-        let (lo_j, hi_j) = spans[j];
-        if lo_j >= hi_j {
-            continue;
+}
+
+/// One block of rows for the products: the rows `rows` (ascending, m of them) touching the
+/// dofs [lo, hi) (whole kinematic trees, outside which their terms are not summed here), with
+/// J's columns `j_cols` (stride `j_stride`) and the LᵀDL factor `h` of M (RBDA §6.3: column k
+/// holds L[k][j] on k's ancestors j, and D_k).
+struct Block<'a> {
+    model: &'a Model,
+    h: &'a [f64],
+    j_cols: &'a [f64],
+    j_stride: usize,
+    rows: &'a [usize],
+    dofs: (usize, usize),
+}
+
+impl Block<'_> {
+    /// Adds the block's Delassus products to A (`a`, column-major with `stride`):
+    /// A += Σ_k x_k x_kᵀ / D_k with X = L⁻ᵀJᵀ ([`Block::half_solve`]), on the lower triangle,
+    /// then mirrored to the upper. For a chain whose contacts come in link order a dof's
+    /// nonzeros are the rows of the links below it, so the work falls with the dof's depth.
+    fn add_gram(&self, ljt: &mut [f64], dof_rows: &mut [(usize, usize)], a: &mut [f64], stride: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above), all `add_gram_avx2` requires.
+            unsafe { self.add_gram_avx2(ljt, dof_rows, a, stride) };
+            return;
         }
-        let y_j = &y[j * nv..(j + 1) * nv];
-        let start = order.partition_point(|&i| spans[i].0 + width <= lo_j);
-        for &i in &order[start..] {
-            let (lo_i, hi_i) = spans[i];
-            if lo_i >= hi_j {
-                break;
+        self.add_gram_kernel(ljt, dof_rows, a, stride);
+    }
+
+    /// [`Block::add_gram_kernel`] compiled for AVX2: the same operations in the same order (no
+    /// fused multiply–adds), four rows per instruction, so the same bits.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn add_gram_avx2(
+        &self,
+        ljt: &mut [f64],
+        dof_rows: &mut [(usize, usize)],
+        a: &mut [f64],
+        stride: usize,
+    ) {
+        self.add_gram_kernel(ljt, dof_rows, a, stride);
+    }
+
+    #[inline(always)]
+    fn add_gram_kernel(
+        &self,
+        ljt: &mut [f64],
+        dof_rows: &mut [(usize, usize)],
+        a: &mut [f64],
+        stride: usize,
+    ) {
+        let (nv, rows, (lo, hi)) = (self.model.nv, self.rows, self.dofs);
+        let m = rows.len();
+        let x = self.half_solve(ljt, dof_rows);
+        let (r0, consecutive) = (rows[0], rows[m - 1] - rows[0] + 1 == m);
+        // A += x_k x_kᵀ / D_k on the lower triangle (row ≥ column), column by column.
+        for k in lo..hi {
+            let (f, l) = dof_rows[k - lo];
+            let d = self.h[k + k * nv];
+            let xk = &x[(k - lo) * m..(k - lo + 1) * m];
+            for c in f..l {
+                let s = xk[c] / d;
+                if s == 0.0 {
+                    continue;
+                }
+                if consecutive {
+                    let base = (r0 + c) * stride + r0;
+                    for (v, w) in a[base + c..base + l].iter_mut().zip(&xk[c..l]) {
+                        *v += w * s;
+                    }
+                } else {
+                    let base = rows[c] * stride;
+                    for (&i, w) in rows[c..l].iter().zip(&xk[c..l]) {
+                        a[base + i] += w * s;
+                    }
+                }
             }
-            let (lo, hi) = (lo_i.max(lo_j), hi_i.min(hi_j));
-            if i > j || lo >= hi {
+        }
+        // The upper triangle (the block's sums so far: another tree's block may add to a pair
+        // of rows touching both, and mirrors it again).
+        for (c, &j) in rows.iter().enumerate() {
+            for &i in &rows[c + 1..] {
+                a[j + i * stride] = a[i + j * stride];
+            }
+        }
+    }
+
+    /// Writes the block's part of M⁻¹Jᵀ = L⁻¹ D⁻¹ X into `y` (row i's column at i · nv, over
+    /// the block's dofs): X ([`Block::half_solve`]), D⁻¹, then L from the root down over all the
+    /// block's rows (the column fills its trees).
+    fn minv_jt(&self, ljt: &mut [f64], dof_rows: &mut [(usize, usize)], y: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above), all `minv_jt_avx2` requires.
+            unsafe { self.minv_jt_avx2(ljt, dof_rows, y) };
+            return;
+        }
+        self.minv_jt_kernel(ljt, dof_rows, y);
+    }
+
+    /// [`Block::minv_jt_kernel`] compiled for AVX2: the same operations in the same order, four
+    /// rows per instruction, so the same bits.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn minv_jt_avx2(&self, ljt: &mut [f64], dof_rows: &mut [(usize, usize)], y: &mut [f64]) {
+        self.minv_jt_kernel(ljt, dof_rows, y);
+    }
+
+    #[inline(always)]
+    fn minv_jt_kernel(&self, ljt: &mut [f64], dof_rows: &mut [(usize, usize)], y: &mut [f64]) {
+        let (model, h, rows, (lo, hi)) = (self.model, self.h, self.rows, self.dofs);
+        let nv = model.nv;
+        let m = rows.len();
+        let x = self.half_solve(ljt, dof_rows);
+        for k in lo..hi {
+            let d = h[k + k * nv];
+            for v in &mut x[(k - lo) * m..(k - lo + 1) * m] {
+                *v /= d;
+            }
+        }
+        // L Y = W from the root down: y_k −= L[k][j] y_j over the ancestors j of k.
+        for k in lo..hi {
+            let col_l = &h[k * nv..(k + 1) * nv];
+            let (before, rest) = x.split_at_mut((k - lo) * m);
+            let yk = &mut rest[..m];
+            let mut e = model.dof_parent[k];
+            while e != NO_DOF {
+                let s = model.dof_run_start[e];
+                for j in s..=e {
+                    let c = col_l[j];
+                    if c != 0.0 {
+                        for (v, w) in yk.iter_mut().zip(&before[(j - lo) * m..(j - lo + 1) * m]) {
+                            *v -= c * w;
+                        }
+                    }
+                }
+                e = model.dof_parent[s];
+            }
+        }
+        for (r, &i) in rows.iter().enumerate() {
+            for k in lo..hi {
+                y[i * nv + k] = x[(k - lo) * m + r];
+            }
+        }
+    }
+
+    /// X = L⁻ᵀJᵀ over the block (in `ljt`, per dof the block's rows contiguous; returned),
+    /// solved from the leaves up: x_j −= L[k][j] x_k over the ancestors j of k, x_k final once
+    /// k's descendants are done. A row's X is zero outside its bodies' ancestor dofs (RBDA
+    /// §6.5); per dof k only the rows [first, last + 1) of its nonzeros (`dof_rows`, indices
+    /// into the block's rows) are updated.
+    #[inline(always)]
+    fn half_solve<'x>(&self, ljt: &'x mut [f64], dof_rows: &mut [(usize, usize)]) -> &'x mut [f64] {
+        let (model, rows, (lo, hi)) = (self.model, self.rows, self.dofs);
+        let nv = model.nv;
+        let m = rows.len();
+        let x = &mut ljt[..m * (hi - lo)];
+        // Rows r0..r0 + m when the block's rows are consecutive (one robot, a chain): J's
+        // columns are then copied as runs.
+        let r0 = rows[0];
+        let consecutive = rows[m - 1] - r0 + 1 == m;
+        for k in lo..hi {
+            let col = &self.j_cols[k * self.j_stride..(k + 1) * self.j_stride];
+            let xk = &mut x[(k - lo) * m..(k - lo + 1) * m];
+            if consecutive {
+                xk.copy_from_slice(&col[r0..r0 + m]);
+            } else {
+                for (v, &i) in xk.iter_mut().zip(rows) {
+                    *v = col[i];
+                }
+            }
+        }
+        for k in (lo..hi).rev() {
+            let (before, rest) = x.split_at_mut((k - lo) * m);
+            let xk = &rest[..m];
+            let (f, l) = match (xk.iter().position(|&v| v != 0.0), xk.iter().rposition(|&v| v != 0.0)) {
+                (Some(f), Some(l)) => (f, l + 1),
+                _ => (0, 0),
+            };
+            dof_rows[k - lo] = (f, l);
+            if f >= l {
                 continue;
             }
-            let v: f64 = jt[i * nv + lo..i * nv + hi].iter().zip(&y_j[lo..hi]).map(|(x, y)| x * y).sum();
-            a[i + j * stride] = v;
-            a[j + i * stride] = v;
-        }
-    }
-}
-
-/// Solves M X = B for the n right-hand sides of `yt` (Bᵀ on entry, Xᵀ on return: n × nv,
-/// column-major, one dof's column of n entries contiguous) with the tree-sparse factor of M: each
-/// step of the solve updates a whole column, across every right-hand side. Per right-hand side
-/// the operations, and their order, are those of `dynamics::crba::solve_with_factor_span_unchecked`
-/// (Lᵀ z = b from the leaves up, D w = z, L x = w from the root down with each run of the
-/// ancestor chain summed apart), so the same bits: dofs outside a row's trees hold zeros and
-/// stay zero, and each dof's step runs over `rows[dof]` only, the rows that may touch its tree.
-/// `acc` and `run` (n each) are scratch.
-fn solve_rows(
-    model: &Model,
-    factor: &[f64],
-    yt: &mut [f64],
-    n: usize,
-    rows: &[(usize, usize)],
-    acc: &mut [f64],
-    run: &mut [f64],
-) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2 (checked just above), all `solve_rows_avx2` requires.
-        unsafe { solve_rows_avx2(model, factor, yt, n, rows, acc, run) };
-        return;
-    }
-    solve_rows_kernel(model, factor, yt, n, rows, acc, run);
-}
-
-/// [`solve_rows_kernel`] compiled for AVX2: the same operations in the same order (no fused
-/// multiply–adds), four right-hand sides per instruction, so the same bits.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn solve_rows_avx2(
-    model: &Model,
-    factor: &[f64],
-    yt: &mut [f64],
-    n: usize,
-    rows: &[(usize, usize)],
-    acc: &mut [f64],
-    run: &mut [f64],
-) {
-    solve_rows_kernel(model, factor, yt, n, rows, acc, run);
-}
-
-#[inline(always)]
-fn solve_rows_kernel(
-    model: &Model,
-    h: &[f64],
-    yt: &mut [f64],
-    n: usize,
-    rows: &[(usize, usize)],
-    acc: &mut [f64],
-    run: &mut [f64],
-) {
-    let nv = model.nv;
-    let lambda = &model.dof_parent[..nv];
-    // The empty sum, as `Iterator::sum` starts it.
-    let zero: f64 = std::iter::empty::<f64>().sum();
-    // Lᵀ z = b: x[j] −= L[i][j] x[i] over the ancestor chain of each dof, from the leaves up
-    // (rows [r0, r1) only: the others are zero on the dof's tree and stay so).
-    for i in (0..nv).rev() {
-        let (r0, r1) = rows[i];
-        if lambda[i] == NO_DOF || r0 >= r1 {
-            continue;
-        }
-        let col_l = &h[i * nv..(i + 1) * nv];
-        let (before, rest) = yt.split_at_mut(i * n);
-        let x_i = &rest[r0..r1];
-        let mut e = lambda[i];
-        while e != NO_DOF {
-            let s = model.dof_run_start[e];
-            for j in s..=e {
-                let l = col_l[j];
-                for (a, b) in before[j * n + r0..j * n + r1].iter_mut().zip(x_i) {
-                    *a -= l * b;
+            let col_l = &self.h[k * nv..(k + 1) * nv];
+            let xk = &xk[f..l];
+            let mut e = model.dof_parent[k];
+            while e != NO_DOF {
+                let s = model.dof_run_start[e];
+                for j in s..=e {
+                    let c = col_l[j];
+                    if c != 0.0 {
+                        let xj = &mut before[(j - lo) * m + f..(j - lo) * m + l];
+                        for (v, w) in xj.iter_mut().zip(xk) {
+                            *v -= c * w;
+                        }
+                    }
                 }
+                e = model.dof_parent[s];
             }
-            e = lambda[s];
         }
-    }
-    // D w = z.
-    for i in 0..nv {
-        let (r0, r1) = rows[i];
-        let d = h[i + i * nv];
-        for a in &mut yt[i * n + r0.min(r1)..i * n + r1] {
-            *a /= d;
-        }
-    }
-    // L x = w: x[i] −= Σ over the runs of its ancestor chain (each run summed, then added).
-    for i in 0..nv {
-        let (r0, r1) = rows[i];
-        if lambda[i] == NO_DOF || r0 >= r1 {
-            continue;
-        }
-        let col_l = &h[i * nv..(i + 1) * nv];
-        let (before, rest) = yt.split_at_mut(i * n);
-        let (acc, run) = (&mut acc[r0..r1], &mut run[r0..r1]);
-        acc.fill(0.0);
-        let mut e = lambda[i];
-        while e != NO_DOF {
-            let s = model.dof_run_start[e];
-            run.fill(zero);
-            for j in s..=e {
-                let l = col_l[j];
-                for (r, x) in run.iter_mut().zip(&before[j * n + r0..j * n + r1]) {
-                    *r += x * l;
-                }
-            }
-            for (a, r) in acc.iter_mut().zip(run.iter()) {
-                *a += r;
-            }
-            e = lambda[s];
-        }
-        for (x, a) in rest[r0..r1].iter_mut().zip(acc.iter()) {
-            *x -= a;
-        }
+        x
     }
 }
 
-/// J_i · x for row `i` of the current rows, over its trees' dofs ([`row_ranges`]; J_i is zero
-/// outside them): the dense sum's terms in its order, without its exact zeros. Needs the rows'
-/// Jᵀ and trees of [`delassus`] at the current J.
+/// J_i · x for row `i` of the current rows, over its nonzeros ([`ExactWork::row_ranges`]).
+/// Needs the rows' Jᵀ and trees of [`delassus`] at the current J.
 fn row_dot(data: &Data, nv: usize, i: usize, x: &[f64]) -> f64 {
     let row = &data.exact.jt.as_slice()[i * nv..(i + 1) * nv];
     let mut sum: f64 = std::iter::empty::<f64>().sum();
-    for (lo, hi) in row_ranges(data, i) {
+    for (lo, hi) in data.exact.row_ranges(i) {
         for (j, x) in row[lo..hi].iter().zip(&x[lo..hi]) {
             sum += j * x;
         }
@@ -516,29 +571,44 @@ fn row_dot(data: &Data, nv: usize, i: usize, x: &[f64]) -> f64 {
     sum
 }
 
-/// The dofs of row i's trees, ascending, as two ranges (`exact.trees`; the second may be
-/// empty), or its span and an empty range when the trees are not known: J_i and M⁻¹J_iᵀ are
-/// zero outside them. Needs [`delassus`] at the current rows.
-fn row_ranges(data: &Data, i: usize) -> [(usize, usize); 2] {
-    if data.exact.trees_valid {
-        data.exact.trees[i]
-    } else {
-        [data.exact.spans[i], (0, 0)]
+/// x += s · M⁻¹Jᵀ μ with μ the first nefc entries of `exact.rhs` (the result of a Delassus
+/// solve): from M⁻¹Jᵀ when a Gauss–Seidel solve formed it ([`form_minv_jt`]; each row's column
+/// over its trees), else Jᵀ μ over each row's nonzeros ([`ExactWork::row_ranges`]) and one solve
+/// with the factor of M.
+fn add_minv_jt_mu(model: &Model, data: &mut Data, s: f64, x: &mut [f64]) {
+    let nv = model.nv;
+    let Data { mass_factor, exact, nefc, .. } = data;
+    if exact.minv_jt_ready {
+        let y = exact.minv_jt.as_slice();
+        for i in 0..*nefc {
+            let mu = s * exact.rhs[i];
+            for (lo, hi) in exact.tree_ranges(i) {
+                for (x, y) in x[lo..hi].iter_mut().zip(&y[i * nv + lo..i * nv + hi]) {
+                    *x += y * mu;
+                }
+            }
+        }
+        return;
     }
-}
-
-/// x += s · M⁻¹Jᵀ μ with μ the first nefc entries of `efc_rhs` (the result of a Delassus solve),
-/// each row's column over its trees' dofs ([`row_ranges`]; zero outside them).
-fn add_minv_jt_mu(data: &Data, nv: usize, s: f64, x: &mut [f64]) {
-    let y = data.exact.minv_jt.as_slice();
-    for i in 0..data.nefc {
-        let mu = s * data.exact.rhs[i];
-        for (lo, hi) in row_ranges(data, i) {
-            for (x, y) in x[lo..hi].iter_mut().zip(&y[i * nv + lo..i * nv + hi]) {
-                *x += y * mu;
+    let mut f = std::mem::take(&mut exact.minv_jt_mu);
+    f.fill(0.0);
+    let jt = exact.jt.as_slice();
+    for i in 0..*nefc {
+        let mu = s * exact.rhs[i];
+        if mu == 0.0 {
+            continue;
+        }
+        for (lo, hi) in exact.row_ranges(i) {
+            for (f, j) in f.as_mut_slice()[lo..hi].iter_mut().zip(&jt[i * nv + lo..i * nv + hi]) {
+                *f += j * mu;
             }
         }
     }
+    solve_with_factor_unchecked(model, mass_factor, f.as_mut_slice());
+    for (x, f) in x.iter_mut().zip(f.iter()) {
+        *x += f;
+    }
+    exact.minv_jt_mu = f;
 }
 
 /// The constraint stage of the exact mode. Needs, at the same state: the factor of M
@@ -584,7 +654,7 @@ pub(crate) fn solve_exact(
     }
     data.qacc.copy_from(&data.qacc_smooth);
     let mut qacc = std::mem::take(&mut data.qacc);
-    add_minv_jt_mu(data, nv, 1.0, qacc.as_mut_slice());
+    add_minv_jt_mu(model, data, 1.0, qacc.as_mut_slice());
     data.qacc = qacc;
     data.qfrc_constraint.fill(0.0);
     data.exact.warm_rows.clear();
@@ -593,7 +663,7 @@ pub(crate) fn solve_exact(
         data.efc_force[i] = lambda;
         data.exact.warm[i] = lambda;
         data.exact.warm_rows.push((data.efc_type[i], data.efc_id[i]));
-        for (lo, hi) in row_ranges(data, i) {
+        for (lo, hi) in data.exact.row_ranges(i) {
             let row = &data.exact.jt.as_slice()[i * nv + lo..i * nv + hi];
             for (f, j) in data.qfrc_constraint.as_mut_slice()[lo..hi].iter_mut().zip(row) {
                 *f += j * lambda;
@@ -664,7 +734,7 @@ pub(crate) fn project_positions(
         solve_delassus(data);
         let mut dq = std::mem::take(&mut data.scratch_v);
         dq.fill(0.0);
-        add_minv_jt_mu(data, model.nv, -1.0, dq.as_mut_slice());
+        add_minv_jt_mu(model, data, -1.0, dq.as_mut_slice());
         integrate_configuration_unchecked(model, q, dq.as_slice(), 1.0);
         data.scratch_v = dq;
         iterations += 1;
@@ -719,7 +789,7 @@ pub(crate) fn project_velocities_unchecked(
         solve_mixed(data, |_, _| false);
     }
     data.exact.pressing[..n].fill(false);
-    add_minv_jt_mu(data, nv, 1.0, v);
+    add_minv_jt_mu(model, data, 1.0, v);
     // J v of the projected velocity, measured as every row violation is.
     for i in 0..n {
         data.efc_vel[i] = row_dot(data, nv, i, v);
@@ -733,12 +803,12 @@ mod tests {
     use crate::constraint::ConstraintMode;
     use crate::dynamics::solve_with_factor_unchecked;
 
-    /// The tree-restricted Delassus products equal the dense J M⁻¹ Jᵀ (each entry the same sum
-    /// without its exact zeros), and the nonzero pattern holds every nonzero, on a scene with several trees: two stacked boxes, a hinged
-    /// pendulum touching the floor, a free capsule.
+    /// The tree-by-tree Delassus products equal the dense J M⁻¹ Jᵀ to round-off, and the nonzero
+    /// pattern holds every nonzero, on scenes with several trees: two stacked boxes, a hinged
+    /// pendulum touching the floor, a free capsule; stacks whose rows do not come in tree order;
+    /// a chain of capsules on the floor (one tree, rows of every depth).
     #[test]
     fn delassus_equals_the_dense_products() {
-        // All pairs visited (the trees' spans cover most dofs).
         check_delassus(
             "<mujoco><worldbody><geom type='plane' size='0 0 1'/>\
              <body pos='0 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
@@ -748,8 +818,8 @@ mod tests {
              <body pos='1 0 0.019' euler='0 90 0'><freejoint/><geom type='capsule' size='0.02 0.1'/></body>\
              </worldbody></mujoco>",
         );
-        // Only the meeting pairs visited: two stacks of two boxes and three lone boxes, in an
-        // order whose rows do not come sorted by tree (a stack's upper box first).
+        // Two stacks of two boxes and three lone boxes, in an order whose rows do not come
+        // sorted by tree (a stack's upper box first).
         check_delassus(
             "<mujoco><worldbody><geom type='plane' size='0 0 1'/>\
              <body pos='0 0 0.148'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
@@ -761,10 +831,26 @@ mod tests {
              <body pos='0.9 0 0.049'><freejoint/><geom type='box' size='0.05 0.05 0.05'/></body>\
              </worldbody></mujoco>",
         );
+        // A chain of eight capsules lying on the floor, a ball joint between each two.
+        let mut chain = String::from(
+            "<mujoco><worldbody><geom type='plane' size='0 0 1'/><body pos='0 0 0.0199'><freejoint/>",
+        );
+        for k in 0..8 {
+            if k > 0 {
+                chain.push_str("<body pos='0.1 0 0'><joint type='ball'/>");
+            }
+            chain.push_str("<geom type='capsule' fromto='0 0 0 0.1 0 0' size='0.02'/>");
+        }
+        chain.push_str(&"</body>".repeat(8));
+        chain.push_str("</worldbody></mujoco>");
+        check_delassus(&chain);
     }
 
-    /// [`delassus`] of the scene `xml` in exact mode against the dense products.
+    /// [`delassus`] of the scene `xml` in exact mode against the dense products J (M⁻¹ Jᵀ): equal
+    /// to round-off of the entries' size (`ROUND_OFF` of the largest diagonal, the rows' scale),
+    /// exactly symmetric, and every nonzero inside the pattern.
     fn check_delassus(xml: &str) {
+        const ROUND_OFF: f64 = 1e-12;
         let mut model = crate::Model::from_str(xml).unwrap();
         model.set_constraint_mode(ConstraintMode::Exact);
         let mut data = Data::new(&model);
@@ -777,25 +863,40 @@ mod tests {
         for c in 0..n {
             solve_with_factor_unchecked(&model, &data.mass_factor, y.column_mut(c).as_mut_slice());
         }
+        let scale = (0..n).map(|i| data.exact.delassus[(i, i)]).fold(0.0, f64::max);
+        assert!(scale > 0.0);
         for i in 0..n {
             for c in 0..n {
                 let dense: f64 = (0..nv).map(|k| j[(i, k)] * y[(k, c)]).sum();
-                let (r, s) = (i.min(c), i.max(c));
-                let dense_upper: f64 = (0..nv).map(|k| j[(r, k)] * y[(k, s)]).sum();
-                assert_eq!(data.exact.delassus[(i, c)], dense_upper, "({i}, {c})");
+                let a = data.exact.delassus[(i, c)];
+                assert!((a - dense).abs() <= ROUND_OFF * scale, "({i}, {c}): {a} against {dense}");
+                assert_eq!(a, data.exact.delassus[(c, i)], "({i}, {c}) symmetric");
                 // Every nonzero lies in the pattern (the Gauss–Seidel gathers read only it).
                 let w = &data.exact;
                 assert_eq!(w.pattern_n, n);
-                let column = &w.pattern_rows[w.pattern_ptr[c]..w.pattern_ptr[c + 1]];
-                assert!(dense_upper == 0.0 || column.contains(&i), "({i}, {c}) outside the pattern");
-                assert!((dense - dense_upper).abs() <= 1e-12 * (1.0 + dense.abs()));
-                let (lo, hi) = data.exact.spans[c];
-                if (lo..hi).contains(&(i % nv)) {
-                    assert_eq!(data.exact.minv_jt[(i % nv, c)], y[(i % nv, c)]);
-                } else {
-                    assert_eq!(y[(i % nv, c)], 0.0);
+                if !w.pattern_full {
+                    let column = &w.pattern_rows[w.pattern_ptr[c]..w.pattern_ptr[c + 1]];
+                    assert!(a == 0.0 || column.contains(&i), "({i}, {c}) outside the pattern");
                 }
             }
+            // M⁻¹Jᵀ formed (the sweeps' second route) is the dense solve's, over the row's trees.
+            if i == 0 {
+                form_minv_jt(&model, &mut data);
+            }
+            let w = &data.exact;
+            let ymax = y.column(i).amax();
+            for (lo, hi) in w.tree_ranges(i) {
+                for k in lo..hi {
+                    assert!((w.minv_jt[(k, i)] - y[(k, i)]).abs() <= ROUND_OFF * ymax, "M⁻¹Jᵀ ({k}, {i})");
+                }
+            }
+            let outside =
+                (0..nv).filter(|&k| !w.tree_ranges(i).iter().any(|&(lo, hi)| (lo..hi).contains(&k)));
+            assert!(outside.into_iter().all(|k| y[(k, i)] == 0.0), "M⁻¹J_{i}ᵀ nonzero outside its trees");
+            // J_i is zero outside its row ranges, and row_dot is J_i · x.
+            let x: Vec<f64> = (0..nv).map(|k| 1.0 + k as f64).collect();
+            let dense: f64 = (0..nv).map(|k| j[(i, k)] * x[k]).sum();
+            assert!((row_dot(&data, nv, i, &x) - dense).abs() <= ROUND_OFF * (1.0 + dense.abs()));
         }
     }
 }

@@ -11,9 +11,6 @@ use nalgebra::{DMatrix, DVector};
 /// sized for the row capacity of [`Data`](crate::Data) (grown with it by `Data::reserve_rows`).
 #[derive(Clone, Debug)]
 pub(crate) struct ExactWork {
-    /// M⁻¹Jᵀ, nv × nefc (columns 0..nefc used, each over its row's span in `spans` only: the
-    /// column is zero outside it, and those entries are not written).
-    pub minv_jt: DMatrix<f64>,
     /// The Delassus matrix J M⁻¹ Jᵀ, nefc × nefc, and its factor or eigenvectors.
     pub delassus: DMatrix<f64>,
     pub factor: DMatrix<f64>,
@@ -71,21 +68,24 @@ pub(crate) struct ExactWork {
     pub lu: super::block_lu::BlockLu,
     /// The ADMM solve's per-row buffers ([`super::admm`]).
     pub admm: super::admm::AdmmWork,
-    /// Jᵀ, nv × nefc (columns 0..nefc used): each row of J contiguous, for the Delassus products.
+    /// Jᵀ, nv × nefc (columns 0..nefc used): each row of J contiguous (J_i · x, Jᵀ λ).
     pub jt: DMatrix<f64>,
-    /// M⁻¹Jᵀ transposed while it is solved, nefc × nv column-major (stride nefc: one dof's
-    /// entries over the rows contiguous), and two per-row sums of its back substitution.
-    pub yt: Vec<f64>,
-    pub yt_acc: Vec<f64>,
-    pub yt_run: Vec<f64>,
-    /// The rows in order of the first dof of their span (the Delassus products' pairing).
-    pub order: Vec<usize>,
-    /// Per dof, the rows [first, last + 1) among which are all the rows whose span holds it
-    /// (empty when none does): the M⁻¹Jᵀ solve updates only those.
+    /// L⁻ᵀJᵀ of the block of rows whose Delassus products are being formed (`super::exact`,
+    /// `gram_block`): per dof of the block's trees, its entries over the block's rows contiguous
+    /// (at most nv · nefc entries).
+    pub ljt: Vec<f64>,
+    /// Per dof of that block, the block's rows [first, last + 1) outside which its row of
+    /// L⁻ᵀJᵀ is zero.
     pub dof_rows: Vec<(usize, usize)>,
+    /// The rows in order of the first dof of their span (the Delassus pattern's pairing when
+    /// some row touches more than two trees), or 0..nefc (that case's single block of rows).
+    pub order: Vec<usize>,
     /// Per row, the dofs [lo, hi) of the kinematic trees it touches (`dynamics::tree_span`):
     /// M⁻¹ J_iᵀ is zero outside them, and A_ij = 0 when two rows' spans are disjoint.
     pub spans: Vec<(usize, usize)>,
+    /// Per row, the dofs [first, last + 1) from its first nonzero of J to its last (empty for a
+    /// zero row): J_i is zero outside them.
+    pub support: Vec<(usize, usize)>,
     /// The nonzero pattern of the Delassus matrix (`super::delassus_pattern`), column by column
     /// in compressed form: column j's rows that may be nonzero (their spans meet j's) are
     /// `pattern_rows[pattern_ptr[j]..pattern_ptr[j + 1]]`, ascending. Valid for `pattern_n` rows
@@ -118,13 +118,55 @@ pub(crate) struct ExactWork {
     /// The Gauss–Seidel sweep's motion change M⁻¹Jᵀ Δλ (entries 0..nv) and correction M⁻¹Jᵀ λ
     /// (nv..2nv).
     pub motion: DVector<f64>,
+    /// M⁻¹Jᵀ μ of a solve's multipliers μ, nv (`super::exact`, `add_minv_jt_mu`).
+    pub minv_jt_mu: DVector<f64>,
+    /// M⁻¹Jᵀ, nv × nefc (column i over row i's trees, `tree_ranges`; not written elsewhere),
+    /// formed only when the Gauss–Seidel sweeps' solves with M would cost more
+    /// (`super::exact::form_minv_jt`), and whether it holds the current rows'.
+    pub minv_jt: DMatrix<f64>,
+    pub minv_jt_ready: bool,
+    /// Estimated work (instructions) of forming `minv_jt` for the current rows, and of one
+    /// solve with M's factor: a sweep's motion costs two such solves, or two passes over
+    /// `minv_jt` once formed.
+    pub minv_jt_work: f64,
+    pub solve_work: f64,
+}
+
+impl ExactWork {
+    /// The dofs of row i's kinematic trees, as two ranges (the second may be empty), or its
+    /// span when the trees are not known: M⁻¹J_iᵀ is zero outside them.
+    pub fn tree_ranges(&self, i: usize) -> [(usize, usize); 2] {
+        if self.trees_valid {
+            self.trees[i]
+        } else {
+            [self.spans[i], (0, 0)]
+        }
+    }
+
+    /// The dofs of row i's nonzeros, as two ranges (the second may be empty): its trees
+    /// (`trees`) cut to its first and last nonzero (`support`), or that support alone when the
+    /// trees are not known. J_i is zero outside them. Needs the Delassus products
+    /// (`super::exact`) at the current rows.
+    pub fn row_ranges(&self, i: usize) -> [(usize, usize); 2] {
+        let (first, end) = self.support[i];
+        if !self.trees_valid {
+            return [(first, end), (0, 0)];
+        }
+        self.trees[i].map(|(lo, hi)| {
+            let (lo, hi) = (lo.max(first), hi.min(end));
+            if lo < hi {
+                (lo, hi)
+            } else {
+                (0, 0)
+            }
+        })
+    }
 }
 
 impl ExactWork {
     /// The workspace for `nefc` rows of a model with `nv` dofs.
     pub fn new(nv: usize, nefc: usize) -> Self {
         Self {
-            minv_jt: DMatrix::zeros(nv, nefc),
             delassus: DMatrix::zeros(nefc, nefc),
             factor: DMatrix::zeros(nefc, nefc),
             rhs: DVector::zeros(nefc),
@@ -151,12 +193,11 @@ impl ExactWork {
             lu: Default::default(),
             admm: Default::default(),
             jt: DMatrix::zeros(nv, nefc),
-            yt: vec![0.0; nv * nefc],
-            yt_acc: vec![0.0; nefc],
-            yt_run: vec![0.0; nefc],
-            order: vec![0; nefc],
+            ljt: vec![0.0; nv * nefc],
             dof_rows: vec![(0, 0); nv],
+            order: vec![0; nefc],
             spans: vec![(0, 0); nefc],
+            support: vec![(0, 0); nefc],
             pattern_ptr: Vec::with_capacity(nefc + 1),
             pattern_rows: Vec::with_capacity(nefc * nefc),
             pattern_n: 0,
@@ -169,28 +210,33 @@ impl ExactWork {
             polish_set: 0,
             polish_work: 0.0,
             motion: DVector::zeros(2 * nv),
+            minv_jt_mu: DVector::zeros(nv),
+            minv_jt: DMatrix::zeros(nv, nefc),
+            minv_jt_ready: false,
+            minv_jt_work: 0.0,
+            solve_work: 0.0,
         }
     }
 
-    /// The dense matrices (M⁻¹Jᵀ, the Delassus matrix and its factors, the block LU's scratch)
+    /// The dense matrices (Jᵀ, L⁻ᵀJᵀ and M⁻¹Jᵀ, the Delassus matrix and its factors, the block LU's scratch)
     /// for `nefc` rows, if smaller, and the Delassus pattern's room: only the exact mode needs them
     /// (nefc² numbers each).
     pub fn grow_matrices(&mut self, nv: usize, nefc: usize) {
         if self.motion.len() != 2 * nv {
             self.motion = DVector::zeros(2 * nv);
+            self.minv_jt_mu = DVector::zeros(nv);
         }
         if self.dof_rows.len() != nv {
             self.dof_rows = vec![(0, 0); nv];
             self.tree_ptr = vec![0; nv + 1];
         }
-        if self.delassus.nrows() >= nefc && self.minv_jt.nrows() == nv {
+        if self.delassus.nrows() >= nefc && self.jt.nrows() == nv {
             return;
         }
-        self.minv_jt = DMatrix::zeros(nv, nefc);
         self.jt = DMatrix::zeros(nv, nefc);
-        self.yt = vec![0.0; nv * nefc];
-        self.yt_acc = vec![0.0; nefc];
-        self.yt_run = vec![0.0; nefc];
+        self.minv_jt = DMatrix::zeros(nv, nefc);
+        self.minv_jt_ready = false;
+        self.ljt = vec![0.0; nv * nefc];
         self.order = vec![0; nefc];
         self.tree_rows = vec![0; 2 * nefc];
         // The pattern's room for every pair, so that it never grows inside a step (its size is
@@ -226,6 +272,7 @@ impl ExactWork {
         self.newton_normal.reserve(nefc.saturating_sub(self.newton_normal.len()));
         self.in_active.resize(nefc, false);
         self.spans.resize(nefc, (0, 0));
+        self.support.resize(nefc, (0, 0));
         self.trees.resize(nefc, [(0, 0); 2]);
         self.admm.grow(nefc);
         self.active.reserve(nefc.saturating_sub(self.active.len()));
