@@ -73,7 +73,7 @@ pub(crate) fn contact_jacobian_columns(
         unsafe { columns_avx2(model, x_world_body, s_body, axes, contact, dim, cols, vals) };
         return;
     }
-    columns_kernel(model, x_world_body, s_body, axes, contact, dim, cols, vals);
+    columns_by_dim(model, x_world_body, s_body, axes, contact, dim, cols, vals);
 }
 
 /// [`columns_kernel`] compiled for AVX2: the same products and sums (Rust fuses no
@@ -92,7 +92,28 @@ unsafe fn columns_avx2(
     cols: &mut Vec<usize>,
     vals: &mut Vec<[f64; 6]>,
 ) {
-    columns_kernel(model, x_world_body, s_body, axes, contact, dim, cols, vals);
+    columns_by_dim(model, x_world_body, s_body, axes, contact, dim, cols, vals);
+}
+
+/// [`columns_kernel`] with condim 3 (MJCF's default) a constant: its copy forms only the three
+/// linear rows, without the tests on `dim` per dof (the same values).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn columns_by_dim(
+    model: &Model,
+    x_world_body: &[Transform],
+    s_body: &[Motion],
+    axes: &mut DofAxes,
+    contact: &Contact,
+    dim: usize,
+    cols: &mut Vec<usize>,
+    vals: &mut Vec<[f64; 6]>,
+) {
+    if dim == 3 {
+        columns_kernel(model, x_world_body, s_body, axes, contact, 3, cols, vals);
+    } else {
+        columns_kernel(model, x_world_body, s_body, axes, contact, dim, cols, vals);
+    }
 }
 
 #[inline(always)]

@@ -167,8 +167,20 @@ impl Rows<'_> {
     pub fn directional(&self, jar: &DVector<f64>, jv: &DVector<f64>) -> (f64, f64) {
         let (jar, jv) = (jar.as_slice(), jv.as_slice());
         let (mut d1, mut d2) = (0.0, 0.0);
+        let d_all = self.d.as_slice();
         let mut i = 0;
         while i < self.nefc {
+            // An equality row (always quadratic), a limit's or a pyramidal or frictionless
+            // contact's (quadratic below zero): `directional_at`'s sums, in line.
+            if i < self.ne || (i >= self.ne + self.nf && self.kind[i] != EfcType::ContactElliptic) {
+                let (x, v, d) = (jar[i], jv[i], d_all[i]);
+                if i < self.ne || x < 0.0 {
+                    d1 += d * x * v;
+                    d2 += d * v * v;
+                }
+                i += 1;
+                continue;
+            }
             i += self.directional_at(i, jar, jv, &mut d1, &mut d2);
         }
         (d1, d2)

@@ -269,11 +269,16 @@ fn transposed_with_coefficients<'a>(
     let kp = k.div_ceil(4) * 4;
     let (gt, rest) = scratch.split_at_mut(n * kp);
     let c = &mut rest[..n * kp];
-    for (p, gt_p) in gt.chunks_exact_mut(kp).enumerate() {
-        for (r, g) in g.iter().enumerate() {
-            gt_p[r] = g[p];
+    // Row by row (each row's values read contiguously), then the padding.
+    for (r, g) in g.iter().enumerate() {
+        for (gt_p, &v) in gt.chunks_exact_mut(kp).zip(&g[..n]) {
+            gt_p[r] = v;
         }
-        gt_p[k..].fill(0.0);
+    }
+    if k < kp {
+        for gt_p in gt.chunks_exact_mut(kp) {
+            gt_p[k..].fill(0.0);
+        }
     }
     for (g_q, c_q) in gt.chunks_exact(kp).zip(c.chunks_exact_mut(kp)) {
         coefficients(&g_q[..k], &mut c_q[..k]);

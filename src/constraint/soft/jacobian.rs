@@ -96,7 +96,13 @@ pub(crate) fn clear_recorded(
         let (lo, end) = (i.max(b0), (b0 + n).min(recorded));
         if lo < end {
             for &k in &index[start[b0]..start[b0 + 1]] {
-                data[k * rows + lo..k * rows + end].fill(0.0);
+                let run = &mut data[k * rows + lo..k * rows + end];
+                // A condim-3 pyramidal contact's four rows in one store, not a call to memset.
+                if let Ok(four) = <&mut [f64; 4]>::try_from(&mut *run) {
+                    *four = [0.0; 4];
+                } else {
+                    run.fill(0.0);
+                }
             }
         }
         i = i.max(end);

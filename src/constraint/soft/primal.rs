@@ -468,7 +468,17 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                             &mut soft.rank_one,
                         );
                     factor_valid = updated || {
-                        soft.hessian.as_mut_slice().copy_from_slice(mass_matrix.as_slice());
+                        // M's lower triangle (all the assembly adds to and the Cholesky reads).
+                        for (h, m) in soft
+                            .hessian
+                            .as_mut_slice()
+                            .chunks_exact_mut(nv)
+                            .zip(mass_matrix.as_slice().chunks_exact(nv))
+                            .enumerate()
+                            .map(|(q, (h, m))| (&mut h[q..], &m[q..]))
+                        {
+                            h.copy_from_slice(m);
+                        }
                         let mut rows_h =
                             Assembler::new(Target::Dense(&mut soft.hessian), &nz, &mut soft.hessian_column);
                         rows.hessian(&soft.jar, efc_state, |i, dim, block| rows_h.add(i, dim, block));
@@ -510,7 +520,8 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
             }
             mul_j(&nz, j_dense, nefc, &soft.dir, &mut soft.jv);
             mul_m(dense, &model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
-            let g0: f64 = (soft.ma.iter().zip(qfrc_smooth.iter()).zip(soft.dir.iter()))
+            // (Over slices: nalgebra's matrix iterators cost several instructions per entry.)
+            let g0: f64 = (soft.ma.as_slice().iter().zip(qfrc_smooth.as_slice()).zip(soft.dir.as_slice()))
                 .map(|((&ma, &f0), &d)| (ma - f0) * d)
                 .sum();
             let dmd = soft.dir.dot(&soft.mdir);

@@ -164,6 +164,17 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
         r += 1;
     }
     let nf = r - ne;
+    // With no row before the joint limits and no tendon limit after them, the limit rows are
+    // recorded as they are written (their nonzeros, ascending: what `record`'s scan of J's
+    // columns would list) instead of by that scan.
+    let direct = r == 0 && cm.tendon_limits.is_empty();
+    if direct {
+        let soft = &mut data.soft;
+        soft.nz_start.clear();
+        soft.nz_start.push(0);
+        soft.nz_index.clear();
+        soft.nz_value.clear();
+    }
     for l in &cm.limits {
         if data.sleep.dof_asleep(model, l.dof_adr) {
             continue;
@@ -175,6 +186,14 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
             data.efc_type[r] = EfcType::LimitJoint;
             for k in 0..ndof {
                 data.efc_j[(r, l.dof_adr + k)] = dir[k];
+                if direct && dir[k] != 0.0 {
+                    data.soft.nz_index.push(l.dof_adr + k);
+                    data.soft.nz_value.push(dir[k]);
+                }
+            }
+            if direct {
+                let end = data.soft.nz_index.len();
+                data.soft.nz_start.push(end);
             }
             data.efc_pos[r] = dist;
             data.efc_margin[r] = margin;
@@ -184,8 +203,9 @@ pub(crate) fn soft_positions(cm: &ConstraintModel, model: &Model, data: &mut Dat
     }
     r = tendon_limit_rows(model, &cm.tendon_limits, data, r);
     // J's nonzeros, for the velocity stage, the solvers and the next clear (`jacobian.rs`): the
-    // rows so far by a scan of their columns, each contact's rows as they are written.
-    {
+    // rows so far by a scan of their columns (unless recorded above), each contact's rows as
+    // they are written.
+    if !direct {
         let Data { efc_j, soft, .. } = &mut *data;
         super::jacobian::record(
             efc_j,
@@ -306,48 +326,76 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
             columns,
             values,
         );
-        if pyramidal {
-            // The edges J_n ± μ_k J_k (pair k − 1 in rows 2k − 2, 2k − 1) in place of the frame
-            // rows, and only the columns where an edge is nonzero.
-            // Each column's edges are written in the next free slot, which moves on only when
-            // one of them is nonzero.
-            let mut kept = 0;
-            for t in 0..columns.len() {
-                let v = &values[t];
-                let e = &mut soft.edge_values[kept];
-                for k in 1..dim {
-                    let mu = contact.friction[k - 1];
-                    e[2 * k - 2] = v[0] + mu * v[k];
-                    e[2 * k - 1] = v[0] - mu * v[k];
-                }
-                if e[..rows].iter().any(|&x| x != 0.0) {
-                    columns[kept] = columns[t];
-                    kept += 1;
-                }
-            }
-            columns.truncate(kept);
-        }
-        // J is stored by columns: each column's rows r..r + rows are contiguous.
-        let n = columns.len();
-        for t in 0..n {
-            let column = &mut j[columns[t] * stride + r..][..rows];
+        if pyramidal && dim == 3 {
+            // condim 3 (MJCF's default): the four edges of `pyramidal3`, written to J and the
+            // record in one pass.
+            let friction = [contact.friction[0], contact.friction[1]];
+            pyramidal3(
+                columns,
+                values,
+                friction,
+                &mut soft.edge4,
+                j,
+                stride,
+                r,
+                &mut soft.nz_index,
+                &mut soft.nz_value,
+            );
+        } else {
             if pyramidal {
-                column.copy_from_slice(&soft.edge_values[t][..rows]);
-            } else {
-                column.copy_from_slice(&soft.column_values[t][..rows]);
+                // The edges J_n ± μ_k J_k (pair k − 1 in rows 2k − 2, 2k − 1) in place of the
+                // frame rows, and only the columns where an edge is nonzero. Each column's edges
+                // are written in the next free slot, which moves on only when one of them is
+                // nonzero.
+                let mut kept = 0;
+                for t in 0..columns.len() {
+                    let v = &values[t];
+                    let e = &mut soft.edge_values[kept];
+                    for k in 1..dim {
+                        let mu = contact.friction[k - 1];
+                        e[2 * k - 2] = v[0] + mu * v[k];
+                        e[2 * k - 1] = v[0] - mu * v[k];
+                    }
+                    if e[..rows].iter().any(|&x| x != 0.0) {
+                        columns[kept] = columns[t];
+                        kept += 1;
+                    }
+                }
+                columns.truncate(kept);
+            }
+            // J is stored by columns: each column's rows r..r + rows are contiguous.
+            let n = columns.len();
+            for t in 0..n {
+                let column = &mut j[columns[t] * stride + r..][..rows];
+                if pyramidal {
+                    column.copy_from_slice(&soft.edge_values[t][..rows]);
+                } else {
+                    column.copy_from_slice(&soft.column_values[t][..rows]);
+                }
+            }
+            // The record: each row over the same columns (exact-size extends, one capacity
+            // check per row).
+            for i in 0..rows {
+                soft.nz_index.extend_from_slice(columns);
+                if pyramidal {
+                    soft.nz_value.extend(soft.edge_values[..n].iter().map(|e| e[i]));
+                } else {
+                    soft.nz_value.extend(soft.column_values.iter().map(|v| v[i]));
+                }
+                soft.nz_start.push(soft.nz_index.len());
             }
         }
-        // The record: each row over the same columns (exact-size extends, one capacity check
-        // per row), and the rows as one block for the next clear.
+        // The record's row ends (`pyramidal3` appends no starts), and the rows as one block for
+        // the next clear.
+        if pyramidal && dim == 3 {
+            let n = columns.len();
+            for _ in 0..rows {
+                let end = soft.nz_start.last().copied().unwrap_or(0) + n;
+                soft.nz_start.push(end);
+            }
+        }
         soft.contact_blocks.push((r, rows));
         for i in 0..rows {
-            soft.nz_index.extend_from_slice(columns);
-            if pyramidal {
-                soft.nz_value.extend(soft.edge_values[..n].iter().map(|e| e[i]));
-            } else {
-                soft.nz_value.extend(soft.column_values.iter().map(|v| v[i]));
-            }
-            soft.nz_start.push(soft.nz_index.len());
             let row = r + i;
             efc_id[row] = c;
             efc_type[row] = kind;
@@ -359,6 +407,55 @@ fn contact_rows(model: &Model, data: &mut Data, mut r: usize, cone: Cone) -> usi
         r += rows;
     }
     r
+}
+
+/// A pyramidal contact of condim 3 from its frame rows' compact columns (`columns`, `values`:
+/// normal, two tangents): the edges J_n + μ₁ J_t1, J_n − μ₁ J_t1, J_n + μ₂ J_t2, J_n − μ₂ J_t2
+/// (the products and sums of the general loop in `contact_rows`, the same bits), only the
+/// columns where an edge is nonzero kept in `columns`; each kept column's four values written
+/// to rows r..r + 4 of J (stored by columns, `stride` rows) and the four rows appended to the
+/// record's `index` and `value` (row by row over the kept columns; the caller appends the row
+/// starts). `edges` is scratch of at least `columns.len()` entries.
+#[allow(clippy::too_many_arguments)]
+fn pyramidal3(
+    columns: &mut Vec<usize>,
+    values: &[[f64; 6]],
+    friction: [f64; 2],
+    edges: &mut [[f64; 4]],
+    j: &mut [f64],
+    stride: usize,
+    r: usize,
+    index: &mut Vec<usize>,
+    value: &mut Vec<f64>,
+) {
+    let [mu1, mu2] = friction;
+    let mut kept = 0;
+    for t in 0..columns.len().min(values.len()).min(edges.len()) {
+        let v = &values[t];
+        let e = [v[0] + mu1 * v[1], v[0] - mu1 * v[1], v[0] + mu2 * v[2], v[0] - mu2 * v[2]];
+        // Each column's edges go to the next free slot, which moves on only when one is nonzero.
+        edges[kept] = e;
+        if (e[0] != 0.0) | (e[1] != 0.0) | (e[2] != 0.0) | (e[3] != 0.0) {
+            if let Some(column) = j.get_mut(columns[t] * stride + r..columns[t] * stride + r + 4) {
+                column.copy_from_slice(&e);
+            }
+            columns[kept] = columns[t];
+            kept += 1;
+        }
+    }
+    columns.truncate(kept);
+    let n = kept;
+    for _ in 0..4 {
+        index.extend_from_slice(columns);
+    }
+    let base = value.len();
+    value.resize(base + 4 * n, 0.0);
+    let (v0, rest) = value[base..].split_at_mut(n);
+    let (v1, rest) = rest.split_at_mut(n);
+    let (v2, v3) = rest.split_at_mut(n);
+    for ((((e, a), b), c), d) in edges[..n].iter().zip(v0).zip(v1).zip(v2).zip(v3) {
+        (*a, *b, *c, *d) = (e[0], e[1], e[2], e[3]);
+    }
 }
 
 /// `efc_vel` = J v of every row and `efc_jdotv` of connect and weld rows (0 elsewhere), at the

@@ -55,6 +55,8 @@ pub(crate) struct SoftWork {
     pub column_values: Vec<[f64; 6]>,
     /// Their values in a pyramidal contact's edge rows (nv).
     pub edge_values: Vec<[f64; 10]>,
+    /// A condim-3 pyramidal contact's four edges per column (`rows.rs`, `pyramidal3`).
+    pub edge4: Vec<[f64; 4]>,
     /// Each dof's world axes at its body's origin, shared by the contacts of a position stage.
     pub dof_axes: super::contact_columns::DofAxes,
     /// The contacts' rows as recorded, (first row, rows): each contact's rows share their columns.
@@ -106,6 +108,7 @@ impl SoftWork {
             columns: Vec::with_capacity(nv),
             column_values: Vec::with_capacity(nv),
             edge_values: vec![[0.0; 10]; nv],
+            edge4: vec![[0.0; 4]; nv],
             dof_axes: super::contact_columns::DofAxes::new(nv),
             contact_blocks: Vec::with_capacity(nefc),
             gathered: vec![0.0; nv],
