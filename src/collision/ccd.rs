@@ -76,12 +76,24 @@ pub(crate) struct CcdObj<'a> {
     /// A height-field prism standing in for `shape` (its frame's three base then three top
     /// vertices, MuJoCo's `data.hfield.prism`), or None.
     prism: Option<&'a [Vec3; 6]>,
+    /// A hull's MuJoCo mesh frame in the world (its rotation, then its origin `x·c`): MuJoCo
+    /// poses a mesh geom there and stores the vertices in it, so a support point is this frame
+    /// applied to the stored vertex, rounded as MuJoCo's is (the identity for other shapes).
+    mesh_frame: (crate::spatial::Mat3, Vec3),
 }
 
 impl<'a> CcdObj<'a> {
     /// Geom `shape` at pose `x`, inflated by half of `margin`.
     pub(crate) fn new(shape: &'a ConvexShape, x: &'a Transform, margin: f64) -> Self {
-        Self { shape, x, margin, core: Core::Shape, vertindex: -1, meshindex: -1, prism: None }
+        let mesh_frame = match shape {
+            ConvexShape::Hull(h) => {
+                let (c, axes) = &h.graph().box_frame;
+                let rot = if h.mesh_axes_identity() { x.rot } else { x.rot * axes };
+                (rot, x.act_point(c))
+            }
+            _ => (crate::spatial::Mat3::identity(), Vec3::zeros()),
+        };
+        Self { shape, x, margin, core: Core::Shape, vertindex: -1, meshindex: -1, prism: None, mesh_frame }
     }
 
     fn discrete(&self) -> bool {
@@ -161,7 +173,6 @@ impl<'a> CcdObj<'a> {
                 s
             }
             ConvexShape::Hull(h) => {
-                let points = h.points();
                 let d = parry3d_f64::math::Vector::new(local.x, local.y, local.z);
                 // MuJoCo climbs meshes of at least HILLCLIMB_MIN vertices (all of the mesh's,
                 // `mesh_vertnum`), and scans the others in their vertex-list order.
@@ -173,8 +184,9 @@ impl<'a> CcdObj<'a> {
                     i
                 };
                 self.vertindex = i as i32;
-                let p = points[i];
-                Vec3::new(p.x, p.y, p.z)
+                // MuJoCo's world support point: its mesh frame applied to the stored vertex.
+                let p = h.mujoco_point(i);
+                return self.mesh_frame.0 * Vec3::new(p.x, p.y, p.z) + self.mesh_frame.1;
             }
         };
         rot * supp + pos

@@ -1,7 +1,8 @@
 //! Convex geom pairs other than planes and MuJoCo's closed forms: the closest points of two
 //! segments (`swept_spheres`, for geom distances; contacts of spheres and capsules are
-//! [`super::capsule`]'s), every other pair by GJK and EPA on support maps (parry3d-f64's
-//! `contact_support_map_support_map`) — including the ellipsoid, whose exact support map is
+//! [`super::capsule`]'s), every other pair by GJK and EPA on support maps (contacts by MuJoCo's
+//! own solver, [`super::ccd`], see [`mujoco_pair`]; distances by parry3d-f64's
+//! `contact_support_map_support_map`, [`support_pair`]) — including the ellipsoid, whose exact support map is
 //! written here (a support-map shape, not a polyhedral approximation), and meshes by their hulls.
 //! One contact per pair, at the midpoint of the two witness points.
 
@@ -222,7 +223,8 @@ impl SupportMap for Warm<'_> {
 /// (`ccd::penetration`: GJK/EPA on the geoms inflated by half of `margin` each, to the
 /// model's `ccd_tolerance` within `ccd_iterations`): witness points whose midpoint is MuJoCo's
 /// contact position, its normal and the contact distance; None when the inflated geoms do not
-/// overlap; boxes and meshes with a margin take parry's exact points instead ([`support_pair`]).
+/// overlap (boxes and meshes too, with a margin or without: MuJoCo's EPA on the margin-inflated
+/// polytopes stops at `ccd_tolerance`, and so does this one).
 /// `touching` (the pair touched at the last pass) skips the separation test of box and mesh
 /// pairs, which does not change the answer.
 pub fn mujoco_pair(
@@ -241,7 +243,7 @@ pub fn mujoco_pair(
 /// [`mujoco_pair`] with the separation test started from `warm` and what it found written back
 /// (its last support vertices and separating direction, see [`super::ccd::separated`]): the
 /// collision pass keeps them per pair from one pass to the next. With the point, the EPA face
-/// it comes from (None when the point is not EPA's: parry's, or a shallow sphere or capsule).
+/// it comes from (None when the point is not EPA's: a shallow pair without a GJK simplex).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn mujoco_pair_warm(
     x1: &Transform,
@@ -270,14 +272,6 @@ pub(crate) fn mujoco_pair_warm(
             )
         {
             return None;
-        }
-        // Boxes and meshes without a margin: MuJoCo's own GJK/EPA (`ccd::penetration`, the
-        // cheaper; multiccd's feature search then starts from its normal). With a margin, the
-        // exact closest points of parry's GJK (EPA when overlapping): MuJoCo's EPA on the
-        // margin-inflated geoms stops at ccd_tolerance, and 3 of the margin box–mesh cases of
-        // tests/convex_mujoco.rs match MuJoCo's contacts only from parry's points.
-        if margin > 0.0 {
-            return support_pair(x1, s1, x2, s2, margin).map(|p| (p, None));
         }
     }
     let c = super::ccd::penetration(

@@ -83,6 +83,18 @@ impl HullSupport {
         &self.points
     }
 
+    /// Hull vertex `i` as MuJoCo stores it (`f32` coordinates in its mesh frame, the graph's
+    /// `box_frame`; the geom-frame vertex when that frame is not known).
+    #[inline(always)]
+    pub fn mujoco_point(&self, i: usize) -> Vector {
+        self.mj_points[i]
+    }
+
+    /// Whether MuJoCo's mesh frame has the geom frame's axes (its rotation the identity).
+    pub fn mesh_axes_identity(&self) -> bool {
+        self.mj_axes_t.is_none()
+    }
+
     /// The hull vertices in the mesh's vertex-list order (see the field).
     pub fn scan_order(&self) -> &[u32] {
         &self.scan_order

@@ -41,10 +41,9 @@
 //! With `multiccd` off every convex pair gives one contact. lagrange reproduces these on its port
 //! of MuJoCo's GJK/EPA (`collision/ccd.rs`), the features read off its final face as MuJoCo does
 //! (`collision/epa_face.rs`, where the live 4.0.0's choice among aligned features is set out: it
-//! differs from the source snapshot). Box and mesh pairs with a margin take their first point
-//! from parry instead ([`super::convex::mujoco_pair`]), with no EPA face: their features are the
-//! vertices of each geom within a small tolerance of its support plane along the contact normal
-//! (`support_plane_features`). The witness points follow the live 4.0.0, not the snapshot (see
+//! differs from the source snapshot), box and mesh pairs with a margin included. A first point
+//! that comes with no EPA face takes as features the vertices of each geom within a small
+//! tolerance of its support plane along the contact normal (`support_plane_features`). The witness points follow the live 4.0.0, not the snapshot (see
 //! `polytope_contacts`' clipping).
 
 use super::ccd::EpaFace;
