@@ -102,15 +102,7 @@ fn delassus(model: &Model, data: &mut Data) {
     };
     if *trees_valid {
         tree_lists(&trees[..n], tree_ptr, tree_rows);
-        let mut root = 0;
-        while root < nv {
-            let end = tree_span(model, root, root).1;
-            let rows = &tree_rows[tree_ptr[root]..tree_ptr[root + 1]];
-            if !rows.is_empty() {
-                block(rows, (root, end), a);
-            }
-            root = end;
-        }
+        for_each_tree_block(model, tree_ptr, tree_rows, |rows, dofs| block(rows, dofs, a));
         *pattern_full = (0..nv).any(|t| tree_ptr[t + 1] - tree_ptr[t] == n);
         if *pattern_full {
             pattern_ptr.clear();
@@ -133,6 +125,26 @@ fn delassus(model: &Model, data: &mut Data) {
     }
     delassus_pattern(&spans[..n], sorted.then_some(&order[..n]), width, pattern_ptr, pattern_rows);
     *pattern_full = pattern_rows.len() == n * n;
+}
+
+/// Calls `block(rows, dofs)` for each kinematic tree that some row touches, in dof order: the
+/// tree's dofs [root, end) and its rows (`tree_lists`' compressed lists `tree_ptr`, `tree_rows`,
+/// indexed by the tree's root dof).
+fn for_each_tree_block(
+    model: &Model,
+    tree_ptr: &[usize],
+    tree_rows: &[usize],
+    mut block: impl FnMut(&[usize], (usize, usize)),
+) {
+    let mut root = 0;
+    while root < model.nv {
+        let end = tree_span(model, root, root).1;
+        let rows = &tree_rows[tree_ptr[root]..tree_ptr[root + 1]];
+        if !rows.is_empty() {
+            block(rows, (root, end));
+        }
+        root = end;
+    }
 }
 
 /// Work estimates (instructions, measured with callgrind on chain_30 and bin_10) of a solve with
@@ -178,15 +190,7 @@ pub(super) fn form_minv_jt(model: &Model, data: &mut Data) {
         Block { model, h, j_cols, j_stride, rows, dofs }.minv_jt(ljt, dof_rows, y);
     };
     if *trees_valid {
-        let mut root = 0;
-        while root < nv {
-            let end = tree_span(model, root, root).1;
-            let rows = &tree_rows[tree_ptr[root]..tree_ptr[root + 1]];
-            if !rows.is_empty() {
-                block(rows, (root, end), y);
-            }
-            root = end;
-        }
+        for_each_tree_block(model, tree_ptr, tree_rows, |rows, dofs| block(rows, dofs, y));
     } else if n > 0 {
         for (i, o) in order[..n].iter_mut().enumerate() {
             *o = i;
