@@ -1,7 +1,7 @@
 //! Convex geom pairs other than planes and MuJoCo's closed forms: the closest points of two
 //! segments (`swept_spheres`, for geom distances; contacts of spheres and capsules are
 //! [`super::capsule`]'s), every other pair by GJK and EPA on support maps (contacts by MuJoCo's
-//! own solver, [`super::ccd`], see [`mujoco_pair`]; distances by parry3d-f64's
+//! own solver, `collision::ccd`, see [`mujoco_pair`]; distances by parry3d-f64's
 //! `contact_support_map_support_map`, [`support_pair`]) — including the ellipsoid, whose exact support map is
 //! written here (a support-map shape, not a polyhedral approximation), and meshes by their hulls.
 //! One contact per pair, at the midpoint of the two witness points.
