@@ -289,6 +289,29 @@ pub(crate) fn solve_coulomb(
     }
 }
 
+/// Σᵢ cᵢ (λᵢ − λ_prev,ᵢ) into `change` and Σᵢ cᵢ λᵢ into `whole`, over the columns cᵢ of
+/// `columns` (nv apart: M⁻¹Jᵀ or Jᵀ), each over its nonzero dof ranges `ranges(i)`.
+fn add_columns(
+    columns: &[f64],
+    nv: usize,
+    lambda: &[f64],
+    lambda_prev: &[f64],
+    ranges: impl Fn(usize) -> [(usize, usize); 2],
+    change: &mut [f64],
+    whole: &mut [f64],
+) {
+    for (i, (&l, &p)) in lambda.iter().zip(lambda_prev).enumerate() {
+        let dl = l - p;
+        for (lo, hi) in ranges(i) {
+            for k in lo..hi {
+                let c = columns[k + i * nv];
+                change[k] += c * dl;
+                whole[k] += c * l;
+            }
+        }
+    }
+}
+
 /// max |M⁻¹Jᵀ Δλ| (the sweep's change, Δλ = λ − `lambda_prev`) and max |M⁻¹Jᵀ λ|, by one of two
 /// routes: Jᵀ Δλ and Jᵀ λ over each row's nonzeros (`ExactWork::row_ranges`) and a solve of each
 /// with the factor of M; or, once the sweeps of this solve (`sweeps`, this one included) have
@@ -306,30 +329,11 @@ fn sweep_motion(model: &Model, data: &mut Data, sweeps: u32) -> (f64, f64) {
     let (change, whole) = motion.as_mut_slice()[..2 * nv].split_at_mut(nv);
     change.fill(0.0);
     whole.fill(0.0);
+    let (rhs, prev) = (&exact.rhs.as_slice()[..n], &exact.lambda_prev.as_slice()[..n]);
     if exact.minv_jt_ready {
-        let y = exact.minv_jt.as_slice();
-        for i in 0..n {
-            let (l, dl) = (exact.rhs[i], exact.rhs[i] - exact.lambda_prev[i]);
-            for (lo, hi) in exact.tree_ranges(i) {
-                for k in lo..hi {
-                    let yk = y[k + i * nv];
-                    change[k] += yk * dl;
-                    whole[k] += yk * l;
-                }
-            }
-        }
+        add_columns(exact.minv_jt.as_slice(), nv, rhs, prev, |i| exact.tree_ranges(i), change, whole);
     } else {
-        let jt = exact.jt.as_slice();
-        for i in 0..n {
-            let (l, dl) = (exact.rhs[i], exact.rhs[i] - exact.lambda_prev[i]);
-            for (lo, hi) in exact.row_ranges(i) {
-                for k in lo..hi {
-                    let jk = jt[k + i * nv];
-                    change[k] += jk * dl;
-                    whole[k] += jk * l;
-                }
-            }
-        }
+        add_columns(exact.jt.as_slice(), nv, rhs, prev, |i| exact.row_ranges(i), change, whole);
         solve_with_factor_unchecked(model, mass_factor, change);
         solve_with_factor_unchecked(model, mass_factor, whole);
     }
