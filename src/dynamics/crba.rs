@@ -408,8 +408,15 @@ fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Opt
             // remainder's mask set-up cost more than the arithmetic.
             assert!(k < nv && lo <= k && before.len() == k * nv);
             let (hp, yk) = (before.as_mut_ptr(), col_k.as_mut_ptr());
+            let run_start = &model.dof_run_start[..nv];
             while i != NO_DOF {
                 assert!(i < k && lo <= i);
+                if run_start[i] == lo && i - lo < MAX_TAIL {
+                    // SAFETY: as below, for each of the ancestors i, i − 1, …, lo (the rest of
+                    // k's chain: one run of consecutive dofs from the tree's first).
+                    unsafe { tail_updates(hp, yk, lo, i + 1 - lo, nv, d_k) };
+                    break;
+                }
                 // SAFETY: i < k (checked), so column i lies in `before` (k · nv entries) and
                 // rows lo ..= i < nv of it, and rows lo ..= i of column k (`col_k`, nv long),
                 // are inside their slices, which are disjoint; the caller is compiled for AVX2.
@@ -434,6 +441,77 @@ fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Opt
     }
     if let Some(first) = singular {
         warnings.singular_factor(first);
+    }
+}
+
+/// The longest tail of a chain that [`factorize_kernel`] updates in one unrolled block
+/// ([`tail_updates`]).
+#[cfg(target_arch = "x86_64")]
+const MAX_TAIL: usize = 16;
+
+/// The updates of [`factorize_kernel`] for the pairs (k, i) of the last `n` ancestors of k when
+/// they are the dofs lo + n − 1, …, lo (the chain's last run, which starts at its tree's first
+/// dof: a floating base's six, a serial arm's whole chain), n ≤ [`MAX_TAIL`]: with n known at
+/// compile time the triangle of updates (column i's rows lo ..= i for each i) is straight-line
+/// code, where the pair-by-pair loop spends more on each short update's set-up than on its
+/// arithmetic (a humanoid's 21 dofs below its free joint end their chains with the same six
+/// pairs of one to six entries). Each entry gets the same product and difference, the ratio
+/// L[k][i] the same division, in the same order per column: the same bits.
+///
+/// # Safety
+/// Columns lo ..= lo + n − 1 of the factor (rows lo ..= lo + n − 1 of each, `nv` entries apart,
+/// from `h`) and rows lo ..= lo + n − 1 of column k (`yk`) are valid and do not overlap.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn tail_updates(h: *mut f64, yk: *mut f64, lo: usize, n: usize, nv: usize, d_k: f64) {
+    // SAFETY: the caller's contract, for each arm.
+    unsafe {
+        match n {
+            1 => tail_block::<1>(h, yk, lo, nv, d_k),
+            2 => tail_block::<2>(h, yk, lo, nv, d_k),
+            3 => tail_block::<3>(h, yk, lo, nv, d_k),
+            4 => tail_block::<4>(h, yk, lo, nv, d_k),
+            5 => tail_block::<5>(h, yk, lo, nv, d_k),
+            6 => tail_block::<6>(h, yk, lo, nv, d_k),
+            7 => tail_block::<7>(h, yk, lo, nv, d_k),
+            8 => tail_block::<8>(h, yk, lo, nv, d_k),
+            9 => tail_block::<9>(h, yk, lo, nv, d_k),
+            10 => tail_block::<10>(h, yk, lo, nv, d_k),
+            11 => tail_block::<11>(h, yk, lo, nv, d_k),
+            12 => tail_block::<12>(h, yk, lo, nv, d_k),
+            13 => tail_block::<13>(h, yk, lo, nv, d_k),
+            14 => tail_block::<14>(h, yk, lo, nv, d_k),
+            15 => tail_block::<15>(h, yk, lo, nv, d_k),
+            _ => tail_block::<MAX_TAIL>(h, yk, lo, nv, d_k),
+        }
+    }
+}
+
+/// [`tail_updates`] for n = `N`: rows lo ..= lo + N − 1 of column k read once (the updates read
+/// them before their ratios replace them: each pair (k, i) reads rows lo ..= i, all below the
+/// ratios already written), then for i from the last to lo: a = L[k][i] / d_k, column i −= a ·
+/// (rows lo ..= i of column k), and L[k][i] ← a.
+///
+/// # Safety
+/// As [`tail_updates`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn tail_block<const N: usize>(h: *mut f64, yk: *mut f64, lo: usize, nv: usize, d_k: f64) {
+    // SAFETY: the caller's contract: rows lo ..= lo + N − 1 of column k and of columns
+    // lo ..= lo + N − 1 are valid, and distinct.
+    unsafe {
+        let mut y = [0.0; N];
+        for (t, y_t) in y.iter_mut().enumerate() {
+            *y_t = *yk.add(lo + t);
+        }
+        for t in (0..N).rev() {
+            let a = y[t] / d_k;
+            let col = h.add((lo + t) * nv + lo);
+            for (j, y_j) in y[..=t].iter().enumerate() {
+                *col.add(j) -= a * y_j;
+            }
+            *yk.add(lo + t) = a;
+        }
     }
 }
 
