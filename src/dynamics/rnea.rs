@@ -3,7 +3,7 @@
 use crate::error::{check, InputError};
 use crate::kinematics::{joint_velocity, update_joint};
 use crate::model::{Data, Model};
-use crate::spatial::{Motion, Vec3};
+use crate::spatial::{Force, Motion, Vec3};
 use nalgebra::DVector;
 
 /// Inverse dynamics τ = M(q) q̈ + c(q, v) into `data.tau` (and returned). Gravity enters as a
@@ -44,26 +44,38 @@ pub(crate) fn rnea_unchecked<'d>(
     v: &[f64],
     qacc: &[f64],
 ) -> &'d DVector<f64> {
+    rnea_dispatch::<true>(model, data, q, v, qacc);
+    &data.tau
+}
+
+/// [`rnea_kernel`] compiled for AVX2 where the CPU has it; `ACC`: with the accelerations `qacc`
+/// (without, `qacc` is not read: the bias forces).
+#[inline(always)]
+fn rnea_dispatch<const ACC: bool>(model: &Model, data: &mut Data, q: &[f64], v: &[f64], qacc: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (checked just above), all `rnea_avx2` requires.
-        unsafe { rnea_avx2(model, data, q, v, qacc) };
-        return &data.tau;
+        unsafe { rnea_avx2::<ACC>(model, data, q, v, qacc) };
+        return;
     }
-    rnea_kernel(model, data, q, v, qacc);
-    &data.tau
+    rnea_kernel::<ACC>(model, data, q, v, qacc);
 }
 
 /// [`rnea_kernel`] compiled for AVX2, as ABA's: no fused multiply–add (Rust fuses none unasked),
 /// so the bits of the baseline build.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn rnea_avx2(model: &Model, data: &mut Data, q: &[f64], v: &[f64], qacc: &[f64]) {
-    rnea_kernel(model, data, q, v, qacc);
+unsafe fn rnea_avx2<const ACC: bool>(model: &Model, data: &mut Data, q: &[f64], v: &[f64], qacc: &[f64]) {
+    rnea_kernel::<ACC>(model, data, q, v, qacc);
 }
 
+/// The two passes. Without `ACC` (q̈ = 0, the bias forces) the terms of q̈ are left out (`S q̈`
+/// in a body's acceleration, `armature · q̈` in τ): adding their zeros changes no bit but the
+/// sign of a zero sum. A body without inertia (a massless link between two hinges of one MuJoCo
+/// body) needs no force of its own: I a + v ×* I v is zero (up to the signs of zeros), so its
+/// net force is its children's alone.
 #[inline(always)]
-fn rnea_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], qacc: &[f64]) {
+fn rnea_kernel<const ACC: bool>(model: &Model, data: &mut Data, q: &[f64], v: &[f64], qacc: &[f64]) {
     // The joint transforms and subspaces of an earlier pass at this q (the position stage's, the
     // same bits) are not formed again (`Data::poses_stamp`).
     let posed = data.poses_stamp.matches(q);
@@ -82,14 +94,20 @@ fn rnea_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], qacc: &[f64
         let v_joint = joint_velocity(model, data, b, v);
         let j = model.joint_of(b);
         let mut a_joint = j.kind.bias_motion(&v_joint);
-        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
-            a_joint += data.s_body[k] * qacc[k];
+        if ACC {
+            for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+                a_joint += data.s_body[k] * qacc[k];
+            }
         }
         let v_body = x.inv_act_motion(&data.v_body[p]) + v_joint;
         let a_body = x.inv_act_motion(&data.a_body[p]) + a_joint + v_body.cross_motion(&v_joint);
         let inertia = &model.bodies[b].inertia;
         // f = I a + v ×* I v (RBDA eq. 5.9).
-        data.f_body[b] = inertia.mul_motion(&a_body) + v_body.cross_force(&inertia.mul_motion(&v_body));
+        data.f_body[b] = if inertia.is_zero() {
+            Force::zero()
+        } else {
+            inertia.mul_motion(&a_body) + v_body.cross_force(&inertia.mul_motion(&v_body))
+        };
         data.v_body[b] = v_body;
         data.a_body[b] = a_body;
     }
@@ -98,7 +116,11 @@ fn rnea_kernel(model: &Model, data: &mut Data, q: &[f64], v: &[f64], qacc: &[f64
     for b in (1..model.nbody()).rev() {
         let j = model.joint_of(b);
         for k in j.dof_adr..j.dof_adr + j.kind.nv() {
-            data.tau[k] = data.s_body[k].dot(&data.f_body[b]) + model.dof_armature[k] * qacc[k];
+            data.tau[k] = if ACC {
+                data.s_body[k].dot(&data.f_body[b]) + model.dof_armature[k] * qacc[k]
+            } else {
+                data.s_body[k].dot(&data.f_body[b])
+            };
         }
         let p = model.bodies[b].parent;
         if p != 0 {
@@ -132,10 +154,7 @@ pub(crate) fn bias_forces_unchecked<'d>(
     q: &[f64],
     v: &[f64],
 ) -> &'d DVector<f64> {
-    data.scratch_v.fill(0.0);
-    let zeros = std::mem::take(&mut data.scratch_v);
-    rnea_unchecked(model, data, q, v, zeros.as_slice());
-    data.scratch_v = zeros;
+    rnea_dispatch::<false>(model, data, q, v, &[]);
     &data.tau
 }
 

@@ -28,6 +28,12 @@ impl RigidInertia {
     pub fn zero() -> Self {
         Self { mass: 0.0, h: Vec3::zeros(), i_origin: Mat3::zeros() }
     }
+    /// Whether all ten parameters are zero (the inertia of nothing: every product with it is
+    /// zero). The mass is tested first, so a body with mass pays one comparison.
+    #[inline]
+    pub fn is_zero(&self) -> bool {
+        self.mass == 0.0 && self.h == Vec3::zeros() && self.i_origin == Mat3::zeros()
+    }
     /// From mass, centre of mass `com` and inertia `i_com` about the centre of mass (same axes).
     pub fn from_com(mass: f64, com: Vec3, i_com: Mat3) -> Self {
         let cx = skew(&com);
