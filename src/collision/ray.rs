@@ -257,6 +257,38 @@ fn local(x: &Transform, p: &Vec3, v: &Vec3) -> (Vec3, Vec3) {
     (x.rot.tr_mul(&(p - x.pos)), x.rot.tr_mul(v))
 }
 
+/// Whether the ray meets a primitive shape at pose `x`: `ray_primitive(..).is_some()`, without
+/// the hit's normal, and for a capsule without its caps once its side is met (the touch sensors'
+/// test, which needs no distance).
+pub(crate) fn ray_meets_primitive(x: &Transform, shape: &Primitive, p: &Vec3, v: &Vec3) -> bool {
+    let Primitive::Capsule { radius, half_length: h } = *shape else {
+        return ray_primitive(x, shape, p, v).is_some();
+    };
+    if !meets_sphere(&x.pos, (radius + h) * (radius + h), p, v) {
+        return false;
+    }
+    let (lp, lv) = local(x, p, v);
+    // The same tests as `ray_primitive`'s capsule arm: its side's first root within the
+    // cylinder, or a root x ≥ 0 of either cap's sphere on the cap.
+    let side = first_root(
+        lv.x * lv.x + lv.y * lv.y,
+        lv.x * lp.x + lv.y * lp.y,
+        lp.x * lp.x + lp.y * lp.y - radius * radius,
+    );
+    if side.is_some_and(|t| (lp.z + t * lv.z).abs() <= h) {
+        return true;
+    }
+    [1.0, -1.0].into_iter().any(|cap| {
+        let d = Vec3::new(lp.x, lp.y, lp.z - cap * h);
+        roots(lv.dot(&lv), lv.dot(&d), d.dot(&d) - radius * radius).is_some_and(|ts| {
+            ts.into_iter().any(|t| {
+                let z = lp.z + t * lv.z;
+                t >= 0.0 && if cap > 0.0 { z >= h } else { z <= -h }
+            })
+        })
+    })
+}
+
 /// The ray against a primitive shape at pose `x` (MuJoCo's `mju_rayGeom` for the primitive
 /// types): the distance (units of |v|) and the world unit normal at the hit, or None.
 pub(crate) fn ray_primitive(x: &Transform, shape: &Primitive, p: &Vec3, v: &Vec3) -> Option<(f64, Vec3)> {
@@ -504,6 +536,43 @@ mod tests {
 
     fn at(pos: Vec3) -> Transform {
         Transform::new(Mat3::identity(), pos)
+    }
+
+    /// `ray_meets_primitive` answers as `ray_primitive(..).is_some()` over a fan of rays from
+    /// points around and inside a tilted capsule (side, caps, misses, grazing).
+    #[test]
+    fn meets_is_whether_the_ray_hits() {
+        let rot = nalgebra::Rotation3::from_euler_angles(0.3, -0.7, 1.1).into_inner();
+        let x = Transform::new(rot, Vec3::new(0.1, -0.2, 0.3));
+        let shapes = [
+            Primitive::Capsule { radius: 0.25, half_length: 0.5 },
+            Primitive::Sphere { radius: 0.5 },
+            Primitive::Box { half_extents: Vec3::new(0.5, 0.3, 0.75) },
+        ];
+        let (mut hits, mut misses) = (0, 0);
+        for shape in &shapes {
+            for i in 0..7 {
+                for j in 0..7 {
+                    let p = Vec3::new(
+                        0.1 + 0.3 * (i as f64 - 3.0),
+                        -0.2 + 0.25 * (j as f64 - 3.0),
+                        0.3 + 0.2 * i as f64 - 0.6,
+                    );
+                    for k in 0..12 {
+                        let a = k as f64 * 0.55;
+                        let v = Vec3::new(a.cos(), a.sin(), 0.8 * (0.7 * a).cos() - 0.2);
+                        let want = ray_primitive(&x, shape, &p, &v).is_some();
+                        assert_eq!(ray_meets_primitive(&x, shape, &p, &v), want, "{shape:?} {p:?} {v:?}");
+                        if want {
+                            hits += 1;
+                        } else {
+                            misses += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(hits > 100 && misses > 100, "{hits} hits, {misses} misses");
     }
 
     #[test]

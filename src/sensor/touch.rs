@@ -11,7 +11,7 @@
 //! contacts' order.
 
 use super::types::{Sensor, SensorObject, SensorType};
-use crate::collision::ray::ray_primitive;
+use crate::collision::ray::ray_meets_primitive;
 use crate::constraint::contact_force::{block_force, contact_force};
 use crate::model::{Contact, Data, Model};
 
@@ -84,7 +84,7 @@ fn meets(model: &Model, data: &Data, t: &TouchSite, contact: &Contact, bodies: [
     if t.body == bodies[1] {
         ray = -ray;
     }
-    ray_primitive(&data.x_world_frame[t.frame], &shape, &contact.pos, &ray).is_some()
+    ray_meets_primitive(&data.x_world_frame[t.frame], &shape, &contact.pos, &ray)
 }
 
 /// The touch sensor `t` alone: every contact on its body, in the contacts' order.
