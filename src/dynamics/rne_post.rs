@@ -44,7 +44,7 @@ use crate::constraint::soft::rows::{conj, weld_quats, weld_rotation_map};
 use crate::constraint::{ConstraintMode, RowGeometry};
 use crate::error::{check, InputError};
 use crate::kinematics::{body_poses, forward_velocities_unchecked};
-use crate::model::{Data, EfcType, EqualityKind, Model};
+use crate::model::{Data, EfcType, EqualityKind, JointKind, Model};
 use crate::spatial::{Force, Motion, RigidInertia, Transform, Vec3};
 
 /// MuJoCo's `mjMINVAL`: a subtree lighter than this has its centre of mass at the body's own.
@@ -328,6 +328,23 @@ fn compiled_motions(model: &Model, data: &Data, w: &mut RnePost, v: &[f64], sens
             continue;
         }
         let j = model.joint_of(b);
+        let x = &data.x_parent_body[b];
+        let p = model.bodies[b].parent;
+        let v_b = &data.v_body[b];
+        if matches!(j.kind, JointKind::Revolute { .. }) {
+            // A hinge's column is (axis, 0): its joint velocity (axis q̇, 0) and acceleration
+            // (axis q̈, 0) have no linear part, and the products with those zeros are left out
+            // (the same bits up to the signs of zeros).
+            let k = j.dof_adr;
+            let axis = data.s_body[k].ang;
+            let w_joint = axis * v[k];
+            let mut a = x.inv_act_motion(&w.a_body[p]);
+            a.ang += axis * data.qacc[k];
+            a.ang += v_b.ang.cross(&w_joint);
+            a.lin += v_b.lin.cross(&w_joint);
+            w.a_body[b] = a;
+            continue;
+        }
         let mut v_joint = Motion::zero();
         let mut a_joint = Motion::zero();
         for k in j.dof_adr..j.dof_adr + j.kind.nv() {
@@ -335,9 +352,6 @@ fn compiled_motions(model: &Model, data: &Data, w: &mut RnePost, v: &[f64], sens
             a_joint += data.s_body[k] * data.qacc[k];
         }
         a_joint += j.kind.bias_motion(&v_joint);
-        let x = &data.x_parent_body[b];
-        let p = model.bodies[b].parent;
-        let v_b = &data.v_body[b];
         w.a_body[b] = x.inv_act_motion(&w.a_body[p]) + a_joint + v_b.cross_motion(&v_joint);
     }
 }

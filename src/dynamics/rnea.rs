@@ -2,7 +2,7 @@
 
 use crate::error::{check, InputError};
 use crate::kinematics::{joint_velocity, update_joint};
-use crate::model::{Data, Model};
+use crate::model::{Data, JointKind, Model};
 use crate::spatial::{Force, Motion, Vec3};
 use nalgebra::DVector;
 
@@ -91,16 +91,35 @@ fn rnea_kernel<const ACC: bool>(model: &Model, data: &mut Data, q: &[f64], v: &[
         }
         let p = model.bodies[b].parent;
         let x = data.x_parent_body[b];
-        let v_joint = joint_velocity(model, data, b, v);
         let j = model.joint_of(b);
-        let mut a_joint = j.kind.bias_motion(&v_joint);
-        if ACC {
-            for k in j.dof_adr..j.dof_adr + j.kind.nv() {
-                a_joint += data.s_body[k] * qacc[k];
+        let (v_body, a_body) = if matches!(j.kind, JointKind::Revolute { .. }) {
+            // A hinge's column is (axis, 0) (`update_joint`): the joint's velocity (axis q̇, 0)
+            // and acceleration have no linear part, and the products with those zeros are left
+            // out (the same bits up to the signs of zeros).
+            let k = j.dof_adr;
+            let axis = data.s_body[k].ang;
+            let w = axis * v[k];
+            let mut v_body = x.inv_act_motion(&data.v_body[p]);
+            v_body.ang += w;
+            let mut a_body = x.inv_act_motion(&data.a_body[p]);
+            if ACC {
+                a_body.ang += axis * qacc[k];
             }
-        }
-        let v_body = x.inv_act_motion(&data.v_body[p]) + v_joint;
-        let a_body = x.inv_act_motion(&data.a_body[p]) + a_joint + v_body.cross_motion(&v_joint);
+            // v × (w, 0) = (ω × w, v_lin × w).
+            a_body.ang += v_body.ang.cross(&w);
+            a_body.lin += v_body.lin.cross(&w);
+            (v_body, a_body)
+        } else {
+            let v_joint = joint_velocity(model, data, b, v);
+            let mut a_joint = j.kind.bias_motion(&v_joint);
+            if ACC {
+                for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+                    a_joint += data.s_body[k] * qacc[k];
+                }
+            }
+            let v_body = x.inv_act_motion(&data.v_body[p]) + v_joint;
+            (v_body, x.inv_act_motion(&data.a_body[p]) + a_joint + v_body.cross_motion(&v_joint))
+        };
         let inertia = &model.bodies[b].inertia;
         // f = I a + v ×* I v (RBDA eq. 5.9).
         data.f_body[b] = if inertia.is_zero() {
@@ -115,12 +134,17 @@ fn rnea_kernel<const ACC: bool>(model: &Model, data: &mut Data, q: &[f64], v: &[
     // Pass 2, leaves to root: project forces on the joint axes, pass the rest to the parent.
     for b in (1..model.nbody()).rev() {
         let j = model.joint_of(b);
-        for k in j.dof_adr..j.dof_adr + j.kind.nv() {
-            data.tau[k] = if ACC {
-                data.s_body[k].dot(&data.f_body[b]) + model.dof_armature[k] * qacc[k]
-            } else {
-                data.s_body[k].dot(&data.f_body[b])
-            };
+        if !ACC && matches!(j.kind, JointKind::Revolute { .. }) {
+            // S = (axis, 0): S · f = axis · f_ang (the same bits up to the sign of a zero).
+            data.tau[j.dof_adr] = data.s_body[j.dof_adr].ang.dot(&data.f_body[b].ang);
+        } else {
+            for k in j.dof_adr..j.dof_adr + j.kind.nv() {
+                data.tau[k] = if ACC {
+                    data.s_body[k].dot(&data.f_body[b]) + model.dof_armature[k] * qacc[k]
+                } else {
+                    data.s_body[k].dot(&data.f_body[b])
+                };
+            }
         }
         let p = model.bodies[b].parent;
         if p != 0 {
