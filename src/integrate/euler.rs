@@ -6,6 +6,7 @@
 //! constraint row exists (the M path instead of ABA), since the step needs M anyway.
 
 use super::{correct_drift, Advance, State, StepReport, Stepper};
+use crate::constraint::ConstraintSolver;
 use crate::dynamics::{crba_unchecked, factorize_mass_matrix_damped, solve_with_factor_unchecked};
 use crate::forward::{advance_activations, forward_at};
 use crate::model::{Data, Model};
@@ -71,16 +72,27 @@ impl Advance for SemiImplicitEuler {
 }
 
 /// The implicitly damped acceleration (M + h·diag(damping))⁻¹ M qacc after `forward` at
-/// configuration `q`, into `out` (MuJoCo's `mj_EulerSkip`). M + h·diag(damping) is factored in
+/// configuration `q`, into `out` (MuJoCo's `mj_EulerSkip`, which solves with
+/// qfrc_smooth + qfrc_constraint: the same in the soft mode where `forward` formed M). M + h·diag(damping) is factored in
 /// the factor's storage (`factorize_mass_matrix_damped`), so M itself stays as CRBA gave it and
 /// `data.mass_factor` holds the factor of the damped matrix afterwards.
 fn damped_acceleration(model: &Model, data: &mut Data, q: &[f64], out: &mut DVector<f64>, h: f64) {
-    // M at q: the position stage's own when `forward` formed it there (CRBA again would give the
-    // same bits), else formed here.
-    if !data.forward_skip.mass_formed {
-        crba_unchecked(model, data, q);
+    // M qacc: in the soft mode on the M path, MuJoCo's sum qfrc_smooth + qfrc_constraint (the
+    // forces M qacc balances, the same to round-off, without the product by M: `forward` formed
+    // both); else the product, with M the position stage's own when `forward` formed it there
+    // (CRBA again would give the same bits), or formed here.
+    let soft = matches!(model.plan.solver, ConstraintSolver::Soft(_));
+    if soft && data.forward_skip.mass_formed {
+        let (smooth, constraint) = (data.qfrc_smooth.as_slice(), data.qfrc_constraint.as_slice());
+        for ((o, s), c) in out.as_mut_slice().iter_mut().zip(smooth).zip(constraint) {
+            *o = s + c;
+        }
+    } else {
+        if !data.forward_skip.mass_formed {
+            crba_unchecked(model, data, q);
+        }
+        mass_times(out, &data.mass_matrix, &data.qacc);
     }
-    mass_times(out, &data.mass_matrix, &data.qacc);
     factorize_mass_matrix_damped(model, data, h, &model.dof_damping);
     solve_with_factor_unchecked(model, &data.mass_factor, out.as_mut_slice());
 }
