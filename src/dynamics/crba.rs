@@ -857,6 +857,45 @@ mod tests {
         }
     }
 
+    /// The AVX2 build of the factorization (its pair-by-pair updates and straight-line tails,
+    /// `tail_updates`) gives the portable build's factor bit for bit, of M and of M + h·diag(d),
+    /// on the panda (one run), solo12 and the humanoid (free joints, legs of one and two runs).
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    #[ignore = "compares the CPU-specific (AVX2) build of the kernel with the portable one; needs such a CPU: cargo test --release -p lagrange --lib -- --ignored (as .ci/run does)"]
+    fn avx2_factor_is_bit_for_bit() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            eprintln!("skipped: this CPU has no AVX2, the AVX2 factorization is never used here");
+            return;
+        }
+        let mut cases = crate::kernel_test_states::robots();
+        let file = "models/mjcf/humanoid/humanoid.xml";
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+        let humanoid = crate::io::load(&path, &Default::default()).unwrap();
+        let mut q = humanoid.neutral();
+        // The hinges away from zero (the free joint's unit quaternion kept).
+        for (i, x) in q.iter_mut().enumerate().skip(7) {
+            *x += 0.1 + 0.37 * (i as f64).sin();
+        }
+        cases.push((file, humanoid, q));
+        for (file, model, q) in cases {
+            let damping: Vec<f64> = (0..model.nv).map(|k| 0.5 + 0.1 * k as f64).collect();
+            for shift in [None, Some((0.002, damping.as_slice()))] {
+                let mut portable = Data::new(&model);
+                crba_unchecked(&model, &mut portable, &q);
+                let mut avx2 = portable.clone();
+                factorize_kernel::<false>(&model, &mut portable, shift);
+                // SAFETY: the CPU has AVX2 (checked above).
+                unsafe { factorize_avx2(&model, &mut avx2, shift) };
+                let (a, b) = (portable.mass_factor.as_slice(), avx2.mass_factor.as_slice());
+                assert!(a.iter().any(|&x| x != 0.0), "{file}: an empty factor");
+                for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                    assert_eq!(x.to_bits(), y.to_bits(), "{file} {shift:?}: entry {i}");
+                }
+            }
+        }
+    }
+
     /// The FMA build of the kernel gives the M of the separate multiply–adds to round-off
     /// (cross-check tolerance), and M stays symmetric bit for bit.
     #[test]
