@@ -213,15 +213,7 @@ fn body_pass<A: MulAdd, const HINGE: bool>(
             data.s_world[k] = fused::act_motion::<A>(&x_world_body, &data.s_body[k]);
         }
     }
-    // A body without inertia (a massless link between two hinges of one MuJoCo body) starts its
-    // composite at zero: the transform of zero is zero (up to the signs of zeros, which adding
-    // its children's inertias in pass 2 leaves no trace of).
-    let inertia = &model.bodies[b].inertia;
-    data.i_composite[b] = if inertia.is_zero() {
-        RigidInertia::zero()
-    } else {
-        fused::transformed::<A>(inertia, &x_world_body)
-    };
+    data.i_composite[b] = fused::transformed::<A>(&model.bodies[b].inertia, &x_world_body);
 }
 
 /// Column k of M (and with `MIRROR` row k): F = Iᶜ S_k, then S_l · F for k and the ancestors l
