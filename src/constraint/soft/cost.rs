@@ -78,8 +78,11 @@ impl Rows<'_> {
             // A run of limit, frictionless or pyramidal rows (quadratic below zero, else
             // satisfied): `update_at`'s terms, in one tight loop; then an elliptic contact.
             let end = self.scalar_run_end(i);
-            for (t, ((&x, &d), (f, st))) in
-                jar[i..end].iter().zip(&d_all[i..end]).zip(force[i..end].iter_mut().zip(&mut state[i..end])).enumerate()
+            for (t, ((&x, &d), (f, st))) in jar[i..end]
+                .iter()
+                .zip(&d_all[i..end])
+                .zip(force[i..end].iter_mut().zip(&mut state[i..end]))
+                .enumerate()
             {
                 if x >= 0.0 {
                     (*st, *f) = (EfcState::Satisfied, 0.0);
