@@ -68,10 +68,43 @@ impl Rows<'_> {
     ) {
         // Slices: the per-row loops index them without nalgebra's shape checks.
         let (jar, force) = (jar.as_slice(), force.as_mut_slice());
+        let (n, scalar) = (self.nefc, self.ne + self.nf);
         let mut i = 0;
-        while i < self.nefc {
+        while i < scalar.min(n) {
             i += self.update_at(i, jar, force, state, &mut each);
         }
+        let d_all = self.d.as_slice();
+        while i < n {
+            // A run of limit, frictionless or pyramidal rows (quadratic below zero, else
+            // satisfied): `update_at`'s terms, in one tight loop; then an elliptic contact.
+            let end = self.scalar_run_end(i);
+            for (t, ((&x, &d), (f, st))) in jar[i..end]
+                .iter()
+                .zip(&d_all[i..end])
+                .zip(force[i..end].iter_mut().zip(&mut state[i..end]))
+                .enumerate()
+            {
+                if x >= 0.0 {
+                    (*st, *f) = (EfcState::Satisfied, 0.0);
+                    each(i + t, 0.0);
+                } else {
+                    (*st, *f) = (EfcState::Quadratic, -d * x);
+                    each(i + t, 0.5 * d * x * x);
+                }
+            }
+            i = end;
+            if i < n {
+                i += self.update_at(i, jar, force, state, &mut each);
+            }
+        }
+    }
+
+    /// The end of the run of rows from row i ≥ ne + nf that are not elliptic contacts' (the
+    /// first elliptic row after it, or nefc).
+    #[inline(always)]
+    fn scalar_run_end(&self, i: usize) -> usize {
+        let n = self.nefc;
+        self.kind[i..n].iter().position(|&k| k == EfcType::ContactElliptic).map_or(n, |p| i + p)
     }
 
     /// As [`Self::update_each`], over the rows `list` only (ascending, an elliptic contact's rows
@@ -168,20 +201,32 @@ impl Rows<'_> {
         let (jar, jv) = (jar.as_slice(), jv.as_slice());
         let (mut d1, mut d2) = (0.0, 0.0);
         let d_all = self.d.as_slice();
-        let mut i = 0;
-        while i < self.nefc {
-            // An equality row (always quadratic), a limit's or a pyramidal or frictionless
-            // contact's (quadratic below zero): `directional_at`'s sums, in line.
-            if i < self.ne || (i >= self.ne + self.nf && self.kind[i] != EfcType::ContactElliptic) {
-                let (x, v, d) = (jar[i], jv[i], d_all[i]);
-                if i < self.ne || x < 0.0 {
+        let n = self.nefc;
+        let ne = self.ne.min(n);
+        // The equality rows (always quadratic), then the friction-loss rows: `directional_at`'s
+        // sums, row by row in order.
+        for ((&x, &v), &d) in jar[..ne].iter().zip(&jv[..ne]).zip(&d_all[..ne]) {
+            d1 += d * x * v;
+            d2 += d * v * v;
+        }
+        let mut i = ne;
+        while i < (self.ne + self.nf).min(n) {
+            i += self.directional_at(i, jar, jv, &mut d1, &mut d2);
+        }
+        while i < n {
+            // A run of limit, frictionless or pyramidal rows (quadratic below zero), in one
+            // tight loop; then an elliptic contact.
+            let end = self.scalar_run_end(i);
+            for ((&x, &v), &d) in jar[i..end].iter().zip(&jv[i..end]).zip(&d_all[i..end]) {
+                if x < 0.0 {
                     d1 += d * x * v;
                     d2 += d * v * v;
                 }
-                i += 1;
-                continue;
             }
-            i += self.directional_at(i, jar, jv, &mut d1, &mut d2);
+            i = end;
+            if i < n {
+                i += self.directional_at(i, jar, jv, &mut d1, &mut d2);
+            }
         }
         (d1, d2)
     }

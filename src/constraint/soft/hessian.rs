@@ -26,7 +26,7 @@ const BLOCK: usize = 6;
 /// The length of the assembler's scratch for `nv` dofs (a group's transposed values and
 /// coefficients, at most `GROUP` rows on at most nv columns each).
 pub(super) const fn scratch_len(nv: usize) -> usize {
-    2 * GROUP.div_ceil(4) * 4 * nv
+    2 * GROUP.div_ceil(4) * 4 * (nv + 3)
 }
 
 /// Where the rows' terms are added: a dense nv × nv H (the dense Newton path, `primal.rs`), or
@@ -46,7 +46,7 @@ pub(super) enum Target<'a> {
 pub(super) struct Assembler<'a> {
     h: Target<'a>,
     nz: &'a Sparsity<'a>,
-    /// Scratch for a group's values laid out transposed, 2 · GROUP · nv long (`add_columns`).
+    /// Scratch for a group's values (laid out transposed, or padded), [`scratch_len`] long.
     column: &'a mut [f64],
     /// The pending group: its rows and their weights.
     rows: [usize; GROUP],
@@ -103,6 +103,19 @@ impl<'a> Assembler<'a> {
             *g = self.nz.row_values(row).1;
         }
         let weights = self.weights;
+        if let Target::Dense(h) = &mut self.h {
+            if k == 1 && cols.len() == 1 {
+                // One row on one dof (a joint limit): H[p][p] += (w g) g, as below.
+                let (p, g) = (cols[0], g[0][0]);
+                h[(p, p)] += weights[0] * g * g;
+                return;
+            }
+            if k > 8 {
+                let nv = h.nrows();
+                add_weighted_rows(h.as_mut_slice(), nv, cols, &g[..k], &weights[..k], self.column);
+                return;
+            }
+        }
         let coefficients = |g_q: &[f64], c: &mut [f64]| {
             for ((c, &w), &g) in c.iter_mut().zip(&weights[..k]).zip(g_q) {
                 *c = w * g;
@@ -188,10 +201,10 @@ impl<'a> Assembler<'a> {
 /// H[p][q] += Σ_r c_r(q) G_r[p] over columns q of `cols` and p ≥ q (rows `g`, all on `cols`;
 /// `coefficients(g_q, c)` writes c_r(q) from the rows' values g_q = (G_0[q], …) at column
 /// position q). Up to eight rows, each entry's sum is formed in registers from the rows' values,
-/// four rows at a time (an elliptic contact of condim 6 is two such passes); more rows are first
-/// laid out transposed in `scratch` — Gᵀ[p] = (G_0[p], …, G_{k−1}[p]) and
-/// C[q] = (c_0(q), …) contiguous, zero-padded to a multiple of four — so that each entry is one
-/// dot product of two contiguous vectors (`dot4`). Either way it is added to H once.
+/// four rows at a time (an elliptic contact of condim 6 is two such passes); more rows by
+/// [`add_columns_wide_kernel`] (scalar rows: [`add_weighted_rows`]), four entries of a column at a time, each entry's sum over the rows the
+/// dot product [`dot4`] of the rows' values transposed and the coefficients. Either way it is
+/// added to H once.
 #[inline(always)]
 fn add_columns(
     h: &mut DMatrix<f64>,
@@ -245,16 +258,186 @@ fn add_columns(
         }
         return;
     }
-    let (gt, c, kp) = transposed_with_coefficients(scratch, g, n, &mut coefficients);
-    for (q, (&col_q, c_q)) in cols.iter().zip(c.chunks_exact(kp)).enumerate() {
+    add_columns_wide_kernel(h, nv, cols, g, scratch, &mut coefficients);
+}
+
+/// H[p][q] += Σ_r w_r G_r[p] G_r[q] (p ≥ q, over `cols`) for more than eight scalar rows `g`
+/// with weights `w` into the dense H (column-major, `nv` rows): the sums [`add_columns`] forms
+/// for them — each entry's sum over the rows in four partial sums (the rows r ≡ l mod 4 in
+/// partial sum l, in order, each term G_r[p] · (w_r G_r[q])), combined as (s₀ + s₂) + (s₁ + s₃)
+/// and added to H once: the dot product [`dot4`] of the rows' values transposed and the
+/// coefficients, the same bits. With AVX2, four entries of a column at a time: the rows' values
+/// are copied once into `scratch`, each followed by three zeros (four consecutive columns of a
+/// row are one load), beside them the coefficients w_r G_r; entries whose four columns are
+/// consecutive dofs are added to H as one vector.
+fn add_weighted_rows(h: &mut [f64], nv: usize, cols: &[usize], g: &[&[f64]], w: &[f64], scratch: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), all `add_weighted_rows_avx2` requires.
+        unsafe { add_weighted_rows_avx2(h, nv, cols, g, w, scratch) };
+        return;
+    }
+    let mut coefficients = |g_q: &[f64], c: &mut [f64]| {
+        for ((c, &w), &g) in c.iter_mut().zip(w).zip(g_q) {
+            *c = w * g;
+        }
+    };
+    add_columns_wide_kernel(h, nv, cols, g, scratch, &mut coefficients);
+}
+
+/// [`add_weighted_rows`] for AVX2 (see there): the same products and sums in the same order, no
+/// fused multiply–adds, so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn add_weighted_rows_avx2(
+    h: &mut [f64],
+    nv: usize,
+    cols: &[usize],
+    g: &[&[f64]],
+    w: &[f64],
+    scratch: &mut [f64],
+) {
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_broadcast_sd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd,
+        _mm256_storeu_pd,
+    };
+    let (n, k) = (cols.len(), g.len().min(GROUP).min(w.len()));
+    let n4 = n + 3;
+    let (rows, rest) = scratch.split_at_mut(k * n4);
+    let coef = &mut rest[..k * n4];
+    for (((row, c), g), &w) in rows.chunks_exact_mut(n4).zip(coef.chunks_exact_mut(n4)).zip(g).zip(w) {
+        row[..n].copy_from_slice(&g[..n]);
+        row[n..].fill(0.0);
+        for (c, &g) in c.iter_mut().zip(&g[..n]) {
+            *c = w * g;
+        }
+    }
+    let (base, coef) = (rows.as_ptr(), coef.as_ptr());
+    let whole = k / 4 * 4;
+    for (q, &col_q) in cols.iter().enumerate() {
         let column = &mut h[col_q * nv..(col_q + 1) * nv];
-        for (&p, g_p) in cols[q..].iter().zip(gt[q * kp..].chunks_exact(kp)) {
-            column[p] += dot4(g_p, c_q);
+        let mut t = q;
+        while t < n {
+            let mut v = [0.0; 4];
+            // SAFETY: row r's four values from position t < n end at r · n4 + t + 4 ≤ (r + 1) · n4,
+            // inside `rows` (k rows of n4), and its coefficient at column position q < n is inside
+            // `coef` (k rows of n4); the CPU has AVX2 (this function's contract).
+            unsafe {
+                let (mut s0, mut s1, mut s2, mut s3) =
+                    (_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd());
+                let (mut p, mut c) = (base.add(t), coef.add(q));
+                let term = |p: *const f64, c: *const f64| {
+                    _mm256_mul_pd(_mm256_loadu_pd(p), _mm256_broadcast_sd(&*c))
+                };
+                let mut r = 0;
+                while r < whole {
+                    s0 = _mm256_add_pd(s0, term(p, c));
+                    s1 = _mm256_add_pd(s1, term(p.add(n4), c.add(n4)));
+                    s2 = _mm256_add_pd(s2, term(p.add(2 * n4), c.add(2 * n4)));
+                    s3 = _mm256_add_pd(s3, term(p.add(3 * n4), c.add(3 * n4)));
+                    p = p.add(4 * n4);
+                    c = c.add(4 * n4);
+                    r += 4;
+                }
+                let left = k - whole;
+                if left > 0 {
+                    s0 = _mm256_add_pd(s0, term(p, c));
+                }
+                if left > 1 {
+                    s1 = _mm256_add_pd(s1, term(p.add(n4), c.add(n4)));
+                }
+                if left > 2 {
+                    s2 = _mm256_add_pd(s2, term(p.add(2 * n4), c.add(2 * n4)));
+                }
+                _mm256_storeu_pd(v.as_mut_ptr(), _mm256_add_pd(_mm256_add_pd(s0, s2), _mm256_add_pd(s1, s3)));
+            }
+            let p0 = cols[t];
+            if t + 4 <= n && cols[t + 3] == p0 + 3 {
+                for (x, &v) in column[p0..p0 + 4].iter_mut().zip(&v) {
+                    *x += v;
+                }
+            } else {
+                for (&p, &v) in cols[t..n.min(t + 4)].iter().zip(&v) {
+                    column[p] += v;
+                }
+            }
+            t += 4;
         }
     }
 }
 
-/// For more than eight rows (`add_columns`, `add_columns_sparse`): the rows' values transposed,
+/// [`add_columns`]'s sums for more than eight rows without AVX2, four entries of a column at a
+/// time lane by lane (see [`add_weighted_rows`]), the coefficients from `coefficients`.
+#[inline(always)]
+fn add_columns_wide_kernel(
+    h: &mut [f64],
+    nv: usize,
+    cols: &[usize],
+    g: &[&[f64]],
+    scratch: &mut [f64],
+    coefficients: &mut impl FnMut(&[f64], &mut [f64]),
+) {
+    let (n, k) = (cols.len(), g.len().min(GROUP));
+    // Each row's values and three zeros: a block of four from any column position t < n.
+    let n4 = n + 3;
+    let rows = &mut scratch[..k * n4];
+    for (row, g) in rows.chunks_exact_mut(n4).zip(g) {
+        row[..n].copy_from_slice(&g[..n]);
+        row[n..].fill(0.0);
+    }
+    let rows = &*rows;
+    let (mut g_q, mut c) = ([0.0; GROUP], [0.0; GROUP]);
+    // Four consecutive values of row r from column position t < n on.
+    let at = |r: usize, t: usize| -> [f64; 4] {
+        let x = &rows[r * n4 + t..r * n4 + t + 4];
+        [x[0], x[1], x[2], x[3]]
+    };
+    let whole = k / 4 * 4;
+    for (q, &col_q) in cols.iter().enumerate() {
+        for (x, row) in g_q.iter_mut().zip(rows.chunks_exact(n4)) {
+            *x = row[q];
+        }
+        coefficients(&g_q[..k], &mut c[..k]);
+        let column = &mut h[col_q * nv..(col_q + 1) * nv];
+        let mut t = q;
+        while t < n {
+            let mut s = [[0.0f64; 4]; 4];
+            let mut r = 0;
+            while r < whole {
+                for (l, s_l) in s.iter_mut().enumerate() {
+                    let (g_p, c_r) = (at(r + l, t), c[r + l]);
+                    for lane in 0..4 {
+                        s_l[lane] += g_p[lane] * c_r;
+                    }
+                }
+                r += 4;
+            }
+            for (l, s_l) in s.iter_mut().enumerate().take(k - whole) {
+                let (g_p, c_r) = (at(r + l, t), c[r + l]);
+                for lane in 0..4 {
+                    s_l[lane] += g_p[lane] * c_r;
+                }
+            }
+            let mut v = [0.0; 4];
+            for (lane, v) in v.iter_mut().enumerate() {
+                *v = (s[0][lane] + s[2][lane]) + (s[1][lane] + s[3][lane]);
+            }
+            let p0 = cols[t];
+            if t + 4 <= n && cols[t + 3] == p0 + 3 {
+                for (x, &v) in column[p0..p0 + 4].iter_mut().zip(&v) {
+                    *x += v;
+                }
+            } else {
+                for (&p, &v) in cols[t..n.min(t + 4)].iter().zip(&v) {
+                    column[p] += v;
+                }
+            }
+            t += 4;
+        }
+    }
+}
+
+/// For more than eight rows (`add_columns_sparse`): the rows' values transposed,
 /// per column q its k values padded with zeros to kp (a multiple of 4), and each column's
 /// coefficients beside them, both in `scratch`; (Gᵀ, C, kp). (Out of line: large groups are
 /// rare, and the callers' common paths stay compact.)
@@ -457,13 +640,15 @@ mod tests {
         // Rows 0..2: one group on columns {1, 3, 4}; row 2 alone on {0, 4}; rows 3..6 a block
         // on {0, 2, 3} (row 4 has an exact zero there, kept); rows 6..8 a block whose rows have
         // different columns (pair by pair); rows 8..14 a group of six on {0, 1, 3, 4} (two
-        // passes of the register path) and rows 14..26 a group of twelve on {0, 2, 4} (the
-        // transposed path).
+        // passes of the register path), rows 14..26 a group of twelve on {0, 2, 4} and rows
+        // 26..35 a group of nine on {0, …, 4} (the wide path; its columns scattered, then
+        // consecutive).
         let nv = 5;
         let mut cols: Vec<&[usize]> =
             vec![&[1, 3, 4], &[1, 3, 4], &[0, 4], &[0, 2, 3], &[0, 2, 3], &[0, 2, 3], &[2], &[1, 2]];
         cols.extend([&[0usize, 1, 3, 4][..]; 6]);
         cols.extend([&[0usize, 2, 4][..]; 12]);
+        cols.extend([&[0usize, 1, 2, 3, 4][..]; 9]);
         let mut j = DMatrix::zeros(cols.len(), nv);
         let (mut start, mut index, mut value) = (vec![0], vec![], vec![]);
         for (i, c) in cols.iter().enumerate() {
@@ -492,7 +677,7 @@ mod tests {
         };
         let mut blocks =
             vec![(0, 1, scalar(2.0)), (1, 1, scalar(0.5)), (2, 1, scalar(3.0)), (3, 3, b3), (6, 2, b2)];
-        blocks.extend((8..26).map(|i| (i, 1, scalar(0.2 + 0.1 * i as f64))));
+        blocks.extend((8..35).map(|i| (i, 1, scalar(0.2 + 0.1 * i as f64))));
         let mut h = DMatrix::zeros(nv, nv);
         let mut column = vec![0.0; scratch_len(nv)];
         let mut asm = Assembler::new(Target::Dense(&mut h), &nz, &mut column);

@@ -90,7 +90,8 @@ pub(super) fn mul_j(
 }
 
 /// [`mul_j`] compiled for AVX2: the same products and sums in the same order (no fused
-/// multiply–adds), four entries per instruction, so the same bits.
+/// multiply–adds), four entries per instruction, so the same bits. From J's dense storage
+/// ([`mul_j_dense_avx2`]) when there are at least four rows.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn mul_j_avx2(
@@ -100,7 +101,83 @@ unsafe fn mul_j_avx2(
     x: &DVector<f64>,
     r: &mut DVector<f64>,
 ) {
+    if let Some(j) = dense {
+        if nefc >= 4
+            && x.len() <= MUL_J_COLUMNS
+            && nefc <= j.nrows()
+            && x.len() <= j.ncols()
+            && nefc <= r.len()
+        {
+            // SAFETY: the sizes were checked just above; the CPU has AVX2 (this function's
+            // contract).
+            unsafe { mul_j_dense_avx2(j, x.as_slice(), &mut r.as_mut_slice()[..nefc]) };
+            return;
+        }
+    }
     mul_j_kernel(s, dense, nefc, x, r);
+}
+
+/// The most columns (dofs) [`mul_j_dense_avx2`] takes (its list of the nonzero entries of x
+/// lives on the stack); the dense Newton path has at most `DENSE_NV_CHAIN`.
+#[cfg(target_arch = "x86_64")]
+const MUL_J_COLUMNS: usize = 256;
+
+/// r ← J x from J's dense storage (column-major, nefc ≥ 4 rows used): each row's sum over the
+/// columns k with x_k ≠ 0 in ascending order, r_i = ((0 + J_ik₀ x_k₀) + J_ik₁ x_k₁) + …, as
+/// [`mul_j_kernel`] forms it (the same bits), but eight rows at a time held in two registers
+/// across all columns instead of each column's update of r in memory. The nonzero entries of x
+/// are listed once. Rows left over at the end (fewer than four) are formed again by a last block
+/// of four ending at row nefc − 1 (the same values stored twice).
+///
+/// # Safety
+/// The CPU has AVX2; `4 ≤ r.len() ≤ j.nrows()`, `x.len() ≤ j.ncols()` and
+/// `x.len() ≤ MUL_J_COLUMNS`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn mul_j_dense_avx2(j: &DMatrix<f64>, x: &[f64], r: &mut [f64]) {
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_broadcast_sd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd,
+        _mm256_storeu_pd,
+    };
+    let (stride, jp) = (j.nrows(), j.as_slice().as_ptr());
+    let nefc = r.len();
+    // The nonzero x_k: their column offsets in J and their values.
+    let mut offsets = [0usize; MUL_J_COLUMNS];
+    let mut values = [0.0f64; MUL_J_COLUMNS];
+    let mut m = 0;
+    for (k, &x_k) in x.iter().enumerate() {
+        offsets[m] = k * stride;
+        values[m] = x_k;
+        m += usize::from(x_k != 0.0);
+    }
+    let (offs, vals) = (&offsets[..m], &values[..m]);
+    let rp = r.as_mut_ptr();
+    let mut i = 0;
+    // SAFETY: every block of rows b..b + 4 has b + 4 ≤ nefc ≤ stride, so the loads at offset
+    // k · stride + b (k < x.len() ≤ J's columns) stay inside J's storage and the stores inside r;
+    // the CPU has AVX2 (this function's contract).
+    unsafe {
+        while i + 8 <= nefc {
+            let (mut r0, mut r1) = (_mm256_setzero_pd(), _mm256_setzero_pd());
+            for (&o, v) in offs.iter().zip(vals) {
+                let v = _mm256_broadcast_sd(v);
+                r0 = _mm256_add_pd(r0, _mm256_mul_pd(_mm256_loadu_pd(jp.add(o + i)), v));
+                r1 = _mm256_add_pd(r1, _mm256_mul_pd(_mm256_loadu_pd(jp.add(o + i + 4)), v));
+            }
+            _mm256_storeu_pd(rp.add(i), r0);
+            _mm256_storeu_pd(rp.add(i + 4), r1);
+            i += 8;
+        }
+        while i < nefc {
+            let b = i.min(nefc - 4);
+            let mut r0 = _mm256_setzero_pd();
+            for (&o, v) in offs.iter().zip(vals) {
+                r0 = _mm256_add_pd(r0, _mm256_mul_pd(_mm256_loadu_pd(jp.add(o + b)), _mm256_broadcast_sd(v)));
+            }
+            _mm256_storeu_pd(rp.add(b), r0);
+            i = b + 4;
+        }
+    }
 }
 
 #[inline(always)]
@@ -160,7 +237,57 @@ unsafe fn mul_jt_avx2(
     f: &DVector<f64>,
     out: &mut [f64],
 ) {
+    if let Some(j) = dense {
+        if nefc <= j.nrows() && out.len() <= j.ncols() && nefc <= f.len() {
+            // SAFETY: the sizes were checked just above; the CPU has AVX2 (this function's
+            // contract).
+            unsafe { mul_jt_dense_avx2(j, &f.as_slice()[..nefc], out) };
+            return;
+        }
+    }
     mul_jt_kernel(s, dense, nefc, f, out);
+}
+
+/// out_k ← (Jᵀ f)_k from J's dense storage, each the [`dot`] of J's column k (rows 0..f.len())
+/// with f: four partial sums in one register, combined as (s₀ + s₂) + (s₁ + s₃), then the
+/// remainder in order — the same bits as [`mul_jt_kernel`], with the column read through
+/// pointers (no slice set-up per column).
+///
+/// # Safety
+/// The CPU has AVX2; `f.len() ≤ j.nrows()` and `out.len() ≤ j.ncols()`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn mul_jt_dense_avx2(j: &DMatrix<f64>, f: &[f64], out: &mut [f64]) {
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+    };
+    let (stride, jp, fp) = (j.nrows(), j.as_slice().as_ptr(), f.as_ptr());
+    let n = f.len();
+    let whole = n / 4 * 4;
+    for (k, o) in out.iter_mut().enumerate() {
+        // SAFETY: column k < out.len() ≤ J's columns, rows below n ≤ stride: inside J's storage;
+        // f has n entries; the CPU has AVX2 (this function's contract).
+        unsafe {
+            let col = jp.add(k * stride);
+            let mut acc = _mm256_setzero_pd();
+            let mut i = 0;
+            while i < whole {
+                acc = _mm256_add_pd(
+                    acc,
+                    _mm256_mul_pd(_mm256_loadu_pd(col.add(i)), _mm256_loadu_pd(fp.add(i))),
+                );
+                i += 4;
+            }
+            let mut s = [0.0; 4];
+            _mm256_storeu_pd(s.as_mut_ptr(), acc);
+            let mut t = (s[0] + s[2]) + (s[1] + s[3]);
+            while i < n {
+                t += *col.add(i) * *fp.add(i);
+                i += 1;
+            }
+            *o = t;
+        }
+    }
 }
 
 #[inline(always)]
