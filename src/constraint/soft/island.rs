@@ -18,12 +18,13 @@
 
 use super::cost::Rows;
 use super::hessian::{Assembler, Target};
-use super::primal::{line_search_with, mul_m_on, term_change, Settings, Sparsity, TermChange};
+use super::primal::{line_search_with, term_change, Settings, Sparsity, TermChange};
 use super::sparse_cholesky::{SparseCholesky, RANK};
+use super::tree_mass::TreeMass;
 use super::work::SoftWork;
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{EfcState, Model, NO_DOF};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 const NONE: usize = usize::MAX;
 
@@ -134,14 +135,14 @@ impl Islands {
     }
 
     /// The islands of the `nefc` rows of `nz` over `nv` dofs with tree parents `dof_parent`,
-    /// numbered in the order of their first row; the scale of each from M's diagonal `m`.
+    /// numbered in the order of their first row; the scale of each from M's diagonal (`m`).
     pub(super) fn discover(
         &mut self,
         nv: usize,
         dof_parent: &[usize],
         nefc: usize,
         nz: &Sparsity,
-        m: &DMatrix<f64>,
+        m: &TreeMass,
     ) {
         // Each dof's tree (its root dof: parents come first), then one union per pair of trees
         // a row joins (a row's columns run tree by tree).
@@ -200,7 +201,7 @@ impl Islands {
         self.scale.clear();
         for i in 0..n {
             let inertia: f64 =
-                self.dofs[self.dof_start[i]..self.dof_start[i + 1]].iter().map(|&k| m[(k, k)]).sum();
+                self.dofs[self.dof_start[i]..self.dof_start[i + 1]].iter().map(|&k| m.diag(k)).sum();
             self.scale.push(1.0 / inertia);
         }
         for v in [
@@ -263,8 +264,8 @@ pub(super) struct Problem<'a> {
     pub model: &'a Model,
     pub rows: &'a Rows<'a>,
     pub nz: &'a Sparsity<'a>,
-    /// M, `qacc_smooth`, `qfrc_smooth` and `efc_aref`.
-    pub m: &'a DMatrix<f64>,
+    /// M (its nonzeros, `tree_mass.rs`), `qacc_smooth`, `qfrc_smooth`.
+    pub m: &'a TreeMass,
     pub a0: &'a DVector<f64>,
     pub f0: &'a DVector<f64>,
     pub settings: Settings,
@@ -287,7 +288,7 @@ pub(super) struct Outcome {
 pub(super) fn newton(
     p: &Problem,
     soft: &mut SoftWork,
-    mass_factor: &DMatrix<f64>,
+    mass_factor: &nalgebra::DMatrix<f64>,
     qacc: &mut DVector<f64>,
     force: &mut DVector<f64>,
     state: &mut [EfcState],
@@ -488,7 +489,7 @@ pub(super) fn newton(
                 jv[r] = cols.iter().zip(vals).map(|(&k, &j_rk)| j_rk * dir[k]).sum();
             }
         }
-        mul_m_on(&model.dof_parent, p.m, isl.active_dofs.iter().copied(), dir, mdir);
+        p.m.mul_on(&model.dof_parent, isl.active_dofs.iter().copied(), dir, mdir);
         // One exact line search per iterating island, over its dofs and rows.
         for i in 0..n {
             isl.alpha[i] = 0.0;
@@ -566,7 +567,9 @@ mod tests {
         let dof_parent = [NO_DOF, 0, NO_DOF, 2, NO_DOF, NO_DOF];
         let (start, index, value) = ([0, 2, 2, 3], [1, 3, 5], [1.0, -1.0, 2.0]);
         let nz = Sparsity { start: &start, index: &index, value: &value };
-        let m = DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]));
+        let dense = nalgebra::DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]));
+        let mut m = TreeMass::new(&dof_parent);
+        m.gather(&dense, &dof_parent);
         let mut isl = Islands::with_capacity(nv, 3);
         isl.discover(nv, &dof_parent, 3, &nz, &m);
         assert_eq!(isl.n, 2);

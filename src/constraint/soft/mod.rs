@@ -22,6 +22,7 @@ pub mod pgs;
 pub mod primal;
 pub mod rows;
 mod sparse_cholesky;
+mod tree_mass;
 pub mod weights;
 mod work;
 

@@ -16,6 +16,7 @@
 
 use super::cost::Rows;
 use super::hessian::{Assembler, Target};
+use super::tree_mass::TreeMass;
 use crate::constraint::dense::{cholesky, cholesky_rank_one, cholesky_solve};
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, EfcState, Model};
@@ -330,12 +331,13 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// r ← M x: a dense product for the dense Newton path (`dense`), else reading only M's
-/// nonzeros: the diagonal and each dof's ancestor chain (`Model::dof_parent`; M[l][k] ≠ 0 only
-/// when l is an ancestor of k or k of l).
+/// nonzeros from their compact copy `tm` (gathered from `m`): the diagonal and each dof's
+/// ancestor chain (`Model::dof_parent`; M[l][k] ≠ 0 only when l is an ancestor of k or k of l).
 pub(super) fn mul_m(
     dense: bool,
     dof_parent: &[usize],
     m: &DMatrix<f64>,
+    tm: &TreeMass,
     x: &DVector<f64>,
     r: &mut DVector<f64>,
 ) {
@@ -350,7 +352,7 @@ pub(super) fn mul_m(
         m.mul_to(x, r);
         return;
     }
-    mul_m_on(dof_parent, m, 0..nv, x.as_slice(), r.as_mut_slice());
+    tm.mul_on(dof_parent, 0..nv, x.as_slice(), r.as_mut_slice());
 }
 
 /// r ← M x (nalgebra's product) compiled for AVX2: the same products and sums in the same
@@ -364,7 +366,9 @@ unsafe fn dense_mul_avx2(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64
 
 /// r ← M x on the dofs `dofs` (whole trees, each tree's dofs ascending; M couples a dof only to
 /// its tree), reading M's nonzeros only: the diagonal and each dof's ancestor chain. The other
-/// entries of r are left as they are.
+/// entries of r are left as they are. (The solves read the compact copy instead,
+/// `TreeMass::mul_on`, the same products in the same order.)
+#[cfg(test)]
 pub(super) fn mul_m_on(
     dof_parent: &[usize],
     m: &DMatrix<f64>,
@@ -467,9 +471,14 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     } = data;
     let (nz_start, nz_index) = (std::mem::take(&mut soft.nz_start), std::mem::take(&mut soft.nz_index));
     let nz_value = std::mem::take(&mut soft.nz_value);
+    // M's nonzeros, once, where the products read them (`tree_mass.rs`).
+    let mut tree_m = std::mem::take(&mut soft.tree_m);
+    let dense = soft.dense;
+    if !dense {
+        tree_m.gather(mass_matrix, &model.dof_parent);
+    }
     let nz = Sparsity { start: &nz_start, index: &nz_index, value: &nz_value };
     // The dense path (`dense_newton`): J's products from its dense storage (`mul_j`, `mul_jt`).
-    let dense = soft.dense;
     let j_dense = dense.then_some(&*efc_j);
     let rows = Rows {
         ne: *ne,
@@ -499,7 +508,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                  jar: &mut DVector<f64>,
                  force: &mut DVector<f64>,
                  state: &mut [_]| {
-        mul_m(dense, &model.dof_parent, mass_matrix, x, ma);
+        mul_m(dense, &model.dof_parent, mass_matrix, &tree_m, x, ma);
         mul_j(&nz, j_dense, nefc, x, jar);
         for (j, &r) in jar.as_mut_slice()[..nefc].iter_mut().zip(&efc_aref.as_slice()[..nefc]) {
             *j -= r;
@@ -546,7 +555,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
             model,
             rows: &rows,
             nz: &nz,
-            m: mass_matrix,
+            m: &tree_m,
             a0: qacc_smooth,
             f0: qfrc_smooth,
             settings: s,
@@ -646,7 +655,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
                 }
             }
             mul_j(&nz, j_dense, nefc, &soft.dir, &mut soft.jv);
-            mul_m(dense, &model.dof_parent, mass_matrix, &soft.dir, &mut soft.mdir);
+            mul_m(dense, &model.dof_parent, mass_matrix, &tree_m, &soft.dir, &mut soft.mdir);
             // (Over slices: nalgebra's matrix iterators cost several instructions per entry.)
             let g0: f64 = (soft.ma.as_slice().iter().zip(qfrc_smooth.as_slice()).zip(soft.dir.as_slice()))
                 .map(|((&ma, &f0), &d)| (ma - f0) * d)
@@ -677,6 +686,7 @@ pub(crate) fn solve_primal(model: &Model, data: &mut Data, method: Primal, s: Se
     data.soft.nz_start = nz_start;
     data.soft.nz_index = nz_index;
     data.soft.nz_value = nz_value;
+    data.soft.tree_m = tree_m;
     data.solver_niter = iter;
     data.solver_improvement = if improvement.is_finite() { improvement } else { 0.0 };
     data.solver_gradient = gradient;

@@ -35,6 +35,7 @@
 //! with the dense ones of P H P to the last bit. Buffers grow only when a Hessian has more
 //! nonzeros than any before it.
 
+#[cfg(test)]
 use nalgebra::DMatrix;
 
 const NONE: usize = usize::MAX;
@@ -183,25 +184,25 @@ impl SparseCholesky {
     }
 
     /// Sets H's rows `dofs` (strictly lower entries and diagonal) to M's: the diagonal, each
-    /// dof's ancestors (`dof_parent`) from `m` (column-major, entry (k, l) at l · nv + k), zero
-    /// elsewhere on the pattern — the start of a Hessian's assembly on those dofs.
-    pub fn set_rows_to_m(&mut self, dofs: &[usize], m: &DMatrix<f64>, dof_parent: &[usize]) {
-        let (ld, m) = (m.nrows(), m.as_slice());
+    /// dof's ancestors (`dof_parent`) from `m` (M's nonzeros, `tree_mass.rs`), zero elsewhere on
+    /// the pattern — the start of a Hessian's assembly on those dofs.
+    pub fn set_rows_to_m(&mut self, dofs: &[usize], m: &super::tree_mass::TreeMass, dof_parent: &[usize]) {
         for &k in dofs {
             let (a, b) = (self.h_start[k], self.h_start[k + 1]);
             let (cols, vals) = (&self.h_cols[a..b], &mut self.h_vals[a..b]);
             vals.fill(0.0);
-            self.h_diag[k] = m[k * ld + k];
+            let column = m.column(k);
+            self.h_diag[k] = column[0];
             // The ancestors descend, the row's columns ascend: one backward walk.
             let mut u = cols.len();
             let mut l = dof_parent[k];
-            while l != NONE {
+            for &m_lk in &column[1..] {
                 while u > 0 && cols[u - 1] > l {
                     u -= 1;
                 }
                 debug_assert!(u > 0 && cols[u - 1] == l, "an ancestor outside H's pattern");
                 if u > 0 {
-                    vals[u - 1] = m[l * ld + k];
+                    vals[u - 1] = m_lk;
                 }
                 l = dof_parent[l];
             }

@@ -67,6 +67,8 @@ pub(crate) struct SoftWork {
     pub nz_scratch: Vec<(usize, usize)>,
     /// Scratch of a row group's Hessian term while H is assembled (`hessian::scratch_len`).
     pub hessian_column: Vec<f64>,
+    /// M's nonzeros, compact, gathered once per solve on the islands' path (`tree_mass.rs`).
+    pub tree_m: super::tree_mass::TreeMass,
     /// The constraint islands of the sparse Newton solve (`island.rs`).
     pub islands: super::island::Islands,
     /// The dual (PGS) matrix J M⁻¹ Jᵀ + R, its right-hand side, and M⁻¹ Jᵀ (nv × nefc).
@@ -114,6 +116,7 @@ impl SoftWork {
             gathered: vec![0.0; nv],
             nz_scratch: Vec::new(),
             hessian_column: vec![0.0; super::hessian::scratch_len(nv)],
+            tree_m: super::tree_mass::TreeMass::new(&model.dof_parent[..nv]),
             islands: super::island::Islands::with_capacity(nv, nefc),
             ar: DMatrix::zeros(0, 0),
             minv_jt: DMatrix::zeros(0, 0),
