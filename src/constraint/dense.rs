@@ -557,7 +557,331 @@ fn cholesky_solve_kernel(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
     }
 }
 
-/// The minimum-norm solution x = A⁺ b of a singular PSD system, in `b`, and A's numerical rank.
+/// The minimum-norm solution x = A⁺ b of a singular PSD system, in `b`, and A's numerical rank:
+/// [`deletion_min_norm`] when `a` has room for its scratch (n columns), else [`pivoted_min_norm`].
+fn min_norm_solve(
+    a: &mut DMatrix<f64>,
+    n: usize,
+    b: &mut [f64],
+    l: &mut DMatrix<f64>,
+    perm: &mut DVector<f64>,
+    tol: f64,
+) -> usize {
+    if a.ncols() >= n && a.nrows() >= n && l.ncols() >= n && perm.len() >= n {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above), all `deletion_min_norm_avx2` requires.
+            return unsafe { deletion_min_norm_avx2(a, n, b, l, perm, tol) };
+        }
+        return deletion_min_norm::<false>(a, n, b, l, perm, tol);
+    }
+    pivoted_min_norm(a, n, b, l, perm, tol)
+}
+
+/// [`deletion_min_norm`] compiled for AVX2 (the column updates four entries per instruction; the
+/// same operations in the same order, so the same bits).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn deletion_min_norm_avx2(
+    a: &mut DMatrix<f64>,
+    n: usize,
+    b: &mut [f64],
+    l: &mut DMatrix<f64>,
+    perm: &mut DVector<f64>,
+    tol: f64,
+) -> usize {
+    deletion_min_norm::<true>(a, n, b, l, perm, tol)
+}
+
+/// Σ xᵢ yᵢ in four interleaved partial sums (lanes i mod 4, added as (s₀ + s₁) + (s₂ + s₃), then
+/// the tail in order): a fixed order, so the same bits on every run; [`dot4_avx2`] with `AVX`.
+#[inline(always)]
+fn dot4<const AVX: bool>(x: &[f64], y: &[f64]) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: `AVX` is true only in `deletion_min_norm_avx2`, which runs on CPUs with AVX2.
+        return unsafe { dot4_avx2(x, y) };
+    }
+    let mut s = [0.0; 4];
+    let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
+    let (xr, yr) = (xc.remainder(), yc.remainder());
+    for (p, q) in xc.zip(yc) {
+        for k in 0..4 {
+            s[k] += p[k] * q[k];
+        }
+    }
+    let mut t = (s[0] + s[1]) + (s[2] + s[3]);
+    for (p, q) in xr.iter().zip(yr) {
+        t += p * q;
+    }
+    t
+}
+
+/// [`dot4`] with AVX2 intrinsics: the four partial sums in one register (a multiply and an add per
+/// chunk, no fused multiply–add), so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn dot4_avx2(x: &[f64], y: &[f64]) -> f64 {
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+    };
+    let len = x.len().min(y.len());
+    let chunks = len / 4;
+    let mut acc = _mm256_setzero_pd();
+    for c in 0..chunks {
+        // SAFETY: 4c + 3 < len, within both slices.
+        let (p, q) =
+            unsafe { (_mm256_loadu_pd(x.as_ptr().add(4 * c)), _mm256_loadu_pd(y.as_ptr().add(4 * c))) };
+        acc = _mm256_add_pd(acc, _mm256_mul_pd(p, q));
+    }
+    let mut s = [0.0; 4];
+    // SAFETY: `s` holds four f64.
+    unsafe { _mm256_storeu_pd(s.as_mut_ptr(), acc) };
+    let mut t = (s[0] + s[1]) + (s[2] + s[3]);
+    for i in 4 * chunks..len {
+        t += x[i] * y[i];
+    }
+    t
+}
+
+/// The minimum-norm solution x = A⁺ b of a singular PSD system (in `b`) from a Cholesky factor in
+/// the rows' own order with the dependent rows deleted, and A's numerical rank r. O(n b² + (n − r)
+/// r² + r³) for a factor of bandwidth b (a stack's or chain's contacts in order couple only their
+/// neighbours): the pivoted factor and QR of [`pivoted_min_norm`] are O(n² r) whatever the
+/// structure (a 20-box stack's 250 redundant rows: most of its step).
+///
+/// 1. Left-looking Cholesky in the given order; a row whose pivot is not above `tol` is dependent
+///    on the earlier ones (for a PSD matrix its Schur complement row then vanishes with the
+///    pivot): its column is zeroed. The independent rows I (r of them) and dependent rows D give
+///    A = L̃ L̃ᵀ with L̃ = L[:, I] = [L₁; L₂] (rows I, rows D), L₁ lower triangular (Golub & Van
+///    Loan, *Matrix Computations*, 4th ed., §4.2.8 on semidefinite Cholesky).
+/// 2. A = U A₁₁ Uᵀ with U = [I; S] (rows I, rows D), S = L₂ L₁⁻¹ (each dependent row as a
+///    combination of the independent ones) and A₁₁ = L₁ L₁ᵀ. U has full column rank, so
+///    A⁺ = U H⁻¹ A₁₁⁻¹ H⁻¹ Uᵀ with H = UᵀU = I + SᵀS (with U = QR: Q R⁻ᵀ A₁₁⁻¹ R⁻¹ Qᵀ).
+///    H's eigenvalues are at least 1: its Cholesky is well conditioned; A₁₁'s condition is that
+///    of A's nonzero part, as a regular solve.
+///
+/// The rank decision is per row, in order, rather than on the largest remaining pivot; for rows
+/// that are exactly redundant (a box's four corners against one face) both find the same rank,
+/// and the solution is the same A⁺ b up to round-off. Scratch: `l` holds L; `a` (n × n, its
+/// stride at least n) holds H (rows 0..r) over S (rows r..n) in its first r columns and two
+/// vectors in column r; `perm` holds each column's extent, then I followed by D (indices as the
+/// bits of its f64 entries).
+#[inline(always)]
+fn deletion_min_norm<const AVX: bool>(
+    a: &mut DMatrix<f64>,
+    n: usize,
+    b: &mut [f64],
+    l: &mut DMatrix<f64>,
+    perm: &mut DVector<f64>,
+    tol: f64,
+) -> usize {
+    let (ls, sa) = (l.nrows(), a.nrows());
+    let lm = l.as_mut_slice();
+    // 1. The factor, dependent columns zeroed.
+    {
+        let am = a.as_slice();
+        let mut kmin = 0;
+        for j in 0..n {
+            let (done, rest) = lm.split_at_mut(j * ls);
+            let col_j = &mut rest[j..n];
+            col_j.copy_from_slice(&am[j * sa + j..j * sa + n]);
+            // The earlier columns reaching row j: from the first whose nonzeros (up to `perm[k]`,
+            // one past its last, as bits) go beyond row j − 1, which only moves down with j.
+            while kmin < j && (perm[kmin].to_bits() as usize) <= j {
+                kmin += 1;
+            }
+            for k in kmin..j {
+                let end = perm[k].to_bits() as usize;
+                if end <= j {
+                    continue;
+                }
+                let col_k = &done[k * ls + j..k * ls + end];
+                let ljk = col_k[0];
+                if ljk == 0.0 {
+                    continue;
+                }
+                for (x, &y) in col_j.iter_mut().zip(col_k) {
+                    *x -= y * ljk;
+                }
+            }
+            let d = col_j[0];
+            if d <= tol {
+                col_j.fill(0.0);
+                perm[j] = f64::from_bits(j as u64);
+            } else {
+                let d = d.sqrt();
+                col_j[0] = d;
+                for x in &mut col_j[1..] {
+                    *x /= d;
+                }
+                perm[j] = f64::from_bits((j + 1 + col_j.iter().rposition(|&x| x != 0.0).unwrap_or(0)) as u64);
+            }
+        }
+    }
+    let mut r = 0;
+    for j in 0..n {
+        if lm[j * ls + j] != 0.0 {
+            perm[r] = f64::from_bits(j as u64);
+            r += 1;
+        }
+    }
+    if r == 0 {
+        b[..n].fill(0.0);
+        return 0;
+    }
+    if r == n {
+        cholesky_solve(l, n, b);
+        return n;
+    }
+    {
+        let mut m = r;
+        for j in 0..n {
+            if lm[j * ls + j] == 0.0 {
+                perm[m] = f64::from_bits(j as u64);
+                m += 1;
+            }
+        }
+    }
+    let m = n - r;
+    let idx = |p: usize| perm[p].to_bits() as usize;
+    let am = a.as_mut_slice();
+    // L[i, j] (zero above the diagonal: `l`'s upper triangle is not written).
+    let lij = |i: usize, j: usize| if i >= j { lm[j * ls + i] } else { 0.0 };
+    // 2. S (m × r) in rows r..n of a's columns 0..r, right to left: S L₁ = L₂.
+    for c in (0..r).rev() {
+        let ic = idx(c);
+        let (head, tail) = am.split_at_mut((c + 1) * sa);
+        let s_c = &mut head[c * sa + r..c * sa + n];
+        for (e, x) in s_c.iter_mut().enumerate() {
+            *x = lij(idx(r + e), ic);
+        }
+        for k in c + 1..r {
+            let lkc = lm[ic * ls + idx(k)];
+            if lkc == 0.0 {
+                continue;
+            }
+            // Column k from its first nonzero row (kept in its row 0, below).
+            let lo = tail[(k - c - 1) * sa].to_bits() as usize;
+            let s_k = &tail[(k - c - 1) * sa + r + lo..(k - c - 1) * sa + n];
+            for (x, &y) in s_c[lo..].iter_mut().zip(s_k) {
+                *x -= y * lkc;
+            }
+        }
+        let d = lm[ic * ls + ic];
+        for x in s_c.iter_mut() {
+            *x /= d;
+        }
+        // Column c's first nonzero row, in its row 0 as bits (above H's diagonal for c ≥ 1, which
+        // nothing below reads): the products with it start there.
+        if c > 0 {
+            let lo = s_c.iter().position(|&x| x != 0.0).unwrap_or(m);
+            head[c * sa] = f64::from_bits(lo as u64);
+        }
+    }
+    // H = I + SᵀS, lower triangle, in rows 0..r; each product over the rows where both columns
+    // can be nonzero (S's columns start at their first nonzero: a dependent row combines nearby
+    // independent ones).
+    for q in 0..r {
+        let lo_q = if q == 0 {
+            am[r..n].iter().position(|&x| x != 0.0).unwrap_or(m)
+        } else {
+            am[q * sa].to_bits() as usize
+        };
+        for p in q..r {
+            let lo_p = if p == 0 { lo_q } else { am[p * sa].to_bits() as usize };
+            let lo = r + lo_p.max(lo_q);
+            let h = dot4::<AVX>(&am[p * sa + lo..p * sa + n], &am[q * sa + lo..q * sa + n]);
+            am[q * sa + p] = h + if p == q { 1.0 } else { 0.0 };
+        }
+    }
+    // H's Cholesky factor in place (left-looking; pivots at least 1 in exact arithmetic).
+    for j in 0..r {
+        let (done, rest) = am.split_at_mut(j * sa);
+        let col_j = &mut rest[j..r];
+        for k in 0..j {
+            let col_k = &done[k * sa + j..k * sa + r];
+            let hjk = col_k[0];
+            if hjk == 0.0 {
+                continue;
+            }
+            for (x, &y) in col_j.iter_mut().zip(col_k) {
+                *x -= y * hjk;
+            }
+        }
+        let d = col_j[0].sqrt();
+        col_j[0] = d;
+        for x in &mut col_j[1..] {
+            *x /= d;
+        }
+    }
+    // 3. Column r of a: b_D in rows 0..m, then g (r entries) in rows m..n.
+    let (hs, t) = am.split_at_mut(r * sa);
+    let t = &mut t[..n];
+    let (bd, g) = t.split_at_mut(m);
+    for e in 0..m {
+        bd[e] = b[idx(r + e)];
+    }
+    // g = Uᵀ b = b_I + Sᵀ b_D.
+    for c in 0..r {
+        g[c] = b[idx(c)] + dot4::<AVX>(&hs[c * sa + r..c * sa + n], bd);
+    }
+    let h_solve = |g: &mut [f64]| {
+        for c in 0..r {
+            let col = &hs[c * sa + c..c * sa + r];
+            g[c] /= col[0];
+            let gc = g[c];
+            for (x, &y) in g[c + 1..r].iter_mut().zip(&col[1..]) {
+                *x -= y * gc;
+            }
+        }
+        for c in (0..r).rev() {
+            let col = &hs[c * sa + c..c * sa + r];
+            let s = g[c] - dot4::<AVX>(&col[1..], &g[c + 1..r]);
+            g[c] = s / col[0];
+        }
+    };
+    h_solve(g);
+    // A₁₁⁻¹ = L₁⁻ᵀ L₁⁻¹ (L₁[k, c] = L[I_k, I_c]).
+    for c in 0..r {
+        let ic = idx(c);
+        g[c] /= lm[ic * ls + ic];
+        let gc = g[c];
+        if gc != 0.0 {
+            for k in c + 1..r {
+                g[k] -= lm[ic * ls + idx(k)] * gc;
+            }
+        }
+    }
+    for c in (0..r).rev() {
+        let ic = idx(c);
+        let mut s = g[c];
+        for k in c + 1..r {
+            s -= lm[ic * ls + idx(k)] * g[k];
+        }
+        g[c] = s / lm[ic * ls + ic];
+    }
+    h_solve(g);
+    // x = U g: x_I = g, x_D = S g.
+    bd.fill(0.0);
+    for c in 0..r {
+        let gc = g[c];
+        for (x, &y) in bd.iter_mut().zip(&hs[c * sa + r..c * sa + n]) {
+            *x += y * gc;
+        }
+    }
+    for c in 0..r {
+        b[idx(c)] = g[c];
+    }
+    for e in 0..m {
+        b[idx(r + e)] = bd[e];
+    }
+    r
+}
+
+/// The minimum-norm solution x = A⁺ b of a singular PSD system, in `b`, and A's numerical rank,
+/// by a pivoted factor and QR (the form [`deletion_min_norm`] replaced; kept for a matrix
+/// buffer too small for that one's scratch, and as its tests' reference).
 ///
 /// 1. Cholesky with symmetric pivoting (Higham, *Accuracy and Stability of Numerical
 ///    Algorithms*, 2nd ed., §10.3): P A Pᵀ = L Lᵀ with L n × r lower trapezoidal, stopping when
@@ -570,7 +894,7 @@ fn cholesky_solve_kernel(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
 /// as a regular Cholesky solve. Cost O(n² r) (a Jacobi eigendecomposition took tens of sweeps of
 /// O(n³)). Scratch: `l` (n × n) holds L, then Q's reflectors and R; `a` is overwritten (P b and
 /// the reflectors' coefficients); `perm` holds P.
-fn min_norm_solve(
+fn pivoted_min_norm(
     a: &mut DMatrix<f64>,
     n: usize,
     b: &mut [f64],
@@ -865,6 +1189,67 @@ mod tests {
             for k in 0..2 {
                 for i in k..5 {
                     assert_eq!(l[(i, k)].to_bits(), want[(i, k)].to_bits(), "failed factor ({i}, {k})");
+                }
+            }
+        }
+    }
+
+    /// The deletion form against the pivoted factor and QR (both called directly) on a chain's
+    /// pattern: groups of rows, each coupling two neighbouring "bodies" of six dofs, half of
+    /// each group's rows combinations of its others (a box's redundant corners); consistent and
+    /// inconsistent right-hand sides. The same rank, the same A⁺ b to round-off.
+    #[test]
+    fn deletion_min_norm_matches_the_pivoted_form() {
+        let mut rand = uniform(3);
+        for bodies in [2usize, 5, 12] {
+            let nv = 6 * bodies;
+            let mut rows: Vec<DVector<f64>> = Vec::new();
+            for g in 0..bodies - 1 {
+                let base: Vec<DVector<f64>> = (0..6)
+                    .map(|_| {
+                        DVector::from_fn(nv, |i, _| if i / 6 == g || i / 6 == g + 1 { rand() } else { 0.0 })
+                    })
+                    .collect();
+                let mut group = base.clone();
+                for _ in 0..6 {
+                    let mut x = DVector::zeros(nv);
+                    for v in &base {
+                        x += v * rand();
+                    }
+                    group.push(x);
+                }
+                // Interleaved: dependent rows between independent ones, as a patch's corners.
+                group.swap(3, 7);
+                rows.extend(group);
+            }
+            let n = rows.len();
+            let j = DMatrix::from_fn(n, nv, |i, k| rows[i][k]);
+            let a0 = &j * j.transpose();
+            for consistent in [true, false] {
+                let z = DVector::from_fn(n, |_, _| rand());
+                let rhs = if consistent { &a0 * &z } else { z.clone() };
+                let tol = RANK_TOLERANCE * (0..n).map(|i| a0[(i, i)]).fold(0.0, f64::max);
+                let (mut a1, mut a2) = (a0.clone(), a0.clone());
+                let (mut l1, mut l2) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+                let (mut p1, mut p2) = (DVector::zeros(n), DVector::zeros(n));
+                let (mut x1, mut x2) = (rhs.as_slice().to_vec(), rhs.as_slice().to_vec());
+                let r1 = deletion_min_norm::<false>(&mut a1, n, &mut x1, &mut l1, &mut p1, tol);
+                let r2 = pivoted_min_norm(&mut a2, n, &mut x2, &mut l2, &mut p2, tol);
+                assert_eq!(r1, r2, "bodies {bodies}");
+                assert_eq!(r1, 6 * (bodies - 1), "bodies {bodies}");
+                let scale = x2.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                let err = x1.iter().zip(&x2).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+                assert!(err < 1e-9 * scale, "bodies {bodies} consistent {consistent}: {err:e}");
+                #[cfg(target_arch = "x86_64")]
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    let (mut a3, mut l3, mut p3) = (a0.clone(), DMatrix::zeros(n, n), DVector::zeros(n));
+                    let mut x3 = rhs.as_slice().to_vec();
+                    // SAFETY: the CPU has AVX2 (checked above).
+                    let r3 = unsafe { deletion_min_norm_avx2(&mut a3, n, &mut x3, &mut l3, &mut p3, tol) };
+                    assert_eq!(r3, r1);
+                    for (a, b) in x3.iter().zip(&x1) {
+                        assert_eq!(a.to_bits(), b.to_bits(), "AVX2 and scalar forms differ");
+                    }
                 }
             }
         }
