@@ -351,17 +351,24 @@ unsafe fn add_weighted_rows_avx2(
                 }
                 _mm256_storeu_pd(v.as_mut_ptr(), _mm256_add_pd(_mm256_add_pd(s0, s2), _mm256_add_pd(s1, s3)));
             }
-            let p0 = cols[t];
-            if t + 4 <= n && cols[t + 3] == p0 + 3 {
-                for (x, &v) in column[p0..p0 + 4].iter_mut().zip(&v) {
-                    *x += v;
-                }
-            } else {
-                for (&p, &v) in cols[t..n.min(t + 4)].iter().zip(&v) {
-                    column[p] += v;
-                }
-            }
+            add_four(column, cols, t, &v);
             t += 4;
+        }
+    }
+}
+
+/// `column[cols[t + i]] += v[i]` for the (up to) four column positions t … t + 3 below
+/// `cols.len()`: one slice update when they are four consecutive dofs (a free joint's block).
+#[inline(always)]
+fn add_four(column: &mut [f64], cols: &[usize], t: usize, v: &[f64; 4]) {
+    let (n, p0) = (cols.len(), cols[t]);
+    if t + 4 <= n && cols[t + 3] == p0 + 3 {
+        for (x, &v) in column[p0..p0 + 4].iter_mut().zip(v) {
+            *x += v;
+        }
+    } else {
+        for (&p, &v) in cols[t..n.min(t + 4)].iter().zip(v) {
+            column[p] += v;
         }
     }
 }
@@ -422,16 +429,7 @@ fn add_columns_wide_kernel(
             for (lane, v) in v.iter_mut().enumerate() {
                 *v = (s[0][lane] + s[2][lane]) + (s[1][lane] + s[3][lane]);
             }
-            let p0 = cols[t];
-            if t + 4 <= n && cols[t + 3] == p0 + 3 {
-                for (x, &v) in column[p0..p0 + 4].iter_mut().zip(&v) {
-                    *x += v;
-                }
-            } else {
-                for (&p, &v) in cols[t..n.min(t + 4)].iter().zip(&v) {
-                    column[p] += v;
-                }
-            }
+            add_four(column, cols, t, &v);
             t += 4;
         }
     }
