@@ -69,11 +69,20 @@ impl Rows<'_> {
         // Slices: the per-row loops index them without nalgebra's shape checks.
         let (jar, force) = (jar.as_slice(), force.as_mut_slice());
         let (n, scalar) = (self.nefc, self.ne + self.nf);
-        let mut i = 0;
+        let d_all = self.d.as_slice();
+        // The equality rows (always quadratic): `update_at`'s terms, in one tight loop; then the
+        // friction-loss rows one by one.
+        let ne = self.ne.min(n);
+        for (t, ((&x, &d), (f, st))) in
+            jar[..ne].iter().zip(&d_all[..ne]).zip(force[..ne].iter_mut().zip(&mut state[..ne])).enumerate()
+        {
+            (*st, *f) = (EfcState::Quadratic, -d * x);
+            each(t, 0.5 * d * x * x);
+        }
+        let mut i = ne;
         while i < scalar.min(n) {
             i += self.update_at(i, jar, force, state, &mut each);
         }
-        let d_all = self.d.as_slice();
         while i < n {
             // A run of limit, frictionless or pyramidal rows (quadratic below zero, else
             // satisfied): `update_at`'s terms, in one tight loop; then an elliptic contact.
