@@ -711,7 +711,7 @@ fn solve_span_runs_avx2(model: &Model, h: &[f64], x: &mut [f64], (lo, hi): (usiz
             let s = run(e);
             // SAFETY: s ≤ e < nv (checked): entries s ..= e of x and of column i, which do not
             // overlap (x and h are distinct borrows); the caller is compiled for AVX2.
-            unsafe { sub_scaled_avx2(xp.add(s), col.add(s), e + 1 - s, x_i) };
+            unsafe { sub_scaled_run(xp.add(s), col.add(s), e + 1 - s, x_i) };
             e = lambda[s];
         }
     }
@@ -725,11 +725,81 @@ fn solve_span_runs_avx2(model: &Model, h: &[f64], x: &mut [f64], (lo, hi): (usiz
         while e != NO_DOF {
             let s = run(e);
             // SAFETY: s ≤ e < nv (checked), inside both slices of nv entries.
-            let (xs, ls) = unsafe { (x.get_unchecked(s..=e), col.get_unchecked(s..=e)) };
-            acc += xs.iter().zip(ls).map(|(xj, l)| xj * l).sum::<f64>();
+            acc += unsafe { dot_run(x.as_ptr().add(s), col.as_ptr().add(s), e + 1 - s) };
             e = lambda[s];
         }
         x[i] -= acc;
+    }
+}
+
+/// [`sub_scaled_avx2`] for a run of the solve: runs of up to eight dofs (a robot's chains are
+/// made of such: a floating base's six, a limb's two or three) with their length known at
+/// compile time, straight-line code instead of the general loop's branches. Each entry gets the
+/// same product then difference: the same bits.
+///
+/// # Safety
+/// As [`sub_scaled_avx2`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn sub_scaled_run(x: *mut f64, y: *const f64, n: usize, a: f64) {
+    /// x[0..N] −= a · y[0..N].
+    #[inline(always)]
+    unsafe fn fixed<const N: usize>(x: *mut f64, y: *const f64, a: f64) {
+        // SAFETY: the caller's contract (N valid entries at x and y, not overlapping).
+        unsafe {
+            let (x, y) = (&mut *(x as *mut [f64; N]), &*(y as *const [f64; N]));
+            for (xj, yj) in x.iter_mut().zip(y) {
+                *xj -= a * yj;
+            }
+        }
+    }
+    // SAFETY: the caller's contract, for each arm.
+    unsafe {
+        match n {
+            1 => fixed::<1>(x, y, a),
+            2 => fixed::<2>(x, y, a),
+            3 => fixed::<3>(x, y, a),
+            4 => fixed::<4>(x, y, a),
+            5 => fixed::<5>(x, y, a),
+            6 => fixed::<6>(x, y, a),
+            7 => fixed::<7>(x, y, a),
+            8 => fixed::<8>(x, y, a),
+            _ => sub_scaled_avx2(x, y, n, a),
+        }
+    }
+}
+
+/// Σ x[j] · l[j] over a run of n entries, summed in order from the first (as the iterator sum of
+/// [`solve_span_kernel`]: the same bits), runs of up to eight unrolled.
+///
+/// # Safety
+/// x and l point to n valid entries each.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn dot_run(x: *const f64, l: *const f64, n: usize) -> f64 {
+    /// The sum over N entries.
+    #[inline(always)]
+    unsafe fn fixed<const N: usize>(x: *const f64, l: *const f64) -> f64 {
+        // SAFETY: the caller's contract (N valid entries at x and l).
+        let (x, l) = unsafe { (&*(x as *const [f64; N]), &*(l as *const [f64; N])) };
+        x.iter().zip(l).map(|(xj, lj)| xj * lj).sum::<f64>()
+    }
+    // SAFETY: the caller's contract, for each arm.
+    unsafe {
+        match n {
+            1 => fixed::<1>(x, l),
+            2 => fixed::<2>(x, l),
+            3 => fixed::<3>(x, l),
+            4 => fixed::<4>(x, l),
+            5 => fixed::<5>(x, l),
+            6 => fixed::<6>(x, l),
+            7 => fixed::<7>(x, l),
+            8 => fixed::<8>(x, l),
+            _ => {
+                let (xs, ls) = (std::slice::from_raw_parts(x, n), std::slice::from_raw_parts(l, n));
+                xs.iter().zip(ls).map(|(xj, lj)| xj * lj).sum::<f64>()
+            }
+        }
     }
 }
 
@@ -884,6 +954,42 @@ mod tests {
                 for (i, (x, y)) in a.iter().zip(b).enumerate() {
                     assert_eq!(x.to_bits(), y.to_bits(), "{file} {shift:?}: entry {i}");
                 }
+            }
+        }
+    }
+
+    /// The AVX2 solve (runs of up to eight dofs unrolled, `sub_scaled_run`, `dot_run`) gives the
+    /// portable solve's bits, on the robots and the humanoid, for a right-hand side with signed
+    /// zeros and mixed magnitudes.
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    #[ignore = "compares the CPU-specific (AVX2) build of the kernel with the portable one; needs such a CPU: cargo test --release -p lagrange --lib -- --ignored (as .ci/run does)"]
+    fn avx2_solve_is_bit_for_bit() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            eprintln!("skipped: this CPU has no AVX2, the AVX2 solve is never used here");
+            return;
+        }
+        let mut cases = crate::kernel_test_states::robots();
+        let file = "models/mjcf/humanoid/humanoid.xml";
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+        let humanoid = crate::io::load(&path, &Default::default()).unwrap();
+        let q = humanoid.neutral();
+        cases.push((file, humanoid, q));
+        for (file, model, q) in cases {
+            let mut data = Data::new(&model);
+            crba_unchecked(&model, &mut data, &q);
+            factorize_mass_matrix(&model, &mut data);
+            let b: Vec<f64> = (0..model.nv)
+                .map(
+                    |k| if k % 7 == 3 { -0.0 } else { (k as f64 * 1.7).sin() * 10f64.powi(k as i32 % 4 - 2) },
+                )
+                .collect();
+            let (mut portable, mut avx2) = (b.clone(), b);
+            solve_span_kernel::<false>(&model, &data.mass_factor, &mut portable, (0, model.nv));
+            // SAFETY: the CPU has AVX2 (checked above).
+            unsafe { solve_span_avx2(&model, &data.mass_factor, &mut avx2, (0, model.nv)) };
+            for (i, (x, y)) in portable.iter().zip(&avx2).enumerate() {
+                assert_eq!(x.to_bits(), y.to_bits(), "{file}: entry {i}");
             }
         }
     }
