@@ -925,6 +925,7 @@ mod tests {
     /// signed zeros and mixed magnitudes in x.
     #[test]
     #[cfg(target_arch = "x86_64")]
+    #[ignore = "compares the CPU-specific (AVX2) build of the product with nalgebra's; needs such a CPU: cargo test --release -p lagrange --lib -- --ignored (as .ci/run does)"]
     fn dense_mul_avx2_is_nalgebras_product_bit_for_bit() {
         use nalgebra::{DMatrix, DVector};
         if !std::arch::is_x86_feature_detected!("avx2") {
