@@ -919,6 +919,22 @@ mod tests {
         }
     }
 
+    /// The kernel tests' robots and the humanoid (free joint, legs of one and two runs of dofs)
+    /// with its hinges away from zero (the free joint's unit quaternion kept).
+    #[cfg(target_arch = "x86_64")]
+    fn robots_and_humanoid() -> Vec<(&'static str, Model, Vec<f64>)> {
+        let mut cases = crate::kernel_test_states::robots();
+        let file = "models/mjcf/humanoid/humanoid.xml";
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+        let humanoid = crate::io::load(&path, &Default::default()).unwrap();
+        let mut q = humanoid.neutral();
+        for (i, x) in q.iter_mut().enumerate().skip(7) {
+            *x += 0.1 + 0.37 * (i as f64).sin();
+        }
+        cases.push((file, humanoid, q));
+        cases
+    }
+
     /// The AVX2 build of the factorization (its pair-by-pair updates and straight-line tails,
     /// `tail_updates`) gives the portable build's factor bit for bit, of M and of M + h·diag(d),
     /// on the panda (one run), solo12 and the humanoid (free joints, legs of one and two runs).
@@ -930,17 +946,7 @@ mod tests {
             eprintln!("skipped: this CPU has no AVX2, the AVX2 factorization is never used here");
             return;
         }
-        let mut cases = crate::kernel_test_states::robots();
-        let file = "models/mjcf/humanoid/humanoid.xml";
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
-        let humanoid = crate::io::load(&path, &Default::default()).unwrap();
-        let mut q = humanoid.neutral();
-        // The hinges away from zero (the free joint's unit quaternion kept).
-        for (i, x) in q.iter_mut().enumerate().skip(7) {
-            *x += 0.1 + 0.37 * (i as f64).sin();
-        }
-        cases.push((file, humanoid, q));
-        for (file, model, q) in cases {
+        for (file, model, q) in robots_and_humanoid() {
             let damping: Vec<f64> = (0..model.nv).map(|k| 0.5 + 0.1 * k as f64).collect();
             for shift in [None, Some((0.002, damping.as_slice()))] {
                 let mut portable = Data::new(&model);
@@ -969,13 +975,7 @@ mod tests {
             eprintln!("skipped: this CPU has no AVX2, the AVX2 solve is never used here");
             return;
         }
-        let mut cases = crate::kernel_test_states::robots();
-        let file = "models/mjcf/humanoid/humanoid.xml";
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
-        let humanoid = crate::io::load(&path, &Default::default()).unwrap();
-        let q = humanoid.neutral();
-        cases.push((file, humanoid, q));
-        for (file, model, q) in cases {
+        for (file, model, q) in robots_and_humanoid() {
             let mut data = Data::new(&model);
             crba_unchecked(&model, &mut data, &q);
             factorize_mass_matrix(&model, &mut data);
