@@ -498,10 +498,14 @@ fn cholesky_rank_one_kernel(l: &mut DMatrix<f64>, n: usize, x: &mut [f64], sign:
         }
         let r = r2.sqrt();
         let (c, s) = (r / lkk, xk / lkk);
+        // 1/c = lkk/r, formed beside c: one division per column instead of one per entry
+        // (MuJoCo's `mju_cholUpdate` scales by 1/c likewise), off the chain from one column's
+        // x to the next's.
+        let c_inv = lkk / r;
         col[0] = r;
         let (_, tail) = x.split_at_mut(k + 1);
         for (lik, xi) in col[1..].iter_mut().zip(tail.iter_mut()) {
-            *lik = (*lik + sign * s * *xi) / c;
+            *lik = (*lik + sign * s * *xi) * c_inv;
             *xi = c * *xi - s * *lik;
         }
     }
