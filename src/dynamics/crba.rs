@@ -398,6 +398,9 @@ fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Opt
             d_k = MIN_PIVOT;
             col_k[k] = d_k;
         }
+        // The ratios L[k][i] = M[k][i] / d_k as products with 1/d_k (as MuJoCo's `mj_factorI`):
+        // one division per dof instead of one per pair (k, ancestor i), a humanoid's ~250.
+        let inv_d = 1.0 / d_k;
         // Every ancestor of k starts its chain where k's does (the tree's root dof).
         let lo = model.dof_tree_start[k];
         let mut i = lambda[k];
@@ -414,14 +417,14 @@ fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Opt
                 if run_start[i] == lo && i - lo < MAX_TAIL {
                     // SAFETY: as below, for each of the ancestors i, i − 1, …, lo (the rest of
                     // k's chain: one run of consecutive dofs from the tree's first).
-                    unsafe { tail_updates(hp, yk, lo, i + 1 - lo, nv, d_k) };
+                    unsafe { tail_updates(hp, yk, lo, i + 1 - lo, nv, inv_d) };
                     break;
                 }
                 // SAFETY: i < k (checked), so column i lies in `before` (k · nv entries) and
                 // rows lo ..= i < nv of it, and rows lo ..= i of column k (`col_k`, nv long),
                 // are inside their slices, which are disjoint; the caller is compiled for AVX2.
                 unsafe {
-                    let a = *yk.add(i) / d_k;
+                    let a = *yk.add(i) * inv_d;
                     sub_scaled_avx2(hp.add(i * nv + lo), yk.add(lo), i + 1 - lo, a);
                     *yk.add(i) = a;
                 }
@@ -430,7 +433,7 @@ fn factorize_kernel<const AVX2: bool>(model: &Model, data: &mut Data, shift: Opt
             continue;
         }
         while i != NO_DOF {
-            let a = col_k[i] / d_k;
+            let a = col_k[i] * inv_d;
             // Column k is nonzero only on k's chain, whose rows up to i are i's chain: the
             // update runs over i's span from its chain's first dof (the same bits on the chain
             // as the whole column, without the products with zeros of other trees).
@@ -456,47 +459,47 @@ const MAX_TAIL: usize = 16;
 /// code, where the pair-by-pair loop spends more on each short update's set-up than on its
 /// arithmetic (a humanoid's 21 dofs below its free joint end their chains with the same six
 /// pairs of one to six entries). Each entry gets the same product and difference, the ratio
-/// L[k][i] the same division, in the same order per column: the same bits.
+/// L[k][i] the same product with 1/d_k, in the same order per column: the same bits.
 ///
 /// # Safety
 /// Columns lo ..= lo + n − 1 of the factor (rows lo ..= lo + n − 1 of each, `nv` entries apart,
 /// from `h`) and rows lo ..= lo + n − 1 of column k (`yk`) are valid and do not overlap.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn tail_updates(h: *mut f64, yk: *mut f64, lo: usize, n: usize, nv: usize, d_k: f64) {
+unsafe fn tail_updates(h: *mut f64, yk: *mut f64, lo: usize, n: usize, nv: usize, inv_d: f64) {
     // SAFETY: the caller's contract, for each arm.
     unsafe {
         match n {
-            1 => tail_block::<1>(h, yk, lo, nv, d_k),
-            2 => tail_block::<2>(h, yk, lo, nv, d_k),
-            3 => tail_block::<3>(h, yk, lo, nv, d_k),
-            4 => tail_block::<4>(h, yk, lo, nv, d_k),
-            5 => tail_block::<5>(h, yk, lo, nv, d_k),
-            6 => tail_block::<6>(h, yk, lo, nv, d_k),
-            7 => tail_block::<7>(h, yk, lo, nv, d_k),
-            8 => tail_block::<8>(h, yk, lo, nv, d_k),
-            9 => tail_block::<9>(h, yk, lo, nv, d_k),
-            10 => tail_block::<10>(h, yk, lo, nv, d_k),
-            11 => tail_block::<11>(h, yk, lo, nv, d_k),
-            12 => tail_block::<12>(h, yk, lo, nv, d_k),
-            13 => tail_block::<13>(h, yk, lo, nv, d_k),
-            14 => tail_block::<14>(h, yk, lo, nv, d_k),
-            15 => tail_block::<15>(h, yk, lo, nv, d_k),
-            _ => tail_block::<MAX_TAIL>(h, yk, lo, nv, d_k),
+            1 => tail_block::<1>(h, yk, lo, nv, inv_d),
+            2 => tail_block::<2>(h, yk, lo, nv, inv_d),
+            3 => tail_block::<3>(h, yk, lo, nv, inv_d),
+            4 => tail_block::<4>(h, yk, lo, nv, inv_d),
+            5 => tail_block::<5>(h, yk, lo, nv, inv_d),
+            6 => tail_block::<6>(h, yk, lo, nv, inv_d),
+            7 => tail_block::<7>(h, yk, lo, nv, inv_d),
+            8 => tail_block::<8>(h, yk, lo, nv, inv_d),
+            9 => tail_block::<9>(h, yk, lo, nv, inv_d),
+            10 => tail_block::<10>(h, yk, lo, nv, inv_d),
+            11 => tail_block::<11>(h, yk, lo, nv, inv_d),
+            12 => tail_block::<12>(h, yk, lo, nv, inv_d),
+            13 => tail_block::<13>(h, yk, lo, nv, inv_d),
+            14 => tail_block::<14>(h, yk, lo, nv, inv_d),
+            15 => tail_block::<15>(h, yk, lo, nv, inv_d),
+            _ => tail_block::<MAX_TAIL>(h, yk, lo, nv, inv_d),
         }
     }
 }
 
 /// [`tail_updates`] for n = `N`: rows lo ..= lo + N − 1 of column k read once (the updates read
 /// them before their ratios replace them: each pair (k, i) reads rows lo ..= i, all below the
-/// ratios already written), then for i from the last to lo: a = L[k][i] / d_k, column i −= a ·
+/// ratios already written), then for i from the last to lo: a = L[k][i] · inv_d (1/d_k), column i −= a ·
 /// (rows lo ..= i of column k), and L[k][i] ← a.
 ///
 /// # Safety
 /// As [`tail_updates`].
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn tail_block<const N: usize>(h: *mut f64, yk: *mut f64, lo: usize, nv: usize, d_k: f64) {
+unsafe fn tail_block<const N: usize>(h: *mut f64, yk: *mut f64, lo: usize, nv: usize, inv_d: f64) {
     // SAFETY: the caller's contract: rows lo ..= lo + N − 1 of column k and of columns
     // lo ..= lo + N − 1 are valid, and distinct.
     unsafe {
@@ -505,7 +508,7 @@ unsafe fn tail_block<const N: usize>(h: *mut f64, yk: *mut f64, lo: usize, nv: u
             *y_t = *yk.add(lo + t);
         }
         for t in (0..N).rev() {
-            let a = y[t] / d_k;
+            let a = y[t] * inv_d;
             let col = h.add((lo + t) * nv + lo);
             for (j, y_j) in y[..=t].iter().enumerate() {
                 *col.add(j) -= a * y_j;
