@@ -514,7 +514,10 @@ fn cholesky_rank_one_kernel(l: &mut DMatrix<f64>, n: usize, x: &mut [f64], sign:
 
 /// Solves L Lᵀ x = b in place with the factor of [`cholesky`] (forward substitution column by
 /// column, per entry in the same order as the row form; back substitution by rows of Lᵀ, which
-/// are L's columns).
+/// are L's columns, each row's sum from its last entry to its first; each unknown scaled by its
+/// pivot's reciprocal). The solve is a chain of n dependent unknowns each way: the sum order and
+/// the reciprocals keep the chain to a product and a difference per unknown (the Newton
+/// direction of a 27-dof humanoid: 1.5 % of its step).
 pub(crate) fn cholesky_solve(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
@@ -542,7 +545,9 @@ fn cholesky_solve_kernel(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
     for k in 0..n {
         let col_k = &ls[k * stride + k..k * stride + n];
         let (head, tail) = b[k..].split_at_mut(1);
-        head[0] /= col_k[0];
+        // The pivot's reciprocal does not wait for b: formed ahead, it leaves a product (not a
+        // division) on the chain from one entry to the next.
+        head[0] *= 1.0 / col_k[0];
         let bk = head[0];
         if bk != 0.0 {
             for (x, &y) in tail.iter_mut().zip(&col_k[1..]) {
@@ -554,10 +559,12 @@ fn cholesky_solve_kernel(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
         let col_i = &ls[i * stride + i..i * stride + n];
         let (head, tail) = b[i..].split_at_mut(1);
         let mut s = head[0];
-        for (&y, &x) in col_i[1..].iter().zip(tail.iter()) {
+        // From the last row up: the term of x[i + 1], found just before, comes last, so the
+        // running difference over the others (known earlier) is formed while x[i + 1] is.
+        for (&y, &x) in col_i[1..].iter().zip(tail.iter()).rev() {
             s -= y * x;
         }
-        head[0] = s / col_i[0];
+        head[0] = s * (1.0 / col_i[0]);
     }
 }
 

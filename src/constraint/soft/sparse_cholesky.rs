@@ -982,10 +982,12 @@ impl SparseCholesky {
         let all = (0..if rows.is_some() { 0 } else { n }).map(|p| n - 1 - p);
         let listed = rows.unwrap_or(&[]);
         // Position p is dof n − 1 − p: b[n − 1 − p] holds (P b)[p]. Forward by columns (each
-        // entry's products subtracted in ascending column order, as the row form would).
+        // entry's products subtracted in ascending column order, as the row form would);
+        // backward by rows of L'ᵀ, each row's sum from its last entry to its first; each unknown
+        // scaled by its pivot's reciprocal: the dense `cholesky_solve`'s arithmetic.
         for k in all.clone().chain(listed.iter().rev().copied()) {
             let p = n - 1 - k;
-            let y = b[k] / self.diag[p];
+            let y = b[k] * (1.0 / self.diag[p]);
             b[k] = y;
             if y == 0.0 {
                 continue;
@@ -999,10 +1001,10 @@ impl SparseCholesky {
             let p = n - 1 - k;
             let (lo, hi) = (self.c_start[p], self.c_start[p + 1]);
             let mut s = b[k];
-            for (&l, &j) in self.c_vals[lo..hi].iter().zip(&self.c_rows[lo..hi]) {
+            for (&l, &j) in self.c_vals[lo..hi].iter().zip(&self.c_rows[lo..hi]).rev() {
                 s -= l * b[n - 1 - j];
             }
-            b[k] = s / self.diag[p];
+            b[k] = s * (1.0 / self.diag[p]);
         }
     }
 }
