@@ -125,10 +125,8 @@ const MUL_J_COLUMNS: usize = 256;
 
 /// r ← J x from J's dense storage (column-major, nefc ≥ 4 rows used): each row's sum over the
 /// columns k with x_k ≠ 0 in ascending order, r_i = ((0 + J_ik₀ x_k₀) + J_ik₁ x_k₁) + …, as
-/// [`mul_j_kernel`] forms it (the same bits), but eight rows at a time held in two registers
-/// across all columns instead of each column's update of r in memory. The nonzero entries of x
-/// are listed once. Rows left over at the end (fewer than four) are formed again by a last block
-/// of four ending at row nefc − 1 (the same values stored twice).
+/// [`mul_j_kernel`] forms it (the same bits), by [`columns_times_avx2`] over the listed nonzero
+/// entries of x.
 ///
 /// # Safety
 /// The CPU has AVX2; `4 ≤ r.len() ≤ j.nrows()`, `x.len() ≤ j.ncols()` and
@@ -136,12 +134,7 @@ const MUL_J_COLUMNS: usize = 256;
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn mul_j_dense_avx2(j: &DMatrix<f64>, x: &[f64], r: &mut [f64]) {
-    use std::arch::x86_64::{
-        _mm256_add_pd, _mm256_broadcast_sd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd,
-        _mm256_storeu_pd,
-    };
-    let (stride, jp) = (j.nrows(), j.as_slice().as_ptr());
-    let nefc = r.len();
+    let stride = j.nrows();
     // The nonzero x_k: their column offsets in J and their values.
     let mut offsets = [0usize; MUL_J_COLUMNS];
     let mut values = [0.0f64; MUL_J_COLUMNS];
@@ -151,29 +144,110 @@ unsafe fn mul_j_dense_avx2(j: &DMatrix<f64>, x: &[f64], r: &mut [f64]) {
         values[m] = x_k;
         m += usize::from(x_k != 0.0);
     }
-    let (offs, vals) = (&offsets[..m], &values[..m]);
+    // SAFETY: the caller's contract: every listed column k < x.len() ≤ J's columns holds
+    // r.len() ≤ stride rows; the CPU has AVX2.
+    let cols = Listed { offs: &offsets[..m], vals: &values[..m] };
+    unsafe { columns_times_avx2::<false>(j.as_slice().as_ptr(), &cols, r) };
+}
+
+/// The columns [`columns_times_avx2`] sums: column c's offset in the matrix's storage and its
+/// factor.
+#[cfg(target_arch = "x86_64")]
+trait Columns {
+    /// How many columns.
+    fn len(&self) -> usize;
+    /// Column c's (offset, factor), c < `len()`.
+    fn get(&self, c: usize) -> (usize, f64);
+}
+
+/// Listed columns: `offs[c]`, `vals[c]` (equal lengths).
+#[cfg(target_arch = "x86_64")]
+struct Listed<'a> {
+    offs: &'a [usize],
+    vals: &'a [f64],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Columns for Listed<'_> {
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.vals.len()
+    }
+    #[inline(always)]
+    fn get(&self, c: usize) -> (usize, f64) {
+        (self.offs[c], self.vals[c])
+    }
+}
+
+/// Every column of a matrix of `stride` rows: c · stride, `vals[c]`.
+#[cfg(target_arch = "x86_64")]
+struct Strided<'a> {
+    stride: usize,
+    vals: &'a [f64],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Columns for Strided<'_> {
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.vals.len()
+    }
+    #[inline(always)]
+    fn get(&self, c: usize) -> (usize, f64) {
+        (c * self.stride, self.vals[c])
+    }
+}
+
+/// r ← Σ_c A[:, c] · v_c over the columns `cols` of a column-major matrix at `a`, summed in
+/// column order, eight rows at a time held in two registers across all columns (instead of r
+/// loaded and stored once per column). Rows left over at the end (fewer than four) are formed
+/// again by a last block of four ending at the last row (the same values stored twice).
+/// `FIRST_AS_IS`: the sum starts with the first column's product as it is (nalgebra's `mul_to`;
+/// needs a column), else at zero, then each product added (`mul_j_kernel`'s sums): the two
+/// differ only in the sign of a zero sum. No fused multiply–adds: the bits of the scalar forms.
+///
+/// # Safety
+/// The CPU has AVX2; `r.len() ≥ 4`; every column of `cols` has `r.len()` valid entries from its
+/// offset; with `FIRST_AS_IS` `cols` has at least one column.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn columns_times_avx2<const FIRST_AS_IS: bool>(a: *const f64, cols: &impl Columns, r: &mut [f64]) {
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+    };
+    let n = r.len();
     let rp = r.as_mut_ptr();
-    let mut i = 0;
-    // SAFETY: every block of rows b..b + 4 has b + 4 ≤ nefc ≤ stride, so the loads at offset
-    // k · stride + b (k < x.len() ≤ J's columns) stay inside J's storage and the stores inside r;
-    // the CPU has AVX2 (this function's contract).
+    let first = usize::from(FIRST_AS_IS);
+    // SAFETY: every block of rows b..b + 4 has b + 4 ≤ n, inside each column (the caller's
+    // contract) and inside r; the CPU has AVX2.
     unsafe {
-        while i + 8 <= nefc {
-            let (mut r0, mut r1) = (_mm256_setzero_pd(), _mm256_setzero_pd());
-            for (&o, v) in offs.iter().zip(vals) {
-                let v = _mm256_broadcast_sd(v);
-                r0 = _mm256_add_pd(r0, _mm256_mul_pd(_mm256_loadu_pd(jp.add(o + i)), v));
-                r1 = _mm256_add_pd(r1, _mm256_mul_pd(_mm256_loadu_pd(jp.add(o + i + 4)), v));
+        let start = |b: usize| {
+            if FIRST_AS_IS {
+                let (o, v) = cols.get(0);
+                _mm256_mul_pd(_mm256_loadu_pd(a.add(o + b)), _mm256_set1_pd(v))
+            } else {
+                _mm256_setzero_pd()
+            }
+        };
+        let mut i = 0;
+        while i + 8 <= n {
+            let (mut r0, mut r1) = (start(i), start(i + 4));
+            for c in first..cols.len() {
+                let (o, v) = cols.get(c);
+                let (v, col) = (_mm256_set1_pd(v), a.add(o + i));
+                r0 = _mm256_add_pd(r0, _mm256_mul_pd(_mm256_loadu_pd(col), v));
+                r1 = _mm256_add_pd(r1, _mm256_mul_pd(_mm256_loadu_pd(col.add(4)), v));
             }
             _mm256_storeu_pd(rp.add(i), r0);
             _mm256_storeu_pd(rp.add(i + 4), r1);
             i += 8;
         }
-        while i < nefc {
-            let b = i.min(nefc - 4);
-            let mut r0 = _mm256_setzero_pd();
-            for (&o, v) in offs.iter().zip(vals) {
-                r0 = _mm256_add_pd(r0, _mm256_mul_pd(_mm256_loadu_pd(jp.add(o + b)), _mm256_broadcast_sd(v)));
+        while i < n {
+            let b = i.min(n - 4);
+            let mut r0 = start(b);
+            for c in first..cols.len() {
+                let (o, v) = cols.get(c);
+                r0 = _mm256_add_pd(r0, _mm256_mul_pd(_mm256_loadu_pd(a.add(o + b)), _mm256_set1_pd(v)));
             }
             _mm256_storeu_pd(rp.add(b), r0);
             i = b + 4;
@@ -357,58 +431,20 @@ pub(super) fn mul_m(
 
 /// r ← M x as nalgebra's product forms it (`mul_to`: a column at a time, r_i = ((M_i0 x_0 +
 /// M_i1 x_1) + M_i2 x_2) + …, the first column's product taken as it is, no fused multiply–add),
-/// the same bits, but eight rows at a time held in two registers across all columns instead of
-/// r loaded and stored once per column. Rows left over at the end (fewer than four) are formed
-/// again by a last block of four ending at row n − 1 (the same values stored twice). Below four
-/// rows: nalgebra's product itself.
+/// the same bits, by [`columns_times_avx2`] over all of M's columns. Below four rows: nalgebra's
+/// product itself.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn dense_mul_avx2(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64>) {
-    use std::arch::x86_64::{
-        _mm256_add_pd, _mm256_broadcast_sd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_storeu_pd,
-    };
     let n = r.len();
     if n < 4 || m.nrows() != n || m.ncols() != x.len() || x.is_empty() {
         m.mul_to(x, r);
         return;
     }
-    let (mp, xs, rp) = (m.as_slice().as_ptr(), x.as_slice(), r.as_mut_slice().as_mut_ptr());
-    // SAFETY: M is n × x.len() (checked), column-major: every block of rows b..b + 4 has
-    // b + 4 ≤ n, so the loads at k · n + b (k < x.len()) stay inside M and the stores inside r;
-    // the CPU has AVX2 (this function's contract).
-    unsafe {
-        let block = |b: usize| {
-            let mut acc = _mm256_mul_pd(_mm256_loadu_pd(mp.add(b)), _mm256_broadcast_sd(&xs[0]));
-            for (k, x_k) in xs.iter().enumerate().skip(1) {
-                acc = _mm256_add_pd(
-                    _mm256_mul_pd(_mm256_loadu_pd(mp.add(k * n + b)), _mm256_broadcast_sd(x_k)),
-                    acc,
-                );
-            }
-            acc
-        };
-        let mut i = 0;
-        while i + 8 <= n {
-            let v = _mm256_broadcast_sd(&xs[0]);
-            let (mut r0, mut r1) = (
-                _mm256_mul_pd(_mm256_loadu_pd(mp.add(i)), v),
-                _mm256_mul_pd(_mm256_loadu_pd(mp.add(i + 4)), v),
-            );
-            for (k, x_k) in xs.iter().enumerate().skip(1) {
-                let (v, col) = (_mm256_broadcast_sd(x_k), mp.add(k * n + i));
-                r0 = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(col), v), r0);
-                r1 = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(col.add(4)), v), r1);
-            }
-            _mm256_storeu_pd(rp.add(i), r0);
-            _mm256_storeu_pd(rp.add(i + 4), r1);
-            i += 8;
-        }
-        while i < n {
-            let b = i.min(n - 4);
-            _mm256_storeu_pd(rp.add(b), block(b));
-            i = b + 4;
-        }
-    }
+    let cols = Strided { stride: n, vals: x.as_slice() };
+    // SAFETY: M is n × x.len() (checked), column-major: each column's n entries from k · n; at
+    // least one column (checked); the CPU has AVX2 (this function's contract).
+    unsafe { columns_times_avx2::<true>(m.as_slice().as_ptr(), &cols, r.as_mut_slice()) };
 }
 
 /// r ← M x on the dofs `dofs` (whole trees, each tree's dofs ascending; M couples a dof only to
@@ -959,6 +995,45 @@ mod tests {
             unsafe { super::dense_mul_avx2(&m, &x, &mut r) };
             for i in 0..n {
                 assert_eq!(r[i].to_bits(), expected[i].to_bits(), "n {n}, row {i}");
+            }
+        }
+    }
+
+    /// The AVX2 product J x from J's dense storage gives the portable sums' bits (each row from
+    /// zero over the columns with x_k ≠ 0), for row counts on both sides of its blocks, a stride
+    /// above the row count, and zeros of both signs in x.
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    #[ignore = "compares the CPU-specific (AVX2) build of the product with the portable one; needs such a CPU: cargo test --release -p lagrange --lib -- --ignored (as .ci/run does)"]
+    fn dense_j_product_avx2_is_the_portable_sums_bit_for_bit() {
+        use nalgebra::{DMatrix, DVector};
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            eprintln!("skipped: this CPU has no AVX2, the AVX2 product is never used here");
+            return;
+        }
+        let nv = 27;
+        for nefc in [4, 5, 7, 8, 9, 12, 15, 16, 37] {
+            let j = DMatrix::from_fn(nefc + 3, nv, |i, k| {
+                if (i + k) % 4 == 0 {
+                    0.0
+                } else {
+                    ((i * 29 + k * 11) as f64 * 0.53).cos() * 10f64.powi((k % 5) as i32 - 2)
+                }
+            });
+            let x = DVector::from_fn(nv, |k, _| match k % 5 {
+                0 => -0.0,
+                1 => 0.0,
+                _ => ((k * 7) as f64).sin() * 1e3f64.powi((k % 3) as i32 - 1),
+            });
+            let mut expected = DVector::from_element(nefc, f64::NAN);
+            let none = super::Sparsity { start: &[], index: &[], value: &[] };
+            super::mul_j_kernel(&none, Some(&j), nefc, &x, &mut expected);
+            let mut r = vec![f64::NAN; nefc];
+            // SAFETY: the CPU has AVX2 (checked above); 4 ≤ nefc ≤ J's rows, nv ≤ its columns
+            // and ≤ MUL_J_COLUMNS.
+            unsafe { super::mul_j_dense_avx2(&j, x.as_slice(), &mut r) };
+            for i in 0..nefc {
+                assert_eq!(r[i].to_bits(), expected[i].to_bits(), "nefc {nefc}, row {i}");
             }
         }
     }
