@@ -6,6 +6,8 @@
 //! Golub & Van Loan, *Matrix Computations*, 4th ed., §5.5). Works in caller-provided buffers: no
 //! allocation.
 
+#[cfg(target_arch = "x86_64")]
+use super::nonzero_list::NonzeroList;
 use super::RANK_TOLERANCE;
 use nalgebra::{DMatrix, DVector};
 
@@ -261,24 +263,14 @@ unsafe fn cholesky_avx2(a: &DMatrix<f64>, n: usize, l: &mut DMatrix<f64>, tol: f
     assert!(n <= stride && n <= a_stride && n <= a.ncols() && n <= l.ncols());
     let (a_s, ls) = (a.as_slice(), l.as_mut_slice());
     // The earlier columns reaching row j: their offsets in `ls` and their entries l_jk.
-    let mut offsets = [0usize; BLOCKED_N];
-    let mut values = [0.0f64; BLOCKED_N];
+    let mut earlier = NonzeroList::<BLOCKED_N>::new();
     let ap = a_s.as_ptr();
     for j in 0..n {
-        let mut m = 0;
-        // Branch-free: every k is written, the count advances past the nonzero ones only.
+        let lr = ls.as_ptr();
         // SAFETY: k < j < n ≤ `l`'s column count and j < n ≤ stride, so k · stride + j is inside
-        // `ls`; m ≤ k < n ≤ BLOCKED_N, inside both lists.
-        unsafe {
-            let (lr, op, vp) = (ls.as_ptr().add(j), offsets.as_mut_ptr(), values.as_mut_ptr());
-            for k in 0..j {
-                let ljk = *lr.add(k * stride);
-                *op.add(m) = k * stride;
-                *vp.add(m) = ljk;
-                m += usize::from(ljk != 0.0);
-            }
-        }
-        let (offs, vals) = (&offsets[..m], &values[..m]);
+        // `ls`.
+        earlier.list(j, |k| (k * stride, unsafe { *lr.add(k * stride + j) }));
+        let (offs, vals) = (earlier.offsets(), earlier.values());
         let (a_col, l_col) = (j * a_stride, j * stride);
         if n < 4 {
             for i in j..n {

@@ -26,6 +26,8 @@ mod exact;
 mod exact_work;
 mod friction_loss;
 mod limits;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod nonzero_list;
 mod row_lifecycle;
 mod rows;
 pub mod soft;

@@ -18,6 +18,8 @@ use super::cost::Rows;
 use super::hessian::{Assembler, Target};
 use super::tree_mass::TreeMass;
 use crate::constraint::dense::{cholesky, cholesky_rank_one, cholesky_solve};
+#[cfg(target_arch = "x86_64")]
+use crate::constraint::nonzero_list::NonzeroList;
 use crate::dynamics::solve_with_factor_unchecked;
 use crate::model::{Data, EfcState, Model};
 use nalgebra::{DMatrix, DVector};
@@ -136,17 +138,11 @@ const MUL_J_COLUMNS: usize = 256;
 unsafe fn mul_j_dense_avx2(j: &DMatrix<f64>, x: &[f64], r: &mut [f64]) {
     let stride = j.nrows();
     // The nonzero x_k: their column offsets in J and their values.
-    let mut offsets = [0usize; MUL_J_COLUMNS];
-    let mut values = [0.0f64; MUL_J_COLUMNS];
-    let mut m = 0;
-    for (k, &x_k) in x.iter().enumerate() {
-        offsets[m] = k * stride;
-        values[m] = x_k;
-        m += usize::from(x_k != 0.0);
-    }
+    let mut nonzero = NonzeroList::<MUL_J_COLUMNS>::new();
+    nonzero.list(x.len(), |k| (k * stride, x[k]));
+    let cols = Listed { offs: nonzero.offsets(), vals: nonzero.values() };
     // SAFETY: the caller's contract: every listed column k < x.len() ≤ J's columns holds
     // r.len() ≤ stride rows; the CPU has AVX2.
-    let cols = Listed { offs: &offsets[..m], vals: &values[..m] };
     unsafe { columns_times_avx2::<false>(j.as_slice().as_ptr(), &cols, r) };
 }
 
