@@ -140,74 +140,32 @@ unsafe fn mul_j_dense_avx2(j: &DMatrix<f64>, x: &[f64], r: &mut [f64]) {
     // The nonzero x_k: their column offsets in J and their values.
     let mut nonzero = NonzeroList::<MUL_J_COLUMNS>::new();
     nonzero.list(x.len(), |k| (k * stride, x[k]));
-    let cols = Listed { offs: nonzero.offsets(), vals: nonzero.values() };
+    let offs = nonzero.offsets();
     // SAFETY: the caller's contract: every listed column k < x.len() ≤ J's columns holds
     // r.len() ≤ stride rows; the CPU has AVX2.
-    unsafe { columns_times_avx2::<false>(j.as_slice().as_ptr(), &cols, r) };
+    unsafe { columns_times_avx2::<false>(j.as_slice().as_ptr(), nonzero.values(), |c| offs[c], r) };
 }
 
-/// The columns [`columns_times_avx2`] sums: column c's offset in the matrix's storage and its
-/// factor.
-#[cfg(target_arch = "x86_64")]
-trait Columns {
-    /// How many columns.
-    fn len(&self) -> usize;
-    /// Column c's (offset, factor), c < `len()`.
-    fn get(&self, c: usize) -> (usize, f64);
-}
-
-/// Listed columns: `offs[c]`, `vals[c]` (equal lengths).
-#[cfg(target_arch = "x86_64")]
-struct Listed<'a> {
-    offs: &'a [usize],
-    vals: &'a [f64],
-}
-
-#[cfg(target_arch = "x86_64")]
-impl Columns for Listed<'_> {
-    #[inline(always)]
-    fn len(&self) -> usize {
-        self.vals.len()
-    }
-    #[inline(always)]
-    fn get(&self, c: usize) -> (usize, f64) {
-        (self.offs[c], self.vals[c])
-    }
-}
-
-/// Every column of a matrix of `stride` rows: c · stride, `vals[c]`.
-#[cfg(target_arch = "x86_64")]
-struct Strided<'a> {
-    stride: usize,
-    vals: &'a [f64],
-}
-
-#[cfg(target_arch = "x86_64")]
-impl Columns for Strided<'_> {
-    #[inline(always)]
-    fn len(&self) -> usize {
-        self.vals.len()
-    }
-    #[inline(always)]
-    fn get(&self, c: usize) -> (usize, f64) {
-        (c * self.stride, self.vals[c])
-    }
-}
-
-/// r ← Σ_c A[:, c] · v_c over the columns `cols` of a column-major matrix at `a`, summed in
-/// column order, eight rows at a time held in two registers across all columns (instead of r
-/// loaded and stored once per column). Rows left over at the end (fewer than four) are formed
-/// again by a last block of four ending at the last row (the same values stored twice).
-/// `FIRST_AS_IS`: the sum starts with the first column's product as it is (nalgebra's `mul_to`;
-/// needs a column), else at zero, then each product added (`mul_j_kernel`'s sums): the two
-/// differ only in the sign of a zero sum. No fused multiply–adds: the bits of the scalar forms.
+/// r ← Σ_c A[:, c] · v_c over the columns c = 0 .. vals.len() − 1 of a column-major matrix at
+/// `a` (column c's first entry at offset `offset(c)`, its factor `vals[c]`), summed in column
+/// order, eight rows at a time held in two registers across all columns (instead of r loaded and
+/// stored once per column). Rows left over at the end (fewer than four) are formed again by a
+/// last block of four ending at the last row (the same values stored twice). `FIRST_AS_IS`: the
+/// sum starts with the first column's product as it is (nalgebra's `mul_to`; needs a column),
+/// else at zero, then each product added (`mul_j_kernel`'s sums): the two differ only in the sign
+/// of a zero sum. No fused multiply–adds: the bits of the scalar forms.
 ///
 /// # Safety
-/// The CPU has AVX2; `r.len() ≥ 4`; every column of `cols` has `r.len()` valid entries from its
-/// offset; with `FIRST_AS_IS` `cols` has at least one column.
+/// The CPU has AVX2; `r.len() ≥ 4`; every column has `r.len()` valid entries from its offset;
+/// with `FIRST_AS_IS` `vals` is not empty.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn columns_times_avx2<const FIRST_AS_IS: bool>(a: *const f64, cols: &impl Columns, r: &mut [f64]) {
+unsafe fn columns_times_avx2<const FIRST_AS_IS: bool>(
+    a: *const f64,
+    vals: &[f64],
+    offset: impl Fn(usize) -> usize,
+    r: &mut [f64],
+) {
     use std::arch::x86_64::{
         _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
     };
@@ -219,8 +177,7 @@ unsafe fn columns_times_avx2<const FIRST_AS_IS: bool>(a: *const f64, cols: &impl
     unsafe {
         let start = |b: usize| {
             if FIRST_AS_IS {
-                let (o, v) = cols.get(0);
-                _mm256_mul_pd(_mm256_loadu_pd(a.add(o + b)), _mm256_set1_pd(v))
+                _mm256_mul_pd(_mm256_loadu_pd(a.add(offset(0) + b)), _mm256_set1_pd(vals[0]))
             } else {
                 _mm256_setzero_pd()
             }
@@ -228,8 +185,8 @@ unsafe fn columns_times_avx2<const FIRST_AS_IS: bool>(a: *const f64, cols: &impl
         let mut i = 0;
         while i + 8 <= n {
             let (mut r0, mut r1) = (start(i), start(i + 4));
-            for c in first..cols.len() {
-                let (o, v) = cols.get(c);
+            for (c, &v) in (first..).zip(&vals[first..]) {
+                let o = offset(c);
                 let (v, col) = (_mm256_set1_pd(v), a.add(o + i));
                 r0 = _mm256_add_pd(r0, _mm256_mul_pd(_mm256_loadu_pd(col), v));
                 r1 = _mm256_add_pd(r1, _mm256_mul_pd(_mm256_loadu_pd(col.add(4)), v));
@@ -241,8 +198,8 @@ unsafe fn columns_times_avx2<const FIRST_AS_IS: bool>(a: *const f64, cols: &impl
         while i < n {
             let b = i.min(n - 4);
             let mut r0 = start(b);
-            for c in first..cols.len() {
-                let (o, v) = cols.get(c);
+            for (c, &v) in (first..).zip(&vals[first..]) {
+                let o = offset(c);
                 r0 = _mm256_add_pd(r0, _mm256_mul_pd(_mm256_loadu_pd(a.add(o + b)), _mm256_set1_pd(v)));
             }
             _mm256_storeu_pd(rp.add(b), r0);
@@ -437,10 +394,9 @@ unsafe fn dense_mul_avx2(m: &DMatrix<f64>, x: &DVector<f64>, r: &mut DVector<f64
         m.mul_to(x, r);
         return;
     }
-    let cols = Strided { stride: n, vals: x.as_slice() };
     // SAFETY: M is n × x.len() (checked), column-major: each column's n entries from k · n; at
     // least one column (checked); the CPU has AVX2 (this function's contract).
-    unsafe { columns_times_avx2::<true>(m.as_slice().as_ptr(), &cols, r.as_mut_slice()) };
+    unsafe { columns_times_avx2::<true>(m.as_slice().as_ptr(), x.as_slice(), |c| c * n, r.as_mut_slice()) };
 }
 
 /// r ← M x on the dofs `dofs` (whole trees, each tree's dofs ascending; M couples a dof only to
