@@ -508,8 +508,8 @@ fn cholesky_rank_one_kernel(l: &mut DMatrix<f64>, n: usize, x: &mut [f64], sign:
 /// column, per entry in the same order as the row form; back substitution by rows of Lᵀ, which
 /// are L's columns, each row's sum from its last entry to its first; each unknown scaled by its
 /// pivot's reciprocal). The solve is a chain of n dependent unknowns each way: the sum order and
-/// the reciprocals keep the chain to a product and a difference per unknown (the Newton
-/// direction of a 27-dof humanoid: 1.5 % of its step).
+/// the reciprocals keep the chain to a product and a difference per unknown (a 27-dof humanoid
+/// steps about 2 % faster than with a division and a row's whole sum on it).
 pub(crate) fn cholesky_solve(l: &DMatrix<f64>, n: usize, b: &mut [f64]) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
